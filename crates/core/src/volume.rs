@@ -1,0 +1,250 @@
+//! The `Volume`: a regular grid of scalar samples with physical geometry.
+//!
+//! Voxels are grid *points* (the paper's `g_ijk`, VTK's point data): voxel
+//! `(i, j, k)` sits at `origin + (i·dx, j·dy, k·dz)`, so the volume spans
+//! `(n − 1)·spacing` along each axis and a cell is bounded by eight voxels.
+//! Values are stored as `f32` with x varying fastest:
+//! `index = x + nx·(y + ny·z)`.
+
+use glam::DVec3;
+use thiserror::Error;
+
+/// Why a grid could not be made into a [`Volume`].
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum VolumeError {
+    #[error("dimensions {0}x{1}x{2}: every axis needs at least 2 points to span a volume")]
+    TooThin(usize, usize, usize),
+    #[error("dimensions {0}x{1}x{2} overflow the address space")]
+    DimsOverflow(usize, usize, usize),
+    #[error("dimensions {dims:?} need {expected} values but {actual} were given")]
+    LengthMismatch {
+        dims: [usize; 3],
+        expected: usize,
+        actual: usize,
+    },
+    #[error("spacing ({0}, {1}, {2}) must be finite and positive on every axis")]
+    BadSpacing(f64, f64, f64),
+    #[error("origin ({0}, {1}, {2}) must be finite")]
+    BadOrigin(f64, f64, f64),
+}
+
+/// A regular grid of `f32` scalars with per-axis spacing and an origin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Volume {
+    dims: [usize; 3],
+    spacing: DVec3,
+    origin: DVec3,
+    data: Vec<f32>,
+}
+
+/// Number of points of a grid of `dims`, or `None` if it overflows `usize`.
+pub fn checked_point_count(dims: [usize; 3]) -> Option<usize> {
+    dims[0].checked_mul(dims[1])?.checked_mul(dims[2])
+}
+
+impl Volume {
+    /// A volume with unit spacing and its first voxel at the world origin.
+    ///
+    /// `data` holds `nx·ny·nz` values, x fastest. Every axis needs at least
+    /// two points: a volume with no extent along an axis cannot be ray cast.
+    pub fn new(dims: [usize; 3], data: Vec<f32>) -> Result<Self, VolumeError> {
+        let [nx, ny, nz] = dims;
+        if nx < 2 || ny < 2 || nz < 2 {
+            return Err(VolumeError::TooThin(nx, ny, nz));
+        }
+        let expected = checked_point_count(dims).ok_or(VolumeError::DimsOverflow(nx, ny, nz))?;
+        if data.len() != expected {
+            return Err(VolumeError::LengthMismatch {
+                dims,
+                expected,
+                actual: data.len(),
+            });
+        }
+        Ok(Volume {
+            dims,
+            spacing: DVec3::ONE,
+            origin: DVec3::ZERO,
+            data,
+        })
+    }
+
+    /// A volume whose value at each voxel is `f(world position)`.
+    pub fn from_fn(
+        dims: [usize; 3],
+        spacing: DVec3,
+        origin: DVec3,
+        f: impl Fn(DVec3) -> f32,
+    ) -> Result<Self, VolumeError> {
+        let [nx, ny, nz] = dims;
+        let count = checked_point_count(dims).ok_or(VolumeError::DimsOverflow(nx, ny, nz))?;
+        let mut data = Vec::with_capacity(count.min(1 << 31));
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let p = origin + DVec3::new(i as f64, j as f64, k as f64) * spacing;
+                    data.push(f(p));
+                }
+            }
+        }
+        Volume::new(dims, data)?
+            .with_spacing(spacing)?
+            .with_origin(origin)
+    }
+
+    /// The same grid with another voxel spacing (world units per voxel step).
+    pub fn with_spacing(mut self, spacing: DVec3) -> Result<Self, VolumeError> {
+        if !(spacing.is_finite() && spacing.min_element() > 0.0) {
+            return Err(VolumeError::BadSpacing(spacing.x, spacing.y, spacing.z));
+        }
+        self.spacing = spacing;
+        Ok(self)
+    }
+
+    /// The same grid with its first voxel at another world position.
+    pub fn with_origin(mut self, origin: DVec3) -> Result<Self, VolumeError> {
+        if !origin.is_finite() {
+            return Err(VolumeError::BadOrigin(origin.x, origin.y, origin.z));
+        }
+        self.origin = origin;
+        Ok(self)
+    }
+
+    /// Points along x, y and z.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// World distance between neighbouring voxels along x, y and z.
+    pub fn spacing(&self) -> DVec3 {
+        self.spacing
+    }
+
+    /// World position of voxel (0, 0, 0).
+    pub fn origin(&self) -> DVec3 {
+        self.origin
+    }
+
+    /// The values, x fastest.
+    pub fn data(&self) -> &[f32] {
+        &self.data
+    }
+
+    /// Number of voxels.
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Always false: a volume has at least 2×2×2 voxels.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// Linear index of voxel (i, j, k): `i + nx·(j + ny·k)`.
+    #[inline]
+    pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
+        i + self.dims[0] * (j + self.dims[1] * k)
+    }
+
+    /// Value at voxel (i, j, k).
+    #[inline]
+    pub fn get(&self, i: usize, j: usize, k: usize) -> f32 {
+        self.data[self.index(i, j, k)]
+    }
+
+    /// World position of voxel (i, j, k).
+    pub fn world_position(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.origin + DVec3::new(i as f64, j as f64, k as f64) * self.spacing
+    }
+
+    /// World size of the volume: `(n − 1)·spacing` per axis.
+    pub fn extent(&self) -> DVec3 {
+        let n = DVec3::new(
+            (self.dims[0] - 1) as f64,
+            (self.dims[1] - 1) as f64,
+            (self.dims[2] - 1) as f64,
+        );
+        n * self.spacing
+    }
+
+    /// The world-space bounding box `(min corner, max corner)`.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        (self.origin, self.origin + self.extent())
+    }
+
+    /// World position of the centre of the bounding box.
+    pub fn centre(&self) -> DVec3 {
+        self.origin + 0.5 * self.extent()
+    }
+
+    /// Number of NaN or infinite values.
+    pub fn count_non_finite(&self) -> usize {
+        self.data.iter().filter(|v| !v.is_finite()).count()
+    }
+
+    /// `(fmin, fmax)` over the finite values, or `None` if there are none.
+    pub fn value_range(&self) -> Option<(f32, f32)> {
+        let mut range: Option<(f32, f32)> = None;
+        for &v in self.data.iter().filter(|v| v.is_finite()) {
+            range = Some(match range {
+                None => (v, v),
+                Some((lo, hi)) => (lo.min(v), hi.max(v)),
+            });
+        }
+        range
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn index_is_x_fastest() {
+        let v = Volume::new([2, 3, 4], (0..24).map(|i| i as f32).collect()).unwrap();
+        assert_eq!(v.index(1, 0, 0), 1);
+        assert_eq!(v.index(0, 1, 0), 2);
+        assert_eq!(v.index(0, 0, 1), 6);
+        assert_eq!(v.get(1, 2, 3), (1 + 2 * (2 + 3 * 3)) as f32);
+    }
+
+    #[test]
+    fn geometry_follows_point_convention() {
+        let v = Volume::new([3, 5, 9], vec![0.0; 135])
+            .unwrap()
+            .with_spacing(DVec3::new(1.0, 0.5, 2.0))
+            .unwrap()
+            .with_origin(DVec3::new(-1.0, 2.0, 3.0))
+            .unwrap();
+        assert_eq!(v.extent(), DVec3::new(2.0, 2.0, 16.0));
+        assert_eq!(v.world_position(2, 4, 8), DVec3::new(1.0, 4.0, 19.0));
+        assert_eq!(v.centre(), DVec3::new(0.0, 3.0, 11.0));
+    }
+
+    #[test]
+    fn rejects_bad_grids() {
+        assert_eq!(
+            Volume::new([1, 4, 4], vec![0.0; 16]),
+            Err(VolumeError::TooThin(1, 4, 4))
+        );
+        assert!(matches!(
+            Volume::new([2, 2, 2], vec![0.0; 7]),
+            Err(VolumeError::LengthMismatch { expected: 8, .. })
+        ));
+        assert!(matches!(
+            Volume::new([usize::MAX, 2, 2], vec![]),
+            Err(VolumeError::DimsOverflow(..))
+        ));
+        let v = Volume::new([2, 2, 2], vec![0.0; 8]).unwrap();
+        assert!(v.clone().with_spacing(DVec3::new(1.0, 0.0, 1.0)).is_err());
+        assert!(v.clone().with_spacing(DVec3::new(1.0, f64::NAN, 1.0)).is_err());
+        assert!(v.with_origin(DVec3::new(f64::INFINITY, 0.0, 0.0)).is_err());
+    }
+
+    #[test]
+    fn value_range_skips_non_finite() {
+        let v = Volume::new([2, 2, 2], vec![1.0, f32::NAN, -2.0, 3.0, 0.0, f32::INFINITY, 0.5, 0.0])
+            .unwrap();
+        assert_eq!(v.value_range(), Some((-2.0, 3.0)));
+        assert_eq!(v.count_non_finite(), 2);
+    }
+}
