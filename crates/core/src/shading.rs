@@ -1,0 +1,168 @@
+//! Stage 1 shading: the paper's Phong colour model, per voxel.
+//!
+//! `C_β = C_s,β·k_a,β + C_s,β·[k_d,β (N·L) + k_s,β (N·H)^n]` with
+//! `H = (V + L)/|V + L|` (Ramesh & Athithan 1993, after Levoy 1988), where
+//! `N` is the unit gradient (see [`crate::gradient`]), `L` the unit direction
+//! towards a light at infinity, `V` the unit direction towards the viewer
+//! and `C_s` the light's colour. The material colour from the transfer
+//! function multiplies the lit colour; with the default white material the
+//! paper's model is exact.
+//!
+//! **Two-sided lighting.** A gradient points towards *increasing* values,
+//! which is into a dense object, so its sign says nothing about which side
+//! faces the viewer. As is usual for volumes (VTK's two-sided lighting), the
+//! normal is first turned to face the viewer (`N := −N` when `N·V < 0`);
+//! then a light behind that surface contributes nothing: `N·L < 0` is
+//! clamped to 0, and so is the highlight. With the default headlight
+//! (`L = V`) every visible surface is lit from the front.
+//!
+//! **Zero gradient.** Where `|∇f| = 0` the normal is undefined (errata 1):
+//! such voxels get the ambient term only.
+
+use glam::Vec3;
+
+/// Phong reflection coefficients and the light, per colour channel (r, g, b).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Phong {
+    pub ambient: [f32; 3],
+    pub diffuse: [f32; 3],
+    pub specular: [f32; 3],
+    /// The highlight exponent `n`.
+    pub shininess: f32,
+    /// `C_s`, the colour of the light source.
+    pub light_color: [f32; 3],
+}
+
+impl Default for Phong {
+    /// ka 0.1, kd 0.7, ks 0.2, n 10 and a white light: the coefficients add
+    /// up to 1, so a surface facing the headlight is exactly white.
+    fn default() -> Self {
+        Phong {
+            ambient: [0.1; 3],
+            diffuse: [0.7; 3],
+            specular: [0.2; 3],
+            shininess: 10.0,
+            light_color: [1.0; 3],
+        }
+    }
+}
+
+/// The light and viewer directions of one frame, and the half vector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightGeometry {
+    /// Unit vector towards the light (at infinity).
+    pub to_light: Vec3,
+    /// Unit vector towards the viewer (orthographic: the same for every voxel).
+    pub to_viewer: Vec3,
+    /// `H = (V + L)/|V + L|`; zero when the light is exactly behind the viewer's
+    /// line of sight, where no highlight can be seen.
+    pub half: Vec3,
+}
+
+impl LightGeometry {
+    pub fn new(to_light: Vec3, to_viewer: Vec3) -> Self {
+        let to_light = to_light.normalize();
+        let to_viewer = to_viewer.normalize();
+        LightGeometry {
+            to_light,
+            to_viewer,
+            half: (to_light + to_viewer).normalize_or_zero(),
+        }
+    }
+
+    /// A light at the eye: `L = V`.
+    pub fn headlight(to_viewer: Vec3) -> Self {
+        Self::new(to_viewer, to_viewer)
+    }
+}
+
+impl Phong {
+    /// The lit colour (before the material colour multiplies it) of a voxel
+    /// with world-space gradient `gradient`.
+    #[inline]
+    pub fn shade(&self, gradient: Vec3, light: &LightGeometry) -> [f32; 3] {
+        let len = gradient.length();
+        let (diffuse, highlight) = if len > 0.0 && len.is_finite() {
+            let mut n = gradient / len;
+            if n.dot(light.to_viewer) < 0.0 {
+                n = -n;
+            }
+            let n_dot_l = n.dot(light.to_light).max(0.0);
+            let highlight = if n_dot_l > 0.0 {
+                n.dot(light.half).max(0.0).powf(self.shininess)
+            } else {
+                0.0
+            };
+            (n_dot_l, highlight)
+        } else {
+            (0.0, 0.0)
+        };
+        std::array::from_fn(|c| {
+            self.light_color[c]
+                * (self.ambient[c] + self.diffuse[c] * diffuse + self.specular[c] * highlight)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: [f32; 3], b: [f32; 3]) -> bool {
+        a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-6)
+    }
+
+    #[test]
+    fn facing_the_headlight_is_white() {
+        let light = LightGeometry::headlight(Vec3::X);
+        let phong = Phong::default();
+        assert!(close(phong.shade(Vec3::new(2.0, 0.0, 0.0), &light), [1.0; 3]));
+        // The same surface seen from its back (gradient into the object) is
+        // lit the same: two-sided lighting.
+        assert!(close(phong.shade(Vec3::new(-5.0, 0.0, 0.0), &light), [1.0; 3]));
+    }
+
+    #[test]
+    fn closed_form_at_an_oblique_angle() {
+        // N at 60° from V = L: N·L = N·H = 0.5.
+        let light = LightGeometry::headlight(Vec3::Z);
+        let n = Vec3::new(3f32.sqrt() / 2.0, 0.0, 0.5);
+        let phong = Phong {
+            ambient: [0.1, 0.2, 0.0],
+            diffuse: [0.7, 0.5, 0.3],
+            specular: [0.2, 0.1, 0.6],
+            shininess: 3.0,
+            light_color: [1.0, 0.5, 2.0],
+        };
+        let expect = |c: usize| {
+            phong.light_color[c]
+                * (phong.ambient[c] + phong.diffuse[c] * 0.5 + phong.specular[c] * 0.125)
+        };
+        assert!(close(phong.shade(n * 4.0, &light), [expect(0), expect(1), expect(2)]));
+    }
+
+    #[test]
+    fn light_behind_the_surface_leaves_only_ambient() {
+        // Viewer on +z, light on −z: the surface facing the viewer is unlit.
+        let light = LightGeometry::new(-Vec3::Z, Vec3::Z);
+        assert_eq!(light.half, Vec3::ZERO);
+        assert!(close(Phong::default().shade(Vec3::Z, &light), [0.1; 3]));
+    }
+
+    #[test]
+    fn zero_gradient_gets_ambient_only() {
+        let light = LightGeometry::headlight(Vec3::Y);
+        assert!(close(Phong::default().shade(Vec3::ZERO, &light), [0.1; 3]));
+    }
+
+    #[test]
+    fn half_vector_between_light_and_viewer() {
+        // Light along x, viewer along y: H at 45°; a normal along H gets
+        // the full highlight and diffuse cos 45°.
+        let light = LightGeometry::new(Vec3::X, Vec3::Y);
+        let n = Vec3::new(1.0, 1.0, 0.0);
+        let c = Phong::default().shade(n, &light);
+        let expect = 0.1 + 0.7 * std::f32::consts::FRAC_1_SQRT_2 + 0.2;
+        assert!(close(c, [expect; 3]), "{c:?}");
+    }
+}
