@@ -1,1 +1,50 @@
-fn main() {}
+//! `volray`: the command line. It parses arguments and calls the libraries:
+//! `volray-io` and `volray-data` for the input, `volray-core` to render,
+//! `volray-io` again for the PNG.
+
+mod bench;
+mod cli;
+mod error;
+mod input;
+mod render;
+
+use clap::Parser;
+use clap::error::ErrorKind;
+use cli::{Cli, Command};
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            return match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                    let _ = e.print();
+                    ExitCode::SUCCESS
+                }
+                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                    ExitCode::from(1)
+                }
+                _ => {
+                    // One line: clap's first, without its usage block.
+                    let text = e.render().to_string();
+                    let first = text.lines().next().unwrap_or("invalid arguments");
+                    eprintln!("volray: {first}");
+                    ExitCode::from(1)
+                }
+            };
+        }
+    };
+    let result = match &cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Bench(args) => bench::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("volray: error: {e}");
+            ExitCode::from(e.code)
+        }
+    }
+}

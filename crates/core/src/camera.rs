@@ -79,7 +79,11 @@ impl OrthographicView {
         let view_point = camera
             .view_point
             .unwrap_or(centre + DVec3::X * 2.0 * diagonal.max(1.0));
-        for (name, v) in [("view point", view_point), ("view reference", centre), ("up", camera.up)] {
+        for (name, v) in [
+            ("view point", view_point),
+            ("view reference", centre),
+            ("up", camera.up),
+        ] {
             if !v.is_finite() {
                 return Err(CameraError::NotFinite(name, v));
             }
@@ -185,7 +189,10 @@ mod tests {
         let (c, r) = v.project(DVec3::new(0.0, 0.0, 40.0));
         assert!(c.abs() < 1e-9 && r.abs() < 1e-9, "{c} {r}");
         let (c, r) = v.project(DVec3::new(10.0, 20.0, 0.0));
-        assert!((c - 64.0).abs() < 1e-9 && (r - 128.0).abs() < 1e-9, "{c} {r}");
+        assert!(
+            (c - 64.0).abs() < 1e-9 && (r - 128.0).abs() < 1e-9,
+            "{c} {r}"
+        );
         // Pixel centres project back to themselves.
         let (c, r) = v.project(v.pixel_centre(3, 7));
         assert!((c - 3.5).abs() < 1e-9 && (r - 7.5).abs() < 1e-9);
@@ -208,7 +215,11 @@ mod tests {
             );
             let (c, r) = v.project(p);
             assert!((-1e-9..=80.0 + 1e-9).contains(&c) && (-1e-9..=60.0 + 1e-9).contains(&r));
-            if c.abs() < 1e-9 || (c - 80.0).abs() < 1e-9 || r.abs() < 1e-9 || (r - 60.0).abs() < 1e-9 {
+            if c.abs() < 1e-9
+                || (c - 80.0).abs() < 1e-9
+                || r.abs() < 1e-9
+                || (r - 60.0).abs() < 1e-9
+            {
                 touches += 1;
             }
         }

@@ -150,8 +150,10 @@ mod tests {
 
     #[test]
     fn transfer_function_domain_and_fallbacks() {
-        let tf = TransferFunction::from_json(r#"{"domain": [0, 10], "color": [[0, 1, 0, 0], [1, 0, 0, 1]]}"#)
-            .unwrap();
+        let tf = TransferFunction::from_json(
+            r#"{"domain": [0, 10], "color": [[0, 1, 0, 0], [1, 0, 0, 1]]}"#,
+        )
+        .unwrap();
         let c = Classifier::from_transfer_function(&tf, (-5.0, 100.0), (0.0, 0.8), 1.0);
         assert_eq!(c.normalise(5.0), 0.5);
         assert_eq!(c.material(5.0), [0.5, 0.0, 0.5]);

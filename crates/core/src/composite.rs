@@ -81,19 +81,31 @@ mod tests {
             let keep = (1.0 - alpha).powi(k as i32);
             let want = c * (1.0 - keep) + bg * keep;
             let got = back_to_front(&samples, bg);
-            assert!((got.truncate() - want).abs().max_element() < 1e-12, "K = {k}");
+            assert!(
+                (got.truncate() - want).abs().max_element() < 1e-12,
+                "K = {k}"
+            );
             assert!((got.w - (1.0 - keep)).abs() < 1e-12);
             let mut f = FrontToBack::new();
             samples.iter().for_each(|s| f.add(s.as_vec4()));
             let fast = f.finish(bg.as_vec3());
-            assert!((fast.as_dvec4() - got).abs().max_element() < 1e-5, "K = {k}");
+            assert!(
+                (fast.as_dvec4() - got).abs().max_element() < 1e-5,
+                "K = {k}"
+            );
         }
     }
 
     #[test]
     fn nearest_sample_wins_when_opaque() {
-        let samples = [DVec4::new(1.0, 0.0, 0.0, 1.0), DVec4::new(0.0, 1.0, 0.0, 1.0)];
-        assert_eq!(back_to_front(&samples, DVec3::ONE), DVec4::new(1.0, 0.0, 0.0, 1.0));
+        let samples = [
+            DVec4::new(1.0, 0.0, 0.0, 1.0),
+            DVec4::new(0.0, 1.0, 0.0, 1.0),
+        ];
+        assert_eq!(
+            back_to_front(&samples, DVec3::ONE),
+            DVec4::new(1.0, 0.0, 0.0, 1.0)
+        );
         let mut f = FrontToBack::new();
         samples.iter().for_each(|s| f.add(s.as_vec4()));
         assert_eq!(f.finish(Vec3::ONE), Vec4::new(1.0, 0.0, 0.0, 1.0));
@@ -104,7 +116,12 @@ mod tests {
         let samples: Vec<DVec4> = (0..40)
             .map(|i| {
                 let x = i as f64;
-                DVec4::new((x * 0.37).sin().abs(), (x * 0.11).cos().abs(), 0.5, 0.3 * (x * 0.7).sin().abs())
+                DVec4::new(
+                    (x * 0.37).sin().abs(),
+                    (x * 0.11).cos().abs(),
+                    0.5,
+                    0.3 * (x * 0.7).sin().abs(),
+                )
             })
             .collect();
         let bg = DVec3::new(0.2, 0.3, 0.4);

@@ -74,7 +74,8 @@ mod tests {
         // f = x² along x: central difference at i is ((i+1)² − (i−1)²)/2 = 2i,
         // one-sided at the faces: 1 at i = 0 and (n−1)² − (n−2)² at i = n−1.
         let n = 5;
-        let v = Volume::from_fn([n, 2, 2], DVec3::ONE, DVec3::ZERO, |p| (p.x * p.x) as f32).unwrap();
+        let v =
+            Volume::from_fn([n, 2, 2], DVec3::ONE, DVec3::ZERO, |p| (p.x * p.x) as f32).unwrap();
         let g = gradients(&v);
         let gx: Vec<f32> = (0..n).map(|i| g[v.index(i, 1, 1)][0]).collect();
         assert_eq!(gx, vec![1.0, 2.0, 4.0, 6.0, 7.0]);

@@ -68,7 +68,13 @@ pub struct GridFrame {
 impl GridFrame {
     /// The samples of the ray through pixel (`col`, `row`) of `view`, `step`
     /// world units apart, or `None` if the ray misses the volume.
-    pub fn ray(&self, view: &OrthographicView, col: usize, row: usize, step: f64) -> Option<RaySamples> {
+    pub fn ray(
+        &self,
+        view: &OrthographicView,
+        col: usize,
+        row: usize,
+        step: f64,
+    ) -> Option<RaySamples> {
         let origin = (view.pixel_centre(col, row) - self.origin) / self.spacing;
         let direction = view.direction / self.spacing;
         let (mut t_enter, mut t_exit) = (f64::NEG_INFINITY, f64::INFINITY);
@@ -146,7 +152,10 @@ mod tests {
         let grid = frame([4, 4, 4], DVec3::ONE);
         let bounds = (grid.origin, grid.origin + DVec3::splat(3.0));
         let default = OrthographicView::frame(&Camera::default(), bounds, 4, 4).unwrap();
-        let far = OrthographicView { centre: default.centre + DVec3::new(0.0, 100.0, 0.0), ..default };
+        let far = OrthographicView {
+            centre: default.centre + DVec3::new(0.0, 100.0, 0.0),
+            ..default
+        };
         assert!(grid.ray(&far, 1, 1, 1.0).is_none());
     }
 }

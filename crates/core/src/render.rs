@@ -98,11 +98,16 @@ impl RenderSettings {
             }
         }
         if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(setting(format!("step {} must be a positive number of voxels", self.step)));
+            return Err(setting(format!(
+                "step {} must be a positive number of voxels",
+                self.step
+            )));
         }
         let (p, q) = self.opacity_ramp;
         if !(0.0 <= p && p < q && q <= 1.0) {
-            return Err(setting(format!("opacity ramp p,q = {p},{q} needs 0 <= p < q <= 1")));
+            return Err(setting(format!(
+                "opacity ramp p,q = {p},{q} needs 0 <= p < q <= 1"
+            )));
         }
         let ph = &self.phong;
         for (name, c) in [
@@ -112,19 +117,29 @@ impl RenderSettings {
             ("light colour", ph.light_color),
         ] {
             if c.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-                return Err(setting(format!("{name} {c:?} must be finite and non-negative")));
+                return Err(setting(format!(
+                    "{name} {c:?} must be finite and non-negative"
+                )));
             }
         }
         if !(ph.shininess.is_finite() && ph.shininess >= 0.0) {
-            return Err(setting(format!("shininess {} must be finite and non-negative", ph.shininess)));
+            return Err(setting(format!(
+                "shininess {} must be finite and non-negative",
+                ph.shininess
+            )));
         }
         if self.background.iter().any(|v| !(0.0..=1.0).contains(v)) {
-            return Err(setting(format!("background {:?} must be in [0, 1]", self.background)));
+            return Err(setting(format!(
+                "background {:?} must be in [0, 1]",
+                self.background
+            )));
         }
         if let Some(l) = self.light_direction
             && !(l.is_finite() && l.length() > 0.0)
         {
-            return Err(setting(format!("light direction {l} must be a finite, non-zero vector")));
+            return Err(setting(format!(
+                "light direction {l} must be a finite, non-zero vector"
+            )));
         }
         Ok(())
     }
@@ -236,7 +251,14 @@ impl<'v> Renderer<'v> {
             Method::Fast => raycast::render,
             Method::Reference => reference::render,
         };
-        cast(shaded, &frame.grid, &frame.view, frame.step, settings.background, progress)
+        cast(
+            shaded,
+            &frame.grid,
+            &frame.view,
+            frame.step,
+            settings.background,
+            progress,
+        )
     }
 }
 

@@ -116,10 +116,16 @@ mod tests {
     fn facing_the_headlight_is_white() {
         let light = LightGeometry::headlight(Vec3::X);
         let phong = Phong::default();
-        assert!(close(phong.shade(Vec3::new(2.0, 0.0, 0.0), &light), [1.0; 3]));
+        assert!(close(
+            phong.shade(Vec3::new(2.0, 0.0, 0.0), &light),
+            [1.0; 3]
+        ));
         // The same surface seen from its back (gradient into the object) is
         // lit the same: two-sided lighting.
-        assert!(close(phong.shade(Vec3::new(-5.0, 0.0, 0.0), &light), [1.0; 3]));
+        assert!(close(
+            phong.shade(Vec3::new(-5.0, 0.0, 0.0), &light),
+            [1.0; 3]
+        ));
     }
 
     #[test]
@@ -138,7 +144,10 @@ mod tests {
             phong.light_color[c]
                 * (phong.ambient[c] + phong.diffuse[c] * 0.5 + phong.specular[c] * 0.125)
         };
-        assert!(close(phong.shade(n * 4.0, &light), [expect(0), expect(1), expect(2)]));
+        assert!(close(
+            phong.shade(n * 4.0, &light),
+            [expect(0), expect(1), expect(2)]
+        ));
     }
 
     #[test]

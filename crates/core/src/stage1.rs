@@ -65,11 +65,25 @@ mod tests {
     #[test]
     fn unlit_voxels_take_the_material_colour_and_ramp_opacity() {
         let v = Volume::from_fn([3, 3, 3], DVec3::ONE, DVec3::ZERO, |p| p.x as f32).unwrap();
-        let color = PiecewiseLinear::new("color", vec![(0.0, [1.0, 0.0, 0.0]), (1.0, [0.0, 0.0, 1.0])]).unwrap();
-        let c = Classifier::new((0.0, 2.0), OpacityMap::Ramp { p: 0.2, q: 0.6 }, Some(color), 1.0);
+        let color = PiecewiseLinear::new(
+            "color",
+            vec![(0.0, [1.0, 0.0, 0.0]), (1.0, [0.0, 0.0, 1.0])],
+        )
+        .unwrap();
+        let c = Classifier::new(
+            (0.0, 2.0),
+            OpacityMap::Ramp { p: 0.2, q: 0.6 },
+            Some(color),
+            1.0,
+        );
         let s = shade_and_classify(&v, &gradients(&v), &c, None);
         assert_eq!(s.voxels[v.index(0, 1, 1)], Vec4::new(1.0, 0.0, 0.0, 0.2));
-        assert!((s.voxels[v.index(1, 2, 0)] - Vec4::new(0.5, 0.0, 0.5, 0.4)).abs().max_element() < 1e-6);
+        assert!(
+            (s.voxels[v.index(1, 2, 0)] - Vec4::new(0.5, 0.0, 0.5, 0.4))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
         assert_eq!(s.voxels[v.index(2, 0, 2)], Vec4::new(0.0, 0.0, 1.0, 0.6));
     }
 
@@ -79,10 +93,18 @@ mod tests {
         // light times the material.
         let v = Volume::from_fn([3, 3, 3], DVec3::ONE, DVec3::ZERO, |p| p.x as f32).unwrap();
         let color = PiecewiseLinear::constant([0.5, 0.25, 1.0]);
-        let c = Classifier::new((0.0, 2.0), OpacityMap::Ramp { p: 0.0, q: 1.0 }, Some(color), 1.0);
+        let c = Classifier::new(
+            (0.0, 2.0),
+            OpacityMap::Ramp { p: 0.0, q: 1.0 },
+            Some(color),
+            1.0,
+        );
         let light = LightGeometry::headlight(Vec3::X);
         let s = shade_and_classify(&v, &gradients(&v), &c, Some((&Phong::default(), &light)));
         let got = s.voxels[v.index(1, 1, 1)];
-        assert!((got - Vec4::new(0.5, 0.25, 1.0, 0.5)).abs().max_element() < 1e-6, "{got:?}");
+        assert!(
+            (got - Vec4::new(0.5, 0.25, 1.0, 0.5)).abs().max_element() < 1e-6,
+            "{got:?}"
+        );
     }
 }

@@ -61,7 +61,10 @@ impl<const N: usize> PiecewiseLinear<N> {
                 return Err(bad(index, format!("t = {t} is not finite")));
             }
             if index > 0 && *t < points[index - 1].0 {
-                return Err(bad(index, format!("t = {t} is smaller than the point before it; sort the points by t")));
+                return Err(bad(
+                    index,
+                    format!("t = {t} is smaller than the point before it; sort the points by t"),
+                ));
             }
             if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
                 return Err(bad(index, format!("value {v} is outside [0, 1]")));
@@ -121,8 +124,8 @@ struct TransferFunctionFile {
 impl TransferFunction {
     /// Parses the JSON form (see the module documentation).
     pub fn from_json(text: &str) -> Result<Self, TransferFunctionError> {
-        let file: TransferFunctionFile = serde_json::from_str(text)
-            .map_err(|e| TransferFunctionError::Json(e.to_string()))?;
+        let file: TransferFunctionFile =
+            serde_json::from_str(text).map_err(|e| TransferFunctionError::Json(e.to_string()))?;
         let domain = match file.domain {
             Some([lo, hi]) if lo.is_finite() && hi.is_finite() && lo < hi => Some((lo, hi)),
             Some([lo, hi]) => return Err(TransferFunctionError::BadDomain(lo, hi)),
@@ -130,12 +133,17 @@ impl TransferFunction {
         };
         let opacity = file
             .opacity
-            .map(|pts| PiecewiseLinear::new("opacity", pts.iter().map(|[t, a]| (*t, [*a])).collect()))
+            .map(|pts| {
+                PiecewiseLinear::new("opacity", pts.iter().map(|[t, a]| (*t, [*a])).collect())
+            })
             .transpose()?;
         let color = file
             .color
             .map(|pts| {
-                PiecewiseLinear::new("color", pts.iter().map(|[t, r, g, b]| (*t, [*r, *g, *b])).collect())
+                PiecewiseLinear::new(
+                    "color",
+                    pts.iter().map(|[t, r, g, b]| (*t, [*r, *g, *b])).collect(),
+                )
             })
             .transpose()?;
         Ok(TransferFunction {
@@ -152,7 +160,8 @@ mod tests {
 
     #[test]
     fn piecewise_linear_interpolates_and_clamps() {
-        let f = PiecewiseLinear::new("opacity", vec![(0.05, [0.0]), (0.95, [0.9]), (1.0, [0.5])]).unwrap();
+        let f = PiecewiseLinear::new("opacity", vec![(0.05, [0.0]), (0.95, [0.9]), (1.0, [0.5])])
+            .unwrap();
         assert_eq!(f.eval(-1.0), [0.0]);
         assert_eq!(f.eval(0.05), [0.0]);
         assert!((f.eval(0.5)[0] - 0.45).abs() < 1e-6);
@@ -163,7 +172,11 @@ mod tests {
 
     #[test]
     fn equal_t_makes_a_jump() {
-        let f = PiecewiseLinear::new("opacity", vec![(0.0, [0.0]), (0.5, [0.0]), (0.5, [1.0]), (1.0, [1.0])]).unwrap();
+        let f = PiecewiseLinear::new(
+            "opacity",
+            vec![(0.0, [0.0]), (0.5, [0.0]), (0.5, [1.0]), (1.0, [1.0])],
+        )
+        .unwrap();
         assert_eq!(f.eval(0.49), [0.0]);
         assert_eq!(f.eval(0.5), [1.0]);
         assert_eq!(f.eval(0.51), [1.0]);
@@ -187,7 +200,10 @@ mod tests {
     fn rejects_malformed_functions() {
         let cases = [
             (r#"{"opacity": []}"#, "at least one point"),
-            (r#"{"opacity": [[0.5, 0.1], [0.2, 0.3]]}"#, "sort the points"),
+            (
+                r#"{"opacity": [[0.5, 0.1], [0.2, 0.3]]}"#,
+                "sort the points",
+            ),
             (r#"{"opacity": [[0, 1.5]]}"#, "outside [0, 1]"),
             (r#"{"color": [[0, 1, -1, 0]]}"#, "outside [0, 1]"),
             (r#"{"color": [[0, 1, 0]]}"#, "not a valid"),

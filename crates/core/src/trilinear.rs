@@ -65,9 +65,11 @@ mod tests {
 
     /// A trilinear function with all eight terms, different per channel.
     fn trilinear_fn(x: f64, y: f64, z: f64) -> [f64; 4] {
-        let f = |c: f64| 0.3 + c * 0.01 * x - 0.02 * y + 0.015 * z + 0.004 * x * y - 0.003 * y * z
-            + 0.002 * x * z * c
-            - 0.0007 * x * y * z;
+        let f = |c: f64| {
+            0.3 + c * 0.01 * x - 0.02 * y + 0.015 * z + 0.004 * x * y - 0.003 * y * z
+                + 0.002 * x * z * c
+                - 0.0007 * x * y * z
+        };
         [f(1.0), f(2.0), f(-1.0), f(0.5)]
     }
 
@@ -77,7 +79,12 @@ mod tests {
             for j in 0..dims[1] {
                 for i in 0..dims[0] {
                     let c = trilinear_fn(i as f64, j as f64, k as f64);
-                    v.push(Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32));
+                    v.push(Vec4::new(
+                        c[0] as f32,
+                        c[1] as f32,
+                        c[2] as f32,
+                        c[3] as f32,
+                    ));
                 }
             }
         }
@@ -89,7 +96,12 @@ mod tests {
         let dims = [7, 5, 6];
         let voxels = grid(dims);
         // Deterministic scatter of points, including the faces and corners.
-        let mut points = vec![[0.0, 0.0, 0.0], [6.0, 4.0, 5.0], [6.0, 0.0, 2.5], [3.0, 4.0, 0.0]];
+        let mut points = vec![
+            [0.0, 0.0, 0.0],
+            [6.0, 4.0, 5.0],
+            [6.0, 0.0, 2.5],
+            [3.0, 4.0, 0.0],
+        ];
         let mut s = 0.123456789f64;
         for _ in 0..200 {
             let mut p = [0.0; 3];
@@ -102,10 +114,24 @@ mod tests {
         for p in points {
             let want = trilinear_fn(p[0], p[1], p[2]);
             let r = sample_reference(&voxels, dims, p);
-            let f = sample(&voxels, dims, Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32));
+            let f = sample(
+                &voxels,
+                dims,
+                Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
+            );
             for c in 0..4 {
-                assert!((r[c] - want[c]).abs() < 1e-6, "reference at {p:?}: {} vs {}", r[c], want[c]);
-                assert!((f[c] as f64 - want[c]).abs() < 1e-5, "fast at {p:?}: {} vs {}", f[c], want[c]);
+                assert!(
+                    (r[c] - want[c]).abs() < 1e-6,
+                    "reference at {p:?}: {} vs {}",
+                    r[c],
+                    want[c]
+                );
+                assert!(
+                    (f[c] as f64 - want[c]).abs() < 1e-5,
+                    "fast at {p:?}: {} vs {}",
+                    f[c],
+                    want[c]
+                );
             }
         }
     }

@@ -236,14 +236,21 @@ mod tests {
         ));
         let v = Volume::new([2, 2, 2], vec![0.0; 8]).unwrap();
         assert!(v.clone().with_spacing(DVec3::new(1.0, 0.0, 1.0)).is_err());
-        assert!(v.clone().with_spacing(DVec3::new(1.0, f64::NAN, 1.0)).is_err());
+        assert!(
+            v.clone()
+                .with_spacing(DVec3::new(1.0, f64::NAN, 1.0))
+                .is_err()
+        );
         assert!(v.with_origin(DVec3::new(f64::INFINITY, 0.0, 0.0)).is_err());
     }
 
     #[test]
     fn value_range_skips_non_finite() {
-        let v = Volume::new([2, 2, 2], vec![1.0, f32::NAN, -2.0, 3.0, 0.0, f32::INFINITY, 0.5, 0.0])
-            .unwrap();
+        let v = Volume::new(
+            [2, 2, 2],
+            vec![1.0, f32::NAN, -2.0, 3.0, 0.0, f32::INFINITY, 0.5, 0.0],
+        )
+        .unwrap();
         assert_eq!(v.value_range(), Some((-2.0, 3.0)));
         assert_eq!(v.count_non_finite(), 2);
     }

@@ -100,12 +100,17 @@ fn uniform_medium_has_the_closed_form_colour() {
             ..RenderSettings::default()
         };
         let keep = (1.0 - alpha).powf(step * k as f64);
-        let want: Vec<f64> = (0..3).map(|i| c[i] as f64 * (1.0 - keep) + bg[i] as f64 * keep).collect();
+        let want: Vec<f64> = (0..3)
+            .map(|i| c[i] as f64 * (1.0 - keep) + bg[i] as f64 * keep)
+            .collect();
         let (fast, reference) = both_paths(&volume, &settings);
         for (image, tol) in [(reference, 1e-5), (fast, 1.0 / 255.0)] {
             for px in image.pixels() {
                 for ch in 0..3 {
-                    assert!((px[ch] as f64 - want[ch]).abs() < tol, "step {step}: {px:?} vs {want:?}");
+                    assert!(
+                        (px[ch] as f64 - want[ch]).abs() < tol,
+                        "step {step}: {px:?} vs {want:?}"
+                    );
                 }
                 assert!((px[3] as f64 - (1.0 - keep)).abs() < tol);
             }
@@ -147,7 +152,10 @@ fn constant_volume_with_shading_gets_ambient_light_only() {
         ..RenderSettings::default()
     };
     for px in render(&volume, &settings).pixels() {
-        assert!((px[0] - 0.05).abs() < 1e-6 && (px[1] - 0.1).abs() < 1e-6, "{px:?}");
+        assert!(
+            (px[0] - 0.05).abs() < 1e-6 && (px[1] - 0.1).abs() < 1e-6,
+            "{px:?}"
+        );
     }
 }
 
@@ -201,9 +209,19 @@ fn fast_path_matches_the_reference_within_one_level() {
         }
     }
     // The images are not trivially empty: the comparison means something.
-    let image = render(&volumes[0], &RenderSettings { width: 40, height: 32, ..Default::default() });
+    let image = render(
+        &volumes[0],
+        &RenderSettings {
+            width: 40,
+            height: 32,
+            ..Default::default()
+        },
+    );
     assert!(image.pixels().iter().any(|p| p[0] > 0.3));
-    println!("largest fast-vs-reference difference: {worst:.6} ({:.3} of 1/255)", worst * 255.0);
+    println!(
+        "largest fast-vs-reference difference: {worst:.6} ({:.3} of 1/255)",
+        worst * 255.0
+    );
 }
 
 #[test]
@@ -221,7 +239,10 @@ fn fast_path_is_bit_identical_for_any_thread_count() {
     let images: Vec<Image> = [1, 2, 7]
         .iter()
         .map(|&n| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .unwrap();
             pool.install(|| renderer.render(&settings).unwrap())
         })
         .collect();
@@ -260,7 +281,10 @@ fn opposite_views_of_a_mirror_symmetric_volume_are_mirror_images() {
             differs_from_itself_mirrored |= (a[0] - plus.get(35 - col, row)[0]).abs() > 0.05;
         }
     }
-    assert!(differs_from_itself_mirrored, "the test volume must not be symmetric in y");
+    assert!(
+        differs_from_itself_mirrored,
+        "the test volume must not be symmetric in y"
+    );
 }
 
 /// Intensity-weighted centroid (column, row) of channel 0, in pixel units
@@ -280,11 +304,20 @@ fn centroid(image: &Image) -> (f64, f64) {
 
 #[test]
 fn a_one_voxel_feature_lands_where_the_projection_says() {
-    let (dims, spacing, origin) = ([21, 33, 17], DVec3::new(1.0, 0.5, 2.0), DVec3::new(10.0, -4.0, 3.0));
+    let (dims, spacing, origin) = (
+        [21, 33, 17],
+        DVec3::new(1.0, 0.5, 2.0),
+        DVec3::new(10.0, -4.0, 3.0),
+    );
     let feature = (5, 7, 11);
     let mut data = vec![0.0f32; 21 * 33 * 17];
     data[feature.0 + 21 * (feature.1 + 33 * feature.2)] = 1.0;
-    let volume = Volume::new(dims, data).unwrap().with_spacing(spacing).unwrap().with_origin(origin).unwrap();
+    let volume = Volume::new(dims, data)
+        .unwrap()
+        .with_spacing(spacing)
+        .unwrap()
+        .with_origin(origin)
+        .unwrap();
     let world = volume.world_position(feature.0, feature.1, feature.2);
     let (lo, hi) = volume.bounds();
 
@@ -300,7 +333,10 @@ fn a_one_voxel_feature_lands_where_the_projection_says() {
     let image = render(&volume, &settings);
     let expect = ((world.y - lo.y) / 0.5, (hi.z - world.z) / 0.5);
     let got = centroid(&image);
-    assert!((got.0 - expect.0).abs() < 0.05 && (got.1 - expect.1).abs() < 0.05, "{got:?} vs {expect:?}");
+    assert!(
+        (got.0 - expect.0).abs() < 0.05 && (got.1 - expect.1).abs() < 0.05,
+        "{got:?} vs {expect:?}"
+    );
 
     // Along −y: screen right is −x.
     let settings = RenderSettings {
@@ -318,7 +354,10 @@ fn a_one_voxel_feature_lands_where_the_projection_says() {
     let expect = ((hi.x - world.x) / 0.5, (hi.z - world.z) / 0.5);
     assert_eq!(view.project(world), expect);
     let got = centroid(&image);
-    assert!((got.0 - expect.0).abs() < 0.05 && (got.1 - expect.1).abs() < 0.05, "{got:?} vs {expect:?}");
+    assert!(
+        (got.0 - expect.0).abs() < 0.05 && (got.1 - expect.1).abs() < 0.05,
+        "{got:?} vs {expect:?}"
+    );
 }
 
 #[test]
@@ -326,7 +365,10 @@ fn anisotropic_spacing_keeps_the_physical_aspect() {
     // The same ball of radius 6 sampled on a cubic and on a stretched grid
     // must cover the same round silhouette.
     let ball = |dims: [usize; 3], spacing: DVec3| {
-        Volume::from_fn(dims, spacing, DVec3::splat(-8.0), |p| (6.0 - p.length()).max(0.0) as f32).unwrap()
+        Volume::from_fn(dims, spacing, DVec3::splat(-8.0), |p| {
+            (6.0 - p.length()).max(0.0) as f32
+        })
+        .unwrap()
     };
     let silhouette = |volume: &Volume| {
         let settings = RenderSettings {
@@ -344,17 +386,25 @@ fn anisotropic_spacing_keeps_the_physical_aspect() {
             .flat_map(|r| (0..64).map(move |c| (c, r)))
             .filter(|&(c, r)| image.get(c, r)[3] > 0.5)
             .collect();
-        let width = covered.iter().map(|p| p.0).max().unwrap() - covered.iter().map(|p| p.0).min().unwrap();
-        let height = covered.iter().map(|p| p.1).max().unwrap() - covered.iter().map(|p| p.1).min().unwrap();
+        let width =
+            covered.iter().map(|p| p.0).max().unwrap() - covered.iter().map(|p| p.0).min().unwrap();
+        let height =
+            covered.iter().map(|p| p.1).max().unwrap() - covered.iter().map(|p| p.1).min().unwrap();
         (width as i64, height as i64, covered.len() as i64)
     };
     let cubic = silhouette(&ball([33, 33, 33], DVec3::splat(0.5)));
     let stretched = silhouette(&ball([33, 17, 9], DVec3::new(0.5, 1.0, 2.0)));
     assert!((cubic.0 - cubic.1).abs() <= 1, "{cubic:?}");
     assert!((stretched.0 - stretched.1).abs() <= 1, "{stretched:?}");
-    assert!((cubic.0 - stretched.0).abs() <= 1, "{cubic:?} vs {stretched:?}");
+    assert!(
+        (cubic.0 - stretched.0).abs() <= 1,
+        "{cubic:?} vs {stretched:?}"
+    );
     // Coarser z sampling reconstructs the edge a little differently.
-    assert!((cubic.2 - stretched.2).abs() * 10 < cubic.2, "areas {cubic:?} vs {stretched:?}");
+    assert!(
+        (cubic.2 - stretched.2).abs() * 10 < cubic.2,
+        "areas {cubic:?} vs {stretched:?}"
+    );
 }
 
 #[test]
@@ -372,15 +422,54 @@ fn invalid_settings_are_refused_by_name() {
     let volume = blobs([5, 5, 5], DVec3::ONE);
     let renderer = Renderer::new(&volume).unwrap();
     let cases: Vec<(RenderSettings, &str)> = vec![
-        (RenderSettings { width: 0, ..Default::default() }, "width 0"),
-        (RenderSettings { step: 0.0, ..Default::default() }, "step 0"),
-        (RenderSettings { step: -1.0, ..Default::default() }, "step -1"),
-        (RenderSettings { step: 1e-9, ..Default::default() }, "too small"),
-        (RenderSettings { opacity_ramp: (0.5, 0.5), ..Default::default() }, "0 <= p < q <= 1"),
-        (RenderSettings { background: [2.0, 0.0, 0.0], ..Default::default() }, "background"),
         (
             RenderSettings {
-                camera: Camera { up: DVec3::X, ..Camera::default() },
+                width: 0,
+                ..Default::default()
+            },
+            "width 0",
+        ),
+        (
+            RenderSettings {
+                step: 0.0,
+                ..Default::default()
+            },
+            "step 0",
+        ),
+        (
+            RenderSettings {
+                step: -1.0,
+                ..Default::default()
+            },
+            "step -1",
+        ),
+        (
+            RenderSettings {
+                step: 1e-9,
+                ..Default::default()
+            },
+            "too small",
+        ),
+        (
+            RenderSettings {
+                opacity_ramp: (0.5, 0.5),
+                ..Default::default()
+            },
+            "0 <= p < q <= 1",
+        ),
+        (
+            RenderSettings {
+                background: [2.0, 0.0, 0.0],
+                ..Default::default()
+            },
+            "background",
+        ),
+        (
+            RenderSettings {
+                camera: Camera {
+                    up: DVec3::X,
+                    ..Camera::default()
+                },
                 ..Default::default()
             },
             "parallel",

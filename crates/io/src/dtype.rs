@@ -1,0 +1,301 @@
+//! Sample types and byte orders of raw data, and their conversion to `f32`.
+
+use std::fmt;
+use std::str::FromStr;
+
+use thiserror::Error;
+
+/// The type of one sample in a raw file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DType {
+    U8,
+    I8,
+    U16,
+    I16,
+    U32,
+    I32,
+    F32,
+    F64,
+}
+
+impl DType {
+    /// Every sample type, in the order of [`DType::NAMES`].
+    pub const ALL: [DType; 8] = [
+        DType::U8,
+        DType::I8,
+        DType::U16,
+        DType::I16,
+        DType::U32,
+        DType::I32,
+        DType::F32,
+        DType::F64,
+    ];
+
+    /// The accepted names, as `FromStr` reads and `Display` writes them.
+    pub const NAMES: [&'static str; 8] = ["u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"];
+
+    /// Bytes per sample.
+    pub fn size(self) -> usize {
+        match self {
+            DType::U8 | DType::I8 => 1,
+            DType::U16 | DType::I16 => 2,
+            DType::U32 | DType::I32 | DType::F32 => 4,
+            DType::F64 => 8,
+        }
+    }
+
+    /// The name `FromStr` accepts: `u8`, `i8`, ..., `f64`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DType::U8 => "u8",
+            DType::I8 => "i8",
+            DType::U16 => "u16",
+            DType::I16 => "i16",
+            DType::U32 => "u32",
+            DType::I32 => "i32",
+            DType::F32 => "f32",
+            DType::F64 => "f64",
+        }
+    }
+}
+
+impl fmt::Display for DType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A name that is not one of the accepted spellings.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("unknown {what} '{given}': expected one of {accepted}")]
+pub struct ParseNameError {
+    /// What was being parsed: "dtype" or "endianness".
+    pub what: &'static str,
+    /// The text given.
+    pub given: String,
+    /// The accepted names, comma separated.
+    pub accepted: &'static str,
+}
+
+impl FromStr for DType {
+    type Err = ParseNameError;
+
+    /// Accepts exactly `u8 i8 u16 i16 u32 i32 f32 f64`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        DType::ALL
+            .into_iter()
+            .find(|d| d.name() == s)
+            .ok_or_else(|| ParseNameError {
+                what: "dtype",
+                given: s.to_string(),
+                accepted: "u8, i8, u16, i16, u32, i32, f32, f64",
+            })
+    }
+}
+
+/// Byte order of multi-byte samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Endian {
+    #[default]
+    Little,
+    Big,
+}
+
+impl Endian {
+    /// The byte order of the machine running this code.
+    pub const NATIVE: Endian = if cfg!(target_endian = "big") {
+        Endian::Big
+    } else {
+        Endian::Little
+    };
+}
+
+impl fmt::Display for Endian {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Endian::Little => "little",
+            Endian::Big => "big",
+        })
+    }
+}
+
+impl FromStr for Endian {
+    type Err = ParseNameError;
+
+    /// Accepts exactly `little` or `big`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "little" => Ok(Endian::Little),
+            "big" => Ok(Endian::Big),
+            _ => Err(ParseNameError {
+                what: "endianness",
+                given: s.to_string(),
+                accepted: "little, big",
+            }),
+        }
+    }
+}
+
+/// Converts `bytes`, a sequence of `dtype` samples in `endian` byte order,
+/// to `f32` (32-bit integers and `f64` with `as f32`, i.e. rounded to the
+/// nearest `f32`). Trailing bytes that do not make a whole sample are ignored.
+pub fn bytes_to_f32(bytes: &[u8], dtype: DType, endian: Endian) -> Vec<f32> {
+    let mut out = Vec::with_capacity(bytes.len() / dtype.size());
+    extend_f32(&mut out, bytes, dtype, endian);
+    out
+}
+
+/// Like [`bytes_to_f32`], appending to `out`.
+pub fn extend_f32(out: &mut Vec<f32>, bytes: &[u8], dtype: DType, endian: Endian) {
+    macro_rules! convert {
+        ($t:ty) => {{
+            const N: usize = std::mem::size_of::<$t>();
+            let conv = match endian {
+                Endian::Little => <$t>::from_le_bytes,
+                Endian::Big => <$t>::from_be_bytes,
+            };
+            out.extend(bytes.chunks_exact(N).map(|c| {
+                let mut a = [0u8; N];
+                a.copy_from_slice(c);
+                conv(a) as f32
+            }));
+        }};
+    }
+    match dtype {
+        DType::U8 => out.extend(bytes.iter().map(|&b| f32::from(b))),
+        DType::I8 => out.extend(bytes.iter().map(|&b| f32::from(b as i8))),
+        DType::U16 => convert!(u16),
+        DType::I16 => convert!(i16),
+        DType::U32 => convert!(u32),
+        DType::I32 => convert!(i32),
+        DType::F32 => convert!(f32),
+        DType::F64 => convert!(f64),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn encode<const N: usize>(
+        values: &[f64],
+        endian: Endian,
+        le: impl Fn(f64) -> [u8; N],
+    ) -> Vec<u8> {
+        values
+            .iter()
+            .flat_map(|&v| {
+                let mut b = le(v);
+                if endian == Endian::Big {
+                    b.reverse();
+                }
+                b
+            })
+            .collect()
+    }
+
+    /// Builds bytes for each dtype by hand in both byte orders and checks
+    /// that they decode to the expected values.
+    #[test]
+    fn every_dtype_round_trips_in_both_byte_orders() {
+        for endian in [Endian::Little, Endian::Big] {
+            let cases: Vec<(DType, Vec<f64>, Vec<u8>)> = vec![
+                (
+                    DType::U8,
+                    vec![0.0, 1.0, 200.0, 255.0],
+                    vec![0, 1, 200, 255],
+                ),
+                (
+                    DType::I8,
+                    vec![0.0, -1.0, 127.0, -128.0],
+                    vec![0, 0xff, 0x7f, 0x80],
+                ),
+                (DType::U16, vec![0.0, 258.0, 65535.0], {
+                    let v = [0.0, 258.0, 65535.0];
+                    encode(&v, endian, |x| (x as u16).to_le_bytes())
+                }),
+                (DType::I16, vec![-32768.0, -2.0, 32767.0], {
+                    let v = [-32768.0, -2.0, 32767.0];
+                    encode(&v, endian, |x| (x as i16).to_le_bytes())
+                }),
+                (DType::U32, vec![0.0, 70000.0, 16_777_216.0], {
+                    let v = [0.0, 70000.0, 16_777_216.0];
+                    encode(&v, endian, |x| (x as u32).to_le_bytes())
+                }),
+                (DType::I32, vec![-2_000_000.0, -1.0, 123_456.0], {
+                    let v = [-2_000_000.0, -1.0, 123_456.0];
+                    encode(&v, endian, |x| (x as i32).to_le_bytes())
+                }),
+                (DType::F32, vec![-1.5, 0.0, 3.25e10], {
+                    let v = [-1.5, 0.0, 3.25e10];
+                    encode(&v, endian, |x| (x as f32).to_le_bytes())
+                }),
+                (DType::F64, vec![-0.125, 1e300, 2.5], {
+                    let v = [-0.125, 1e300, 2.5];
+                    encode(&v, endian, |x| x.to_le_bytes())
+                }),
+            ];
+            for (dtype, values, bytes) in cases {
+                assert_eq!(bytes.len(), values.len() * dtype.size(), "{dtype}");
+                let got = bytes_to_f32(&bytes, dtype, endian);
+                let want: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+                assert_eq!(got, want, "{dtype} {endian}");
+            }
+        }
+    }
+
+    #[test]
+    fn byte_order_matters() {
+        let bytes = [0x01, 0x02];
+        assert_eq!(bytes_to_f32(&bytes, DType::U16, Endian::Little), [513.0]);
+        assert_eq!(bytes_to_f32(&bytes, DType::U16, Endian::Big), [258.0]);
+        // 1.0f64 big-endian is 3f f0 00 .. 00.
+        let one_be = [0x3f, 0xf0, 0, 0, 0, 0, 0, 0];
+        assert_eq!(bytes_to_f32(&one_be, DType::F64, Endian::Big), [1.0]);
+        assert_ne!(bytes_to_f32(&one_be, DType::F64, Endian::Little), [1.0]);
+    }
+
+    #[test]
+    fn wide_values_convert_with_as() {
+        let big = u32::MAX.to_le_bytes();
+        assert_eq!(
+            bytes_to_f32(&big, DType::U32, Endian::Little),
+            [u32::MAX as f32]
+        );
+        let tiny = 1e-300f64.to_be_bytes();
+        assert_eq!(bytes_to_f32(&tiny, DType::F64, Endian::Big), [0.0]);
+        let huge = 1e300f64.to_le_bytes();
+        assert_eq!(
+            bytes_to_f32(&huge, DType::F64, Endian::Little),
+            [f32::INFINITY]
+        );
+    }
+
+    #[test]
+    fn trailing_partial_sample_is_ignored() {
+        let bytes = [0, 0, 0x80, 0x3f, 0xaa];
+        assert_eq!(bytes_to_f32(&bytes, DType::F32, Endian::Little), [1.0]);
+    }
+
+    #[test]
+    fn names_parse_exactly() {
+        for (d, name) in DType::ALL.into_iter().zip(DType::NAMES) {
+            assert_eq!(name.parse::<DType>(), Ok(d));
+            assert_eq!(d.to_string(), name);
+        }
+        let sizes: Vec<usize> = DType::ALL.iter().map(|d| d.size()).collect();
+        assert_eq!(sizes, [1, 1, 2, 2, 4, 4, 4, 8]);
+        for bad in ["F32", "float", "f16", "u64", "", " u8"] {
+            let err = bad.parse::<DType>().unwrap_err().to_string();
+            assert!(
+                err.contains("u8, i8, u16, i16, u32, i32, f32, f64"),
+                "{err}"
+            );
+        }
+        assert_eq!("little".parse::<Endian>(), Ok(Endian::Little));
+        assert_eq!("big".parse::<Endian>(), Ok(Endian::Big));
+        let err = "Big".parse::<Endian>().unwrap_err().to_string();
+        assert_eq!(err, "unknown endianness 'Big': expected one of little, big");
+        assert_eq!(Endian::Big.to_string(), "big");
+    }
+}

@@ -1,0 +1,139 @@
+//! `volray render`: INPUT → Volume → Renderer → Image → PNG.
+
+use crate::cli::{RenderArgs, ViewArgs};
+use crate::error::CliError;
+use crate::input::{self, Input};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::Path;
+use volray_core::glam::DVec3;
+use volray_core::{Camera, Method, Phong, RenderSettings, Renderer, TransferFunction};
+use volray_io::BitDepth;
+
+pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let input = input::load(&args.input)?;
+    check_output(&args.output, &input)?;
+    let settings = settings(&args.view)?;
+    let pool = thread_pool(args.view.threads)?;
+    let renderer = Renderer::new(&input.volume)
+        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+
+    let pixels = (settings.width * settings.height) as u64;
+    let bar = if std::io::stderr().is_terminal() && pixels >= 256 * 256 {
+        let bar = ProgressBar::new(pixels);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent}% ({eta} left)")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let image = pool
+        .install(|| renderer.render_with_progress(&settings, &|n| bar.inc(n as u64)))
+        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+    bar.finish_and_clear();
+
+    let depth = if args.bit_depth == 16 {
+        BitDepth::Sixteen
+    } else {
+        BitDepth::Eight
+    };
+    volray_io::write_png(&args.output, &image, depth)?;
+    Ok(())
+}
+
+/// Refuses, before any work, an output that would overwrite the input or
+/// that cannot be written where it is asked for.
+fn check_output(output: &Path, input: &Input) -> Result<(), CliError> {
+    if let Some(path) = &input.path
+        && let (Ok(a), Ok(b)) = (path.canonicalize(), output.canonicalize())
+        && a == b
+    {
+        return Err(CliError::input(format!(
+            "{}: the output is the input file; refusing to overwrite it",
+            output.display()
+        )));
+    }
+    let dir = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(CliError::io(format!(
+            "{}: directory {} does not exist",
+            output.display(),
+            dir.display()
+        )));
+    }
+    if output.is_dir() {
+        return Err(CliError::io(format!(
+            "{}: is a directory",
+            output.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The render settings the view arguments describe.
+pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
+    let transfer_function = match &view.tf {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::io(format!("{}: cannot read: {e}", path.display())))?;
+            TransferFunction::from_json(&text)
+                .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?
+        }
+        None => TransferFunction::default(),
+    };
+    if view.opacity.is_some() && transfer_function.opacity.is_some() {
+        return Err(CliError::input(
+            "--opacity conflicts with the opacity function in --tf: give one of them",
+        ));
+    }
+    let settings = RenderSettings {
+        width: view.size.0,
+        height: view.size.1,
+        camera: Camera {
+            view_point: view.view.map(DVec3::from),
+            look_at: view.look_at.map(DVec3::from),
+            up: DVec3::from(view.up),
+        },
+        step: view.step,
+        opacity_ramp: view
+            .opacity
+            .unwrap_or(RenderSettings::default().opacity_ramp),
+        transfer_function,
+        phong: Phong {
+            ambient: view.ambient,
+            diffuse: view.diffuse,
+            specular: view.specular,
+            shininess: view.shininess,
+            light_color: view.light_color,
+        },
+        shading: !view.no_shading,
+        light_direction: view.light.map(DVec3::from),
+        background: view.background,
+        method: if view.reference {
+            Method::Reference
+        } else {
+            Method::Fast
+        },
+    };
+    settings
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    Ok(settings)
+}
+
+/// A pool of `threads` workers (default: one per core).
+pub fn thread_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, CliError> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        builder = builder.num_threads(n as usize);
+    }
+    builder
+        .build()
+        .map_err(|e| CliError::io(format!("cannot start worker threads: {e}")))
+}
