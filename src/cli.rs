@@ -78,12 +78,17 @@ pub struct ViewArgs {
     pub up: [f64; 3],
 
     /// Sample spacing along the rays, in voxels (of the smallest spacing).
-    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
     pub step: f64,
 
     /// The paper's opacity ramp: α = p + t·(q − p) over the normalised value
     /// t, with 0 ≤ p < q ≤ 1 [default: 0,0.5]. Conflicts with an opacity in --tf.
-    #[arg(long, value_name = "P,Q", value_parser = parse_pair)]
+    #[arg(long, value_name = "P,Q", value_parser = parse_pair, allow_hyphen_values = true)]
     pub opacity: Option<(f32, f32)>,
 
     /// Transfer function JSON: {"domain": [lo, hi], "opacity": [[t, a], ...],
@@ -92,19 +97,24 @@ pub struct ViewArgs {
     pub tf: Option<PathBuf>,
 
     /// Ambient reflection k_a: one value or r,g,b.
-    #[arg(long, value_name = "A|R,G,B", default_value = "0.1", value_parser = parse_rgb)]
+    #[arg(long, value_name = "A|R,G,B", allow_hyphen_values = true, default_value = "0.1", value_parser = parse_rgb)]
     pub ambient: [f32; 3],
 
     /// Diffuse reflection k_d: one value or r,g,b.
-    #[arg(long, value_name = "D|R,G,B", default_value = "0.7", value_parser = parse_rgb)]
+    #[arg(long, value_name = "D|R,G,B", allow_hyphen_values = true, default_value = "0.7", value_parser = parse_rgb)]
     pub diffuse: [f32; 3],
 
     /// Specular reflection k_s: one value or r,g,b.
-    #[arg(long, value_name = "S|R,G,B", default_value = "0.2", value_parser = parse_rgb)]
+    #[arg(long, value_name = "S|R,G,B", allow_hyphen_values = true, default_value = "0.2", value_parser = parse_rgb)]
     pub specular: [f32; 3],
 
     /// Specular exponent n.
-    #[arg(long, value_name = "N", default_value_t = 10.0)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 10.0,
+        allow_hyphen_values = true
+    )]
     pub shininess: f32,
 
     /// Direction towards the light at infinity [default: a headlight, L = V].

@@ -137,3 +137,21 @@ pub fn thread_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, CliError> 
         .build()
         .map_err(|e| CliError::io(format!("cannot start worker threads: {e}")))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+
+    #[test]
+    fn command_line_defaults_are_the_library_defaults() {
+        // The defaults are written twice, for `--help` and in volray-core:
+        // they must say the same.
+        let cli = Cli::try_parse_from(["volray", "render", "-o", "x.png"]).unwrap();
+        let Command::Render(args) = cli.command else {
+            panic!("not a render command")
+        };
+        assert_eq!(settings(&args.view).unwrap(), RenderSettings::default());
+    }
+}
