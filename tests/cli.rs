@@ -250,6 +250,11 @@ fn bad_input_gets_one_clear_line_and_a_non_zero_exit() {
     refused(&["render", "sphere:8", "--step", "1e-12"], 1, "too small");
     refused(&["render", "sphere:8", "--size", "0"], 1, "size");
     refused(&["render", "sphere:8", "--size", "20000"], 1, "16384");
+    refused(
+        &["render", "sphere:8", "--size", "10000x10000"],
+        1,
+        "pixels",
+    );
     refused(&["render", "sphere:8", "--threads", "0"], 1, "threads");
     refused(&["render", "sphere:8", "--view", "1,2"], 1, "X,Y,Z");
     refused(&["render", "sphere:8", "--up", "1,0,0"], 1, "parallel");

@@ -17,6 +17,8 @@ use thiserror::Error;
 
 /// Largest image side, in pixels.
 pub const MAX_IMAGE_SIDE: usize = 16384;
+/// Largest image, in pixels (8192², a 1 GiB frame buffer).
+pub const MAX_IMAGE_PIXELS: usize = 1 << 26;
 /// Largest number of samples one ray may take: a smaller step is refused
 /// rather than left to run for hours.
 pub const MAX_SAMPLES_PER_RAY: f64 = 1.0e6;
@@ -96,6 +98,12 @@ impl RenderSettings {
                     "image {name} {n} must be between 1 and {MAX_IMAGE_SIDE} pixels"
                 )));
             }
+        }
+        if self.width * self.height > MAX_IMAGE_PIXELS {
+            return Err(setting(format!(
+                "image {}x{} has more than {MAX_IMAGE_PIXELS} pixels",
+                self.width, self.height
+            )));
         }
         if !(self.step.is_finite() && self.step > 0.0) {
             return Err(setting(format!(
