@@ -156,6 +156,7 @@ mod tests {
             centre: default.centre + DVec3::new(0.0, 100.0, 0.0),
             ..default
         };
+        assert!(grid.ray(&default, 1, 1, 1.0).is_some());
         assert!(grid.ray(&far, 1, 1, 1.0).is_none());
     }
 }
