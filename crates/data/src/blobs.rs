@@ -107,10 +107,7 @@ impl Blobs {
         let blobs = Blobs {
             n: args.usize_or("n", Self::default().n)?,
         };
-        grid::check_points(blobs.n).map_err(|message| DataError::Invalid {
-            spec: spec.to_string(),
-            message,
-        })?;
+        grid::check_points(blobs.n).map_err(DataError::invalid(spec))?;
         Ok(blobs)
     }
 

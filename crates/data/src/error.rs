@@ -85,3 +85,14 @@ pub enum DataError {
     #[error("{spec}: {error}")]
     Volume { spec: String, error: VolumeError },
 }
+
+impl DataError {
+    /// Turns a source's parameter check message into an [`DataError::Invalid`]
+    /// naming `spec`: `check().map_err(DataError::invalid(spec))?`.
+    pub fn invalid(spec: impl std::fmt::Display) -> impl FnOnce(String) -> DataError {
+        move |message| DataError::Invalid {
+            spec: spec.to_string(),
+            message,
+        }
+    }
+}

@@ -55,10 +55,7 @@ pub fn cube_volume(
     half_width: f64,
     f: impl Fn(DVec3) -> f64 + Sync,
 ) -> Result<Volume, DataError> {
-    check_points(n).map_err(|message| DataError::Invalid {
-        spec: spec.to_string(),
-        message,
-    })?;
+    check_points(n).map_err(DataError::invalid(spec))?;
     if !(half_width.is_finite() && half_width > 0.0) {
         return Err(DataError::Invalid {
             spec: spec.to_string(),

@@ -81,10 +81,7 @@ impl MarschnerLobb {
             fm: args.f64_or("fm", d.fm)?,
             alpha: args.f64_or("alpha", d.alpha)?,
         };
-        ml.check().map_err(|message| DataError::Invalid {
-            spec: spec.to_string(),
-            message,
-        })?;
+        ml.check().map_err(DataError::invalid(spec))?;
         Ok(ml)
     }
 
@@ -114,10 +111,7 @@ impl MarschnerLobb {
     /// The sampled volume: origin `(−1, −1, −1)`, spacing `2/(n − 1)`.
     pub fn volume(&self) -> Result<Volume, DataError> {
         let spec = self.to_string();
-        self.check().map_err(|message| DataError::Invalid {
-            spec: spec.clone(),
-            message,
-        })?;
+        self.check().map_err(DataError::invalid(&spec))?;
         grid::cube_volume(&spec, self.n, 1.0, |p| self.density(p))
     }
 }

@@ -83,10 +83,7 @@ impl Sphere {
             radius: args.f64_or("radius", d.radius)?,
             edge: args.f64_or("edge", d.edge)?,
         };
-        sphere.check().map_err(|message| DataError::Invalid {
-            spec: spec.to_string(),
-            message,
-        })?;
+        sphere.check().map_err(DataError::invalid(spec))?;
         Ok(sphere)
     }
 
@@ -123,10 +120,7 @@ impl Sphere {
     /// The sampled volume: origin `(−1, −1, −1)`, spacing `2/(n − 1)`.
     pub fn volume(&self) -> Result<Volume, DataError> {
         let spec = self.to_string();
-        self.check().map_err(|message| DataError::Invalid {
-            spec: spec.clone(),
-            message,
-        })?;
+        self.check().map_err(DataError::invalid(&spec))?;
         grid::cube_volume(&spec, self.n, 1.0, |p| self.density(p))
     }
 }

@@ -78,10 +78,7 @@ impl Torus {
             major: args.f64_or("major", d.major)?,
             minor: args.f64_or("minor", d.minor)?,
         };
-        torus.check().map_err(|message| DataError::Invalid {
-            spec: spec.to_string(),
-            message,
-        })?;
+        torus.check().map_err(DataError::invalid(spec))?;
         Ok(torus)
     }
 
@@ -117,10 +114,7 @@ impl Torus {
     /// The sampled volume: origin `(−1, −1, −1)`, spacing `2/(n − 1)`.
     pub fn volume(&self) -> Result<Volume, DataError> {
         let spec = self.to_string();
-        self.check().map_err(|message| DataError::Invalid {
-            spec: spec.clone(),
-            message,
-        })?;
+        self.check().map_err(DataError::invalid(&spec))?;
         grid::cube_volume(&spec, self.n, 1.0, |p| self.density(p))
     }
 }
