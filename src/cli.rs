@@ -28,7 +28,7 @@ pub enum Command {
 /// Where the volume comes from and how to read it.
 #[derive(Debug, Args)]
 pub struct InputArgs {
-    /// A volume file (raw, .npy) or a built-in source spec such as
+    /// A volume file or a built-in source spec such as
     /// `marschner-lobb:41`, `blobs:64`, `sphere:64,radius=0.7`, `torus`
     /// (see `volray-data`); default: the demo volume `blobs:64`.
     /// A file whose name is a source's name needs a path, e.g. `./sphere`.
@@ -41,7 +41,7 @@ pub struct InputArgs {
     /// Raw files: the sample type.
     #[arg(
         long,
-        value_name = "u8|i8|u16|i16|u32|i32|f32|f64",
+        value_name = "u8|i8|u16|i16|u32|i32|u64|i64|f16|f32|f64",
         help_heading = "Raw files"
     )]
     pub dtype: Option<String>,
@@ -50,10 +50,29 @@ pub struct InputArgs {
     #[arg(long, value_name = "little|big", help_heading = "Raw files")]
     pub endian: Option<String>,
 
-    /// Voxel spacing in world units along x, y and z [default: 1,1,1 for
-    /// raw and .npy files; built-in sources have their own].
+    /// Voxel spacing in world units along x, y and z, replacing what the
+    /// file says [default: the file's spacing; 1,1,1 for raw and .npy
+    /// files; built-in sources have their own].
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_positive_vec3)]
     pub spacing: Option<[f64; 3]>,
+
+    /// Read the file as this format, whatever its name and content say
+    /// [default: from the extension, else from the file's magic number].
+    #[arg(
+        long,
+        value_name = "raw|npy|nrrd|metaimage|nifti|vtk|vti|dicom|tiff|hdf5|cube|mrc|chgcar"
+    )]
+    pub format: Option<String>,
+
+    /// Which volume of a file that holds several, from 0: a 4-D NIfTI,
+    /// NRRD or MetaImage time point, a cube file's orbital, ... [default: 0].
+    #[arg(long, value_name = "N")]
+    pub frame: Option<usize>,
+
+    /// Which named array of a VTK file (.vtk, .vti) [default: the active
+    /// scalars, else the first array].
+    #[arg(long, value_name = "NAME")]
+    pub array: Option<String>,
 }
 
 /// How to render a frame.

@@ -5,7 +5,7 @@ use crate::error::CliError;
 use std::path::{Path, PathBuf};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
-use volray_io::{DType, Endian, RawOptions};
+use volray_io::{DType, Endian, FileInfo, RawOptions, ReadOptions, VolumeFormat};
 
 /// What `volray render` shows when given no input.
 pub const DEMO: &str = "blobs:64";
@@ -17,26 +17,48 @@ pub struct Input {
     pub name: String,
     /// The file it came from, if any.
     pub path: Option<PathBuf>,
+    /// The file's format and what its header said, if it came from a file.
+    #[allow(dead_code)] // read by `volray info` (issue 6, in progress)
+    pub file: Option<(VolumeFormat, FileInfo)>,
 }
 
 pub fn load(args: &InputArgs) -> Result<Input, CliError> {
     let spec = args.input.as_deref().unwrap_or(DEMO);
     let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
-    let (volume, path) = if volray_data::is_source_spec(spec) {
-        if raw_flags {
+    let file_flags = args.format.is_some() || args.frame.is_some() || args.array.is_some();
+    let (volume, path, file) = if volray_data::is_source_spec(spec) {
+        if raw_flags || file_flags {
             return Err(CliError::input(format!(
-                "{spec}: --dims, --dtype and --endian apply to raw files only, not to built-in sources"
+                "{spec}: --dims, --dtype, --endian, --format, --frame and --array apply to files only, not to built-in sources"
             )));
         }
-        (volray_data::generate(spec)?, None)
+        (volray_data::generate(spec)?, None, None)
     } else {
         let path = PathBuf::from(spec);
-        let raw = if raw_flags {
+        let format = match &args.format {
+            Some(f) => Some(
+                f.parse::<VolumeFormat>()
+                    .map_err(|e| CliError::input(format!("--format: {e}")))?,
+            ),
+            None => None,
+        };
+        let raw = if raw_flags || format == Some(VolumeFormat::Raw) {
             Some(raw_options(args, &path)?)
         } else {
             None
         };
-        (volray_io::read_volume(&path, raw.as_ref())?, Some(path))
+        let opts = ReadOptions {
+            format,
+            raw,
+            frame: args.frame,
+            array: args.array.clone(),
+        };
+        let loaded = volray_io::read(&path, &opts)?;
+        (
+            loaded.volume,
+            Some(path),
+            Some((loaded.format, loaded.info)),
+        )
     };
     let volume = match args.spacing {
         Some(s) => volume
@@ -48,6 +70,7 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
         volume,
         name: spec.to_string(),
         path,
+        file,
     })
 }
 

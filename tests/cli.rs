@@ -266,7 +266,7 @@ fn bad_input_gets_one_clear_line_and_a_non_zero_exit() {
     refused(
         &["render", "sphere:8", "--dims", "8,8,8"],
         1,
-        "raw files only",
+        "apply to files only",
     );
     refused(&["render", "sphere:1"], 1, "at least 2");
     refused(&["render", "sphere:8,radius=abc"], 1, "abc");

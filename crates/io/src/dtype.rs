@@ -14,33 +14,42 @@ pub enum DType {
     I16,
     U32,
     I32,
+    U64,
+    I64,
+    /// IEEE 754 half precision (MRC mode 12, NumPy `f2`, NRRD has none).
+    F16,
     F32,
     F64,
 }
 
 impl DType {
     /// Every sample type, in the order of [`DType::NAMES`].
-    pub const ALL: [DType; 8] = [
+    pub const ALL: [DType; 11] = [
         DType::U8,
         DType::I8,
         DType::U16,
         DType::I16,
         DType::U32,
         DType::I32,
+        DType::U64,
+        DType::I64,
+        DType::F16,
         DType::F32,
         DType::F64,
     ];
 
     /// The accepted names, as `FromStr` reads and `Display` writes them.
-    pub const NAMES: [&'static str; 8] = ["u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"];
+    pub const NAMES: [&'static str; 11] = [
+        "u8", "i8", "u16", "i16", "u32", "i32", "u64", "i64", "f16", "f32", "f64",
+    ];
 
     /// Bytes per sample.
     pub fn size(self) -> usize {
         match self {
             DType::U8 | DType::I8 => 1,
-            DType::U16 | DType::I16 => 2,
+            DType::U16 | DType::I16 | DType::F16 => 2,
             DType::U32 | DType::I32 | DType::F32 => 4,
-            DType::F64 => 8,
+            DType::U64 | DType::I64 | DType::F64 => 8,
         }
     }
 
@@ -53,6 +62,9 @@ impl DType {
             DType::I16 => "i16",
             DType::U32 => "u32",
             DType::I32 => "i32",
+            DType::U64 => "u64",
+            DType::I64 => "i64",
+            DType::F16 => "f16",
             DType::F32 => "f32",
             DType::F64 => "f64",
         }
@@ -80,7 +92,7 @@ pub struct ParseNameError {
 impl FromStr for DType {
     type Err = ParseNameError;
 
-    /// Accepts exactly `u8 i8 u16 i16 u32 i32 f32 f64`.
+    /// Accepts exactly `u8 i8 u16 i16 u32 i32 u64 i64 f16 f32 f64`.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         DType::ALL
             .into_iter()
@@ -88,7 +100,7 @@ impl FromStr for DType {
             .ok_or_else(|| ParseNameError {
                 what: "dtype",
                 given: s.to_string(),
-                accepted: "u8, i8, u16, i16, u32, i32, f32, f64",
+                accepted: "u8, i8, u16, i16, u32, i32, u64, i64, f16, f32, f64",
             })
     }
 }
@@ -136,8 +148,23 @@ impl FromStr for Endian {
     }
 }
 
+/// Converts IEEE 754 binary16 bits to `f32` exactly (every half-precision
+/// value is an `f32`).
+pub fn f16_to_f32(h: u16) -> f32 {
+    let negative = h & 0x8000 != 0;
+    let exp = u32::from((h >> 10) & 0x1f);
+    let mant = u32::from(h & 0x3ff);
+    let magnitude = match exp {
+        // Zero and subnormals: mant · 2^-24, exact in f32.
+        0 => mant as f32 * f32::from_bits(0x3380_0000),
+        0x1f => f32::from_bits(0x7f80_0000 | (mant << 13)),
+        _ => f32::from_bits(((exp + 112) << 23) | (mant << 13)),
+    };
+    if negative { -magnitude } else { magnitude }
+}
+
 /// Converts `bytes`, a sequence of `dtype` samples in `endian` byte order,
-/// to `f32` (32-bit integers and `f64` with `as f32`, i.e. rounded to the
+/// to `f32` (32- and 64-bit integers and `f64` with `as f32`, i.e. rounded to the
 /// nearest `f32`). Trailing bytes that do not make a whole sample are ignored.
 pub fn bytes_to_f32(bytes: &[u8], dtype: DType, endian: Endian) -> Vec<f32> {
     let mut out = Vec::with_capacity(bytes.len() / dtype.size());
@@ -168,6 +195,19 @@ pub fn extend_f32(out: &mut Vec<f32>, bytes: &[u8], dtype: DType, endian: Endian
         DType::I16 => convert!(i16),
         DType::U32 => convert!(u32),
         DType::I32 => convert!(i32),
+        DType::U64 => convert!(u64),
+        DType::I64 => convert!(i64),
+        DType::F16 => {
+            let conv = match endian {
+                Endian::Little => u16::from_le_bytes,
+                Endian::Big => u16::from_be_bytes,
+            };
+            out.extend(
+                bytes
+                    .chunks_exact(2)
+                    .map(|c| f16_to_f32(conv([c[0], c[1]]))),
+            );
+        }
         DType::F32 => convert!(f32),
         DType::F64 => convert!(f64),
     }
@@ -284,11 +324,11 @@ mod tests {
             assert_eq!(d.to_string(), name);
         }
         let sizes: Vec<usize> = DType::ALL.iter().map(|d| d.size()).collect();
-        assert_eq!(sizes, [1, 1, 2, 2, 4, 4, 4, 8]);
-        for bad in ["F32", "float", "f16", "u64", "", " u8"] {
+        assert_eq!(sizes, [1, 1, 2, 2, 4, 4, 8, 8, 2, 4, 8]);
+        for bad in ["F32", "float", "f128", "u128", "", " u8"] {
             let err = bad.parse::<DType>().unwrap_err().to_string();
             assert!(
-                err.contains("u8, i8, u16, i16, u32, i32, f32, f64"),
+                err.contains("u8, i8, u16, i16, u32, i32, u64, i64, f16, f32, f64"),
                 "{err}"
             );
         }

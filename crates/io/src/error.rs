@@ -79,15 +79,22 @@ pub enum IoError {
     #[error("{}: {reason}", path.display())]
     Npy { path: PathBuf, reason: String },
 
+    /// A malformed, inconsistent or unsupported file of a known format, or
+    /// a reader option (`--frame`, `--array`) the file cannot satisfy.
+    /// `reason` names the field and the value, e.g.
+    /// `NRRD field "sizes": 3 values for dimension 4`.
+    #[error("{}: {reason}", path.display())]
+    Invalid { path: PathBuf, reason: String },
+
     /// No reader is known for the file and no raw layout was given.
     #[error(
-        "{}: unknown volume format (known: .npy); raw data needs --dims (and --dtype, --endian, --spacing as needed)",
-        path.display()
+        "{}: unknown volume format (known by extension or content: {}); raw data needs --dims (and --dtype, --endian, --spacing as needed), or name the format with --format",
+        path.display(), crate::VolumeFormat::KNOWN
     )]
     UnknownFormat { path: PathBuf },
 
     /// Raw layout options given for a file whose format carries its own layout.
-    #[error("{}: raw options do not apply to .{format} files", path.display())]
+    #[error("{}: raw options (--dims, --dtype, --endian) do not apply to {format} files", path.display())]
     RawOptionsNotApplicable { path: PathBuf, format: &'static str },
 
     /// An image that PNG cannot hold (a side of 0 or more than 2^31 − 1 pixels).
@@ -122,6 +129,7 @@ impl IoError {
             | IoError::DimsOverflow { .. }
             | IoError::Volume { .. }
             | IoError::Npy { .. }
+            | IoError::Invalid { .. }
             | IoError::UnknownFormat { .. }
             | IoError::RawOptionsNotApplicable { .. }
             | IoError::ImageSize { .. } => false,
@@ -140,6 +148,7 @@ impl IoError {
             | IoError::DimsOverflow { path, .. }
             | IoError::Volume { path, .. }
             | IoError::Npy { path, .. }
+            | IoError::Invalid { path, .. }
             | IoError::UnknownFormat { path }
             | IoError::RawOptionsNotApplicable { path, .. }
             | IoError::ImageSize { path, .. } => path,
@@ -156,6 +165,15 @@ impl IoError {
 
     pub(crate) fn npy(path: &Path, reason: impl Into<String>) -> Self {
         IoError::Npy {
+            path: path.to_path_buf(),
+            reason: reason.into(),
+        }
+    }
+
+    /// A bad-input error about `path`: `reason` should name the field and
+    /// the value that are wrong.
+    pub fn invalid(path: &Path, reason: impl Into<String>) -> Self {
+        IoError::Invalid {
             path: path.to_path_buf(),
             reason: reason.into(),
         }

@@ -22,7 +22,7 @@ use std::path::Path;
 use volray_core::{Volume, VolumeError};
 
 use crate::atomic::write_atomically;
-use crate::dtype::{DType, Endian, extend_f32};
+use crate::dtype::{DType, Endian, extend_f32, f16_to_f32};
 use crate::error::IoError;
 use crate::input::{open_input, read_exact_at, read_samples};
 
@@ -183,20 +183,6 @@ impl Elem {
     }
 }
 
-/// Converts IEEE 754 binary16 bits to `f32` exactly.
-fn f16_to_f32(h: u16) -> f32 {
-    let negative = h & 0x8000 != 0;
-    let exp = u32::from((h >> 10) & 0x1f);
-    let mant = u32::from(h & 0x3ff);
-    let magnitude = match exp {
-        // Zero and subnormals: mant · 2^-24, exact in f32.
-        0 => mant as f32 * f32::from_bits(0x3380_0000),
-        0x1f => f32::from_bits(0x7f80_0000 | (mant << 13)),
-        _ => f32::from_bits(((exp + 112) << 23) | (mant << 13)),
-    };
-    if negative { -magnitude } else { magnitude }
-}
-
 /// What the header says about the array.
 #[derive(Debug, PartialEq)]
 struct Header {
@@ -294,8 +280,8 @@ fn descr_name(elem: Elem) -> String {
         Elem::Plain(DType::I8, _) => "|i1".into(),
         Elem::Plain(d, e) => {
             let kind = match d {
-                DType::F32 | DType::F64 => 'f',
-                DType::U16 | DType::U32 => 'u',
+                DType::F16 | DType::F32 | DType::F64 => 'f',
+                DType::U16 | DType::U32 | DType::U64 => 'u',
                 _ => 'i',
             };
             format!("{}{kind}{}", order(e), d.size())

@@ -1,0 +1,128 @@
+//! Inflating gzip and zlib payloads to exactly the size a header declares.
+//!
+//! A compressed stream is only trusted as far as its header: the output is
+//! allocated for the declared size (which the caller has checked against
+//! its limits), reading stops one byte past it, and a stream that inflates
+//! to less or more is refused. A lying header can therefore neither make
+//! volray allocate more than it declared nor hide extra data.
+
+use std::io::Read;
+use std::path::Path;
+
+use flate2::read::{MultiGzDecoder, ZlibDecoder};
+
+use crate::error::IoError;
+
+/// The compressed encodings readers meet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Compression {
+    /// gzip (RFC 1952), possibly several concatenated members (NRRD, `.nii.gz`).
+    Gzip,
+    /// zlib (RFC 1950): MetaImage `CompressedData`, VTK XML blocks.
+    Zlib,
+}
+
+impl Compression {
+    fn name(self) -> &'static str {
+        match self {
+            Compression::Gzip => "gzip",
+            Compression::Zlib => "zlib",
+        }
+    }
+}
+
+/// Inflates `compressed` to exactly `expected` bytes. `what` names the
+/// payload in messages ("data", "block 3").
+pub fn inflate_exact(
+    path: &Path,
+    compressed: &[u8],
+    kind: Compression,
+    expected: usize,
+    what: &str,
+) -> Result<Vec<u8>, IoError> {
+    let decoder: Box<dyn Read + '_> = match kind {
+        Compression::Gzip => Box::new(MultiGzDecoder::new(compressed)),
+        Compression::Zlib => Box::new(ZlibDecoder::new(compressed)),
+    };
+    let mut out = Vec::with_capacity(expected);
+    let limit = expected as u64 + 1;
+    decoder.take(limit).read_to_end(&mut out).map_err(|e| {
+        IoError::invalid(path, format!("{what}: corrupt {} stream: {e}", kind.name()))
+    })?;
+    if out.len() < expected {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "{what}: {} stream inflates to {} bytes, but the header declares {expected}",
+                kind.name(),
+                out.len()
+            ),
+        ));
+    }
+    if out.len() > expected {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "{what}: {} stream inflates past the {expected} bytes the header declares",
+                kind.name()
+            ),
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flate2::write::{GzEncoder, ZlibEncoder};
+    use std::io::Write;
+
+    fn gz(bytes: &[u8]) -> Vec<u8> {
+        let mut e = GzEncoder::new(Vec::new(), flate2::Compression::default());
+        e.write_all(bytes).unwrap();
+        e.finish().unwrap()
+    }
+
+    #[test]
+    fn exact_sizes_inflate_and_others_are_refused() {
+        let data: Vec<u8> = (0..1000u32).map(|i| (i % 7) as u8).collect();
+        let p = Path::new("v.nrrd");
+        assert_eq!(
+            inflate_exact(p, &gz(&data), Compression::Gzip, 1000, "data").unwrap(),
+            data
+        );
+        let short = inflate_exact(p, &gz(&data), Compression::Gzip, 1001, "data").unwrap_err();
+        assert!(
+            short.to_string().contains("inflates to 1000 bytes"),
+            "{short}"
+        );
+        let long = inflate_exact(p, &gz(&data), Compression::Gzip, 999, "data").unwrap_err();
+        assert!(
+            long.to_string().contains("inflates past the 999 bytes"),
+            "{long}"
+        );
+
+        let mut z = ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+        z.write_all(&data).unwrap();
+        let z = z.finish().unwrap();
+        assert_eq!(
+            inflate_exact(p, &z, Compression::Zlib, 1000, "block 0").unwrap(),
+            data
+        );
+        let corrupt =
+            inflate_exact(p, &z[..z.len() / 2], Compression::Zlib, 1000, "block 0").unwrap_err();
+        assert!(!corrupt.is_io_failure());
+        assert!(
+            corrupt.to_string().starts_with("v.nrrd: block 0: "),
+            "{corrupt}"
+        );
+    }
+
+    #[test]
+    fn concatenated_gzip_members_are_one_stream() {
+        let mut two = gz(b"abc");
+        two.extend(gz(b"def"));
+        let out = inflate_exact(Path::new("f"), &two, Compression::Gzip, 6, "data").unwrap();
+        assert_eq!(out, b"abcdef");
+    }
+}
