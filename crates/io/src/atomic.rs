@@ -21,38 +21,81 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> Result<(), IoError> {
-    let dir = destination_dir(path)?;
-
-    let mut builder = tempfile::Builder::new();
-    let prefix = match path.file_name() {
-        Some(name) => format!(".{}.", name.to_string_lossy()),
-        None => ".volray.".to_string(),
-    };
-    builder.prefix(&prefix).suffix(".tmp");
-    #[cfg(unix)]
+    let mut file = AtomicFile::create(path)?;
     {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder
-        .tempfile_in(&dir)
-        .map_err(|e| IoError::os(path, "create a temporary file for", e))?;
-
-    // From here on, returning early drops `tmp`, which deletes it.
-    {
-        let mut out = BufWriter::new(tmp.as_file_mut());
+        let mut out = BufWriter::new(file.file());
         write(&mut out).map_err(|e| IoError::os(path, "write", e))?;
         out.flush().map_err(|e| IoError::os(path, "write", e))?;
     }
-    tmp.as_file()
-        .sync_all()
-        .map_err(|e| IoError::os(path, "sync", e))?;
-    // On failure the PersistError holds the temporary file; dropping it
-    // deletes the file.
-    tmp.persist(path)
-        .map_err(|e| IoError::os(path, "replace", e.error))?;
-    sync_dir(&dir);
-    Ok(())
+    file.commit()
+}
+
+/// A file being written that appears at its path only when complete: for
+/// outputs written piece by piece (animations), where
+/// [`write_atomically`]'s single closure does not fit.
+///
+/// The contents go to a temporary file beside the destination; dropping
+/// an `AtomicFile` without [`commit`](AtomicFile::commit) deletes it and
+/// leaves any existing file at the path untouched.
+#[derive(Debug)]
+pub struct AtomicFile {
+    tmp: tempfile::NamedTempFile,
+    path: PathBuf,
+    dir: PathBuf,
+}
+
+impl AtomicFile {
+    /// Starts writing `path`: checks its directory and creates the
+    /// temporary file.
+    pub fn create(path: &Path) -> Result<Self, IoError> {
+        let dir = destination_dir(path)?;
+        let mut builder = tempfile::Builder::new();
+        let prefix = match path.file_name() {
+            Some(name) => format!(".{}.", name.to_string_lossy()),
+            None => ".volray.".to_string(),
+        };
+        builder.prefix(&prefix).suffix(".tmp");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let tmp = builder
+            .tempfile_in(&dir)
+            .map_err(|e| IoError::os(path, "create a temporary file for", e))?;
+        Ok(AtomicFile {
+            tmp,
+            path: path.to_path_buf(),
+            dir,
+        })
+    }
+
+    /// The temporary file, to write the contents to.
+    pub fn file(&mut self) -> &mut std::fs::File {
+        self.tmp.as_file_mut()
+    }
+
+    /// The path the file will have.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Syncs the contents to disk and renames the temporary file over the
+    /// destination.
+    pub fn commit(self) -> Result<(), IoError> {
+        let path = self.path;
+        self.tmp
+            .as_file()
+            .sync_all()
+            .map_err(|e| IoError::os(&path, "sync", e))?;
+        // On failure the PersistError holds the temporary file; dropping it
+        // deletes the file.
+        self.tmp
+            .persist(&path)
+            .map_err(|e| IoError::os(&path, "replace", e.error))?;
+        sync_dir(&self.dir);
+        Ok(())
+    }
 }
 
 /// The directory `path` will be created in, checked to exist, with `path`

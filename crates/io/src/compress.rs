@@ -13,6 +13,12 @@ use flate2::read::{MultiGzDecoder, ZlibDecoder};
 
 use crate::error::IoError;
 
+/// The most bytes one byte of a deflate stream (zlib, gzip) can inflate
+/// to: a 258-byte match costs at least two bits (RFC 1951), so about
+/// 1032:1. A header that declares more than this many times its compressed
+/// bytes is lying, and every reader refuses it before allocating.
+pub const MAX_DEFLATE_RATIO: u64 = 1032;
+
 /// The compressed encodings readers meet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Compression {
@@ -44,6 +50,15 @@ pub fn inflate_exact(
         Compression::Gzip => Box::new(MultiGzDecoder::new(compressed)),
         Compression::Zlib => Box::new(ZlibDecoder::new(compressed)),
     };
+    if expected as u64 > (compressed.len() as u64).saturating_mul(MAX_DEFLATE_RATIO) {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "{what}: the header declares {expected} bytes, more than {} compressed bytes can inflate to",
+                compressed.len()
+            ),
+        ));
+    }
     let mut out = Vec::with_capacity(expected);
     let limit = expected as u64 + 1;
     decoder.take(limit).read_to_end(&mut out).map_err(|e| {

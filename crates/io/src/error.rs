@@ -172,10 +172,28 @@ impl IoError {
 
     /// A bad-input error about `path`: `reason` should name the field and
     /// the value that are wrong.
+    /// Control characters from the file (a name with a newline in it, a
+    /// parser's multi-line message) are escaped, so the message stays one
+    /// line.
     pub fn invalid(path: &Path, reason: impl Into<String>) -> Self {
+        let reason: String = reason.into();
+        let reason = if reason.chars().any(char::is_control) {
+            reason
+                .chars()
+                .map(|c| {
+                    if c.is_control() {
+                        c.escape_default().to_string()
+                    } else {
+                        c.to_string()
+                    }
+                })
+                .collect()
+        } else {
+            reason
+        };
         IoError::Invalid {
             path: path.to_path_buf(),
-            reason: reason.into(),
+            reason,
         }
     }
 

@@ -81,11 +81,11 @@ pub fn grid_to_volume(
     // Which world axis each index axis runs along, and in which sense.
     let mut world_axis = [usize::MAX; 3];
     let mut flipped = [false; 3];
-    for a in 0..3 {
+    for (a, unit) in units.iter().enumerate() {
         for w in 0..3 {
-            if units[a][w].abs() > 1.0 - COS_TOLERANCE {
+            if unit[w].abs() > 1.0 - COS_TOLERANCE {
                 world_axis[a] = w;
-                flipped[a] = units[a][w] < 0.0;
+                flipped[a] = unit[w] < 0.0;
             }
         }
     }

@@ -3,23 +3,48 @@
 //! The data path of the renderer is
 //!
 //! ```text
-//! file (raw, .npy) --read_volume--> Volume --volray-core renders--> Image --write_png--> PNG
+//! file --read--> Volume --volray-core renders--> Image --write_png / write_exr / Animation--> file
 //! ```
 //!
-//! This crate owns both ends: [`read_volume`] turns a file into a
-//! [`Volume`] (x fastest, `index = x + nx·(y + ny·z)`),
-//! choosing the reader from the file name, and [`write_png`] turns an
-//! [`Image`](volray_core::Image) into an RGB PNG. Every file is written
-//! through [`write_atomically`], so a failed write never leaves a
-//! half-written file. Errors are [`IoError`]s: one-line messages that name
-//! the file, split by [`IoError::is_io_failure`] into operating-system
-//! failures and bad input.
+//! This crate owns both ends: [`read`] turns a file into a [`Volume`]
+//! (x fastest, `index = x + nx·(y + ny·z)`, axis-aligned with the file's
+//! spacing and origin) plus a [`FileInfo`] saying what the header said and
+//! what was done with it; [`write_png`], [`write_exr`] and [`Animation`]
+//! turn [`Image`](volray_core::Image)s into pictures, and [`write_nrrd`],
+//! [`write_npy`] and [`write_raw`] write volumes. Every file is written
+//! through [`write_atomically`] or [`AtomicFile`], so a failed write never
+//! leaves a half-written file. Errors are [`IoError`]s: one-line messages
+//! that name the file and the field, split by [`IoError::is_io_failure`]
+//! into operating-system failures and bad input. Readers check every
+//! header against the file's length before allocating.
 //!
-//! Readers:
-//! - raw: headerless samples whose layout the caller gives in
-//!   [`RawOptions`] (dims, [`DType`], [`Endian`], spacing); see [`read_raw`].
-//! - NumPy `.npy`: 3-D arrays indexed `a[x, y, z]`; see [`read_npy`] and
-//!   [`write_npy`].
+//! The format comes from `--format`, else the file name
+//! ([`VolumeFormat::from_path`]), else its magic number
+//! ([`VolumeFormat::sniff`]). One module per format:
+//!
+//! | format | module | notes |
+//! |---|---|---|
+//! | raw | `raw.rs` | layout from [`RawOptions`] |
+//! | NumPy `.npy` | `npy.rs` | `a[x, y, z]`; C order transposed |
+//! | NRRD `.nrrd`, `.nhdr` | `nrrd/` | raw, gzip, ascii, hex; detached and multi-file data; space directions; 4-D frames |
+//! | MetaImage `.mha`, `.mhd` | `metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
+//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `nifti.rs` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
+//! | legacy VTK `.vtk` | `vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
+//! | VTK XML `.vti` | `vti/` | ascii, base64, appended, zlib; Direction; pieces |
+//! | DICOM directory or `.dcm` | `dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose |
+//! | TIFF stacks `.tif` | `tiff_stack.rs` | pages are z; ImageJ spacing; hyperstack frames |
+//! | HDF5 `file.h5:/dataset` | `hdf5.rs` | cargo feature `hdf5`; `a[x, y, z]`, `a[t, x, y, z]` |
+//! | Gaussian cube `.cube` | `cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled |
+//! | CCP4/MRC `.map`, `.mrc` | `mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin |
+//! | VASP CHGCAR/CHG | `chgcar.rs` | divided by the cell volume; periodic plane added; spin blocks as frames |
+//!
+//! Shared pieces: [`grid_to_volume`] (`geometry.rs`) maps a file's grid
+//! (origin and one step vector per index axis) onto the axis-aligned
+//! volume, reordering and flipping axes exactly; `payload.rs` reads a
+//! header's data (skips, encodings, multi-file lists) within the file's
+//! bounds; [`inflate_exact`] inflates to a declared size; `text_reader.rs`
+//! streams numbers out of text formats; `periodic_cell.rs` resamples skewed
+//! periodic cells.
 //!
 //! # Example
 //!
@@ -51,6 +76,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod animation;
 mod atomic;
 mod chgcar;
 mod compress;
@@ -58,6 +84,7 @@ mod cube;
 mod dicom;
 mod dtype;
 mod error;
+mod exr;
 mod geometry;
 #[cfg(feature = "hdf5")]
 mod hdf5;
@@ -67,10 +94,14 @@ mod mrc;
 mod nifti;
 mod npy;
 mod nrrd;
+mod payload;
+mod periodic_cell;
 mod png;
 mod raw;
+mod text_reader;
 mod tiff_stack;
 mod vti;
+mod vtk_arrays;
 mod vtk_legacy;
 
 use std::fmt;
@@ -80,13 +111,16 @@ use std::str::FromStr;
 use volray_core::Volume;
 
 pub use self::png::{BitDepth, quantize_8, quantize_16, write_png};
-pub use atomic::write_atomically;
+pub use animation::{Animation, AnimationKind, sequence_path};
+pub use atomic::{AtomicFile, write_atomically};
 pub use compress::{Compression, inflate_exact};
 pub use dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
 pub use error::IoError;
+pub use exr::write_exr;
 pub use geometry::grid_to_volume;
 pub use npy::{read_npy, write_npy};
-pub use raw::{RawOptions, read_raw};
+pub use nrrd::write_nrrd;
+pub use raw::{RawOptions, read_raw, write_raw};
 
 /// The volume file formats volray reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -285,7 +319,8 @@ pub struct ReadOptions {
     pub raw: Option<RawOptions>,
     /// Which volume of a file holding several, counted from 0 (`--frame`):
     /// the 4th dimension of NIfTI, NRRD, MetaImage and HDF5, the orbital of
-    /// a cube file, the frame set of a TIFF stack.
+    /// a cube file, the frame set of a TIFF stack, the density block of a
+    /// CHGCAR (0 total, 1 magnetisation).
     pub frame: Option<usize>,
     /// Which named array of a file holding several (`--array`): VTK point
     /// or cell data arrays.
@@ -370,6 +405,7 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
                 | VolumeFormat::Tiff
                 | VolumeFormat::Hdf5
                 | VolumeFormat::Cube
+                | VolumeFormat::Chgcar
         )
     {
         return Err(IoError::invalid(
@@ -405,11 +441,11 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             }),
         },
         VolumeFormat::Npy => {
-            let volume = read_npy(path)?;
+            let (volume, info) = npy::read_npy_with_info(path)?;
             Ok(Loaded {
                 volume,
                 format,
-                info: FileInfo::new("npy"),
+                info,
             })
         }
         VolumeFormat::Nrrd => nrrd::read(path, opts),

@@ -21,6 +21,7 @@ use std::path::Path;
 
 use volray_core::{Volume, VolumeError};
 
+use crate::FileInfo;
 use crate::atomic::write_atomically;
 use crate::dtype::{DType, Endian, extend_f32, f16_to_f32};
 use crate::error::IoError;
@@ -46,6 +47,11 @@ const ALIGN: usize = 64;
 /// The header is checked against the file's length before anything is
 /// allocated, and the file must end exactly where the data does.
 pub fn read_npy(path: &Path) -> Result<Volume, IoError> {
+    read_npy_with_info(path).map(|(v, _)| v)
+}
+
+/// [`read_npy`], with the header's fields for `volray info`.
+pub(crate) fn read_npy_with_info(path: &Path) -> Result<(Volume, FileInfo), IoError> {
     let (mut file, file_len) = open_input(path)?;
     let header = read_header(path, &mut file, file_len)?;
     let [nx, ny, nz] = header.shape;
@@ -96,7 +102,26 @@ pub fn read_npy(path: &Path) -> Result<Volume, IoError> {
         )?;
         data
     };
-    Volume::new(header.shape, data).map_err(|e| IoError::volume(path, e))
+    let mut info = FileInfo::new(descr_name(elem));
+    info.header = vec![
+        ("descr".into(), descr_name(elem)),
+        (
+            "fortran_order".into(),
+            if header.fortran_order {
+                "True"
+            } else {
+                "False"
+            }
+            .into(),
+        ),
+        ("shape".into(), format!("({nx}, {ny}, {nz})")),
+    ];
+    if !header.fortran_order {
+        info.notes
+            .push("C order: the array a[x, y, z] was transposed to x fastest".into());
+    }
+    let volume = Volume::new(header.shape, data).map_err(|e| IoError::volume(path, e))?;
+    Ok((volume, info))
 }
 
 /// Writes `volume` to `path` as a `.npy` file, atomically: format version

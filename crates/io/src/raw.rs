@@ -9,6 +9,7 @@ use std::path::Path;
 use volray_core::glam::DVec3;
 use volray_core::{Volume, VolumeError};
 
+use crate::atomic::write_atomically;
 use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::input::{open_input, read_samples};
@@ -101,6 +102,21 @@ pub fn read_raw(path: &Path, opts: &RawOptions) -> Result<Volume, IoError> {
         .map_err(|e| IoError::volume(path, e))
 }
 
+/// Writes `volume` to `path` as raw little-endian `f32` samples, x fastest,
+/// atomically: the layout `--dims NX,NY,NZ --dtype f32 --endian little`
+/// reads back. Spacing and origin are not stored.
+pub fn write_raw(path: &Path, volume: &Volume) -> Result<(), IoError> {
+    write_atomically(path, |w| {
+        let mut buf = Vec::with_capacity(4 * 4096);
+        for chunk in volume.data().chunks(4096) {
+            buf.clear();
+            buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
+            w.write_all(&buf)?;
+        }
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,6 +126,19 @@ mod tests {
         let p = dir.join(name);
         fs::write(&p, bytes).unwrap();
         p
+    }
+
+    #[test]
+    fn write_raw_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let v = Volume::new([3, 2, 2], (0..12).map(|i| i as f32 * 0.5 - 1.0).collect()).unwrap();
+        let p = dir.path().join("v.raw");
+        write_raw(&p, &v).unwrap();
+        assert_eq!(fs::metadata(&p).unwrap().len(), 48);
+        assert_eq!(
+            read_raw(&p, &RawOptions::new([3, 2, 2], DType::F32)).unwrap(),
+            v
+        );
     }
 
     #[test]

@@ -1,0 +1,304 @@
+//! Stacking DICOM slices into a grid: order along the slice normal,
+//! equal spacing, consistent orientation and pixel spacing.
+//!
+//! Slice k's pixel (column i, row j) lies at
+//! `IPP_k + i·Δc·row + j·Δr·col` (PS3.3 C.7.6.2.1.1), where `row` and
+//! `col` are the two direction cosines of ImageOrientationPatient and
+//! PixelSpacing = [Δr, Δc]. Slices are sorted by `IPP_k · n` with the
+//! normal `n = row × col`, so index axes (i, j, k) form a right-handed
+//! grid, and the slice step is `n` times the mean gap.
+
+use volray_core::glam::DVec3;
+
+use super::header::Plane;
+
+/// Positions closer than this (mm) along the normal are the same slice.
+const SAME_POSITION_MM: f64 = 1e-3;
+
+/// Gaps may differ from their mean by this fraction and still be equal
+/// spacing (DICOM positions are decimal strings of limited precision).
+const GAP_TOLERANCE: f64 = 0.01;
+
+/// Gap differences above this fraction of the mean are reported in a note.
+const GAP_NOTE: f64 = 1e-4;
+
+/// A slice's in-plane shift per step may be this fraction of the step
+/// (about 0.06 degrees of tilt).
+const SHEAR_TOLERANCE: f64 = 1e-3;
+
+/// Orientations agree if their direction cosines differ by at most this.
+const ORIENTATION_TOLERANCE: f64 = 1e-4;
+
+/// A sorted stack of slices as a grid.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Stack {
+    /// Indices into the planes, in order along the normal.
+    pub order: Vec<usize>,
+    /// World step per index along columns, rows and slices.
+    pub steps: [DVec3; 3],
+    /// World position of the first pixel of the first slice.
+    pub origin: DVec3,
+    pub notes: Vec<String>,
+}
+
+/// Sorts `planes` into a grid. `name(i)` names plane i in messages
+/// (a file name, or "frame 3"). Every plane needs a position and
+/// orientation; the caller handles stacks without geometry.
+pub(super) fn stack(planes: &[Plane], name: &dyn Fn(usize) -> String) -> Result<Stack, String> {
+    let n = planes.len();
+    if n < 2 {
+        return Err(format!("{n} slice(s): a volume needs at least 2 slices"));
+    }
+    let mut positions = Vec::with_capacity(n);
+    let mut orientation = None;
+    let mut spacing: Option<[f64; 2]> = None;
+    for (i, p) in planes.iter().enumerate() {
+        let (Some(pos), Some(o)) = (p.position, p.orientation) else {
+            return Err(format!(
+                "{} has no ImagePositionPatient or ImageOrientationPatient, but other slices have: cannot order the slices",
+                name(i)
+            ));
+        };
+        positions.push(pos);
+        match orientation {
+            None => orientation = Some((o, i)),
+            Some((first, j)) => {
+                let differs =
+                    (0..2).any(|a| (o[a] - first[a]).abs().max_element() > ORIENTATION_TOLERANCE);
+                if differs {
+                    return Err(format!(
+                        "{} has ImageOrientationPatient {} but {} has {}: slices of one volume must share their orientation",
+                        name(i),
+                        cosines(o),
+                        name(j),
+                        cosines(first)
+                    ));
+                }
+            }
+        }
+        let ps = p.pixel_spacing.unwrap_or([1.0, 1.0]);
+        match spacing {
+            None => spacing = Some(ps),
+            Some(first) => {
+                if (0..2).any(|a| (ps[a] - first[a]).abs() > 1e-6 * first[a]) {
+                    return Err(format!(
+                        "{} has PixelSpacing {}\\{} but the first slice has {}\\{}",
+                        name(i),
+                        ps[0],
+                        ps[1],
+                        first[0],
+                        first[1]
+                    ));
+                }
+            }
+        }
+    }
+    let ([row, col], _) = orientation.expect("n >= 2 planes");
+    let spacing = spacing.expect("n >= 2 planes");
+    let normal = row.cross(col).normalize();
+    let along: Vec<f64> = positions.iter().map(|p| p.dot(normal)).collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| along[a].total_cmp(&along[b]).then(a.cmp(&b)));
+
+    let mut notes = Vec::new();
+    let gaps: Vec<f64> = order
+        .windows(2)
+        .map(|w| along[w[1]] - along[w[0]])
+        .collect();
+    for (k, &g) in gaps.iter().enumerate() {
+        if g < SAME_POSITION_MM {
+            return Err(format!(
+                "{} and {} lie at the same position ({} mm along the slice normal): the series holds more than one volume or duplicate slices",
+                name(order[k]),
+                name(order[k + 1]),
+                along[order[k]]
+            ));
+        }
+    }
+    let mean = (along[order[n - 1]] - along[order[0]]) / (n - 1) as f64;
+    let (kmin, gmin) = extreme(&gaps, |a, b| a < b);
+    let (kmax, gmax) = extreme(&gaps, |a, b| a > b);
+    let deviation = (gmax - mean).max(mean - gmin) / mean;
+    if deviation > GAP_TOLERANCE {
+        return Err(format!(
+            "slice gaps are uneven: {gmin} mm (between {} and {}) to {gmax} mm (between {} and {}), mean {mean} mm; a slice may be missing, and volray needs equally spaced slices",
+            name(order[kmin]),
+            name(order[kmin + 1]),
+            name(order[kmax]),
+            name(order[kmax + 1])
+        ));
+    }
+    if deviation > GAP_NOTE {
+        notes.push(format!(
+            "slice gaps vary from {gmin} to {gmax} mm; their mean {mean} mm is used"
+        ));
+    }
+
+    // Slices must stack straight along the normal (no gantry tilt).
+    let step = (positions[order[n - 1]] - positions[order[0]]) / (n - 1) as f64;
+    let shear = step - normal * step.dot(normal);
+    if shear.length() > SHEAR_TOLERANCE * step.length() {
+        return Err(format!(
+            "each slice is shifted by ({:.4}, {:.4}, {:.4}) mm within its plane from the one before (gantry tilt?): volray needs slices stacked straight along their normal",
+            shear.x, shear.y, shear.z
+        ));
+    }
+    Ok(Stack {
+        steps: [row * spacing[1], col * spacing[0], normal * mean],
+        origin: positions[order[0]],
+        order,
+        notes,
+    })
+}
+
+/// The index and value of the extreme element under `better`.
+fn extreme(values: &[f64], better: impl Fn(f64, f64) -> bool) -> (usize, f64) {
+    let mut best = (0, values[0]);
+    for (i, &v) in values.iter().enumerate().skip(1) {
+        if better(v, best.1) {
+            best = (i, v);
+        }
+    }
+    best
+}
+
+fn cosines(o: [DVec3; 2]) -> String {
+    format!(
+        "{}\\{}\\{}\\{}\\{}\\{}",
+        o[0].x, o[0].y, o[0].z, o[1].x, o[1].y, o[1].z
+    )
+}
+
+/// Splits frames that repeat positions into volumes: if every position
+/// occurs `m` times, volume `v` is the `v`-th occurrence of each position
+/// in frame order. Returns the frame indices of each volume.
+pub(super) fn volumes(planes: &[Plane]) -> Result<Vec<Vec<usize>>, String> {
+    let normal = planes
+        .iter()
+        .find_map(|p| p.orientation)
+        .map(|[r, c]| r.cross(c).normalize());
+    // Group by position (exact positions within tolerance, not only the
+    // component along the normal, so frames of different stacks differ).
+    let mut groups: Vec<(DVec3, Vec<usize>)> = Vec::new();
+    for (i, p) in planes.iter().enumerate() {
+        let Some(pos) = p.position else {
+            return Ok(vec![(0..planes.len()).collect()]);
+        };
+        match groups
+            .iter_mut()
+            .find(|(q, _)| (*q - pos).length() < SAME_POSITION_MM)
+        {
+            Some((_, members)) => members.push(i),
+            None => groups.push((pos, vec![i])),
+        }
+    }
+    let m = groups[0].1.len();
+    if m == 1 {
+        return Ok(vec![(0..planes.len()).collect()]);
+    }
+    if let Some((pos, members)) = groups.iter().find(|(_, g)| g.len() != m) {
+        let along = normal.map(|n| pos.dot(n)).unwrap_or(pos.z);
+        return Err(format!(
+            "frames repeat positions unevenly: {m} frames at the first position but {} at {along} mm: cannot split them into volumes",
+            members.len()
+        ));
+    }
+    Ok((0..m)
+        .map(|v| groups.iter().map(|(_, members)| members[v]).collect())
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane(pos: DVec3, row: DVec3, col: DVec3) -> Plane {
+        Plane {
+            position: Some(pos),
+            orientation: Some([row, col]),
+            pixel_spacing: Some([0.8, 0.6]),
+            slope: 1.0,
+            intercept: 0.0,
+        }
+    }
+
+    fn name(i: usize) -> String {
+        format!("slice{i}")
+    }
+
+    #[test]
+    fn sorts_along_the_normal_and_builds_steps() {
+        // Sagittal: row +y, column -z, normal +y × -z = -x.
+        let (row, col) = (DVec3::Y, -DVec3::Z);
+        let xs = [3.0, 6.0, 0.0, 4.5, 1.5];
+        let planes: Vec<Plane> = xs
+            .iter()
+            .map(|&x| plane(DVec3::new(x, 2.0, 7.0), row, col))
+            .collect();
+        let s = stack(&planes, &name).unwrap();
+        // Ascending along -x: x = 6, 4.5, 3, 1.5, 0.
+        assert_eq!(s.order, [1, 3, 0, 4, 2]);
+        assert_eq!(s.origin, DVec3::new(6.0, 2.0, 7.0));
+        assert_eq!(s.steps, [row * 0.6, col * 0.8, -DVec3::X * 1.5]);
+        assert!(s.notes.is_empty());
+    }
+
+    #[test]
+    fn uneven_duplicate_and_sheared_stacks_are_refused() {
+        let z = |zs: &[f64]| -> Vec<Plane> {
+            zs.iter()
+                .map(|&z| plane(DVec3::new(0.0, 0.0, z), DVec3::X, DVec3::Y))
+                .collect()
+        };
+        let err = stack(&z(&[0.0, 1.0, 2.0, 4.0, 5.0]), &name).unwrap_err();
+        assert!(
+            err.starts_with("slice gaps are uneven: 1 mm (between slice0 and slice1) to 2 mm (between slice2 and slice3), mean 1.25 mm"),
+            "{err}"
+        );
+        let err = stack(&z(&[0.0, 1.0, 1.0]), &name).unwrap_err();
+        assert!(
+            err.contains("slice1 and slice2 lie at the same position"),
+            "{err}"
+        );
+        // Jitter under 1% is accepted with a note.
+        let s = stack(&z(&[0.0, 1.0, 2.005, 3.0]), &name).unwrap();
+        assert!(s.notes[0].contains("vary from 0.995"), "{:?}", s.notes);
+        assert!((s.steps[2].z - 1.0).abs() < 1e-12);
+
+        let tilted: Vec<Plane> = (0..3)
+            .map(|k| {
+                plane(
+                    DVec3::new(0.0, 0.3 * k as f64, k as f64),
+                    DVec3::X,
+                    DVec3::Y,
+                )
+            })
+            .collect();
+        let err = stack(&tilted, &name).unwrap_err();
+        assert!(err.contains("(0.0000, 0.3000, 0.0000) mm"), "{err}");
+
+        let mut mixed = z(&[0.0, 1.0, 2.0]);
+        mixed[2].orientation = Some([DVec3::Y, DVec3::X]);
+        let err = stack(&mixed, &name).unwrap_err();
+        assert!(
+            err.contains("slice2 has ImageOrientationPatient 0\\1\\0\\1\\0\\0"),
+            "{err}"
+        );
+        let mut spacing = z(&[0.0, 1.0]);
+        spacing[1].pixel_spacing = Some([0.8, 0.7]);
+        let err = stack(&spacing, &name).unwrap_err();
+        assert!(err.contains("PixelSpacing 0.8\\0.7"), "{err}");
+        assert!(stack(&z(&[0.0]), &name).unwrap_err().contains("at least 2"));
+    }
+
+    #[test]
+    fn repeated_positions_split_into_volumes() {
+        let at = |z: f64| plane(DVec3::new(0.0, 0.0, z), DVec3::X, DVec3::Y);
+        let frames: Vec<Plane> = [0.0, 1.0, 2.0, 0.0, 1.0, 2.0].map(at).to_vec();
+        assert_eq!(volumes(&frames).unwrap(), [vec![0, 1, 2], vec![3, 4, 5]]);
+        let single: Vec<Plane> = [2.0, 0.0, 1.0].map(at).to_vec();
+        assert_eq!(volumes(&single).unwrap(), [vec![0, 1, 2]]);
+        let uneven: Vec<Plane> = [0.0, 1.0, 0.0].map(at).to_vec();
+        assert!(volumes(&uneven).unwrap_err().contains("unevenly"));
+    }
+}
