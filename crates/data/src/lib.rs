@@ -22,8 +22,9 @@
 //!
 //! # Sources
 //!
-//! All sample the cube `[−1, 1]³` with `N` points per side (2 ≤ N ≤ 1025),
-//! point `i` at `−1 + 2i/(N − 1)` (see [`grid`]):
+//! All sample a cube with `N` points per side (2 ≤ N ≤ 1025), `[−1, 1]³`
+//! with point `i` at `−1 + 2i/(N − 1)` (see [`grid`]) except `hydrogen`,
+//! which samples `[−R, R]³`:
 //!
 //! | spec | volume |
 //! |------|--------|
@@ -31,6 +32,8 @@
 //! | `blobs[:N]` | four Gaussian blobs without mirror symmetry (N = 64), [`blobs`] |
 //! | `sphere[:N][,radius=R][,edge=W]` | a solid ball with a smoothstep edge (N = 64, R = 0.8, W = 0.1), [`sphere`] |
 //! | `torus[:N][,major=R][,minor=r]` | a Gaussian tube around the z axis (N = 64, R = 0.6, r = 0.25), [`torus`] |
+//! | `hydrogen[:N[,L[,M]]][,grid=G][,extent=R][,real=true\|false]` | the hydrogen density `\|ψ_nlm\|²` in `a₀⁻³` on `[−R, R]³` in Bohr radii, `R` holding 99.5% of the probability unless given (1, 0, 0, G = 50), [`hydrogen`] |
+//! | `fractal[:SIZE][,seed=S][,dim=D][,sigma=X][,ramp=R][,threshold=T][,raw=true][,additions=true]` | a fractal cloud by 3-D midpoint displacement, SIZE = 2^k + 1 (129, seed 1, D = 3.7, σ = 1, ramp 0.3, threshold 0.45), [`fractal`] |
 //!
 //! # Example
 //!
@@ -64,7 +67,9 @@
 
 pub mod blobs;
 mod error;
+pub mod fractal;
 pub mod grid;
+pub mod hydrogen;
 pub mod marschner_lobb;
 mod sources;
 mod spec;

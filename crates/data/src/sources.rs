@@ -3,7 +3,7 @@
 
 use volray_core::Volume;
 
-use crate::{DataError, SourceSpec, blobs, marschner_lobb, sphere, torus};
+use crate::{DataError, SourceSpec, blobs, fractal, hydrogen, marschner_lobb, sphere, torus};
 
 /// A built-in source: its name, usage line and one-line description, and the
 /// generator behind it.
@@ -29,7 +29,14 @@ impl SourceInfo {
 
 /// Every built-in source, in the order help text lists them.
 /// To add a source, add its module and its `INFO` here.
-static SOURCES: &[SourceInfo] = &[marschner_lobb::INFO, blobs::INFO, sphere::INFO, torus::INFO];
+static SOURCES: &[SourceInfo] = &[
+    marschner_lobb::INFO,
+    blobs::INFO,
+    sphere::INFO,
+    torus::INFO,
+    hydrogen::INFO,
+    fractal::INFO,
+];
 
 /// The built-in sources.
 pub fn sources() -> &'static [SourceInfo] {
@@ -77,7 +84,17 @@ mod tests {
     #[test]
     fn registry_is_consistent() {
         let names: Vec<&str> = sources().iter().map(|s| s.name).collect();
-        assert_eq!(names, ["marschner-lobb", "blobs", "sphere", "torus"]);
+        assert_eq!(
+            names,
+            [
+                "marschner-lobb",
+                "blobs",
+                "sphere",
+                "torus",
+                "hydrogen",
+                "fractal"
+            ]
+        );
         for (i, s) in sources().iter().enumerate() {
             assert!(!names[..i].contains(&s.name), "duplicate name {}", s.name);
             assert!(s.usage.starts_with(s.name), "{}", s.usage);
@@ -95,6 +112,10 @@ mod tests {
     #[test]
     fn every_source_generates_a_small_grid_by_name() {
         for s in sources() {
+            // hydrogen's positional arguments are quantum numbers, not the grid.
+            if s.name == "hydrogen" {
+                continue;
+            }
             let v = generate(&format!("{}:5", s.name)).unwrap();
             assert_eq!(v.dims(), [5, 5, 5], "{}", s.name);
             assert_eq!(v.count_non_finite(), 0, "{}", s.name);
@@ -148,7 +169,7 @@ mod tests {
         let e = generate("marschner:41").unwrap_err();
         assert_eq!(
             e.to_string(),
-            "marschner:41: unknown source `marschner`; known sources: marschner-lobb, blobs, sphere, torus"
+            "marschner:41: unknown source `marschner`; known sources: marschner-lobb, blobs, sphere, torus, hydrogen, fractal"
         );
         assert!(matches!(generate(""), Err(DataError::EmptySpec)));
         assert!(matches!(

@@ -266,6 +266,16 @@ impl<'a> Args<'a> {
     pub fn f64_or(&self, key: &str, default: f64) -> Result<f64, DataError> {
         Ok(self.f64(key)?.unwrap_or(default))
     }
+
+    /// Parameter `key` as a boolean, `true` or `false` exactly, if given.
+    pub fn bool(&self, key: &str) -> Result<Option<bool>, DataError> {
+        self.parse(key, "true or false")
+    }
+
+    /// Parameter `key` as a boolean (`true` or `false`), or `default`.
+    pub fn bool_or(&self, key: &str, default: bool) -> Result<bool, DataError> {
+        Ok(self.bool(key)?.unwrap_or(default))
+    }
 }
 
 #[cfg(test)]
@@ -403,6 +413,22 @@ mod tests {
         let a = Args::new(&s, &["n", "l", "m"], &["seed"]).unwrap();
         assert_eq!(a.i64("m").unwrap(), Some(-1));
         assert_eq!(a.u64("seed").unwrap(), Some(u64::MAX));
+    }
+
+    #[test]
+    fn args_read_booleans_exactly() {
+        let s = parse("src:real=true,flag=false,bad=yes,caps=True");
+        let a = Args::new(&s, &[], &["real", "flag", "bad", "caps", "unset"]).unwrap();
+        assert_eq!(a.bool("real").unwrap(), Some(true));
+        assert_eq!(a.bool("flag").unwrap(), Some(false));
+        assert_eq!(a.bool("unset").unwrap(), None);
+        assert!(a.bool_or("unset", true).unwrap());
+        assert!(!a.bool_or("flag", true).unwrap());
+        assert_eq!(
+            a.bool("bad").unwrap_err().to_string(),
+            "src:real=true,flag=false,bad=yes,caps=True: bad must be true or false, got `yes`"
+        );
+        assert!(a.bool_or("caps", false).is_err());
     }
 
     #[test]
