@@ -51,7 +51,6 @@ use self::prescan::{Prescan, prescan};
 use self::stack::{Stack, stack, volumes};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
-use crate::vtk_arrays::one_line;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// A directory with more entries than this is refused before any is read
@@ -71,11 +70,6 @@ const LISTED: usize = 5;
 /// Reads the DICOM volume at `path`: a directory of slices or one
 /// multi-frame file.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    // Values and file names quoted in messages may hold control characters.
-    read_any(path, opts).map_err(one_line)
-}
-
-fn read_any(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     if path.is_dir() {
         read_directory(path, opts)
     } else {
@@ -329,10 +323,9 @@ fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let names = |i: usize| file_name(&files[i].path);
     let grid =
         geometry(dir, &planes, &names, &files[0], &mut info).map_err(|e| match (e, &skipped) {
-            (IoError::Invalid { path, reason }, Some(s)) => IoError::Invalid {
-                path,
-                reason: format!("{reason} ({s})"),
-            },
+            (IoError::Invalid { path, reason }, Some(s)) => {
+                IoError::invalid(&path, format!("{reason} ({s})"))
+            }
             (e, _) => e,
         })?;
 

@@ -247,6 +247,16 @@ mod tests {
     }
 
     #[test]
+    fn invalid_escapes_control_characters() {
+        // A name with a newline, a parser's multi-line message: still one line.
+        let e = IoError::invalid(Path::new("f.vti"), "a\nb\tc\u{1b}");
+        assert_eq!(e.to_string(), "f.vti: a\\nb\\tc\\u{1b}");
+        let plain = IoError::invalid(Path::new("f"), "x \"y\" é");
+        assert_eq!(plain.to_string(), "f: x \"y\" é");
+        assert!(!plain.is_io_failure());
+    }
+
+    #[test]
     fn io_failures_are_told_from_bad_input() {
         let os = IoError::os(Path::new("f"), "read", io::Error::other("boom"));
         assert!(os.is_io_failure());

@@ -31,7 +31,6 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
-use crate::vtk_arrays::one_line;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
 /// A dataset may decode to at most this many times the file's length
@@ -54,11 +53,6 @@ const LISTED: usize = 10;
 /// Reads the dataset `path` names (`file.h5:/dataset`, or `file.h5`
 /// holding a single volume).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    // Dataset and attribute names quoted in messages may hold control characters.
-    read_dataset(path, opts).map_err(one_line)
-}
-
-fn read_dataset(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (file_path, dataset_path): (PathBuf, Option<String>) = match split_hdf5_path(path) {
         Some((file, dataset)) => (file, Some(dataset)),
         None => (path.to_path_buf(), None),

@@ -40,11 +40,12 @@
 //!
 //! Shared pieces: [`grid_to_volume`] (`geometry.rs`) maps a file's grid
 //! (origin and one step vector per index axis) onto the axis-aligned
-//! volume, reordering and flipping axes exactly; `payload.rs` reads a
-//! header's data (skips, encodings, multi-file lists) within the file's
-//! bounds; [`inflate_exact`] inflates to a declared size; `text_reader.rs`
-//! streams numbers out of text formats; `periodic_cell.rs` resamples skewed
-//! periodic cells.
+//! volume, reordering and flipping axes exactly; `text_header.rs` reads
+//! the lines and field values of NRRD and MetaImage headers, and
+//! `payload.rs` their data (skips, encodings, multi-file lists) within the
+//! file's bounds; [`inflate_exact`] inflates to a declared size;
+//! `text_reader.rs` streams numbers out of text formats and text data;
+//! `periodic_cell.rs` resamples skewed periodic cells.
 //!
 //! # Example
 //!
@@ -98,6 +99,7 @@ mod payload;
 mod periodic_cell;
 mod png;
 mod raw;
+mod text_header;
 mod text_reader;
 mod tiff_stack;
 mod vti;

@@ -28,6 +28,7 @@ use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
 use crate::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
+use crate::text_header::Field;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// The fields MetaIO reads for an image; any other is noted as ignored.
@@ -86,7 +87,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             format!("MetaImage field ObjectType = {t}: not an image"),
         ));
     }
-    let ndims = parse_uint(path, "NDims", required(path, &header, "NDims")?)?;
+    let field = |name| Field::metaimage(path, name);
+    let ndims = field("NDims").uint(required(path, &header, "NDims")?)?;
     if !(3..=4).contains(&ndims) {
         return Err(IoError::invalid(
             path,
@@ -95,18 +97,9 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             ),
         ));
     }
-    let dims: Vec<usize> = words(path, "DimSize", required(path, &header, "DimSize")?, ndims)?
-        .iter()
-        .map(|w| parse_uint(path, "DimSize", w))
-        .collect::<Result<_, _>>()?;
-    if let Some(a) = dims.iter().position(|&d| d == 0) {
-        return Err(IoError::invalid(
-            path,
-            format!("MetaImage field DimSize: axis {a} has size 0"),
-        ));
-    }
+    let dims = field("DimSize").sizes(required(path, &header, "DimSize")?, ndims)?;
     if let Some(c) = header.get("ElementNumberOfChannels") {
-        let channels = parse_uint(path, "ElementNumberOfChannels", c)?;
+        let channels = field("ElementNumberOfChannels").uint(c)?;
         if channels != 1 {
             return Err(IoError::invalid(
                 path,
@@ -139,30 +132,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
 
     // Every product of sizes below fits in memory once the total does.
-    let total = dims
-        .iter()
-        .try_fold(1usize, |acc, &s| acc.checked_mul(s))
-        .filter(|n| n.checked_mul(dtype.size()).is_some())
-        .ok_or_else(|| {
-            IoError::invalid(
-                path,
-                format!("MetaImage field DimSize: {dims:?} describe more data than this machine can address"),
-            )
-        })?;
+    let total = field("DimSize").sample_count(&dims, dtype.size())?;
 
     // Frames along the 4th axis.
     let frames = if ndims == 4 { dims[3] } else { 1 };
-    let frame = opts.frame.unwrap_or(0);
-    if frame >= frames {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "--frame {frame} but the file holds {frames} volume{} (frames 0 to {})",
-                if frames == 1 { "" } else { "s" },
-                frames - 1
-            ),
-        ));
-    }
+    let frame = payload::chosen_frame(path, opts.frame, frames)?;
     let select = if ndims == 4 {
         notes.push(format!(
             "4-D image: volume {frame} of {frames} along the 4th axis read (--frame picks another)"
@@ -270,53 +244,21 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 }
 
 fn required<'h>(path: &Path, header: &'h Header, key: &str) -> Result<&'h str, IoError> {
-    header.get(key).ok_or_else(|| {
-        IoError::invalid(
-            path,
-            format!("MetaImage header has no {key} field (it is required)"),
-        )
-    })
+    Field::metaimage(path, key).required(header.get(key))
 }
 
-fn parse_uint(path: &Path, key: &str, value: &str) -> Result<usize, IoError> {
-    value.trim().parse().map_err(|_| {
-        IoError::invalid(
-            path,
-            format!("MetaImage field {key} = {value}: \"{value}\" is not a non-negative integer"),
-        )
-    })
-}
-
-fn words<'v>(path: &Path, key: &str, value: &'v str, n: usize) -> Result<Vec<&'v str>, IoError> {
-    let w: Vec<&str> = value.split_whitespace().collect();
-    if w.len() != n {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "MetaImage field {key}: {} values but {n} are needed",
-                w.len()
-            ),
-        ));
-    }
-    Ok(w)
-}
-
-/// `n` numbers of field `key`, if given.
+/// `n` finite numbers of field `key`, if given.
 fn numbers(path: &Path, header: &Header, key: &str, n: usize) -> Result<Option<Vec<f64>>, IoError> {
     let Some(value) = header.get(key) else {
         return Ok(None);
     };
-    words(path, key, value, n)?
-        .iter()
-        .map(|w| match w.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(IoError::invalid(
-                path,
-                format!("MetaImage field {key}: \"{w}\" is not a finite number"),
-            )),
-        })
-        .collect::<Result<Vec<_>, _>>()
-        .map(Some)
+    let field = Field::metaimage(path, key);
+    let numbers = field.numbers(value, n)?;
+    if let Some(i) = numbers.iter().position(|v| !v.is_finite()) {
+        let word = value.split_whitespace().nth(i).unwrap_or_default();
+        return Err(field.error(format!("\"{word}\" is not a finite number")));
+    }
+    Ok(Some(numbers))
 }
 
 /// A boolean field: MetaIO reads a value starting with `T`, `t` or `1` as
@@ -380,8 +322,7 @@ fn data_files(
     }
     let dir = path.parent().unwrap_or(Path::new(""));
     let resolve = |name: &str| dir.join(name);
-    let bad =
-        |why: String| IoError::invalid(path, format!("MetaImage field ElementDataFile: {why}"));
+    let bad = |why: String| Field::metaimage(path, "ElementDataFile").error(why);
 
     let files = if let Some(rest) = spec.strip_prefix("LIST") {
         // MetaIO: each file holds a `fileImageDim`-D piece (default NDims-1;

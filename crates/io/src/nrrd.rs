@@ -30,12 +30,13 @@ use std::path::{Path, PathBuf};
 
 use self::geometry::Geometry;
 use self::header::Header;
-use self::values::{parse_uint, required, words};
+use self::values::required;
 use crate::dtype::{DType, Endian};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
 use crate::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
+use crate::text_header::Field;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 pub use write::write_nrrd;
@@ -48,25 +49,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.header = header.written.clone();
     let notes = &mut info.notes;
 
-    let dim = parse_uint(path, "dimension", required(path, &header, "dimension")?)?;
+    let field = |name| Field::nrrd(path, name);
+    let dim = field("dimension").uint(required(path, &header, "dimension")?)?;
     if !(3..=4).contains(&dim) {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "NRRD field \"dimension\": {dim}: volray reads 3-D volumes and 4-D files of volumes"
-            ),
-        ));
+        return Err(field("dimension").error(format!(
+            "{dim}: volray reads 3-D volumes and 4-D files of volumes"
+        )));
     }
-    let sizes: Vec<usize> = words(path, "sizes", required(path, &header, "sizes")?, dim)?
-        .iter()
-        .map(|w| parse_uint(path, "sizes", w))
-        .collect::<Result<_, _>>()?;
-    if let Some(a) = sizes.iter().position(|&s| s == 0) {
-        return Err(IoError::invalid(
-            path,
-            format!("NRRD field \"sizes\": axis {a} has size 0"),
-        ));
-    }
+    let sizes = field("sizes").sizes(required(path, &header, "sizes")?, dim)?;
     let type_name = required(path, &header, "type")?;
     let dtype = parse_type(path, type_name)?;
     let encoding = parse_encoding(path, required(path, &header, "encoding")?)?;
@@ -75,10 +65,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             "little" => Endian::Little,
             "big" => Endian::Big,
             _ => {
-                return Err(IoError::invalid(
-                    path,
-                    format!("NRRD field \"endian\": \"{e}\" is neither little nor big"),
-                ));
+                return Err(field("endian").error(format!("\"{e}\" is neither little nor big")));
             }
         },
         None if dtype.size() > 1 && encoding != Encoding::Text => {
@@ -99,46 +86,20 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
 
     // Every product of sizes below fits in memory once the total does.
-    let total = sizes
-        .iter()
-        .try_fold(1usize, |acc, &s| acc.checked_mul(s))
-        .filter(|n| n.checked_mul(dtype.size()).is_some())
-        .ok_or_else(|| {
-            IoError::invalid(
-                path,
-                format!("NRRD field \"sizes\": {sizes:?} describe more data than this machine can address"),
-            )
-        })?;
+    let total = field("sizes").sample_count(&sizes, dtype.size())?;
 
     // Which axis, if any, holds several volumes, and the geometry.
     let geometry = Geometry::parse(path, &header, &sizes, notes)?;
-    let (frames, select) = match geometry.frame_axis {
-        None => (1, FrameSelect::ALL),
-        Some(f) => {
-            let count = sizes[f];
-            let index = opts.frame.unwrap_or(0);
-            let stride = sizes[..f].iter().product();
-            (
-                count,
-                FrameSelect {
-                    stride,
-                    count,
-                    index,
-                },
-            )
-        }
+    let frames = geometry.frame_axis.map_or(1, |f| sizes[f]);
+    let frame = payload::chosen_frame(path, opts.frame, frames)?;
+    let select = match geometry.frame_axis {
+        None => FrameSelect::ALL,
+        Some(f) => FrameSelect {
+            stride: sizes[..f].iter().product(),
+            count: frames,
+            index: frame,
+        },
     };
-    let frame = opts.frame.unwrap_or(0);
-    if frame >= frames {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "--frame {frame} but the file holds {frames} volume{} (frames 0 to {})",
-                if frames == 1 { "" } else { "s" },
-                frames - 1
-            ),
-        ));
-    }
     if let Some(f) = geometry.frame_axis {
         notes.push(format!(
             "4-D file: volume {frame} of {frames} along axis {f}{} read (--frame picks another)",
@@ -156,16 +117,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (files, base) = data_files(path, &header, &sizes)?;
     let per_file = total / files.len();
     let line_skip = match header.get("line skip") {
-        Some(v) => parse_uint(path, "line skip", v)? as u64,
+        Some(v) => field("line skip").uint(v)? as u64,
         None => 0,
     };
     let byte_skip: i64 = match header.get("byte skip") {
-        Some(v) => v.trim().parse().map_err(|_| {
-            IoError::invalid(
-                path,
-                format!("NRRD field \"byte skip\": \"{v}\" is not an integer"),
-            )
-        })?,
+        Some(v) => v
+            .trim()
+            .parse()
+            .map_err(|_| field("byte skip").error(format!("\"{v}\" is not an integer")))?,
         None => 0,
     };
     let mut layout = Layout {
@@ -182,13 +141,10 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         n if n >= 0 => Skip::Forward(n as u64),
         n if encoding == Encoding::Raw => Skip::BeforeEnd((-(n + 1)) as u64),
         n => {
-            return Err(IoError::invalid(
-                path,
-                format!(
-                    "NRRD field \"byte skip\": {n} (counting back from the end of the file) works with raw encoding only, not {}",
-                    required(path, &header, "encoding")?
-                ),
-            ));
+            return Err(field("byte skip").error(format!(
+                "{n} (counting back from the end of the file) works with raw encoding only, not {}",
+                required(path, &header, "encoding")?
+            )));
         }
     };
     let data_len = (per_file * dtype.size()) as u64;
@@ -259,18 +215,13 @@ fn parse_type(path: &Path, name: &str) -> Result<DType, IoError> {
         "float" => DType::F32,
         "double" => DType::F64,
         "block" => {
-            return Err(IoError::invalid(
-                path,
-                "NRRD field \"type\": \"block\" samples are opaque bytes with no value to render",
-            ));
+            return Err(Field::nrrd(path, "type")
+                .error("\"block\" samples are opaque bytes with no value to render"));
         }
         _ => {
-            return Err(IoError::invalid(
-                path,
-                format!(
-                    "NRRD field \"type\": unknown type \"{name}\" (known: signed char, uchar, short, ushort, int, uint, longlong, ulonglong, float, double and their synonyms)"
-                ),
-            ));
+            return Err(Field::nrrd(path, "type").error(format!(
+                "unknown type \"{name}\" (known: signed char, uchar, short, ushort, int, uint, longlong, ulonglong, float, double and their synonyms)"
+            )));
         }
     };
     Ok(dtype)
@@ -282,18 +233,12 @@ fn parse_encoding(path: &Path, name: &str) -> Result<Encoding, IoError> {
         "gz" | "gzip" => Ok(Encoding::Gzip),
         "txt" | "text" | "ascii" => Ok(Encoding::Text),
         "hex" => Ok(Encoding::Hex),
-        "bz2" | "bzip2" => Err(IoError::invalid(
-            path,
-            format!(
-                "NRRD field \"encoding\": {name} is not supported: save the file with raw or gzip encoding (e.g. `unu save -e gzip`)"
-            ),
-        )),
-        _ => Err(IoError::invalid(
-            path,
-            format!(
-                "NRRD field \"encoding\": unknown encoding \"{name}\" (known: raw, gzip, ascii, hex)"
-            ),
-        )),
+        "bz2" | "bzip2" => Err(Field::nrrd(path, "encoding").error(format!(
+            "{name} is not supported: save the file with raw or gzip encoding (e.g. `unu save -e gzip`)"
+        ))),
+        _ => Err(Field::nrrd(path, "encoding").error(format!(
+            "unknown encoding \"{name}\" (known: raw, gzip, ascii, hex)"
+        ))),
     }
 }
 
@@ -317,7 +262,7 @@ fn data_files(
     };
     let dir = path.parent().unwrap_or(Path::new(""));
     let resolve = |name: &str| dir.join(name);
-    let bad = |why: String| IoError::invalid(path, format!("NRRD field \"data file\": {why}"));
+    let bad = |why: String| Field::nrrd(path, "data file").error(why);
     let parse_subdim = |word: &str| -> Result<usize, IoError> {
         word.parse::<usize>()
             .ok()

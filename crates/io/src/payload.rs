@@ -21,6 +21,7 @@ use flate2::read::{MultiGzDecoder, ZlibDecoder};
 use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::input::{open_input, read_samples};
+use crate::text_reader::TextReader;
 
 /// Deflate's largest compression ratio (RFC 1951: a 258-byte match costs
 /// at least two bits, so 1032 output bytes per input byte at most).
@@ -29,9 +30,6 @@ use crate::compress::MAX_DEFLATE_RATIO;
 /// Output samples allocated up front for a compressed stream; beyond this
 /// the output grows with the data actually inflated.
 const COMPRESSED_PREALLOC: usize = 1 << 20;
-
-/// Longest text token accepted (`-1.2345678901234567e-123` is 24 bytes).
-const MAX_TOKEN: usize = 64;
 
 /// Bytes decoded per chunk from compressed and text streams.
 const CHUNK: usize = 1 << 16;
@@ -323,6 +321,27 @@ impl FrameSelect {
     }
 }
 
+/// The volume `--frame` asks for (`requested`, default 0) of a file that
+/// holds `frames`; refused if there is no such volume.
+pub(crate) fn chosen_frame(
+    path: &Path,
+    requested: Option<usize>,
+    frames: usize,
+) -> Result<usize, IoError> {
+    let frame = requested.unwrap_or(0);
+    if frame >= frames {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "--frame {frame} but the file holds {frames} volume{} (frames 0 to {})",
+                if frames == 1 { "" } else { "s" },
+                frames.saturating_sub(1)
+            ),
+        ));
+    }
+    Ok(frame)
+}
+
 /// Reads `per_region` samples from each region in turn (all checked with
 /// [`check_region`] first), keeping those `frame` selects.
 pub(crate) fn read_regions(
@@ -392,7 +411,7 @@ fn read_region(
             };
             read_inflated(path, name, &mut decoder, samples, layout, sink)
         }
-        Encoding::Text => read_text(path, &mut BufReader::new(bounded), samples, sink),
+        Encoding::Text => read_text(path, BufReader::new(bounded), samples, sink),
         Encoding::Hex => read_hex(path, &mut BufReader::new(bounded), samples, layout, sink),
     }
 }
@@ -484,74 +503,22 @@ fn read_inflated(
 /// anything after them is ignored.
 fn read_text(
     path: &Path,
-    reader: &mut impl BufRead,
+    reader: impl BufRead,
     samples: usize,
     sink: &mut dyn FnMut(&[f32]),
 ) -> Result<(), IoError> {
     let mut values = Vec::with_capacity(CHUNK.min(samples));
-    let mut token = Vec::with_capacity(MAX_TOKEN);
-    let mut done = 0usize;
-    let flush = |token: &mut Vec<u8>, values: &mut Vec<f32>, done: &mut usize| {
-        if token.is_empty() {
-            return Ok(());
-        }
-        let text = std::str::from_utf8(token).unwrap_or("");
-        let v: f64 = text.parse().map_err(|_| {
-            IoError::invalid(
-                path,
-                format!(
-                    "text value {} is \"{}\", not a number",
-                    *done + 1,
-                    String::from_utf8_lossy(token)
-                ),
-            )
-        })?;
+    TextReader::data_section(path, reader).tokens(samples, "the text data", |n, token| {
+        let v: f64 = token
+            .parse()
+            .map_err(|_| format!("text value {} is \"{token}\", not a number", n + 1))?;
         values.push(v as f32);
-        *done += 1;
-        token.clear();
-        Ok::<(), IoError>(())
-    };
-    while done < samples {
-        let buf = reader
-            .fill_buf()
-            .map_err(|e| IoError::os(path, "read", e))?;
-        if buf.is_empty() {
-            flush(&mut token, &mut values, &mut done)?;
-            break;
+        if values.len() == CHUNK {
+            sink(&values);
+            values.clear();
         }
-        let mut used = 0;
-        for &b in buf {
-            used += 1;
-            if b.is_ascii_whitespace() || b == b',' {
-                flush(&mut token, &mut values, &mut done)?;
-                if values.len() >= CHUNK {
-                    sink(&values);
-                    values.clear();
-                }
-                if done == samples {
-                    break;
-                }
-            } else {
-                if token.len() == MAX_TOKEN {
-                    return Err(IoError::invalid(
-                        path,
-                        format!(
-                            "text value {} is longer than {MAX_TOKEN} characters: not a number",
-                            done + 1
-                        ),
-                    ));
-                }
-                token.push(b);
-            }
-        }
-        reader.consume(used);
-    }
-    if done < samples {
-        return Err(IoError::invalid(
-            path,
-            format!("the text data holds {done} values, but the header declares {samples}"),
-        ));
-    }
+        Ok(())
+    })?;
     sink(&values);
     Ok(())
 }
@@ -905,14 +872,16 @@ mod tests {
         );
         let err = read_regions(std::slice::from_ref(&r), 5, &l, FrameSelect::ALL).unwrap_err();
         assert!(
-            err.to_string().contains("\"trailing\", not a number"),
+            err.to_string()
+                .ends_with("t: line 2 of the data: text value 5 is \"trailing\", not a number"),
             "{err}"
         );
         let short = region_of(dir.path(), "s", b"1 2 3");
         let err = read_regions(std::slice::from_ref(&short), 4, &l, FrameSelect::ALL).unwrap_err();
         assert!(
-            err.to_string()
-                .contains("holds 3 values, but the header declares 4"),
+            err.to_string().ends_with(
+                "s: file ends at line 1 of the data after 3 of the 4 values of the text data"
+            ),
             "{err}"
         );
         let mut notes = Vec::new();

@@ -1,11 +1,13 @@
 //! Streaming reader for the text volume formats (Gaussian cube, VASP
-//! CHGCAR/CHG): header lines one at a time, then long runs of
+//! CHGCAR/CHG) and for the decimal text samples behind a NRRD or
+//! MetaImage header: header lines one at a time, then long runs of
 //! whitespace-separated numbers read token by token, so a file of
 //! hundreds of megabytes is never held in memory as text.
 //!
-//! Every message names the line it is about (1-based). Lines and tokens
-//! have bounded lengths, so a file without line breaks cannot make the
-//! reader allocate more than [`MAX_LINE`] bytes of text.
+//! Every message names the line it is about (1-based; for data that starts
+//! partway into a file, counted from the data's start and said so). Lines
+//! and tokens have bounded lengths, so a file without line breaks cannot
+//! make the reader allocate more than [`MAX_LINE`] bytes of text.
 
 use std::io::{BufRead, ErrorKind, Read};
 use std::path::{Path, PathBuf};
@@ -26,6 +28,11 @@ pub(crate) struct TextReader<R> {
     lines: usize,
     /// False after a token run that stopped inside a line.
     at_line_start: bool,
+    /// Whether commas separate tokens as white space does.
+    commas: bool,
+    /// What line numbers count from, after "line N" in messages: empty for
+    /// a whole file.
+    lines_of: &'static str,
 }
 
 impl<R: BufRead> TextReader<R> {
@@ -35,6 +42,19 @@ impl<R: BufRead> TextReader<R> {
             inner,
             lines: 0,
             at_line_start: true,
+            commas: false,
+            lines_of: "",
+        }
+    }
+
+    /// A reader of the text samples that follow a header in `path`
+    /// (`inner` starts at the data): commas separate numbers too, and
+    /// messages count lines from the start of the data.
+    pub(crate) fn data_section(path: &Path, inner: R) -> Self {
+        TextReader {
+            commas: true,
+            lines_of: " of the data",
+            ..TextReader::new(path, inner)
         }
     }
 
@@ -45,7 +65,15 @@ impl<R: BufRead> TextReader<R> {
 
     /// A bad-input error about the line [`TextReader::line`] returned last.
     pub(crate) fn error(&self, reason: impl std::fmt::Display) -> IoError {
-        IoError::invalid(&self.path, format!("line {}: {reason}", self.lines.max(1)))
+        self.error_at(self.lines.max(1), reason)
+    }
+
+    /// A bad-input error about line `line`.
+    fn error_at(&self, line: usize, reason: impl std::fmt::Display) -> IoError {
+        IoError::invalid(
+            &self.path,
+            format!("line {line}{}: {reason}", self.lines_of),
+        )
     }
 
     /// The next line without its line break, or `None` at the end of the
@@ -81,8 +109,9 @@ impl<R: BufRead> TextReader<R> {
             None => Err(IoError::invalid(
                 &self.path,
                 format!(
-                    "file ends at line {} where {what} should be",
-                    self.line_number()
+                    "file ends at line {}{} where {what} should be",
+                    self.line_number(),
+                    self.lines_of
                 ),
             )),
         }
@@ -102,13 +131,14 @@ impl<R: BufRead> TextReader<R> {
         let mut token = [0u8; MAX_TOKEN];
         let mut len = 0;
         let mut done = 0;
+        let (commas, lines_of) = (self.commas, self.lines_of);
+        let error_at = |line: usize, reason: &dyn std::fmt::Display| {
+            IoError::invalid(&self.path, format!("line {line}{lines_of}: {reason}"))
+        };
         let mut emit = |token: &[u8], done: &mut usize, lines: usize| -> Result<(), IoError> {
-            let text = std::str::from_utf8(token).map_err(|_| {
-                IoError::invalid(&self.path, format!("line {}: not UTF-8 text", lines + 1))
-            })?;
-            f(*done, text).map_err(|reason| {
-                IoError::invalid(&self.path, format!("line {}: {reason}", lines + 1))
-            })?;
+            let text =
+                std::str::from_utf8(token).map_err(|_| error_at(lines + 1, &"not UTF-8 text"))?;
+            f(*done, text).map_err(|reason| error_at(lines + 1, &reason))?;
             *done += 1;
             Ok(())
         };
@@ -127,7 +157,7 @@ impl<R: BufRead> TextReader<R> {
                     return Err(IoError::invalid(
                         &self.path,
                         format!(
-                            "file ends at line {} after {done} of the {count} values of {what}",
+                            "file ends at line {}{lines_of} after {done} of the {count} values of {what}",
                             self.lines + 1
                         ),
                     ));
@@ -137,7 +167,7 @@ impl<R: BufRead> TextReader<R> {
             let mut used = 0;
             for &b in buf {
                 used += 1;
-                if b.is_ascii_whitespace() {
+                if b.is_ascii_whitespace() || (commas && b == b',') {
                     if len > 0 {
                         emit(&token[..len], &mut done, self.lines)?;
                         len = 0;
@@ -153,12 +183,9 @@ impl<R: BufRead> TextReader<R> {
                     }
                 } else {
                     if len == MAX_TOKEN {
-                        return Err(IoError::invalid(
-                            &self.path,
-                            format!(
-                                "line {}: a value longer than {MAX_TOKEN} characters",
-                                self.lines + 1
-                            ),
+                        return Err(error_at(
+                            self.lines + 1,
+                            &format!("a value longer than {MAX_TOKEN} characters"),
                         ));
                     }
                     token[len] = b;
@@ -181,9 +208,9 @@ impl<R: BufRead> TextReader<R> {
         if let Some(rest) = self.try_line()?
             && let Some(extra) = rest.split_whitespace().next()
         {
-            return Err(IoError::invalid(
-                &self.path,
-                format!("line {line_number}: \"{extra}\" follows the last of {what}"),
+            return Err(self.error_at(
+                line_number,
+                format!("\"{extra}\" follows the last of {what}"),
             ));
         }
         Ok(())
@@ -201,10 +228,6 @@ impl<R: BufRead> TextReader<R> {
             }
         }
         Ok(())
-    }
-
-    fn error_at(&self, line: usize, reason: String) -> IoError {
-        IoError::invalid(&self.path, format!("line {line}: {reason}"))
     }
 }
 
@@ -327,6 +350,43 @@ mod tests {
         let mut r = reader(&long);
         let err = r.tokens(1, "data", |_, _| Ok(())).unwrap_err().to_string();
         assert!(err.contains("longer than 64 characters"), "{err}");
+    }
+
+    #[test]
+    fn data_sections_split_at_commas_and_count_their_own_lines() {
+        let data = |text: &str| {
+            TextReader::data_section(Path::new("d.nrrd"), Cursor::new(text.as_bytes().to_vec()))
+        };
+        let mut got = Vec::new();
+        data("1,2 ,3\n,4")
+            .tokens(4, "the data", |_, t| {
+                got.push(number(t, "v")?);
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(got, [1.0, 2.0, 3.0, 4.0]);
+        let err = data("1\n2,x")
+            .tokens(3, "the data", |_, t| number(t, "value").map(|_| ()))
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "d.nrrd: line 2 of the data: value: \"x\" is not a number"
+        );
+        let err = data("1\n")
+            .tokens(2, "the data", |_, _| Ok(()))
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "d.nrrd: file ends at line 2 of the data after 1 of the 2 values of the data"
+        );
+        // Whole files keep commas inside tokens.
+        let err = reader("1,2")
+            .tokens(1, "values", |_, t| number(t, "value").map(|_| ()))
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "t.txt: line 1: value: \"1,2\" is not a number"
+        );
     }
 
     #[test]

@@ -36,7 +36,6 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
-use crate::vtk_arrays::one_line;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// A compressed page may decode to more bytes than the file holds; a stack
@@ -92,11 +91,6 @@ impl Sample {
 
 /// Reads the TIFF stack at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    // Metadata quoted in messages may hold control characters.
-    read_stack(path, opts).map_err(one_line)
-}
-
-fn read_stack(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (file, file_len) = open_input(path)?;
     let mut decoder = Decoder::new(BufReader::new(file))
         .map_err(|e| tiff_error(path, "header", e))?

@@ -33,8 +33,7 @@ use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
 use crate::vtk_arrays::{
-    ArrayEntry, Association, cell_centres, cell_dims, no_match, not_scalar, one_line, rank,
-    record_choice,
+    ArrayEntry, Association, cell_centres, cell_dims, no_match, not_scalar, rank, record_choice,
 };
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 use blocks::{base64_block, raw_block};
@@ -42,10 +41,6 @@ use structure::{DataArray, Format, Structure, join, parse, type_name};
 
 /// Reads the VTK XML image data file at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    read_file(path, opts).map_err(one_line)
-}
-
-fn read_file(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (mut file, len) = open_input(path)?;
     let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
     file.read_to_end(&mut bytes)

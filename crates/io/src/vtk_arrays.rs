@@ -168,28 +168,6 @@ pub(crate) fn record_choice(
     ));
 }
 
-/// Makes a bad-input message one line whatever the file put in it (array
-/// names may hold `%0A`, XML parser messages quote the document): control
-/// characters are shown escaped.
-pub(crate) fn one_line(e: IoError) -> IoError {
-    match e {
-        IoError::Invalid { path, reason } if reason.chars().any(char::is_control) => {
-            let reason = reason
-                .chars()
-                .map(|c| {
-                    if c.is_control() {
-                        c.escape_default().to_string()
-                    } else {
-                        c.to_string()
-                    }
-                })
-                .collect::<String>();
-            IoError::Invalid { path, reason }
-        }
-        other => other,
-    }
-}
-
 /// Cells per axis of a grid of `points` per axis (VTK: `max(n − 1, 1)`).
 pub(crate) fn cell_dims(points: [usize; 3]) -> [usize; 3] {
     points.map(|n| n.saturating_sub(1).max(1))
@@ -290,16 +268,6 @@ mod tests {
             msg.contains("has 3 components") && msg.contains("(a, a)"),
             "{msg}"
         );
-    }
-
-    #[test]
-    fn messages_become_one_line() {
-        let e = one_line(IoError::invalid(Path::new("f.vti"), "a\nb\tc"));
-        assert_eq!(e.to_string(), "f.vti: a\\nb\\tc");
-        assert!(matches!(
-            one_line(IoError::invalid(Path::new("f"), "x")),
-            IoError::Invalid { .. }
-        ));
     }
 
     #[test]

@@ -28,8 +28,7 @@ use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
 use crate::vtk_arrays::{
-    ArrayEntry, Association, cell_centres, cell_dims, no_match, not_scalar, one_line, rank,
-    record_choice,
+    ArrayEntry, Association, cell_centres, cell_dims, no_match, not_scalar, rank, record_choice,
 };
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 use lexer::Lexer;
@@ -113,10 +112,6 @@ struct Scan<'a> {
 
 /// Reads the legacy VTK file at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    read_file(path, opts).map_err(one_line)
-}
-
-fn read_file(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (file, len) = open_input(path)?;
     let mut lx = Lexer::new(path, BufReader::new(file), len);
     let mut info = FileInfo::new("");

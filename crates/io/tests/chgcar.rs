@@ -5,24 +5,21 @@
 //! geometry, the frames and what `FileInfo` reports. Malformed variants
 //! are made here from the fixtures.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{check_resampled, has_note, refused_file, with_frame};
 use volray_core::Volume;
 use volray_core::glam::{DMat3, DVec3};
-use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{IoError, Loaded, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/chgcar")
-        .join(name)
+    common::fixture("chgcar", name)
 }
 
 fn load(path: &Path, frame: Option<usize>) -> Result<Loaded, IoError> {
-    let opts = ReadOptions {
-        frame,
-        ..ReadOptions::default()
-    };
-    read(path, &opts)
+    read(path, &with_frame(frame))
 }
 
 fn ramp(i: usize, j: usize, k: usize) -> f64 {
@@ -46,10 +43,6 @@ fn check_periodic(v: &Volume, ng: [usize; 3], rho: impl Fn(usize, usize, usize) 
             }
         }
     }
-}
-
-fn has_note(l: &Loaded, text: &str) -> bool {
-    l.info.notes.iter().any(|n| n.contains(text))
 }
 
 #[test]
@@ -186,42 +179,18 @@ fn hexagonal_chg_is_resampled_periodically() {
     let c = DVec3::new(0.0, 0.0, 4.0);
     let volume = DMat3::from_cols(a, b, c).determinant();
     let to_grid = DMat3::from_cols(a / 6.0, b / 6.0, c / 4.0).inverse();
-    let v = &l.volume;
-    let [nx, ny, nz] = v.dims();
-    let mut inside = 0;
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                let g = to_grid * v.world_position(i, j, k);
-                if g.x >= 0.0 && g.x <= 5.0 && g.y >= 0.0 && g.y <= 5.0 && g.z >= 0.0 && g.z <= 3.0
-                {
-                    let want = (1.0 + g.x + 10.0 * g.y + 100.0 * g.z) / volume;
-                    let got = f64::from(v.get(i, j, k));
-                    assert!(
-                        (got - want).abs() < 1e-5,
-                        "({i}, {j}, {k}): {got} vs {want}"
-                    );
-                    inside += 1;
-                }
-            }
-        }
-    }
+    let inside = check_resampled(&l.volume, to_grid, [5.0, 5.0, 3.0], 1e-5, |g| {
+        (1.0 + g.x + 10.0 * g.y + 100.0 * g.z) / volume
+    });
     assert!(inside > 50, "{inside}");
     assert!(has_note(&l, "angle(a, b) 120.000"), "{:?}", l.info.notes);
     assert!(has_note(&l, "periodic images"));
 }
 
-/// Writes `text` under `name` in a temporary directory and reads it.
+/// Writes `text` under `name` in a temporary directory and reads it,
+/// expecting a refusal; returns the message.
 fn error_of(name: &str, text: &str, frame: Option<usize>) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join(name);
-    std::fs::write(&path, text).unwrap();
-    let err = load(&path, frame).unwrap_err();
-    assert!(!err.is_io_failure(), "{err}");
-    let msg = err.to_string();
-    assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-    assert!(!msg.contains('\n'), "{msg}");
-    msg
+    refused_file(name, text.as_bytes(), &with_frame(frame))
 }
 
 #[test]
@@ -290,42 +259,10 @@ fn malformed_variants_of_a_real_file() {
     );
 }
 
-const FUZZ_NAME: &str = "CHGCAR_fuzzed";
-
-/// Truncations of the fixtures every 61 bytes and 25 single-byte
-/// corruptions of each (digits, signs, exponents, line breaks, binary bytes):
-/// each read either succeeds or fails with a one-line error naming the
-/// file; none panics.
+/// Truncations and single-byte corruptions of every fixture: each read
+/// either succeeds or fails with a one-line error naming the file; none
+/// panics.
 #[test]
 fn corrupted_files_never_panic() {
-    let dir = tempfile::tempdir().unwrap();
-    let replacements = b"0 9-+.eEdD\n\r\t*x\xff\x00";
-    let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut next = move || {
-        seed = seed
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (seed >> 33) as usize
-    };
-    for entry in std::fs::read_dir(fixture("")).unwrap() {
-        let good = std::fs::read(entry.unwrap().path()).unwrap();
-        let path = dir.path().join(FUZZ_NAME);
-        let check = |bytes: &[u8], frame: Option<usize>| {
-            std::fs::write(&path, bytes).unwrap();
-            if let Err(e) = load(&path, frame) {
-                let msg = e.to_string();
-                assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-                assert!(!msg.contains('\n'), "{msg}");
-            }
-        };
-        for len in (0..good.len()).step_by(61) {
-            check(&good[..len], None);
-        }
-        for _ in 0..25 {
-            let mut b = good.clone();
-            let at = next() % b.len();
-            b[at] = replacements[next() % replacements.len()];
-            check(&b, Some(next() % 3));
-        }
-    }
+    common::text_edits_never_panic(&fixture(""), "CHGCAR_fuzzed");
 }

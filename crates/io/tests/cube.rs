@@ -4,23 +4,20 @@
 //! the header, and what `FileInfo` reports. Malformed variants are made
 //! here from the fixtures.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{check_resampled, check_voxels, refused_file, with_frame};
 use volray_core::glam::{DMat3, DVec3};
 use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/cube")
-        .join(name)
+    common::fixture("cube", name)
 }
 
 fn load(path: &Path, frame: Option<usize>) -> Result<Loaded, IoError> {
-    let opts = ReadOptions {
-        frame,
-        ..ReadOptions::default()
-    };
-    read(path, &opts)
+    read(path, &with_frame(frame))
 }
 
 fn ramp(i1: usize, i2: usize, i3: usize) -> f32 {
@@ -40,13 +37,7 @@ fn ase_ramp_in_bohr() {
     assert_eq!(v.dims(), [4, 3, 5]);
     assert_close(v.spacing(), DVec3::new(0.5, 0.25, 0.75));
     assert_close(v.origin(), DVec3::new(-1.0, 2.0, 0.5));
-    for k in 0..5 {
-        for j in 0..3 {
-            for i in 0..4 {
-                assert_eq!(v.get(i, j, k), ramp(i, j, k), "({i}, {j}, {k})");
-            }
-        }
-    }
+    check_voxels("", v, [4, 3, 5], ramp);
     let info = &l.info;
     assert_eq!(info.length_unit.as_deref(), Some("bohr"));
     assert_eq!((info.frames, info.frame), (1, 0));
@@ -118,14 +109,9 @@ fn gaussian_orbitals_in_angstrom_are_frames() {
         assert_close(v.spacing(), DVec3::new(0.4, 0.5, 0.25));
         assert_close(v.origin(), DVec3::new(-1.0, -2.0, -3.0));
         let sign = if frame % 2 == 0 { 1.0 } else { -1.0 };
-        for k in 0..5 {
-            for j in 0..3 {
-                for i in 0..4 {
-                    let want = 1000.0 * (frame + 1) as f32 + sign * ramp(i, j, k);
-                    assert_eq!(v.get(i, j, k), want, "frame {frame} at ({i}, {j}, {k})");
-                }
-            }
-        }
+        check_voxels(&format!("frame {frame}"), v, [4, 3, 5], |i, j, k| {
+            1000.0 * (frame + 1) as f32 + sign * ramp(i, j, k)
+        });
         let info = &l.info;
         assert_eq!((info.frames, info.frame), (3, frame));
         assert_eq!(info.length_unit.as_deref(), Some("angstrom"));
@@ -157,22 +143,15 @@ fn gaussian_orbitals_in_angstrom_are_frames() {
 #[test]
 fn fortran_exponent_forms() {
     let l = load(&fixture("fortran_exponents.cube"), None).unwrap();
-    let v = &l.volume;
-    assert_eq!(v.dims(), [2, 2, 3]);
-    for k in 0..3 {
-        for j in 0..2 {
-            for i in 0..2 {
-                let base = 1.0 + f64::from(ramp(i, j, k));
-                // Even parity: 0.ddddd-ee (below f32's range, so 0); odd: D exponent.
-                let want = if (i + j + k) % 2 == 0 {
-                    (base * 1e-100) as f32
-                } else {
-                    base as f32
-                };
-                assert_eq!(v.get(i, j, k), want, "({i}, {j}, {k})");
-            }
+    check_voxels("", &l.volume, [2, 2, 3], |i, j, k| {
+        let base = 1.0 + f64::from(ramp(i, j, k));
+        // Even parity: 0.ddddd-ee (below f32's range, so 0); odd: D exponent.
+        if (i + j + k) % 2 == 0 {
+            (base * 1e-100) as f32
+        } else {
+            base as f32
         }
-    }
+    });
 }
 
 /// A hexagonal cell is resampled as one periodic cell: every output
@@ -197,25 +176,11 @@ fn skewed_hexagonal_cell_is_resampled_periodically() {
         (hi - DVec3::new(3.0, 6.0 * 0.433013, 4.0)).length() < 1e-9,
         "{hi}"
     );
-    let [nx, ny, nz] = v.dims();
-    let mut inside = 0;
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                let g = to_grid * v.world_position(i, j, k);
-                if (0..3).all(|a| g[a] >= 0.0 && g[a] <= (dims[a] - 1) as f64) {
-                    // index axis 0 is file axis 3 (the ramp's 100s).
-                    let want = 100.0 * g[0] + 10.0 * g[1] + g[2];
-                    let got = f64::from(v.get(i, j, k));
-                    assert!(
-                        (got - want).abs() < 1e-3,
-                        "({i}, {j}, {k}): {got} vs {want}"
-                    );
-                    inside += 1;
-                }
-            }
-        }
-    }
+    let last = dims.map(|n| (n - 1) as f64);
+    // Index axis 0 is file axis 3 (the ramp's 100s).
+    let inside = check_resampled(v, to_grid, last, 1e-3, |g| {
+        100.0 * g[0] + 10.0 * g[1] + g[2]
+    });
     assert!(inside > 50, "{inside}");
     let note = l
         .info
@@ -233,16 +198,10 @@ fn skewed_hexagonal_cell_is_resampled_periodically() {
     );
 }
 
-/// Writes `text` as a .cube file in a temporary directory and reads it.
-fn read_text(text: &str) -> IoError {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("bad.cube");
-    std::fs::write(&path, text).unwrap();
-    let err = load(&path, None).unwrap_err();
-    let msg = err.to_string();
-    assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-    assert!(!msg.contains('\n'), "{msg}");
-    err
+/// Writes `text` as a .cube file in a temporary directory and reads it,
+/// expecting a refusal; returns the message.
+fn error_of(text: &str) -> String {
+    refused_file("bad.cube", text.as_bytes(), &ReadOptions::default())
 }
 
 #[test]
@@ -252,92 +211,56 @@ fn malformed_variants_of_a_real_file() {
 
     // Truncated in the data.
     let cut = lines[..lines.len() - 3].join("\n");
-    let err = read_text(&cut);
-    assert!(!err.is_io_failure());
+    let msg = error_of(&cut);
     assert!(
-        err.to_string()
-            .contains("after 57 of the 60 values of the grid"),
-        "{err}"
+        msg.contains("after 57 of the 60 values of the grid"),
+        "{msg}"
     );
 
     // A lying point count: N1 = 40000 on each axis needs far more bytes.
     let mut lying = lines.clone();
     lying[3] = "40000    0.500000    0.000000    0.000000";
     lying[4] = "40000    0.000000    0.250000    0.000000";
-    let err = read_text(&lying.join("\n"));
+    let msg = error_of(&lying.join("\n"));
     assert!(
-        err.to_string()
-            .contains("40000x40000x5 points with 1 value(s) each, more than a"),
-        "{err}"
+        msg.contains("40000x40000x5 points with 1 value(s) each, more than a"),
+        "{msg}"
     );
 
     // More atoms declared than there are atom lines: a data line is read
     // as an atom.
     let mut atoms = lines.clone();
     atoms[2] = "    4   -1.000000    2.000000    0.500000";
-    let err = read_text(&atoms.join("\n"));
+    let msg = error_of(&atoms.join("\n"));
     assert!(
-        err.to_string()
-            .contains("line 10: atom 4: expected atomic number"),
-        "{err}"
+        msg.contains("line 10: atom 4: expected atomic number"),
+        "{msg}"
     );
 
     // A non-numeric value.
     let mut bad = lines.clone();
     bad[20] = "1.0e+0x";
-    let err = read_text(&bad.join("\n"));
+    let msg = error_of(&bad.join("\n"));
     assert!(
-        err.to_string()
-            .contains("line 21: grid value: \"1.0e+0x\" is not a number"),
-        "{err}"
+        msg.contains("line 21: grid value: \"1.0e+0x\" is not a number"),
+        "{msg}"
     );
 
     // An empty file and a binary one.
-    let err = read_text("");
-    assert!(err.to_string().contains("comment line 1"), "{err}");
-    let dir = tempfile::tempdir().unwrap();
-    let bin = dir.path().join("b.cube");
-    std::fs::write(&bin, [0x93u8, 0xff, 0xfe, b'\n', 0, 1, 2]).unwrap();
-    let err = load(&bin, None).unwrap_err();
-    assert!(err.to_string().contains("line 1: not UTF-8 text"), "{err}");
+    let msg = error_of("");
+    assert!(msg.contains("comment line 1"), "{msg}");
+    let msg = refused_file(
+        "b.cube",
+        &[0x93, 0xff, 0xfe, b'\n', 0, 1, 2],
+        &ReadOptions::default(),
+    );
+    assert!(msg.contains("line 1: not UTF-8 text"), "{msg}");
 }
 
-const FUZZ_NAME: &str = "fuzzed.cube";
-
-/// Truncations of the fixtures every 61 bytes and 25 single-byte
-/// corruptions of each (digits, signs, exponents, line breaks, binary bytes):
-/// each read either succeeds or fails with a one-line error naming the
-/// file; none panics.
+/// Truncations and single-byte corruptions of every fixture: each read
+/// either succeeds or fails with a one-line error naming the file; none
+/// panics.
 #[test]
 fn corrupted_files_never_panic() {
-    let dir = tempfile::tempdir().unwrap();
-    let replacements = b"0 9-+.eEdD\n\r\t*x\xff\x00";
-    let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut next = move || {
-        seed = seed
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (seed >> 33) as usize
-    };
-    for entry in std::fs::read_dir(fixture("")).unwrap() {
-        let good = std::fs::read(entry.unwrap().path()).unwrap();
-        let path = dir.path().join(FUZZ_NAME);
-        let check = |bytes: &[u8], frame: Option<usize>| {
-            std::fs::write(&path, bytes).unwrap();
-            if let Err(e) = load(&path, frame) {
-                let msg = e.to_string();
-                assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-                assert!(!msg.contains('\n'), "{msg}");
-            }
-        };
-        for len in (0..good.len()).step_by(61) {
-            check(&good[..len], None);
-        }
-        for _ in 0..25 {
-            let mut b = good.clone();
-            let at = next() % b.len();
-            b[at] = replacements[next() % replacements.len()];
-            check(&b, Some(next() % 3));
-        }
-    }
+    common::text_edits_never_panic(&fixture(""), "fuzzed.cube");
 }

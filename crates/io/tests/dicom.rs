@@ -7,24 +7,18 @@
 //! script wrote: pixel (x, y) of slice z lies at
 //! `IPP(z) + x·dx·ROW + y·dy·COL`.
 
+mod common;
+
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use common::{assert_note, frame, refused};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
 use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/dicom")
-        .join(name)
-}
-
-fn frame(n: usize) -> ReadOptions {
-    ReadOptions {
-        frame: Some(n),
-        ..ReadOptions::default()
-    }
+    common::fixture("dicom", name)
 }
 
 fn load_path(path: &Path, opts: &ReadOptions) -> Loaded {
@@ -38,18 +32,9 @@ fn load(name: &str, opts: &ReadOptions) -> Loaded {
     load_path(&fixture(name), opts)
 }
 
-fn error_at(path: &Path, opts: &ReadOptions) -> String {
-    let err = read(path, opts).expect_err("should be refused");
-    assert!(!err.is_io_failure(), "{err}");
-    let msg = err.to_string();
-    assert!(!msg.contains('\n'), "{msg}");
-    msg
-}
-
+/// The refusal of fixture `name`.
 fn error(name: &str, opts: &ReadOptions) -> String {
-    let msg = error_at(&fixture(name), opts);
-    assert!(msg.contains(name), "{msg}");
-    msg
+    refused(&fixture(name), opts)
 }
 
 /// The fixture geometry: IPP of slice z, and the world steps of x and y.
@@ -108,14 +93,6 @@ const UNIT: Geometry = Geometry {
     y_step: DVec3::Y,
 };
 
-fn has_note(l: &Loaded, text: &str) {
-    assert!(
-        l.info.notes.iter().any(|n| n.contains(text)),
-        "no note with {text:?} in {:?}",
-        l.info.notes
-    );
-}
-
 #[test]
 fn ct_series_sorted_by_position_with_rescale() {
     let l = load("ct", &ReadOptions::default());
@@ -134,12 +111,12 @@ fn ct_series_sorted_by_position_with_rescale() {
         "int16 (Implicit VR Little Endian, 1.2.840.10008.1.2)"
     );
     assert_eq!((l.info.frames, l.info.frame), (1, 0));
-    has_note(&l, "skipped 1 file(s) not DICOM (README.txt)");
-    has_note(
+    assert_note(&l, "skipped 1 file(s) not DICOM (README.txt)");
+    assert_note(
         &l,
         "RescaleSlope (0028,1053) 2 and RescaleIntercept (0028,1052) -1024 applied",
     );
-    has_note(&l, "LPS");
+    assert_note(&l, "LPS");
     let keys: Vec<&str> = l.info.header.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(keys[0], "TransferSyntaxUID (0002,0010)");
     assert!(
@@ -181,7 +158,7 @@ fn sagittal_series_is_reordered_to_world_axes() {
         l.info.stored_type,
         "uint16 (12 bits stored) (Explicit VR Little Endian, 1.2.840.10008.1.2.1)"
     );
-    has_note(&l, "samples reordered");
+    assert_note(&l, "samples reordered");
 }
 
 #[test]
@@ -199,7 +176,7 @@ fn several_series_are_listed_then_picked_by_frame() {
     let b = load("two_series", &frame(0));
     check(&b.volume, 2, |v| (v + 7) as f32, &UNIT);
     assert_eq!((b.info.frames, b.info.frame), (2, 0));
-    has_note(&b, "series 0 of 2 read");
+    assert_note(&b, "series 0 of 2 read");
     let a = load("two_series", &frame(1));
     check(&a.volume, 3, |v| v as f32, &UNIT);
     let msg = error("two_series", &frame(2));
@@ -236,7 +213,7 @@ fn rle_and_big_endian_series() {
 
 #[test]
 fn undecodable_transfer_syntax_is_named() {
-    let msg = error_at(&fixture("j2k"), &ReadOptions::default());
+    let msg = refused(&fixture("j2k"), &ReadOptions::default());
     assert!(
         msg.contains("cannot decode the pixel data (JPEG 2000 Lossless, 1.2.840.10008.1.2.4.90)"),
         "{msg}"
@@ -257,7 +234,7 @@ fn enhanced_ct_frames_sorted_with_shared_rescale() {
     let l = load("enhanced_ct.dcm", &ReadOptions::default());
     check(&l.volume, 5, |v| (0.5 * v as f64 - 100.0) as f32, &CT);
     assert_eq!((l.info.frames, l.info.frame), (1, 0));
-    has_note(
+    assert_note(
         &l,
         "RescaleSlope (0028,1053) 0.5 and RescaleIntercept (0028,1052) -100 applied",
     );
@@ -276,7 +253,7 @@ fn enhanced_time_series_volumes_by_frame() {
         let l = load("enhanced_4d.dcm", &frame(t));
         check(&l.volume, 5, |v| (v + 1000 * t) as f32, &CT);
         assert_eq!((l.info.frames, l.info.frame), (2, t));
-        has_note(&l, &format!("volume {t} of 2 read"));
+        assert_note(&l, &format!("volume {t} of 2 read"));
     }
     let msg = error("enhanced_4d.dcm", &frame(2));
     assert!(
@@ -296,11 +273,11 @@ fn rt_dose_with_offsets_and_scaling() {
     check(&l.volume, 5, |v| ((1000 * v + 5) as f64 * 1e-3) as f32, &g);
     assert_eq!(l.volume.origin(), DVec3::new(100.0, -50.0, 0.0));
     assert!((l.volume.spacing() - DVec3::new(4.0, 2.0, 3.0)).length() < 1e-12);
-    has_note(
+    assert_note(
         &l,
         "DoseGridScaling (3004,000E) 0.001 applied: values are dose in GY",
     );
-    has_note(&l, "GridFrameOffsetVector");
+    assert_note(&l, "GridFrameOffsetVector");
     assert_eq!(
         l.info.stored_type,
         "uint32 (Explicit VR Little Endian, 1.2.840.10008.1.2.1)"
@@ -323,37 +300,10 @@ fn float_pixel_data_and_deflated_data_sets() {
     );
 }
 
-/// Overwrites `count` pseudo-random bytes of `bytes` (a fixed LCG, so the
-/// test is deterministic), sometimes cutting the file short too.
-fn mutate(bytes: &[u8], seed: &mut u64, count: usize) -> Vec<u8> {
-    let mut next = || {
-        *seed = seed
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        *seed >> 33
-    };
-    let mut out = bytes.to_vec();
-    for _ in 0..count {
-        let at = next() as usize % out.len();
-        out[at] = match next() % 3 {
-            0 => 0xff,
-            1 => 0,
-            _ => next() as u8,
-        };
-    }
-    if next() % 4 == 0 {
-        out.truncate(next() as usize % out.len() + 1);
-    }
-    out
-}
-
 #[test]
 fn mutated_files_never_panic() {
     // Every fixture file with bytes overwritten at random: the reader
     // returns a volume or a one-line bad-input error, never panics.
-    let dir = tempfile::tempdir().unwrap();
-    let target = dir.path().join("m.dcm");
-    let mut seed = 7;
     let mut files = Vec::new();
     for sub in ["", "ct", "rle", "sagittal", "deflated"] {
         for e in fs::read_dir(fixture(sub)).unwrap() {
@@ -363,16 +313,7 @@ fn mutated_files_never_panic() {
             }
         }
     }
-    for p in files {
-        let bytes = fs::read(&p).unwrap();
-        for n in 1..=8 {
-            fs::write(&target, mutate(&bytes, &mut seed, n)).unwrap();
-            if let Err(e) = read(&target, &ReadOptions::default()) {
-                assert!(!e.is_io_failure(), "{}: {e}", p.display());
-                assert!(!e.to_string().contains('\n'), "{e}");
-            }
-        }
-    }
+    common::mutations_never_panic(&files, "m.dcm", 7);
 }
 
 /// The offset of `needle` in `hay`.
@@ -395,15 +336,14 @@ fn damaged_files_give_clean_errors() {
     // Cut short anywhere: a clean error naming the file.
     for cut in [100, 140, 400, dose.len() / 2, dose.len() - 3] {
         let p = write(&format!("cut{cut}.dcm"), &dose[..cut]);
-        let msg = error_at(&p, &ReadOptions::default());
-        assert!(msg.starts_with(&p.display().to_string()), "{msg}");
+        refused(&p, &ReadOptions::default());
     }
 
     // Pixel data declaring 4 GB in a 1 KB file: refused before parsing.
     let mut lying = dose.clone();
     let at = find(&lying, &[0xe0, 0x7f, 0x10, 0x00, b'O']);
     lying[at + 8..at + 12].copy_from_slice(&0xffff_fff0u32.to_le_bytes());
-    let msg = error_at(&write("lying.dcm", &lying), &ReadOptions::default());
+    let msg = refused(&write("lying.dcm", &lying), &ReadOptions::default());
     assert!(
         msg.contains("(7FE0,0010)") && msg.contains("declares 4294967280 bytes"),
         "{msg}"
@@ -413,7 +353,7 @@ fn damaged_files_give_clean_errors() {
     let mut rows = dose.clone();
     let at = find(&rows, &[0x28, 0x00, 0x10, 0x00, b'U', b'S', 0x02, 0x00]);
     rows[at + 8..at + 10].copy_from_slice(&60000u16.to_le_bytes());
-    let msg = error_at(&write("rows.dcm", &rows), &ReadOptions::default());
+    let msg = refused(&write("rows.dcm", &rows), &ReadOptions::default());
     assert!(
         msg.contains("pixel data (7FE0,0010) holds 240 bytes, but Rows 60000 x Columns 4 x 5 frame(s) x 4 byte(s) need 4800000"),
         "{msg}"
@@ -423,14 +363,14 @@ fn damaged_files_give_clean_errors() {
     let mut scaling = dose.clone();
     let at = find(&scaling, b"0.001");
     scaling[at..at + 5].copy_from_slice(b"0.0x1");
-    let msg = error_at(&write("scaling.dcm", &scaling), &ReadOptions::default());
+    let msg = refused(&write("scaling.dcm", &scaling), &ReadOptions::default());
     assert!(
         msg.contains("DoseGridScaling (3004,000E): \"0.0x1"),
         "{msg}"
     );
 
     // Not DICOM at all.
-    let msg = error_at(&write("text.dcm", &[b'x'; 300]), &ReadOptions::default());
+    let msg = refused(&write("text.dcm", &[b'x'; 300]), &ReadOptions::default());
     assert!(msg.contains("not a DICOM file"), "{msg}");
 }
 
@@ -453,7 +393,7 @@ fn inconsistent_directories_are_refused() {
     let at = find(&bytes, &[0x00, 0x28, 0x00, 0x11, b'U', b'S', 0x00, 0x02]);
     bytes[at + 8..at + 10].copy_from_slice(&5u16.to_be_bytes());
     fs::write(&p, bytes).unwrap();
-    let msg = error_at(&dir, &ReadOptions::default());
+    let msg = refused(&dir, &ReadOptions::default());
     assert!(msg.contains("b2.dcm is 5x3 int16"), "{msg}");
     assert!(
         msg.contains("every slice of a series must have the same size"),
@@ -464,7 +404,7 @@ fn inconsistent_directories_are_refused() {
     let dir = tmp.path().join("duplicate");
     copy("bigendian", &dir);
     fs::copy(dir.join("b1.dcm"), dir.join("b1_copy.dcm")).unwrap();
-    let msg = error_at(&dir, &ReadOptions::default());
+    let msg = refused(&dir, &ReadOptions::default());
     assert!(
         msg.contains("b1.dcm and b1_copy.dcm lie at the same position"),
         "{msg}"
@@ -476,7 +416,7 @@ fn inconsistent_directories_are_refused() {
     let p = dir.join("b2.dcm");
     let bytes = fs::read(&p).unwrap();
     fs::write(&p, &bytes[..200]).unwrap();
-    let msg = error_at(&dir, &ReadOptions::default());
+    let msg = refused(&dir, &ReadOptions::default());
     assert!(msg.contains("slice gaps are uneven"), "{msg}");
     assert!(
         msg.contains("skipped 1 unreadable DICOM file(s) (b2.dcm: "),
@@ -487,7 +427,7 @@ fn inconsistent_directories_are_refused() {
     let dir = tmp.path().join("empty");
     fs::create_dir(&dir).unwrap();
     fs::write(dir.join("notes.txt"), "x").unwrap();
-    let msg = error_at(&dir, &ReadOptions::default());
+    let msg = refused(&dir, &ReadOptions::default());
     assert!(
         msg.contains(
             "no DICOM image files in this directory (skipped 1 file(s) not DICOM (notes.txt))"

@@ -5,30 +5,30 @@
 //! Every volume has shape (4, 3, 5), indexed `a[x, y, z]`, and holds
 //! `v = x + 10y + 100z` with a per-dataset offset or scale.
 
+mod common;
+
 use std::path::PathBuf;
 
-use volray_io::{ReadOptions, read};
+use volray_io::ReadOptions;
 
 fn fixture(spec: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/hdf5")
-        .join(spec)
+    common::fixture("hdf5", spec)
 }
 
 #[cfg(not(feature = "hdf5"))]
 #[test]
 fn without_the_feature_the_reader_says_how_to_get_it() {
-    let err = read(&fixture("one.h5"), &ReadOptions::default()).unwrap_err();
-    assert!(!err.is_io_failure());
-    assert!(err.to_string().contains("--features hdf5"), "{err}");
+    let msg = common::refused(&fixture("one.h5"), &ReadOptions::default());
+    assert!(msg.contains("--features hdf5"), "{msg}");
 }
 
 #[cfg(feature = "hdf5")]
 mod with_hdf5 {
     use super::*;
+    use common::{check_voxels, error_about, frame, ramp, refused_at};
     use volray_core::Volume;
     use volray_core::glam::DVec3;
-    use volray_io::{Loaded, VolumeFormat};
+    use volray_io::{Loaded, VolumeFormat, read};
 
     fn load(spec: &str, opts: &ReadOptions) -> Loaded {
         let l = read(&fixture(spec), opts).unwrap_or_else(|e| panic!("{spec}: {e}"));
@@ -36,38 +36,20 @@ mod with_hdf5 {
         l
     }
 
+    /// The refusal of `spec` (`file.h5` or `file.h5:/dataset`), which
+    /// names the file.
     fn error(spec: &str, opts: &ReadOptions) -> String {
-        let err = read(&fixture(spec), opts).expect_err(spec);
-        assert!(!err.is_io_failure(), "{err}");
-        let msg = err.to_string();
-        assert!(!msg.contains('\n'), "{msg}");
         let file = spec.split(':').next().unwrap();
-        assert!(msg.contains(file), "{msg}");
-        msg
-    }
-
-    fn frame(n: usize) -> ReadOptions {
-        ReadOptions {
-            frame: Some(n),
-            ..ReadOptions::default()
-        }
+        let err = error_about(&fixture(spec), opts, &fixture(file));
+        assert!(!err.is_io_failure(), "{err}");
+        err.to_string()
     }
 
     /// Voxel (x, y, z) holds `f(v, x, y, z)` exactly, v = x + 10y + 100z.
     fn assert_values(volume: &Volume, f: impl Fn(f64, [usize; 3]) -> f64) {
-        assert_eq!(volume.dims(), [4, 3, 5]);
-        for z in 0..5 {
-            for y in 0..3 {
-                for x in 0..4 {
-                    let v = (x + 10 * y + 100 * z) as f64;
-                    assert_eq!(
-                        volume.get(x, y, z),
-                        f(v, [x, y, z]) as f32,
-                        "({x}, {y}, {z})"
-                    );
-                }
-            }
-        }
+        check_voxels("", volume, [4, 3, 5], |x, y, z| {
+            f(ramp(x, y, z) as f64, [x, y, z]) as f32
+        });
     }
 
     #[test]
@@ -164,19 +146,13 @@ mod with_hdf5 {
 
         // Not an HDF5 file; a missing file is an I/O failure.
         let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("fake.h5");
-        std::fs::write(&p, b"not hdf5 at all").unwrap();
-        let err = read(&p, &none).unwrap_err();
-        assert!(!err.is_io_failure());
-        assert!(err.to_string().contains("HDF5: cannot open"), "{err}");
+        let msg = refused_at(dir.path(), "fake.h5", b"not hdf5 at all", &none);
+        assert!(msg.contains("HDF5: cannot open"), "{msg}");
         let err = read(&dir.path().join("gone.h5:/x"), &none).unwrap_err();
         assert!(err.is_io_failure(), "{err}");
 
         // Truncated: the header survives, the data does not.
         let bytes = std::fs::read(fixture("one.h5")).unwrap();
-        let p = dir.path().join("cut.h5");
-        std::fs::write(&p, &bytes[..bytes.len() / 2]).unwrap();
-        let err = read(&p, &none).unwrap_err();
-        assert!(!err.is_io_failure(), "{err}");
+        refused_at(dir.path(), "cut.h5", &bytes[..bytes.len() / 2], &none);
     }
 }

@@ -4,16 +4,19 @@
 //! and what `FileInfo` reports. Malformed variants are made here by
 //! patching the header of a good file.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{
+    check_resampled, check_voxels, has_note, header_value, read_or_refuse, refused, truncations,
+};
 use volray_core::Volume;
 use volray_core::glam::{DMat3, DVec3};
 use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/mrc")
-        .join(name)
+    common::fixture("mrc", name)
 }
 
 fn load(path: &Path) -> Result<Loaded, IoError> {
@@ -30,27 +33,7 @@ fn assert_close(a: DVec3, b: DVec3) {
 
 /// Every voxel of a 4x3x5 map (columns along x) against `formula`.
 fn check_values(v: &Volume, formula: impl Fn(usize, usize, usize) -> f32) {
-    assert_eq!(v.dims(), [4, 3, 5]);
-    for s in 0..5 {
-        for r in 0..3 {
-            for c in 0..4 {
-                assert_eq!(v.get(c, r, s), formula(c, r, s), "({c}, {r}, {s})");
-            }
-        }
-    }
-}
-
-fn header<'a>(l: &'a Loaded, key: &str) -> &'a str {
-    l.info
-        .header
-        .iter()
-        .find(|(k, _)| k == key)
-        .map(|(_, v)| v.as_str())
-        .unwrap_or_else(|| panic!("no {key} in {:?}", l.info.header))
-}
-
-fn has_note(l: &Loaded, text: &str) -> bool {
-    l.info.notes.iter().any(|n| n.contains(text))
+    check_voxels("", v, [4, 3, 5], formula);
 }
 
 #[test]
@@ -63,13 +46,13 @@ fn float32_with_origin() {
     assert_eq!(l.info.stored_type, "float32 (MODE 2, little-endian)");
     assert_eq!(l.info.length_unit.as_deref(), Some("angstrom"));
     assert_eq!((l.info.frames, l.info.frame), (1, 0));
-    assert_eq!(header(&l, "NX NY NZ"), "4 3 5");
-    assert_eq!(header(&l, "MODE"), "2");
-    assert_eq!(header(&l, "CELLA"), "2 0.75 3.75");
-    assert_eq!(header(&l, "MAP"), "'MAP '");
-    assert_eq!(header(&l, "MACHST"), "44 44 00 00");
-    assert_eq!(header(&l, "NVERSION"), "20141");
-    assert_eq!(header(&l, "LABEL 1"), "volray float32 ramp");
+    assert_eq!(header_value(&l, "NX NY NZ"), "4 3 5");
+    assert_eq!(header_value(&l, "MODE"), "2");
+    assert_eq!(header_value(&l, "CELLA"), "2 0.75 3.75");
+    assert_eq!(header_value(&l, "MAP"), "'MAP '");
+    assert_eq!(header_value(&l, "MACHST"), "44 44 00 00");
+    assert_eq!(header_value(&l, "NVERSION"), "20141");
+    assert_eq!(header_value(&l, "LABEL 1"), "volray float32 ramp");
     let keys: Vec<&str> = l.info.header.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(
         &keys[..4],
@@ -101,7 +84,7 @@ fn big_endian_int16() {
     let l = load(&fixture("mode1_i16_be.mrc")).unwrap();
     check_values(&l.volume, |c, r, s| -7.0 * ramp(c, r, s));
     assert_eq!(l.info.stored_type, "int16 (MODE 1, big-endian)");
-    assert_eq!(header(&l, "MACHST"), "11 11 00 00");
+    assert_eq!(header_value(&l, "MACHST"), "11 11 00 00");
     assert_close(l.volume.spacing(), DVec3::ONE);
 }
 
@@ -109,8 +92,8 @@ fn big_endian_int16() {
 fn uint16_after_an_extended_header() {
     let l = load(&fixture("mode6_u16_ext.mrc")).unwrap();
     check_values(&l.volume, |c, r, s| 100.0 * ramp(c, r, s));
-    assert_eq!(header(&l, "NSYMBT"), "80");
-    assert_eq!(header(&l, "EXTTYP"), "'MRCO'");
+    assert_eq!(header_value(&l, "NSYMBT"), "80");
+    assert_eq!(header_value(&l, "EXTTYP"), "'MRCO'");
     assert!(has_note(
         &l,
         "extended header of 80 bytes (EXTTYP 'MRCO') skipped"
@@ -129,7 +112,7 @@ fn imod_unsigned_bytes() {
     let l = load(&fixture("imod_unsigned.mrc")).unwrap();
     check_values(&l.volume, |c, r, s| (200 + c + r + s) as f32);
     assert_eq!(l.info.stored_type, "uint8 (MODE 0, little-endian)");
-    assert_eq!(header(&l, "imodStamp"), "1146047817");
+    assert_eq!(header_value(&l, "imodStamp"), "1146047817");
     assert!(has_note(&l, "unsigned bytes"), "{:?}", l.info.notes);
 }
 
@@ -141,13 +124,7 @@ fn mapc_mapr_maps_permutation() {
     assert_eq!(v.dims(), [4, 3, 2]);
     assert_close(v.spacing(), DVec3::new(0.5, 1.0, 1.5));
     assert_close(v.origin(), DVec3::new(2.0 * 0.5, 3.0 * 1.0, 1.0 * 1.5));
-    for x in 0..4 {
-        for y in 0..3 {
-            for z in 0..2 {
-                assert_eq!(v.get(x, y, z), ramp(z, x, y), "({x}, {y}, {z})");
-            }
-        }
-    }
+    check_voxels("", v, [4, 3, 2], |x, y, z| ramp(z, x, y));
     assert!(has_note(&l, "columns, rows and sections run along Z, X, Y"));
     assert!(has_note(&l, "samples reordered"));
 }
@@ -163,25 +140,9 @@ fn whole_skewed_cell_is_resampled() {
     let (lo, hi) = v.bounds();
     assert_close(lo, DVec3::new(-3.0, 0.0, 0.0));
     assert_close(hi, DVec3::new(6.0, 6.0 * 0.75f64.sqrt(), 8.0));
-    let [nx, ny, nz] = v.dims();
-    let mut inside = 0;
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                let g = to_grid * v.world_position(i, j, k);
-                if g.x >= 0.0 && g.x <= 5.0 && g.y >= 0.0 && g.y <= 5.0 && g.z >= 0.0 && g.z <= 3.0
-                {
-                    let want = g.x + 10.0 * g.y + 100.0 * g.z;
-                    let got = f64::from(v.get(i, j, k));
-                    assert!(
-                        (got - want).abs() < 1e-3,
-                        "({i}, {j}, {k}): {got} vs {want}"
-                    );
-                    inside += 1;
-                }
-            }
-        }
-    }
+    let inside = check_resampled(v, to_grid, [5.0, 5.0, 3.0], 1e-3, |g| {
+        g.x + 10.0 * g.y + 100.0 * g.z
+    });
     assert!(inside > 50, "{inside}");
     assert!(has_note(&l, "angle(X, Y) 120.000"), "{:?}", l.info.notes);
 }
@@ -204,14 +165,10 @@ fn put_f32(bytes: &mut [u8], word: usize, v: f32) {
     bytes[4 * (word - 1)..4 * word].copy_from_slice(&v.to_le_bytes());
 }
 
+/// The refusal of fixture `name` with `patch` applied.
 fn error_of(name: &str, patch: impl FnOnce(&mut Vec<u8>)) -> String {
     let (_dir, path) = patched(name, patch);
-    let err = load(&path).unwrap_err();
-    assert!(!err.is_io_failure(), "{err}");
-    let msg = err.to_string();
-    assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-    assert!(!msg.contains('\n'), "{msg}");
-    msg
+    refused(&path, &ReadOptions::default())
 }
 
 #[test]
@@ -320,10 +277,7 @@ fn malformed_headers_are_refused_clearly() {
         "{e}"
     );
     // A map that is one section thin cannot be a volume.
-    let e = {
-        let (_dir, path) = patched("mode2_f32.mrc", |b| put_i32(b, 3, 1));
-        load(&path).unwrap_err().to_string()
-    };
+    let e = error_of("mode2_f32.mrc", |b| put_i32(b, 3, 1));
     assert!(e.contains("at least 2 points"), "{e}");
 }
 
@@ -342,11 +296,7 @@ fn hostile_headers_never_panic() {
         let path = dir.path().join(name);
         let check = |bytes: &[u8]| {
             std::fs::write(&path, bytes).unwrap();
-            if let Err(e) = load(&path) {
-                let msg = e.to_string();
-                assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-                assert!(!msg.contains('\n'), "{msg}");
-            }
+            read_or_refuse(&path, &ReadOptions::default());
         };
         for word in 1..=words {
             for &v in values {
@@ -355,8 +305,8 @@ fn hostile_headers_never_panic() {
                 check(&b);
             }
         }
-        for len in (0..good.len()).step_by(97) {
-            check(&good[..len]);
+        for cut in truncations(&good, 97) {
+            check(cut);
         }
     }
 }

@@ -4,16 +4,17 @@
 //! indexed `a[x, y, z]`, so a correct reader gives `dims == [2, 3, 4]` and
 //! `get(x, y, z) == formula(x, y, z)` whatever the file's memory order.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::PathBuf;
+
+use common::check_voxels;
 use volray_core::Volume;
 use volray_core::glam::DVec3;
 use volray_io::{read_npy, read_volume, write_npy};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures")
-        .join(name)
+    common::fixture("", name)
 }
 
 fn ramp(x: usize, y: usize, z: usize) -> f32 {
@@ -22,20 +23,9 @@ fn ramp(x: usize, y: usize, z: usize) -> f32 {
 
 fn check(name: &str, formula: impl Fn(usize, usize, usize) -> f32) {
     let v = read_npy(&fixture(name)).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(v.dims(), [2, 3, 4], "{name}");
+    check_voxels(name, &v, [2, 3, 4], formula);
     assert_eq!(v.spacing(), DVec3::ONE, "{name}");
     assert_eq!(v.origin(), DVec3::ZERO, "{name}");
-    for z in 0..4 {
-        for y in 0..3 {
-            for x in 0..2 {
-                assert_eq!(
-                    v.get(x, y, z),
-                    formula(x, y, z),
-                    "{name} at ({x}, {y}, {z})"
-                );
-            }
-        }
-    }
 }
 
 #[test]

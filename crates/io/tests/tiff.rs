@@ -4,8 +4,11 @@
 //! Every stack is 4 columns (x) by 3 rows (y) by 5 pages (z) holding
 //! `v = x + 10y + 100z` with a per-file offset or scale.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::PathBuf;
+
+use common::{check_voxels, frame, header_value, ramp, refused, refused_at};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
 use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
@@ -14,9 +17,7 @@ use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
 type Formula = fn(f64, [usize; 3]) -> f64;
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/tiff")
-        .join(name)
+    common::fixture("tiff", name)
 }
 
 fn load(name: &str) -> Loaded {
@@ -29,28 +30,17 @@ fn load_with(name: &str, opts: &ReadOptions) -> Loaded {
     loaded
 }
 
+/// The refusal of fixture `name`.
 fn error(name: &str, opts: &ReadOptions) -> String {
-    let err = read(&fixture(name), opts).expect_err(name);
-    assert!(!err.is_io_failure(), "{err}");
-    let msg = err.to_string();
-    assert!(!msg.contains('\n'), "{msg}");
-    assert!(msg.contains(name), "{msg}");
-    msg
+    refused(&fixture(name), opts)
 }
 
 /// Asserts that voxel (x, y, z) of a 4x3x5 volume holds `f(v)` with
 /// `v = x + 10y + 100z`, exactly.
 fn assert_values(v: &Volume, f: impl Fn(f64, [usize; 3]) -> f64) {
-    assert_eq!(v.dims(), [4, 3, 5]);
-    for z in 0..5 {
-        for y in 0..3 {
-            for x in 0..4 {
-                let base = (x + 10 * y + 100 * z) as f64;
-                let want = f(base, [x, y, z]) as f32;
-                assert_eq!(v.get(x, y, z), want, "voxel ({x}, {y}, {z})");
-            }
-        }
-    }
+    check_voxels("voxel", v, [4, 3, 5], |x, y, z| {
+        f(ramp(x, y, z) as f64, [x, y, z]) as f32
+    });
 }
 
 #[test]
@@ -76,14 +66,9 @@ fn imagej_stack_with_spacing_origin_and_unit() {
     assert_eq!(header[0], "pages");
     assert_eq!(l.info.header[0].1, "5");
     assert!(header.contains(&"ImageWidth"), "{header:?}");
-    let description = l
-        .info
-        .header
-        .iter()
-        .find(|(k, _)| k == "ImageDescription")
-        .unwrap();
+    let description = header_value(&l, "ImageDescription");
     assert!(
-        description.1.starts_with("ImageJ=1.11a; images=5"),
+        description.starts_with("ImageJ=1.11a; images=5"),
         "{description:?}"
     );
 }
@@ -102,11 +87,7 @@ fn imagej_float_stack_with_deflate_pages() {
 fn imagej_hyperstack_volumes_by_frame() {
     // TZCYX = (2, 5, 2, 3, 4): volume n is time n / 2, channel n % 2.
     for n in 0..4 {
-        let opts = ReadOptions {
-            frame: Some(n),
-            ..ReadOptions::default()
-        };
-        let l = load_with("imagej_hyper.tif", &opts);
+        let l = load_with("imagej_hyper.tif", &frame(n));
         let (t, c) = (n / 2, n % 2);
         assert_values(&l.volume, |v, _| v + 1000.0 * c as f64 + 10000.0 * t as f64);
         assert_eq!((l.info.frames, l.info.frame), (4, n));
@@ -122,11 +103,7 @@ fn imagej_hyperstack_volumes_by_frame() {
     // Without --frame the first volume is read.
     let l = load("imagej_hyper.tif");
     assert_values(&l.volume, |v, _| v);
-    let opts = ReadOptions {
-        frame: Some(4),
-        ..ReadOptions::default()
-    };
-    let msg = error("imagej_hyper.tif", &opts);
+    let msg = error("imagej_hyper.tif", &frame(4));
     assert!(
         msg.contains("--frame 4 is out of range: the stack holds 4 volume(s) (2 channel(s) x 2 time point(s))"),
         "{msg}"
@@ -231,80 +208,37 @@ fn unsupported_stacks_are_refused_clearly() {
 #[test]
 fn damaged_files_give_clean_errors() {
     let dir = tempfile::tempdir().unwrap();
+    let none = ReadOptions::default();
     let good = std::fs::read(fixture("imagej_u16.tif")).unwrap();
 
     // Bad magic, forced to TIFF.
-    let p = dir.path().join("magic.tif");
     let mut bytes = good.clone();
     bytes[..2].copy_from_slice(b"XX");
-    std::fs::write(&p, &bytes).unwrap();
-    let err = read(&p, &ReadOptions::default()).unwrap_err();
-    assert!(err.to_string().contains("TIFF header"), "{err}");
+    let msg = refused_at(dir.path(), "magic.tif", &bytes, &none);
+    assert!(msg.contains("TIFF header"), "{msg}");
 
     // Cut short in the pixel data and in the header.
     for len in [good.len() - 40, 12, 3] {
-        let p = dir.path().join(format!("cut{len}.tif"));
-        std::fs::write(&p, &good[..len]).unwrap();
-        let err = read(&p, &ReadOptions::default()).unwrap_err();
-        assert!(!err.is_io_failure(), "{err}");
-        assert!(
-            err.to_string().starts_with(&p.display().to_string()),
-            "{err}"
-        );
+        refused_at(dir.path(), &format!("cut{len}.tif"), &good[..len], &none);
     }
 
     // Pages that claim 60000 x 60000 pixels in a 1 KB file are refused
     // before decoding (here by the decoder's strip-size check; compressed
     // pages by the reader's decoded-size bound, tested in the module).
-    let p = dir.path().join("huge.tif");
-    std::fs::write(&p, patch_dimensions(&good, 60000)).unwrap();
-    let err = read(&p, &ReadOptions::default()).unwrap_err();
-    assert!(!err.is_io_failure(), "{err}");
-    assert!(err.to_string().contains(": TIFF "), "{err}");
-}
-
-/// Overwrites `count` pseudo-random bytes of `bytes` (a fixed LCG, so the
-/// test is deterministic), sometimes cutting the file short too.
-fn mutate(bytes: &[u8], seed: &mut u64, count: usize) -> Vec<u8> {
-    let mut next = || {
-        *seed = seed
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        *seed >> 33
-    };
-    let mut out = bytes.to_vec();
-    for _ in 0..count {
-        let at = next() as usize % out.len();
-        out[at] = match next() % 3 {
-            0 => 0xff,
-            1 => 0,
-            _ => next() as u8,
-        };
-    }
-    if next() % 4 == 0 {
-        out.truncate(next() as usize % out.len() + 1);
-    }
-    out
+    let huge = patch_dimensions(&good, 60000);
+    let msg = refused_at(dir.path(), "huge.tif", &huge, &none);
+    assert!(msg.contains(": TIFF "), "{msg}");
 }
 
 #[test]
 fn mutated_files_never_panic() {
     // Every fixture with bytes overwritten at random: a volume or a
     // one-line bad-input error, never a panic.
-    let dir = tempfile::tempdir().unwrap();
-    let target = dir.path().join("m.tif");
-    let mut seed = 11;
-    for e in std::fs::read_dir(fixture("")).unwrap() {
-        let p = e.unwrap().path();
-        let bytes = std::fs::read(&p).unwrap();
-        for n in 1..=8 {
-            std::fs::write(&target, mutate(&bytes, &mut seed, n)).unwrap();
-            if let Err(e) = read(&target, &ReadOptions::default()) {
-                assert!(!e.is_io_failure(), "{}: {e}", p.display());
-                assert!(!e.to_string().contains('\n'), "{e}");
-            }
-        }
-    }
+    let files: Vec<PathBuf> = std::fs::read_dir(fixture(""))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    common::mutations_never_panic(&files, "m.tif", 11);
 }
 
 /// Rewrites the ImageWidth (256) and ImageLength (257) SHORT/LONG values of

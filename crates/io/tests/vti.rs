@@ -5,49 +5,25 @@
 //! that broken files made here are refused with specific messages.
 //!
 //! Every image has 4 x 3 x 5 points, spacing (0.5, 2, 1.5), origin
-//! (-1, 2, 3); point arrays hold v(i, j, k) = i + 10j + 100k through the
+//! (-1, 2, 3); point arrays hold ramp(i, j, k) = i + 10j + 100k through the
 //! script's per-type formula, cell arrays c = i + 10j + 100k + 0.5 on the
 //! 3 x 2 x 4 cells. Values are checked at their world positions, so the
 //! check does not depend on how the reader lays out a rotated grid.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::PathBuf;
+
+use common::{Grid, header_value, ramp, refused_file, replace, typed, with_array};
 use volray_core::glam::DVec3;
 use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/vtk")
-        .join(name)
-}
-
-fn v(i: usize, j: usize, k: usize) -> i64 {
-    (i + 10 * j + 100 * k) as i64
-}
-
-/// The value the script stored for type `name` at v (`TYPES` in the script).
-fn typed(name: &str, v: i64) -> f32 {
-    match name {
-        "u8" => (v % 256) as u8 as f32,
-        "i8" => (v % 256 - 128) as i8 as f32,
-        "u16" => (v + 60000) as u16 as f32,
-        "i16" => (v - 1000) as i16 as f32,
-        "u32" => (v + 3_000_000_000) as u32 as f32,
-        "i32" => (v - 2_000_000) as i32 as f32,
-        "u64" => (v as u64 + (1 << 40)) as f32,
-        "i64" => (v - (1 << 40)) as f32,
-        "f32" => v as f32 + 0.25,
-        "f64" => (v as f64 - 0.125) as f32,
-        _ => unreachable!("{name}"),
-    }
+    common::fixture("vtk", name)
 }
 
 fn read_with(name: &str, array: Option<&str>) -> Result<Loaded, IoError> {
-    let opts = ReadOptions {
-        array: array.map(str::to_string),
-        ..ReadOptions::default()
-    };
-    read(&fixture(name), &opts)
+    read(&fixture(name), &with_array(array))
 }
 
 fn load(name: &str, array: Option<&str>) -> Loaded {
@@ -56,78 +32,44 @@ fn load(name: &str, array: Option<&str>) -> Loaded {
     l
 }
 
-/// A grid of `n` samples per axis whose sample (i, j, k) sits at
-/// `origin + i·steps[0] + j·steps[1] + k·steps[2]` must hold `want(i, j, k)`
-/// at that world position in the volume.
-fn check_world(
-    name: &str,
-    l: &Loaded,
-    n: [usize; 3],
-    steps: [DVec3; 3],
-    origin: DVec3,
-    want: impl Fn(usize, usize, usize) -> f32,
-) {
-    let vol = &l.volume;
-    assert_eq!(vol.len(), n[0] * n[1] * n[2], "{name}");
-    for k in 0..n[2] {
-        for j in 0..n[1] {
-            for i in 0..n[0] {
-                let world =
-                    origin + steps[0] * i as f64 + steps[1] * j as f64 + steps[2] * k as f64;
-                let g = (world - vol.origin()) / vol.spacing();
-                let idx = [g.x, g.y, g.z].map(|x| {
-                    let r = x.round();
-                    assert!(
-                        (x - r).abs() < 1e-9,
-                        "{name}: ({i}, {j}, {k}) at {world} is off the grid"
-                    );
-                    r as usize
-                });
-                assert_eq!(
-                    vol.get(idx[0], idx[1], idx[2]),
-                    want(i, j, k),
-                    "{name} at ({i}, {j}, {k})"
-                );
-            }
-        }
-    }
-}
+/// The point grid of every fixture.
+const POINTS: Grid = Grid {
+    n: [4, 3, 5],
+    steps: [
+        DVec3::new(0.5, 0.0, 0.0),
+        DVec3::new(0.0, 2.0, 0.0),
+        DVec3::new(0.0, 0.0, 1.5),
+    ],
+    origin: DVec3::new(-1.0, 2.0, 3.0),
+};
 
-const STEPS: [DVec3; 3] = [
-    DVec3::new(0.5, 0.0, 0.0),
-    DVec3::new(0.0, 2.0, 0.0),
-    DVec3::new(0.0, 0.0, 1.5),
-];
-const ORIGIN: DVec3 = DVec3::new(-1.0, 2.0, 3.0);
+/// Every sample of `grid` at its world position in the volume of `l`.
+fn check_world(name: &str, l: &Loaded, grid: &Grid, want: impl Fn(usize, usize, usize) -> f32) {
+    common::check_world(name, &l.volume, grid, 1e-9, want);
+}
 
 fn check_ramp(name: &str, l: &Loaded) {
     assert_eq!(l.volume.dims(), [4, 3, 5], "{name}");
     assert_eq!(l.volume.spacing(), DVec3::new(0.5, 2.0, 1.5), "{name}");
-    assert_eq!(l.volume.origin(), ORIGIN, "{name}");
-    check_world(name, l, [4, 3, 5], STEPS, ORIGIN, |i, j, k| {
-        typed("f32", v(i, j, k))
-    });
+    assert_eq!(l.volume.origin(), POINTS.origin, "{name}");
+    check_world(name, l, &POINTS, |i, j, k| typed("f32", ramp(i, j, k)));
 }
 
-fn check_cells(name: &str, l: &Loaded, steps: [DVec3; 3], origin: DVec3) {
-    let centre = origin + (steps[0] + steps[1] + steps[2]) * 0.5;
-    check_world(name, l, [3, 2, 4], steps, centre, |i, j, k| {
-        v(i, j, k) as f32 + 0.5
-    });
+/// The cell array on the cells of the point grid `points`: 3 x 2 x 4
+/// values at the cell centres.
+fn check_cells(name: &str, l: &Loaded, points: &Grid) {
+    let [s0, s1, s2] = points.steps;
+    let cells = Grid {
+        n: [3, 2, 4],
+        origin: points.origin + (s0 + s1 + s2) * 0.5,
+        ..*points
+    };
+    check_world(name, l, &cells, |i, j, k| ramp(i, j, k) as f32 + 0.5);
     assert!(
         l.info.notes.iter().any(|n| n.contains("3x2x4 cells")),
         "{:?}",
         l.info.notes
     );
-}
-
-fn header_value<'a>(l: &'a Loaded, key: &str) -> &'a str {
-    l.info
-        .header
-        .iter()
-        .find(|(k, _)| k == key)
-        .map(|(_, v)| v.as_str())
-        .unwrap_or_else(|| panic!("no header field {key}: {:?}", l.info.header))
 }
 
 const VARIANTS: [(&str, &str); 11] = [
@@ -174,13 +116,11 @@ fn every_data_mode_encoding_and_compression() {
 
         let l = load(file, Some("other"));
         assert_eq!(l.info.stored_type, format!("UInt8 ({endian}-endian)"));
-        check_world(file, &l, [4, 3, 5], STEPS, ORIGIN, |i, j, k| {
-            typed("u8", v(i, j, k))
-        });
+        check_world(file, &l, &POINTS, |i, j, k| typed("u8", ramp(i, j, k)));
 
         let l = load(file, Some("cells"));
         assert_eq!(l.volume.dims(), [3, 2, 4]);
-        check_cells(file, &l, STEPS, ORIGIN);
+        check_cells(file, &l, &POINTS);
 
         for (name, n) in [("velocity", 3), ("pair a", 2)] {
             let err = read_with(file, Some(name)).unwrap_err();
@@ -212,9 +152,7 @@ fn every_sample_type() {
         "u8", "i8", "u16", "i16", "u32", "i32", "u64", "i64", "f32", "f64",
     ] {
         let l = load("vti_types.vti", Some(name));
-        check_world(name, &l, [4, 3, 5], STEPS, ORIGIN, |i, j, k| {
-            typed(name, v(i, j, k))
-        });
+        check_world(name, &l, &POINTS, |i, j, k| typed(name, ramp(i, j, k)));
     }
     // No active scalars: the first one-component point array.
     let l = load("vti_types.vti", None);
@@ -244,15 +182,18 @@ fn several_pieces_are_assembled() {
 #[test]
 fn direction_matrix_and_extent_offsets() {
     // Direction "0 -1 0 1 0 0 0 0 1" (row-major): i along +y, j along -x.
-    let steps = [
-        DVec3::new(0.0, 0.5, 0.0),
-        DVec3::new(-2.0, 0.0, 0.0),
-        DVec3::new(0.0, 0.0, 1.5),
-    ];
+    let rotated = Grid {
+        steps: [
+            DVec3::new(0.0, 0.5, 0.0),
+            DVec3::new(-2.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.5),
+        ],
+        ..POINTS
+    };
     let l = load("vti_direction.vti", None);
     assert_eq!(l.volume.dims(), [3, 4, 5]);
-    check_world("direction", &l, [4, 3, 5], steps, ORIGIN, |i, j, k| {
-        typed("f32", v(i, j, k))
+    check_world("direction", &l, &rotated, |i, j, k| {
+        typed("f32", ramp(i, j, k))
     });
     assert!(
         l.info
@@ -261,17 +202,18 @@ fn direction_matrix_and_extent_offsets() {
             .any(|n| n.contains("index axis 0 -> +y, index axis 1 -> -x"))
     );
     let l = load("vti_direction.vti", Some("cells"));
-    check_cells("direction cells", &l, steps, ORIGIN);
+    check_cells("direction cells", &l, &rotated);
 
     // Extent 2..5, 1..3, 0..4: the first point is at Origin + (2, 1, 0)·Spacing.
-    let first = ORIGIN + DVec3::new(1.0, 2.0, 0.0);
+    let offset = Grid {
+        origin: POINTS.origin + DVec3::new(1.0, 2.0, 0.0),
+        ..POINTS
+    };
     let l = load("vti_extent.vti", None);
-    assert_eq!(l.volume.origin(), first);
-    check_world("extent", &l, [4, 3, 5], STEPS, first, |i, j, k| {
-        typed("f32", v(i, j, k))
-    });
+    assert_eq!(l.volume.origin(), offset.origin);
+    check_world("extent", &l, &offset, |i, j, k| typed("f32", ramp(i, j, k)));
     let l = load("vti_extent.vti", Some("cells"));
-    check_cells("extent cells", &l, STEPS, first);
+    check_cells("extent cells", &l, &offset);
 }
 
 #[test]
@@ -288,27 +230,11 @@ fn lz4_is_refused_clearly() {
 // ---- broken files ----
 
 fn error_for(bytes: &[u8]) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("bad.vti");
-    std::fs::write(&p, bytes).unwrap();
-    let err = read(&p, &ReadOptions::default()).unwrap_err();
-    assert!(!err.is_io_failure(), "{err}");
-    let msg = err.to_string();
-    assert!(!msg.contains('\n'), "{msg}");
-    assert!(msg.starts_with(&p.display().to_string()), "{msg}");
-    msg
+    refused_file("bad.vti", bytes, &ReadOptions::default())
 }
 
 fn fixture_text(name: &str) -> Vec<u8> {
     std::fs::read(fixture(name)).unwrap()
-}
-
-fn replace(bytes: &[u8], from: &str, to: &str) -> Vec<u8> {
-    let at = bytes
-        .windows(from.len())
-        .position(|w| w == from.as_bytes())
-        .unwrap_or_else(|| panic!("{from} not found"));
-    [&bytes[..at], to.as_bytes(), &bytes[at + from.len()..]].concat()
 }
 
 #[test]
@@ -319,10 +245,7 @@ fn truncated_appended_data() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("cut.vti");
     std::fs::write(&p, &b[..b.len() - 100]).unwrap();
-    let opts = ReadOptions {
-        array: Some("cells".into()),
-        ..ReadOptions::default()
-    };
+    let opts = with_array(Some("cells"));
     let msg = read(&p, &opts).unwrap_err().to_string();
     assert!(
         msg.contains("appended DataArray \"cells\": the file ends inside its data"),
@@ -465,51 +388,22 @@ fn malformed_files() {
     assert!(msg.contains("holds more than the 60 values"), "{msg}");
 }
 
-/// Deterministic byte flips and truncations of a few fixtures: each read
-/// either succeeds or fails with a one-line message; none panics.
+/// Deterministic byte flips and truncations of a few fixtures, each read
+/// for its point and its cell array: a volume or a one-line message,
+/// never a panic.
 #[test]
 fn no_panic_on_truncation_or_corruption() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut seed = 0xd1b5_4a32_d192_ed03u64;
-    for name in [
+    let fixtures = [
         "vti_binary_zlib.vti",
         "vti_appended_raw_zlib.vti",
         "vti_appended_base64_zlib_u32.vti",
         "vti_binary.vti",
         "vti_pieces.vti",
-    ] {
-        let good = std::fs::read(fixture(name)).unwrap();
-        let p = dir.path().join(name);
-        let mut variants: Vec<Vec<u8>> = (0..good.len())
-            .step_by(good.len() / 25 + 1)
-            .map(|n| good[..n].to_vec())
-            .collect();
-        for _ in 0..30 {
-            let mut b = good.clone();
-            for _ in 0..3 {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                let at = (seed % b.len() as u64) as usize;
-                b[at] = (seed >> 32) as u8;
-            }
-            variants.push(b);
-        }
-        for b in variants {
-            std::fs::write(&p, &b).unwrap();
-            for array in [None, Some("cells".to_string())] {
-                let opts = ReadOptions {
-                    array,
-                    ..ReadOptions::default()
-                };
-                if let Err(e) = read(&p, &opts) {
-                    let msg = e.to_string();
-                    assert!(
-                        !msg.contains('\n') && msg.starts_with(&p.display().to_string()),
-                        "{msg}"
-                    );
-                }
-            }
-        }
-    }
+    ]
+    .map(fixture);
+    common::byte_flips_never_panic(
+        &fixtures,
+        0xd1b5_4a32_d192_ed03,
+        &[ReadOptions::default(), with_array(Some("cells"))],
+    );
 }

@@ -4,48 +4,24 @@
 //! checks that broken files made here are refused with specific messages.
 //!
 //! Every image has 4 x 3 x 5 points, spacing (0.5, 2, 1.5), origin
-//! (-1, 2, 3); point arrays hold v(i, j, k) = i + 10j + 100k through the
+//! (-1, 2, 3); point arrays hold ramp(i, j, k) = i + 10j + 100k through the
 //! script's per-type formula, cell arrays c = i + 10j + 100k + 0.5 on the
 //! 3 x 2 x 4 cells.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::PathBuf;
+
+use common::{check_voxels, header_value, ramp, refused_file, typed, with_array};
 use volray_core::glam::DVec3;
-use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/vtk")
-        .join(name)
+    common::fixture("vtk", name)
 }
 
-fn v(i: usize, j: usize, k: usize) -> i64 {
-    (i + 10 * j + 100 * k) as i64
-}
-
-/// The value the script stored for type `name` at v (`TYPES` in the script).
-fn typed(name: &str, v: i64) -> f32 {
-    match name {
-        "u8" => (v % 256) as u8 as f32,
-        "i8" => (v % 256 - 128) as i8 as f32,
-        "u16" => (v + 60000) as u16 as f32,
-        "i16" => (v - 1000) as i16 as f32,
-        "u32" => (v + 3_000_000_000) as u32 as f32,
-        "i32" => (v - 2_000_000) as i32 as f32,
-        "u64" => (v as u64 + (1 << 40)) as f32,
-        "i64" => (v - (1 << 40)) as f32,
-        "f32" => v as f32 + 0.25,
-        "f64" => (v as f64 - 0.125) as f32,
-        _ => unreachable!("{name}"),
-    }
-}
-
-fn read_with(name: &str, array: Option<&str>) -> Result<Loaded, volray_io::IoError> {
-    let opts = ReadOptions {
-        array: array.map(str::to_string),
-        ..ReadOptions::default()
-    };
-    read(&fixture(name), &opts)
+fn read_with(name: &str, array: Option<&str>) -> Result<Loaded, IoError> {
+    read(&fixture(name), &with_array(array))
 }
 
 fn load(name: &str, array: Option<&str>) -> Loaded {
@@ -60,13 +36,7 @@ fn check_points(name: &str, l: &Loaded, want: impl Fn(usize, usize, usize) -> f3
     assert_eq!(vol.dims(), [4, 3, 5], "{name}");
     assert_eq!(vol.spacing(), DVec3::new(0.5, 2.0, 1.5), "{name}");
     assert_eq!(vol.origin(), DVec3::new(-1.0, 2.0, 3.0), "{name}");
-    for k in 0..5 {
-        for j in 0..3 {
-            for i in 0..4 {
-                assert_eq!(vol.get(i, j, k), want(i, j, k), "{name} at ({i}, {j}, {k})");
-            }
-        }
-    }
+    check_voxels(name, vol, [4, 3, 5], want);
 }
 
 /// The cell-centre grid: 3 x 2 x 4 voxels half a step inside.
@@ -75,17 +45,7 @@ fn check_cells(name: &str, l: &Loaded) {
     assert_eq!(vol.dims(), [3, 2, 4], "{name}");
     assert_eq!(vol.spacing(), DVec3::new(0.5, 2.0, 1.5), "{name}");
     assert_eq!(vol.origin(), DVec3::new(-0.75, 3.0, 3.75), "{name}");
-    for k in 0..4 {
-        for j in 0..2 {
-            for i in 0..3 {
-                assert_eq!(
-                    vol.get(i, j, k),
-                    v(i, j, k) as f32 + 0.5,
-                    "{name} at cell ({i}, {j}, {k})"
-                );
-            }
-        }
-    }
+    check_voxels(name, vol, [3, 2, 4], |i, j, k| ramp(i, j, k) as f32 + 0.5);
     assert!(
         l.info
             .notes
@@ -94,15 +54,6 @@ fn check_cells(name: &str, l: &Loaded) {
         "{:?}",
         l.info.notes
     );
-}
-
-fn header_value<'a>(l: &'a Loaded, key: &str) -> &'a str {
-    l.info
-        .header
-        .iter()
-        .find(|(k, _)| k == key)
-        .map(|(_, v)| v.as_str())
-        .unwrap_or_else(|| panic!("no header field {key}: {:?}", l.info.header))
 }
 
 #[test]
@@ -122,7 +73,7 @@ fn every_sample_type_in_binary_files() {
     for (name, vtk_type) in types {
         let file = format!("legacy_{name}.vtk");
         let l = load(&file, None);
-        check_points(&file, &l, |i, j, k| typed(name, v(i, j, k)));
+        check_points(&file, &l, |i, j, k| typed(name, ramp(i, j, k)));
         assert_eq!(
             l.info.stored_type,
             format!("{vtk_type} (big-endian)"),
@@ -153,7 +104,7 @@ fn ascii_files_of_several_versions() {
     for name in ["f32", "f64", "i16", "u8"] {
         let file = format!("legacy_{name}_ascii.vtk");
         let l = load(&file, None);
-        check_points(&file, &l, |i, j, k| typed(name, v(i, j, k)));
+        check_points(&file, &l, |i, j, k| typed(name, ramp(i, j, k)));
         assert!(
             l.info.stored_type.ends_with("(ASCII)"),
             "{}",
@@ -165,7 +116,7 @@ fn ascii_files_of_several_versions() {
     let l = load("legacy_u8_ascii.vtk", None);
     assert_eq!(header_value(&l, "COLOR_SCALARS"), "v 1");
     let l = load("legacy_v42_ascii.vtk", None);
-    check_points("v42", &l, |i, j, k| typed("f32", v(i, j, k)));
+    check_points("v42", &l, |i, j, k| typed("f32", ramp(i, j, k)));
     assert_eq!(header_value(&l, "version"), "4.2");
 }
 
@@ -174,7 +125,7 @@ fn several_arrays_default_and_by_name() {
     for file in ["legacy_multi_ascii.vtk", "legacy_multi_binary.vtk"] {
         // Default: the point SCALARS, although CELL_DATA comes first.
         let l = load(file, None);
-        check_points(file, &l, |i, j, k| typed("f32", v(i, j, k)));
+        check_points(file, &l, |i, j, k| typed("f32", ramp(i, j, k)));
         assert_eq!(
             l.info.arrays,
             ["cells", "ramp", "velocity", "other", "pair a"]
@@ -183,7 +134,7 @@ fn several_arrays_default_and_by_name() {
 
         // A FIELD array after the VECTORS and before a METADATA block.
         let l = load(file, Some("other"));
-        check_points(file, &l, |i, j, k| typed("u8", v(i, j, k)));
+        check_points(file, &l, |i, j, k| typed("u8", ramp(i, j, k)));
         assert!(
             l.info.stored_type.starts_with("unsigned_char"),
             "{}",
@@ -235,15 +186,7 @@ fn cell_data_only() {
 // ---- broken files ----
 
 fn error_for(bytes: &[u8]) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("bad.vtk");
-    std::fs::write(&p, bytes).unwrap();
-    let err = read(&p, &ReadOptions::default()).unwrap_err();
-    assert!(!err.is_io_failure(), "{err}");
-    let msg = err.to_string();
-    assert!(!msg.contains('\n'), "{msg}");
-    assert!(msg.starts_with(&p.display().to_string()), "{msg}");
-    msg
+    refused_file("bad.vtk", bytes, &ReadOptions::default())
 }
 
 const HEAD: &str =
@@ -394,49 +337,24 @@ fn malformed_files() {
     );
 }
 
-/// Deterministic byte flips and truncations of a few fixtures: each read
-/// either succeeds or fails with a one-line message; none panics.
+/// Deterministic byte flips and truncations of a few fixtures, each read
+/// for its default, cell and field array: a volume or a one-line message,
+/// never a panic.
 #[test]
 fn no_panic_on_truncation_or_corruption() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    for name in [
+    let fixtures = [
         "legacy_multi_binary.vtk",
         "legacy_multi_ascii.vtk",
         "legacy_u8.vtk",
-    ] {
-        let good = std::fs::read(fixture(name)).unwrap();
-        let p = dir.path().join(name);
-        let mut variants: Vec<Vec<u8>> = (0..good.len())
-            .step_by(good.len() / 25 + 1)
-            .map(|n| good[..n].to_vec())
-            .collect();
-        for _ in 0..30 {
-            let mut b = good.clone();
-            for _ in 0..3 {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                let at = (seed % b.len() as u64) as usize;
-                b[at] = (seed >> 32) as u8;
-            }
-            variants.push(b);
-        }
-        for b in variants {
-            std::fs::write(&p, &b).unwrap();
-            for array in [None, Some("cells".to_string()), Some("other".to_string())] {
-                let opts = ReadOptions {
-                    array,
-                    ..ReadOptions::default()
-                };
-                if let Err(e) = read(&p, &opts) {
-                    let msg = e.to_string();
-                    assert!(
-                        !msg.contains('\n') && msg.starts_with(&p.display().to_string()),
-                        "{msg}"
-                    );
-                }
-            }
-        }
-    }
+    ]
+    .map(fixture);
+    common::byte_flips_never_panic(
+        &fixtures,
+        0x9e37_79b9_7f4a_7c15,
+        &[
+            ReadOptions::default(),
+            with_array(Some("cells")),
+            with_array(Some("other")),
+        ],
+    );
 }

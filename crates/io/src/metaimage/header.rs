@@ -5,13 +5,10 @@
 
 use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 use crate::error::IoError;
-
-/// Largest header accepted, in bytes, including a `LIST` of data files.
-const MAX_HEADER: u64 = 16 << 20;
+use crate::text_header::{HeaderFormat, HeaderLines, MAX_HEADER};
 
 /// A MetaImage header split into its fields.
 #[derive(Debug, Default)]
@@ -34,56 +31,31 @@ impl Header {
 
     /// Reads the header at the start of `file` (its length `file_len`).
     pub(super) fn read(path: &Path, file: File, file_len: u64) -> Result<Header, IoError> {
-        let mut reader = BufReader::new(file.take(MAX_HEADER.min(file_len)));
+        let mut lines = HeaderLines::new(file, file_len);
         let mut header = Header::default();
-        let mut pos = 0u64;
-        let mut line_no = 0usize;
-        let mut buf = Vec::new();
         let mut in_list = false;
-        loop {
-            buf.clear();
-            let n = reader
-                .read_until(b'\n', &mut buf)
-                .map_err(|e| IoError::os(path, "read", e))?;
-            if n == 0 {
-                if in_list {
-                    return Ok(header);
-                }
-                let why = if pos >= MAX_HEADER {
-                    format!("no ElementDataFile field in the first {MAX_HEADER} bytes")
-                } else if header.written.is_empty() {
-                    "not a MetaImage header: no \"Key = Value\" lines".to_string()
-                } else {
-                    "MetaImage header has no ElementDataFile field (it is required, as the last field)".to_string()
-                };
-                return Err(IoError::invalid(path, why));
-            }
-            pos += n as u64;
-            line_no += 1;
-            while matches!(buf.last(), Some(b'\n' | b'\r')) {
-                buf.pop();
-            }
-            let line = std::str::from_utf8(&buf).map_err(|_| {
-                IoError::invalid(
-                    path,
-                    format!("MetaImage header line {line_no} is not text: is the ElementDataFile field missing?"),
-                )
-            })?;
+        while let Some(line) = lines.next(path)? {
+            let line_no = line.number;
+            let text = line.text(
+                path,
+                HeaderFormat::MetaImage,
+                "is the ElementDataFile field missing?",
+            )?;
             if in_list {
-                if !line.trim().is_empty() {
-                    header.list.push(line.trim().to_string());
+                if !text.trim().is_empty() {
+                    header.list.push(text.trim().to_string());
                 }
                 continue;
             }
-            if line.trim().is_empty() {
+            if text.trim().is_empty() {
                 continue;
             }
-            let Some((key, value)) = line.split_once('=') else {
+            let Some((key, value)) = text.split_once('=') else {
                 return Err(IoError::invalid(
                     path,
                     format!(
                         "MetaImage header line {line_no} (\"{}\") is not \"Key = Value\"",
-                        line.chars().take(60).collect::<String>().escape_debug()
+                        text.chars().take(60).collect::<String>().escape_debug()
                     ),
                 ));
             };
@@ -100,7 +72,7 @@ impl Header {
                 ));
             }
             if key == "ElementDataFile" {
-                header.data_offset = pos;
+                header.data_offset = line.end;
                 if value.starts_with("LIST") {
                     in_list = true;
                 } else {
@@ -108,6 +80,18 @@ impl Header {
                 }
             }
         }
+        if in_list {
+            return Ok(header);
+        }
+        let why = if lines.hit_limit() {
+            format!("no ElementDataFile field in the first {MAX_HEADER} bytes")
+        } else if header.written.is_empty() {
+            "not a MetaImage header: no \"Key = Value\" lines".to_string()
+        } else {
+            "MetaImage header has no ElementDataFile field (it is required, as the last field)"
+                .to_string()
+        };
+        Err(IoError::invalid(path, why))
     }
 }
 

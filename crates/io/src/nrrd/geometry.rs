@@ -8,8 +8,9 @@ use std::path::Path;
 use volray_core::glam::DVec3;
 
 use super::header::Header;
-use super::values::{numbers, parse_uint, quoted, vectors, words};
+use super::values::{quoted, vectors};
 use crate::error::IoError;
+use crate::text_header::Field;
 
 /// Axis kinds that describe positions in space (`???` and `none` say
 /// nothing and count as spatial).
@@ -132,10 +133,7 @@ fn parse_space(path: &Path, name: &str) -> Result<Space, IoError> {
             true,
         ),
         _ => {
-            return Err(IoError::invalid(
-                path,
-                format!("NRRD field \"space\": unknown space \"{name}\""),
-            ));
+            return Err(Field::nrrd(path, "space").error(format!("unknown space \"{name}\"")));
         }
     })
 }
@@ -161,9 +159,7 @@ impl Geometry {
         notes: &mut Vec<String>,
     ) -> Result<Geometry, IoError> {
         let dim = sizes.len();
-        let bad = |field: &str, why: String| {
-            IoError::invalid(path, format!("NRRD field \"{field}\": {why}"))
-        };
+        let bad = |field, why: String| Field::nrrd(path, field).error(why);
 
         let space = header
             .get("space")
@@ -171,7 +167,7 @@ impl Geometry {
             .transpose()?;
         let space_dim = match (header.get("space dimension"), &space) {
             (Some(v), Some(s)) => {
-                let d = parse_uint(path, "space dimension", v)?;
+                let d = Field::nrrd(path, "space dimension").uint(v)?;
                 if d != s.dim {
                     return Err(bad(
                         "space dimension",
@@ -180,7 +176,7 @@ impl Geometry {
                 }
                 Some(d)
             }
-            (Some(v), None) => Some(parse_uint(path, "space dimension", v)?),
+            (Some(v), None) => Some(Field::nrrd(path, "space dimension").uint(v)?),
             (None, Some(s)) => Some(s.dim),
             (None, None) => None,
         };
@@ -199,7 +195,8 @@ impl Geometry {
 
         let kinds = match header.get("kinds") {
             Some(v) => {
-                let k: Vec<String> = words(path, "kinds", v, dim)?
+                let k: Vec<String> = Field::nrrd(path, "kinds")
+                    .words(v, dim)?
                     .iter()
                     .map(|s| s.to_string())
                     .collect();
@@ -313,19 +310,20 @@ impl Geometry {
 
         let spacings = header
             .get("spacings")
-            .map(|v| numbers(path, "spacings", v, dim))
+            .map(|v| Field::nrrd(path, "spacings").numbers(v, dim))
             .transpose()?;
         let mins = header
             .get("axis mins")
-            .map(|v| numbers(path, "axis mins", v, dim))
+            .map(|v| Field::nrrd(path, "axis mins").numbers(v, dim))
             .transpose()?;
         let maxs = header
             .get("axis maxs")
-            .map(|v| numbers(path, "axis maxs", v, dim))
+            .map(|v| Field::nrrd(path, "axis maxs").numbers(v, dim))
             .transpose()?;
         let centers = match header.get("centers") {
             Some(v) => {
-                let c: Vec<String> = words(path, "centers", v, dim)?
+                let c: Vec<String> = Field::nrrd(path, "centers")
+                    .words(v, dim)?
                     .iter()
                     .map(|s| s.to_ascii_lowercase())
                     .collect();

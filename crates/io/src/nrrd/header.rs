@@ -6,14 +6,10 @@
 
 use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 use crate::error::IoError;
-
-/// Largest header accepted, in bytes. Real headers are a few kilobytes; a
-/// `data file: LIST` of ten thousand slice names is a few hundred.
-const MAX_HEADER: u64 = 16 << 20;
+use crate::text_header::{HeaderFormat, HeaderLines, MAX_HEADER};
 
 /// Every field the format defines, by canonical name, with the other
 /// spellings teem accepts.
@@ -88,72 +84,45 @@ impl Header {
 
     /// Reads the header at the start of `file` (its length `file_len`).
     pub(super) fn read(path: &Path, file: File, file_len: u64) -> Result<Header, IoError> {
-        let mut reader = BufReader::new(file.take(MAX_HEADER.min(file_len)));
+        let mut lines = HeaderLines::new(file, file_len);
         let mut header = Header::default();
-        let mut pos = 0u64;
-        let mut line_no = 0usize;
-        let mut buf = Vec::new();
         let mut in_list = false;
-        loop {
-            buf.clear();
-            let n = reader
-                .read_until(b'\n', &mut buf)
-                .map_err(|e| IoError::os(path, "read", e))?;
-            if n == 0 {
-                if pos >= MAX_HEADER {
-                    return Err(IoError::invalid(
-                        path,
-                        format!(
-                            "the NRRD header has no end within its first {MAX_HEADER} bytes (no blank line)"
-                        ),
-                    ));
-                }
-                if line_no == 0 {
-                    return Err(IoError::invalid(path, "empty file: not a NRRD file"));
-                }
-                break;
-            }
-            pos += n as u64;
-            line_no += 1;
-            let ended = buf.last() == Some(&b'\n');
-            while matches!(buf.last(), Some(b'\n' | b'\r')) {
-                buf.pop();
-            }
-            if line_no == 1 {
-                header.version = parse_magic(path, &buf)?;
+        while let Some(line) = lines.next(path)? {
+            if line.number == 1 {
+                header.version = parse_magic(path, line.bytes)?;
                 continue;
             }
-            let line = std::str::from_utf8(&buf).map_err(|_| {
-                IoError::invalid(
-                    path,
-                    format!("NRRD header line {line_no} is not text: is the blank line before the data missing?"),
-                )
-            })?;
+            let line_no = line.number;
+            let text = line.text(
+                path,
+                HeaderFormat::Nrrd,
+                "is the blank line before the data missing?",
+            )?;
             if in_list {
-                if line.trim().is_empty() {
-                    header.data_offset = Some(pos);
-                    break;
+                if text.trim().is_empty() {
+                    header.data_offset = Some(line.end);
+                    return Ok(header);
                 }
-                header.list.push(line.trim().to_string());
+                header.list.push(text.trim().to_string());
                 continue;
             }
-            if line.is_empty() {
-                header.data_offset = ended.then_some(pos);
-                break;
+            if text.is_empty() {
+                header.data_offset = line.ended.then_some(line.end);
+                return Ok(header);
             }
-            if line.starts_with('#') {
+            if text.starts_with('#') {
                 continue;
             }
-            let Some(colon) = line.find(':') else {
+            let Some(colon) = text.find(':') else {
                 return Err(IoError::invalid(
                     path,
                     format!(
                         "NRRD header line {line_no} (\"{}\") is neither \"field: value\" nor \"key:=value\"",
-                        line.escape_debug()
+                        text.escape_debug()
                     ),
                 ));
             };
-            let (name, rest) = (&line[..colon], &line[colon + 1..]);
+            let (name, rest) = (&text[..colon], &text[colon + 1..]);
             if let Some(value) = rest.strip_prefix('=') {
                 header.written.push((name.to_string(), value.to_string()));
                 continue;
@@ -174,6 +143,18 @@ impl Header {
                 }
                 None => header.unknown.push(name.to_string()),
             }
+        }
+        // The file (or the bound) ends before a blank line: no attached data.
+        if lines.hit_limit() {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "the NRRD header has no end within its first {MAX_HEADER} bytes (no blank line)"
+                ),
+            ));
+        }
+        if lines.count() == 0 {
+            return Err(IoError::invalid(path, "empty file: not a NRRD file"));
         }
         Ok(header)
     }

@@ -1,11 +1,12 @@
-//! Parsing the values of NRRD header fields: integers, per-axis lists of
-//! words and numbers, quoted strings, and space vectors `(x,y,z)`, each
-//! error naming the field and the value.
+//! Parsing the values of NRRD header fields that only NRRD has: quoted
+//! strings and space vectors `(x,y,z)`, each error naming the field and
+//! the value (integers and per-axis lists: [`Field`]).
 
 use std::path::Path;
 
 use super::header::Header;
 use crate::error::IoError;
+use crate::text_header::Field;
 
 /// The value of a field the format requires.
 pub(super) fn required<'h>(
@@ -13,62 +14,7 @@ pub(super) fn required<'h>(
     header: &'h Header,
     field: &str,
 ) -> Result<&'h str, IoError> {
-    header.get(field).ok_or_else(|| {
-        IoError::invalid(
-            path,
-            format!("NRRD header has no \"{field}\" field (it is required)"),
-        )
-    })
-}
-
-pub(super) fn parse_uint(path: &Path, field: &str, value: &str) -> Result<usize, IoError> {
-    value.trim().parse().map_err(|_| {
-        IoError::invalid(
-            path,
-            format!("NRRD field \"{field}\": \"{value}\" is not a non-negative integer"),
-        )
-    })
-}
-
-/// The whitespace-separated words of a per-axis field, which must number
-/// `n` (the dimension).
-pub(super) fn words<'v>(
-    path: &Path,
-    field: &str,
-    value: &'v str,
-    n: usize,
-) -> Result<Vec<&'v str>, IoError> {
-    let w: Vec<&str> = value.split_whitespace().collect();
-    if w.len() != n {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "NRRD field \"{field}\": {} values but dimension is {n}",
-                w.len()
-            ),
-        ));
-    }
-    Ok(w)
-}
-
-/// A per-axis list of numbers (`nan` allowed).
-pub(super) fn numbers(
-    path: &Path,
-    field: &str,
-    value: &str,
-    n: usize,
-) -> Result<Vec<f64>, IoError> {
-    words(path, field, value, n)?
-        .iter()
-        .map(|w| {
-            w.parse::<f64>().map_err(|_| {
-                IoError::invalid(
-                    path,
-                    format!("NRRD field \"{field}\": \"{w}\" is not a number"),
-                )
-            })
-        })
-        .collect()
+    Field::nrrd(path, field).required(header.get(field))
 }
 
 /// A list of `n` double-quoted strings (`units`, `space units`).
@@ -78,6 +24,7 @@ pub(super) fn quoted(
     value: &str,
     n: usize,
 ) -> Result<Vec<String>, IoError> {
+    let bad = |why: String| Field::nrrd(path, field).error(why);
     let mut out = Vec::new();
     let mut chars = value.chars().peekable();
     loop {
@@ -87,22 +34,12 @@ pub(super) fn quoted(
         match chars.next() {
             None => break,
             Some('"') => {}
-            Some(c) => {
-                return Err(IoError::invalid(
-                    path,
-                    format!("NRRD field \"{field}\": expected a quoted string, found '{c}'"),
-                ));
-            }
+            Some(c) => return Err(bad(format!("expected a quoted string, found '{c}'"))),
         }
         let mut s = String::new();
         loop {
             match chars.next() {
-                None => {
-                    return Err(IoError::invalid(
-                        path,
-                        format!("NRRD field \"{field}\": a string has no closing quote"),
-                    ));
-                }
+                None => return Err(bad("a string has no closing quote".to_string())),
                 Some('\\') if chars.peek() == Some(&'"') => s.push(chars.next().unwrap_or('"')),
                 Some('"') => break,
                 Some(c) => s.push(c),
@@ -111,13 +48,7 @@ pub(super) fn quoted(
         out.push(s);
     }
     if out.len() != n {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "NRRD field \"{field}\": {} strings but {n} are needed",
-                out.len()
-            ),
-        ));
+        return Err(bad(format!("{} strings but {n} are needed", out.len())));
     }
     Ok(out)
 }
@@ -131,7 +62,7 @@ pub(super) fn vectors(
     n: usize,
     sd: usize,
 ) -> Result<Vec<Option<Vec<f64>>>, IoError> {
-    let bad = |why: String| IoError::invalid(path, format!("NRRD field \"{field}\": {why}"));
+    let bad = |why: String| Field::nrrd(path, field).error(why);
     let mut out = Vec::new();
     let mut rest = value.trim_start();
     while !rest.is_empty() {
