@@ -1,36 +1,170 @@
-//! `volray bench`: time whole frames of one volume.
+//! `volray bench`: time whole frames, of one volume or of the peer
+//! benchmark's workloads (`--peers`, see [`peers`]).
 //!
-//! A frame is everything after the volume is in memory and its
-//! view-independent gradients are computed (as VTK caches its normals):
-//! stage 1 (shade and classify every voxel for this view) and stage 2 (cast
-//! the rays into the frame buffer); PNG encoding is not timed. One warm-up
-//! frame, then `--frames` timed ones, each turned a further half degree
-//! about the up axis so that no view-dependent work is reused.
+//! A frame is everything after the volume is in memory: classification
+//! (done on the first frame and kept while the transfer function stays the
+//! same, as VTK keeps its normals), lighting the voxels for this view,
+//! binning the bricks into tiles and casting the rays into the frame
+//! buffer; PNG encoding is not timed. One warm-up view (rendered for at
+//! least a quarter of a second, untimed, so that the CPU is awake), then
+//! `--frames` timed ones, each turned a further half degree about the up
+//! axis so that no view-dependent work is reused.
+
+mod peers;
+mod vtk;
 
 use crate::cli::BenchArgs;
 use crate::error::CliError;
 use crate::input;
 use crate::render::{settings, thread_pool};
-use std::time::Instant;
+use std::path::Path;
+use std::time::{Duration, Instant};
 use volray_core::glam::{DQuat, DVec3};
-use volray_core::{Method, RenderSettings, Renderer};
+use volray_core::{Camera, FrameTimes, Image, Method, RenderSettings, Renderer};
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
+    match &args.peers {
+        Some(dir) => {
+            if let Some(input) = &args.input.input {
+                return Err(CliError::input(format!(
+                    "{input}: --peers times the peers' volumes; give INPUT or --peers, not both"
+                )));
+            }
+            peers::run(args, dir)
+        }
+        None => one_volume(args),
+    }
+}
+
+/// One timed frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Timed {
+    /// Wall time of the whole frame, seconds.
+    pub wall: f64,
+    /// The fast path's breakdown (`None` on the reference path).
+    pub parts: Option<FrameTimes>,
+}
+
+/// The least time the warm-up view is rendered for, untimed. A CPU that
+/// was idle (while the volume was read, or while VTK ran) comes back to
+/// full speed only after some tens of milliseconds of work; VTK's harness
+/// gets that while Python imports VTK.
+const WARM_UP: Duration = Duration::from_millis(250);
+
+/// Renders the warm-up view (`base`'s camera) until [`WARM_UP`] has passed,
+/// then `frames` timed frames each turned half a degree further about the
+/// up axis, calling `report` after the first warm-up frame (frame 0, which
+/// includes the classification) and after each timed one. Returns the
+/// warm-up image and the timed frames.
+pub fn time_frames(
+    renderer: &Renderer,
+    base: &RenderSettings,
+    frames: u32,
+    mut report: impl FnMut(u32, &Timed),
+) -> Result<(Image, Vec<Timed>), volray_core::RenderError> {
+    let volume = renderer.volume();
+    let look_at = base.camera.look_at.unwrap_or(volume.centre());
+    let view_point = base.camera.view_point.unwrap_or(look_at + DVec3::X);
+    let axis = base.camera.up.normalize();
+    let mut image = Image::new(base.width, base.height, [0.0; 4]);
+    let render = |frame: u32, image: &mut Image| {
+        let turn = DQuat::from_axis_angle(axis, (0.5 * frame as f64).to_radians());
+        let settings = RenderSettings {
+            camera: Camera {
+                view_point: Some(look_at + turn * (view_point - look_at)),
+                look_at: Some(look_at),
+                ..base.camera
+            },
+            ..base.clone()
+        };
+        let t0 = Instant::now();
+        let parts = match settings.method {
+            Method::Fast => Some(renderer.render_into(&settings, image)?),
+            Method::Reference => {
+                *image = renderer.render(&settings)?;
+                None
+            }
+        };
+        Ok::<_, volray_core::RenderError>(Timed {
+            wall: t0.elapsed().as_secs_f64(),
+            parts,
+        })
+    };
+    let start = Instant::now();
+    report(0, &render(0, &mut image)?);
+    let warm = image.clone();
+    while start.elapsed() < WARM_UP {
+        render(0, &mut image)?;
+    }
+    let mut timed = Vec::new();
+    for frame in 1..=frames {
+        let t = render(frame, &mut image)?;
+        report(frame, &t);
+        timed.push(t);
+    }
+    Ok((warm, timed))
+}
+
+/// The median of `values` (the mean of the middle two for an even count).
+pub fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// Milliseconds of one part of a frame, for the tables.
+fn ms(d: std::time::Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// One row of `--json`.
+pub struct JsonRow {
+    pub dataset: String,
+    pub window: usize,
+    pub threads: usize,
+    pub median_s: f64,
+    /// VTK's median on the same workload, when it ran.
+    pub vtk_median_s: Option<f64>,
+}
+
+/// Writes `rows` to `path` as a JSON list, atomically.
+pub fn write_json(path: &Path, rows: &[JsonRow]) -> Result<(), CliError> {
+    let list: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| {
+            let mut v = serde_json::json!({
+                "dataset": r.dataset,
+                "window": r.window,
+                "threads": r.threads,
+                "median_s": r.median_s,
+            });
+            if let Some(vtk) = r.vtk_median_s {
+                v["vtk_median_s"] = vtk.into();
+            }
+            v
+        })
+        .collect();
+    let text = serde_json::to_string_pretty(&list).expect("plain values serialise");
+    volray_io::write_atomically(path, |w| writeln!(w, "{text}"))?;
+    Ok(())
+}
+
+/// `volray bench INPUT`: the frames of one volume.
+fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
     let input = input::load(&args.input)?;
     let base = settings(&args.view)?;
     let pool = thread_pool(args.view.threads)?;
     let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
 
-    pool.install(|| {
-        let start = Instant::now();
+    let median_s = pool.install(|| {
         let renderer = Renderer::new(&input.volume).map_err(fail)?;
-        let prepare = start.elapsed().as_secs_f64();
-
-        let volume = renderer.volume();
-        let look_at = base.camera.look_at.unwrap_or(volume.centre());
-        let view_point = base.camera.view_point.unwrap_or(look_at + DVec3::X);
-        let axis = base.camera.up.normalize();
-        let [nx, ny, nz] = volume.dims();
+        let [nx, ny, nz] = input.volume.dims();
         println!(
             "volray bench: {} ({nx}x{ny}x{nz}), {}x{} pixels, step {} voxel, {} threads, {} path",
             input.name,
@@ -38,56 +172,59 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             base.height,
             base.step,
             rayon::current_num_threads(),
-            if base.method == Method::Fast { "fast" } else { "reference" },
+            if base.method == Method::Fast {
+                "fast"
+            } else {
+                "reference"
+            },
         );
-        println!("gradients and value range (once per volume): {:.1} ms", prepare * 1e3);
-        println!("{:>6} {:>12} {:>12} {:>12}", "frame", "stage 1 ms", "stage 2 ms", "total ms");
-
-        let mut times = Vec::new();
-        let mut samples = 0usize;
-        for frame in 0..=args.frames {
-            let turn = DQuat::from_axis_angle(axis, (0.5 * frame as f64).to_radians());
-            let settings = RenderSettings {
-                camera: volray_core::Camera {
-                    view_point: Some(look_at + turn * (view_point - look_at)),
-                    look_at: Some(look_at),
-                    ..base.camera
-                },
-                ..base.clone()
-            };
-            let t0 = Instant::now();
-            let prepared = renderer.prepare(&settings).map_err(fail)?;
-            let shaded = renderer.stage1(&settings, &prepared.view);
-            let t1 = Instant::now();
-            let image = renderer.stage2(&settings, &prepared, &shaded, &|_| {});
-            let t2 = Instant::now();
-            std::hint::black_box(image);
-            let (s1, s2) = ((t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64());
-            if frame == 0 {
-                println!("{:>6} {:>12.2} {:>12.2} {:>12.2}", "warm", s1 * 1e3, s2 * 1e3, (s1 + s2) * 1e3);
-                samples = nominal_samples(&prepared);
-                continue;
-            }
-            println!("{frame:>6} {:>12.2} {:>12.2} {:>12.2}", s1 * 1e3, s2 * 1e3, (s1 + s2) * 1e3);
-            times.push((s1, s2, s1 + s2));
-        }
-        let median = |pick: fn(&(f64, f64, f64)) -> f64| {
-            let mut v: Vec<f64> = times.iter().map(pick).collect();
-            v.sort_by(f64::total_cmp);
-            let n = v.len();
-            if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
-        };
-        let (m1, m2, total) = (median(|t| t.0), median(|t| t.1), median(|t| t.2));
-        println!("{:>6} {:>12.2} {:>12.2} {:>12.2}", "median", m1 * 1e3, m2 * 1e3, total * 1e3);
         println!(
-            "nominal samples per second: {:.3e} ({samples} samples per frame, before early termination)",
+            "{:>6} {:>11} {:>9} {:>15} {:>10}",
+            "frame", "classify ms", "bin ms", "shade+cast ms", "total ms"
+        );
+        let row = |frame: u32, t: &Timed| {
+            let name = if frame == 0 {
+                "warm".to_string()
+            } else {
+                frame.to_string()
+            };
+            match t.parts {
+                Some(p) => println!(
+                    "{name:>6} {:>11.2} {:>9.2} {:>15.2} {:>10.2}",
+                    ms(p.classify),
+                    ms(p.bin),
+                    ms(p.cast),
+                    t.wall * 1e3
+                ),
+                None => println!("{name:>6} {:>48.2}", t.wall * 1e3),
+            }
+        };
+        let (_, timed) = time_frames(&renderer, &base, args.frames, row).map_err(fail)?;
+        let total = median(timed.iter().map(|t| t.wall).collect());
+        println!("{:>6} {:>48.2}", "median", total * 1e3);
+        let frame = renderer.prepare(&base).map_err(fail)?;
+        let samples = nominal_samples(&frame);
+        println!(
+            "nominal samples per second: {:.3e} ({samples} samples per frame, before skipping and early termination)",
             samples as f64 / total
         );
-        Ok(())
-    })
+        Ok::<f64, CliError>(total)
+    })?;
+    if let Some(path) = &args.json {
+        let row = JsonRow {
+            dataset: input.name.clone(),
+            window: base.width,
+            threads: pool.current_num_threads(),
+            median_s,
+            vtk_median_s: None,
+        };
+        write_json(path, &[row])?;
+    }
+    Ok(())
 }
 
-/// Samples the rays of `frame` would take without early termination.
+/// Samples the rays of `frame` would take without skipping or early
+/// termination.
 fn nominal_samples(frame: &volray_core::render::Frame) -> usize {
     let view = &frame.view;
     (0..view.height)

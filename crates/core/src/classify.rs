@@ -97,6 +97,29 @@ impl Classifier {
         correct_opacity(self.unit_opacity(f), self.step_voxels)
     }
 
+    /// Whether every value in `[lo, hi]` gets zero opacity, so that a
+    /// region whose values all lie there contributes nothing to any ray
+    /// (the zero-opacity test of empty-space skipping, Levoy 1990).
+    /// Exact: a piecewise-linear opacity is zero on an interval iff it is
+    /// zero at the interval's ends and at every break point inside it.
+    pub fn is_transparent_between(&self, lo: f32, hi: f32) -> bool {
+        // `normalise` is monotone (a subtraction and a non-negative scale).
+        let (t0, t1) = (self.normalise(lo), self.normalise(hi));
+        match &self.opacity {
+            // q > p >= 0, so the ramp is zero only at p = 0, for t <= 0.
+            OpacityMap::Ramp { p, .. } => *p == 0.0 && t1 <= 0.0,
+            OpacityMap::Table(table) => {
+                table.eval(t0)[0] == 0.0
+                    && table.eval(t1)[0] == 0.0
+                    && table
+                        .points()
+                        .iter()
+                        .filter(|(t, _)| t0 < *t && *t < t1)
+                        .all(|(_, a)| a[0] == 0.0)
+            }
+        }
+    }
+
     /// Material colour of value `f` (white without a colour function).
     #[inline]
     pub fn material(&self, f: f32) -> [f32; 3] {
@@ -104,6 +127,17 @@ impl Classifier {
             Some(color) => color.eval(self.normalise(f)),
             None => [1.0; 3],
         }
+    }
+
+    /// `(lo, 1/(hi − lo))`: [`Self::normalise`] is `(f − lo)·(1/(hi − lo))`
+    /// (the second is 0 for a constant volume).
+    pub fn normalisation(&self) -> (f32, f32) {
+        (self.lo, self.inv_range)
+    }
+
+    /// The colour function, if any (white without one).
+    pub fn color(&self) -> Option<&PiecewiseLinear<3>> {
+        self.color.as_ref()
     }
 }
 
@@ -146,6 +180,39 @@ mod tests {
         assert_eq!(correct_opacity(0.0, 0.37), 0.0);
         assert_eq!(correct_opacity(1.0, 0.37), 1.0);
         assert_eq!(correct_opacity(0.42, 1.0), 0.42);
+    }
+
+    #[test]
+    fn zero_opacity_ranges_are_found_exactly() {
+        let table = PiecewiseLinear::new(
+            "opacity",
+            vec![
+                (0.0, [0.0]),
+                (0.2, [0.0]),
+                (0.5, [0.6]),
+                (0.7, [0.0]),
+                (0.8, [0.0]),
+            ],
+        )
+        .unwrap();
+        let c = Classifier::new((0.0, 10.0), OpacityMap::Table(table), None, 0.5);
+        assert!(c.is_transparent_between(-3.0, 2.0));
+        assert!(!c.is_transparent_between(-3.0, 2.01));
+        // Both ends transparent, the bump between them is not.
+        assert!(!c.is_transparent_between(1.0, 7.5));
+        assert!(c.is_transparent_between(7.0, 100.0));
+        assert!(!c.is_transparent_between(6.9, 100.0));
+        // Whatever the test says, sampling agrees.
+        for (lo, hi) in [(-3.0, 2.0), (7.0, 100.0)] {
+            for i in 0..=100 {
+                let f = lo + (hi - lo) * i as f32 / 100.0;
+                assert_eq!(c.sample_opacity(f), 0.0, "{f}");
+            }
+        }
+        let ramp = |p| Classifier::new((0.0, 1.0), OpacityMap::Ramp { p, q: 0.5 }, None, 1.0);
+        assert!(ramp(0.0).is_transparent_between(-1.0, 0.0));
+        assert!(!ramp(0.0).is_transparent_between(-1.0, 0.01));
+        assert!(!ramp(0.1).is_transparent_between(-1.0, -0.5));
     }
 
     #[test]

@@ -14,39 +14,46 @@ use rayon::prelude::*;
 
 /// World-space gradient of `volume` at every voxel, x fastest.
 pub fn gradients(volume: &Volume) -> Vec<[f32; 3]> {
-    let [nx, ny, nz] = volume.dims();
-    let inv = 1.0 / volume.spacing();
-    let inv = [inv.x as f32, inv.y as f32, inv.z as f32];
-    let data = volume.data();
+    let [nx, ny, _] = volume.dims();
     let mut out = vec![[0.0f32; 3]; volume.len()];
     out.par_chunks_mut(nx * ny)
         .enumerate()
         .for_each(|(k, slice)| {
             for j in 0..ny {
                 for i in 0..nx {
-                    let at = |i: usize, j: usize, k: usize| data[i + nx * (j + ny * k)];
-                    let d = |lo: f32, hi: f32, span: usize, inv_spacing: f32| {
-                        (hi - lo) * inv_spacing / span as f32
-                    };
-                    // One axis: the neighbours below and above, clamped to the
-                    // grid, and how many voxel steps they span (2, or 1 at a face).
-                    let axis = |c: usize, n: usize| {
-                        let lo = c.saturating_sub(1);
-                        let hi = (c + 1).min(n - 1);
-                        (lo, hi, hi - lo)
-                    };
-                    let (i0, i1, si) = axis(i, nx);
-                    let (j0, j1, sj) = axis(j, ny);
-                    let (k0, k1, sk) = axis(k, nz);
-                    slice[i + nx * j] = [
-                        d(at(i0, j, k), at(i1, j, k), si, inv[0]),
-                        d(at(i, j0, k), at(i, j1, k), sj, inv[1]),
-                        d(at(i, j, k0), at(i, j, k1), sk, inv[2]),
-                    ];
+                    slice[i + nx * j] = gradient_at(volume, i, j, k);
                 }
             }
         });
     out
+}
+
+/// World-space gradient of `volume` at voxel (`i`, `j`, `k`): central
+/// differences inside, one-sided ones on the faces.
+#[inline]
+pub fn gradient_at(volume: &Volume, i: usize, j: usize, k: usize) -> [f32; 3] {
+    let [nx, ny, nz] = volume.dims();
+    let spacing = volume.spacing();
+    let data = volume.data();
+    let at = |i: usize, j: usize, k: usize| data[i + nx * (j + ny * k)];
+    // One axis: the neighbours below and above, clamped to the grid, and
+    // how many voxel steps they span (2, or 1 at a face).
+    let axis = |c: usize, n: usize| {
+        let lo = c.saturating_sub(1);
+        let hi = (c + 1).min(n - 1);
+        (lo, hi, hi - lo)
+    };
+    let d = |lo: f32, hi: f32, span: usize, spacing: f64| {
+        (hi - lo) * (1.0 / spacing) as f32 / span as f32
+    };
+    let (i0, i1, si) = axis(i, nx);
+    let (j0, j1, sj) = axis(j, ny);
+    let (k0, k1, sk) = axis(k, nz);
+    [
+        d(at(i0, j, k), at(i1, j, k), si, spacing.x),
+        d(at(i, j0, k), at(i, j1, k), sj, spacing.y),
+        d(at(i, j, k0), at(i, j, k1), sk, spacing.z),
+    ]
 }
 
 #[cfg(test)]

@@ -1,97 +1,408 @@
-//! The fast path: the reference's samples composited front to back, with
-//! early ray termination, in parallel over image tiles.
+//! The fast path's stage 2: the reference's samples, composited front to
+//! back, visiting only the occupied cells, in parallel over image tiles.
 //!
+//! For each pixel the ray walks its tile's list of occupied bricks (see
+//! [`crate::tiles`]) front to back. In each brick it finds the samples `k`
+//! (the same global planes `t = k·step` as the reference, see
+//! [`crate::ray`]) whose positions lie in the box of the brick's occupied
+//! cells, and for each sample in an occupied cell it interpolates the
+//! brick's lit voxels (see [`crate::shade_bricks`]) trilinearly and
+//! composites. Everything else contributes exactly nothing: a sample
+//! outside these boxes, or in a cell whose eight corners are transparent,
+//! has opacity 0. A sample on a face shared by two bricks is taken once, by
+//! the first.
+//!
+//! The ray stops once its transmittance is below
+//! [`TERMINATION_TRANSMITTANCE`]: colours are in [0, 1], so what lies
+//! behind could change the pixel by at most that much, well under 1/255.
 //! Each pixel is computed from its own ray alone, by the same arithmetic
 //! whatever thread runs it, so the image is bit-identical for any thread
-//! count. A ray stops once its transmittance is below
-//! [`TERMINATION_TRANSMITTANCE`]: colours are in [0, 1], so what lies behind
-//! could change the pixel by at most that much, well under 1/255.
+//! count.
+//!
+//! SIMD: positions and colours are `f32x4` (x, y, z or r, g, b, α in the
+//! lanes); the eight corners of a cell are eight 16-byte loads.
 
+use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
 use crate::camera::OrthographicView;
-use crate::composite::FrontToBack;
+use crate::classified::ClassifiedBricks;
 use crate::image::Image;
 use crate::ray::GridFrame;
-use crate::stage1::ShadedVolume;
-use crate::trilinear::sample;
-use glam::{Vec3, Vec4};
+use crate::shade_bricks::{Lighting, LitBricks};
+use crate::tiles::{TILE, TileBins};
+use glam::{DVec3, Vec4};
 use rayon::prelude::*;
+use wide::f32x4;
 
 /// Rays stop when less than this fraction of light gets through.
 pub const TERMINATION_TRANSMITTANCE: f32 = 1.0 / 1024.0;
 
-/// Tile edge in pixels: a 16×16 tile's rays stay close together in the
-/// volume, so neighbouring rays reuse cached voxels.
-const TILE: usize = 16;
+/// Slack, in samples, around each box's range of samples: a sample on a
+/// box face is found whatever the rounding (it is clamped into the box, so
+/// at most this far from where it belongs).
+const SAMPLE_SLACK: f32 = 1e-3;
+/// Slack, in voxels, for rays parallel to a box face.
+const PARALLEL_SLACK: f32 = 1e-4;
 
-/// Renders `shaded` through `view` with samples `step` world units apart.
-/// `progress` is called with the number of pixels finished, a tile at a time.
+/// The box of an occupied brick's occupied cells, in index space.
+#[derive(Debug, Clone, Copy)]
+struct CellBox {
+    /// The brick's first voxel.
+    origin: f32x4,
+    /// The box relative to `origin`.
+    lo: f32x4,
+    hi: f32x4,
+    /// Whether a face of the brick is on the volume's boundary, where the
+    /// samples must also be inside the ray's exact range.
+    boundary: bool,
+}
+
+/// One frame's rays, in the index space of the grid.
+struct Rays<'a> {
+    grid: &'a GridFrame,
+    view: &'a OrthographicView,
+    step: f64,
+    /// Index-space point on the image plane (`t = 0`) of pixel (0, 0), and
+    /// its change per column and per row.
+    corner: DVec3,
+    per_col: DVec3,
+    per_row: DVec3,
+    /// Index-space displacement from one sample to the next.
+    delta: f32x4,
+    /// `1/delta` per axis, 0 where `delta` is 0 (lane 3: 0).
+    inv_delta: f32x4,
+    /// All bits set in the lanes of the axes the rays are parallel to, and
+    /// in lane 3.
+    parallel: f32x4,
+    background: [f32; 3],
+}
+
+/// Everything a ray reads.
+struct Scene<'a> {
+    boxes: Vec<CellBox>,
+    cells: &'a [[u64; 8]],
+    lit: &'a LitBricks,
+    lighting: &'a Lighting<'a>,
+}
+
+/// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
+/// as the rays reach them (see [`crate::shade_bricks`]), binned into
+/// `bins`, through `view` with samples `step` world units apart, into
+/// `image` (`view.width × view.height`). `progress` is called with the
+/// number of pixels finished, a tile at a time.
+#[allow(clippy::too_many_arguments)]
 pub fn render(
-    shaded: &ShadedVolume,
+    bricks: &ClassifiedBricks,
+    lit: &LitBricks,
+    lighting: &Lighting,
+    bins: &TileBins,
     grid: &GridFrame,
     view: &OrthographicView,
     step: f64,
     background: [f32; 3],
+    image: &mut Image,
     progress: &(dyn Fn(usize) + Sync),
-) -> Image {
-    let (width, height) = (view.width, view.height);
-    let tiles_x = width.div_ceil(TILE);
-    let tiles_y = height.div_ceil(TILE);
-    let bg = Vec3::from(background);
-    let tiles: Vec<Vec<[f32; 4]>> = (0..tiles_x * tiles_y)
-        .into_par_iter()
-        .map(|tile| {
-            let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-            let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-            let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
-            for row in y0..y1 {
-                for col in x0..x1 {
-                    out.push(cast(shaded, grid, view, col, row, step, bg).to_array());
-                }
-            }
-            progress(out.len());
-            out
-        })
+) {
+    assert_eq!((image.width(), image.height()), (view.width, view.height));
+    let scene = Scene {
+        boxes: (0..bricks.len()).map(|n| cell_box(bricks, n)).collect(),
+        cells: &bricks.cells,
+        lit,
+        lighting,
+    };
+    let rays = Rays::new(grid, view, step, background);
+    // Each tile's rows, as slices of the image rows: the tiles are then
+    // independent pieces of work, small enough to balance the threads.
+    let mut tiles: Vec<Vec<&mut [[f32; 4]]>> = (0..bins.tiles_x * bins.tiles_y)
+        .map(|_| Vec::with_capacity(TILE))
         .collect();
-
-    let mut image = Image::new(width, height, [0.0; 4]);
-    for (tile, pixels) in tiles.iter().enumerate() {
-        let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-        let tile_width = (x0 + TILE).min(width) - x0;
-        for (n, rgba) in pixels.iter().enumerate() {
-            image.set(x0 + n % tile_width, y0 + n / tile_width, *rgba);
+    for (row, pixels) in image.pixels_mut().chunks_mut(view.width).enumerate() {
+        for (tx, segment) in pixels.chunks_mut(TILE).enumerate() {
+            tiles[(row / TILE) * bins.tiles_x + tx].push(segment);
         }
     }
-    image
+    tiles.into_par_iter().enumerate().for_each(|(t, mut rows)| {
+        let (tx, ty) = (t % bins.tiles_x, t / bins.tiles_x);
+        rays.tile(&scene, bins.list(tx, ty), tx, ty, &mut rows);
+        progress(rows.iter().map(|r| r.len()).sum());
+    });
 }
 
-/// The colour of one ray.
-#[inline]
-fn cast(
-    shaded: &ShadedVolume,
-    grid: &GridFrame,
-    view: &OrthographicView,
-    col: usize,
-    row: usize,
-    step: f64,
-    background: Vec3,
-) -> Vec4 {
-    let mut acc = FrontToBack::new();
-    if let Some(ray) = grid.ray(view, col, row, step) {
-        let dims = grid.dims;
-        let origin = ray.origin.as_vec3();
-        let delta = (ray.direction * step).as_vec3();
-        let upper = Vec3::new(
-            (dims[0] - 1) as f32,
-            (dims[1] - 1) as f32,
-            (dims[2] - 1) as f32,
-        );
-        for k in ray.first..=ray.last {
-            let p = (origin + k as f32 * delta).clamp(Vec3::ZERO, upper);
-            acc.add(sample(&shaded.voxels, dims, p));
-            if acc.transmittance() < TERMINATION_TRANSMITTANCE {
-                break;
-            }
+/// Index-space coordinates as SIMD lanes (the last one 0).
+fn lanes(v: [usize; 3]) -> f32x4 {
+    f32x4::new([v[0] as f32, v[1] as f32, v[2] as f32, 0.0])
+}
+
+fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
+    let b = bricks.occupied[n];
+    let origin = lanes(bricks.grid.origin(b));
+    let (lo, hi) = bricks.occupied_box(n);
+    CellBox {
+        origin,
+        lo: lanes(lo) - origin,
+        hi: lanes(hi) - origin,
+        boundary: bricks.grid.touches_boundary(b),
+    }
+}
+
+impl<'a> Rays<'a> {
+    fn new(grid: &'a GridFrame, view: &'a OrthographicView, step: f64, bg: [f32; 3]) -> Self {
+        let to_index = |world: DVec3| (world - grid.origin) / grid.spacing;
+        let delta = (view.direction * step / grid.spacing).as_vec3();
+        let inv = |d: f32| if d == 0.0 { 0.0 } else { 1.0 / d };
+        let mask = |d: f32| if d == 0.0 { f32::from_bits(!0) } else { 0.0 };
+        Rays {
+            grid,
+            view,
+            step,
+            corner: to_index(view.pixel_centre(0, 0)),
+            per_col: view.right * view.pixel_size / grid.spacing,
+            per_row: -view.up * view.pixel_size / grid.spacing,
+            delta: f32x4::new([delta.x, delta.y, delta.z, 0.0]),
+            inv_delta: f32x4::new([inv(delta.x), inv(delta.y), inv(delta.z), 0.0]),
+            parallel: f32x4::new([mask(delta.x), mask(delta.y), mask(delta.z), mask(0.0)]),
+            background: bg,
         }
     }
-    acc.finish(background)
+
+    /// Renders tile (`tx`, `ty`), whose bricks are `list`, into `rows`
+    /// (its rows of pixels, top to bottom).
+    ///
+    /// Brick by brick, every ray of the tile crosses the brick before the
+    /// next brick is touched: the brick's voxels are loaded into the cache
+    /// once for all the tile's rays. Each ray still takes its bricks front
+    /// to back, so its arithmetic is that of a ray cast on its own.
+    fn tile(
+        &self,
+        scene: &Scene,
+        list: &[u32],
+        tx: usize,
+        ty: usize,
+        rows: &mut [&mut [[f32; 4]]],
+    ) {
+        let cols = tx * TILE..tx * TILE + rows[0].len();
+        let row_count = rows.len();
+        let mut states = [RayState::EMPTY; TILE * TILE];
+        let states = &mut states[..cols.len() * row_count];
+        if !list.is_empty() {
+            for (i, state) in states.iter_mut().enumerate() {
+                let (col, row) = (cols.start + i % cols.len(), ty * TILE + i / cols.len());
+                let o = self.corner + self.per_col * col as f64 + self.per_row * row as f64;
+                *state = RayState {
+                    origin: f32x4::new([o.x as f32, o.y as f32, o.z as f32, 0.0]),
+                    ..RayState::EMPTY
+                };
+            }
+        }
+        for &n in list {
+            let b = &scene.boxes[n as usize];
+            let lit = scene.lit.get(n as usize, scene.lighting);
+            let cells = &scene.cells[n as usize];
+            for (i, state) in states.iter_mut().enumerate() {
+                if state.done {
+                    continue;
+                }
+                let local = state.origin - b.origin;
+                let Some((first, mut last)) = self.samples_in(b, local) else {
+                    continue;
+                };
+                let mut first = first.max(state.next);
+                if b.boundary {
+                    let (col, row) = (cols.start + i % cols.len(), ty * TILE + i / cols.len());
+                    let range = *state.exact.get_or_insert_with(|| {
+                        self.grid
+                            .ray(self.view, col, row, self.step)
+                            .map(|r| (r.first as i32, r.last as i32))
+                    });
+                    let Some((f, l)) = range else {
+                        // The ray misses the volume: it has no samples.
+                        state.done = true;
+                        continue;
+                    };
+                    (first, last) = (first.max(f), last.min(l));
+                }
+                if first > last {
+                    continue;
+                }
+                state.next = last + 1;
+                let segment = Segment {
+                    origin: local,
+                    delta: self.delta,
+                    lo: b.lo,
+                    hi: b.hi,
+                    first,
+                    last,
+                };
+                state.done = march(&mut state.acc, lit.voxels(), cells, &segment);
+            }
+        }
+        for (i, state) in states.iter().enumerate() {
+            let (c, r) = (i % cols.len(), i / cols.len());
+            rows[r][c] = state.acc.finish(self.background).to_array();
+        }
+    }
+
+    /// The samples `k` whose positions `local + k·delta` (relative to the
+    /// brick's origin) lie in box `b` (with [`SAMPLE_SLACK`]), or `None`.
+    #[inline]
+    fn samples_in(&self, b: &CellBox, local: f32x4) -> Option<(i32, i32)> {
+        let to_lo = b.lo - local;
+        let to_hi = b.hi - local;
+        let (near, far) = (to_lo * self.inv_delta, to_hi * self.inv_delta);
+        // Along a parallel axis the ray is inside the slab everywhere or
+        // nowhere.
+        let slack = f32x4::splat(PARALLEL_SLACK);
+        let inside = to_lo.simd_le(slack) & to_hi.simd_ge(-slack);
+        let inf = f32x4::splat(f32::INFINITY);
+        let enter = self
+            .parallel
+            .select(inside.select(-inf, inf), near.fast_min(far));
+        let leave = self.parallel.select(inf, near.fast_max(far));
+        // Lane 3 is neutral (−∞, +∞): the box is the three slabs' overlap.
+        let lo = Vec4::from_array(enter.to_array()).max_element();
+        let hi = Vec4::from_array(leave.to_array()).min_element();
+        // A miss along a parallel axis enters at +∞; rays are not parallel
+        // to all three axes, so a hit is finite.
+        if lo > hi {
+            return None;
+        }
+        let first = ceil_i32(lo - SAMPLE_SLACK);
+        let last = floor_i32(hi + SAMPLE_SLACK);
+        (first <= last).then_some((first, last))
+    }
+}
+
+/// Where one ray crosses one brick's box of occupied cells.
+struct Segment {
+    /// The ray's `t = 0` point and its step, relative to the brick's first
+    /// voxel (lane 3 unused).
+    origin: f32x4,
+    delta: f32x4,
+    /// The box, relative to the brick's first voxel.
+    lo: f32x4,
+    hi: f32x4,
+    /// Its samples.
+    first: i32,
+    last: i32,
+}
+
+/// Composites the samples of `segment` into `acc` from the brick's `lit`
+/// voxels and occupied `cells`. Returns whether the ray has terminated.
+#[inline]
+fn march(
+    acc: &mut Accumulator,
+    lit: &[[f32; 4]; SLOTS],
+    cells: &[u64; 8],
+    segment: &Segment,
+) -> bool {
+    let last_cell = f32x4::splat((BRICK - 1) as f32);
+    let (mut color, mut transmittance) = (acc.color, acc.transmittance);
+    let mut p = segment.origin + segment.delta * f32x4::splat(segment.first as f32);
+    let mut terminated = false;
+    // A count down: an inclusive range costs a flag test per sample.
+    let mut left = segment.last - segment.first + 1;
+    while left > 0 {
+        left -= 1;
+        let here = p.fast_max(segment.lo).fast_min(segment.hi);
+        p += segment.delta;
+        // `here` ≥ 0, so truncation is the floor; the masks only tell the
+        // compiler what the clamp already ensures.
+        let c = here.fast_min(last_cell).fast_trunc_int();
+        let [i, j, l, _] = c.to_array().map(|x| x as usize & (BRICK - 1));
+        let bit = cell(i, j, l);
+        if cells[bit / 64] >> (bit % 64) & 1 == 0 {
+            continue;
+        }
+        let [fx, fy, fz, _] = (here - f32x4::from_i32x4(c)).to_array();
+        let s = slot(i, j, l);
+        let v = |o: usize| f32x4::new(lit[s + o]);
+        let lerp = |a: f32x4, b: f32x4, t: f32| a + (b - a) * f32x4::splat(t);
+        let (dy, dz) = (SIDE, SIDE * SIDE);
+        let y0 = lerp(lerp(v(0), v(1), fx), lerp(v(dy), v(dy + 1), fx), fy);
+        let y1 = lerp(
+            lerp(v(dz), v(dz + 1), fx),
+            lerp(v(dy + dz), v(dy + dz + 1), fx),
+            fy,
+        );
+        let sample = lerp(y0, y1, fz);
+        // Front to back: C += T·α·c, T ·= 1 − α.
+        let alpha = sample.as_array()[3];
+        color += sample * f32x4::splat(transmittance * alpha);
+        transmittance *= 1.0 - alpha;
+        if transmittance < TERMINATION_TRANSMITTANCE {
+            terminated = true;
+            break;
+        }
+    }
+    (acc.color, acc.transmittance) = (color, transmittance);
+    terminated
+}
+
+/// A ray of a tile, between bricks.
+#[derive(Clone, Copy)]
+struct RayState {
+    /// Index-space point on the image plane (`t = 0`).
+    origin: f32x4,
+    acc: Accumulator,
+    /// The first sample not yet taken.
+    next: i32,
+    /// The ray's exact samples (as the reference finds them), found when
+    /// first needed, in a brick on the volume's boundary.
+    exact: Option<Option<(i32, i32)>>,
+    /// Terminated, or off the volume.
+    done: bool,
+}
+
+impl RayState {
+    const EMPTY: RayState = RayState {
+        origin: f32x4::ZERO,
+        acc: Accumulator::NEW,
+        next: i32::MIN,
+        exact: None,
+        done: false,
+    };
+}
+
+/// Front-to-back compositing of one ray (see [`crate::composite`]): the
+/// colour so far in lanes r, g, b, and the transmittance `T = Π(1 − αᵢ)`.
+#[derive(Clone, Copy)]
+struct Accumulator {
+    color: f32x4,
+    transmittance: f32,
+}
+
+impl Accumulator {
+    /// Nothing composited yet.
+    const NEW: Accumulator = Accumulator {
+        color: f32x4::ZERO,
+        transmittance: 1.0,
+    };
+
+    /// The final colour over the opaque `background`, with the volume's
+    /// accumulated opacity in `w`.
+    fn finish(&self, background: [f32; 3]) -> Vec4 {
+        let [r, g, b, _] = self.color.to_array();
+        let t = self.transmittance;
+        Vec4::new(
+            r + t * background[0],
+            g + t * background[1],
+            b + t * background[2],
+            1.0 - t,
+        )
+    }
+}
+
+/// `⌈x⌉` and `⌊x⌋` for `|x| < 2³¹` without a library call (SSE2 has no
+/// rounding instruction). Sample numbers are far smaller: a ray has at most
+/// [`crate::render::MAX_SAMPLES_PER_RAY`] samples on either side of the
+/// image plane.
+#[inline]
+fn ceil_i32(x: f32) -> i32 {
+    let t = x as i32;
+    t + ((t as f32) < x) as i32
+}
+
+#[inline]
+fn floor_i32(x: f32) -> i32 {
+    let t = x as i32;
+    t - ((t as f32) > x) as i32
 }

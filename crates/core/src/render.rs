@@ -1,18 +1,28 @@
-//! The whole pipeline for one frame: validate the settings, run stage 1
-//! (shade and classify every voxel), frame the camera, run stage 2 (cast
-//! the rays) on the fast or the reference path.
+//! The whole pipeline for one frame: validate the settings, frame the
+//! camera, then run the fast or the reference path. The reference shades
+//! and classifies every voxel (stage 1) and composites every sample (stage
+//! 2). The fast path keeps its view-independent work across frames (the
+//! min/max macro-cells, and the occupied bricks classified for the last
+//! transfer function), then per frame bins the bricks into tiles and casts
+//! the rays, lighting each brick as the rays first reach it.
 
 use crate::camera::{Camera, CameraError, OrthographicView};
+use crate::classified::ClassifiedBricks;
 use crate::classify::Classifier;
 use crate::gradient::gradients;
 use crate::image::Image;
+use crate::macrocells::Macrocells;
 use crate::ray::GridFrame;
+use crate::shade_bricks::{Lighting, LitBricks};
 use crate::shading::{LightGeometry, Phong};
 use crate::stage1::{ShadedVolume, shade_and_classify};
+use crate::tiles::TileBins;
 use crate::transfer_function::TransferFunction;
 use crate::volume::Volume;
 use crate::{raycast, reference};
 use glam::DVec3;
+use std::sync::{Mutex, OnceLock};
+use std::time::{Duration, Instant};
 use thiserror::Error;
 
 /// Largest image side, in pixels.
@@ -153,12 +163,49 @@ impl RenderSettings {
     }
 }
 
-/// A volume ready to render: its value range and gradients are computed
-/// once and kept for every frame.
+/// A volume ready to render. Its value range is found once; the fast
+/// path's view-independent work (the min/max macro-cells, and the occupied
+/// bricks with their normals and classification for the last transfer
+/// function used) is done on the first frame that needs it and kept.
+///
+/// Frames of one `Renderer` are rendered one at a time: a frame holds the
+/// fast path's buffers while it runs.
 pub struct Renderer<'v> {
     volume: &'v Volume,
     value_range: (f32, f32),
-    gradients: Vec<[f32; 3]>,
+    macrocells: OnceLock<Macrocells>,
+    fast: Mutex<Option<FastState>>,
+}
+
+/// The fast path's state kept between frames.
+struct FastState {
+    /// What `bricks` were classified with.
+    classifier: Classifier,
+    bricks: ClassifiedBricks,
+    /// The frame's lit bricks, buffers reused from frame to frame.
+    lit: LitBricks,
+}
+
+/// Where a fast frame's time went.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrameTimes {
+    /// Classifying the volume into bricks: zero unless the transfer
+    /// function (or the step) changed since the last frame.
+    pub classify: Duration,
+    /// Binning the occupied bricks into image tiles.
+    pub bin: Duration,
+    /// Stage 1 per frame, lighting the occupied bricks' voxels (done as the
+    /// rays first reach each brick), and stage 2, casting the rays.
+    pub cast: Duration,
+    /// Occupied bricks, and the voxel slots they hold.
+    pub bricks: usize,
+}
+
+impl FrameTimes {
+    /// The whole frame.
+    pub fn total(&self) -> Duration {
+        self.classify + self.bin + self.cast
+    }
 }
 
 impl<'v> Renderer<'v> {
@@ -175,7 +222,8 @@ impl<'v> Renderer<'v> {
         Ok(Renderer {
             volume,
             value_range,
-            gradients: gradients(volume),
+            macrocells: OnceLock::new(),
+            fast: Mutex::new(None),
         })
     }
 
@@ -201,8 +249,38 @@ impl<'v> Renderer<'v> {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<Image, RenderError> {
         let frame = self.prepare(settings)?;
-        let shaded = self.stage1(settings, &frame.view);
-        Ok(self.stage2(settings, &frame, &shaded, progress))
+        match settings.method {
+            Method::Fast => {
+                let mut image = Image::new(settings.width, settings.height, [0.0; 4]);
+                self.render_fast(settings, &frame, &mut image, progress);
+                Ok(image)
+            }
+            Method::Reference => {
+                let shaded = self.stage1(settings, &frame.view);
+                Ok(reference::render(
+                    &shaded,
+                    &frame.grid,
+                    &frame.view,
+                    frame.step,
+                    settings.background,
+                    progress,
+                ))
+            }
+        }
+    }
+
+    /// Renders one frame on the fast path into `image` (reallocated only if
+    /// its size is not the frame's), and says where the time went.
+    pub fn render_into(
+        &self,
+        settings: &RenderSettings,
+        image: &mut Image,
+    ) -> Result<FrameTimes, RenderError> {
+        let frame = self.prepare(settings)?;
+        if (image.width(), image.height()) != (settings.width, settings.height) {
+            *image = Image::new(settings.width, settings.height, [0.0; 4]);
+        }
+        Ok(self.render_fast(settings, &frame, image, &|_| {}))
     }
 
     /// Validates `settings` and frames the view.
@@ -230,43 +308,92 @@ impl<'v> Renderer<'v> {
         Ok(Frame { view, grid, step })
     }
 
-    /// Stage 1: per-voxel colour and opacity for this frame's light and view.
-    pub fn stage1(&self, settings: &RenderSettings, view: &OrthographicView) -> ShadedVolume {
-        let classifier = Classifier::from_transfer_function(
+    /// The classifier `settings` describe for this volume.
+    fn classifier(&self, settings: &RenderSettings) -> Classifier {
+        Classifier::from_transfer_function(
             &settings.transfer_function,
             self.value_range,
             settings.opacity_ramp,
             settings.step as f32,
-        );
-        let to_viewer = (-view.direction).as_vec3();
-        let light = match settings.light_direction {
-            Some(l) => LightGeometry::new(l.as_vec3(), to_viewer),
-            None => LightGeometry::headlight(to_viewer),
-        };
-        let lighting = settings.shading.then_some((&settings.phong, &light));
-        shade_and_classify(self.volume, &self.gradients, &classifier, lighting)
+        )
     }
 
-    /// Stage 2: cast the rays through the shaded voxels.
-    pub fn stage2(
+    /// This frame's light: towards the light and towards the viewer.
+    fn light(settings: &RenderSettings, view: &OrthographicView) -> LightGeometry {
+        let to_viewer = (-view.direction).as_vec3();
+        match settings.light_direction {
+            Some(l) => LightGeometry::new(l.as_vec3(), to_viewer),
+            None => LightGeometry::headlight(to_viewer),
+        }
+    }
+
+    /// The reference path's stage 1: colour and opacity of every voxel for
+    /// this frame's light and view, from gradients computed afresh.
+    pub fn stage1(&self, settings: &RenderSettings, view: &OrthographicView) -> ShadedVolume {
+        let light = Self::light(settings, view);
+        let lighting = settings.shading.then_some((&settings.phong, &light));
+        shade_and_classify(
+            self.volume,
+            &gradients(self.volume),
+            &self.classifier(settings),
+            lighting,
+        )
+    }
+
+    /// The fast path: classify (only when the classifier changed), light
+    /// the occupied bricks, bin them into tiles, cast the rays.
+    fn render_fast(
         &self,
         settings: &RenderSettings,
         frame: &Frame,
-        shaded: &ShadedVolume,
+        image: &mut Image,
         progress: &(dyn Fn(usize) + Sync),
-    ) -> Image {
-        let cast = match settings.method {
-            Method::Fast => raycast::render,
-            Method::Reference => reference::render,
-        };
-        cast(
-            shaded,
+    ) -> FrameTimes {
+        let mut times = FrameTimes::default();
+        let classifier = self.classifier(settings);
+        let mut guard = self.fast.lock().unwrap_or_else(|e| e.into_inner());
+        let t0 = Instant::now();
+        if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
+            // Drop the old bricks before building the new ones.
+            let lit = guard.take().map(|s| s.lit).unwrap_or_default();
+            let macrocells = self.macrocells.get_or_init(|| Macrocells::new(self.volume));
+            let bricks = ClassifiedBricks::new(self.volume, macrocells, &classifier);
+            *guard = Some(FastState {
+                classifier,
+                bricks,
+                lit,
+            });
+        }
+        let state = guard.as_mut().expect("the state was just made");
+        let t1 = Instant::now();
+        let bins = TileBins::new(&state.bricks, &frame.grid, &frame.view);
+        let t2 = Instant::now();
+        let light = Self::light(settings, &frame.view);
+        let lighting = Lighting::new(
+            self.volume,
+            &state.bricks,
+            &state.classifier,
+            settings.shading.then_some((&settings.phong, &light)),
+        );
+        state.lit.next_frame(state.bricks.len());
+        raycast::render(
+            &state.bricks,
+            &state.lit,
+            &lighting,
+            &bins,
             &frame.grid,
             &frame.view,
             frame.step,
             settings.background,
+            image,
             progress,
-        )
+        );
+        let t3 = Instant::now();
+        times.classify = t1 - t0;
+        times.bin = t2 - t1;
+        times.cast = t3 - t2;
+        times.bricks = state.bricks.len();
+        times
     }
 }
 

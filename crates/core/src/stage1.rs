@@ -5,9 +5,9 @@
 //! colour of [`crate::classify`], clamped to [0, 1]; the opacity is the
 //! classified opacity corrected for the sampling step. Stage 2 interpolates
 //! these per-voxel values along the rays (pre-classification, as in the
-//! paper and Levoy 1988). The light follows the camera by default, so this
-//! pass runs once per frame; the gradients it reads are computed once per
-//! volume.
+//! paper and Levoy 1988). This is the reference path's stage 1, over every
+//! voxel, dense; the fast path's is [`crate::classified`] (view-independent,
+//! kept across frames) and [`crate::shade_bricks`] (the light, per frame).
 
 use crate::classify::Classifier;
 use crate::shading::{LightGeometry, Phong};

@@ -1,0 +1,489 @@
+//! The fast path's per-frame stage 1: the paper's Phong colour of every
+//! voxel slot of the occupied bricks, for this frame's light and viewer.
+//!
+//! The light follows the camera (a headlight by default), so this cannot
+//! be kept across frames; everything it reads can (see
+//! [`crate::classified`]). It is the model of [`crate::shading`] and
+//! [`crate::stage1`] on the stored normals: two-sided (the normal turned to
+//! face the viewer), `C = Cs·(ka + kd·max(N·L, 0) + ks·max(N·H, 0)^n)` times
+//! the material colour, clamped to [0, 1], with ambient light only where
+//! the gradient is zero (a zero normal makes every dot product zero). Every
+//! slot is lit, transparent ones included: colours and opacities are
+//! interpolated separately (pre-classification), so a transparent voxel's
+//! colour still tints the samples next to it.
+//!
+//! The work is SIMD across four voxels at a time (one voxel per lane), and
+//! the result is `f32` RGBA per slot, ready for the ray caster to load
+//! without conversion.
+
+use crate::bricks::{SIDE, SLOTS, slot_coords};
+use crate::classified::{ClassifiedBricks, NORMAL_UNIT, UNIT, Voxel};
+use crate::classify::Classifier;
+use crate::shading::{LightGeometry, Phong};
+use crate::volume::Volume;
+use std::sync::{RwLock, RwLockReadGuard};
+use wide::bytemuck::cast;
+use wide::{f32x4, i16x8, i32x4, i32x8};
+
+/// The frame's lit bricks, each lit the first time a ray needs it.
+///
+/// Lighting a brick just before its rays cross it keeps its voxels in the
+/// cache for them, lets the lighting's memory traffic overlap the ray
+/// casting's arithmetic, and skips the bricks no tile lists (off screen),
+/// which then need no buffer either. The buffers are kept from frame to
+/// frame; a brick lit in an earlier frame is lit again, because the light
+/// moves with the camera.
+#[derive(Debug, Default)]
+pub struct LitBricks {
+    bricks: Vec<RwLock<LitBrick>>,
+    /// The frame being rendered: bricks lit for another are stale.
+    frame: u64,
+}
+
+/// One brick's lit voxels, `f32` RGBA in slot order, once it has been lit.
+#[derive(Debug, Default)]
+pub struct LitBrick {
+    frame: u64,
+    voxels: Option<Box<[[f32; 4]; SLOTS]>>,
+}
+
+impl LitBrick {
+    /// The lit voxels (only for a brick [`LitBricks::get`] returned).
+    pub fn voxels(&self) -> &[[f32; 4]; SLOTS] {
+        self.voxels
+            .as_ref()
+            .expect("a brick is lit before it is read")
+    }
+}
+
+impl LitBricks {
+    /// Starts a new frame of `bricks` occupied bricks: every brick is stale.
+    pub fn next_frame(&mut self, bricks: usize) {
+        self.frame += 1;
+        self.bricks.resize_with(bricks, Default::default);
+    }
+
+    /// Occupied brick `n`, lit by `lighting` if it is not yet lit for this
+    /// frame.
+    pub fn get(&self, n: usize, lighting: &Lighting) -> RwLockReadGuard<'_, LitBrick> {
+        let lock = &self.bricks[n];
+        let read = lock.read().unwrap_or_else(|e| e.into_inner());
+        if read.frame == self.frame {
+            return read;
+        }
+        drop(read);
+        {
+            let mut write = lock.write().unwrap_or_else(|e| e.into_inner());
+            // Another thread may have lit it meanwhile.
+            if write.frame != self.frame {
+                let voxels = write
+                    .voxels
+                    .get_or_insert_with(|| Box::new([[0.0; 4]; SLOTS]));
+                lighting.shade(n, voxels);
+                write.frame = self.frame;
+            }
+        }
+        lock.read().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// Everything needed to light one brick of one frame.
+pub struct Lighting<'a> {
+    volume: &'a Volume,
+    bricks: &'a ClassifiedBricks,
+    material: Material,
+    /// `None`: unlit, the colour is the material colour.
+    light: Option<FrameLight>,
+}
+
+impl<'a> Lighting<'a> {
+    /// The lighting of `bricks` (classified from `volume` by `classifier`)
+    /// under `lighting` (`None` for unlit rendering).
+    pub fn new(
+        volume: &'a Volume,
+        bricks: &'a ClassifiedBricks,
+        classifier: &Classifier,
+        lighting: Option<(&Phong, &LightGeometry)>,
+    ) -> Self {
+        Lighting {
+            volume,
+            bricks,
+            material: Material::new(classifier),
+            light: lighting.map(|(phong, light)| FrameLight::new(phong, light)),
+        }
+    }
+
+    /// Lights occupied brick `n` into `out`: `lit × material`, clamped, and
+    /// the stored opacity.
+    pub fn shade(&self, n: usize, out: &mut [[f32; 4]; SLOTS]) {
+        let (bricks, b) = (self.bricks, self.bricks.occupied[n]);
+        let voxels = &bricks.voxels[n * SLOTS..][..SLOTS];
+        let data = self.volume.data();
+        // The slots' values: rows of slots along x are rows of the volume,
+        // the last voxel repeated past its end.
+        let mut values = [0.0f32; SLOTS];
+        for s in slot_coords().step_by(SIDE) {
+            let start = bricks.grid.voxel_of_slot(b, s);
+            let end = bricks.grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
+            let row = &data[start..=end];
+            let first = SIDE * (s[1] + SIDE * s[2]);
+            for (i, v) in values[first..first + SIDE].iter_mut().enumerate() {
+                *v = row[i.min(row.len() - 1)];
+            }
+        }
+        // Four slots at a time, one per SIMD lane.
+        let mut group = |slots: [usize; 4], lanes: usize| {
+            let colours = shade4(
+                slots.map(|s| &voxels[s]),
+                f32x4::new(slots.map(|s| values[s])),
+                self.light.as_ref(),
+                &self.material,
+            );
+            for (lane, colour) in colours.iter().take(lanes).enumerate() {
+                out[slots[lane]] = colour.to_array();
+            }
+        };
+        // Slots that are no occupied cell's corner are never sampled (64 is
+        // a multiple of 4, so a group's bits are in one word).
+        let needed = &bricks.needed[n];
+        for s in (0..SLOTS - 3).step_by(4) {
+            if needed[s / 64] >> (s % 64) & 0xF != 0 {
+                group([s, s + 1, s + 2, s + 3], 4);
+            }
+        }
+        // The last slot (SLOTS = 4·182 + 1), in every lane.
+        group([SLOTS - 1; 4], 1);
+    }
+}
+
+/// The RGBA of four voxels with values `values`.
+#[inline]
+fn shade4(
+    voxels: [&Voxel; 4],
+    values: f32x4,
+    light: Option<&FrameLight>,
+    material: &Material,
+) -> [f32x4; 4] {
+    let [x, y, z, alpha] = unpack4(voxels);
+    let [mr, mg, mb] = material.at(values);
+    let (r, g, b) = match light {
+        Some(light) => {
+            let [lr, lg, lb] = light.lit(x, y, z);
+            (lr * mr, lg * mg, lb * mb)
+        }
+        None => (mr, mg, mb),
+    };
+    let unit = |c: f32x4| c.fast_max(f32x4::ZERO).fast_min(f32x4::ONE);
+    f32x4::transpose([unit(r), unit(g), unit(b), alpha * f32x4::splat(1.0 / UNIT)])
+}
+
+/// Four voxels as SIMD lanes: their normals' x, y and z, and their
+/// opacities, in the stored units. Each pair of voxels is one 16-byte
+/// vector of `i16`, widened to `i32` and converted.
+#[inline]
+fn unpack4(v: [&Voxel; 4]) -> [f32x4; 4] {
+    let pair = |a: &Voxel, b: &Voxel| {
+        let words = i16x8::new([
+            a.normal[0],
+            a.normal[1],
+            a.normal[2],
+            a.alpha as i16,
+            b.normal[0],
+            b.normal[1],
+            b.normal[2],
+            b.alpha as i16,
+        ]);
+        let [lo, hi]: [i32x4; 2] = cast(i32x8::from_i16x8(words));
+        [f32x4::from_i32x4(lo), f32x4::from_i32x4(hi)]
+    };
+    let [v0, v1] = pair(v[0], v[1]);
+    let [v2, v3] = pair(v[2], v[3]);
+    let [x, y, z, alpha] = f32x4::transpose([v0, v1, v2, v3]);
+    // The opacity is a `u16`: undo the sign extension.
+    let alpha = alpha
+        .simd_lt(f32x4::ZERO)
+        .select(alpha + f32x4::splat(65536.0), alpha);
+    [x, y, z, alpha]
+}
+
+/// One frame's lighting, reduced to what each voxel needs.
+#[derive(Debug, Clone, Copy)]
+struct FrameLight {
+    /// `Cs·ka`, `Cs·kd`, `Cs·ks` per channel (each in every lane).
+    ambient: [f32x4; 3],
+    diffuse: [f32x4; 3],
+    specular: [f32x4; 3],
+    shininess: Exponent,
+    /// `V`, `L` and `H`, in units of the stored normals (1/32767), per
+    /// component.
+    to_viewer: [f32x4; 3],
+    to_light: [f32x4; 3],
+    half: [f32x4; 3],
+}
+
+/// The highlight exponent: whole numbers by repeated squaring, which is
+/// faster than `powf` and as exact.
+#[derive(Debug, Clone, Copy)]
+enum Exponent {
+    Whole(u32),
+    Real(f32),
+}
+
+impl Exponent {
+    fn new(n: f32) -> Self {
+        if n.fract() == 0.0 && (0.0..=1024.0).contains(&n) {
+            Exponent::Whole(n as u32)
+        } else {
+            Exponent::Real(n)
+        }
+    }
+
+    /// `x^n` for `x` in [0, 1].
+    #[inline]
+    fn raise(self, x: f32x4) -> f32x4 {
+        match self {
+            Exponent::Whole(mut n) => {
+                let (mut result, mut power) = (f32x4::ONE, x);
+                while n > 0 {
+                    if n & 1 == 1 {
+                        result *= power;
+                    }
+                    power *= power;
+                    n >>= 1;
+                }
+                result
+            }
+            Exponent::Real(n) => f32x4::new(x.to_array().map(|x| x.powf(n))),
+        }
+    }
+}
+
+impl FrameLight {
+    fn new(phong: &Phong, light: &LightGeometry) -> Self {
+        let cs = phong.light_color;
+        let scaled = |v: glam::Vec3| (v / NORMAL_UNIT).to_array().map(f32x4::splat);
+        let times_cs = |k: [f32; 3]| std::array::from_fn(|c| f32x4::splat(cs[c] * k[c]));
+        FrameLight {
+            ambient: times_cs(phong.ambient),
+            diffuse: times_cs(phong.diffuse),
+            specular: times_cs(phong.specular),
+            shininess: Exponent::new(phong.shininess),
+            to_viewer: scaled(light.to_viewer),
+            to_light: scaled(light.to_light),
+            half: scaled(light.half),
+        }
+    }
+
+    /// The lit colour (before the material), per channel, of four voxels
+    /// whose quantised unit normals have components `x`, `y` and `z`.
+    #[inline]
+    fn lit(&self, x: f32x4, y: f32x4, z: f32x4) -> [f32x4; 3] {
+        let dot = |d: [f32x4; 3]| x * d[0] + y * d[1] + z * d[2];
+        // Two-sided: turn the normal to face the viewer.
+        let facing = dot(self.to_viewer)
+            .simd_lt(f32x4::ZERO)
+            .select(-f32x4::ONE, f32x4::ONE);
+        let n_dot_l = (dot(self.to_light) * facing).fast_max(f32x4::ZERO);
+        let n_dot_h = (dot(self.half) * facing).fast_max(f32x4::ZERO);
+        // No highlight where the light is behind the surface.
+        let lit_side = n_dot_l.simd_gt(f32x4::ZERO);
+        let highlight = lit_side.select(self.shininess.raise(n_dot_h), f32x4::ZERO);
+        std::array::from_fn(|c| {
+            self.ambient[c] + self.diffuse[c] * n_dot_l + self.specular[c] * highlight
+        })
+    }
+}
+
+/// The material colour function of one classifier, as a sum of clamped
+/// ramps: `f(t) = v₀ + Σᵢ (vᵢ₊₁ − vᵢ)·clamp((t − tᵢ)/(tᵢ₊₁ − tᵢ), 0, 1)`,
+/// a step where `tᵢ₊₁ = tᵢ` (the value after the jump, as
+/// [`crate::transfer_function::PiecewiseLinear::eval`] takes it). It
+/// equals the piecewise-linear function exactly, up to rounding, and needs
+/// no search for the segment, so four voxels go through it at once.
+struct Material {
+    /// `(lo, 1/(hi − lo))` of the classifier's normalisation, in every lane.
+    lo: f32x4,
+    inv_range: f32x4,
+    /// The value below the first point; white without a colour function.
+    first: [f32x4; 3],
+    /// Per segment: `tᵢ`, `1/(tᵢ₊₁ − tᵢ)` (`None` for a jump) and
+    /// `vᵢ₊₁ − vᵢ`, in every lane.
+    segments: Vec<(f32x4, Option<f32x4>, [f32x4; 3])>,
+}
+
+impl Material {
+    fn new(classifier: &Classifier) -> Self {
+        let points = classifier.color().map_or(&[][..], |c| c.points());
+        let (lo, inv_range) = classifier.normalisation();
+        Material {
+            lo: f32x4::splat(lo),
+            inv_range: f32x4::splat(inv_range),
+            first: points.first().map_or([1.0; 3], |p| p.1).map(f32x4::splat),
+            segments: points
+                .windows(2)
+                .map(|w| {
+                    let ((t0, v0), (t1, v1)) = (w[0], w[1]);
+                    let inv = (t1 > t0).then(|| f32x4::splat(1.0 / (t1 - t0)));
+                    let step = std::array::from_fn(|c| f32x4::splat(v1[c] - v0[c]));
+                    (f32x4::splat(t0), inv, step)
+                })
+                .collect(),
+        }
+    }
+
+    /// The material colour, per channel, of four voxels of `values`.
+    #[inline]
+    fn at(&self, values: f32x4) -> [f32x4; 3] {
+        let mut colour = self.first;
+        // As `Classifier::normalise`, lane by lane.
+        let t = (values - self.lo) * self.inv_range;
+        for (t0, inv, step) in &self.segments {
+            let d = t - *t0;
+            let ramp = match inv {
+                Some(inv) => (d * *inv).fast_max(f32x4::ZERO).fast_min(f32x4::ONE),
+                None => d.simd_ge(f32x4::ZERO).select(f32x4::ONE, f32x4::ZERO),
+            };
+            for c in 0..3 {
+                colour[c] += step[c] * ramp;
+            }
+        }
+        colour
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::classified::quantise_normal;
+    use crate::classify::OpacityMap;
+    use crate::transfer_function::PiecewiseLinear;
+    use glam::Vec3;
+
+    #[test]
+    fn quantised_shading_is_within_a_twentieth_of_a_level_of_phong() {
+        // Normals all round the sphere and zero ones, several lights: the
+        // stored normals cost well under 1/255.
+        let phongs = [
+            Phong::default(),
+            Phong {
+                ambient: [0.2, 0.1, 0.0],
+                diffuse: [0.5, 0.9, 0.3],
+                specular: [0.6, 0.2, 1.0],
+                shininess: 7.5,
+                light_color: [1.0, 0.8, 0.6],
+            },
+        ];
+        let lights = [
+            LightGeometry::headlight(Vec3::new(0.3, -0.8, 0.5).normalize()),
+            LightGeometry::new(Vec3::new(1.0, 0.2, 0.0), Vec3::new(0.0, 0.0, 1.0)),
+        ];
+        let mut worst = 0.0f32;
+        for phong in &phongs {
+            for light in &lights {
+                let frame = FrameLight::new(phong, light);
+                for i in (0..2000).step_by(4) {
+                    // A Fibonacci sphere of gradient directions, varied
+                    // lengths, and every 25th gradient zero.
+                    let gradient = |i: usize| {
+                        let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
+                        let r = (1.0 - z * z).sqrt();
+                        let phi = i as f32 * 2.399_963;
+                        let length = if i.is_multiple_of(25) {
+                            0.0
+                        } else {
+                            0.01 + i as f32
+                        };
+                        Vec3::new(r * phi.cos(), r * phi.sin(), z) * length
+                    };
+                    let g: [Vec3; 4] = std::array::from_fn(|k| gradient(i + k));
+                    let voxels = g.map(|g| Voxel {
+                        normal: quantise_normal(g.to_array()),
+                        alpha: 0,
+                    });
+                    let [x, y, z, _] = unpack4(voxels.each_ref());
+                    let lit = frame.lit(x, y, z);
+                    for (k, g) in g.iter().enumerate() {
+                        let exact = phong.shade(*g, light);
+                        for c in 0..3 {
+                            let got = lit[c].to_array()[k];
+                            worst = worst.max((got - exact[c]).abs());
+                        }
+                    }
+                }
+            }
+        }
+        assert!(worst < 1.0 / 255.0 / 20.0, "{worst}");
+        println!("largest quantised-shading error: {worst:e}");
+    }
+
+    #[test]
+    fn materials_are_the_classifiers() {
+        let color = PiecewiseLinear::new(
+            "color",
+            vec![
+                (0.1, [0.2, 0.3, 0.4]),
+                (0.5, [0.9, 0.1, 0.0]),
+                (0.5, [0.0, 1.0, 0.5]),
+                (0.8, [1.0, 1.0, 1.0]),
+            ],
+        )
+        .unwrap();
+        let c = Classifier::new(
+            (-2.0, 3.0),
+            OpacityMap::Ramp { p: 0.0, q: 1.0 },
+            Some(color),
+            1.0,
+        );
+        let m = Material::new(&c);
+        for i in (0..=1000).step_by(4) {
+            let f: [f32; 4] = std::array::from_fn(|k| -3.0 + 7.0 * (i + k) as f32 / 1000.0);
+            let got = m.at(f32x4::new(f));
+            for (k, f) in f.iter().enumerate() {
+                let want = c.material(*f);
+                for ch in 0..3 {
+                    let g = got[ch].to_array()[k];
+                    assert!((g - want[ch]).abs() < 1e-6, "{f}: {g} vs {want:?}");
+                }
+            }
+        }
+        // The jump at t = 0.5 (f = 0.5) takes the value after it.
+        let at_jump = m.at(f32x4::splat(0.5)).map(|c| c.to_array()[0]);
+        assert_eq!(c.material(0.5), [0.0, 1.0, 0.5]);
+        for ch in 0..3 {
+            assert!((at_jump[ch] - [0.0, 1.0, 0.5][ch]).abs() < 1e-6);
+        }
+        let white = Classifier::new((0.0, 1.0), OpacityMap::Ramp { p: 0.0, q: 1.0 }, None, 1.0);
+        let w = Material::new(&white).at(f32x4::splat(0.3));
+        assert!(w.iter().all(|c| *c == f32x4::ONE));
+    }
+
+    #[test]
+    fn lit_and_unlit_voxels_take_their_material_and_opacity() {
+        let color = PiecewiseLinear::constant([1.0, 0.5, 0.0]);
+        let c = Classifier::new(
+            (0.0, 1.0),
+            OpacityMap::Ramp { p: 0.0, q: 1.0 },
+            Some(color),
+            1.0,
+        );
+        let material = Material::new(&c);
+        let frame = FrameLight::new(&Phong::default(), &LightGeometry::headlight(Vec3::X));
+        let flat = Voxel {
+            normal: [0; 3],
+            alpha: 65535,
+        };
+        let facing = Voxel {
+            normal: [-32767, 0, 0],
+            alpha: 32768,
+        };
+        let voxels = [&flat, &facing, &flat, &facing];
+        let lit = shade4(voxels, f32x4::splat(0.5), Some(&frame), &material);
+        // Ambient only, then full light (ka + kd + ks = 1) on the back face.
+        assert_eq!(lit[0].to_array(), [0.1, 0.05, 0.0, 1.0]);
+        let full = lit[1].to_array();
+        assert!((full[0] - 1.0).abs() < 1e-6 && (full[1] - 0.5).abs() < 1e-6);
+        assert_eq!(full[3], 32768.0 / UNIT);
+        let unlit = shade4(voxels, f32x4::splat(0.5), None, &material);
+        assert_eq!(unlit[1].to_array(), [1.0, 0.5, 0.0, 32768.0 / UNIT]);
+    }
+}

@@ -1,0 +1,381 @@
+//! `volray bench --peers DIR`: the peer benchmark's six workloads, rendered
+//! exactly as the peers' harness (`../shared/peers`, `common.py`) defines
+//! them, so that volray's times compare with VTK's and yt's.
+//!
+//! The workload, from the peers' README:
+//! - volumes: `DIR/<name>.raw`, float32 little-endian, x fastest, with a
+//!   JSON sidecar `DIR/<name>.json` giving `dims`, `min`, `max` (and
+//!   `spacing`, `origin`);
+//! - view: orthographic along +x through the volume's centre, +z up (so
+//!   screen right is −y), the window fitting the y-z extent exactly;
+//! - sampling: 0.5 voxel, trilinear, front-to-back compositing;
+//! - transfer functions of `t = (v − min)/(max − min)`: opacity per voxel
+//!   through (0, 0), (0.05, 0), (0.95, 0.95), (1, 0.95), corrected to
+//!   `1 − (1 − a)^0.5` per sample; colour linear through (0.230, 0.299,
+//!   0.754), (0.865, 0.865, 0.865) at 0.5 and (0.706, 0.016, 0.150) at 1;
+//! - shading: one white headlight, ambient 0.1, diffuse 0.7, specular 0.2,
+//!   power 10; black background;
+//! - timing: one warm-up, then 5 timed frames, the median reported;
+//!   samples/s is nominal, `W²·(n − 1)/0.5` per frame over the median.
+
+use super::vtk::Harness;
+use super::{JsonRow, Timed, median, ms, time_frames, write_json};
+use crate::cli::BenchArgs;
+use crate::error::CliError;
+use crate::render::thread_pool;
+use std::path::Path;
+use volray_core::glam::DVec3;
+use volray_core::transfer_function::PiecewiseLinear;
+use volray_core::{Camera, Phong, RenderSettings, Renderer, TransferFunction, Volume};
+use volray_io::{DType, Endian, RawOptions};
+
+/// The workloads: dataset and window (pixels per side), as in `common.py`.
+pub const CASES: [(&str, usize); 6] = [
+    ("hydrogen_421", 120),
+    ("hydrogen_632", 120),
+    ("fractal_65", 240),
+    ("fractal_129", 480),
+    ("fractal_257", 480),
+    ("fractal_257", 1024),
+];
+
+/// The sample step, in voxels.
+pub const STEP: f64 = 0.5;
+/// Opacity per unit voxel distance at `t`.
+const OPACITY: [(f32, f32); 4] = [(0.0, 0.0), (0.05, 0.0), (0.95, 0.95), (1.0, 0.95)];
+/// Colour at `t`.
+const COLOR: [(f32, [f32; 3]); 3] = [
+    (0.0, [0.230, 0.299, 0.754]),
+    (0.5, [0.865, 0.865, 0.865]),
+    (1.0, [0.706, 0.016, 0.150]),
+];
+
+/// What a sidecar says about its volume.
+struct Sidecar {
+    dims: [usize; 3],
+    min: f64,
+    max: f64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+}
+
+/// Reads `DIR/<name>.json` and the raw volume it describes.
+fn load(dir: &Path, name: &str) -> Result<(Volume, Sidecar), CliError> {
+    let path = dir.join(format!("{name}.json"));
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        CliError::io(format!(
+            "{}: cannot read the sidecar: {e} (make the volumes with the peers' make_volumes.py)",
+            path.display()
+        ))
+    })?;
+    let side =
+        parse_sidecar(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let mut raw = RawOptions::new(side.dims, DType::F32);
+    raw.endian = Endian::Little;
+    raw.spacing = DVec3::from(side.spacing);
+    let raw_path = dir.join(format!("{name}.raw"));
+    let volume = volray_io::read_volume(&raw_path, Some(&raw))?
+        .with_origin(DVec3::from(side.origin))
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    Ok((volume, side))
+}
+
+fn parse_sidecar(text: &str) -> Result<Sidecar, String> {
+    let json: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+    let field = |key: &str| json.get(key).ok_or(format!("no \"{key}\""));
+    let number = |key: &str| {
+        field(key)?
+            .as_f64()
+            .filter(|v| v.is_finite())
+            .ok_or(format!("\"{key}\" is not a finite number"))
+    };
+    let triple = |key: &str, default: [f64; 3]| -> Result<[f64; 3], String> {
+        match json.get(key) {
+            None => Ok(default),
+            Some(v) => v
+                .as_array()
+                .filter(|a| a.len() == 3)
+                .and_then(|a| {
+                    let v: Option<Vec<f64>> = a.iter().map(|x| x.as_f64()).collect();
+                    v.and_then(|v| <[f64; 3]>::try_from(v).ok())
+                })
+                .ok_or(format!("\"{key}\" is not three numbers")),
+        }
+    };
+    for (key, want) in [("dtype", "float32"), ("byte_order", "little")] {
+        if let Some(v) = json.get(key)
+            && v.as_str() != Some(want)
+        {
+            return Err(format!("\"{key}\" is {v}, expected \"{want}\""));
+        }
+    }
+    let dims = triple("dims", [0.0; 3])?;
+    if dims
+        .iter()
+        .any(|d| d.fract() != 0.0 || *d < 2.0 || *d > 1e5)
+    {
+        return Err(format!(
+            "\"dims\" {dims:?} must be three whole numbers from 2"
+        ));
+    }
+    let (min, max) = (number("min")?, number("max")?);
+    if min >= max {
+        return Err(format!("\"min\" {min} must be below \"max\" {max}"));
+    }
+    Ok(Sidecar {
+        dims: dims.map(|d| d as usize),
+        min,
+        max,
+        spacing: triple("spacing", [1.0; 3])?,
+        origin: triple("origin", [0.0; 3])?,
+    })
+}
+
+/// The peers' transfer functions over `[min, max]`.
+fn transfer_function(min: f64, max: f64) -> TransferFunction {
+    let opacity = OPACITY.iter().map(|&(t, a)| (t, [a])).collect();
+    TransferFunction {
+        domain: Some((min, max)),
+        opacity: Some(PiecewiseLinear::new("opacity", opacity).expect("valid points")),
+        color: Some(PiecewiseLinear::new("color", COLOR.to_vec()).expect("valid points")),
+    }
+}
+
+/// The peers' settings for `volume` (value range `[min, max]`) in a
+/// `window²` image.
+fn workload(volume: &Volume, (min, max): (f64, f64), window: usize) -> RenderSettings {
+    let centre = volume.centre();
+    RenderSettings {
+        width: window,
+        height: window,
+        camera: Camera {
+            // Orthographic: only the direction matters, along +x.
+            view_point: Some(centre - DVec3::X * (1.0 + 2.0 * volume.extent().x)),
+            look_at: Some(centre),
+            up: DVec3::Z,
+        },
+        step: STEP,
+        transfer_function: transfer_function(min, max),
+        phong: Phong {
+            ambient: [0.1; 3],
+            diffuse: [0.7; 3],
+            specular: [0.2; 3],
+            shininess: 10.0,
+            light_color: [1.0; 3],
+        },
+        shading: true,
+        light_direction: None,
+        background: [0.0; 3],
+        ..RenderSettings::default()
+    }
+}
+
+/// One workload's result.
+struct Row {
+    dataset: String,
+    dims: [usize; 3],
+    window: usize,
+    median_s: f64,
+    /// Medians of the parts of the timed frames, ms: binning, and lighting
+    /// with casting.
+    parts: [f64; 2],
+    classify_ms: f64,
+    bricks: usize,
+    vtk: Option<super::vtk::VtkRun>,
+}
+
+pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
+    let pool = thread_pool(args.view.threads)?;
+    let threads = pool.current_num_threads();
+    let harness = if args.vs_vtk {
+        Some(Harness::find(dir, args.peers_python.as_deref())?)
+    } else {
+        None
+    };
+    let cases: Vec<(String, usize)> = match &args.cases {
+        Some(cases) => cases.0.clone(),
+        None => CASES.iter().map(|(d, w)| (d.to_string(), *w)).collect(),
+    };
+    println!(
+        "volray bench --peers {}: {} workloads, {threads} threads, 1 warm-up + {} timed frames each, turned 0.5° apart",
+        dir.display(),
+        cases.len(),
+        args.frames
+    );
+    let mut rows = Vec::new();
+    for (dataset, window) in cases {
+        let dataset = dataset.as_str();
+        let (volume, side) = load(dir, dataset)?;
+        let settings = workload(&volume, (side.min, side.max), window);
+        let fail = |e: volray_core::RenderError| CliError::input(format!("{dataset}: {e}"));
+        // VTK first, then volray: each sees the machine as the other left it.
+        let vtk = match &harness {
+            Some(h) => Some(h.run(dataset, window, threads, args.frames)?),
+            None => None,
+        };
+        let mut classify_ms = 0.0;
+        let (warm, timed) = pool.install(|| {
+            let renderer = Renderer::new(&volume).map_err(fail)?;
+            time_frames(&renderer, &settings, args.frames, |frame, t| {
+                if frame == 0 {
+                    classify_ms = t.parts.map_or(0.0, |p| ms(p.classify));
+                }
+            })
+            .map_err(fail)
+        })?;
+        let part = |pick: fn(&volray_core::FrameTimes) -> f64| {
+            median(
+                timed
+                    .iter()
+                    .filter_map(|t: &Timed| t.parts.as_ref().map(pick))
+                    .collect(),
+            )
+        };
+        let row = Row {
+            dataset: dataset.to_string(),
+            dims: volume.dims(),
+            window,
+            median_s: median(timed.iter().map(|t| t.wall).collect()),
+            parts: [part(|p| ms(p.bin)), part(|p| ms(p.cast))],
+            classify_ms,
+            bricks: timed
+                .first()
+                .and_then(|t| t.parts.map(|p| p.bricks))
+                .unwrap_or(0),
+            vtk: match (&harness, vtk) {
+                (Some(h), Some(run)) => Some(h.compare(run, &warm, dataset, window)?),
+                _ => None,
+            },
+        };
+        print_row(&row, threads);
+        rows.push(row);
+    }
+    print_table(&rows, threads);
+    if let Some(path) = &args.json {
+        let json: Vec<JsonRow> = rows
+            .iter()
+            .map(|r| JsonRow {
+                dataset: r.dataset.clone(),
+                window: r.window,
+                threads,
+                median_s: r.median_s,
+                vtk_median_s: r.vtk.as_ref().map(|v| v.median_s),
+            })
+            .collect();
+        write_json(path, &json)?;
+    }
+    Ok(())
+}
+
+/// Nominal samples per frame: `W²` rays of `(n − 1)/step` samples (point
+/// data, as the peers count them for VTK).
+fn nominal(row: &Row) -> f64 {
+    (row.window * row.window) as f64 * (row.dims[0] - 1) as f64 / STEP
+}
+
+fn print_row(row: &Row, threads: usize) {
+    let [bin, cast] = row.parts;
+    print!(
+        "  {:<13} {:>5}² t={threads}: median {:.4} s, {:.3e} samples/s (bin {bin:.2} + shade and cast {cast:.2} ms; {} bricks, classified once in {:.1} ms)",
+        row.dataset,
+        row.window,
+        row.median_s,
+        nominal(row) / row.median_s,
+        row.bricks,
+        row.classify_ms,
+    );
+    match &row.vtk {
+        Some(v) => println!(
+            "; VTK {:.4} s: VTK/volray {:.2}x",
+            v.median_s,
+            v.median_s / row.median_s
+        ),
+        None => println!(),
+    }
+}
+
+/// The closing table, in Markdown.
+fn print_table(rows: &[Row], threads: usize) {
+    println!();
+    let vtk = rows.iter().any(|r| r.vtk.is_some());
+    if vtk {
+        println!(
+            "| dataset, window | volray median s | samples/s (nominal) | VTK fixed-point median s | VTK / volray | image vs VTK: mean abs diff (levels of 255) |"
+        );
+        println!("|---|---|---|---|---|---|");
+    } else {
+        println!("| dataset, window | volray median s | samples/s (nominal) |");
+        println!("|---|---|---|");
+    }
+    for r in rows {
+        let name = format!(
+            "{} {}^3, {}^2 ({threads} thread{})",
+            r.dataset,
+            r.dims[0],
+            r.window,
+            if threads == 1 { "" } else { "s" }
+        );
+        let volray = format!("{:.4} | {:.3e}", r.median_s, nominal(r) / r.median_s);
+        match &r.vtk {
+            Some(v) => println!(
+                "| {name} | {volray} | {:.4} | {:.2} | {:.2} (means {:.1} vs {:.1}) |",
+                v.median_s,
+                v.median_s / r.median_s,
+                v.mean_abs_diff,
+                v.mean_volray,
+                v.mean_vtk
+            ),
+            None => println!("| {name} | {volray} |"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sidecars_are_read_and_checked() {
+        let ok = parse_sidecar(
+            r#"{"dims": [50, 50, 50], "dtype": "float32", "byte_order": "little",
+                "min": 0.5, "max": 2.0, "spacing": [1.0, 1.0, 2.0]}"#,
+        )
+        .unwrap();
+        assert_eq!(ok.dims, [50, 50, 50]);
+        assert_eq!((ok.min, ok.max), (0.5, 2.0));
+        assert_eq!(ok.spacing, [1.0, 1.0, 2.0]);
+        assert_eq!(ok.origin, [0.0; 3]);
+        for (text, want) in [
+            (r#"{"dims": [50, 50], "min": 0, "max": 1}"#, "\"dims\""),
+            (r#"{"dims": [50, 50, 1], "min": 0, "max": 1}"#, "\"dims\""),
+            (r#"{"dims": [5, 5, 5], "min": 1, "max": 1}"#, "below"),
+            (r#"{"dims": [5, 5, 5], "max": 1}"#, "no \"min\""),
+            (
+                r#"{"dims": [5, 5, 5], "min": 0, "max": 1, "dtype": "uint8"}"#,
+                "float32",
+            ),
+            ("[1,", "not JSON"),
+        ] {
+            let err = parse_sidecar(text).err().unwrap();
+            assert!(err.contains(want), "{text}: {err}");
+        }
+    }
+
+    #[test]
+    fn the_workload_is_the_peers() {
+        let v = Volume::new([65, 65, 65], vec![0.0; 65 * 65 * 65]).unwrap();
+        let s = workload(&v, (0.0, 2.0), 240);
+        let view =
+            volray_core::camera::OrthographicView::frame(&s.camera, v.bounds(), 240, 240).unwrap();
+        // Along +x, screen right −y, up +z; the window is the y-z face.
+        assert_eq!(view.direction, DVec3::X);
+        assert!((view.right + DVec3::Y).length() < 1e-12);
+        assert!((view.pixel_size - 64.0 / 240.0).abs() < 1e-12);
+        let tf = &s.transfer_function;
+        assert_eq!(tf.opacity.as_ref().unwrap().eval(0.5), [0.475]);
+        assert!((tf.color.as_ref().unwrap().eval(0.25)[0] - 0.5475).abs() < 1e-6);
+        assert_eq!((s.step, s.background), (0.5, [0.0; 3]));
+        assert_eq!(s.light_direction, None);
+    }
+}
