@@ -3,6 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
+use volray_data::fractal::FractalParams;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -23,6 +24,107 @@ pub enum Command {
     Render(RenderArgs),
     /// Time frames of a volume: median of several views, each new.
     Bench(BenchArgs),
+    /// Describe a volume: format, dims, spacing, origin, sample type, value
+    /// range, a histogram, and what the header said versus what was used.
+    Info(InfoArgs),
+    /// Write a generated volume to a file: a hydrogen-atom density or a
+    /// fractal cloud (the paper's two test data sets).
+    Generate(GenerateArgs),
+}
+
+/// `volray generate`.
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    #[command(subcommand)]
+    pub kind: GenerateKind,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum GenerateKind {
+    /// The hydrogen-atom probability density |ψ_nlm|² (in a₀⁻³) on an
+    /// N³ grid over [−R, R]³ (in a₀).
+    Hydrogen(HydrogenArgs),
+    /// A fractal cloud by 3-D midpoint displacement, post-processed as in
+    /// the paper (ramp toward the boundary, threshold, negatives to 0).
+    Fractal(FractalArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct HydrogenArgs {
+    /// Principal quantum number, 1 to 12.
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub n: u32,
+    /// Orbital quantum number, 0 to n − 1.
+    #[arg(long, value_name = "L")]
+    pub l: u32,
+    /// Magnetic quantum number, −l to l.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub m: i32,
+    /// Points per side of the grid.
+    #[arg(long, value_name = "N", default_value_t = 50)]
+    pub grid: usize,
+    /// Half-width R of the cube [−R, R]³ in Bohr radii [default: the
+    /// radius that holds 99.5% of the radial probability].
+    #[arg(long, value_name = "R")]
+    pub extent: Option<f64>,
+    /// The real orbital chemists use (p_x, p_y, d_xy, ...: cos mφ for m > 0,
+    /// sin |m|φ for m < 0) instead of the complex e^{imφ} one.
+    #[arg(long)]
+    pub real: bool,
+    /// Output file: .nrrd (keeps spacing and origin), .npy or .raw
+    /// (f32, little-endian, x fastest), written atomically.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct FractalArgs {
+    /// Points per side: 2^k + 1 (3, 5, 9, ..., 1025).
+    #[arg(long, value_name = "N", default_value_t = FractalParams::default().size)]
+    pub size: usize,
+    /// Fractal dimension D of the field's graph, 3 ≤ D < 4 (Hurst H = 4 − D).
+    #[arg(long, value_name = "D", default_value_t = FractalParams::default().dimension)]
+    pub dimension: f64,
+    /// Standard deviation of the corner values (the coarsest displacements).
+    #[arg(long, value_name = "SIGMA", default_value_t = FractalParams::default().sigma)]
+    pub sigma: f64,
+    /// Random seed: the same seed gives the same bytes on any machine.
+    #[arg(long, value_name = "SEED", default_value_t = FractalParams::default().seed)]
+    pub seed: u64,
+    /// Post-processing: the fraction of the half width over which the
+    /// field is ramped down to 0 at the boundary sphere (0 < R ≤ 1).
+    #[arg(long, value_name = "R", default_value_t = FractalParams::default().ramp)]
+    pub ramp: f64,
+    /// Post-processing: subtracted from the field scaled to [0, 1] (after
+    /// the ramp) before negatives are set to 0 (0 ≤ T < 1).
+    #[arg(long, value_name = "T", default_value_t = FractalParams::default().threshold, allow_hyphen_values = true)]
+    pub threshold: f64,
+    /// Skip the post-processing: write the raw midpoint-displacement field.
+    #[arg(long)]
+    pub raw_field: bool,
+    /// Voss's successive random additions: displace every point at every
+    /// level, for better statistics.
+    #[arg(long)]
+    pub random_additions: bool,
+    /// Output file: .nrrd (keeps spacing and origin), .npy or .raw
+    /// (f32, little-endian, x fastest), written atomically.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+}
+
+/// `volray info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+
+    /// Histogram bins.
+    #[arg(long, value_name = "N", default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    pub bins: u16,
+
+    /// Print the description as JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Where the volume comes from and how to read it.
@@ -115,6 +217,26 @@ pub struct ViewArgs {
     #[arg(long, value_name = "FILE.json")]
     pub tf: Option<PathBuf>,
 
+    /// A transfer-function preset: ct-bone and ct-soft-tissue (Hounsfield
+    /// units), mr and electron-density (relative to the value range).
+    /// Conflicts with --tf.
+    #[arg(long, value_name = "ct-bone|ct-soft-tissue|mr|electron-density")]
+    pub preset: Option<String>,
+
+    /// A named colour map for the colour transfer function, replacing a
+    /// preset's colours. Conflicts with a colour in --tf [default: white].
+    #[arg(
+        long,
+        value_name = "viridis|magma|inferno|plasma|cividis|turbo|coolwarm|grey"
+    )]
+    pub colormap: Option<String>,
+
+    /// The value window LO,HI that t = 0..1 spans (values outside are
+    /// clamped) [default: the volume's min and max]. Conflicts with a
+    /// domain in --tf and with the CT presets, whose window is fixed.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_range, allow_hyphen_values = true)]
+    pub range: Option<(f64, f64)>,
+
     /// Ambient reflection k_a: one value or r,g,b.
     #[arg(long, value_name = "A|R,G,B", allow_hyphen_values = true, default_value = "0.1", value_parser = parse_rgb)]
     pub ambient: [f32; 3],
@@ -167,11 +289,12 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
 
-    /// Output PNG file, written atomically (never half-written).
-    #[arg(short, long, value_name = "OUT.png")]
+    /// Output image, written atomically (never half-written): PNG, or
+    /// OpenEXR (32-bit float RGBA, unquantised) if the name ends in .exr.
+    #[arg(short, long, value_name = "OUT.png|OUT.exr")]
     pub output: PathBuf,
 
-    /// Bits per channel of the PNG.
+    /// Bits per channel of a PNG.
     #[arg(long, value_name = "8|16", default_value = "8", value_parser = parse_bit_depth)]
     pub bit_depth: u8,
 
@@ -188,6 +311,38 @@ pub struct BenchArgs {
     /// half degree about the up axis, so no frame reuses view-dependent work.
     #[arg(long, value_name = "N", default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub frames: u32,
+
+    /// Instead of INPUT, time the peer benchmark's six workloads from the
+    /// raw float32 volumes and JSON sidecars in DIR (made by the peers'
+    /// make_volumes.py), each exactly as the peers define it: view along
+    /// +x, step 0.5 voxel, their transfer functions and shading. The view
+    /// options other than --threads do not apply.
+    #[arg(long, value_name = "DIR")]
+    pub peers: Option<PathBuf>,
+
+    /// With --peers: only these workloads, each NAME:W (the volume
+    /// DIR/NAME.raw with its sidecar, in a W×W window) [default: the six
+    /// workloads hydrogen_421:120, hydrogen_632:120, fractal_65:240,
+    /// fractal_129:480, fractal_257:480, fractal_257:1024].
+    #[arg(long, value_name = "NAME:W,...", requires = "peers", value_parser = parse_cases)]
+    pub cases: Option<Cases>,
+
+    /// Also write the medians to FILE as a JSON list of
+    /// {"dataset", "window", "threads", "median_s"}.
+    #[arg(long, value_name = "FILE.json")]
+    pub json: Option<PathBuf>,
+
+    /// With --peers: also time VTK's fixed-point ray caster on each
+    /// workload in the same run, alternating with volray, through the
+    /// peers' vtk_bench.py in DIR's parent, and print the ratios and the
+    /// image differences.
+    #[arg(long, requires = "peers")]
+    pub vs_vtk: bool,
+
+    /// The Python of the peers' venv, for --vs-vtk [default:
+    /// $VOLRAY_PEERS_PYTHON, else DIR/../.venv/bin/python].
+    #[arg(long, value_name = "PATH", requires = "vs_vtk")]
+    pub peers_python: Option<PathBuf>,
 
     #[command(flatten)]
     pub view: ViewArgs,
@@ -235,6 +390,14 @@ fn parse_pair(s: &str) -> Result<(f32, f32), String> {
     }
 }
 
+fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    match finite(numbers::<f64>(s, "number")?)?[..] {
+        [lo, hi] if lo < hi => Ok((lo, hi)),
+        [lo, hi] => Err(format!("LO {lo} must be below HI {hi}")),
+        ref v => Err(format!("expected LO,HI (two numbers), got {}", v.len())),
+    }
+}
+
 /// One value for all three channels, or r,g,b.
 pub fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
     match finite(numbers::<f64>(s, "number")?)?[..] {
@@ -262,6 +425,33 @@ pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
         return Err(format!("image size {w}x{h} must be at least 1x1"));
     }
     Ok((w, h))
+}
+
+/// Workloads of `bench --cases`: volume names and window sizes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cases(pub Vec<(String, usize)>);
+
+/// `NAME:W,NAME:W,...` for `bench --cases`.
+fn parse_cases(s: &str) -> Result<Cases, String> {
+    s.split(',')
+        .map(|case| {
+            let (name, window) = case
+                .split_once(':')
+                .ok_or(format!("'{case}' is not NAME:W"))?;
+            let window = window
+                .trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|w| (1..=16384).contains(w))
+                .ok_or(format!("'{window}' is not a window size from 1 to 16384"))?;
+            let name = name.trim();
+            if name.is_empty() || name.contains(['/', '\\']) {
+                return Err(format!("'{name}' is not a volume name"));
+            }
+            Ok((name.to_string(), window))
+        })
+        .collect::<Result<_, _>>()
+        .map(Cases)
 }
 
 fn parse_bit_depth(s: &str) -> Result<u8, String> {
@@ -293,6 +483,16 @@ mod tests {
         assert_eq!(parse_pair("0.1,0.9"), Ok((0.1, 0.9)));
         assert!(parse_positive_vec3("1,0,1").is_err());
         assert_eq!(parse_bit_depth("16"), Ok(16));
+        assert_eq!(
+            parse_cases("fractal_129:480, hydrogen_421:120"),
+            Ok(Cases(vec![
+                ("fractal_129".to_string(), 480),
+                ("hydrogen_421".to_string(), 120)
+            ]))
+        );
+        assert!(parse_cases("fractal_129").is_err());
+        assert!(parse_cases("fractal_129:0").is_err());
+        assert!(parse_cases("../x:10").is_err());
         assert!(parse_bit_depth("12").is_err());
     }
 }

@@ -18,7 +18,6 @@ pub struct Input {
     /// The file it came from, if any.
     pub path: Option<PathBuf>,
     /// The file's format and what its header said, if it came from a file.
-    #[allow(dead_code)] // read by `volray info` (issue 6, in progress)
     pub file: Option<(VolumeFormat, FileInfo)>,
 }
 

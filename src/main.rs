@@ -5,6 +5,8 @@
 mod bench;
 mod cli;
 mod error;
+mod generate;
+mod info;
 mod input;
 mod render;
 
@@ -39,6 +41,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Info(args) => info::run(args),
+        Command::Generate(args) => generate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

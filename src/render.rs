@@ -7,12 +7,15 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
 use volray_core::glam::DVec3;
-use volray_core::{Camera, Method, Phong, RenderSettings, Renderer, TransferFunction};
+use volray_core::{
+    Camera, Method, Phong, RenderSettings, Renderer, TransferFunction, colormap, presets,
+};
 use volray_io::BitDepth;
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let input = input::load(&args.input)?;
     check_output(&args.output, &input)?;
+    output_kind(&args.output, args.bit_depth)?;
     let settings = settings(&args.view)?;
     let pool = thread_pool(args.view.threads)?;
     let renderer = Renderer::new(&input.volume)
@@ -35,13 +38,40 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
     bar.finish_and_clear();
 
-    let depth = if args.bit_depth == 16 {
-        BitDepth::Sixteen
-    } else {
-        BitDepth::Eight
-    };
-    volray_io::write_png(&args.output, &image, depth)?;
+    match output_kind(&args.output, args.bit_depth)? {
+        OutputKind::Png(depth) => volray_io::write_png(&args.output, &image, depth)?,
+        OutputKind::Exr => volray_io::write_exr(&args.output, &image)?,
+    }
     Ok(())
+}
+
+/// What an output file name asks for.
+enum OutputKind {
+    Png(BitDepth),
+    /// OpenEXR: the f32 frame buffer, unquantised.
+    Exr,
+}
+
+/// The output format from the file name: `.exr` is OpenEXR, anything else
+/// PNG (at `--bit-depth`). `--bit-depth 16` with `.exr` is refused: EXR
+/// holds 32-bit floats.
+fn output_kind(output: &Path, bit_depth: u8) -> Result<OutputKind, CliError> {
+    let ext = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("exr") if bit_depth != 8 => Err(CliError::input(format!(
+            "{}: --bit-depth applies to PNG output; OpenEXR holds 32-bit floats",
+            output.display()
+        ))),
+        Some("exr") => Ok(OutputKind::Exr),
+        _ => Ok(OutputKind::Png(if bit_depth == 16 {
+            BitDepth::Sixteen
+        } else {
+            BitDepth::Eight
+        })),
+    }
 }
 
 /// Refuses, before any work, an output that would overwrite the input or
@@ -87,10 +117,50 @@ pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
         }
         None => TransferFunction::default(),
     };
+    let from = if view.tf.is_some() {
+        "--tf"
+    } else {
+        "--preset"
+    };
+    let mut transfer_function = match &view.preset {
+        Some(_) if view.tf.is_some() => {
+            return Err(CliError::input(
+                "--preset conflicts with --tf: give one of them",
+            ));
+        }
+        Some(name) => presets::preset(name).ok_or_else(|| {
+            CliError::input(format!(
+                "--preset: unknown preset '{name}': expected one of {}",
+                presets::NAMES.join(", ")
+            ))
+        })?,
+        None => transfer_function,
+    };
     if view.opacity.is_some() && transfer_function.opacity.is_some() {
-        return Err(CliError::input(
-            "--opacity conflicts with the opacity function in --tf: give one of them",
-        ));
+        return Err(CliError::input(format!(
+            "--opacity conflicts with the opacity function in {from}: give one of them"
+        )));
+    }
+    if let Some(name) = &view.colormap {
+        if view.tf.is_some() && transfer_function.color.is_some() {
+            return Err(CliError::input(
+                "--colormap conflicts with the colour function in --tf: give one of them",
+            ));
+        }
+        transfer_function.color = Some(colormap::colormap(name).ok_or_else(|| {
+            CliError::input(format!(
+                "--colormap: unknown colour map '{name}': expected one of {}",
+                colormap::NAMES.join(", ")
+            ))
+        })?);
+    }
+    if let Some(range) = view.range {
+        if transfer_function.domain.is_some() {
+            return Err(CliError::input(format!(
+                "--range conflicts with the value domain fixed by {from}: give one of them"
+            )));
+        }
+        transfer_function.domain = Some(range);
     }
     let settings = RenderSettings {
         width: view.size.0,

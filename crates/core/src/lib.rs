@@ -21,10 +21,18 @@
 //!   finds each ray's samples at a fixed step (default one voxel, errata 8);
 //!   [`trilinear`] resamples colour and opacity there; [`composite`] applies
 //!   the transparency formula `C_out = C_in (1 − α) + C α`.
-//! - Two stage-2 paths: [`reference`], the paper's back-to-front
-//!   compositing, kept as the oracle; [`raycast`], front to back with early
-//!   ray termination over parallel tiles, the default. They agree within
-//!   1/255 per channel; the fast path is bit-identical for any thread count.
+//! - Two paths: [`reference`](mod@reference), the paper's algorithm as written (stage 1
+//!   on every voxel, back-to-front compositing of every sample), kept as
+//!   the oracle; and the fast default, which computes the same samples but
+//!   skips what contributes nothing. Its view-independent stage 1 groups
+//!   the cells into [`bricks`], rules out empty ones with the [`macrocells`]
+//!   min/max grid and keeps the occupied ones compact ([`classified`]); per
+//!   frame, [`shade_bricks`] lights them, [`tiles`] lists them per image
+//!   tile front to back, and [`raycast`] composites front to back through
+//!   the occupied cells only, with early ray termination, in parallel over
+//!   tiles. The paths agree within 1/255 per channel; the fast path is
+//!   bit-identical for any thread count. `docs/performance.md` records the
+//!   design and what each step bought.
 //! - [`render`] ties it together; [`image`] is the RGBA `f32` result.
 //!
 //! ```
@@ -44,25 +52,34 @@
 //! assert!(centre[0] > 0.5 && corner == [0.0, 0.0, 0.0, 0.0]);
 //! ```
 
+pub mod bricks;
 pub mod camera;
+pub mod classified;
 pub mod classify;
+pub mod colormap;
 pub mod composite;
 pub mod gradient;
+pub mod histogram;
 pub mod image;
+pub mod macrocells;
+pub mod presets;
 pub mod ray;
 pub mod raycast;
 pub mod reference;
 pub mod render;
+pub mod shade_bricks;
 pub mod shading;
 pub mod stage1;
+pub mod tiles;
 pub mod transfer_function;
 pub mod trilinear;
 pub mod volume;
 
 pub use camera::Camera;
 pub use glam;
+pub use histogram::Histogram;
 pub use image::Image;
-pub use render::{Method, RenderError, RenderSettings, Renderer};
+pub use render::{FrameTimes, Method, RenderError, RenderSettings, Renderer};
 pub use shading::Phong;
 pub use transfer_function::TransferFunction;
 pub use volume::{Volume, VolumeError};
