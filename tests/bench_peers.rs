@@ -3,18 +3,9 @@
 
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn volray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volray"))
-        .args(args)
-        .output()
-        .expect("volray runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{stderr, volray};
 
 /// Writes `name.raw` (a ball, `n³` little-endian f32, x fastest) and its
 /// sidecar, as the peers' make_volumes.py does.

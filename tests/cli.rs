@@ -2,18 +2,9 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn volray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volray"))
-        .args(args)
-        .output()
-        .expect("volray runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{stderr, volray};
 
 /// Decoded PNG: (width, height, bit depth, samples as u16).
 fn read_png(path: &Path) -> (u32, u32, u8, Vec<u16>) {

@@ -3,22 +3,9 @@
 
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn volray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volray"))
-        .args(args)
-        .output()
-        .expect("volray runs")
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{stderr, stdout, volray};
 
 const C_F4: &str = "crates/io/tests/fixtures/c_f4.npy";
 

@@ -1,18 +1,9 @@
 //! `volray generate`: the paper's data sets written to files that read back.
 
 use std::fs;
-use std::process::{Command, Output};
 
-fn volray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volray"))
-        .args(args)
-        .output()
-        .expect("volray runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{stderr, volray};
 
 fn info_json(input: &str) -> serde_json::Value {
     let out = volray(&["info", input, "--json"]);
