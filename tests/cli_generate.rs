@@ -22,41 +22,28 @@ fn read_f32(path: &std::path::Path) -> Vec<f32> {
 #[test]
 fn hydrogen_density_is_normalised_and_keeps_its_geometry() {
     let dir = tempfile::tempdir().unwrap();
-    let raw = dir.path().join("h.raw");
-    let out = volray(&[
-        "generate",
-        "hydrogen",
-        "--n",
-        "2",
-        "--l",
-        "1",
-        "--m",
-        "1",
-        "--grid",
-        "61",
-        "-o",
-        raw.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    // The same density as raw f32 values and as NRRD (which carries the grid).
+    let (raw, nrrd) = (dir.path().join("h.raw"), dir.path().join("h.nrrd"));
+    for path in [&raw, &nrrd] {
+        let out = volray(&[
+            "generate",
+            "hydrogen",
+            "--n",
+            "2",
+            "--l",
+            "1",
+            "--m",
+            "1",
+            "--grid",
+            "61",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
     let values = read_f32(&raw);
     assert_eq!(values.len(), 61 * 61 * 61);
-    // The NRRD copy carries the grid: [−R, R]³ with R holding 99.5%.
-    let nrrd = dir.path().join("h.nrrd");
-    let out = volray(&[
-        "generate",
-        "hydrogen",
-        "--n",
-        "2",
-        "--l",
-        "1",
-        "--m",
-        "1",
-        "--grid",
-        "61",
-        "-o",
-        nrrd.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    // The grid is [−R, R]³ with R holding 99.5%.
     let info = info_json(nrrd.to_str().unwrap());
     let h = info["spacing"][0].as_f64().unwrap();
     let r = -info["origin"][0].as_f64().unwrap();
