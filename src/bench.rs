@@ -15,11 +15,9 @@ mod vtk;
 
 use crate::cli::BenchArgs;
 use crate::error::CliError;
-use crate::input;
 use crate::render::{settings, thread_pool};
 use std::path::Path;
 use std::time::{Duration, Instant};
-use volray_core::glam::{DQuat, DVec3};
 use volray_core::{Camera, FrameTimes, Image, Method, RenderSettings, Renderer};
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
@@ -62,17 +60,13 @@ pub fn time_frames(
     frames: u32,
     mut report: impl FnMut(u32, &Timed),
 ) -> Result<(Image, Vec<Timed>), volray_core::RenderError> {
-    let volume = renderer.volume();
-    let look_at = base.camera.look_at.unwrap_or(volume.centre());
-    let view_point = base.camera.view_point.unwrap_or(look_at + DVec3::X);
-    let axis = base.camera.up.normalize();
     let mut image = Image::new(base.width, base.height, [0.0; 4]);
     let render = |frame: u32, image: &mut Image| {
-        let turn = DQuat::from_axis_angle(axis, (0.5 * frame as f64).to_radians());
+        // Orbit about the up axis through the view reference (VTK's
+        // azimuth), for either projection and with or without --view.
         let settings = RenderSettings {
             camera: Camera {
-                view_point: Some(look_at + turn * (view_point - look_at)),
-                look_at: Some(look_at),
+                azimuth: base.camera.azimuth + 0.5 * frame as f64,
                 ..base.camera
             },
             ..base.clone()
@@ -157,7 +151,7 @@ pub fn write_json(path: &Path, rows: &[JsonRow]) -> Result<(), CliError> {
 
 /// `volray bench INPUT`: the frames of one volume.
 fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
-    let input = input::load(&args.input)?;
+    let input = crate::render::load(&args.input, args.view.log)?;
     let base = settings(&args.view)?;
     let pool = thread_pool(args.view.threads)?;
     let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
@@ -226,10 +220,5 @@ fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
 /// Samples the rays of `frame` would take without skipping or early
 /// termination.
 fn nominal_samples(frame: &volray_core::render::Frame) -> usize {
-    let view = &frame.view;
-    (0..view.height)
-        .flat_map(|row| (0..view.width).map(move |col| (col, row)))
-        .filter_map(|(col, row)| frame.grid.ray(view, col, row, frame.step))
-        .map(|ray| ray.count())
-        .sum()
+    frame.nominal_samples()
 }

@@ -20,7 +20,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Render a volume to a PNG image.
+    /// Render a volume to an image (PNG, OpenEXR), or a turntable or a
+    /// series of volumes to an animation (animated PNG, GIF, numbered PNGs).
     Render(RenderArgs),
     /// Time frames of a volume: median of several views, each new.
     Bench(BenchArgs),
@@ -128,7 +129,7 @@ pub struct InfoArgs {
 }
 
 /// Where the volume comes from and how to read it.
-#[derive(Debug, Args)]
+#[derive(Debug, Clone, Args)]
 pub struct InputArgs {
     /// A volume file or a built-in source spec such as
     /// `marschner-lobb:41`, `blobs:64`, `sphere:64,radius=0.7`, `torus`
@@ -282,6 +283,108 @@ pub struct ViewArgs {
     /// Worker threads [default: one per core].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub threads: Option<u16>,
+
+    /// How the samples along a ray make the pixel: composite (the paper's
+    /// transparency formula), mip (maximum intensity projection, also
+    /// `maximum`), minip (minimum, also `minimum`), average (the mean), or
+    /// iso (composite of the --iso contour, as --iso alone). The
+    /// projections show the value through the colour map (grey without
+    /// one: with --range 0,1 a mip pixel's grey is the ray's maximum),
+    /// unshaded and opaque.
+    #[arg(
+        long,
+        value_enum,
+        value_name = "MODE",
+        default_value = "composite",
+        help_heading = "Rendering options"
+    )]
+    pub blend: BlendMode,
+
+    /// Levoy's isovalue contour (1988, eq. 3): only a shell about the
+    /// surface f = VALUE is opaque, with the opacity the transfer function
+    /// gives VALUE on it, falling to 0 at --iso-thickness voxels either
+    /// side, whatever the steepness of the data.
+    #[arg(long, value_name = "VALUE", allow_hyphen_values = true, value_parser = parse_iso_value, help_heading = "Rendering options")]
+    pub iso: Option<f32>,
+
+    /// Half-width R of the --iso shell, in voxels of the smallest spacing
+    /// [default: 1].
+    #[arg(long, value_name = "R", allow_hyphen_values = true, value_parser = parse_thickness, help_heading = "Rendering options")]
+    pub iso_thickness: Option<f32>,
+
+    /// Render log10 of the data, for values that span decades (densities);
+    /// values <= 0 take the log of the smallest positive value. --range,
+    /// --iso and a --tf domain stay in the data's own units (they must
+    /// then be positive) and are converted: `--log --range 1e-4,1` spans
+    /// four decades.
+    #[arg(long, help_heading = "Rendering options")]
+    pub log: bool,
+
+    /// Opacity times a ramp of the gradient magnitude |∇f|, 0 at LO and 1
+    /// at HI, fractions of the volume's largest |∇f| (0 <= LO < HI <= 1):
+    /// boundaries show and uniform insides fade.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_gradient_opacity, allow_hyphen_values = true, help_heading = "Rendering options")]
+    pub gradient_opacity: Option<(f32, f32)>,
+
+    /// Interpolate the scalar (and its gradient) at each sample, then
+    /// classify and shade it, instead of the paper's classified voxel
+    /// colours: sharper, slower.
+    #[arg(long, help_heading = "Rendering options")]
+    pub post_classification: bool,
+
+    /// Start each pixel's samples a fraction of a step further (a fixed
+    /// hash of the pixel, the same every run) against wood-grain artifacts.
+    #[arg(long, help_heading = "Rendering options")]
+    pub jitter: bool,
+
+    /// Perspective projection with this vertical field of view in degrees
+    /// (0 < FOV < 180) [default: orthographic]. Without --view the eye
+    /// stands where the volume's bounding sphere just fills the view.
+    #[arg(long, value_name = "FOV", value_parser = parse_fov, allow_hyphen_values = true, help_heading = "Camera")]
+    pub perspective: Option<f64>,
+
+    /// Magnification about the image centre, > 0: 2 shows everything twice
+    /// as large (as VTK's Zoom).
+    #[arg(long, value_name = "Z", default_value_t = 1.0, value_parser = parse_zoom, allow_hyphen_values = true, help_heading = "Camera")]
+    pub zoom: f64,
+
+    /// Degrees the view point orbits about the up vector through the view
+    /// reference (VTK's Azimuth: 90 takes the default eye from +x to +y).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = parse_angle, allow_hyphen_values = true, help_heading = "Camera")]
+    pub azimuth: f64,
+
+    /// Degrees the view point then rises about the screen's horizontal
+    /// axis (VTK's Elevation: 90 looks down the up vector).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = parse_angle, allow_hyphen_values = true, help_heading = "Camera")]
+    pub elevation: f64,
+
+    /// A clip plane through the world point X,Y,Z with normal NX,NY,NZ:
+    /// keeps the side the normal points to. Repeatable: what every plane
+    /// keeps is rendered.
+    #[arg(long, value_name = "X,Y,Z,NX,NY,NZ", value_parser = parse_clip, allow_hyphen_values = true, help_heading = "Camera")]
+    pub clip: Vec<([f64; 3], [f64; 3])>,
+
+    /// Render only the world box X0..X1, Y0..Y1, Z0..Z1 (VTK's cropping
+    /// region planes, in world coordinates rather than voxels).
+    #[arg(long, value_name = "X0,X1,Y0,Y1,Z0,Z1", value_parser = parse_crop, allow_hyphen_values = true, help_heading = "Camera")]
+    pub crop: Option<([f64; 3], [f64; 3])>,
+}
+
+/// `--blend`: how a ray's samples make its pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BlendMode {
+    /// The paper's compositing of classified, shaded samples.
+    Composite,
+    /// Maximum intensity projection.
+    #[value(alias = "maximum")]
+    Mip,
+    /// Minimum intensity projection.
+    #[value(alias = "minimum")]
+    Minip,
+    /// The mean value along the ray.
+    Average,
+    /// Composite of Levoy's isovalue contour (needs --iso).
+    Iso,
 }
 
 #[derive(Debug, Args)]
@@ -289,14 +392,34 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
 
+    /// More volumes after INPUT: render them all as an animation, one
+    /// frame per volume in the order given, with one transfer function
+    /// (the value range spans every volume unless --range) and one framing
+    /// (the box around every volume). They are read one at a time, twice.
+    #[arg(value_name = "MORE")]
+    pub series: Vec<String>,
+
     /// Output image, written atomically (never half-written): PNG, or
     /// OpenEXR (32-bit float RGBA, unquantised) if the name ends in .exr.
-    #[arg(short, long, value_name = "OUT.png|OUT.exr")]
+    /// An animation (--turntable, several inputs) is an animated PNG
+    /// (.png), a GIF (.gif) or numbered PNGs (a name with %03d or %d).
+    #[arg(short, long, value_name = "OUT.png|OUT.exr|OUT.gif|OUT_%03d.png")]
     pub output: PathBuf,
 
     /// Bits per channel of a PNG.
     #[arg(long, value_name = "8|16", default_value = "8", value_parser = parse_bit_depth)]
     pub bit_depth: u8,
+
+    /// Render FRAMES views into an animation, the view point orbiting the
+    /// up vector (azimuth --azimuth + 360·i/FRAMES for frame i) with the
+    /// window fitted to the bounding sphere so the picture keeps its scale.
+    #[arg(long, value_name = "FRAMES", value_parser = clap::value_parser!(u32).range(1..=100_000), help_heading = "Animations")]
+    pub turntable: Option<u32>,
+
+    /// Frames per second of an animation, in (0, 100] [default: 24]; GIF
+    /// keeps the delay in hundredths of a second.
+    #[arg(long, value_name = "FPS", value_parser = parse_fps, help_heading = "Animations")]
+    pub fps: Option<f64>,
 
     #[command(flatten)]
     pub view: ViewArgs,
@@ -454,6 +577,102 @@ fn parse_cases(s: &str) -> Result<Cases, String> {
         .map(Cases)
 }
 
+/// One finite number.
+fn parse_number(s: &str) -> Result<f64, String> {
+    match finite(numbers::<f64>(s, "number")?)?[..] {
+        [v] => Ok(v),
+        ref v => Err(format!("expected one number, got {}", v.len())),
+    }
+}
+
+fn parse_iso_value(s: &str) -> Result<f32, String> {
+    let v = parse_number(s)?;
+    if v.abs() > f32::MAX as f64 {
+        return Err(format!("{v} is out of the range of the data's f32 values"));
+    }
+    Ok(v as f32)
+}
+
+fn parse_thickness(s: &str) -> Result<f32, String> {
+    match parse_number(s)? {
+        r if r > 0.0 && r <= 1e6 => Ok(r as f32),
+        r => Err(format!(
+            "the shell's half-width {r} must be a positive number of voxels"
+        )),
+    }
+}
+
+fn parse_gradient_opacity(s: &str) -> Result<(f32, f32), String> {
+    match parse_pair(s)? {
+        (lo, hi) if 0.0 <= lo && lo < hi && hi <= 1.0 => Ok((lo, hi)),
+        (lo, hi) => Err(format!(
+            "LO,HI = {lo},{hi} needs 0 <= LO < HI <= 1 (fractions of the largest gradient magnitude)"
+        )),
+    }
+}
+
+fn parse_fov(s: &str) -> Result<f64, String> {
+    match parse_number(s)? {
+        fov if fov > 0.0 && fov < 180.0 => Ok(fov),
+        fov => Err(format!(
+            "field of view {fov} must lie strictly between 0 and 180 degrees"
+        )),
+    }
+}
+
+fn parse_zoom(s: &str) -> Result<f64, String> {
+    match parse_number(s)? {
+        z if z > 0.0 => Ok(z),
+        z => Err(format!("zoom {z} must be greater than 0")),
+    }
+}
+
+fn parse_angle(s: &str) -> Result<f64, String> {
+    match parse_number(s)? {
+        a if a.abs() <= 1e6 => Ok(a),
+        a => Err(format!("{a} degrees is not a usable angle")),
+    }
+}
+
+/// `X,Y,Z,NX,NY,NZ`: a point on the plane and its normal.
+fn parse_clip(s: &str) -> Result<([f64; 3], [f64; 3]), String> {
+    match finite(numbers::<f64>(s, "number")?)?[..] {
+        [_, _, _, nx, ny, nz] if nx == 0.0 && ny == 0.0 && nz == 0.0 => {
+            Err("the normal NX,NY,NZ must not be zero".into())
+        }
+        [x, y, z, nx, ny, nz] => Ok(([x, y, z], [nx, ny, nz])),
+        ref v => Err(format!(
+            "expected X,Y,Z,NX,NY,NZ (a point and a normal, six numbers), got {}",
+            v.len()
+        )),
+    }
+}
+
+/// `X0,X1,Y0,Y1,Z0,Z1` as the box's (low, high) corners.
+fn parse_crop(s: &str) -> Result<([f64; 3], [f64; 3]), String> {
+    let v = finite(numbers::<f64>(s, "number")?)?;
+    if v.len() != 6 {
+        return Err(format!(
+            "expected X0,X1,Y0,Y1,Z0,Z1 (six numbers), got {}",
+            v.len()
+        ));
+    }
+    for (axis, name) in ["X", "Y", "Z"].iter().enumerate() {
+        let (lo, hi) = (v[2 * axis], v[2 * axis + 1]);
+        if lo >= hi {
+            return Err(format!("{name}0 {lo} must be below {name}1 {hi}"));
+        }
+    }
+    Ok(([v[0], v[2], v[4]], [v[1], v[3], v[5]]))
+}
+
+fn parse_fps(s: &str) -> Result<f64, String> {
+    match parse_number(s)? {
+        f if f > 0.0 && f <= 100.0 => Ok(f),
+        f => Err(format!("{f} frames per second must be in (0, 100]")),
+    }
+}
+
 fn parse_bit_depth(s: &str) -> Result<u8, String> {
     match s {
         "8" => Ok(8),
@@ -494,5 +713,82 @@ mod tests {
         assert!(parse_cases("fractal_129:0").is_err());
         assert!(parse_cases("../x:10").is_err());
         assert!(parse_bit_depth("12").is_err());
+    }
+
+    #[test]
+    fn rendering_option_parsers() {
+        assert_eq!(parse_fov("30"), Ok(30.0));
+        for bad in ["0", "180", "-5", "nan", "30,40"] {
+            assert!(parse_fov(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_zoom("2"), Ok(2.0));
+        assert!(parse_zoom("0").is_err() && parse_zoom("-1").is_err());
+        assert_eq!(parse_angle("-90"), Ok(-90.0));
+        assert!(parse_angle("inf").is_err());
+        assert_eq!(parse_thickness("0.5"), Ok(0.5));
+        assert!(parse_thickness("0").is_err());
+        assert_eq!(parse_iso_value("-3e2"), Ok(-300.0));
+        assert!(parse_iso_value("1e300").is_err());
+        assert_eq!(parse_gradient_opacity("0,0.5"), Ok((0.0, 0.5)));
+        assert!(parse_gradient_opacity("0.5,0.5").is_err());
+        assert!(parse_gradient_opacity("0.1,1.5").is_err());
+        assert_eq!(
+            parse_clip("1,2,3,0,-1,0"),
+            Ok(([1.0, 2.0, 3.0], [0.0, -1.0, 0.0]))
+        );
+        assert!(parse_clip("1,2,3,0,0,0").is_err());
+        assert!(parse_clip("1,2,3,0,1").is_err());
+        // X0,X1,Y0,Y1,Z0,Z1 → (low corner, high corner).
+        assert_eq!(
+            parse_crop("-1,1,0,2,-3,-2"),
+            Ok(([-1.0, 0.0, -3.0], [1.0, 2.0, -2.0]))
+        );
+        assert!(parse_crop("1,-1,0,2,-3,-2").is_err());
+        assert!(parse_crop("0,1,0,1,2,2").is_err());
+        assert!(parse_crop("0,1,0,1").is_err());
+        assert_eq!(parse_fps("24"), Ok(24.0));
+        assert!(parse_fps("0").is_err() && parse_fps("101").is_err());
+    }
+
+    #[test]
+    fn blend_names_and_aliases() {
+        let blend = |name: &str| {
+            let cli = Cli::try_parse_from(["volray", "render", "-o", "x.png", "--blend", name])
+                .map_err(|e| e.to_string())?;
+            match cli.command {
+                Command::Render(args) => Ok(args.view.blend),
+                _ => Err("not render".to_string()),
+            }
+        };
+        assert_eq!(blend("mip"), Ok(BlendMode::Mip));
+        assert_eq!(blend("maximum"), Ok(BlendMode::Mip));
+        assert_eq!(blend("minimum"), Ok(BlendMode::Minip));
+        assert_eq!(blend("average"), Ok(BlendMode::Average));
+        assert!(blend("sum").is_err());
+    }
+
+    #[test]
+    fn several_inputs_and_repeated_clip_planes() {
+        let cli = Cli::try_parse_from([
+            "volray",
+            "render",
+            "a.cube",
+            "b.cube",
+            "c.cube",
+            "-o",
+            "x.gif",
+            "--clip",
+            "0,0,0,1,0,0",
+            "--clip",
+            "0,0,0,0,-1,0",
+        ])
+        .unwrap();
+        let Command::Render(args) = cli.command else {
+            panic!("not render")
+        };
+        assert_eq!(args.input.input.as_deref(), Some("a.cube"));
+        assert_eq!(args.series, ["b.cube", "c.cube"]);
+        assert_eq!(args.view.clip.len(), 2);
+        assert_eq!(args.view.clip[1].1, [0.0, -1.0, 0.0]);
     }
 }

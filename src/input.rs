@@ -15,8 +15,6 @@ pub struct Input {
     pub volume: Volume,
     /// The spec or the file's path, for messages.
     pub name: String,
-    /// The file it came from, if any.
-    pub path: Option<PathBuf>,
     /// The file's format and what its header said, if it came from a file.
     pub file: Option<(VolumeFormat, FileInfo)>,
 }
@@ -25,13 +23,13 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
     let spec = args.input.as_deref().unwrap_or(DEMO);
     let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
     let file_flags = args.format.is_some() || args.frame.is_some() || args.array.is_some();
-    let (volume, path, file) = if volray_data::is_source_spec(spec) {
+    let (volume, file) = if volray_data::is_source_spec(spec) {
         if raw_flags || file_flags {
             return Err(CliError::input(format!(
                 "{spec}: --dims, --dtype, --endian, --format, --frame and --array apply to files only, not to built-in sources"
             )));
         }
-        (volray_data::generate(spec)?, None, None)
+        (volray_data::generate(spec)?, None)
     } else {
         let path = PathBuf::from(spec);
         let format = match &args.format {
@@ -53,11 +51,7 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
             array: args.array.clone(),
         };
         let loaded = volray_io::read(&path, &opts)?;
-        (
-            loaded.volume,
-            Some(path),
-            Some((loaded.format, loaded.info)),
-        )
+        (loaded.volume, Some((loaded.format, loaded.info)))
     };
     let volume = match args.spacing {
         Some(s) => volume
@@ -68,7 +62,6 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
     Ok(Input {
         volume,
         name: spec.to_string(),
-        path,
         file,
     })
 }

@@ -2,6 +2,7 @@
 //! `volray-io` and `volray-data` for the input, `volray-core` to render,
 //! `volray-io` again for the PNG.
 
+mod animate;
 mod bench;
 mod cli;
 mod error;

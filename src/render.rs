@@ -1,28 +1,117 @@
-//! `volray render`: INPUT → Volume → Renderer → Image → PNG.
+//! `volray render`: INPUT → Volume → Renderer → Image → PNG or OpenEXR;
+//! with `--turntable` or several inputs, an animation (`animate.rs`).
 
-use crate::cli::{RenderArgs, ViewArgs};
+use crate::animate;
+use crate::cli::{BlendMode, InputArgs, RenderArgs, ViewArgs};
 use crate::error::CliError;
 use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use volray_core::glam::DVec3;
 use volray_core::{
-    Camera, Method, Phong, RenderSettings, Renderer, TransferFunction, colormap, presets,
+    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, Phong, Projection,
+    RenderSettings, Renderer, TransferFunction, colormap, presets,
 };
-use volray_io::BitDepth;
+use volray_io::{Animation, AnimationKind, BitDepth};
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
-    let input = input::load(&args.input)?;
-    check_output(&args.output, &input)?;
-    output_kind(&args.output, args.bit_depth)?;
+    let specs = specs(args);
+    let animation = animation_reason(args)?;
+    let kind = output_kind(&args.output, args.bit_depth, animation)?;
+    if args.fps.is_some() && animation.is_none() {
+        return Err(CliError::input(
+            "--fps applies to animations: give --turntable FRAMES or several inputs",
+        ));
+    }
     let settings = settings(&args.view)?;
+    for spec in &specs {
+        check_output(&args.output, spec)?;
+    }
     let pool = thread_pool(args.view.threads)?;
+    match (kind, args.turntable) {
+        (OutputKind::Animation, Some(frames)) => {
+            animate::turntable(args, &settings, &pool, frames as usize)
+        }
+        (OutputKind::Animation, None) => animate::series(args, &specs, &settings, &pool),
+        (kind, _) => still(args, &settings, &pool, kind),
+    }
+}
+
+/// One frame of one volume, to an image file.
+fn still(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    pool: &rayon::ThreadPool,
+    kind: OutputKind,
+) -> Result<(), CliError> {
+    let input = load(&args.input, args.view.log)?;
     let renderer = Renderer::new(&input.volume)
         .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+    note_general_path(settings);
+    let bar = progress_bar((settings.width * settings.height) as u64);
+    let image = pool
+        .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
+        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+    bar.finish_and_clear();
 
-    let pixels = (settings.width * settings.height) as u64;
-    let bar = if std::io::stderr().is_terminal() && pixels >= 256 * 256 {
+    match kind {
+        OutputKind::Png(depth) => volray_io::write_png(&args.output, &image, depth)?,
+        OutputKind::Exr => volray_io::write_exr(&args.output, &image)?,
+        OutputKind::Gif => {
+            let mut gif = Animation::create(
+                &args.output,
+                image.width(),
+                image.height(),
+                1,
+                animate::DEFAULT_FPS,
+            )?;
+            gif.push(&image)?;
+            gif.finish()?;
+        }
+        OutputKind::Animation => unreachable!("animations are rendered by animate.rs"),
+    }
+    Ok(())
+}
+
+/// The inputs in order: INPUT (or the demo volume), then MORE.
+fn specs(args: &RenderArgs) -> Vec<String> {
+    let first = args.input.input.as_deref().unwrap_or(input::DEMO);
+    std::iter::once(first.to_string())
+        .chain(args.series.iter().cloned())
+        .collect()
+}
+
+/// Why the output is an animation (the flag that asks for one), or
+/// `None` for a single frame. A turntable of a series is refused: which
+/// frame would turn how far is not obvious.
+fn animation_reason(args: &RenderArgs) -> Result<Option<&'static str>, CliError> {
+    match (args.turntable, args.series.is_empty()) {
+        (Some(_), false) => Err(CliError::input(
+            "--turntable renders one volume: give one input, or several inputs without --turntable",
+        )),
+        (Some(_), true) => Ok(Some("--turntable")),
+        (None, false) => Ok(Some("several inputs")),
+        (None, true) => Ok(None),
+    }
+}
+
+/// Reads the volume `args` name and, with `--log`, takes its log10.
+pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
+    let mut input = input::load(args)?;
+    if log {
+        input.volume = input
+            .volume
+            .to_log10()
+            .map_err(|e| CliError::input(format!("--log: {}: {e}", input.name)))?;
+    }
+    Ok(input)
+}
+
+/// A progress bar on a terminal for work of at least 256² pixels, else a
+/// hidden one.
+pub fn progress_bar(pixels: u64) -> ProgressBar {
+    if std::io::stderr().is_terminal() && pixels >= 256 * 256 {
         let bar = ProgressBar::new(pixels);
         bar.set_style(
             ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent}% ({eta} left)")
@@ -32,40 +121,115 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         bar
     } else {
         ProgressBar::hidden()
-    };
-    let image = pool
-        .install(|| renderer.render_with_progress(&settings, &|n| bar.inc(n as u64)))
-        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
-    bar.finish_and_clear();
-
-    match output_kind(&args.output, args.bit_depth)? {
-        OutputKind::Png(depth) => volray_io::write_png(&args.output, &image, depth)?,
-        OutputKind::Exr => volray_io::write_exr(&args.output, &image)?,
     }
-    Ok(())
+}
+
+/// Tells the user, once, when frames run on the reference path because
+/// the fast one cannot render what was asked (it renders orthographic,
+/// composited, pre-classified frames).
+pub fn note_general_path(settings: &RenderSettings) {
+    if let Some(note) = general_path_note(settings) {
+        eprintln!("volray: note: {note}");
+    }
+}
+
+fn general_path_note(settings: &RenderSettings) -> Option<String> {
+    if settings.method != Method::Fast || Renderer::path_for(settings) == Method::Fast {
+        return None;
+    }
+    // The options given that keep the frame off the fast paths: those
+    // whose removal alone would put it back, else all that could.
+    let mut ortho = settings.clone();
+    ortho.camera.projection = Projection::Orthographic;
+    let mut composite = settings.clone();
+    composite.blend = Blend::Composite;
+    let mut pre = settings.clone();
+    pre.classification = Classification::Pre;
+    let given = [
+        (
+            "--perspective",
+            matches!(settings.camera.projection, Projection::Perspective { .. }),
+            ortho,
+        ),
+        ("--blend", settings.blend.is_projection(), composite),
+        (
+            "--post-classification",
+            settings.classification == Classification::Post,
+            pre,
+        ),
+    ];
+    let given: Vec<_> = given.into_iter().filter(|(_, on, _)| *on).collect();
+    let culprits: Vec<&str> = (given.iter())
+        .filter(|(_, _, without)| Renderer::path_for(without) == Method::Fast)
+        .map(|(flag, _, _)| *flag)
+        .collect();
+    let what = match (culprits.is_empty(), given.is_empty()) {
+        (false, _) => culprits.join(" and "),
+        (true, false) => given
+            .iter()
+            .map(|(f, _, _)| *f)
+            .collect::<Vec<_>>()
+            .join(" and "),
+        (true, true) => "these options".to_string(),
+    };
+    Some(format!(
+        "{what}: rendering on the general path (every sample, in f64), slower than the fast one"
+    ))
 }
 
 /// What an output file name asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum OutputKind {
     Png(BitDepth),
     /// OpenEXR: the f32 frame buffer, unquantised.
     Exr,
+    /// A one-frame GIF.
+    Gif,
+    /// Frames through [`Animation`]: APNG, GIF or a PNG sequence.
+    Animation,
 }
 
-/// The output format from the file name: `.exr` is OpenEXR, anything else
-/// PNG (at `--bit-depth`). `--bit-depth 16` with `.exr` is refused: EXR
-/// holds 32-bit floats.
-fn output_kind(output: &Path, bit_depth: u8) -> Result<OutputKind, CliError> {
+/// The output format from the file name: `.exr` is OpenEXR, `.gif` a GIF,
+/// anything else PNG (at `--bit-depth`). An animation (`animation` says
+/// which flag asks for one) is an animated PNG, a GIF or a PNG sequence,
+/// at 8 bits. `--bit-depth 16` is refused where the format cannot hold it.
+fn output_kind(
+    output: &Path,
+    bit_depth: u8,
+    animation: Option<&str>,
+) -> Result<OutputKind, CliError> {
+    let name = output.display();
     let ext = output
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
+    if let Some(why) = animation {
+        if ext.as_deref() == Some("exr") {
+            return Err(CliError::input(format!(
+                "{name}: {why} makes an animation, which OpenEXR cannot hold: write .png (animated PNG), .gif or numbered PNGs (e.g. turn_%03d.png)"
+            )));
+        }
+        if AnimationKind::from_path(output).is_none() {
+            return Err(CliError::input(format!(
+                "{name}: {why} makes an animation: write .png (animated PNG), .gif or numbered PNGs (e.g. turn_%03d.png)"
+            )));
+        }
+        if bit_depth != 8 {
+            return Err(CliError::input(format!(
+                "{name}: --bit-depth {bit_depth}: animations are written at 8 bits per channel"
+            )));
+        }
+        return Ok(OutputKind::Animation);
+    }
     match ext.as_deref() {
         Some("exr") if bit_depth != 8 => Err(CliError::input(format!(
-            "{}: --bit-depth applies to PNG output; OpenEXR holds 32-bit floats",
-            output.display()
+            "{name}: --bit-depth applies to PNG output; OpenEXR holds 32-bit floats"
         ))),
         Some("exr") => Ok(OutputKind::Exr),
+        Some("gif") if bit_depth != 8 => Err(CliError::input(format!(
+            "{name}: --bit-depth applies to PNG output; GIF holds 8 bits per channel"
+        ))),
+        Some("gif") => Ok(OutputKind::Gif),
         _ => Ok(OutputKind::Png(if bit_depth == 16 {
             BitDepth::Sixteen
         } else {
@@ -74,11 +238,11 @@ fn output_kind(output: &Path, bit_depth: u8) -> Result<OutputKind, CliError> {
     }
 }
 
-/// Refuses, before any work, an output that would overwrite the input or
-/// that cannot be written where it is asked for.
-fn check_output(output: &Path, input: &Input) -> Result<(), CliError> {
-    if let Some(path) = &input.path
-        && let (Ok(a), Ok(b)) = (path.canonicalize(), output.canonicalize())
+/// Refuses, before any work, an output that would overwrite the input
+/// `spec` or that cannot be written where it is asked for.
+fn check_output(output: &Path, spec: &str) -> Result<(), CliError> {
+    if !volray_data::is_source_spec(spec)
+        && let (Ok(a), Ok(b)) = (PathBuf::from(spec).canonicalize(), output.canonicalize())
         && a == b
     {
         return Err(CliError::input(format!(
@@ -162,14 +326,26 @@ pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
         }
         transfer_function.domain = Some(range);
     }
+    if view.log
+        && let Some((lo, hi)) = transfer_function.domain
+    {
+        // The window is given in the data's units; the renderer sees log10.
+        let from = if view.range.is_some() {
+            "--range"
+        } else {
+            from
+        };
+        if lo <= 0.0 {
+            return Err(CliError::input(format!(
+                "{from}: with --log the value window is in the data's own units and must be positive, but LO is {lo}"
+            )));
+        }
+        transfer_function.domain = Some((lo.log10(), hi.log10()));
+    }
     let settings = RenderSettings {
         width: view.size.0,
         height: view.size.1,
-        camera: Camera {
-            view_point: view.view.map(DVec3::from),
-            look_at: view.look_at.map(DVec3::from),
-            up: DVec3::from(view.up),
-        },
+        camera: camera(view),
         step: view.step,
         opacity_ramp: view
             .opacity
@@ -190,11 +366,106 @@ pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
         } else {
             Method::Fast
         },
+        blend: blend(view)?,
+        classification: if view.post_classification {
+            Classification::Post
+        } else {
+            Classification::Pre
+        },
+        jitter: view.jitter,
+        clip_planes: (view.clip.iter())
+            .map(|&(point, normal)| ClipPlane {
+                point: DVec3::from(point),
+                normal: DVec3::from(normal),
+            })
+            .collect(),
+        crop: view.crop.map(|(lo, hi)| (DVec3::from(lo), DVec3::from(hi))),
+        iso: iso(view)?,
+        gradient_opacity: view.gradient_opacity,
     };
     settings
         .validate()
         .map_err(|e| CliError::input(e.to_string()))?;
+    settings
+        .camera
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
     Ok(settings)
+}
+
+/// The camera of the view options.
+fn camera(view: &ViewArgs) -> Camera {
+    Camera {
+        view_point: view.view.map(DVec3::from),
+        look_at: view.look_at.map(DVec3::from),
+        up: DVec3::from(view.up),
+        projection: match view.perspective {
+            Some(fov_degrees) => Projection::Perspective { fov_degrees },
+            None => Projection::Orthographic,
+        },
+        zoom: view.zoom,
+        azimuth: view.azimuth,
+        elevation: view.elevation,
+        ..Camera::default()
+    }
+}
+
+/// `--blend`, checked against the options that only compositing uses:
+/// a projection shows the interpolated scalar, with no opacity to shape.
+fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
+    let (blend, name) = match view.blend {
+        BlendMode::Composite => (Blend::Composite, "composite"),
+        BlendMode::Iso if view.iso.is_none() => {
+            return Err(CliError::input(
+                "--blend iso needs the isovalue: give --iso VALUE",
+            ));
+        }
+        BlendMode::Iso => (Blend::Composite, "iso"),
+        BlendMode::Mip => (Blend::Maximum, "mip"),
+        BlendMode::Minip => (Blend::Minimum, "minip"),
+        BlendMode::Average => (Blend::Average, "average"),
+    };
+    if blend.is_projection() {
+        for (given, flag) in [
+            (view.iso.is_some(), "--iso"),
+            (view.gradient_opacity.is_some(), "--gradient-opacity"),
+            (view.post_classification, "--post-classification"),
+        ] {
+            if given {
+                return Err(CliError::input(format!(
+                    "{flag} shapes the opacity of --blend composite; --blend {name} projects the interpolated value and has none"
+                )));
+            }
+        }
+    }
+    Ok(blend)
+}
+
+/// `--iso VALUE --iso-thickness R`; with `--log` the value is in the data's
+/// units, like `--range`.
+fn iso(view: &ViewArgs) -> Result<Option<IsoSurface>, CliError> {
+    let Some(value) = view.iso else {
+        return match view.iso_thickness {
+            Some(_) => Err(CliError::input(
+                "--iso-thickness is the half-width of the --iso shell: give --iso VALUE too",
+            )),
+            None => Ok(None),
+        };
+    };
+    let value = if view.log {
+        if value <= 0.0 {
+            return Err(CliError::input(format!(
+                "--iso: with --log the isovalue is in the data's own units and must be positive, but it is {value}"
+            )));
+        }
+        (value as f64).log10() as f32
+    } else {
+        value
+    };
+    Ok(Some(IsoSurface {
+        value,
+        thickness: view.iso_thickness.unwrap_or(1.0),
+    }))
 }
 
 /// A pool of `threads` workers (default: one per core).
@@ -223,5 +494,144 @@ mod tests {
             panic!("not a render command")
         };
         assert_eq!(settings(&args.view).unwrap(), RenderSettings::default());
+    }
+
+    fn parse(args: &[&str]) -> RenderArgs {
+        let all = [&["volray", "render", "-o", "x.png"][..], args].concat();
+        match Cli::try_parse_from(all).unwrap().command {
+            Command::Render(args) => args,
+            _ => panic!("not a render command"),
+        }
+    }
+
+    #[test]
+    fn the_general_path_is_noted_only_when_the_fast_one_was_asked_for() {
+        let note = |args: &[&str]| general_path_note(&settings(&parse(args).view).unwrap());
+        assert_eq!(note(&[]), None);
+        assert_eq!(
+            note(&["--jitter", "--crop", "0,1,0,1,0,1", "--zoom", "2"]),
+            None
+        );
+        assert_eq!(note(&["--perspective", "30", "--reference"]), None);
+        assert!(
+            note(&["--perspective", "30"])
+                .unwrap()
+                .starts_with("--perspective:")
+        );
+        assert!(
+            note(&["--post-classification"])
+                .unwrap()
+                .starts_with("--post-classification:")
+        );
+        let both = note(&["--perspective", "30", "--post-classification"]).unwrap();
+        assert!(
+            both.starts_with("--perspective and --post-classification:"),
+            "{both}"
+        );
+        // Whatever the routing, a note exactly when a frame asked for the
+        // fast path does not get it.
+        for args in [
+            &["--blend", "mip"][..],
+            &["--blend", "average", "--perspective", "50"],
+            &["--blend", "average", "--reference"],
+            &["--iso", "0.2", "--perspective", "50"],
+        ] {
+            let s = settings(&parse(args).view).unwrap();
+            let slow = s.method == Method::Fast && Renderer::path_for(&s) == Method::Reference;
+            assert_eq!(general_path_note(&s).is_some(), slow, "{args:?}");
+        }
+    }
+
+    #[test]
+    fn options_reach_the_settings() {
+        let args = parse(&[
+            "--perspective",
+            "40",
+            "--zoom",
+            "2",
+            "--azimuth",
+            "-30",
+            "--elevation",
+            "15",
+            "--clip",
+            "1,2,3,0,0,-2",
+            "--crop",
+            "-1,1,-2,2,-3,3",
+            "--jitter",
+            "--iso",
+            "100",
+            "--iso-thickness",
+            "2",
+            "--log",
+            "--range",
+            "1,1000",
+            "--gradient-opacity",
+            "0.1,0.9",
+        ]);
+        let s = settings(&args.view).unwrap();
+        assert_eq!(
+            s.camera.projection,
+            Projection::Perspective { fov_degrees: 40.0 }
+        );
+        assert_eq!(
+            (s.camera.zoom, s.camera.azimuth, s.camera.elevation),
+            (2.0, -30.0, 15.0)
+        );
+        assert_eq!(
+            s.clip_planes,
+            [ClipPlane {
+                point: DVec3::new(1.0, 2.0, 3.0),
+                normal: DVec3::new(0.0, 0.0, -2.0)
+            }]
+        );
+        assert_eq!(
+            s.crop,
+            Some((DVec3::new(-1.0, -2.0, -3.0), DVec3::new(1.0, 2.0, 3.0)))
+        );
+        assert!(s.jitter);
+        // --log: the window and the isovalue were given in the data's units.
+        assert_eq!(s.transfer_function.domain, Some((0.0, 3.0)));
+        assert_eq!(
+            s.iso,
+            Some(IsoSurface {
+                value: 2.0,
+                thickness: 2.0
+            })
+        );
+        assert_eq!(s.gradient_opacity, Some((0.1, 0.9)));
+        assert_eq!(s.blend, Blend::Composite);
+        let mip = parse(&["--blend", "minimum"]);
+        assert_eq!(settings(&mip.view).unwrap().blend, Blend::Minimum);
+    }
+
+    #[test]
+    fn output_names_pick_the_format() {
+        let kind = |name: &str, depth: u8, animation: Option<&str>| {
+            output_kind(Path::new(name), depth, animation).map_err(|e| e.message)
+        };
+        assert_eq!(
+            kind("a.png", 16, None),
+            Ok(OutputKind::Png(BitDepth::Sixteen))
+        );
+        assert_eq!(kind("a.EXR", 8, None), Ok(OutputKind::Exr));
+        assert_eq!(kind("a.gif", 8, None), Ok(OutputKind::Gif));
+        assert!(kind("a.gif", 16, None).is_err());
+        for name in ["a.png", "a.gif", "a_%03d.png"] {
+            assert_eq!(
+                kind(name, 8, Some("--turntable")),
+                Ok(OutputKind::Animation)
+            );
+        }
+        assert!(
+            kind("a.exr", 8, Some("--turntable"))
+                .unwrap_err()
+                .contains("OpenEXR")
+        );
+        assert!(kind("a.mp4", 8, Some("several inputs")).is_err());
+        assert!(
+            kind("a.png", 16, Some("--turntable"))
+                .unwrap_err()
+                .contains("8 bits")
+        );
     }
 }

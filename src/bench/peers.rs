@@ -154,6 +154,7 @@ fn workload(volume: &Volume, (min, max): (f64, f64), window: usize) -> RenderSet
             view_point: Some(centre - DVec3::X * (1.0 + 2.0 * volume.extent().x)),
             look_at: Some(centre),
             up: DVec3::Z,
+            ..Camera::default()
         },
         step: STEP,
         transfer_function: transfer_function(min, max),

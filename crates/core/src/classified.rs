@@ -7,7 +7,8 @@
 //! (trilinear interpolation of eight zero opacities is exactly zero), so
 //! they are neither stored nor visited. The min/max macro-cell grid rules
 //! out most of them at once (see [`crate::macrocells`]); the rest are
-//! classified voxel by voxel. Inside an occupied brick a mask marks the
+//! classified voxel by voxel, with the voxel's gradient where the opacity
+//! depends on it (an iso-surface, gradient-magnitude opacity). Inside an occupied brick a mask marks the
 //! occupied *cells* (any of the eight corners with non-zero opacity), so
 //! that the ray caster skips empty cells with one bit test.
 //!
@@ -94,14 +95,26 @@ impl ClassifiedBricks {
     pub fn new(volume: &Volume, macrocells: &Macrocells, classifier: &Classifier) -> Self {
         let grid = macrocells.grid;
         let data = volume.data();
-        let opacity = |f: f32| quantise(classifier.sample_opacity(f));
+        let [nx, ny, _] = grid.dims;
+        let coords = |v: usize| (v % nx, (v / nx) % ny, v / (nx * ny));
+        // The gradient is computed here only where the opacity needs it;
+        // the occupied bricks' voxels below need it for their normals anyway.
+        let opacity = |v: usize| {
+            let gradient = if classifier.uses_gradient() {
+                let (x, y, z) = coords(v);
+                gradient_at(volume, x, y, z)
+            } else {
+                [0.0; 3]
+            };
+            quantise(classifier.opacity_at(data[v], gradient))
+        };
         let is_occupied: Vec<bool> = (0..grid.len())
             .into_par_iter()
             .map(|i| {
                 let (lo, hi) = macrocells.ranges[i];
                 let b = grid.coords(i);
                 !classifier.is_transparent_between(lo, hi)
-                    && slot_coords().any(|s| opacity(data[grid.voxel_of_slot(b, s)]) > 0)
+                    && slot_coords().any(|s| opacity(grid.voxel_of_slot(b, s)) > 0)
             })
             .collect();
 
@@ -123,13 +136,13 @@ impl ClassifiedBricks {
             .zip(needed.par_iter_mut())
             .zip(occupied.par_iter())
             .for_each(|((((voxels, cells), bounds), needed), &b)| {
-                let [nx, ny, _] = grid.dims;
                 for (s, [i, j, k]) in slot_coords().enumerate() {
                     let v = grid.voxel_of_slot(b, [i, j, k]);
-                    let (x, y, z) = (v % nx, (v / nx) % ny, v / (nx * ny));
+                    let (x, y, z) = coords(v);
+                    let gradient = gradient_at(volume, x, y, z);
                     voxels[s] = Voxel {
-                        normal: quantise_normal(gradient_at(volume, x, y, z)),
-                        alpha: opacity(data[v]),
+                        normal: quantise_normal(gradient),
+                        alpha: quantise(classifier.opacity_at(data[v], gradient)),
                     };
                 }
                 *cells = cell_mask(voxels);
@@ -233,6 +246,8 @@ fn cell_bounds(cells: &[u64; CELLS / 64]) -> ([u8; 3], [u8; 3]) {
 mod tests {
     use super::*;
     use crate::classify::OpacityMap;
+    use crate::gradient::max_magnitude;
+    use crate::iso::IsoSurface;
     use crate::transfer_function::PiecewiseLinear;
     use glam::DVec3;
 
@@ -310,5 +325,56 @@ mod tests {
         assert_eq!(quantise_normal([0.0, -1e-10, 0.0]), [0, -32767, 0]);
         // As in [`crate::shading`], a gradient whose square underflows has no normal.
         assert_eq!(quantise_normal([0.0, -1e-30, 0.0]), [0; 3]);
+    }
+
+    #[test]
+    fn iso_bricks_are_exactly_those_near_the_surface() {
+        // The distance from the centre of a 40³ grid, iso-surface at 9
+        // voxels, 2 voxels thick: bricks far inside and far outside the
+        // shell are skipped by their value range alone, and every brick
+        // with a voxel of non-zero contour opacity is kept.
+        let v = Volume::from_fn([40, 40, 40], DVec3::ONE, DVec3::ZERO, |p| {
+            (p - DVec3::splat(19.5)).length() as f32
+        })
+        .unwrap();
+        let m = Macrocells::new(&v);
+        let base = Classifier::new((0.0, 30.0), OpacityMap::Ramp { p: 0.1, q: 0.6 }, None, 0.7);
+        let iso = IsoSurface {
+            value: 9.0,
+            thickness: 2.0,
+        };
+        let c = base.with_iso(iso, 1.0, max_magnitude(&v));
+        let b = ClassifiedBricks::new(&v, &m, &c);
+        let mut skipped_by_range = 0;
+        for i in 0..m.grid.len() {
+            let brick = m.grid.coords(i);
+            let alphas: Vec<u16> = slot_coords()
+                .map(|s| {
+                    let n = m.grid.voxel_of_slot(brick, s);
+                    let (x, y, z) = (n % 40, (n / 40) % 40, n / 1600);
+                    quantise(c.opacity_at(v.data()[n], gradient_at(&v, x, y, z)))
+                })
+                .collect();
+            let visible = alphas.iter().any(|a| *a > 0);
+            assert_eq!(b.slot_of[i] != EMPTY, visible, "brick {brick:?}");
+            let (lo, hi) = m.ranges[i];
+            if c.is_transparent_between(lo, hi) {
+                assert!(!visible, "brick {brick:?} called transparent");
+                skipped_by_range += 1;
+            }
+            if visible {
+                let n = b.slot_of[i] as usize;
+                let stored: Vec<u16> = b.voxels[n * SLOTS..][..SLOTS]
+                    .iter()
+                    .map(|v| v.alpha)
+                    .collect();
+                assert_eq!(stored, alphas);
+            }
+        }
+        // 5³ bricks; the 98 that touch the grid's faces hold no value
+        // nearer the centre than 11.5, beyond 9 + 2·max|∇f| ≈ 11; the 27
+        // inner ones all hold values within reach of 9.
+        assert_eq!(skipped_by_range, 98);
+        assert!(!b.is_empty());
     }
 }

@@ -11,7 +11,17 @@
 //! paper's step). Sampling at another step `s` (in voxels) corrects each
 //! voxel's opacity to `α_s = 1 − (1 − α)^s`, so that a ray through a uniform
 //! medium gathers the same opacity per unit length whatever the step.
+//!
+//! Two options make opacity depend on the gradient as well as the value
+//! ([`Classifier::opacity_at`]): Levoy's isovalue contours
+//! ([`crate::iso`]), which replace the value's opacity by eq. 3 of Levoy
+//! 1988 with `α_v` the opacity at the isovalue, and gradient-magnitude
+//! opacity ([`crate::gradient_opacity`]), which multiplies it by a ramp of
+//! `|∇f|`. Both act on the unit opacity, before the step correction.
 
+use crate::gradient::magnitude;
+use crate::gradient_opacity::GradientOpacity;
+use crate::iso::{IsoContour, IsoSurface};
 use crate::transfer_function::{PiecewiseLinear, TransferFunction};
 
 /// How opacity is assigned before the step correction.
@@ -31,6 +41,8 @@ pub struct Classifier {
     opacity: OpacityMap,
     color: Option<PiecewiseLinear<3>>,
     step_voxels: f32,
+    iso: Option<IsoContour>,
+    gradient_opacity: Option<GradientOpacity>,
 }
 
 impl Classifier {
@@ -49,7 +61,52 @@ impl Classifier {
             opacity,
             color,
             step_voxels,
+            iso: None,
+            gradient_opacity: None,
         }
+    }
+
+    /// The same classifier drawing Levoy's isovalue contour of `iso`
+    /// instead of the value's opacity, with `α_v` from [`Self::iso_alpha`]. `voxel_size` is the smallest grid spacing
+    /// (the unit of the thickness) and `max_gradient` the largest world
+    /// gradient magnitude of the volume ([`crate::gradient::max_magnitude`]),
+    /// which bounds the contour for [`Self::is_transparent_between`].
+    pub fn with_iso(mut self, iso: IsoSurface, voxel_size: f32, max_gradient: f32) -> Self {
+        let alpha = self.iso_alpha(iso.value);
+        self.iso = Some(IsoContour::new(iso, alpha, voxel_size, max_gradient));
+        self
+    }
+
+    /// The same classifier with opacity multiplied by the ramp of
+    /// `|∇f|/max_gradient` from 0 at `lo` to 1 at `hi`
+    /// ([`crate::gradient_opacity`]).
+    pub fn with_gradient_opacity(mut self, (lo, hi): (f32, f32), max_gradient: f32) -> Self {
+        self.gradient_opacity = Some(GradientOpacity::new((lo, hi), max_gradient));
+        self
+    }
+
+    /// Levoy's `α_v`, the opacity of the isovalue `f_v`: an opacity table's
+    /// value at `f_v`, or with the paper's ramp its top opacity `q`. (The
+    /// ramp's value at `f_v` would make a contour at a low value, the
+    /// usual case for densities, all but invisible: the ramp spreads
+    /// opacity over values, while a contour has the one value.)
+    pub fn iso_alpha(&self, f_v: f32) -> f32 {
+        match &self.opacity {
+            OpacityMap::Ramp { q, .. } => *q,
+            OpacityMap::Table(table) => table.eval(self.normalise(f_v))[0],
+        }
+    }
+
+    /// Whether [`Self::opacity_at`] depends on the gradient (an iso-surface
+    /// or gradient-magnitude opacity); if not, it is [`Self::sample_opacity`].
+    #[inline]
+    pub fn uses_gradient(&self) -> bool {
+        self.iso.is_some() || self.gradient_opacity.is_some()
+    }
+
+    /// The iso-surface's contour, if any.
+    pub fn iso(&self) -> Option<&IsoContour> {
+        self.iso.as_ref()
     }
 
     /// The classifier a transfer function describes, falling back to the
@@ -90,19 +147,47 @@ impl Classifier {
         }
     }
 
-    /// Opacity of one sample taken `step` voxels from the last:
-    /// `α_s = 1 − (1 − α)^s`.
+    /// Opacity of one sample taken `step` voxels from the last, from the
+    /// value alone: `α_s = 1 − (1 − α)^s`. This ignores an iso-surface and
+    /// gradient-magnitude opacity; [`Self::opacity_at`] is the opacity.
     #[inline]
     pub fn sample_opacity(&self, f: f32) -> f32 {
         correct_opacity(self.unit_opacity(f), self.step_voxels)
     }
 
+    /// Opacity of one sample of value `f` with world gradient `gradient`,
+    /// taken `step` voxels from the last: the unit opacity (Levoy's
+    /// contour for an iso-surface, else the value's), times the
+    /// gradient-magnitude ramp if any, then corrected for the step. Without
+    /// either option it is exactly [`Self::sample_opacity`].
+    #[inline]
+    pub fn opacity_at(&self, f: f32, gradient: [f32; 3]) -> f32 {
+        if !self.uses_gradient() {
+            return self.sample_opacity(f);
+        }
+        let g = magnitude(gradient);
+        let mut alpha = match &self.iso {
+            Some(iso) => iso.opacity(f, g),
+            None => self.unit_opacity(f),
+        };
+        if let Some(ramp) = &self.gradient_opacity {
+            alpha *= ramp.factor(g);
+        }
+        correct_opacity(alpha, self.step_voxels)
+    }
+
     /// Whether every value in `[lo, hi]` gets zero opacity, so that a
     /// region whose values all lie there contributes nothing to any ray
-    /// (the zero-opacity test of empty-space skipping, Levoy 1990).
-    /// Exact: a piecewise-linear opacity is zero on an interval iff it is
-    /// zero at the interval's ends and at every break point inside it.
+    /// (the zero-opacity test of empty-space skipping, Levoy 1990),
+    /// whatever the gradients in the volume. Exact: a piecewise-linear
+    /// opacity is zero on an interval iff it is zero at the interval's ends
+    /// and at every break point inside it. An iso-surface decides by the
+    /// distance to its isovalue (see [`IsoContour::is_transparent_between`]);
+    /// gradient-magnitude opacity only multiplies, so the value's test holds.
     pub fn is_transparent_between(&self, lo: f32, hi: f32) -> bool {
+        if let Some(iso) = &self.iso {
+            return iso.is_transparent_between(lo, hi);
+        }
         // `normalise` is monotone (a subtraction and a non-negative scale).
         let (t0, t1) = (self.normalise(lo), self.normalise(hi));
         match &self.opacity {
@@ -227,5 +312,141 @@ mod tests {
         assert!((c.unit_opacity(5.0) - 0.4).abs() < 1e-7);
         // Beyond the domain the ramp holds its end value.
         assert_eq!(c.unit_opacity(50.0), 0.8);
+    }
+
+    /// A table with a zero stretch, a bump and a jump, over [0, 10].
+    fn table_classifier(step: f32) -> Classifier {
+        let table = PiecewiseLinear::new(
+            "opacity",
+            vec![(0.1, [0.0]), (0.4, [0.7]), (0.6, [0.2]), (0.6, [0.9])],
+        )
+        .unwrap();
+        Classifier::new((0.0, 10.0), OpacityMap::Table(table), None, step)
+    }
+
+    #[test]
+    fn without_options_opacity_at_is_the_value_opacity_to_the_bit() {
+        for c in [
+            table_classifier(0.37),
+            Classifier::new((-1.0, 3.0), OpacityMap::Ramp { p: 0.1, q: 0.6 }, None, 1.0),
+        ] {
+            assert!(!c.uses_gradient());
+            for i in 0..=200 {
+                let f = -2.0 + 14.0 * i as f32 / 200.0;
+                for g in [[0.0; 3], [1.0, -2.0, 0.5], [1e6, 0.0, 0.0]] {
+                    assert_eq!(c.opacity_at(f, g).to_bits(), c.sample_opacity(f).to_bits());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn iso_opacity_is_levoys_contour_with_the_transfer_functions_alpha() {
+        // α_v = q = 0.7 for the ramp 0.2..0.7 (not its 0.45 at f_v = 5); r = 3 voxels
+        // of 0.5, so the contour reaches 1.5·|∇f| either side of 5.
+        let iso = IsoSurface {
+            value: 5.0,
+            thickness: 3.0,
+        };
+        let ramp = Classifier::new((0.0, 10.0), OpacityMap::Ramp { p: 0.2, q: 0.7 }, None, 1.0);
+        let c = ramp.clone().with_iso(iso, 0.5, 8.0);
+        assert!(c.uses_gradient());
+        let alpha_v = ramp.iso_alpha(5.0);
+        assert_eq!(alpha_v, 0.7);
+        assert_eq!(c.iso().unwrap().alpha(), alpha_v);
+        let g = [0.0, 2.0, 0.0]; // |∇f| = 2: the contour spans 5 ± 3
+        assert_eq!(c.opacity_at(5.0, g), alpha_v);
+        assert!((c.opacity_at(6.0, g) - 0.7 * (2.0 / 3.0)).abs() < 1e-6);
+        assert!((c.opacity_at(3.5, g) - 0.7 * 0.5).abs() < 1e-6);
+        assert_eq!(c.opacity_at(8.0, g), 0.0);
+        assert_eq!(c.opacity_at(1.0, g), 0.0);
+        // The value's own opacity no longer counts: 10 is opaque on the ramp.
+        assert_eq!(c.opacity_at(10.0, g), 0.0);
+        assert_eq!(c.opacity_at(5.0, [0.0; 3]), alpha_v);
+        assert_eq!(c.opacity_at(5.5, [0.0; 3]), 0.0);
+        // The step corrects the contour's opacity as any other.
+        let half = Classifier::new((0.0, 10.0), OpacityMap::Ramp { p: 0.2, q: 0.7 }, None, 0.5)
+            .with_iso(iso, 0.5, 8.0);
+        assert_eq!(
+            half.opacity_at(6.0, g),
+            correct_opacity(c.opacity_at(6.0, g), 0.5)
+        );
+        // Changing the iso-surface makes a different classifier (the fast
+        // path reclassifies on any change).
+        assert_ne!(c, ramp.with_iso(IsoSurface { value: 5.5, ..iso }, 0.5, 8.0));
+    }
+
+    #[test]
+    fn iso_transparency_agrees_with_sampling_at_every_gradient() {
+        // |∇f| <= 8 world units and r·h = 1.5: values within 12 of f_v = 5
+        // may be opaque; the table's zero stretch below t = 0.1 no longer
+        // matters.
+        let iso = IsoSurface {
+            value: 5.0,
+            thickness: 3.0,
+        };
+        let c = table_classifier(0.6).with_iso(iso, 0.5, 8.0);
+        assert!(!c.is_transparent_between(-20.0, -6.9));
+        assert!(!c.is_transparent_between(16.9, 20.0));
+        assert!(!c.is_transparent_between(4.0, 4.5));
+        let transparent = [(-30.0f32, -7.1f32), (17.1, 40.0)];
+        for (lo, hi) in transparent {
+            assert!(c.is_transparent_between(lo, hi), "{lo}..{hi}");
+        }
+        // The test is sharp: just inside the reach a voxel is opaque.
+        let steepest = [8.0, 0.0, 0.0];
+        assert!(c.opacity_at(-6.9, steepest) > 0.0);
+        assert!(c.opacity_at(16.9, steepest) > 0.0);
+        for (lo, hi) in transparent {
+            for i in 0..=100 {
+                let f = lo + (hi - lo) * i as f32 / 100.0;
+                for k in 0..=16 {
+                    let g = [k as f32 * 0.3, -(k as f32) * 0.4, 0.0]; // |g| = k/2
+                    assert_eq!(c.opacity_at(f, g), 0.0, "{f} {g:?}");
+                }
+            }
+        }
+        // α_v = 0 (f_v in the table's zero stretch): nothing is ever opaque.
+        let hidden = table_classifier(1.0).with_iso(
+            IsoSurface {
+                value: 0.5,
+                thickness: 3.0,
+            },
+            0.5,
+            8.0,
+        );
+        assert!(hidden.is_transparent_between(-100.0, 100.0));
+        assert_eq!(hidden.opacity_at(0.5, [1.0, 0.0, 0.0]), 0.0);
+    }
+
+    #[test]
+    fn gradient_opacity_multiplies_the_value_opacity() {
+        // Ramp from 0 at 25% to 1 at 75% of |∇f| = 4.
+        let base = table_classifier(1.0);
+        let c = base.clone().with_gradient_opacity((0.25, 0.75), 4.0);
+        assert!(c.uses_gradient());
+        let f = 4.0; // α = 0.7
+        assert_eq!(base.opacity_at(f, [0.0; 3]), 0.7);
+        assert_eq!(c.opacity_at(f, [0.0; 3]), 0.0);
+        assert_eq!(c.opacity_at(f, [0.0, 0.0, -1.0]), 0.0);
+        assert!((c.opacity_at(f, [0.0, 2.0, 0.0]) - 0.35).abs() < 1e-6);
+        assert_eq!(c.opacity_at(f, [3.0, 0.0, 0.0]), 0.7);
+        assert_eq!(c.opacity_at(f, [4.0, 0.0, 0.0]), 0.7);
+        // Only a multiplier: the value's zero-opacity test stands.
+        assert_eq!(
+            c.is_transparent_between(0.0, 1.0),
+            base.is_transparent_between(0.0, 1.0)
+        );
+        assert!(c.is_transparent_between(0.0, 1.0));
+        assert!(!c.is_transparent_between(0.0, 1.1));
+        // With an iso-surface, both apply: the contour times the ramp.
+        let iso = IsoSurface {
+            value: 4.0,
+            thickness: 1.0,
+        };
+        let both = base
+            .with_iso(iso, 1.0, 4.0)
+            .with_gradient_opacity((0.25, 0.75), 4.0);
+        assert!((both.opacity_at(4.5, [2.0, 0.0, 0.0]) - 0.7 * 0.75 * 0.5).abs() < 1e-6);
     }
 }

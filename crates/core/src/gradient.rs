@@ -8,6 +8,8 @@
 //!
 //! Gradients depend on the data alone, not on the view: they are computed
 //! once per volume and kept across frames (as VTK caches its normals).
+//! Their largest magnitude, [`max_magnitude`], scales gradient-magnitude
+//! opacity and bounds Levoy's iso-surfaces (see [`crate::classify`]).
 
 use crate::volume::Volume;
 use rayon::prelude::*;
@@ -56,6 +58,32 @@ pub fn gradient_at(volume: &Volume, i: usize, j: usize, k: usize) -> [f32; 3] {
     ]
 }
 
+/// `|g|`, in `f32` as every path computes it: the classifier's opacity
+/// and [`max_magnitude`] must agree on it to the last bit, so that the
+/// maximum bounds every voxel's magnitude exactly.
+#[inline]
+pub fn magnitude(g: [f32; 3]) -> f32 {
+    (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt()
+}
+
+/// The largest [`magnitude`] of [`gradient_at`] over every voxel of
+/// `volume` (0 for a constant volume), without storing the gradients.
+pub fn max_magnitude(volume: &Volume) -> f32 {
+    let [nx, ny, nz] = volume.dims();
+    (0..nz)
+        .into_par_iter()
+        .map(|k| {
+            let mut max = 0.0f32;
+            for j in 0..ny {
+                for i in 0..nx {
+                    max = max.max(magnitude(gradient_at(volume, i, j, k)));
+                }
+            }
+            max
+        })
+        .reduce(|| 0.0, f32::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,5 +115,26 @@ mod tests {
         let gx: Vec<f32> = (0..n).map(|i| g[v.index(i, 1, 1)][0]).collect();
         assert_eq!(gx, vec![1.0, 2.0, 4.0, 6.0, 7.0]);
         assert!(g.iter().all(|g| g[1] == 0.0 && g[2] == 0.0));
+    }
+
+    #[test]
+    fn the_largest_magnitude_is_the_steepest_voxels() {
+        // f = x² + 2y on a grid with x spacing 0.5: the gradient is (2x, 2)
+        // inside; the face x = 2 (i = 4) has the one-sided difference
+        // (4 − 2.25)/0.5 = 3.5, the largest, so the maximum is √(3.5² + 2²).
+        let v = Volume::from_fn([5, 3, 2], DVec3::new(0.5, 1.0, 1.0), DVec3::ZERO, |p| {
+            (p.x * p.x + 2.0 * p.y) as f32
+        })
+        .unwrap();
+        let want = (3.5f32 * 3.5 + 4.0).sqrt();
+        assert!(
+            (max_magnitude(&v) - want).abs() < 1e-6,
+            "{}",
+            max_magnitude(&v)
+        );
+        let all = gradients(&v).into_iter().map(magnitude).fold(0.0, f32::max);
+        assert_eq!(max_magnitude(&v), all);
+        let flat = Volume::new([2, 2, 2], vec![4.0; 8]).unwrap();
+        assert_eq!(max_magnitude(&flat), 0.0);
     }
 }

@@ -16,11 +16,19 @@
 //!   central differences (errata 1), [`shading`] the paper's Phong colour
 //!   `C = Cs·ka + Cs·(kd (N·L) + ks (N·H)^n)`, [`classify`] the opacity
 //!   `α = p + (f − fmin)/(fmax − fmin)·(q − p)` or a
-//!   [`transfer_function`], corrected for the sampling step.
-//! - **Stage 2**, per pixel: [`camera`] frames an orthographic view; [`ray`]
+//!   [`transfer_function`], corrected for the sampling step; optionally
+//!   Levoy's isovalue contours ([`iso`]) or gradient-magnitude opacity
+//!   ([`gradient_opacity`]).
+//! - **Stage 2**, per pixel: [`camera`] frames an orthographic or a
+//!   [`perspective`] view, orbited as VTK does ([`pose`]); [`ray`]
 //!   finds each ray's samples at a fixed step (default one voxel, errata 8);
 //!   [`trilinear`] resamples colour and opacity there; [`composite`] applies
 //!   the transparency formula `C_out = C_in (1 − α) + C α`.
+//! - **Options** of stage 2: [`sampling`] gives every pixel's samples, cut
+//!   by the crop box and clip planes ([`clipping`]) and offset by
+//!   [`jitter`]; [`post_classification`] classifies and shades samples
+//!   instead of voxels; [`blend`] projects the scalar (maximum, minimum,
+//!   average) instead of compositing.
 //! - Two paths: [`reference`](mod@reference), the paper's algorithm as written (stage 1
 //!   on every voxel, back-to-front compositing of every sample), kept as
 //!   the oracle; and the fast default, which computes the same samples but
@@ -32,7 +40,11 @@
 //!   the occupied cells only, with early ray termination, in parallel over
 //!   tiles. The paths agree within 1/255 per channel; the fast path is
 //!   bit-identical for any thread count. `docs/performance.md` records the
-//!   design and what each step bought.
+//!   design and what each step bought. The fast path renders orthographic,
+//!   composited, pre-classified frames (with any crop, clip planes and
+//!   jitter), and [`intensity`] the projection blend modes fast; the
+//!   reference renders every option, and [`Renderer::path_for`] sends it
+//!   the frames the fast paths cannot.
 //! - [`render`] ties it together; [`image`] is the RGBA `f32` result.
 //!
 //! ```
@@ -52,21 +64,31 @@
 //! assert!(centre[0] > 0.5 && corner == [0.0, 0.0, 0.0, 0.0]);
 //! ```
 
+pub mod blend;
 pub mod bricks;
 pub mod camera;
 pub mod classified;
 pub mod classify;
+pub mod clipping;
 pub mod colormap;
 pub mod composite;
 pub mod gradient;
+pub mod gradient_opacity;
 pub mod histogram;
 pub mod image;
+pub mod intensity;
+pub mod iso;
+pub mod jitter;
 pub mod macrocells;
+pub mod perspective;
+pub mod pose;
+pub mod post_classification;
 pub mod presets;
 pub mod ray;
 pub mod raycast;
 pub mod reference;
 pub mod render;
+pub mod sampling;
 pub mod shade_bricks;
 pub mod shading;
 pub mod stage1;
@@ -75,10 +97,14 @@ pub mod transfer_function;
 pub mod trilinear;
 pub mod volume;
 
-pub use camera::Camera;
+pub use blend::Blend;
+pub use camera::{Camera, Fit, Projection, View};
+pub use clipping::ClipPlane;
 pub use glam;
 pub use histogram::Histogram;
 pub use image::Image;
+pub use iso::IsoSurface;
+pub use post_classification::Classification;
 pub use render::{FrameTimes, Method, RenderError, RenderSettings, Renderer};
 pub use shading::Phong;
 pub use transfer_function::TransferFunction;

@@ -10,7 +10,8 @@
 //! the same depths, which avoids the wood-grain pattern that per-ray start
 //! offsets cause. Sample 0 is the nearest to the eye (errata 4). The fast and
 //! the reference path take their positions from here, so they sample the
-//! very same points.
+//! very same points. [`GridFrame::span`] gives where any world ray (a
+//! perspective one from the eye, say) is inside the box.
 
 use crate::camera::OrthographicView;
 use glam::DVec3;
@@ -77,6 +78,36 @@ impl GridFrame {
     ) -> Option<RaySamples> {
         let origin = (view.pixel_centre(col, row) - self.origin) / self.spacing;
         let direction = view.direction / self.spacing;
+        let (t_enter, t_exit) = self.slabs(origin, direction)?;
+        // Samples within a millionth of a step of a face count as inside.
+        let tolerance = 1e-6 * step;
+        let first = ((t_enter - tolerance) / step).ceil();
+        let last = ((t_exit + tolerance) / step).floor();
+        (first <= last).then_some(RaySamples {
+            origin,
+            direction,
+            step,
+            first: first as i64,
+            last: last as i64,
+        })
+    }
+
+    /// Where a world ray `origin + t·dir` (`dir` a unit vector) is inside
+    /// the grid's box: `(t_enter, t_exit)` in world units of `t`, the same
+    /// `t` as [`GridFrame::ray`]'s. `None` if the line misses the box. The
+    /// whole line counts: `t_enter` may be negative (behind a perspective
+    /// eye, or in front of an orthographic image plane); callers clip.
+    pub fn span(&self, origin: DVec3, dir: DVec3) -> Option<(f64, f64)> {
+        let (t_enter, t_exit) =
+            self.slabs((origin - self.origin) / self.spacing, dir / self.spacing)?;
+        (t_enter <= t_exit).then_some((t_enter, t_exit))
+    }
+
+    /// The slab test (Kay and Kajiya 1986) of the index-space line
+    /// `origin + t·direction` against `[0, n−1]³`: the largest entry and the
+    /// smallest exit `t` over the three axes (`t_enter > t_exit` when it
+    /// misses), or `None` if it runs parallel to an axis outside the box.
+    fn slabs(&self, origin: DVec3, direction: DVec3) -> Option<(f64, f64)> {
         let (mut t_enter, mut t_exit) = (f64::NEG_INFINITY, f64::INFINITY);
         for axis in 0..3 {
             let (o, d) = (origin[axis], direction[axis]);
@@ -91,17 +122,7 @@ impl GridFrame {
                 t_exit = t_exit.min(a.max(b));
             }
         }
-        // Samples within a millionth of a step of a face count as inside.
-        let tolerance = 1e-6 * step;
-        let first = ((t_enter - tolerance) / step).ceil();
-        let last = ((t_exit + tolerance) / step).floor();
-        (first <= last).then_some(RaySamples {
-            origin,
-            direction,
-            step,
-            first: first as i64,
-            last: last as i64,
-        })
+        Some((t_enter, t_exit))
     }
 }
 
@@ -158,5 +179,89 @@ mod tests {
         };
         assert!(grid.ray(&default, 1, 1, 1.0).is_some());
         assert!(grid.ray(&far, 1, 1, 1.0).is_none());
+    }
+    #[test]
+    fn span_gives_entry_and_exit_in_world_t() {
+        // Box x ∈ [−3, 5], y ∈ [1, 5], z ∈ [2, 10] (anisotropic spacing).
+        let grid = frame([5, 9, 3], DVec3::new(2.0, 0.5, 4.0));
+        let (lo, hi) = (DVec3::new(-3.0, 1.0, 2.0), DVec3::new(5.0, 5.0, 10.0));
+        // Along −x from x = 20: enters at x = 5, leaves at x = −3.
+        let span = grid.span(DVec3::new(20.0, 3.0, 6.0), -DVec3::X).unwrap();
+        assert_eq!(span, (15.0, 23.0));
+        // Along the box's diagonal, 6 units before its low corner: the
+        // diagonal is 12 long.
+        let dir = (hi - lo) / 12.0;
+        let (enter, exit) = grid.span(lo - 6.0 * dir, dir).unwrap();
+        assert!((enter - 6.0).abs() < 1e-12 && (exit - 18.0).abs() < 1e-12);
+        // From inside, the entry lies behind the origin.
+        let (enter, exit) = grid.span(DVec3::new(0.0, 3.0, 6.0), DVec3::Z).unwrap();
+        assert_eq!((enter, exit), (-4.0, 4.0));
+        // Misses: parallel outside, and oblique past a corner.
+        assert!(grid.span(DVec3::new(20.0, 6.0, 6.0), -DVec3::X).is_none());
+        let past = DVec3::new(1.0, -1.0, 0.0).normalize();
+        assert!(grid.span(DVec3::new(-10.0, 0.0, 6.0), past).is_none());
+        // A line rising towards the box from below it hits it.
+        let towards = DVec3::new(1.0, 1.0, 0.0).normalize();
+        assert!(grid.span(DVec3::new(-10.0, -6.0, 6.0), towards).is_some());
+    }
+
+    #[test]
+    fn span_brackets_the_samples_of_ray() {
+        let grid = frame([7, 5, 9], DVec3::new(1.0, 1.5, 0.5));
+        let bounds = (grid.origin, grid.origin + DVec3::new(6.0, 6.0, 4.0));
+        let camera = Camera {
+            view_point: Some(DVec3::new(30.0, -20.0, 17.0)),
+            ..Camera::default()
+        };
+        let view = OrthographicView::frame(&camera, bounds, 12, 10).unwrap();
+        let step = 0.37;
+        let mut hits = 0;
+        for row in 0..10 {
+            for col in 0..12 {
+                let span = grid.span(view.pixel_centre(col, row), view.direction);
+                let Some(ray) = grid.ray(&view, col, row, step) else {
+                    // Rays without samples may still graze the box between them.
+                    if let Some((enter, exit)) = span {
+                        assert!((enter / step).ceil() > (exit / step).floor() + 0.5);
+                    }
+                    continue;
+                };
+                hits += 1;
+                let (enter, exit) = span.unwrap();
+                assert_eq!(ray.first, (enter / step).ceil() as i64);
+                assert_eq!(ray.last, (exit / step).floor() as i64);
+            }
+        }
+        assert!(hits > 40, "{hits}");
+    }
+
+    #[test]
+    fn a_perspective_ray_enters_and_leaves_on_the_box_faces() {
+        use crate::camera::{Projection, View};
+        let grid = frame([9, 9, 9], DVec3::splat(0.25));
+        let bounds = (grid.origin, grid.origin + DVec3::splat(2.0));
+        let camera = Camera {
+            projection: Projection::Perspective { fov_degrees: 45.0 },
+            azimuth: 20.0,
+            elevation: 35.0,
+            ..Camera::default()
+        };
+        let view = View::frame(&camera, bounds, 9, 9).unwrap();
+        let on_face = |p: DVec3| {
+            let inside = (p - bounds.0).cmpge(DVec3::splat(-1e-9)).all()
+                && (bounds.1 - p).cmpge(DVec3::splat(-1e-9)).all();
+            let touches = (0..3)
+                .any(|a| (p[a] - bounds.0[a]).abs() < 1e-9 || (p[a] - bounds.1[a]).abs() < 1e-9);
+            inside && touches
+        };
+        let (eye, dir) = view.pixel_ray(4, 4);
+        let (enter, exit) = grid.span(eye, dir).unwrap();
+        assert!(0.0 < enter && enter < exit, "the eye is outside the box");
+        assert!(on_face(eye + enter * dir) && on_face(eye + exit * dir));
+        // The corner pixel's ray misses the box: it fits the sphere.
+        assert!(
+            grid.span(view.pixel_ray(0, 0).0, view.pixel_ray(0, 0).1)
+                .is_none()
+        );
     }
 }

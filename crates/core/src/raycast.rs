@@ -12,6 +12,14 @@
 //! has opacity 0. A sample on a face shared by two bricks is taken once, by
 //! the first.
 //!
+//! With a crop box or clip planes, or jitter, the samples are still the
+//! reference's ([`crate::sampling`]): each ray's exact range of samples
+//! `k` (inside the grid, the crop box and the clip planes) bounds what it
+//! takes in every brick, and a jittered ray's `t = 0` point is moved by
+//! its offset, so that its `k`-th sample is at `t = (k + u)·step`. The
+//! exact range is found once per ray, when first needed: in a brick on
+//! the volume's boundary, or in any brick when something is cut away.
+//!
 //! The ray stops once its transmittance is below
 //! [`TERMINATION_TRANSMITTANCE`]: colours are in [0, 1], so what lies
 //! behind could change the pixel by at most that much, well under 1/255.
@@ -26,7 +34,8 @@ use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
 use crate::camera::OrthographicView;
 use crate::classified::ClassifiedBricks;
 use crate::image::Image;
-use crate::ray::GridFrame;
+use crate::jitter;
+use crate::sampling::Sampling;
 use crate::shade_bricks::{Lighting, LitBricks};
 use crate::tiles::{TILE, TileBins};
 use glam::{DVec3, Vec4};
@@ -58,9 +67,11 @@ struct CellBox {
 
 /// One frame's rays, in the index space of the grid.
 struct Rays<'a> {
-    grid: &'a GridFrame,
+    sampling: &'a Sampling,
     view: &'a OrthographicView,
-    step: f64,
+    /// Whether every brick, not just the boundary ones, needs the rays'
+    /// exact ranges (something is cut away).
+    clipped: bool,
     /// Index-space point on the image plane (`t = 0`) of pixel (0, 0), and
     /// its change per column and per row.
     corner: DVec3,
@@ -68,6 +79,8 @@ struct Rays<'a> {
     per_row: DVec3,
     /// Index-space displacement from one sample to the next.
     delta: f32x4,
+    /// The same in `f64`, for the jitter.
+    delta_f64: DVec3,
     /// `1/delta` per axis, 0 where `delta` is 0 (lane 3: 0).
     inv_delta: f32x4,
     /// All bits set in the lanes of the axes the rays are parallel to, and
@@ -86,7 +99,7 @@ struct Scene<'a> {
 
 /// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
 /// as the rays reach them (see [`crate::shade_bricks`]), binned into
-/// `bins`, through `view` with samples `step` world units apart, into
+/// `bins`, through `view` with samples where `sampling` says, into
 /// `image` (`view.width × view.height`). `progress` is called with the
 /// number of pixels finished, a tile at a time.
 #[allow(clippy::too_many_arguments)]
@@ -95,9 +108,8 @@ pub fn render(
     lit: &LitBricks,
     lighting: &Lighting,
     bins: &TileBins,
-    grid: &GridFrame,
+    sampling: &Sampling,
     view: &OrthographicView,
-    step: f64,
     background: [f32; 3],
     image: &mut Image,
     progress: &(dyn Fn(usize) + Sync),
@@ -109,7 +121,7 @@ pub fn render(
         lit,
         lighting,
     };
-    let rays = Rays::new(grid, view, step, background);
+    let rays = Rays::new(sampling, view, background);
     // Each tile's rows, as slices of the image rows: the tiles are then
     // independent pieces of work, small enough to balance the threads.
     let mut tiles: Vec<Vec<&mut [[f32; 4]]>> = (0..bins.tiles_x * bins.tiles_y)
@@ -145,19 +157,22 @@ fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
 }
 
 impl<'a> Rays<'a> {
-    fn new(grid: &'a GridFrame, view: &'a OrthographicView, step: f64, bg: [f32; 3]) -> Self {
+    fn new(sampling: &'a Sampling, view: &'a OrthographicView, bg: [f32; 3]) -> Self {
+        let grid = &sampling.grid;
         let to_index = |world: DVec3| (world - grid.origin) / grid.spacing;
-        let delta = (view.direction * step / grid.spacing).as_vec3();
+        let delta_f64 = view.direction * sampling.step / grid.spacing;
+        let delta = delta_f64.as_vec3();
         let inv = |d: f32| if d == 0.0 { 0.0 } else { 1.0 / d };
         let mask = |d: f32| if d == 0.0 { f32::from_bits(!0) } else { 0.0 };
         Rays {
-            grid,
+            sampling,
             view,
-            step,
+            clipped: sampling.clipping.is_active(),
             corner: to_index(view.pixel_centre(0, 0)),
             per_col: view.right * view.pixel_size / grid.spacing,
             per_row: -view.up * view.pixel_size / grid.spacing,
             delta: f32x4::new([delta.x, delta.y, delta.z, 0.0]),
+            delta_f64,
             inv_delta: f32x4::new([inv(delta.x), inv(delta.y), inv(delta.z), 0.0]),
             parallel: f32x4::new([mask(delta.x), mask(delta.y), mask(delta.z), mask(0.0)]),
             background: bg,
@@ -186,7 +201,11 @@ impl<'a> Rays<'a> {
         if !list.is_empty() {
             for (i, state) in states.iter_mut().enumerate() {
                 let (col, row) = (cols.start + i % cols.len(), ty * TILE + i / cols.len());
-                let o = self.corner + self.per_col * col as f64 + self.per_row * row as f64;
+                let mut o = self.corner + self.per_col * col as f64 + self.per_row * row as f64;
+                if self.sampling.jitter {
+                    // Sample k at t = (k + u)·step: move the t = 0 point.
+                    o += jitter::offset(col, row) * self.delta_f64;
+                }
                 *state = RayState {
                     origin: f32x4::new([o.x as f32, o.y as f32, o.z as f32, 0.0]),
                     ..RayState::EMPTY
@@ -206,11 +225,13 @@ impl<'a> Rays<'a> {
                     continue;
                 };
                 let mut first = first.max(state.next);
-                if b.boundary {
+                if b.boundary || self.clipped {
                     let (col, row) = (cols.start + i % cols.len(), ty * TILE + i / cols.len());
                     let range = *state.exact.get_or_insert_with(|| {
-                        self.grid
-                            .ray(self.view, col, row, self.step)
+                        let (origin, direction) =
+                            (self.view.pixel_centre(col, row), self.view.direction);
+                        self.sampling
+                            .ray(col, row, origin, direction)
                             .map(|r| (r.first as i32, r.last as i32))
                     });
                     let Some((f, l)) = range else {
@@ -346,7 +367,8 @@ struct RayState {
     /// The first sample not yet taken.
     next: i32,
     /// The ray's exact samples (as the reference finds them), found when
-    /// first needed, in a brick on the volume's boundary.
+    /// first needed, in a brick on the volume's boundary (or in any brick
+    /// when something is cut away).
     exact: Option<Option<(i32, i32)>>,
     /// Terminated, or off the volume.
     done: bool,

@@ -1,47 +1,105 @@
-//! The reference path: the paper's algorithm as written, the oracle every
-//! faster path is tested against.
+//! The reference path: the paper's algorithm as written, generalised to
+//! every rendering option, and the oracle every faster path is tested
+//! against.
 //!
-//! For each pixel: collect every sample along the ray by trilinear
-//! interpolation in `f64`, drape the opaque background behind them as the
-//! last sample, and composite back to front with the paper's formula. No
-//! shortcuts: no early termination, no empty-space skipping.
+//! For each pixel: take every sample of its ray ([`crate::sampling`]:
+//! orthographic or perspective, cropped and clipped, jittered or not), in
+//! `f64`, and make the pixel from them by the frame's [`Shader`]:
+//!
+//! - pre-classified (the paper's): interpolate the voxels' colours and
+//!   opacities ([`crate::stage1`]) trilinearly, drape the opaque background
+//!   behind them as the last sample, and composite back to front with the
+//!   paper's formula;
+//! - post-classified: interpolate the scalar and the gradient, classify and
+//!   shade each sample ([`crate::post_classification`]), composite alike;
+//! - a projection (maximum, minimum, average; [`crate::blend`]): project the
+//!   interpolated scalar and show it through the colour map.
+//!
+//! No shortcuts: no early termination, no empty-space skipping.
 
-use crate::camera::OrthographicView;
+use crate::blend::{Blend, ScalarProjection, projection_color};
+use crate::camera::View;
+use crate::classify::Classifier;
 use crate::composite::back_to_front;
 use crate::image::Image;
-use crate::ray::GridFrame;
+use crate::post_classification::PostClassifier;
+use crate::sampling::Sampling;
 use crate::stage1::ShadedVolume;
-use crate::trilinear::sample_reference;
-use glam::DVec3;
+use crate::trilinear::{sample_reference, scalar_reference};
+use crate::volume::Volume;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// Renders `shaded` through `view` with samples `step` world units apart.
-/// `progress` is called with the number of pixels finished, a row at a time.
+/// What a ray's samples are made of, and how they make the pixel.
+pub enum Shader<'a> {
+    /// The voxels' colours and opacities (stage 1), interpolated and
+    /// composited: the paper's.
+    Pre(&'a ShadedVolume),
+    /// Samples classified and shaded after interpolation, composited.
+    Post(&'a PostClassifier<'a>),
+    /// The interpolated scalar, projected by `blend` (not
+    /// [`Blend::Composite`]) and coloured by `classifier`.
+    Projection {
+        volume: &'a Volume,
+        blend: Blend,
+        classifier: &'a Classifier,
+    },
+}
+
+/// Renders `view` with `shader`, sampling as `sampling` says, over the
+/// opaque `background`. `progress` is called with the number of pixels
+/// finished, a row at a time.
 pub fn render(
-    shaded: &ShadedVolume,
-    grid: &GridFrame,
-    view: &OrthographicView,
-    step: f64,
+    shader: &Shader,
+    view: &View,
+    sampling: &Sampling,
     background: [f32; 3],
     progress: &(dyn Fn(usize) + Sync),
 ) -> Image {
+    let (width, height) = (view.width(), view.height());
     let bg = DVec3::from(background.map(f64::from));
-    let mut image = Image::new(view.width, view.height, [0.0; 4]);
+    let dims = sampling.grid.dims;
+    let mut image = Image::new(width, height, [0.0; 4]);
     image
         .pixels_mut()
-        .par_chunks_mut(view.width)
+        .par_chunks_mut(width)
         .enumerate()
         .for_each(|(row, pixels)| {
             let mut samples = Vec::new();
             for (col, pixel) in pixels.iter_mut().enumerate() {
-                samples.clear();
-                if let Some(ray) = grid.ray(view, col, row, step) {
-                    for k in ray.first..=ray.last {
-                        let p = ray.position(k, grid.dims);
-                        samples.push(sample_reference(&shaded.voxels, grid.dims, p.to_array()));
+                // Index-space positions of the ray's samples, nearest first.
+                let positions = (sampling.pixel(view, col, row).into_iter())
+                    .flat_map(|r| (r.first..=r.last).map(move |k| r.position(k, dims).to_array()));
+                let rgba = match shader {
+                    Shader::Pre(shaded) => {
+                        samples.clear();
+                        samples
+                            .extend(positions.map(|p| sample_reference(&shaded.voxels, dims, p)));
+                        back_to_front(&samples, bg)
                     }
-                }
-                *pixel = back_to_front(&samples, bg).as_vec4().to_array();
+                    Shader::Post(post) => {
+                        samples.clear();
+                        samples.extend(positions.map(|p| post.sample(p)));
+                        back_to_front(&samples, bg)
+                    }
+                    Shader::Projection {
+                        volume,
+                        blend,
+                        classifier,
+                    } => {
+                        let mut projection = ScalarProjection::new(*blend);
+                        for p in positions {
+                            projection.add(scalar_reference(volume.data(), dims, p));
+                        }
+                        match projection.value() {
+                            Some(f) => Vec3::from(projection_color(classifier, f as f32))
+                                .as_dvec3()
+                                .extend(1.0),
+                            None => bg.extend(0.0),
+                        }
+                    }
+                };
+                *pixel = rgba.as_vec4().to_array();
             }
             progress(pixels.len());
         });

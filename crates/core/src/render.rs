@@ -5,14 +5,31 @@
 //! min/max macro-cells, and the occupied bricks classified for the last
 //! transfer function), then per frame bins the bricks into tiles and casts
 //! the rays, lighting each brick as the rays first reach it.
+//!
+//! **Routing.** [`Method::Fast`] asks for the fast paths: the bricked ray
+//! caster ([`crate::raycast`]) renders orthographic views composited from
+//! pre-classified voxels (the paper's method), and [`crate::intensity`]
+//! renders the projection blend modes (maximum, minimum, average) for
+//! either projection; both take any crop box, clip planes and jitter.
+//! What neither can render, perspective or post-classified compositing,
+//! runs on the reference path ([`crate::reference`]), which renders every
+//! option. [`Renderer::path_for`] says which path a frame takes.
 
-use crate::camera::{Camera, CameraError, OrthographicView};
+use crate::blend::Blend;
+use crate::camera::{Camera, CameraError, Projection, View};
 use crate::classified::ClassifiedBricks;
 use crate::classify::Classifier;
-use crate::gradient::gradients;
+use crate::clipping::{ClipPlane, Clipping};
+use crate::gradient::{gradients, max_magnitude};
+use crate::gradient_opacity::GradientOpacity;
 use crate::image::Image;
+use crate::intensity;
+use crate::iso::IsoSurface;
 use crate::macrocells::Macrocells;
+use crate::post_classification::{Classification, PostClassifier};
 use crate::ray::GridFrame;
+use crate::reference::Shader;
+use crate::sampling::{PixelSamples, Sampling};
 use crate::shade_bricks::{Lighting, LitBricks};
 use crate::shading::{LightGeometry, Phong};
 use crate::stage1::{ShadedVolume, shade_and_classify};
@@ -47,10 +64,12 @@ pub enum RenderError {
 /// Which stage 2 to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
-    /// Front to back, early ray termination, parallel tiles.
+    /// Front to back, early ray termination, parallel tiles; frames it
+    /// cannot render go to the reference (see [`Renderer::path_for`]).
     #[default]
     Fast,
-    /// The paper's back-to-front compositing in `f64`: the oracle.
+    /// The paper's back-to-front compositing in `f64`, and every other
+    /// option: the oracle.
     Reference,
 }
 
@@ -75,6 +94,22 @@ pub struct RenderSettings {
     /// The opaque background, the last sample of every ray.
     pub background: [f32; 3],
     pub method: Method,
+    /// How the samples make the pixel: composite (the paper's) or a
+    /// projection of the scalar.
+    pub blend: Blend,
+    /// Classify voxels (the paper's) or samples.
+    pub classification: Classification,
+    /// Offset each pixel's samples by a per-pixel fraction of a step.
+    pub jitter: bool,
+    /// Render only what every plane keeps.
+    pub clip_planes: Vec<ClipPlane>,
+    /// Render only what lies in this world box `(lo, hi)`.
+    pub crop: Option<(DVec3, DVec3)>,
+    /// Levoy's isovalue contour instead of the value's opacity (`None`: off).
+    pub iso: Option<IsoSurface>,
+    /// Opacity times a ramp of `|∇f|` from 0 at `LO` to 1 at `HI`,
+    /// fractions of the volume's largest gradient magnitude (`None`: off).
+    pub gradient_opacity: Option<(f32, f32)>,
 }
 
 impl Default for RenderSettings {
@@ -91,6 +126,13 @@ impl Default for RenderSettings {
             light_direction: None,
             background: [0.0; 3],
             method: Method::Fast,
+            blend: Blend::Composite,
+            classification: Classification::Pre,
+            jitter: false,
+            clip_planes: Vec::new(),
+            crop: None,
+            iso: None,
+            gradient_opacity: None,
         }
     }
 }
@@ -159,6 +201,34 @@ impl RenderSettings {
                 "light direction {l} must be a finite, non-zero vector"
             )));
         }
+        if let Some((lo, hi)) = self.crop
+            && !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all())
+        {
+            return Err(setting(format!(
+                "crop box {lo} .. {hi} must be finite with low < high on every axis"
+            )));
+        }
+        for plane in &self.clip_planes {
+            if !plane.point.is_finite() {
+                return Err(setting(format!(
+                    "clip plane point {} must be finite",
+                    plane.point
+                )));
+            }
+            let length = plane.normal.length();
+            if !(length.is_finite() && length > 0.0) {
+                return Err(setting(format!(
+                    "clip plane normal {} must be a finite, non-zero vector",
+                    plane.normal
+                )));
+            }
+        }
+        if let Some(iso) = &self.iso {
+            iso.validate().map_err(setting)?;
+        }
+        if let Some(range) = self.gradient_opacity {
+            GradientOpacity::validate(range).map_err(setting)?;
+        }
         Ok(())
     }
 }
@@ -174,6 +244,8 @@ pub struct Renderer<'v> {
     volume: &'v Volume,
     value_range: (f32, f32),
     macrocells: OnceLock<Macrocells>,
+    /// The largest gradient magnitude, found on the first frame that needs it.
+    max_gradient: OnceLock<f32>,
     fast: Mutex<Option<FastState>>,
 }
 
@@ -223,6 +295,7 @@ impl<'v> Renderer<'v> {
             volume,
             value_range,
             macrocells: OnceLock::new(),
+            max_gradient: OnceLock::new(),
             fast: Mutex::new(None),
         })
     }
@@ -249,34 +322,49 @@ impl<'v> Renderer<'v> {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<Image, RenderError> {
         let frame = self.prepare(settings)?;
-        match settings.method {
+        match Self::path_for(settings) {
             Method::Fast => {
                 let mut image = Image::new(settings.width, settings.height, [0.0; 4]);
                 self.render_fast(settings, &frame, &mut image, progress);
                 Ok(image)
             }
-            Method::Reference => {
-                let shaded = self.stage1(settings, &frame.view);
-                Ok(reference::render(
-                    &shaded,
-                    &frame.grid,
-                    &frame.view,
-                    frame.step,
-                    settings.background,
-                    progress,
-                ))
-            }
+            Method::Reference => Ok(self.render_reference(settings, &frame, progress)),
         }
     }
 
-    /// Renders one frame on the fast path into `image` (reallocated only if
-    /// its size is not the frame's), and says where the time went.
+    /// The path a frame with `settings` runs on: a fast path when asked
+    /// for and one can (an orthographic view composited from
+    /// pre-classified voxels, or any projection blend mode), else the
+    /// reference path, which renders every option.
+    pub fn path_for(settings: &RenderSettings) -> Method {
+        let fast_can = settings.blend.is_projection()
+            || (matches!(settings.camera.projection, Projection::Orthographic)
+                && settings.classification == Classification::Pre);
+        if settings.method == Method::Fast && fast_can {
+            Method::Fast
+        } else {
+            Method::Reference
+        }
+    }
+
+    /// Renders one frame into `image` (reallocated only if its size is not
+    /// the frame's), and says where the time went. On the bricked fast path
+    /// the parts are timed; a projection, or a frame on the reference path
+    /// (see [`Self::path_for`]), counts all its time as `cast`.
     pub fn render_into(
         &self,
         settings: &RenderSettings,
         image: &mut Image,
     ) -> Result<FrameTimes, RenderError> {
         let frame = self.prepare(settings)?;
+        if Self::path_for(settings) == Method::Reference {
+            let start = Instant::now();
+            *image = self.render_reference(settings, &frame, &|_| {});
+            return Ok(FrameTimes {
+                cast: start.elapsed(),
+                ..FrameTimes::default()
+            });
+        }
         if (image.width(), image.height()) != (settings.width, settings.height) {
             *image = Image::new(settings.width, settings.height, [0.0; 4]);
         }
@@ -286,7 +374,7 @@ impl<'v> Renderer<'v> {
     /// Validates `settings` and frames the view.
     pub fn prepare(&self, settings: &RenderSettings) -> Result<Frame, RenderError> {
         settings.validate()?;
-        let view = OrthographicView::frame(
+        let view = View::frame(
             &settings.camera,
             self.volume.bounds(),
             settings.width,
@@ -305,22 +393,56 @@ impl<'v> Renderer<'v> {
             origin: self.volume.origin(),
             spacing: self.volume.spacing(),
         };
-        Ok(Frame { view, grid, step })
+        let clipping = Clipping {
+            crop: settings.crop,
+            // Unit normals: the planes' arithmetic stays in range.
+            planes: (settings.clip_planes.iter())
+                .map(|p| ClipPlane {
+                    point: p.point,
+                    normal: p.normal.normalize(),
+                })
+                .collect(),
+        };
+        let sampling = Sampling {
+            grid,
+            step,
+            clipping,
+            jitter: settings.jitter,
+            from_eye: matches!(view, View::Perspective(_)),
+        };
+        Ok(Frame { view, sampling })
     }
 
     /// The classifier `settings` describe for this volume.
     fn classifier(&self, settings: &RenderSettings) -> Classifier {
-        Classifier::from_transfer_function(
+        let mut classifier = Classifier::from_transfer_function(
             &settings.transfer_function,
             self.value_range,
             settings.opacity_ramp,
             settings.step as f32,
-        )
+        );
+        if let Some(iso) = settings.iso {
+            let voxel_size = self.volume.spacing().min_element() as f32;
+            classifier = classifier.with_iso(iso, voxel_size, self.max_gradient());
+        }
+        if let Some(range) = settings.gradient_opacity {
+            classifier = classifier.with_gradient_opacity(range, self.max_gradient());
+        }
+        classifier
     }
 
-    /// This frame's light: towards the light and towards the viewer.
-    fn light(settings: &RenderSettings, view: &OrthographicView) -> LightGeometry {
-        let to_viewer = (-view.direction).as_vec3();
+    /// The volume's largest gradient magnitude (world units), found once.
+    pub fn max_gradient(&self) -> f32 {
+        *self.max_gradient.get_or_init(|| max_magnitude(self.volume))
+    }
+
+    /// This frame's light: towards the light and towards the viewer. The
+    /// viewer is at infinity along the central view direction, for
+    /// perspective views too (as a headlight at infinity): one light
+    /// geometry for the whole frame, so that pre-classification can light
+    /// the voxels once.
+    fn light(settings: &RenderSettings, view: &View) -> LightGeometry {
+        let to_viewer = (-view.direction()).as_vec3();
         match settings.light_direction {
             Some(l) => LightGeometry::new(l.as_vec3(), to_viewer),
             None => LightGeometry::headlight(to_viewer),
@@ -329,7 +451,7 @@ impl<'v> Renderer<'v> {
 
     /// The reference path's stage 1: colour and opacity of every voxel for
     /// this frame's light and view, from gradients computed afresh.
-    pub fn stage1(&self, settings: &RenderSettings, view: &OrthographicView) -> ShadedVolume {
+    pub fn stage1(&self, settings: &RenderSettings, view: &View) -> ShadedVolume {
         let light = Self::light(settings, view);
         let lighting = settings.shading.then_some((&settings.phong, &light));
         shade_and_classify(
@@ -340,9 +462,78 @@ impl<'v> Renderer<'v> {
         )
     }
 
-    /// The fast path: classify (only when the classifier changed), light
-    /// the occupied bricks, bin them into tiles, cast the rays.
+    /// The reference path, with every option: the paper's stage 1 and
+    /// back-to-front compositing, post-classified samples, or a projection
+    /// of the scalar.
+    fn render_reference(
+        &self,
+        settings: &RenderSettings,
+        frame: &Frame,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Image {
+        let classifier = self.classifier(settings);
+        let render = |shader: &Shader| {
+            reference::render(
+                shader,
+                &frame.view,
+                &frame.sampling,
+                settings.background,
+                progress,
+            )
+        };
+        match (settings.blend, settings.classification) {
+            (Blend::Composite, Classification::Pre) => {
+                render(&Shader::Pre(&self.stage1(settings, &frame.view)))
+            }
+            (Blend::Composite, Classification::Post) => {
+                let light = Self::light(settings, &frame.view);
+                let lighting = settings.shading.then_some((&settings.phong, light));
+                let post = PostClassifier::new(self.volume, &classifier, lighting);
+                render(&Shader::Post(&post))
+            }
+            (blend, _) => render(&Shader::Projection {
+                volume: self.volume,
+                blend,
+                classifier: &classifier,
+            }),
+        }
+    }
+
+    /// The fast paths: the projections' ([`crate::intensity`]), or the
+    /// bricked ray caster's ([`Self::render_bricks`]).
     fn render_fast(
+        &self,
+        settings: &RenderSettings,
+        frame: &Frame,
+        image: &mut Image,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> FrameTimes {
+        if !settings.blend.is_projection() {
+            return self.render_bricks(settings, frame, image, progress);
+        }
+        let start = Instant::now();
+        let macrocells = self.macrocells.get_or_init(|| Macrocells::new(self.volume));
+        intensity::render(
+            self.volume,
+            macrocells,
+            self.value_range,
+            &frame.view,
+            &frame.sampling,
+            settings.blend,
+            &self.classifier(settings),
+            settings.background,
+            image,
+            progress,
+        );
+        FrameTimes {
+            cast: start.elapsed(),
+            ..FrameTimes::default()
+        }
+    }
+
+    /// The bricked ray caster: classify (only when the classifier changed),
+    /// light the occupied bricks, bin them into tiles, cast the rays.
+    fn render_bricks(
         &self,
         settings: &RenderSettings,
         frame: &Frame,
@@ -366,7 +557,9 @@ impl<'v> Renderer<'v> {
         }
         let state = guard.as_mut().expect("the state was just made");
         let t1 = Instant::now();
-        let bins = TileBins::new(&state.bricks, &frame.grid, &frame.view);
+        let view =
+            (frame.view.as_orthographic()).expect("the fast path renders orthographic views");
+        let bins = TileBins::new(&state.bricks, &frame.sampling, view);
         let t2 = Instant::now();
         let light = Self::light(settings, &frame.view);
         let lighting = Lighting::new(
@@ -381,9 +574,8 @@ impl<'v> Renderer<'v> {
             &state.lit,
             &lighting,
             &bins,
-            &frame.grid,
-            &frame.view,
-            frame.step,
+            &frame.sampling,
+            view,
             settings.background,
             image,
             progress,
@@ -398,10 +590,27 @@ impl<'v> Renderer<'v> {
 }
 
 /// A validated, framed view of a volume.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
-    pub view: OrthographicView,
-    pub grid: GridFrame,
-    /// Sample spacing along the rays, in world units.
-    pub step: f64,
+    pub view: View,
+    /// Where each pixel's ray takes its samples (the grid, the step in
+    /// world units, the crop box and clip planes, jitter).
+    pub sampling: Sampling,
+}
+
+impl Frame {
+    /// The samples of pixel (`col`, `row`), or `None` if its ray takes none.
+    pub fn samples(&self, col: usize, row: usize) -> Option<PixelSamples> {
+        self.sampling.pixel(&self.view, col, row)
+    }
+
+    /// Samples all rays take together, before skipping and early
+    /// termination (a measure of a frame's work).
+    pub fn nominal_samples(&self) -> usize {
+        (0..self.view.height())
+            .flat_map(|row| (0..self.view.width()).map(move |col| (col, row)))
+            .filter_map(|(col, row)| self.samples(col, row))
+            .map(|s| s.count())
+            .sum()
+    }
 }

@@ -3,9 +3,10 @@
 //!
 //! The colour is the lit colour of [`crate::shading`] times the material
 //! colour of [`crate::classify`], clamped to [0, 1]; the opacity is the
-//! classified opacity corrected for the sampling step. Stage 2 interpolates
-//! these per-voxel values along the rays (pre-classification, as in the
-//! paper and Levoy 1988). This is the reference path's stage 1, over every
+//! classified opacity of the voxel's value and gradient
+//! ([`Classifier::opacity_at`]) corrected for the sampling step. Stage 2
+//! interpolates these per-voxel values along the rays (pre-classification,
+//! as in the paper and Levoy 1988). This is the reference path's stage 1, over every
 //! voxel, dense; the fast path's is [`crate::classified`] (view-independent,
 //! kept across frames) and [`crate::shade_bricks`] (the light, per frame).
 
@@ -45,7 +46,7 @@ pub fn shade_and_classify(
                     None => Vec3::ONE,
                 };
                 let color = (lit * material).clamp(Vec3::ZERO, Vec3::ONE);
-                *o = color.extend(classifier.sample_opacity(f));
+                *o = color.extend(classifier.opacity_at(f, *g));
             }
         });
     ShadedVolume {
@@ -58,7 +59,9 @@ pub fn shade_and_classify(
 mod tests {
     use super::*;
     use crate::classify::OpacityMap;
-    use crate::gradient::gradients;
+    use crate::classify::correct_opacity;
+    use crate::gradient::{gradients, max_magnitude};
+    use crate::iso::IsoSurface;
     use crate::transfer_function::PiecewiseLinear;
     use glam::DVec3;
 
@@ -106,5 +109,68 @@ mod tests {
             (got - Vec4::new(0.5, 0.25, 1.0, 0.5)).abs().max_element() < 1e-6,
             "{got:?}"
         );
+    }
+
+    /// Levoy's contour of `f_v` on `volume` as the renderer sets it up:
+    /// `r` in voxels of the smallest spacing, the volume's largest gradient.
+    fn iso_classifier(volume: &Volume, value: f32, thickness: f32, step: f32) -> Classifier {
+        let c = Classifier::new((0.0, 10.0), OpacityMap::Ramp { p: 0.2, q: 0.6 }, None, step);
+        let h = volume.spacing().min_element() as f32;
+        let iso = IsoSurface { value, thickness };
+        c.with_iso(iso, h, max_magnitude(volume))
+    }
+
+    #[test]
+    fn iso_on_a_linear_ramp_is_a_slab_r_voxels_thick_either_side() {
+        // f = x (world), so |f − f_v| / |∇f| is the distance to the plane
+        // x = f_v and eq. 3 is α_v (1 − |x − x_v| / (r·h)): in voxels of the
+        // smallest spacing h, whatever the spacing along the ramp. Spacings
+        // 0.5 along x, 0.25 along y: h = 0.25.
+        let v = Volume::from_fn([17, 3, 3], DVec3::new(0.5, 0.25, 1.0), DVec3::ZERO, |p| {
+            p.x as f32
+        })
+        .unwrap();
+        let g = gradients(&v);
+        for (value, thickness, step) in [(3.0, 4.0, 1.0), (3.2, 4.0, 1.0), (4.1, 7.0, 0.5)] {
+            let c = iso_classifier(&v, value, thickness, step);
+            // With the ramp, α_v is its top opacity q.
+            let alpha_v = c.iso().unwrap().alpha();
+            assert_eq!(alpha_v, 0.6);
+            let s = shade_and_classify(&v, &g, &c, None);
+            let half_width = thickness * 0.25; // world units
+            let mut opaque = 0;
+            for i in 0..17 {
+                let x = 0.5 * i as f32;
+                let want = alpha_v * (1.0 - (x - value).abs() / half_width).max(0.0);
+                let want = correct_opacity(want, step);
+                for (j, k) in [(0, 0), (1, 2), (2, 1)] {
+                    let got = s.voxels[v.index(i, j, k)].w;
+                    assert!((got - want).abs() < 1e-6, "x {x}: {got} vs {want}");
+                }
+                opaque += (want > 0.0) as usize;
+            }
+            // The slab is 2·r·h wide: 2 world units (4 voxels of 0.5) for
+            // r = 4, 3.5 for r = 7; an open interval of that width holds 3
+            // or 4 (r = 4 at 3.0: x = 2.5, 3, 3.5) or 7 grid points.
+            let want_count = match (value, thickness) {
+                (3.0, _) => 3,
+                (3.2, _) => 4,
+                _ => 7,
+            };
+            assert_eq!(opaque, want_count, "f_v {value}, r {thickness}");
+        }
+        // The same slab along z, where the spacing is 1 but h is still
+        // 0.25: r = 4 reaches 1 world unit, so only the voxel on the plane
+        // is opaque.
+        let vz = Volume::from_fn([3, 3, 9], DVec3::new(0.5, 0.25, 1.0), DVec3::ZERO, |p| {
+            p.z as f32
+        })
+        .unwrap();
+        let c = iso_classifier(&vz, 3.0, 4.0, 1.0);
+        let s = shade_and_classify(&vz, &gradients(&vz), &c, None);
+        let alphas: Vec<f32> = (0..9).map(|k| s.voxels[vz.index(1, 1, k)].w).collect();
+        let mut want = vec![0.0; 9];
+        want[3] = c.iso().unwrap().alpha();
+        assert_eq!(alphas, want);
     }
 }

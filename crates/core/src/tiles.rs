@@ -15,11 +15,15 @@
 //! neighbour one brick further along some axis `a` in the direction of
 //! `D_a`, and that neighbour's centre is deeper by `8·|D_a| > 0`. Bricks in
 //! a list that a ray misses are rejected by the ray's own box test.
+//!
+//! Bricks wholly outside the crop box or wholly behind a clip plane are
+//! left out: no sample of theirs is taken.
 
 use crate::bricks::BRICK;
 use crate::camera::OrthographicView;
 use crate::classified::ClassifiedBricks;
 use crate::ray::GridFrame;
+use crate::sampling::Sampling;
 use glam::DVec3;
 
 /// Tile edge in pixels.
@@ -41,8 +45,10 @@ pub struct TileBins {
 }
 
 impl TileBins {
-    /// Bins the occupied bricks of `bricks` for `view`.
-    pub fn new(bricks: &ClassifiedBricks, grid: &GridFrame, view: &OrthographicView) -> Self {
+    /// Bins the occupied bricks of `bricks` for `view`, leaving out those
+    /// whose samples `sampling` cuts away.
+    pub fn new(bricks: &ClassifiedBricks, sampling: &Sampling, view: &OrthographicView) -> Self {
+        let grid = &sampling.grid;
         let tiles_x = view.width.div_ceil(TILE);
         let tiles_y = view.height.div_ceil(TILE);
         let direction = view.direction / grid.spacing;
@@ -59,9 +65,25 @@ impl TileBins {
         order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
 
         // Each brick's tile rectangle, then a counting sort into the tiles.
+        let clipping = &sampling.clipping;
+        let kept = |(lo, hi): ([usize; 3], [usize; 3])| {
+            // The box in world space, a step larger all round: a sample a
+            // rounding error outside the kept part still counts as inside.
+            let world = |i: [usize; 3]| {
+                grid.origin + DVec3::new(i[0] as f64, i[1] as f64, i[2] as f64) * grid.spacing
+            };
+            let margin = DVec3::splat(sampling.step);
+            clipping.may_keep_box((world(lo) - margin, world(hi) + margin))
+        };
         let rects: Vec<Option<[usize; 4]>> = order
             .iter()
-            .map(|&(_, n)| tile_rect(bricks.occupied_box(n as usize), grid, view))
+            .map(|&(_, n)| {
+                let cells = bricks.occupied_box(n as usize);
+                if clipping.is_active() && !kept(cells) {
+                    return None;
+                }
+                tile_rect(cells, grid, view)
+            })
             .collect();
         let mut count = vec![0u32; tiles_x * tiles_y + 1];
         for &[x0, x1, y0, y1] in rects.iter().flatten() {
@@ -148,6 +170,7 @@ mod tests {
     use crate::camera::Camera;
     use crate::classified::ClassifiedBricks;
     use crate::classify::{Classifier, OpacityMap};
+    use crate::clipping::Clipping;
     use crate::macrocells::Macrocells;
     use crate::volume::Volume;
 
@@ -160,13 +183,19 @@ mod tests {
         let c = Classifier::new((0.0, 1.0), OpacityMap::Ramp { p: 0.1, q: 0.5 }, None, 1.0);
         let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c);
         assert_eq!(bricks.len(), 64);
-        let grid = GridFrame {
-            dims: v.dims(),
-            origin: v.origin(),
-            spacing: v.spacing(),
+        let sampling = Sampling {
+            grid: GridFrame {
+                dims: v.dims(),
+                origin: v.origin(),
+                spacing: v.spacing(),
+            },
+            step: 1.0,
+            clipping: Clipping::default(),
+            jitter: false,
+            from_eye: false,
         };
         let view = OrthographicView::frame(&Camera::default(), v.bounds(), 64, 64).unwrap();
-        let bins = TileBins::new(&bricks, &grid, &view);
+        let bins = TileBins::new(&bricks, &sampling, &view);
         assert_eq!((bins.tiles_x, bins.tiles_y), (4, 4));
         // Brick faces fall exactly between pixels 15 and 16: no brick leaks
         // into a neighbouring tile.
@@ -181,5 +210,21 @@ mod tests {
             .map(|b| b[0])
             .collect();
         assert_eq!(xs, vec![3, 2, 1, 0]);
+
+        // Cropped to x ≤ 10, the bricks from x = 16 on hold no sample (with
+        // a step of margin, the brick [8, 16] still may): they are left out.
+        let cropped = Sampling {
+            clipping: Clipping {
+                crop: Some((DVec3::splat(-1.0), DVec3::new(10.0, 40.0, 40.0))),
+                planes: vec![],
+            },
+            ..sampling
+        };
+        let bins = TileBins::new(&bricks, &cropped, &view);
+        assert_eq!(bins.len(), 32);
+        let xs: Vec<usize> = (bins.list(2, 3).iter())
+            .map(|&n| bricks.occupied[n as usize][0])
+            .collect();
+        assert_eq!(xs, vec![1, 0]);
     }
 }

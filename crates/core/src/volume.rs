@@ -4,7 +4,8 @@
 //! `(i, j, k)` sits at `origin + (i·dx, j·dy, k·dz)`, so the volume spans
 //! `(n − 1)·spacing` along each axis and a cell is bounded by eight voxels.
 //! Values are stored as `f32` with x varying fastest:
-//! `index = x + nx·(y + ny·z)`.
+//! `index = x + nx·(y + ny·z)`. [`Volume::to_log10`] puts values that span
+//! decades on a log scale.
 
 use glam::DVec3;
 use thiserror::Error;
@@ -26,6 +27,8 @@ pub enum VolumeError {
     BadSpacing(f64, f64, f64),
     #[error("origin ({0}, {1}, {2}) must be finite")]
     BadOrigin(f64, f64, f64),
+    #[error("a log scale needs a positive value, but the largest value is {0}")]
+    NoPositiveValue(f32),
 }
 
 /// A regular grid of `f32` scalars with per-axis spacing and an origin.
@@ -192,6 +195,40 @@ impl Volume {
         }
         range
     }
+
+    /// The same grid with every value `f` replaced by `log10 f`, for data
+    /// that span decades (densities), as yt's `take_log`. Values `<= 0`
+    /// have no logarithm: they become the log of the smallest positive
+    /// finite value in the volume, the bottom of the scale, so that they
+    /// show as the lowest value (yt leaves them `−inf` or NaN and masks
+    /// them). NaN stays NaN and `+∞` stays `+∞` (the renderer refuses
+    /// both). A volume with no positive finite value is refused.
+    pub fn to_log10(&self) -> Result<Volume, VolumeError> {
+        let smallest = self
+            .data
+            .iter()
+            .copied()
+            .filter(|v| *v > 0.0 && v.is_finite())
+            .fold(f32::INFINITY, f32::min);
+        if smallest == f32::INFINITY {
+            let largest = self.data.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            return Err(VolumeError::NoPositiveValue(largest));
+        }
+        // In f64, so that exact powers of ten give exact exponents.
+        let log = |v: f32| (v as f64).log10() as f32;
+        let floor = log(smallest);
+        let data = self
+            .data
+            .iter()
+            .map(|&v| if v <= 0.0 { floor } else { log(v) })
+            .collect();
+        Ok(Volume {
+            dims: self.dims,
+            spacing: self.spacing,
+            origin: self.origin,
+            data,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -253,5 +290,54 @@ mod tests {
         .unwrap();
         assert_eq!(v.value_range(), Some((-2.0, 3.0)));
         assert_eq!(v.count_non_finite(), 2);
+    }
+
+    #[test]
+    fn log_scale_gives_the_exponent_and_floors_non_positive_values() {
+        // 10^k for k = −6..=9 at the first 16 voxels, then 0, a negative
+        // value, NaN and +∞; spacing and origin kept.
+        let mut data: Vec<f32> = (-6..=9).map(|k| 10f64.powi(k) as f32).collect();
+        data.extend([0.0, -3.0, f32::NAN, f32::INFINITY]);
+        data.resize(24, 1.0);
+        let v = Volume::new([2, 3, 4], data)
+            .unwrap()
+            .with_spacing(DVec3::new(1.0, 2.0, 3.0))
+            .unwrap()
+            .with_origin(DVec3::new(-1.0, 0.5, 7.0))
+            .unwrap();
+        let log = v.to_log10().unwrap();
+        assert_eq!(log.dims(), v.dims());
+        assert_eq!(log.bounds(), v.bounds());
+        for (i, k) in (-6..=9).enumerate() {
+            let got = log.data()[i];
+            assert!((got - k as f32).abs() <= 1e-6, "10^{k}: {got}");
+        }
+        // Exact powers of ten that f32 holds exactly give exact exponents.
+        for (i, k) in (0..=9).enumerate() {
+            assert_eq!(log.data()[6 + i], k as f32);
+        }
+        // 0 and −3 sit at the bottom of the scale, log10(1e−6).
+        assert_eq!(log.data()[16], log.data()[0]);
+        assert_eq!(log.data()[17], log.data()[0]);
+        assert!(log.data()[18].is_nan());
+        assert_eq!(log.data()[19], f32::INFINITY);
+        assert_eq!(log.data()[20], 0.0);
+    }
+
+    #[test]
+    fn log_scale_refuses_a_volume_with_no_positive_value() {
+        let v = Volume::new([2, 2, 2], vec![0.0, -1.0, -2.5, 0.0, -0.1, 0.0, 0.0, -4.0]).unwrap();
+        let err = v.to_log10().unwrap_err();
+        assert_eq!(err, VolumeError::NoPositiveValue(0.0));
+        assert_eq!(
+            err.to_string(),
+            "a log scale needs a positive value, but the largest value is 0"
+        );
+        // Only +∞ is positive: there is no finite bottom for the scale.
+        let inf = Volume::new(
+            [2, 2, 2],
+            vec![f32::INFINITY, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        );
+        assert!(inf.unwrap().to_log10().is_err());
     }
 }

@@ -1,0 +1,164 @@
+//! The fast path of the intensity projections (maximum, minimum, average;
+//! see [`crate::blend`]): the reference's samples, in `f32`, skipping what
+//! cannot change the result.
+//!
+//! Each ray takes the samples [`crate::sampling`] gives it (any view,
+//! crop, clip planes, jitter), interpolates the scalar trilinearly in
+//! `f32` and keeps the running maximum, minimum or sum (in `f64`). Two
+//! exact shortcuts serve the maximum (and, mirrored, the minimum):
+//!
+//! - **Macro-cell skipping.** A trilinear sample lies between the smallest
+//!   and the largest of its cell's eight voxels, so no sample in a brick
+//!   whose largest voxel ([`crate::macrocells`]) is at most the running
+//!   maximum can raise it: the ray jumps to the first sample past the
+//!   brick (Parker et al., "Interactive ray tracing for volume
+//!   visualization", IEEE TVCG 1999, use the same min/max bound for
+//!   maximum intensity projection).
+//! - **Early termination.** Once the running maximum is the volume's
+//!   largest value, nothing can raise it.
+//!
+//! The average visits every sample. Each pixel is computed from its own
+//! ray alone, so the image is the same for any thread count.
+
+use crate::blend::{Blend, projection_color};
+use crate::bricks::BRICK;
+use crate::camera::View;
+use crate::classify::Classifier;
+use crate::image::Image;
+use crate::macrocells::Macrocells;
+use crate::sampling::{PixelSamples, Sampling};
+use crate::trilinear::sample_scalar;
+use crate::volume::Volume;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Samples within this fraction of a step before a brick's exit count as
+/// past it: rounding cannot carry a sample counted in the brick out of it.
+const EXIT_SLACK: f64 = 1e-4;
+
+/// What the rays read.
+struct Scene<'a> {
+    volume: &'a Volume,
+    macrocells: &'a Macrocells,
+    blend: Blend,
+    /// The volume's `(min, max)`.
+    range: (f32, f32),
+}
+
+/// Renders the projection `blend` (not [`Blend::Composite`]) of `volume`
+/// through `view`, sampling as `sampling` says, coloured by `classifier`
+/// over the opaque `background`, into `image` (the view's size).
+/// `macrocells` are the volume's and `range` its `(min, max)`. `progress`
+/// is called with the number of pixels finished, a row at a time.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    volume: &Volume,
+    macrocells: &Macrocells,
+    range: (f32, f32),
+    view: &View,
+    sampling: &Sampling,
+    blend: Blend,
+    classifier: &Classifier,
+    background: [f32; 3],
+    image: &mut Image,
+    progress: &(dyn Fn(usize) + Sync),
+) {
+    assert_eq!(
+        (image.width(), image.height()),
+        (view.width(), view.height())
+    );
+    let scene = Scene {
+        volume,
+        macrocells,
+        blend,
+        range,
+    };
+    let width = view.width();
+    image
+        .pixels_mut()
+        .par_chunks_mut(width)
+        .enumerate()
+        .for_each(|(row, pixels)| {
+            for (col, pixel) in pixels.iter_mut().enumerate() {
+                let rgba = match sampling.pixel(view, col, row) {
+                    Some(ray) => {
+                        let f = scene.project(&ray);
+                        Vec3::from(projection_color(classifier, f)).extend(1.0)
+                    }
+                    None => Vec3::from(background).extend(0.0),
+                };
+                *pixel = rgba.to_array();
+            }
+            progress(pixels.len());
+        });
+}
+
+impl Scene<'_> {
+    /// The projected value of one ray's samples (it has at least one).
+    fn project(&self, ray: &PixelSamples) -> f32 {
+        let dims = self.volume.dims();
+        let data = self.volume.data();
+        let top = Vec3::new(
+            (dims[0] - 1) as f32,
+            (dims[1] - 1) as f32,
+            (dims[2] - 1) as f32,
+        );
+        let start = (ray.origin + ray.t(ray.first) * ray.direction).as_vec3();
+        let delta = (ray.step * ray.direction).as_vec3();
+        let at = |k: i64| (start + delta * (k - ray.first) as f32).clamp(Vec3::ZERO, top);
+        // Maximum and minimum are one search: for the minimum, the largest −f.
+        let sign = match self.blend {
+            Blend::Maximum => 1.0,
+            Blend::Minimum => -1.0,
+            Blend::Average | Blend::Composite => {
+                let sum: f64 = (ray.first..=ray.last)
+                    .map(|k| sample_scalar(data, dims, at(k)) as f64)
+                    .sum();
+                return (sum / ray.count() as f64) as f32;
+            }
+        };
+        let largest = if sign > 0.0 {
+            self.range.1
+        } else {
+            -self.range.0
+        };
+        let grid = &self.macrocells.grid;
+        let mut best = f32::NEG_INFINITY;
+        let mut k = ray.first;
+        // Brick by brick: the samples from k up to the brick's exit lie in
+        // the brick (its box is convex), so its range bounds them all.
+        while k <= ray.last {
+            let p = at(k);
+            // The brick of the sample's cell (the last cell holds the far faces).
+            let b = std::array::from_fn(|a| (p[a] as usize).min(dims[a] - 2) / BRICK);
+            let (lo, hi) = self.macrocells.ranges[grid.index(b)];
+            // At least sample k, even if rounding puts it on the exit face.
+            let next = exit(ray, grid.bounds(b)).max(k + 1);
+            let bound = if sign > 0.0 { hi } else { -lo };
+            if bound > best {
+                for j in k..next.min(ray.last + 1) {
+                    best = best.max(sign * sample_scalar(data, dims, at(j)));
+                }
+                if best >= largest {
+                    break;
+                }
+            }
+            k = next;
+        }
+        sign * best
+    }
+}
+
+/// The first sample of `ray` past the index-space box `(lo, hi)` that the
+/// ray is inside of (counting those [`EXIT_SLACK`] before the exit as past).
+fn exit(ray: &PixelSamples, (lo, hi): ([usize; 3], [usize; 3])) -> i64 {
+    let mut t_exit = f64::INFINITY;
+    for a in 0..3 {
+        let d = ray.direction[a];
+        let face = if d > 0.0 { hi[a] } else { lo[a] } as f64;
+        if d != 0.0 {
+            t_exit = t_exit.min((face - ray.origin[a]) / d);
+        }
+    }
+    (t_exit / ray.step - ray.offset - EXIT_SLACK).ceil() as i64
+}

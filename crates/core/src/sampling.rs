@@ -1,0 +1,260 @@
+//! Which samples each pixel's ray takes, with every option of the frame:
+//! orthographic or perspective rays, the crop box and clip planes, and
+//! jitter.
+//!
+//! A pixel's world ray `p(t) = o + t·d` ([`View::pixel_ray`]) is sampled at
+//! `t = (k + u)·step` for the integers `k` whose `t` lies in the ray's
+//! interval: where it is inside the grid ([`GridFrame::span`]), cut by the
+//! crop box and the clip planes ([`crate::clipping`]), and, for a
+//! perspective ray, in front of the eye (`t ≥ 0`). `u` is 0, or the pixel's
+//! jitter offset ([`crate::jitter`]). Without options this is exactly
+//! [`GridFrame::ray`]: the samples lie on planes parallel to the image,
+//! `t = k·step` from it. Samples within a millionth of a step of the
+//! interval's ends count as inside, as there.
+//!
+//! Both paths take their samples from here (the fast path for its rays'
+//! exact ranges), so they sample the very same points.
+
+use crate::camera::View;
+use crate::clipping::Clipping;
+use crate::jitter;
+use crate::ray::{GridFrame, clamp_to_grid};
+use glam::DVec3;
+
+/// The sample positions of one frame's rays.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sampling {
+    pub grid: GridFrame,
+    /// World distance between samples.
+    pub step: f64,
+    pub clipping: Clipping,
+    /// Offset each pixel's samples by its jitter.
+    pub jitter: bool,
+    /// Rays start at the eye (perspective): only `t ≥ 0` is sampled.
+    pub from_eye: bool,
+}
+
+/// The samples of one pixel's ray: `k` from `first` to `last` (inclusive).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelSamples {
+    /// Index-space point where `t = 0`.
+    pub origin: DVec3,
+    /// Index-space displacement per world unit of `t`.
+    pub direction: DVec3,
+    /// World distance between samples.
+    pub step: f64,
+    /// Sample `k` is at `t = (k + offset)·step`.
+    pub offset: f64,
+    pub first: i64,
+    pub last: i64,
+}
+
+impl PixelSamples {
+    /// Number of samples.
+    pub fn count(&self) -> usize {
+        (self.last - self.first + 1) as usize
+    }
+
+    /// The ray parameter of sample `k`.
+    #[inline]
+    pub fn t(&self, k: i64) -> f64 {
+        (k as f64 + self.offset) * self.step
+    }
+
+    /// Index-space position of sample `k`, clamped into the grid.
+    #[inline]
+    pub fn position(&self, k: i64, dims: [usize; 3]) -> DVec3 {
+        clamp_to_grid(self.origin + self.t(k) * self.direction, dims)
+    }
+}
+
+impl Sampling {
+    /// The samples of pixel (`col`, `row`) of `view`, or `None` if its ray
+    /// takes none.
+    pub fn pixel(&self, view: &View, col: usize, row: usize) -> Option<PixelSamples> {
+        let (origin, direction) = view.pixel_ray(col, row);
+        self.ray(col, row, origin, direction)
+    }
+
+    /// The samples of pixel (`col`, `row`) whose world ray is
+    /// `origin + t·direction` (`direction` a unit vector), or `None`.
+    pub fn ray(
+        &self,
+        col: usize,
+        row: usize,
+        origin: DVec3,
+        direction: DVec3,
+    ) -> Option<PixelSamples> {
+        let (mut t0, t1) = self.grid.span(origin, direction)?;
+        if self.from_eye {
+            t0 = t0.max(0.0);
+        }
+        let (t0, t1) = if self.clipping.is_active() {
+            self.clipping.clip(origin, direction, (t0, t1))?
+        } else {
+            (t0, t1)
+        };
+        let offset = if self.jitter {
+            jitter::offset(col, row)
+        } else {
+            0.0
+        };
+        let step = self.step;
+        let tolerance = 1e-6 * step;
+        let first = ((t0 - tolerance) / step - offset).ceil();
+        let last = ((t1 + tolerance) / step - offset).floor();
+        (first <= last).then_some(PixelSamples {
+            origin: (origin - self.grid.origin) / self.grid.spacing,
+            direction: direction / self.grid.spacing,
+            step,
+            offset,
+            first: first as i64,
+            last: last as i64,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::{Camera, OrthographicView, Projection};
+
+    fn grid() -> GridFrame {
+        GridFrame {
+            dims: [11, 7, 9],
+            origin: DVec3::new(-3.0, 1.0, 2.0),
+            spacing: DVec3::new(1.0, 0.5, 0.75),
+        }
+    }
+
+    fn sampling(jitter: bool, clipping: Clipping, from_eye: bool) -> Sampling {
+        Sampling {
+            grid: grid(),
+            step: 0.4,
+            clipping,
+            jitter,
+            from_eye,
+        }
+    }
+
+    fn oblique() -> View {
+        let g = grid();
+        let bounds = (g.origin, g.origin + DVec3::new(10.0, 3.0, 6.0));
+        let camera = Camera {
+            view_point: Some(DVec3::new(40.0, -25.0, 30.0)),
+            ..Camera::default()
+        };
+        View::Orthographic(OrthographicView::frame(&camera, bounds, 20, 16).unwrap())
+    }
+
+    #[test]
+    fn without_options_the_samples_are_the_grid_rays() {
+        let (view, s) = (oblique(), sampling(false, Clipping::default(), false));
+        let ortho = view.as_orthographic().unwrap();
+        let mut hits = 0;
+        for row in 0..16 {
+            for col in 0..20 {
+                let ours = s.pixel(&view, col, row);
+                let grid_ray = grid().ray(ortho, col, row, 0.4);
+                assert_eq!(
+                    ours.map(|r| (r.first, r.last)),
+                    grid_ray.map(|r| (r.first, r.last))
+                );
+                if let (Some(a), Some(b)) = (ours, grid_ray) {
+                    hits += 1;
+                    for k in a.first..=a.last {
+                        assert_eq!(a.position(k, grid().dims), b.position(k, grid().dims));
+                    }
+                }
+            }
+        }
+        assert!(hits > 100);
+    }
+
+    #[test]
+    fn jitter_moves_each_pixel_by_its_offset_within_the_same_interval() {
+        let view = oblique();
+        let (plain, jittered) = (
+            sampling(false, Clipping::default(), false),
+            sampling(true, Clipping::default(), false),
+        );
+        let mut hits = 0;
+        for (col, row) in (0..16).flat_map(|row| (0..20).map(move |col| (col, row))) {
+            let (Some(a), Some(b)) = (
+                plain.pixel(&view, col, row),
+                jittered.pixel(&view, col, row),
+            ) else {
+                continue;
+            };
+            hits += 1;
+            let u = jitter::offset(col, row);
+            assert_eq!(b.offset, u);
+            // t = (k + u)·step: every jittered sample lies in the grid,
+            // the ones before and after it do not, and the first one lies
+            // within a step of the first plain one.
+            let (t0, t1) = grid()
+                .span(view.pixel_ray(col, row).0, view.direction())
+                .unwrap();
+            assert!(b.t(b.first) >= t0 - 1e-6 && b.t(b.last) <= t1 + 1e-6);
+            assert!(b.t(b.first - 1) < t0 && b.t(b.last + 1) > t1);
+            assert!((b.t(b.first) - a.t(a.first)).abs() < 0.4);
+        }
+        assert!(hits > 100);
+    }
+
+    #[test]
+    fn perspective_rays_sample_only_ahead_of_the_eye() {
+        // The eye inside the grid: samples start at t = 0, the eye itself.
+        let g = grid();
+        let bounds = (g.origin, g.origin + DVec3::new(10.0, 3.0, 6.0));
+        let camera = Camera {
+            view_point: Some(g.origin + DVec3::new(5.0, 1.5, 3.0)),
+            look_at: Some(g.origin),
+            projection: Projection::Perspective { fov_degrees: 60.0 },
+            ..Camera::default()
+        };
+        let view = View::frame(&camera, bounds, 8, 8).unwrap();
+        let s = sampling(false, Clipping::default(), true)
+            .pixel(&view, 4, 4)
+            .unwrap();
+        assert_eq!(s.first, 0);
+        let unbounded = sampling(false, Clipping::default(), false)
+            .pixel(&view, 4, 4)
+            .unwrap();
+        assert!(unbounded.first < 0);
+        assert_eq!(unbounded.last, s.last);
+    }
+
+    #[test]
+    fn crops_cut_the_samples_to_the_box() {
+        let view = oblique();
+        let crop = (DVec3::new(-1.0, 1.5, 3.0), DVec3::new(4.0, 2.5, 5.0));
+        let cropped = sampling(
+            false,
+            Clipping {
+                crop: Some(crop),
+                planes: vec![],
+            },
+            false,
+        );
+        let mut inside = 0;
+        for row in 0..16 {
+            for col in 0..20 {
+                let Some(s) = cropped.pixel(&view, col, row) else {
+                    continue;
+                };
+                let (o, d) = view.pixel_ray(col, row);
+                for k in s.first..=s.last {
+                    let p = o + s.t(k) * d;
+                    assert!(p.cmpge(crop.0 - 1e-9).all() && p.cmple(crop.1 + 1e-9).all());
+                    inside += 1;
+                }
+                for k in [s.first - 1, s.last + 1] {
+                    let p = o + s.t(k) * d;
+                    assert!(!(p.cmpge(crop.0).all() && p.cmple(crop.1).all()));
+                }
+            }
+        }
+        assert!(inside > 50);
+    }
+}

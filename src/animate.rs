@@ -1,0 +1,240 @@
+//! Animations of `volray render`, rendered frame by frame into volray-io's
+//! [`Animation`] writer (animated PNG, GIF or numbered PNGs), which
+//! publishes its file only once every frame is in: a failed run leaves
+//! nothing behind.
+//!
+//! - A **turntable** orbits the view point about the up vector, frame `i`
+//!   of `n` at azimuth `--azimuth + 360·i/n`. The orthographic window (or
+//!   the perspective eye's distance) fits the bounding sphere rather than
+//!   the box ([`Fit::Sphere`]), so the object keeps its scale as it turns
+//!   instead of breathing with its box's outline.
+//! - A **series** renders several volumes, one frame each, as they are
+//!   given: the paper's "repeat the calculation for various unit-cell
+//!   parameters and see". Every frame has the same transfer function (the
+//!   value window spans all the volumes unless one is given) and the same
+//!   framing (the box around all the volumes), so the frames differ only
+//!   where the data do. The volumes are read one at a time, twice (first
+//!   for their ranges and bounds, then to render), so a long series never
+//!   has to fit in memory.
+
+use crate::cli::RenderArgs;
+use crate::error::CliError;
+use crate::render::{load, note_general_path, progress_bar};
+use rayon::ThreadPool;
+use volray_core::glam::DVec3;
+use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
+use volray_io::Animation;
+
+/// Frames per second when `--fps` is not given.
+pub const DEFAULT_FPS: f64 = 24.0;
+
+/// `--turntable FRAMES`: `frames` views of INPUT.
+pub fn turntable(
+    args: &RenderArgs,
+    base: &RenderSettings,
+    pool: &ThreadPool,
+    frames: usize,
+) -> Result<(), CliError> {
+    let input = load(&args.input, args.view.log)?;
+    let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
+    let renderer = Renderer::new(&input.volume).map_err(fail)?;
+    let mut writer = Writer::new(args, base, frames)?;
+    for i in 0..frames {
+        let image = writer.render(pool, &renderer, &turntable_frame(base, i, frames));
+        writer.push(&image.map_err(fail)?)?;
+    }
+    writer.finish()
+}
+
+/// The settings of frame `i` of an `n`-frame turntable of `base`.
+pub fn turntable_frame(base: &RenderSettings, i: usize, n: usize) -> RenderSettings {
+    RenderSettings {
+        camera: Camera {
+            azimuth: base.camera.azimuth + 360.0 * i as f64 / n as f64,
+            fit: Fit::Sphere,
+            ..base.camera
+        },
+        ..base.clone()
+    }
+}
+
+/// Several inputs: one frame per volume in `specs`, in order.
+pub fn series(
+    args: &RenderArgs,
+    specs: &[String],
+    base: &RenderSettings,
+    pool: &ThreadPool,
+) -> Result<(), CliError> {
+    // Pass 1: the value range and bounds of all the volumes together.
+    let mut extent = Extent::default();
+    for spec in specs {
+        let input = load_one(args, spec)?;
+        let renderer = Renderer::new(&input.volume)
+            .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+        extent.add(renderer.value_range(), input.volume.bounds());
+    }
+    let settings = extent.fix(base);
+
+    // Pass 2: render each.
+    let mut writer = Writer::new(args, &settings, specs.len())?;
+    for spec in specs {
+        let input = load_one(args, spec)?;
+        let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
+        let renderer = Renderer::new(&input.volume).map_err(fail)?;
+        let image = writer.render(pool, &renderer, &settings);
+        writer.push(&image.map_err(fail)?)?;
+    }
+    writer.finish()
+}
+
+/// The volume `spec` names, read with the options of INPUT.
+fn load_one(args: &RenderArgs, spec: &str) -> Result<crate::input::Input, CliError> {
+    let mut input = args.input.clone();
+    input.input = Some(spec.to_string());
+    load(&input, args.view.log)
+}
+
+/// The value range and the bounds of the volumes seen so far.
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+struct Extent {
+    range: Option<(f32, f32)>,
+    bounds: Option<(DVec3, DVec3)>,
+}
+
+impl Extent {
+    fn add(&mut self, (lo, hi): (f32, f32), (min, max): (DVec3, DVec3)) {
+        self.range = Some(match self.range {
+            Some((a, b)) => (a.min(lo), b.max(hi)),
+            None => (lo, hi),
+        });
+        self.bounds = Some(match self.bounds {
+            Some((a, b)) => (a.min(min), b.max(max)),
+            None => (min, max),
+        });
+    }
+
+    /// `base` with one value window and one framed box for every volume:
+    /// the window is the union of the ranges unless the transfer function
+    /// fixes one (`--range`, `--tf`, a CT preset); the box is the union of
+    /// the bounds. Volumes that are all the same constant keep no window
+    /// (each one's own range is then that constant).
+    fn fix(&self, base: &RenderSettings) -> RenderSettings {
+        let mut settings = base.clone();
+        if settings.transfer_function.domain.is_none()
+            && let Some((lo, hi)) = self.range
+            && lo < hi
+        {
+            settings.transfer_function.domain = Some((lo as f64, hi as f64));
+        }
+        if settings.camera.bounds.is_none() {
+            settings.camera.bounds = self.bounds;
+        }
+        settings
+    }
+}
+
+/// The animation being written, with its progress bar.
+struct Writer {
+    animation: Animation,
+    bar: indicatif::ProgressBar,
+}
+
+impl Writer {
+    /// Starts the animation `args` asks for: `frames` frames of the size
+    /// in `settings`. Tells the user if the frames take the general path.
+    fn new(args: &RenderArgs, settings: &RenderSettings, frames: usize) -> Result<Self, CliError> {
+        let animation = Animation::create(
+            &args.output,
+            settings.width,
+            settings.height,
+            frames,
+            args.fps.unwrap_or(DEFAULT_FPS),
+        )?;
+        note_general_path(settings);
+        let bar = progress_bar((frames * settings.width * settings.height) as u64);
+        Ok(Writer { animation, bar })
+    }
+
+    fn render(
+        &self,
+        pool: &ThreadPool,
+        renderer: &Renderer,
+        settings: &RenderSettings,
+    ) -> Result<Image, volray_core::RenderError> {
+        pool.install(|| renderer.render_with_progress(settings, &|n| self.bar.inc(n as u64)))
+    }
+
+    fn push(&mut self, image: &Image) -> Result<(), CliError> {
+        Ok(self.animation.push(image)?)
+    }
+
+    fn finish(self) -> Result<(), CliError> {
+        self.bar.finish_and_clear();
+        self.animation.finish()?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turntable_frames_turn_by_equal_steps_from_the_given_azimuth() {
+        let base = RenderSettings {
+            camera: Camera {
+                azimuth: 10.0,
+                elevation: 20.0,
+                ..Camera::default()
+            },
+            ..RenderSettings::default()
+        };
+        let azimuths: Vec<f64> = (0..4)
+            .map(|i| turntable_frame(&base, i, 4).camera.azimuth)
+            .collect();
+        assert_eq!(azimuths, [10.0, 100.0, 190.0, 280.0]);
+        let frame = turntable_frame(&base, 3, 4);
+        assert_eq!(frame.camera.fit, Fit::Sphere);
+        assert_eq!(frame.camera.elevation, 20.0);
+        assert_eq!(
+            RenderSettings {
+                camera: base.camera,
+                ..frame.clone()
+            },
+            base
+        );
+    }
+
+    #[test]
+    fn a_series_shares_the_union_of_ranges_and_bounds() {
+        let mut extent = Extent::default();
+        extent.add((0.0, 2.0), (DVec3::ZERO, DVec3::ONE));
+        extent.add(
+            (-1.0, 1.5),
+            (DVec3::new(0.5, -1.0, 0.0), DVec3::new(3.0, 0.5, 1.0)),
+        );
+        let fixed = extent.fix(&RenderSettings::default());
+        assert_eq!(fixed.transfer_function.domain, Some((-1.0, 2.0)));
+        assert_eq!(
+            fixed.camera.bounds,
+            Some((DVec3::new(0.0, -1.0, 0.0), DVec3::new(3.0, 1.0, 1.0)))
+        );
+        // A window the user gave stays.
+        let mut given = RenderSettings::default();
+        given.transfer_function.domain = Some((0.0, 10.0));
+        assert_eq!(
+            extent.fix(&given).transfer_function.domain,
+            Some((0.0, 10.0))
+        );
+        // Constant volumes all alike keep no window.
+        let mut flat = Extent::default();
+        flat.add((3.0, 3.0), (DVec3::ZERO, DVec3::ONE));
+        flat.add((3.0, 3.0), (DVec3::ZERO, DVec3::ONE));
+        assert_eq!(
+            flat.fix(&RenderSettings::default())
+                .transfer_function
+                .domain,
+            None
+        );
+    }
+}
