@@ -9,6 +9,7 @@ mod error;
 mod generate;
 mod info;
 mod input;
+mod paper;
 mod render;
 
 use clap::Parser;
@@ -44,6 +45,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::Info(args) => info::run(args),
         Command::Generate(args) => generate::run(args),
+        Command::Paper(args) => paper::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
