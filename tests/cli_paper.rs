@@ -9,64 +9,35 @@ use std::path::Path;
 use volray_paper::montage::TriangleLayout;
 
 mod common;
-use common::{stderr, stdout, volray};
+use common::{Picture, stderr, stdout, volray};
 
 /// Quick panels are this many pixels square.
 const PANEL: usize = 40;
 
-/// An 8-bit RGB PNG as (width, height, rows of [r, g, b] in 0..=255).
-struct Rgb {
-    width: usize,
-    height: usize,
-    pixels: Vec<[u8; 3]>,
-}
-
-impl Rgb {
-    fn read(path: &Path) -> Rgb {
-        let decoder = png::Decoder::new(std::io::BufReader::new(fs::File::open(path).unwrap()));
-        let mut reader = decoder.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-        let info = reader.next_frame(&mut buf).unwrap();
-        assert_eq!(info.color_type, png::ColorType::Rgb);
-        assert_eq!(info.bit_depth, png::BitDepth::Eight);
-        let pixels = buf[..info.buffer_size()]
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        Rgb {
-            width: info.width as usize,
-            height: info.height as usize,
-            pixels,
-        }
-    }
-
-    fn get(&self, x: usize, y: usize) -> [u8; 3] {
-        self.pixels[x + self.width * y]
-    }
-
+impl Picture {
     /// The `side × side` block with its top-left corner at (x0, y0).
-    fn crop(&self, x0: usize, y0: usize, side: usize) -> Rgb {
+    fn crop(&self, x0: usize, y0: usize, side: usize) -> Picture {
         let pixels = (0..side)
             .flat_map(|y| (0..side).map(move |x| (x, y)))
-            .map(|(x, y)| self.get(x0 + x, y0 + y))
+            .map(|(x, y)| self.at(x0 + x, y0 + y))
             .collect();
-        Rgb {
+        Picture {
             width: side,
             height: side,
-            pixels,
+            rgb: pixels,
         }
     }
 
     /// Pixels that are not the black background.
     fn lit(&self) -> usize {
-        self.pixels.iter().filter(|p| **p != [0; 3]).count()
+        self.rgb.iter().filter(|p| **p != [0; 3]).count()
     }
 
     /// Brightness (mean of r, g, b) at a continuous position, bilinear
     /// between pixel centres ((x, y) = (0.5, 0.5) is pixel (0, 0)).
     fn brightness_at(&self, x: f64, y: f64) -> f64 {
         let value = |i: usize, j: usize| {
-            let p = self.get(i, j);
+            let p = self.at(i, j);
             (p[0] as f64 + p[1] as f64 + p[2] as f64) / 3.0
         };
         let (fx, fy) = (x - 0.5, y - 0.5);
@@ -92,7 +63,7 @@ fn layout() -> TriangleLayout {
 }
 
 /// Panel (l, m) of a montage.
-fn panel(montage: &Rgb, l: usize, m: usize) -> Rgb {
+fn panel(montage: &Picture, l: usize, m: usize) -> Picture {
     let (x, y) = layout().panel_origin(l, m);
     montage.crop(x, y, PANEL)
 }
@@ -100,7 +71,7 @@ fn panel(montage: &Rgb, l: usize, m: usize) -> Rgb {
 /// The largest spread of brightness around circles about the panel's
 /// centre (radii 2..=18 pixels, 48 angles each), over the panel's
 /// largest brightness: 0 for an image symmetric under every rotation.
-fn rotational_spread(panel: &Rgb) -> f64 {
+fn rotational_spread(panel: &Picture) -> f64 {
     let c = PANEL as f64 / 2.0;
     let peak = (0..PANEL)
         .flat_map(|y| (0..PANEL).map(move |x| (x, y)))
@@ -156,7 +127,7 @@ fn all_writes_the_five_figures_and_the_table() {
     }
     // Montages: 6 rows of 40-pixel panels, 4-pixel gaps, 11-pixel labels.
     for name in ["figure1a.png", "figure1b.png", "figure1c.png"] {
-        let image = Rgb::read(&out_dir.join(name));
+        let image = Picture::read(&out_dir.join(name));
         assert_eq!(
             (image.width, image.height),
             (4 + 6 * 44, 4 + 6 * 55),
@@ -164,7 +135,7 @@ fn all_writes_the_five_figures_and_the_table() {
         );
     }
     for name in ["figure2a.png", "figure2b.png"] {
-        let image = Rgb::read(&out_dir.join(name));
+        let image = Picture::read(&out_dir.join(name));
         assert_eq!((image.width, image.height), (96, 96), "{name}");
     }
 
@@ -221,7 +192,7 @@ fn all_writes_the_five_figures_and_the_table() {
 fn montage_has_the_paper_layout_and_every_panel_is_drawn() {
     let dir = tempfile::tempdir().unwrap();
     paper("figure1a", dir.path());
-    let montage = Rgb::read(&dir.path().join("figure1a.png"));
+    let montage = Picture::read(&dir.path().join("figure1a.png"));
     let layout = layout();
     let strip = layout.label_strip;
     for l in 0..6 {
@@ -231,7 +202,7 @@ fn montage_has_the_paper_layout_and_every_panel_is_drawn() {
             // The label strip above the panel.
             let label = (y - strip..y)
                 .flat_map(|yy| (x..x + PANEL).map(move |xx| (xx, yy)))
-                .filter(|&(xx, yy)| montage.get(xx, yy) != [0; 3])
+                .filter(|&(xx, yy)| montage.at(xx, yy) != [0; 3])
                 .count();
             if m <= l {
                 // A density fills a good part of its panel.
@@ -247,7 +218,7 @@ fn montage_has_the_paper_layout_and_every_panel_is_drawn() {
     // The gaps between cells are background.
     for y in 0..montage.height {
         for x in 0..4 {
-            assert_eq!(montage.get(x, y), [0; 3]);
+            assert_eq!(montage.at(x, y), [0; 3]);
         }
     }
 }
@@ -256,7 +227,7 @@ fn montage_has_the_paper_layout_and_every_panel_is_drawn() {
 fn l0_panel_is_rotationally_symmetric_seen_along_x() {
     let dir = tempfile::tempdir().unwrap();
     paper("figure1a", dir.path());
-    let montage = Rgb::read(&dir.path().join("figure1a.png"));
+    let montage = Picture::read(&dir.path().join("figure1a.png"));
     // |ψ_600|² is spherically symmetric: its image is the same on every
     // circle about the centre (to the grid's and the pixels' resolution).
     let s = panel(&montage, 0, 0);
@@ -273,16 +244,16 @@ fn the_two_views_differ() {
     let dir = tempfile::tempdir().unwrap();
     paper("figure1a", dir.path());
     paper("figure1b", dir.path());
-    let a = Rgb::read(&dir.path().join("figure1a.png"));
-    let b = Rgb::read(&dir.path().join("figure1b.png"));
+    let a = Picture::read(&dir.path().join("figure1a.png"));
+    let b = Picture::read(&dir.path().join("figure1b.png"));
     assert_eq!((a.width, a.height), (b.width, b.height));
     // Every non-spherical state looks different from the other view point.
     for (l, m) in [(1, 0), (2, 1), (3, 3), (5, 0), (5, 5)] {
         let (pa, pb) = (panel(&a, l, m), panel(&b, l, m));
         let differing = pa
-            .pixels
+            .rgb
             .iter()
-            .zip(&pb.pixels)
+            .zip(&pb.rgb)
             .filter(|(p, q)| p.iter().zip(q.iter()).any(|(u, v)| u.abs_diff(*v) > 8))
             .count();
         assert!(
@@ -294,13 +265,13 @@ fn the_two_views_differ() {
 
 /// Distance from the centre of `panel` to the edge of its lit region along
 /// direction `angle` (radians), in pixels.
-fn edge_radius(panel: &Rgb, angle: f64) -> f64 {
+fn edge_radius(panel: &Picture, angle: f64) -> f64 {
     let c = PANEL as f64 / 2.0;
     let mut r = 0.0;
     while r < c {
         let (x, y) = (c + (r + 0.1) * angle.cos(), c + (r + 0.1) * angle.sin());
         let (i, j) = (x.floor() as usize, y.floor() as usize);
-        if i >= PANEL || j >= PANEL || panel.get(i, j).iter().all(|&v| v < 8) {
+        if i >= PANEL || j >= PANEL || panel.at(i, j).iter().all(|&v| v < 8) {
             return r;
         }
         r += 0.1;
@@ -312,7 +283,7 @@ fn edge_radius(panel: &Rgb, angle: f64) -> f64 {
 fn the_surface_of_y00_is_a_disc_of_uniform_radius() {
     let dir = tempfile::tempdir().unwrap();
     paper("figure1c", dir.path());
-    let montage = Rgb::read(&dir.path().join("figure1c.png"));
+    let montage = Picture::read(&dir.path().join("figure1c.png"));
     let disc = panel(&montage, 0, 0);
     let radii: Vec<f64> = (0..72)
         .map(|k| edge_radius(&disc, k as f64 * std::f64::consts::TAU / 72.0))
@@ -345,20 +316,20 @@ fn the_two_clouds_differ() {
     let dir = tempfile::tempdir().unwrap();
     paper("figure2a", dir.path());
     paper("figure2b", dir.path());
-    let a = Rgb::read(&dir.path().join("figure2a.png"));
-    let b = Rgb::read(&dir.path().join("figure2b.png"));
+    let a = Picture::read(&dir.path().join("figure2a.png"));
+    let b = Picture::read(&dir.path().join("figure2b.png"));
     for cloud in [&a, &b] {
         // A cloud in the middle of a black sky.
         let share = cloud.lit() as f64 / (96.0 * 96.0);
         assert!((0.1..0.8).contains(&share), "lit share {share:.3}");
         for (x, y) in [(0, 0), (95, 0), (0, 95), (95, 95)] {
-            assert_eq!(cloud.get(x, y), [0; 3]);
+            assert_eq!(cloud.at(x, y), [0; 3]);
         }
     }
     let differing = a
-        .pixels
+        .rgb
         .iter()
-        .zip(&b.pixels)
+        .zip(&b.rgb)
         .filter(|(p, q)| p.iter().zip(q.iter()).any(|(u, v)| u.abs_diff(*v) > 8))
         .count();
     assert!(differing > 96 * 96 / 10, "only {differing} pixels differ");
