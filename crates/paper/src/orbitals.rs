@@ -45,8 +45,6 @@ use volray_core::{
     Camera, Fit, Image, Method, Phong, RenderSettings, Renderer, TransferFunction, Volume,
 };
 use volray_data::hydrogen::HydrogenParams;
-use volray_data::hydrogen::extent::{radial_tail, tail_rule};
-use volray_data::hydrogen::radial::Radial;
 
 use crate::PaperError;
 use crate::montage::{Panel, TriangleLayout};
@@ -124,31 +122,9 @@ pub fn states(n: u32) -> impl Iterator<Item = (u32, u32)> {
 /// inscribed ball holds at least.
 pub const ENCLOSED: f64 = 0.9;
 
-/// The radius (in `a₀`) inside which state `(n, l)` has the share
-/// `share` (0 < share < 1) of its radial probability: bisection on
-/// `volray-data`'s exact radial tail, as for its default extent.
-pub fn enclosing_radius(n: u32, l: u32, share: f64) -> f64 {
-    let radial = Radial::new(n, l).unwrap_or_else(|e| panic!("enclosing_radius: {e}"));
-    let rule = tail_rule();
-    let tail = |r: f64| radial_tail(&radial, &rule, r);
-    let target = 1.0 - share;
-    let (mut lo, mut hi) = (0.0, f64::from(n * n));
-    while tail(hi) > target {
-        lo = hi;
-        hi *= 2.0;
-    }
-    loop {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            return hi;
-        }
-        if tail(mid) > target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-}
+/// The radius inside which a state has a given share of its radial
+/// probability (`volray-data`'s bisection, as for its default extent).
+pub use volray_data::hydrogen::extent::enclosing_radius;
 
 /// The half width shared by all panels: the largest over `l` of the
 /// radius enclosing [`ENCLOSED`] of the radial probability, for principal

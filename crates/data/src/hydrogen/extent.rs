@@ -55,9 +55,16 @@ pub fn tail_rule() -> GaussLaguerre {
 /// `HydrogenParams::validate` first, or use
 /// `HydrogenParams::resolved_extent`.
 pub fn default_extent(n: u32, l: u32) -> f64 {
-    let radial = Radial::new(n, l).unwrap_or_else(|e| panic!("default_extent: {e}"));
+    enclosing_radius(n, l, CONTAINED_PROBABILITY)
+}
+
+/// The radius (in `a₀`) inside which state `(n, l)` has the share `share`
+/// (0 < share < 1) of its radial probability: bisection on the exact
+/// radial tail. Panics on an invalid `(n, l)`, as [`default_extent`].
+pub fn enclosing_radius(n: u32, l: u32, share: f64) -> f64 {
+    let radial = Radial::new(n, l).unwrap_or_else(|e| panic!("enclosing_radius: {e}"));
     let rule = tail_rule();
-    let target = 1.0 - CONTAINED_PROBABILITY;
+    let target = 1.0 - share;
     let tail = |r: f64| radial_tail(&radial, &rule, r);
     // The mean radius is n²(3 − l(l + 1)/n²)/2 ≤ 1.5 n²; grow from there.
     let mut hi = 1.5 * f64::from(n * n);
