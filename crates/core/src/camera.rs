@@ -166,7 +166,7 @@ impl Camera {
     }
 }
 
-fn check_size(width: usize, height: usize) -> Result<(), CameraError> {
+pub(crate) fn check_size(width: usize, height: usize) -> Result<(), CameraError> {
     if width == 0 || height == 0 {
         return Err(CameraError::EmptyImage { width, height });
     }

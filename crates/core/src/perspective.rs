@@ -17,7 +17,7 @@
 //! from the view reference, so with the default one (the box's centre) the
 //! framing does not change as the camera orbits.
 
-use crate::camera::{Camera, CameraError, Projection};
+use crate::camera::{Camera, CameraError, Projection, check_size};
 use crate::pose::Pose;
 use glam::DVec3;
 
@@ -50,9 +50,7 @@ impl PerspectiveView {
         height: usize,
     ) -> Result<Self, CameraError> {
         camera.validate()?;
-        if width == 0 || height == 0 {
-            return Err(CameraError::EmptyImage { width, height });
-        }
+        check_size(width, height)?;
         let Projection::Perspective { fov_degrees } = camera.projection else {
             return Err(CameraError::WrongProjection {
                 camera: "orthographic",
