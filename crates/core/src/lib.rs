@@ -40,11 +40,11 @@
 //!   the occupied cells only, with early ray termination, in parallel over
 //!   tiles. The paths agree within 1/255 per channel; the fast path is
 //!   bit-identical for any thread count. `docs/performance.md` records the
-//!   design and what each step bought. The fast path renders orthographic,
-//!   composited, pre-classified frames (with any crop, clip planes and
-//!   jitter), and [`intensity`] the projection blend modes fast; the
-//!   reference renders every option, and [`Renderer::path_for`] sends it
-//!   the frames the fast paths cannot.
+//!   design and what each step bought. The fast path renders composited,
+//!   pre-classified frames of either projection (with any crop, clip
+//!   planes and jitter), and [`intensity`] the projection blend modes fast;
+//!   the reference renders every option, and [`Renderer::path_for`] sends
+//!   it the frames the fast paths cannot (post-classified compositing).
 //! - [`render`] ties it together; [`image`] is the RGBA `f32` result.
 //!
 //! ```

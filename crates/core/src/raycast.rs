@@ -1,16 +1,27 @@
 //! The fast path's stage 2: the reference's samples, composited front to
-//! back, visiting only the occupied cells, in parallel over image tiles.
+//! back, visiting only the occupied cells, in parallel over image tiles,
+//! for orthographic and perspective views.
 //!
 //! For each pixel the ray walks its tile's list of occupied bricks (see
 //! [`crate::tiles`]) front to back. In each brick it finds the samples `k`
-//! (the same global planes `t = k·step` as the reference, see
-//! [`crate::ray`]) whose positions lie in the box of the brick's occupied
-//! cells, and for each sample in an occupied cell it interpolates the
-//! brick's lit voxels (see [`crate::shade_bricks`]) trilinearly and
-//! composites. Everything else contributes exactly nothing: a sample
-//! outside these boxes, or in a cell whose eight corners are transparent,
-//! has opacity 0. A sample on a face shared by two bricks is taken once, by
-//! the first.
+//! (the same as the reference's, see [`crate::sampling`]: `t = k·step`
+//! from the image plane for parallel rays, from the eye in perspective)
+//! whose positions lie in the box of the brick's occupied cells, and for
+//! each sample in an occupied cell it interpolates the brick's lit voxels
+//! (see [`crate::shade_bricks`]) trilinearly and composites. Everything
+//! else contributes exactly nothing: a sample outside these boxes, or in a
+//! cell whose eight corners are transparent, has opacity 0. A sample on a
+//! face shared by two bricks is taken once, by the first.
+//!
+//! **Rays.** Parallel rays share one index-space step between samples and
+//! start on the image plane. Perspective rays each have their own step
+//! (along the pixel's direction from the eye, as [`View::pixel_ray`] gives
+//! it) and take only the samples ahead of the eye (`t ≥ 0`, as the
+//! reference). Positions are `f32`; so that an eye far from the volume
+//! costs no precision, a perspective ray counts its samples from a base
+//! sample near the volume's centre (its `t = 0` point is moved there).
+//! The parallel rays' code is the same code with the shared step
+//! (monomorphised: it pays nothing for the per-ray case).
 //!
 //! With a crop box or clip planes, or jitter, the samples are still the
 //! reference's ([`crate::sampling`]): each ray's exact range of samples
@@ -31,7 +42,7 @@
 //! lanes); the eight corners of a cell are eight 16-byte loads.
 
 use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
-use crate::camera::OrthographicView;
+use crate::camera::View;
 use crate::classified::ClassifiedBricks;
 use crate::image::Image;
 use crate::jitter;
@@ -68,197 +79,68 @@ struct CellBox {
 /// One frame's rays, in the index space of the grid.
 struct Rays<'a> {
     sampling: &'a Sampling,
-    view: &'a OrthographicView,
+    view: &'a View,
     /// Whether every brick, not just the boundary ones, needs the rays'
     /// exact ranges (something is cut away).
     clipped: bool,
-    /// Index-space point on the image plane (`t = 0`) of pixel (0, 0), and
-    /// its change per column and per row.
-    corner: DVec3,
-    per_col: DVec3,
-    per_row: DVec3,
+    geometry: Geometry,
+    background: [f32; 3],
+}
+
+/// Where the rays start and which way they run.
+enum Geometry {
+    /// Orthographic: parallel rays from the image plane.
+    Parallel {
+        /// Index-space point on the image plane (`t = 0`) of pixel (0, 0),
+        /// and its change per column and per row.
+        corner: DVec3,
+        per_col: DVec3,
+        per_row: DVec3,
+        /// Every ray's step from one sample to the next.
+        stepping: Stepping,
+        /// The same in `f64`, for the jitter.
+        delta: DVec3,
+    },
+    /// Perspective: rays from the eye, each with its own step.
+    FromEye {
+        /// The centre of the grid, in world units: each ray counts its
+        /// samples from the one nearest to where it passes the centre.
+        centre: DVec3,
+    },
+}
+
+/// How one ray steps from sample to sample, in index space.
+#[derive(Debug, Clone, Copy)]
+struct Stepping {
     /// Index-space displacement from one sample to the next.
     delta: f32x4,
-    /// The same in `f64`, for the jitter.
-    delta_f64: DVec3,
     /// `1/delta` per axis, 0 where `delta` is 0 (lane 3: 0).
     inv_delta: f32x4,
-    /// All bits set in the lanes of the axes the rays are parallel to, and
+    /// All bits set in the lanes of the axes the ray is parallel to, and
     /// in lane 3.
     parallel: f32x4,
-    background: [f32; 3],
+    /// The reference's number of this ray's sample 0: sample numbers here
+    /// are counted from it.
+    base: i64,
 }
 
-/// Everything a ray reads.
-struct Scene<'a> {
-    boxes: Vec<CellBox>,
-    cells: &'a [[u64; 8]],
-    lit: &'a LitBricks,
-    lighting: &'a Lighting<'a>,
-}
-
-/// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
-/// as the rays reach them (see [`crate::shade_bricks`]), binned into
-/// `bins`, through `view` with samples where `sampling` says, into
-/// `image` (`view.width × view.height`). `progress` is called with the
-/// number of pixels finished, a tile at a time.
-#[allow(clippy::too_many_arguments)]
-pub fn render(
-    bricks: &ClassifiedBricks,
-    lit: &LitBricks,
-    lighting: &Lighting,
-    bins: &TileBins,
-    sampling: &Sampling,
-    view: &OrthographicView,
-    background: [f32; 3],
-    image: &mut Image,
-    progress: &(dyn Fn(usize) + Sync),
-) {
-    assert_eq!((image.width(), image.height()), (view.width, view.height));
-    let scene = Scene {
-        boxes: (0..bricks.len()).map(|n| cell_box(bricks, n)).collect(),
-        cells: &bricks.cells,
-        lit,
-        lighting,
+impl Stepping {
+    const EMPTY: Stepping = Stepping {
+        delta: f32x4::ZERO,
+        inv_delta: f32x4::ZERO,
+        parallel: f32x4::ZERO,
+        base: 0,
     };
-    let rays = Rays::new(sampling, view, background);
-    // Each tile's rows, as slices of the image rows: the tiles are then
-    // independent pieces of work, small enough to balance the threads.
-    let mut tiles: Vec<Vec<&mut [[f32; 4]]>> = (0..bins.tiles_x * bins.tiles_y)
-        .map(|_| Vec::with_capacity(TILE))
-        .collect();
-    for (row, pixels) in image.pixels_mut().chunks_mut(view.width).enumerate() {
-        for (tx, segment) in pixels.chunks_mut(TILE).enumerate() {
-            tiles[(row / TILE) * bins.tiles_x + tx].push(segment);
-        }
-    }
-    tiles.into_par_iter().enumerate().for_each(|(t, mut rows)| {
-        let (tx, ty) = (t % bins.tiles_x, t / bins.tiles_x);
-        rays.tile(&scene, bins.list(tx, ty), tx, ty, &mut rows);
-        progress(rows.iter().map(|r| r.len()).sum());
-    });
-}
 
-/// Index-space coordinates as SIMD lanes (the last one 0).
-fn lanes(v: [usize; 3]) -> f32x4 {
-    f32x4::new([v[0] as f32, v[1] as f32, v[2] as f32, 0.0])
-}
-
-fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
-    let b = bricks.occupied[n];
-    let origin = lanes(bricks.grid.origin(b));
-    let (lo, hi) = bricks.occupied_box(n);
-    CellBox {
-        origin,
-        lo: lanes(lo) - origin,
-        hi: lanes(hi) - origin,
-        boundary: bricks.grid.touches_boundary(b),
-    }
-}
-
-impl<'a> Rays<'a> {
-    fn new(sampling: &'a Sampling, view: &'a OrthographicView, bg: [f32; 3]) -> Self {
-        let grid = &sampling.grid;
-        let to_index = |world: DVec3| (world - grid.origin) / grid.spacing;
-        let delta_f64 = view.direction * sampling.step / grid.spacing;
-        let delta = delta_f64.as_vec3();
+    fn new(delta: DVec3, base: i64) -> Self {
+        let delta = delta.as_vec3();
         let inv = |d: f32| if d == 0.0 { 0.0 } else { 1.0 / d };
         let mask = |d: f32| if d == 0.0 { f32::from_bits(!0) } else { 0.0 };
-        Rays {
-            sampling,
-            view,
-            clipped: sampling.clipping.is_active(),
-            corner: to_index(view.pixel_centre(0, 0)),
-            per_col: view.right * view.pixel_size / grid.spacing,
-            per_row: -view.up * view.pixel_size / grid.spacing,
+        Stepping {
             delta: f32x4::new([delta.x, delta.y, delta.z, 0.0]),
-            delta_f64,
             inv_delta: f32x4::new([inv(delta.x), inv(delta.y), inv(delta.z), 0.0]),
             parallel: f32x4::new([mask(delta.x), mask(delta.y), mask(delta.z), mask(0.0)]),
-            background: bg,
-        }
-    }
-
-    /// Renders tile (`tx`, `ty`), whose bricks are `list`, into `rows`
-    /// (its rows of pixels, top to bottom).
-    ///
-    /// Brick by brick, every ray of the tile crosses the brick before the
-    /// next brick is touched: the brick's voxels are loaded into the cache
-    /// once for all the tile's rays. Each ray still takes its bricks front
-    /// to back, so its arithmetic is that of a ray cast on its own.
-    fn tile(
-        &self,
-        scene: &Scene,
-        list: &[u32],
-        tx: usize,
-        ty: usize,
-        rows: &mut [&mut [[f32; 4]]],
-    ) {
-        let cols = tx * TILE..tx * TILE + rows[0].len();
-        let row_count = rows.len();
-        let mut states = [RayState::EMPTY; TILE * TILE];
-        let states = &mut states[..cols.len() * row_count];
-        if !list.is_empty() {
-            for (i, state) in states.iter_mut().enumerate() {
-                let (col, row) = (cols.start + i % cols.len(), ty * TILE + i / cols.len());
-                let mut o = self.corner + self.per_col * col as f64 + self.per_row * row as f64;
-                if self.sampling.jitter {
-                    // Sample k at t = (k + u)·step: move the t = 0 point.
-                    o += jitter::offset(col, row) * self.delta_f64;
-                }
-                *state = RayState {
-                    origin: f32x4::new([o.x as f32, o.y as f32, o.z as f32, 0.0]),
-                    ..RayState::EMPTY
-                };
-            }
-        }
-        for &n in list {
-            let b = &scene.boxes[n as usize];
-            let lit = scene.lit.get(n as usize, scene.lighting);
-            let cells = &scene.cells[n as usize];
-            for (i, state) in states.iter_mut().enumerate() {
-                if state.done {
-                    continue;
-                }
-                let local = state.origin - b.origin;
-                let Some((first, mut last)) = self.samples_in(b, local) else {
-                    continue;
-                };
-                let mut first = first.max(state.next);
-                if b.boundary || self.clipped {
-                    let (col, row) = (cols.start + i % cols.len(), ty * TILE + i / cols.len());
-                    let range = *state.exact.get_or_insert_with(|| {
-                        let (origin, direction) =
-                            (self.view.pixel_centre(col, row), self.view.direction);
-                        self.sampling
-                            .ray(col, row, origin, direction)
-                            .map(|r| (r.first as i32, r.last as i32))
-                    });
-                    let Some((f, l)) = range else {
-                        // The ray misses the volume: it has no samples.
-                        state.done = true;
-                        continue;
-                    };
-                    (first, last) = (first.max(f), last.min(l));
-                }
-                if first > last {
-                    continue;
-                }
-                state.next = last + 1;
-                let segment = Segment {
-                    origin: local,
-                    delta: self.delta,
-                    lo: b.lo,
-                    hi: b.hi,
-                    first,
-                    last,
-                };
-                state.done = march(&mut state.acc, lit.voxels(), cells, &segment);
-            }
-        }
-        for (i, state) in states.iter().enumerate() {
-            let (c, r) = (i % cols.len(), i / cols.len());
-            rows[r][c] = state.acc.finish(self.background).to_array();
+            base,
         }
     }
 
@@ -289,6 +171,287 @@ impl<'a> Rays<'a> {
         let first = ceil_i32(lo - SAMPLE_SLACK);
         let last = floor_i32(hi + SAMPLE_SLACK);
         (first <= last).then_some((first, last))
+    }
+}
+
+/// The steppings of a tile's rays: one for all (parallel rays) or one per
+/// ray (perspective), ray `i` in row-major order within the tile.
+trait Steppings {
+    fn of(&self, i: usize) -> &Stepping;
+}
+
+/// One stepping for every ray.
+struct Shared(Stepping);
+
+impl Steppings for Shared {
+    #[inline]
+    fn of(&self, _: usize) -> &Stepping {
+        &self.0
+    }
+}
+
+impl Steppings for [Stepping] {
+    #[inline]
+    fn of(&self, i: usize) -> &Stepping {
+        &self[i]
+    }
+}
+
+/// Everything a ray reads.
+struct Scene<'a> {
+    boxes: Vec<CellBox>,
+    cells: &'a [[u64; 8]],
+    lit: &'a LitBricks,
+    lighting: &'a Lighting<'a>,
+}
+
+/// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
+/// as the rays reach them (see [`crate::shade_bricks`]), binned into
+/// `bins`, through `view` (either projection) with samples where
+/// `sampling` says, into `image` (the view's size). `progress` is called
+/// with the number of pixels finished, a tile at a time.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    bricks: &ClassifiedBricks,
+    lit: &LitBricks,
+    lighting: &Lighting,
+    bins: &TileBins,
+    sampling: &Sampling,
+    view: &View,
+    background: [f32; 3],
+    image: &mut Image,
+    progress: &(dyn Fn(usize) + Sync),
+) {
+    let width = view.width();
+    assert_eq!((image.width(), image.height()), (width, view.height()));
+    let scene = Scene {
+        boxes: (0..bricks.len()).map(|n| cell_box(bricks, n)).collect(),
+        cells: &bricks.cells,
+        lit,
+        lighting,
+    };
+    let rays = Rays::new(sampling, view, background);
+    // Each tile's rows, as slices of the image rows: the tiles are then
+    // independent pieces of work, small enough to balance the threads.
+    let mut tiles: Vec<Vec<&mut [[f32; 4]]>> = (0..bins.tiles_x * bins.tiles_y)
+        .map(|_| Vec::with_capacity(TILE))
+        .collect();
+    for (row, pixels) in image.pixels_mut().chunks_mut(width).enumerate() {
+        for (tx, segment) in pixels.chunks_mut(TILE).enumerate() {
+            tiles[(row / TILE) * bins.tiles_x + tx].push(segment);
+        }
+    }
+    tiles.into_par_iter().enumerate().for_each(|(t, mut rows)| {
+        let (tx, ty) = (t % bins.tiles_x, t / bins.tiles_x);
+        rays.tile(&scene, bins.list(tx, ty), tx, ty, &mut rows);
+        progress(rows.iter().map(|r| r.len()).sum());
+    });
+}
+
+/// Index-space coordinates as SIMD lanes (the last one 0).
+fn lanes(v: [usize; 3]) -> f32x4 {
+    f32x4::new([v[0] as f32, v[1] as f32, v[2] as f32, 0.0])
+}
+
+fn to_lanes(v: DVec3) -> f32x4 {
+    f32x4::new([v.x as f32, v.y as f32, v.z as f32, 0.0])
+}
+
+fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
+    let b = bricks.occupied[n];
+    let origin = lanes(bricks.grid.origin(b));
+    let (lo, hi) = bricks.occupied_box(n);
+    CellBox {
+        origin,
+        lo: lanes(lo) - origin,
+        hi: lanes(hi) - origin,
+        boundary: bricks.grid.touches_boundary(b),
+    }
+}
+
+/// A sample number counted from a ray's base, as the `i32` the ray caster
+/// counts in (a ray has at most [`crate::render::MAX_SAMPLES_PER_RAY`]
+/// samples in the grid, and its base is near them).
+fn relative(k: i64, base: i64) -> i32 {
+    (k.saturating_sub(base)).clamp(i32::MIN as i64, i32::MAX as i64) as i32
+}
+
+impl<'a> Rays<'a> {
+    fn new(sampling: &'a Sampling, view: &'a View, background: [f32; 3]) -> Self {
+        let grid = &sampling.grid;
+        let geometry = match view {
+            View::Orthographic(v) => {
+                let to_index = |world: DVec3| (world - grid.origin) / grid.spacing;
+                let delta = v.direction * sampling.step / grid.spacing;
+                Geometry::Parallel {
+                    corner: to_index(v.pixel_centre(0, 0)),
+                    per_col: v.right * v.pixel_size / grid.spacing,
+                    per_row: -v.up * v.pixel_size / grid.spacing,
+                    stepping: Stepping::new(delta, 0),
+                    delta,
+                }
+            }
+            View::Perspective(_) => {
+                let extent = DVec3::new(
+                    (grid.dims[0] - 1) as f64,
+                    (grid.dims[1] - 1) as f64,
+                    (grid.dims[2] - 1) as f64,
+                ) * grid.spacing;
+                Geometry::FromEye {
+                    centre: grid.origin + 0.5 * extent,
+                }
+            }
+        };
+        Rays {
+            sampling,
+            view,
+            clipped: sampling.clipping.is_active(),
+            geometry,
+            background,
+        }
+    }
+
+    /// Renders tile (`tx`, `ty`), whose bricks are `list`, into `rows`
+    /// (its rows of pixels, top to bottom).
+    fn tile(
+        &self,
+        scene: &Scene,
+        list: &[u32],
+        tx: usize,
+        ty: usize,
+        rows: &mut [&mut [[f32; 4]]],
+    ) {
+        let cols = tx * TILE..tx * TILE + rows[0].len();
+        let count = cols.len() * rows.len();
+        let pixel = |i: usize| (cols.start + i % cols.len(), ty * TILE + i / cols.len());
+        let mut states = [RayState::EMPTY; TILE * TILE];
+        let states = &mut states[..count];
+        match self.geometry {
+            Geometry::Parallel {
+                corner,
+                per_col,
+                per_row,
+                stepping,
+                delta,
+            } => {
+                if !list.is_empty() {
+                    for (i, state) in states.iter_mut().enumerate() {
+                        let (col, row) = pixel(i);
+                        let mut o = corner + per_col * col as f64 + per_row * row as f64;
+                        if self.sampling.jitter {
+                            // Sample k at t = (k + u)·step: move the t = 0 point.
+                            o += jitter::offset(col, row) * delta;
+                        }
+                        state.origin = to_lanes(o);
+                    }
+                }
+                self.cast(scene, list, &pixel, states, &Shared(stepping));
+            }
+            Geometry::FromEye { centre } => {
+                let mut steppings = [Stepping::EMPTY; TILE * TILE];
+                let steppings = &mut steppings[..count];
+                if !list.is_empty() {
+                    for (i, (state, stepping)) in
+                        states.iter_mut().zip(steppings.iter_mut()).enumerate()
+                    {
+                        let (col, row) = pixel(i);
+                        (*state, *stepping) = self.ray_from_eye(col, row, centre);
+                    }
+                }
+                self.cast(scene, list, &pixel, states, &*steppings);
+            }
+        }
+        for (i, state) in states.iter().enumerate() {
+            let (c, r) = (i % cols.len(), i / cols.len());
+            rows[r][c] = state.acc.finish(self.background).to_array();
+        }
+    }
+
+    /// The start and the stepping of pixel (`col`, `row`)'s perspective ray:
+    /// the reference's ray ([`View::pixel_ray`]), its samples counted from
+    /// the one nearest to where the ray passes `centre`, and none behind
+    /// the eye.
+    fn ray_from_eye(&self, col: usize, row: usize, centre: DVec3) -> (RayState, Stepping) {
+        let (grid, step) = (&self.sampling.grid, self.sampling.step);
+        let (eye, direction) = self.view.pixel_ray(col, row);
+        let offset = if self.sampling.jitter {
+            jitter::offset(col, row)
+        } else {
+            0.0
+        };
+        let base = ((centre - eye).dot(direction).max(0.0) / step).floor() as i64;
+        let delta = direction * step / grid.spacing;
+        let origin = (eye - grid.origin) / grid.spacing + (base as f64 + offset) * delta;
+        // The first sample at t ≥ 0, exactly as `Sampling::ray` finds it
+        // for a ray whose interval starts at the eye.
+        let tolerance = 1e-6 * step;
+        let first = ((0.0 - tolerance) / step - offset).ceil() as i64;
+        let state = RayState {
+            origin: to_lanes(origin),
+            next: relative(first, base),
+            ..RayState::EMPTY
+        };
+        (state, Stepping::new(delta, base))
+    }
+
+    /// Casts the rays of one tile, whose bricks are `list`, from their
+    /// `states` (ray `i` is pixel `pixel(i)`, stepping `steppings.of(i)`).
+    ///
+    /// Brick by brick, every ray of the tile crosses the brick before the
+    /// next brick is touched: the brick's voxels are loaded into the cache
+    /// once for all the tile's rays. Each ray still takes its bricks front
+    /// to back, so its arithmetic is that of a ray cast on its own.
+    fn cast<S: Steppings + ?Sized>(
+        &self,
+        scene: &Scene,
+        list: &[u32],
+        pixel: &impl Fn(usize) -> (usize, usize),
+        states: &mut [RayState],
+        steppings: &S,
+    ) {
+        for &n in list {
+            let b = &scene.boxes[n as usize];
+            let lit = scene.lit.get(n as usize, scene.lighting);
+            let cells = &scene.cells[n as usize];
+            for (i, state) in states.iter_mut().enumerate() {
+                if state.done {
+                    continue;
+                }
+                let stepping = steppings.of(i);
+                let local = state.origin - b.origin;
+                let Some((first, mut last)) = stepping.samples_in(b, local) else {
+                    continue;
+                };
+                let mut first = first.max(state.next);
+                if b.boundary || self.clipped {
+                    let range = *state.exact.get_or_insert_with(|| {
+                        let (col, row) = pixel(i);
+                        let base = stepping.base;
+                        (self.sampling.pixel(self.view, col, row))
+                            .map(|r| (relative(r.first, base), relative(r.last, base)))
+                    });
+                    let Some((f, l)) = range else {
+                        // The ray misses the volume: it has no samples.
+                        state.done = true;
+                        continue;
+                    };
+                    (first, last) = (first.max(f), last.min(l));
+                }
+                if first > last {
+                    continue;
+                }
+                state.next = last + 1;
+                let segment = Segment {
+                    origin: local,
+                    delta: stepping.delta,
+                    lo: b.lo,
+                    hi: b.hi,
+                    first,
+                    last,
+                };
+                state.done = march(&mut state.acc, lit.voxels(), cells, &segment);
+            }
+        }
     }
 }
 
@@ -361,10 +524,12 @@ fn march(
 /// A ray of a tile, between bricks.
 #[derive(Clone, Copy)]
 struct RayState {
-    /// Index-space point on the image plane (`t = 0`).
+    /// Index-space position of the ray's sample 0 (for parallel rays on
+    /// the image plane, `t = 0`; see [`Stepping::base`]).
     origin: f32x4,
     acc: Accumulator,
-    /// The first sample not yet taken.
+    /// The first sample not yet taken (a perspective ray's first is the
+    /// first ahead of the eye).
     next: i32,
     /// The ray's exact samples (as the reference finds them), found when
     /// first needed, in a brick on the volume's boundary (or in any brick
@@ -416,7 +581,8 @@ impl Accumulator {
 /// `⌈x⌉` and `⌊x⌋` for `|x| < 2³¹` without a library call (SSE2 has no
 /// rounding instruction). Sample numbers are far smaller: a ray has at most
 /// [`crate::render::MAX_SAMPLES_PER_RAY`] samples on either side of the
-/// image plane.
+/// image plane (of its base sample, in perspective, which lies level with
+/// the grid's centre).
 #[inline]
 fn ceil_i32(x: f32) -> i32 {
     let t = x as i32;

@@ -7,16 +7,16 @@
 //! the rays, lighting each brick as the rays first reach it.
 //!
 //! **Routing.** [`Method::Fast`] asks for the fast paths: the bricked ray
-//! caster ([`crate::raycast`]) renders orthographic views composited from
+//! caster ([`crate::raycast`]) renders views composited from
 //! pre-classified voxels (the paper's method), and [`crate::intensity`]
-//! renders the projection blend modes (maximum, minimum, average) for
-//! either projection; both take any crop box, clip planes and jitter.
-//! What neither can render, perspective or post-classified compositing,
-//! runs on the reference path ([`crate::reference`]), which renders every
-//! option. [`Renderer::path_for`] says which path a frame takes.
+//! renders the projection blend modes (maximum, minimum, average); both
+//! take either projection and any crop box, clip planes and jitter. What
+//! neither can render, post-classified compositing, runs on the reference
+//! path ([`crate::reference`]), which renders every option.
+//! [`Renderer::path_for`] says which path a frame takes.
 
 use crate::blend::Blend;
-use crate::camera::{Camera, CameraError, Projection, View};
+use crate::camera::{Camera, CameraError, View};
 use crate::classified::ClassifiedBricks;
 use crate::classify::Classifier;
 use crate::clipping::{ClipPlane, Clipping};
@@ -333,13 +333,12 @@ impl<'v> Renderer<'v> {
     }
 
     /// The path a frame with `settings` runs on: a fast path when asked
-    /// for and one can (an orthographic view composited from
+    /// for and one can (a view of either projection composited from
     /// pre-classified voxels, or any projection blend mode), else the
     /// reference path, which renders every option.
     pub fn path_for(settings: &RenderSettings) -> Method {
-        let fast_can = settings.blend.is_projection()
-            || (matches!(settings.camera.projection, Projection::Orthographic)
-                && settings.classification == Classification::Pre);
+        let fast_can =
+            settings.blend.is_projection() || settings.classification == Classification::Pre;
         if settings.method == Method::Fast && fast_can {
             Method::Fast
         } else {
@@ -557,9 +556,7 @@ impl<'v> Renderer<'v> {
         }
         let state = guard.as_mut().expect("the state was just made");
         let t1 = Instant::now();
-        let view =
-            (frame.view.as_orthographic()).expect("the fast path renders orthographic views");
-        let bins = TileBins::new(&state.bricks, &frame.sampling, view);
+        let bins = TileBins::new(&state.bricks, &frame.sampling, &frame.view);
         let t2 = Instant::now();
         let light = Self::light(settings, &frame.view);
         let lighting = Lighting::new(
@@ -575,7 +572,7 @@ impl<'v> Renderer<'v> {
             &lighting,
             &bins,
             &frame.sampling,
-            view,
+            &frame.view,
             settings.background,
             image,
             progress,

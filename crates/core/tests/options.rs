@@ -776,7 +776,8 @@ fn perspective_shows_a_near_ball_larger_than_the_same_ball_far_away() {
             },
             ..RenderSettings::default()
         };
-        // Perspective runs on the reference path, whichever is asked for.
+        // Post-classified compositing runs on the reference path, whichever
+        // is asked for.
         assert_eq!(Renderer::path_for(&settings), Method::Reference);
         let image = renderer.render(&settings).unwrap();
         assert!(image == renderer.render(&reference(&settings)).unwrap());
@@ -816,6 +817,15 @@ fn frames_go_to_the_path_that_can_render_them() {
         ..fast.clone()
     };
     assert_eq!(Renderer::path_for(&cut_and_jittered), Method::Fast);
+    // Perspective compositing too (tests/perspective_fast.rs).
+    let perspective = RenderSettings {
+        camera: Camera {
+            projection: Projection::Perspective { fov_degrees: 30.0 },
+            ..Camera::default()
+        },
+        ..cut_and_jittered
+    };
+    assert_eq!(Renderer::path_for(&perspective), Method::Fast);
     // The projections have their own fast path, for both projections.
     for blend in [Blend::Maximum, Blend::Minimum, Blend::Average] {
         let settings = RenderSettings {
@@ -836,13 +846,11 @@ fn frames_go_to_the_path_that_can_render_them() {
             ..fast.clone()
         },
         RenderSettings {
-            camera: Camera {
-                projection: Projection::Perspective { fov_degrees: 30.0 },
-                ..Camera::default()
-            },
-            ..fast.clone()
+            classification: Classification::Post,
+            ..perspective.clone()
         },
         reference(&fast),
+        reference(&perspective),
     ] {
         assert_eq!(Renderer::path_for(&settings), Method::Reference);
     }
