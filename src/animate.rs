@@ -72,6 +72,10 @@ pub fn series(
         let renderer = Renderer::new(&input.volume)
             .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
         extent.add(renderer.value_range(), input.volume.bounds());
+        if base.gradient_opacity.is_some() {
+            let max = pool.install(|| renderer.max_gradient());
+            extent.max_gradient = extent.max_gradient.max(max);
+        }
     }
     let settings = extent.fix(base);
 
@@ -94,11 +98,13 @@ fn load_one(args: &RenderArgs, spec: &str) -> Result<crate::input::Input, CliErr
     load(&input, args.view.log)
 }
 
-/// The value range and the bounds of the volumes seen so far.
+/// The value range, the bounds and (for gradient opacity) the largest
+/// gradient magnitude of the volumes seen so far.
 #[derive(Debug, Default, Clone, Copy, PartialEq)]
 struct Extent {
     range: Option<(f32, f32)>,
     bounds: Option<(DVec3, DVec3)>,
+    max_gradient: f32,
 }
 
 impl Extent {
@@ -116,7 +122,7 @@ impl Extent {
     /// `base` with one value window and one framed box for every volume:
     /// the window is the union of the ranges unless the transfer function
     /// fixes one (`--range`, `--tf`, a CT preset); the box is the union of
-    /// the bounds. Volumes that are all the same constant keep no window
+    /// the bounds; gradient opacity is relative to the largest gradient. Volumes that are all the same constant keep no window
     /// (each one's own range is then that constant).
     fn fix(&self, base: &RenderSettings) -> RenderSettings {
         let mut settings = base.clone();
@@ -128,6 +134,11 @@ impl Extent {
         }
         if settings.camera.bounds.is_none() {
             settings.camera.bounds = self.bounds;
+        }
+        // Gradient opacity relative to the steepest volume of all, so that
+        // one gradient magnitude gets one opacity in every frame.
+        if settings.gradient_opacity.is_some() && self.max_gradient > 0.0 {
+            settings.gradient_opacity_max = Some(self.max_gradient);
         }
         settings
     }

@@ -382,6 +382,7 @@ pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
         crop: view.crop.map(|(lo, hi)| (DVec3::from(lo), DVec3::from(hi))),
         iso: iso(view)?,
         gradient_opacity: view.gradient_opacity,
+        gradient_opacity_max: None,
     };
     settings
         .validate()

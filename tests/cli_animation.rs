@@ -258,6 +258,67 @@ fn a_series_is_one_frame_per_file_under_one_transfer_function() {
     );
 }
 
+/// The 9³ paraboloid ball 1 − (r/4)² times `scale`, as a raw f32 file:
+/// its gradient grows from 0 at the centre to the largest at r = 4.
+fn paraboloid(dir: &Path, name: &str, scale: f32) -> String {
+    let mut values = Vec::new();
+    for k in 0..9 {
+        for j in 0..9 {
+            for i in 0..9 {
+                let d = |n: i32| (n - 4) as f32 / 4.0;
+                let r2 = d(i) * d(i) + d(j) * d(j) + d(k) * d(k);
+                values.push(scale * (1.0 - r2).max(0.0));
+            }
+        }
+    }
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let p = dir.join(name);
+    fs::write(&p, bytes).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn a_series_shares_its_gradient_opacity_scale() {
+    // Volume 2 is volume 1 doubled, so its largest gradient is twice
+    // volume 1's. In the series, --gradient-opacity fractions are of
+    // volume 2's largest gradient: volume 1's frame equals volume 1 alone
+    // with the fractions doubled (of its own largest gradient) and the
+    // same value window.
+    let dir = tempfile::tempdir().unwrap();
+    let one = paraboloid(dir.path(), "one.raw", 1.0);
+    let two = paraboloid(dir.path(), "two.raw", 2.0);
+    let raw = ["--dims", "9,9,9", "--size", "24", "--no-shading"];
+    let out = path(dir.path(), "series.png");
+    let go = ["--gradient-opacity", "0.2,0.5"];
+    run_ok(
+        &[
+            &["render", &one, &two][..],
+            &raw[..],
+            &go[..],
+            &["-o", out.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    let (_, frames, _) = read_apng(&out);
+    let alone = |fractions: &str, name: &str| {
+        let still = path(dir.path(), name);
+        run_ok(
+            &[
+                &["render", &one][..],
+                &raw[..],
+                &["--range", "0,2", "--gradient-opacity", fractions],
+                &["-o", still.to_str().unwrap()],
+            ]
+            .concat(),
+        );
+        read_png(&still)
+    };
+    assert!(max_diff(&alone("0.4,1", "doubled.png"), &frames[0]) <= 1);
+    // Its own scale would give another picture.
+    let own = max_diff(&alone("0.2,0.5", "own.png"), &frames[0]);
+    assert!(own > 8, "{own}");
+}
+
 /// A NRRD file of the 9³ ball 1 − r/4 with its first voxel at `origin`.
 fn ball_nrrd(dir: &Path, name: &str, origin: [f64; 3]) -> String {
     let mut data = Vec::new();

@@ -110,6 +110,11 @@ pub struct RenderSettings {
     /// Opacity times a ramp of `|∇f|` from 0 at `LO` to 1 at `HI`,
     /// fractions of the volume's largest gradient magnitude (`None`: off).
     pub gradient_opacity: Option<(f32, f32)>,
+    /// The gradient magnitude (world units) the `gradient_opacity`
+    /// fractions are fractions of; `None`: the volume's own largest. A
+    /// series of volumes shares the largest of them all, as it shares one
+    /// value window.
+    pub gradient_opacity_max: Option<f32>,
 }
 
 impl Default for RenderSettings {
@@ -133,6 +138,7 @@ impl Default for RenderSettings {
             crop: None,
             iso: None,
             gradient_opacity: None,
+            gradient_opacity_max: None,
         }
     }
 }
@@ -228,6 +234,13 @@ impl RenderSettings {
         }
         if let Some(range) = self.gradient_opacity {
             GradientOpacity::validate(range).map_err(setting)?;
+        }
+        if let Some(max) = self.gradient_opacity_max
+            && !(max.is_finite() && max > 0.0)
+        {
+            return Err(setting(format!(
+                "gradient-opacity maximum {max} must be a finite gradient magnitude above 0"
+            )));
         }
         Ok(())
     }
@@ -425,7 +438,10 @@ impl<'v> Renderer<'v> {
             classifier = classifier.with_iso(iso, voxel_size, self.max_gradient());
         }
         if let Some(range) = settings.gradient_opacity {
-            classifier = classifier.with_gradient_opacity(range, self.max_gradient());
+            let max = settings
+                .gradient_opacity_max
+                .unwrap_or_else(|| self.max_gradient());
+            classifier = classifier.with_gradient_opacity(range, max);
         }
         classifier
     }
