@@ -19,7 +19,7 @@
 
 use crate::cli::RenderArgs;
 use crate::error::CliError;
-use crate::render::{load, note_general_path, progress_bar};
+use crate::render::{load, progress_bar};
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
@@ -152,7 +152,7 @@ struct Writer {
 
 impl Writer {
     /// Starts the animation `args` asks for: `frames` frames of the size
-    /// in `settings`. Tells the user if the frames take the general path.
+    /// in `settings`.
     fn new(args: &RenderArgs, settings: &RenderSettings, frames: usize) -> Result<Self, CliError> {
         let animation = Animation::create(
             &args.output,
@@ -161,7 +161,6 @@ impl Writer {
             frames,
             args.fps.unwrap_or(DEFAULT_FPS),
         )?;
-        note_general_path(settings);
         let bar = progress_bar((frames * settings.width * settings.height) as u64);
         Ok(Writer { animation, bar })
     }

@@ -48,7 +48,6 @@ fn still(
     let input = load(&args.input, args.view.log)?;
     let renderer = Renderer::new(&input.volume)
         .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
-    note_general_path(settings);
     let bar = progress_bar((settings.width * settings.height) as u64);
     let image = pool
         .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
@@ -122,59 +121,6 @@ pub fn progress_bar(pixels: u64) -> ProgressBar {
     } else {
         ProgressBar::hidden()
     }
-}
-
-/// Tells the user, once, when frames run on the reference path because
-/// the fast one cannot render what was asked (it composites
-/// pre-classified frames and projects, in either projection).
-pub fn note_general_path(settings: &RenderSettings) {
-    if let Some(note) = general_path_note(settings) {
-        eprintln!("volray: note: {note}");
-    }
-}
-
-fn general_path_note(settings: &RenderSettings) -> Option<String> {
-    if settings.method != Method::Fast || Renderer::path_for(settings) == Method::Fast {
-        return None;
-    }
-    // The options given that keep the frame off the fast paths: those
-    // whose removal alone would put it back, else all that could.
-    let mut ortho = settings.clone();
-    ortho.camera.projection = Projection::Orthographic;
-    let mut composite = settings.clone();
-    composite.blend = Blend::Composite;
-    let mut pre = settings.clone();
-    pre.classification = Classification::Pre;
-    let given = [
-        (
-            "--perspective",
-            matches!(settings.camera.projection, Projection::Perspective { .. }),
-            ortho,
-        ),
-        ("--blend", settings.blend.is_projection(), composite),
-        (
-            "--post-classification",
-            settings.classification == Classification::Post,
-            pre,
-        ),
-    ];
-    let given: Vec<_> = given.into_iter().filter(|(_, on, _)| *on).collect();
-    let culprits: Vec<&str> = (given.iter())
-        .filter(|(_, _, without)| Renderer::path_for(without) == Method::Fast)
-        .map(|(flag, _, _)| *flag)
-        .collect();
-    let what = match (culprits.is_empty(), given.is_empty()) {
-        (false, _) => culprits.join(" and "),
-        (true, false) => given
-            .iter()
-            .map(|(f, _, _)| *f)
-            .collect::<Vec<_>>()
-            .join(" and "),
-        (true, true) => "these options".to_string(),
-    };
-    Some(format!(
-        "{what}: rendering on the general path (every sample, in f64), slower than the fast one"
-    ))
 }
 
 /// What an output file name asks for.
@@ -502,38 +448,6 @@ mod tests {
         match Cli::try_parse_from(all).unwrap().command {
             Command::Render(args) => args,
             _ => panic!("not a render command"),
-        }
-    }
-
-    #[test]
-    fn the_general_path_is_noted_only_when_the_fast_one_was_asked_for() {
-        let note = |args: &[&str]| general_path_note(&settings(&parse(args).view).unwrap());
-        assert_eq!(note(&[]), None);
-        assert_eq!(
-            note(&["--jitter", "--crop", "0,1,0,1,0,1", "--zoom", "2"]),
-            None
-        );
-        assert_eq!(note(&["--perspective", "30", "--reference"]), None);
-        // Perspective compositing has a fast path; post-classification not.
-        assert_eq!(note(&["--perspective", "30"]), None);
-        assert!(
-            note(&["--post-classification"])
-                .unwrap()
-                .starts_with("--post-classification:")
-        );
-        let both = note(&["--perspective", "30", "--post-classification"]).unwrap();
-        assert!(both.starts_with("--post-classification:"), "{both}");
-        // Whatever the routing, a note exactly when a frame asked for the
-        // fast path does not get it.
-        for args in [
-            &["--blend", "mip"][..],
-            &["--blend", "average", "--perspective", "50"],
-            &["--blend", "average", "--reference"],
-            &["--iso", "0.2", "--perspective", "50"],
-        ] {
-            let s = settings(&parse(args).view).unwrap();
-            let slow = s.method == Method::Fast && Renderer::path_for(&s) == Method::Reference;
-            assert_eq!(general_path_note(&s).is_some(), slow, "{args:?}");
         }
     }
 

@@ -42,9 +42,11 @@
 //!   bit-identical for any thread count. `docs/performance.md` records the
 //!   design and what each step bought. The fast path renders composited,
 //!   pre-classified frames of either projection (with any crop, clip
-//!   planes and jitter), and [`intensity`] the projection blend modes fast;
-//!   the reference renders every option, and [`Renderer::path_for`] sends
-//!   it the frames the fast paths cannot (post-classified compositing).
+//!   planes and jitter); [`intensity`] renders the projection blend modes
+//!   fast, and [`post_cast`] post-classified compositing (walking each ray
+//!   brick by brick, skipping the transparent ones, from per-voxel
+//!   gradients kept at 12 bytes per voxel). The reference renders every
+//!   option too, as the oracle ([`Method::Reference`]).
 //! - [`render`] ties it together; [`image`] is the RGBA `f32` result.
 //!
 //! ```
@@ -82,6 +84,7 @@ pub mod jitter;
 pub mod macrocells;
 pub mod perspective;
 pub mod pose;
+pub mod post_cast;
 pub mod post_classification;
 pub mod presets;
 pub mod ray;

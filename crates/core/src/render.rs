@@ -9,11 +9,13 @@
 //! **Routing.** [`Method::Fast`] asks for the fast paths: the bricked ray
 //! caster ([`crate::raycast`]) renders views composited from
 //! pre-classified voxels (the paper's method), and [`crate::intensity`]
-//! renders the projection blend modes (maximum, minimum, average); both
-//! take either projection and any crop box, clip planes and jitter. What
-//! neither can render, post-classified compositing, runs on the reference
-//! path ([`crate::reference`]), which renders every option.
-//! [`Renderer::path_for`] says which path a frame takes.
+//! renders the projection blend modes (maximum, minimum, average), and
+//! [`crate::post_cast`] views composited from post-classified samples
+//! (interpolate the scalar and the gradient, then classify and shade,
+//! skipping transparent bricks); all take either projection and any crop
+//! box, clip planes and jitter. [`Method::Reference`] runs the reference
+//! path ([`crate::reference`]), which renders every option too, as the
+//! oracle.
 
 use crate::blend::Blend;
 use crate::camera::{Camera, CameraError, View};
@@ -36,7 +38,7 @@ use crate::stage1::{ShadedVolume, shade_and_classify};
 use crate::tiles::TileBins;
 use crate::transfer_function::TransferFunction;
 use crate::volume::Volume;
-use crate::{raycast, reference};
+use crate::{post_cast, raycast, reference};
 use glam::DVec3;
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
@@ -64,8 +66,8 @@ pub enum RenderError {
 /// Which stage 2 to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
-    /// Front to back, early ray termination, parallel tiles; frames it
-    /// cannot render go to the reference (see [`Renderer::path_for`]).
+    /// Front to back, early ray termination, empty-space skipping, in
+    /// parallel; every option has a fast path (see the module docs).
     #[default]
     Fast,
     /// The paper's back-to-front compositing in `f64`, and every other
@@ -249,7 +251,8 @@ impl RenderSettings {
 /// A volume ready to render. Its value range is found once; the fast
 /// path's view-independent work (the min/max macro-cells, and the occupied
 /// bricks with their normals and classification for the last transfer
-/// function used) is done on the first frame that needs it and kept.
+/// function used; for post-classification, every voxel's gradient, 12
+/// bytes per voxel) is done on the first frame that needs it and kept.
 ///
 /// Frames of one `Renderer` are rendered one at a time: a frame holds the
 /// fast path's buffers while it runs.
@@ -259,6 +262,9 @@ pub struct Renderer<'v> {
     macrocells: OnceLock<Macrocells>,
     /// The largest gradient magnitude, found on the first frame that needs it.
     max_gradient: OnceLock<f32>,
+    /// Every voxel's gradient, for the post-classified fast path: computed
+    /// on its first frame and kept (12 bytes per voxel).
+    gradients: OnceLock<Vec<[f32; 3]>>,
     fast: Mutex<Option<FastState>>,
 }
 
@@ -309,6 +315,7 @@ impl<'v> Renderer<'v> {
             value_range,
             macrocells: OnceLock::new(),
             max_gradient: OnceLock::new(),
+            gradients: OnceLock::new(),
             fast: Mutex::new(None),
         })
     }
@@ -335,7 +342,7 @@ impl<'v> Renderer<'v> {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<Image, RenderError> {
         let frame = self.prepare(settings)?;
-        match Self::path_for(settings) {
+        match settings.method {
             Method::Fast => {
                 let mut image = Image::new(settings.width, settings.height, [0.0; 4]);
                 self.render_fast(settings, &frame, &mut image, progress);
@@ -345,31 +352,17 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// The path a frame with `settings` runs on: a fast path when asked
-    /// for and one can (a view of either projection composited from
-    /// pre-classified voxels, or any projection blend mode), else the
-    /// reference path, which renders every option.
-    pub fn path_for(settings: &RenderSettings) -> Method {
-        let fast_can =
-            settings.blend.is_projection() || settings.classification == Classification::Pre;
-        if settings.method == Method::Fast && fast_can {
-            Method::Fast
-        } else {
-            Method::Reference
-        }
-    }
-
     /// Renders one frame into `image` (reallocated only if its size is not
     /// the frame's), and says where the time went. On the bricked fast path
-    /// the parts are timed; a projection, or a frame on the reference path
-    /// (see [`Self::path_for`]), counts all its time as `cast`.
+    /// the parts are timed; a projection, a post-classified frame, or a
+    /// frame on the reference path counts all its time as `cast`.
     pub fn render_into(
         &self,
         settings: &RenderSettings,
         image: &mut Image,
     ) -> Result<FrameTimes, RenderError> {
         let frame = self.prepare(settings)?;
-        if Self::path_for(settings) == Method::Reference {
+        if settings.method == Method::Reference {
             let start = Instant::now();
             *image = self.render_reference(settings, &frame, &|_| {});
             return Ok(FrameTimes {
@@ -514,7 +507,8 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// The fast paths: the projections' ([`crate::intensity`]), or the
+    /// The fast paths: the projections' ([`crate::intensity`]),
+    /// post-classified compositing's ([`Self::render_post`]), or the
     /// bricked ray caster's ([`Self::render_bricks`]).
     fn render_fast(
         &self,
@@ -524,6 +518,9 @@ impl<'v> Renderer<'v> {
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
         if !settings.blend.is_projection() {
+            if settings.classification == Classification::Post {
+                return self.render_post(settings, frame, image, progress);
+            }
             return self.render_bricks(settings, frame, image, progress);
         }
         let start = Instant::now();
@@ -540,6 +537,34 @@ impl<'v> Renderer<'v> {
             image,
             progress,
         );
+        FrameTimes {
+            cast: start.elapsed(),
+            ..FrameTimes::default()
+        }
+    }
+
+    /// Post-classified compositing ([`crate::post_cast`]), from the
+    /// volume's gradients and min/max bricks (both computed on the first
+    /// frame that needs them, and kept); all its time counts as `cast`.
+    fn render_post(
+        &self,
+        settings: &RenderSettings,
+        frame: &Frame,
+        image: &mut Image,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> FrameTimes {
+        let start = Instant::now();
+        let classifier = self.classifier(settings);
+        let scene = post_cast::PostScene {
+            volume: self.volume,
+            gradients: self.gradients.get_or_init(|| gradients(self.volume)),
+            macrocells: self.macrocells.get_or_init(|| Macrocells::new(self.volume)),
+            classifier: &classifier,
+            lighting: (settings.shading)
+                .then(|| (&settings.phong, Self::light(settings, &frame.view))),
+        };
+        let (view, sampling) = (&frame.view, &frame.sampling);
+        post_cast::render(&scene, view, sampling, settings.background, image, progress);
         FrameTimes {
             cast: start.elapsed(),
             ..FrameTimes::default()

@@ -20,7 +20,7 @@ fn reference(settings: &RenderSettings) -> RenderSettings {
 
 /// The fast and the reference image of one frame.
 fn both_paths(renderer: &Renderer, settings: &RenderSettings) -> (Image, Image) {
-    assert_eq!(Renderer::path_for(settings), Method::Fast);
+    assert_eq!(settings.method, Method::Fast);
     let fast = renderer.render(settings).unwrap();
     let reference = renderer.render(&reference(settings)).unwrap();
     (fast, reference)
@@ -135,7 +135,6 @@ fn projections_of_a_ramp_seen_along_it_are_its_maximum_minimum_and_mean() {
                 method,
                 ..RenderSettings::default()
             };
-            assert_eq!(Renderer::path_for(&settings), method);
             let image = renderer.render(&settings).unwrap();
             for row in 0..8 {
                 for col in 0..12 {
@@ -663,7 +662,10 @@ fn post_classification_of_a_uniform_medium_has_the_closed_form_colour() {
     let renderer = Renderer::new(&volume).unwrap();
     let (alpha, c, bg) = (0.3f64, [0.9, 0.5, 0.2], [0.1, 0.2, 1.0]);
     for (step, k) in [(1.0, 11), (0.5, 21), (0.25, 41)] {
-        for shading in [false, true] {
+        for (shading, method) in [false, true]
+            .into_iter()
+            .flat_map(|s| [(s, Method::Fast), (s, Method::Reference)])
+        {
             let settings = RenderSettings {
                 width: 14,
                 height: 10,
@@ -672,9 +674,9 @@ fn post_classification_of_a_uniform_medium_has_the_closed_form_colour() {
                 classification: Classification::Post,
                 transfer_function: constant_tf(alpha as f32, c),
                 background: bg,
+                method,
                 ..RenderSettings::default()
             };
-            assert_eq!(Renderer::path_for(&settings), Method::Reference);
             let keep = (1.0 - alpha).powf(step * k as f64);
             let light = if shading { 0.1 } else { 1.0 };
             let image = renderer.render(&settings).unwrap();
@@ -776,84 +778,33 @@ fn perspective_shows_a_near_ball_larger_than_the_same_ball_far_away() {
             },
             ..RenderSettings::default()
         };
-        // Post-classified compositing runs on the reference path, whichever
-        // is asked for.
-        assert_eq!(Renderer::path_for(&settings), Method::Reference);
-        let image = renderer.render(&settings).unwrap();
-        assert!(image == renderer.render(&reference(&settings)).unwrap());
+        // Both paths (post-classified compositing has its fast path,
+        // tests/post_fast.rs).
         let view = View::frame(&camera, volume.bounds(), 64, 64).unwrap();
-        let mut count = 0;
-        for row in 0..64 {
-            for col in 0..64 {
-                let (o, d) = view.pixel_ray(col, row);
-                let miss_distance = o.cross(d).length();
-                let hit = image.get(col, row)[3] > 0.5;
-                count += hit as usize;
-                // Rays grazing the ball within a fifth of a voxel may go
-                // either way.
-                if (miss_distance - radius).abs() > 0.2 * h {
-                    assert_eq!(hit, miss_distance < radius, "D {distance} ({col}, {row})");
+        let mut counts = Vec::new();
+        for settings in [settings.clone(), reference(&settings)] {
+            let image = renderer.render(&settings).unwrap();
+            let mut count = 0;
+            for row in 0..64 {
+                for col in 0..64 {
+                    let (o, d) = view.pixel_ray(col, row);
+                    let miss_distance = o.cross(d).length();
+                    let hit = image.get(col, row)[3] > 0.5;
+                    count += hit as usize;
+                    // Rays grazing the ball within a fifth of a voxel may go
+                    // either way.
+                    if (miss_distance - radius).abs() > 0.2 * h {
+                        assert_eq!(hit, miss_distance < radius, "D {distance} ({col}, {row})");
+                    }
                 }
             }
+            counts.push(count);
         }
-        count
+        counts[0]
     };
     let (near, far) = (covered(1.5), covered(3.0));
     println!("the ball covers {near} pixels from 1.5, {far} from 3");
     assert!(near > 3 * far + far / 2, "{near} vs {far}");
-}
-
-#[test]
-fn frames_go_to_the_path_that_can_render_them() {
-    let fast = RenderSettings::default();
-    assert_eq!(Renderer::path_for(&fast), Method::Fast);
-    let cut_and_jittered = RenderSettings {
-        jitter: true,
-        crop: Some((DVec3::ZERO, DVec3::ONE)),
-        clip_planes: vec![ClipPlane {
-            point: DVec3::ZERO,
-            normal: DVec3::X,
-        }],
-        ..fast.clone()
-    };
-    assert_eq!(Renderer::path_for(&cut_and_jittered), Method::Fast);
-    // Perspective compositing too (tests/perspective_fast.rs).
-    let perspective = RenderSettings {
-        camera: Camera {
-            projection: Projection::Perspective { fov_degrees: 30.0 },
-            ..Camera::default()
-        },
-        ..cut_and_jittered
-    };
-    assert_eq!(Renderer::path_for(&perspective), Method::Fast);
-    // The projections have their own fast path, for both projections.
-    for blend in [Blend::Maximum, Blend::Minimum, Blend::Average] {
-        let settings = RenderSettings {
-            blend,
-            classification: Classification::Post,
-            camera: Camera {
-                projection: Projection::Perspective { fov_degrees: 30.0 },
-                ..Camera::default()
-            },
-            ..fast.clone()
-        };
-        assert_eq!(Renderer::path_for(&settings), Method::Fast);
-        assert_eq!(Renderer::path_for(&reference(&settings)), Method::Reference);
-    }
-    for settings in [
-        RenderSettings {
-            classification: Classification::Post,
-            ..fast.clone()
-        },
-        RenderSettings {
-            classification: Classification::Post,
-            ..perspective.clone()
-        },
-        reference(&fast),
-        reference(&perspective),
-    ] {
-        assert_eq!(Renderer::path_for(&settings), Method::Reference);
-    }
 }
 
 #[test]

@@ -1,0 +1,560 @@
+//! Post-classified compositing on its fast path ([`volray_core::post_cast`]),
+//! held to the reference path (the oracle) within 1/255 per channel: a
+//! smooth ball, the Marschner–Lobb signal and a step edge; views along an
+//! axis, oblique and in perspective (the eye outside and inside the
+//! volume); steps of 0.5 and 1; lit and unlit; crop boxes, clip planes and
+//! jitter; Levoy's iso-surfaces and gradient-magnitude opacity;
+//! anisotropic spacing. Also: bit-identical images for any thread count,
+//! the brick walk skipping empty bricks and still finding small features
+//! behind them and on brick faces, and the routing.
+
+use volray_core::camera::{Camera, Projection, View};
+use volray_core::classify::Classifier;
+use volray_core::glam::DVec3;
+use volray_core::gradient::gradients;
+use volray_core::macrocells::Macrocells;
+use volray_core::post_cast::{self, PostScene, PostWork};
+use volray_core::shading::LightGeometry;
+use volray_core::{
+    Classification, ClipPlane, Image, IsoSurface, Method, RenderSettings, Renderer,
+    TransferFunction, Volume,
+};
+
+fn reference(settings: &RenderSettings) -> RenderSettings {
+    RenderSettings {
+        method: Method::Reference,
+        ..settings.clone()
+    }
+}
+
+/// Asserts the fast path equals the reference within 1/255 per channel and
+/// that the reference shows something; returns the largest difference.
+fn assert_matches(renderer: &Renderer, settings: &RenderSettings, what: &str) -> f32 {
+    assert_eq!(settings.classification, Classification::Post);
+    assert_eq!(settings.method, Method::Fast);
+    let fast = renderer.render(settings).unwrap();
+    let slow = renderer.render(&reference(settings)).unwrap();
+    let diff = fast.max_abs_diff(&slow).unwrap();
+    assert!(diff <= 1.0 / 255.0, "{what}: {diff}");
+    let shown = slow.pixels().iter().filter(|p| p[3] > 0.2).count();
+    assert!(shown >= 10, "{what}: the image is (nearly) empty");
+    diff
+}
+
+fn tf(json: &str) -> TransferFunction {
+    TransferFunction::from_json(json).unwrap()
+}
+
+/// Opacity zero below t = 0.25, so that empty bricks are skipped, a bump
+/// and a plateau; colours from blue through grey to red.
+fn colorful() -> TransferFunction {
+    tf(
+        r#"{"opacity": [[0, 0], [0.25, 0], [0.5, 0.35], [0.7, 0.15], [1, 0.8]],
+           "color": [[0, 0.23, 0.3, 0.75], [0.5, 0.87, 0.87, 0.87], [1, 0.7, 0.02, 0.15]]}"#,
+    )
+}
+
+/// The cube [−1, 1]³ with `n` points per side.
+fn cube(n: usize, f: impl Fn(DVec3) -> f64) -> Volume {
+    let h = 2.0 / (n - 1) as f64;
+    Volume::from_fn([n, n, n], DVec3::splat(h), DVec3::splat(-1.0), |p| {
+        f(p) as f32
+    })
+    .unwrap()
+}
+
+/// A ball of radius 0.6, density falling smoothly from 1 at its centre
+/// (off the grid's centre, so that no ray meets a zero gradient by
+/// symmetry) to 0 at its edge and beyond.
+fn smooth_ball(n: usize) -> Volume {
+    let centre = DVec3::new(0.07, -0.05, 0.11);
+    cube(n, |p| {
+        (1.0 - ((p - centre).length() / 0.6).powi(2)).max(0.0)
+    })
+}
+
+/// The Marschner–Lobb test signal (S. R. Marschner and R. J. Lobb, "An
+/// evaluation of reconstruction filters for volume rendering", 1994):
+/// `(1 − sin(πz/2) + α(1 + cos(2π f_M cos(πr/2))))/(2(1 + α))`,
+/// `r = √(x² + y²)`, `f_M = 6`, `α = 0.25`.
+fn marschner_lobb(n: usize) -> Volume {
+    use std::f64::consts::PI;
+    let (fm, alpha) = (6.0, 0.25);
+    cube(n, |p| {
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        let rho = (2.0 * PI * fm * (PI * r / 2.0).cos()).cos();
+        (1.0 - (PI * p.z / 2.0).sin() + alpha * (1.0 + rho)) / (2.0 * (1.0 + alpha))
+    })
+}
+
+/// A step edge: 0.9 on one side of an oblique plane, 0.1 on the other,
+/// the step across one cell (on a grid whose last bricks are partial).
+fn step_edge() -> Volume {
+    Volume::from_fn([30, 26, 22], DVec3::ONE, DVec3::ZERO, |p| {
+        if p.x + 0.3 * p.y - 0.2 * p.z > 12.1 {
+            0.9
+        } else {
+            0.1
+        }
+    })
+    .unwrap()
+}
+
+fn views() -> Vec<(&'static str, Camera)> {
+    vec![
+        ("along -x", Camera::default()),
+        (
+            "oblique",
+            Camera {
+                view_point: Some(DVec3::new(150.0, 150.0, 500.0)),
+                ..Camera::default()
+            },
+        ),
+        (
+            "orbit",
+            Camera {
+                azimuth: -115.0,
+                elevation: 35.0,
+                ..Camera::default()
+            },
+        ),
+        (
+            "perspective",
+            Camera {
+                projection: Projection::Perspective { fov_degrees: 40.0 },
+                azimuth: 30.0,
+                elevation: 20.0,
+                ..Camera::default()
+            },
+        ),
+    ]
+}
+
+fn settings(camera: Camera, step: f64, shading: bool) -> RenderSettings {
+    RenderSettings {
+        width: 36,
+        height: 30,
+        camera,
+        step,
+        shading,
+        classification: Classification::Post,
+        transfer_function: colorful(),
+        background: [0.1, 0.1, 0.3],
+        ..RenderSettings::default()
+    }
+}
+
+#[test]
+fn the_fast_path_matches_the_reference_on_several_volumes_views_and_steps() {
+    let mut worst = 0.0f32;
+    for (name, volume) in [
+        ("ball", smooth_ball(27)),
+        ("marschner-lobb", marschner_lobb(25)),
+        ("step edge", step_edge()),
+    ] {
+        let renderer = Renderer::new(&volume).unwrap();
+        for (view, camera) in views() {
+            for step in [1.0, 0.5] {
+                for shading in [false, true] {
+                    let what = format!("{name}, {view}, step {step}, lit {shading}");
+                    let s = settings(camera, step, shading);
+                    worst = worst.max(assert_matches(&renderer, &s, &what));
+                }
+            }
+        }
+    }
+    println!("largest fast-vs-reference difference: {worst:.6}");
+}
+
+#[test]
+fn the_default_ramp_and_a_sharp_table_match_the_reference() {
+    // The paper's ramp (opacity 0 only at the volume's minimum), and a
+    // table whose opacity rises steeply about t = 0.5: post-classification
+    // resolves the rise at each sample, as the reference does.
+    let volume = marschner_lobb(25);
+    let renderer = Renderer::new(&volume).unwrap();
+    let sharp =
+        tf(r#"{"opacity": [[0.49, 0], [0.51, 0.6]], "color": [[0, 1, 0.5, 0], [1, 0, 0.5, 1]]}"#);
+    for transfer_function in [TransferFunction::default(), sharp] {
+        for (view, camera) in views() {
+            let s = RenderSettings {
+                transfer_function: transfer_function.clone(),
+                ..settings(camera, 0.7, true)
+            };
+            assert_matches(&renderer, &s, view);
+        }
+    }
+}
+
+/// A crop box and clip planes.
+type Cut = (Option<(DVec3, DVec3)>, Vec<ClipPlane>);
+
+#[test]
+fn crops_clip_planes_and_jitter_match_the_reference() {
+    let volume = Volume::from_fn(
+        [33, 25, 29],
+        DVec3::new(1.0, 1.5, 0.75),
+        DVec3::new(-2.0, 5.0, 1.0),
+        |p| {
+            let c = DVec3::new(14.0, 23.0, 12.0);
+            let d = (p - c) / DVec3::new(11.0, 14.0, 9.0);
+            (1.0 - d.length_squared()).max(0.0) as f32
+        },
+    )
+    .unwrap();
+    let renderer = Renderer::new(&volume).unwrap();
+    let (lo, hi) = volume.bounds();
+    let centre = 0.5 * (lo + hi);
+    let cuts: Vec<Cut> = vec![
+        (
+            Some((
+                centre - DVec3::new(6.0, 20.0, 5.0),
+                centre + DVec3::new(3.3, 4.1, 20.0),
+            )),
+            vec![],
+        ),
+        (
+            None,
+            vec![
+                ClipPlane {
+                    point: centre,
+                    normal: DVec3::new(1.0, -0.4, 0.7),
+                },
+                ClipPlane {
+                    point: centre + DVec3::new(0.0, 3.0, 0.0),
+                    normal: DVec3::new(0.1, -1.0, 0.2),
+                },
+            ],
+        ),
+    ];
+    for (view, camera) in views() {
+        for (crop, planes) in &cuts {
+            for (jitter, step) in [(false, 1.0), (true, 0.6), (true, 1.0)] {
+                let s = RenderSettings {
+                    crop: *crop,
+                    clip_planes: planes.clone(),
+                    jitter,
+                    ..settings(camera, step, true)
+                };
+                let what = format!(
+                    "{view}, crop {crop:?}, {} planes, jitter {jitter}",
+                    planes.len()
+                );
+                assert_matches(&renderer, &s, &what);
+            }
+        }
+    }
+}
+
+#[test]
+fn iso_surfaces_and_gradient_opacity_match_the_reference() {
+    // Levoy's contour needs the gradient at every sample for the opacity
+    // itself; gradient-magnitude opacity fades the flat inside of the ball
+    // and the flat sides of the step.
+    let cases = [
+        ("ball", smooth_ball(27), 0.45f32),
+        ("marschner-lobb", marschner_lobb(25), 0.5),
+        ("step edge", step_edge(), 0.5),
+    ];
+    for (name, volume, iso) in cases {
+        let renderer = Renderer::new(&volume).unwrap();
+        for (view, camera) in views() {
+            for shading in [false, true] {
+                let contour = RenderSettings {
+                    iso: Some(IsoSurface {
+                        value: iso,
+                        thickness: 1.5,
+                    }),
+                    ..settings(camera, 0.5, shading)
+                };
+                assert_matches(
+                    &renderer,
+                    &contour,
+                    &format!("{name} iso, {view}, {shading}"),
+                );
+                let graded = RenderSettings {
+                    gradient_opacity: Some((0.1, 0.6)),
+                    transfer_function: TransferFunction::default(),
+                    opacity_ramp: (0.2, 0.9),
+                    ..settings(camera, 1.0, shading)
+                };
+                assert_matches(
+                    &renderer,
+                    &graded,
+                    &format!("{name} |∇f|, {view}, {shading}"),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn anisotropic_grids_and_eyes_inside_the_volume_match_the_reference() {
+    let volume = Volume::from_fn([37, 26, 45], DVec3::new(1.0, 2.0, 0.6), DVec3::ZERO, |p| {
+        let u = p / DVec3::new(36.0, 50.0, 26.4);
+        let blob = |c: DVec3, w: f64| (-(u - c).length_squared() / (2.0 * w * w)).exp();
+        (blob(DVec3::new(0.3, 0.4, 0.5), 0.18) + 0.8 * blob(DVec3::new(0.7, 0.6, 0.3), 0.1)) as f32
+    })
+    .unwrap();
+    let renderer = Renderer::new(&volume).unwrap();
+    let look = |eye: DVec3, at: DVec3, fov_degrees: f64| Camera {
+        view_point: Some(eye),
+        look_at: Some(at),
+        projection: Projection::Perspective { fov_degrees },
+        ..Camera::default()
+    };
+    let cameras = [
+        ("orthographic", Camera::default()),
+        (
+            "eye inside",
+            look(
+                DVec3::new(14.0, 22.0, 11.0),
+                DVec3::new(30.0, 40.0, 5.0),
+                70.0,
+            ),
+        ),
+        (
+            "eye on a brick corner",
+            look(
+                DVec3::new(8.0, 16.0, 4.8),
+                DVec3::new(20.0, 25.0, 13.0),
+                90.0,
+            ),
+        ),
+        (
+            "eye far away",
+            look(
+                DVec3::new(900.0, -700.0, 400.0),
+                DVec3::new(18.0, 25.0, 13.0),
+                3.0,
+            ),
+        ),
+    ];
+    for (view, camera) in cameras {
+        for step in [1.0, 0.5] {
+            assert_matches(
+                &renderer,
+                &settings(camera, step, true),
+                &format!("{view}, step {step}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn a_uniform_medium_has_the_closed_form_colour_on_the_fast_path() {
+    // K = 10/step + 1 samples of colour c and opacity α_s = 1 − (1 − α)^step
+    // give c(1 − (1 − α_s)^K) + bg(1 − α_s)^K; lit, the medium has no
+    // gradient, so only the ambient 0.1 lights it.
+    let volume = Volume::new([11, 7, 5], vec![3.0; 11 * 7 * 5]).unwrap();
+    let renderer = Renderer::new(&volume).unwrap();
+    let (alpha, c, bg) = (0.3f64, [0.9, 0.5, 0.2], [0.1, 0.2, 1.0]);
+    let constant = TransferFunction {
+        domain: None,
+        opacity: Some(volray_core::transfer_function::PiecewiseLinear::constant([
+            alpha as f32,
+        ])),
+        color: Some(volray_core::transfer_function::PiecewiseLinear::constant(c)),
+    };
+    for (step, k) in [(1.0, 11), (0.5, 21)] {
+        for shading in [false, true] {
+            let s = RenderSettings {
+                width: 14,
+                height: 10,
+                step,
+                shading,
+                classification: Classification::Post,
+                transfer_function: constant.clone(),
+                background: bg,
+                ..RenderSettings::default()
+            };
+            let keep = (1.0 - alpha).powf(step * k as f64);
+            let light = if shading { 0.1 } else { 1.0 };
+            for px in renderer.render(&s).unwrap().pixels() {
+                for ch in 0..3 {
+                    let want = light * c[ch] as f64 * (1.0 - keep) + bg[ch] as f64 * keep;
+                    assert!((px[ch] as f64 - want).abs() < 1e-5, "{px:?} vs {want}");
+                }
+                assert!((px[3] as f64 - (1.0 - keep)).abs() < 1e-5);
+            }
+        }
+    }
+}
+
+#[test]
+fn images_are_bit_identical_for_any_thread_count() {
+    let volume = marschner_lobb(25);
+    let renderer = Renderer::new(&volume).unwrap();
+    for (view, camera) in views() {
+        let s = RenderSettings {
+            jitter: true,
+            gradient_opacity: Some((0.05, 0.5)),
+            ..settings(camera, 0.6, true)
+        };
+        let images: Vec<Image> = [1, 2, 3]
+            .into_iter()
+            .map(|threads| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| renderer.render(&s).unwrap())
+            })
+            .collect();
+        assert!(images[0] == images[1] && images[1] == images[2], "{view}");
+    }
+}
+
+/// 48³ of nothing but three small dense features: a 3³ block deep behind
+/// empty bricks (seen along −x, the eye is on +x), a single voxel on a
+/// brick corner, and a 2-voxel rod lying in a brick face.
+fn sparse() -> Volume {
+    let n = 48;
+    Volume::from_fn([n, n, n], DVec3::ONE, DVec3::ZERO, |p| {
+        let (x, y, z) = (p.x as usize, p.y as usize, p.z as usize);
+        let block = (3..6).contains(&x) && (30..33).contains(&y) && (10..13).contains(&z);
+        let corner = (x, y, z) == (16, 16, 24);
+        let rod = x == 8 && y == 40 && (20..22).contains(&z);
+        if block || corner || rod { 1.0 } else { 0.0 }
+    })
+    .unwrap()
+}
+
+/// Renders `settings` with [`post_cast::render`] directly, to see its work.
+fn post_cast_work(renderer: &Renderer, settings: &RenderSettings) -> (Image, PostWork, usize) {
+    let volume = renderer.volume();
+    let frame = renderer.prepare(settings).unwrap();
+    let mut classifier = Classifier::from_transfer_function(
+        &settings.transfer_function,
+        renderer.value_range(),
+        settings.opacity_ramp,
+        settings.step as f32,
+    );
+    if let Some(iso) = settings.iso {
+        let voxel_size = volume.spacing().min_element() as f32;
+        classifier = classifier.with_iso(iso, voxel_size, renderer.max_gradient());
+    }
+    let grads = gradients(volume);
+    let macrocells = Macrocells::new(volume);
+    let light = LightGeometry::headlight((-frame.view.direction()).as_vec3());
+    let scene = PostScene {
+        volume,
+        gradients: &grads,
+        macrocells: &macrocells,
+        classifier: &classifier,
+        lighting: Some((&settings.phong, light)),
+    };
+    let mut image = Image::new(settings.width, settings.height, [0.0; 4]);
+    let work = post_cast::render(
+        &scene,
+        &frame.view,
+        &frame.sampling,
+        settings.background,
+        &mut image,
+        &|_| {},
+    );
+    (image, work, frame.nominal_samples())
+}
+
+#[test]
+fn empty_bricks_are_skipped_and_small_features_behind_them_are_found() {
+    let volume = sparse();
+    let renderer = Renderer::new(&volume).unwrap();
+    let cameras = [
+        Camera::default(),
+        Camera {
+            view_point: Some(DVec3::new(100.0, 30.0, 45.0)),
+            ..Camera::default()
+        },
+        Camera {
+            projection: Projection::Perspective { fov_degrees: 50.0 },
+            azimuth: 20.0,
+            elevation: -15.0,
+            ..Camera::default()
+        },
+    ];
+    for camera in cameras {
+        // The paper's ramp from 0: the empty bricks (all 0, the minimum)
+        // are transparent; a dense voxel's opacity is 0.9.
+        let s = RenderSettings {
+            width: 96,
+            height: 96,
+            camera,
+            step: 0.5,
+            opacity_ramp: (0.0, 0.9),
+            classification: Classification::Post,
+            ..RenderSettings::default()
+        };
+        let (image, work, nominal) = post_cast_work(&renderer, &s);
+        // The renderer's fast path is this very function.
+        assert!(image == renderer.render(&s).unwrap(), "{camera:?}");
+        let slow = renderer.render(&reference(&s)).unwrap();
+        assert!(
+            image.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0,
+            "{camera:?}"
+        );
+        // Most samples lie in empty bricks and are never interpolated.
+        println!("{camera:?}: {work:?} of {nominal} nominal samples");
+        assert!(work.bricks_skipped > 10_000, "{work:?}");
+        assert!(work.samples * 10 < nominal as u64, "{work:?} of {nominal}");
+        // Each feature shows where its centre projects.
+        let view = View::frame(&camera, volume.bounds(), 96, 96).unwrap();
+        for centre in [
+            DVec3::new(4.0, 31.0, 11.0),
+            DVec3::new(16.0, 16.0, 24.0),
+            DVec3::new(8.0, 40.0, 20.5),
+        ] {
+            let (c, r) = view.project(centre).unwrap();
+            let alpha = image.get(c as usize, r as usize)[3];
+            assert!(
+                alpha > 0.3,
+                "{camera:?}: feature at {centre} has alpha {alpha}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bricks_near_an_isovalue_are_visited_and_far_ones_skipped() {
+    // With an iso-surface, a brick is skipped only if its values lie
+    // farther from the isovalue than the contour can reach at the
+    // volume's steepest gradient. The steepest is at the block's corners,
+    // |∇f| = |(½, ½, ½)| = √3/2 per voxel, so a contour 0.5 voxels thick
+    // reaches 0.43 from the isovalue 0.5: the empty bricks (all 0) are
+    // skipped, and the features' bricks are not.
+    let volume = sparse();
+    let renderer = Renderer::new(&volume).unwrap();
+    assert!((renderer.max_gradient() - 0.75f32.sqrt()).abs() < 1e-6);
+    let s = RenderSettings {
+        width: 64,
+        height: 64,
+        step: 0.5,
+        classification: Classification::Post,
+        iso: Some(IsoSurface {
+            value: 0.5,
+            thickness: 0.5,
+        }),
+        ..RenderSettings::default()
+    };
+    let (fast, work, nominal) = post_cast_work(&renderer, &s);
+    assert!(fast == renderer.render(&s).unwrap());
+    let slow = renderer.render(&reference(&s)).unwrap();
+    assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
+    assert!(slow.pixels().iter().filter(|p| p[3] > 0.3).count() >= 4);
+    println!("iso: {work:?} of {nominal} nominal samples");
+    assert!(work.bricks_skipped > 1000, "{work:?}");
+    assert!(work.samples * 10 < nominal as u64, "{work:?} of {nominal}");
+    // A contour reaching every value (a thickness of 100 voxels) rules
+    // out no brick.
+    let thick = RenderSettings {
+        iso: Some(IsoSurface {
+            value: 0.5,
+            thickness: 100.0,
+        }),
+        ..s
+    };
+    let (fast, work, _) = post_cast_work(&renderer, &thick);
+    assert_eq!(work.bricks_skipped, 0);
+    let slow = renderer.render(&reference(&thick)).unwrap();
+    assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
+}
