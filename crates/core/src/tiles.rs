@@ -14,7 +14,7 @@
 //! projected from the eye. A box that reaches to or behind the plane of the
 //! eye projects to an unbounded region, so it is first cut by a plane a
 //! little in front of the eye, at the depth `ε` below which every point of
-//! the box projects outside the image (see [`perspective_bounds`]); the
+//! the box projects outside the image (see `perspective_bounds`); the
 //! projection of the cut box (a convex polytope) is the convex hull of its
 //! vertices' projections, which is bounded. A box holding the eye is
 //! listed in every tile: every ray starts inside it.

@@ -6,14 +6,14 @@
 //! `[−1, 1]³` (origin `(−1, −1, −1)`, spacing `2/(size − 1)`, like the other
 //! built-in sources) with `size = 2^k + 1` points per side:
 //!
-//! 1. [`midpoint`]: the 8 corners from `N(0, σ²)`, then per level the cube
+//! 1. `midpoint`: the 8 corners from `N(0, σ²)`, then per level the cube
 //!    centres, face centres and edge midpoints, each the mean of the corners
 //!    of its cell, face or edge plus a Gaussian displacement whose size
 //!    ([`scaling`]) gives increments of variance ∝ distance^{2H},
 //!    `H = 4 − D`. The random number of each point depends only on
 //!    (seed, level, point) ([`noise`]), so the bytes do not depend on the
 //!    thread count.
-//! 2. [`postprocess`] (unless `raw_field`): scale to `[0, 1]`, multiply by a
+//! 2. `postprocess` (unless `raw_field`): scale to `[0, 1]`, multiply by a
 //!    ramp that falls to 0 at the inscribed sphere, subtract the threshold,
 //!    set negatives to 0.
 //!
@@ -78,7 +78,7 @@ pub struct FractalParams {
     /// Seed of every random number.
     pub seed: u64,
     /// Width of the boundary ramp, as a fraction of the half width:
-    /// `0 < ramp ≤ 1` ([`postprocess`]).
+    /// `0 < ramp ≤ 1` (`postprocess`).
     pub ramp: f64,
     /// Subtracted from the field scaled to `[0, 1]`: `0 ≤ threshold < 1`.
     pub threshold: f64,
