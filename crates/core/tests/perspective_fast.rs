@@ -3,13 +3,11 @@
 //! outside near the volume, inside it and on brick faces and corners,
 //! oblique orbits, crop boxes, clip planes and jitter, steps of 0.5 and 1,
 //! anisotropic spacing; opaque plates whose picture depends on the order
-//! the bricks are composited in; thread invariance; and the routing.
+//! the bricks are composited in; and thread invariance.
 
 use volray_core::camera::{Camera, Projection, View};
 use volray_core::glam::DVec3;
-use volray_core::{
-    Classification, ClipPlane, Image, Method, RenderSettings, Renderer, TransferFunction, Volume,
-};
+use volray_core::{ClipPlane, Image, Method, RenderSettings, Renderer, TransferFunction, Volume};
 
 /// The fast and the reference image of one frame, after checking that the
 /// frame does run on the fast path.
