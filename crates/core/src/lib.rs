@@ -45,8 +45,8 @@
 //!   planes and jitter); [`intensity`] renders the projection blend modes
 //!   fast, and [`post_cast`] post-classified compositing (walking each ray
 //!   brick by brick, skipping the transparent ones, from per-voxel
-//!   gradients kept at 12 bytes per voxel). The reference renders every
-//!   option too, as the oracle ([`Method::Reference`]).
+//!   gradients packed with the values, 16 bytes per voxel). The reference
+//!   renders every option too, as the oracle ([`Method::Reference`]).
 //! - [`render`] ties it together; [`image`] is the RGBA `f32` result.
 //!
 //! ```

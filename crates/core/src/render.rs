@@ -251,8 +251,9 @@ impl RenderSettings {
 /// A volume ready to render. Its value range is found once; the fast
 /// path's view-independent work (the min/max macro-cells, and the occupied
 /// bricks with their normals and classification for the last transfer
-/// function used; for post-classification, every voxel's gradient, 12
-/// bytes per voxel) is done on the first frame that needs it and kept.
+/// function used; for post-classification, every voxel's gradient packed
+/// with its value, 16 bytes per voxel) is done on the first frame that
+/// needs it and kept.
 ///
 /// Frames of one `Renderer` are rendered one at a time: a frame holds the
 /// fast path's buffers while it runs.
@@ -262,9 +263,10 @@ pub struct Renderer<'v> {
     macrocells: OnceLock<Macrocells>,
     /// The largest gradient magnitude, found on the first frame that needs it.
     max_gradient: OnceLock<f32>,
-    /// Every voxel's gradient, for the post-classified fast path: computed
-    /// on its first frame and kept (12 bytes per voxel).
-    gradients: OnceLock<Vec<[f32; 3]>>,
+    /// Every voxel's gradient and value ([`post_cast::packed_voxels`]), for
+    /// the post-classified fast path: computed on its first frame and kept
+    /// (16 bytes per voxel).
+    packed_voxels: OnceLock<Vec<wide::f32x4>>,
     fast: Mutex<Option<FastState>>,
 }
 
@@ -315,7 +317,7 @@ impl<'v> Renderer<'v> {
             value_range,
             macrocells: OnceLock::new(),
             max_gradient: OnceLock::new(),
-            gradients: OnceLock::new(),
+            packed_voxels: OnceLock::new(),
             fast: Mutex::new(None),
         })
     }
@@ -544,8 +546,9 @@ impl<'v> Renderer<'v> {
     }
 
     /// Post-classified compositing ([`crate::post_cast`]), from the
-    /// volume's gradients and min/max bricks (both computed on the first
-    /// frame that needs them, and kept); all its time counts as `cast`.
+    /// volume's packed gradients and values and its min/max bricks (both
+    /// computed on the first frame that needs them, and kept); all its time
+    /// counts as `cast`.
     fn render_post(
         &self,
         settings: &RenderSettings,
@@ -555,16 +558,17 @@ impl<'v> Renderer<'v> {
     ) -> FrameTimes {
         let start = Instant::now();
         let classifier = self.classifier(settings);
-        let scene = post_cast::PostScene {
-            volume: self.volume,
-            gradients: self.gradients.get_or_init(|| gradients(self.volume)),
+        let voxels = (self.packed_voxels)
+            .get_or_init(|| post_cast::packed_voxels(self.volume, &gradients(self.volume)));
+        let scene = post_cast::PackedScene {
+            voxels,
             macrocells: self.macrocells.get_or_init(|| Macrocells::new(self.volume)),
             classifier: &classifier,
             lighting: (settings.shading)
                 .then(|| (&settings.phong, Self::light(settings, &frame.view))),
         };
         let (view, sampling) = (&frame.view, &frame.sampling);
-        post_cast::render(&scene, view, sampling, settings.background, image, progress);
+        post_cast::render_packed(&scene, view, sampling, settings.background, image, progress);
         FrameTimes {
             cast: start.elapsed(),
             ..FrameTimes::default()
