@@ -28,6 +28,7 @@ use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot, slot_coord
 use crate::classify::Classifier;
 use crate::gradient::gradient_at;
 use crate::macrocells::Macrocells;
+use crate::non_finite::NonFiniteMask;
 use crate::volume::Volume;
 use rayon::prelude::*;
 
@@ -93,13 +94,28 @@ pub struct ClassifiedBricks {
 impl ClassifiedBricks {
     /// Classifies `volume` brick by brick; `macrocells` are its value ranges.
     pub fn new(volume: &Volume, macrocells: &Macrocells, classifier: &Classifier) -> Self {
+        Self::with_mask(volume, macrocells, classifier, None)
+    }
+
+    /// [`Self::new`] for a cleaned volume whose `mask`ed voxels (non-finite
+    /// in the original, see [`crate::non_finite`]) get zero opacity.
+    pub fn with_mask(
+        volume: &Volume,
+        macrocells: &Macrocells,
+        classifier: &Classifier,
+        mask: Option<&NonFiniteMask>,
+    ) -> Self {
         let grid = macrocells.grid;
+        let masked = |v: usize| mask.is_some_and(|m| m.contains(v));
         let data = volume.data();
         let [nx, ny, _] = grid.dims;
         let coords = |v: usize| (v % nx, (v / nx) % ny, v / (nx * ny));
         // The gradient is computed here only where the opacity needs it;
         // the occupied bricks' voxels below need it for their normals anyway.
         let opacity = |v: usize| {
+            if masked(v) {
+                return 0;
+            }
             let gradient = if classifier.uses_gradient() {
                 let (x, y, z) = coords(v);
                 gradient_at(volume, x, y, z)
@@ -140,9 +156,14 @@ impl ClassifiedBricks {
                     let v = grid.voxel_of_slot(b, [i, j, k]);
                     let (x, y, z) = coords(v);
                     let gradient = gradient_at(volume, x, y, z);
+                    let alpha = if masked(v) {
+                        0.0
+                    } else {
+                        classifier.opacity_at(data[v], gradient)
+                    };
                     voxels[s] = Voxel {
                         normal: quantise_normal(gradient),
-                        alpha: quantise(classifier.opacity_at(data[v], gradient)),
+                        alpha: quantise(alpha),
                     };
                 }
                 *cells = cell_mask(voxels);

@@ -19,6 +19,12 @@
 //!
 //! The average visits every sample. Each pixel is computed from its own
 //! ray alone, so the image is the same for any thread count.
+//!
+//! Non-finite voxels rendered as empty space ([`crate::non_finite`]): in a
+//! brick near one, each sample is tested by the reference's rule, on the
+//! reference's `f64` position, and not counted if skipped; a ray that
+//! counts no sample shows the background. The bricks' ranges, of the
+//! cleaned volume, still bound every counted sample.
 
 use crate::blend::{Blend, projection_color};
 use crate::bricks::BRICK;
@@ -26,6 +32,7 @@ use crate::camera::View;
 use crate::classify::Classifier;
 use crate::image::Image;
 use crate::macrocells::Macrocells;
+use crate::non_finite::NonFiniteMask;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::trilinear::sample_scalar;
 use crate::volume::Volume;
@@ -39,6 +46,8 @@ const EXIT_SLACK: f64 = 1e-4;
 /// What the rays read.
 struct Scene<'a> {
     volume: &'a Volume,
+    /// The samples not to count, if the volume had non-finite values.
+    mask: Option<&'a NonFiniteMask>,
     macrocells: &'a Macrocells,
     blend: Blend,
     /// The volume's `(min, max)`.
@@ -49,10 +58,13 @@ struct Scene<'a> {
 /// through `view`, sampling as `sampling` says, coloured by `classifier`
 /// over the opaque `background`, into `image` (the view's size).
 /// `macrocells` are the volume's and `range` its `(min, max)`. `progress`
-/// is called with the number of pixels finished, a row at a time.
+/// is called with the number of pixels finished, a row at a time. With a
+/// `mask`, `volume` is the cleaned copy and the samples the mask skips are
+/// not counted.
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     volume: &Volume,
+    mask: Option<&NonFiniteMask>,
     macrocells: &Macrocells,
     range: (f32, f32),
     view: &View,
@@ -69,6 +81,7 @@ pub fn render(
     );
     let scene = Scene {
         volume,
+        mask,
         macrocells,
         blend,
         range,
@@ -80,11 +93,11 @@ pub fn render(
         .enumerate()
         .for_each(|(row, pixels)| {
             for (col, pixel) in pixels.iter_mut().enumerate() {
-                let rgba = match sampling.pixel(view, col, row) {
-                    Some(ray) => {
-                        let f = scene.project(&ray);
-                        Vec3::from(projection_color(classifier, f)).extend(1.0)
-                    }
+                let value = sampling
+                    .pixel(view, col, row)
+                    .and_then(|ray| scene.project(&ray));
+                let rgba = match value {
+                    Some(f) => Vec3::from(projection_color(classifier, f)).extend(1.0),
                     None => Vec3::from(background).extend(0.0),
                 };
                 *pixel = rgba.to_array();
@@ -94,8 +107,9 @@ pub fn render(
 }
 
 impl Scene<'_> {
-    /// The projected value of one ray's samples (it has at least one).
-    fn project(&self, ray: &PixelSamples) -> f32 {
+    /// The projected value of one ray's samples (it has at least one), or
+    /// `None` if the mask skips them all.
+    fn project(&self, ray: &PixelSamples) -> Option<f32> {
         let dims = self.volume.dims();
         let data = self.volume.data();
         let top = Vec3::new(
@@ -106,15 +120,31 @@ impl Scene<'_> {
         let start = (ray.origin + ray.t(ray.first) * ray.direction).as_vec3();
         let delta = (ray.step * ray.direction).as_vec3();
         let at = |k: i64| (start + delta * (k - ray.first) as f32).clamp(Vec3::ZERO, top);
+        // Whether sample `k`, at `p`, is skipped: tested only near a masked
+        // voxel, on the reference's position.
+        let skipped = |k: i64, p: Vec3| {
+            self.mask
+                .is_some_and(|m| m.near_point(p) && m.skips(ray.position(k, dims)))
+        };
         // Maximum and minimum are one search: for the minimum, the largest −f.
         let sign = match self.blend {
             Blend::Maximum => 1.0,
             Blend::Minimum => -1.0,
             Blend::Average | Blend::Composite => {
-                let sum: f64 = (ray.first..=ray.last)
-                    .map(|k| sample_scalar(data, dims, at(k)) as f64)
-                    .sum();
-                return (sum / ray.count() as f64) as f32;
+                let (sum, count) = match self.mask {
+                    None => {
+                        let sum: f64 = (ray.first..=ray.last)
+                            .map(|k| sample_scalar(data, dims, at(k)) as f64)
+                            .sum();
+                        (sum, ray.count())
+                    }
+                    Some(_) => (ray.first..=ray.last)
+                        .filter_map(|k| Some(at(k)).filter(|&p| !skipped(k, p)))
+                        .fold((0.0f64, 0usize), |(sum, count), p| {
+                            (sum + sample_scalar(data, dims, p) as f64, count + 1)
+                        }),
+                };
+                return (count > 0).then(|| (sum / count as f64) as f32);
             }
         };
         let largest = if sign > 0.0 {
@@ -124,6 +154,7 @@ impl Scene<'_> {
         };
         let grid = &self.macrocells.grid;
         let mut best = f32::NEG_INFINITY;
+        let mut counted = false;
         let mut k = ray.first;
         // Brick by brick: the samples from k up to the brick's exit lie in
         // the brick (its box is convex), so its range bounds them all.
@@ -136,8 +167,21 @@ impl Scene<'_> {
             let next = exit(ray, grid.bounds(b)).max(k + 1);
             let bound = if sign > 0.0 { hi } else { -lo };
             if bound > best {
-                for j in k..next.min(ray.last + 1) {
-                    best = best.max(sign * sample_scalar(data, dims, at(j)));
+                let samples = k..next.min(ray.last + 1);
+                if self.mask.is_some_and(|m| m.near(b)) {
+                    for j in samples {
+                        let p = at(j);
+                        if !skipped(j, p) {
+                            best = best.max(sign * sample_scalar(data, dims, p));
+                            counted = true;
+                        }
+                    }
+                } else {
+                    // At least sample k (next > k, k <= last).
+                    for j in samples {
+                        best = best.max(sign * sample_scalar(data, dims, at(j)));
+                    }
+                    counted = true;
                 }
                 if best >= largest {
                     break;
@@ -145,7 +189,10 @@ impl Scene<'_> {
             }
             k = next;
         }
-        sign * best
+        // Without a mask every ray counts a sample (no brick's bound is
+        // below −∞, the best before the first); with one, every sample may
+        // have been skipped, and the ray shows the background.
+        counted.then_some(sign * best)
     }
 }
 

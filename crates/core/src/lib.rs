@@ -48,6 +48,8 @@
 //!   gradients packed with the values, 16 bytes per voxel). The reference
 //!   renders every option too, as the oracle ([`Method::Reference`]).
 //! - [`render`] ties it together; [`image`] is the RGBA `f32` result.
+//!   Volumes with NaN or infinite values are refused, or rendered with
+//!   those voxels as empty space ([`non_finite`]).
 //!
 //! ```
 //! use volray_core::{Renderer, RenderSettings, Volume, glam::DVec3};
@@ -82,6 +84,7 @@ pub mod intensity;
 pub mod iso;
 pub mod jitter;
 pub mod macrocells;
+pub mod non_finite;
 pub mod perspective;
 pub mod pose;
 pub mod post_cast;
@@ -107,6 +110,7 @@ pub use glam;
 pub use histogram::Histogram;
 pub use image::Image;
 pub use iso::IsoSurface;
+pub use non_finite::{NonFinite, NonFiniteMask};
 pub use post_classification::Classification;
 pub use render::{FrameTimes, Method, RenderError, RenderSettings, Renderer};
 pub use shading::Phong;

@@ -21,6 +21,7 @@
 
 use crate::classify::Classifier;
 use crate::gradient::gradients;
+use crate::non_finite::NonFiniteMask;
 use crate::shading::{LightGeometry, Phong};
 use crate::trilinear::{scalar_reference, vector_reference};
 use crate::volume::Volume;
@@ -42,6 +43,8 @@ pub struct PostClassifier<'a> {
     gradients: Vec<[f32; 3]>,
     classifier: &'a Classifier,
     lighting: Option<(&'a Phong, LightGeometry)>,
+    /// Samples this skips are empty ([`crate::non_finite`]).
+    mask: Option<&'a NonFiniteMask>,
 }
 
 impl<'a> PostClassifier<'a> {
@@ -57,11 +60,22 @@ impl<'a> PostClassifier<'a> {
             gradients: gradients(volume),
             classifier,
             lighting,
+            mask: None,
         }
+    }
+
+    /// The same, for a cleaned volume: a sample `mask` skips (a non-finite
+    /// voxel of the original weighs in it) is empty, zero colour and
+    /// opacity.
+    pub fn with_mask(self, mask: Option<&'a NonFiniteMask>) -> Self {
+        PostClassifier { mask, ..self }
     }
 
     /// Colour and opacity `(r, g, b, α)` of the sample at index-space point `p`.
     pub fn sample(&self, p: [f64; 3]) -> DVec4 {
+        if self.mask.is_some_and(|m| m.skips(p.into())) {
+            return DVec4::ZERO;
+        }
         let dims = self.volume.dims();
         let f = scalar_reference(self.volume.data(), dims, p) as f32;
         let g = vector_reference(&self.gradients, dims, p).as_vec3();

@@ -15,6 +15,10 @@
 //! - a projection (maximum, minimum, average; [`crate::blend`]): project the
 //!   interpolated scalar and show it through the colour map.
 //!
+//! Non-finite voxels rendered as empty space ([`crate::non_finite`]) have
+//! zero opacity in stage 1; post-classified and projected samples that a
+//! non-finite voxel weighs in are skipped.
+//!
 //! No shortcuts: no early termination, no empty-space skipping.
 
 use crate::blend::{Blend, ScalarProjection, projection_color};
@@ -22,6 +26,7 @@ use crate::camera::View;
 use crate::classify::Classifier;
 use crate::composite::back_to_front;
 use crate::image::Image;
+use crate::non_finite::NonFiniteMask;
 use crate::post_classification::PostClassifier;
 use crate::sampling::Sampling;
 use crate::stage1::ShadedVolume;
@@ -43,6 +48,8 @@ pub enum Shader<'a> {
         volume: &'a Volume,
         blend: Blend,
         classifier: &'a Classifier,
+        /// Samples this skips are not counted ([`crate::non_finite`]).
+        mask: Option<&'a NonFiniteMask>,
     },
 }
 
@@ -86,9 +93,13 @@ pub fn render(
                         volume,
                         blend,
                         classifier,
+                        mask,
                     } => {
                         let mut projection = ScalarProjection::new(*blend);
                         for p in positions {
+                            if mask.is_some_and(|m| m.skips(p.into())) {
+                                continue;
+                            }
                             projection.add(scalar_reference(volume.data(), dims, p));
                         }
                         match projection.value() {

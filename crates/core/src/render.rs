@@ -16,6 +16,11 @@
 //! box, clip planes and jitter. [`Method::Reference`] runs the reference
 //! path ([`crate::reference`]), which renders every option too, as the
 //! oracle.
+//!
+//! **Non-finite values.** [`Renderer::new`] refuses a volume with NaN or
+//! infinite values; [`Renderer::with_non_finite`] with
+//! [`NonFinite::Transparent`] renders them as empty space, from a cleaned
+//! copy and a mask (see [`crate::non_finite`] for the exact rules).
 
 use crate::blend::Blend;
 use crate::camera::{Camera, CameraError, View};
@@ -28,6 +33,7 @@ use crate::image::Image;
 use crate::intensity;
 use crate::iso::IsoSurface;
 use crate::macrocells::Macrocells;
+use crate::non_finite::{NonFinite, NonFiniteMask};
 use crate::post_classification::{Classification, PostClassifier};
 use crate::ray::GridFrame;
 use crate::reference::Shader;
@@ -40,6 +46,7 @@ use crate::transfer_function::TransferFunction;
 use crate::volume::Volume;
 use crate::{post_cast, raycast, reference};
 use glam::DVec3;
+use std::borrow::Cow;
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -258,7 +265,11 @@ impl RenderSettings {
 /// Frames of one `Renderer` are rendered one at a time: a frame holds the
 /// fast path's buffers while it runs.
 pub struct Renderer<'v> {
-    volume: &'v Volume,
+    /// The volume as rendered: the caller's, or its cleaned copy where it
+    /// has non-finite values rendered as empty space.
+    volume: Cow<'v, Volume>,
+    /// The non-finite voxels, when they are rendered as empty space.
+    non_finite: Option<NonFiniteMask>,
     value_range: (f32, f32),
     macrocells: OnceLock<Macrocells>,
     /// The largest gradient magnitude, found on the first frame that needs it.
@@ -304,16 +315,31 @@ impl FrameTimes {
 impl<'v> Renderer<'v> {
     /// Prepares `volume`; refuses one with non-finite values.
     pub fn new(volume: &'v Volume) -> Result<Self, RenderError> {
+        Self::with_non_finite(volume, NonFinite::Refuse)
+    }
+
+    /// Prepares `volume`, whose non-finite values are refused
+    /// ([`RenderError::NonFinite`]) or rendered as empty space, as `mode`
+    /// says. Rendered as empty space, they cost a cleaned copy of the
+    /// volume and a bit per voxel (see [`crate::non_finite`]); a volume
+    /// without them is used as it is, whatever `mode`.
+    pub fn with_non_finite(volume: &'v Volume, mode: NonFinite) -> Result<Self, RenderError> {
         let count = volume.count_non_finite();
-        if count > 0 {
+        if count > 0 && mode == NonFinite::Refuse {
             return Err(RenderError::NonFinite {
                 count,
                 total: volume.len(),
             });
         }
-        let value_range = volume.value_range().expect("a volume has finite values");
+        let (volume, non_finite) = match NonFiniteMask::clean(volume) {
+            None => (Cow::Borrowed(volume), None),
+            Some((mask, cleaned)) => (Cow::Owned(cleaned), Some(mask)),
+        };
+        // Finite values only; none at all: an empty window at the fill value.
+        let value_range = volume.value_range().unwrap_or((0.0, 0.0));
         Ok(Renderer {
             volume,
+            non_finite,
             value_range,
             macrocells: OnceLock::new(),
             max_gradient: OnceLock::new(),
@@ -322,8 +348,16 @@ impl<'v> Renderer<'v> {
         })
     }
 
+    /// The volume as rendered: the one given, or, where its non-finite
+    /// values are rendered as empty space, its cleaned copy (those voxels
+    /// hold [`NonFiniteMask::fill`]).
     pub fn volume(&self) -> &Volume {
-        self.volume
+        &self.volume
+    }
+
+    /// The non-finite voxels rendered as empty space, if there are any.
+    pub fn non_finite(&self) -> Option<&NonFiniteMask> {
+        self.non_finite.as_ref()
     }
 
     /// `(fmin, fmax)` of the volume.
@@ -443,7 +477,9 @@ impl<'v> Renderer<'v> {
 
     /// The volume's largest gradient magnitude (world units), found once.
     pub fn max_gradient(&self) -> f32 {
-        *self.max_gradient.get_or_init(|| max_magnitude(self.volume))
+        *self
+            .max_gradient
+            .get_or_init(|| max_magnitude(&self.volume))
     }
 
     /// This frame's light: towards the light and towards the viewer. The
@@ -460,16 +496,25 @@ impl<'v> Renderer<'v> {
     }
 
     /// The reference path's stage 1: colour and opacity of every voxel for
-    /// this frame's light and view, from gradients computed afresh.
+    /// this frame's light and view, from gradients computed afresh. Masked
+    /// non-finite voxels get zero opacity.
     pub fn stage1(&self, settings: &RenderSettings, view: &View) -> ShadedVolume {
         let light = Self::light(settings, view);
         let lighting = settings.shading.then_some((&settings.phong, &light));
-        shade_and_classify(
-            self.volume,
-            &gradients(self.volume),
+        let mut shaded = shade_and_classify(
+            &self.volume,
+            &gradients(&self.volume),
             &self.classifier(settings),
             lighting,
-        )
+        );
+        if let Some(mask) = &self.non_finite {
+            for (i, voxel) in shaded.voxels.iter_mut().enumerate() {
+                if mask.contains(i) {
+                    voxel.w = 0.0;
+                }
+            }
+        }
+        shaded
     }
 
     /// The reference path, with every option: the paper's stage 1 and
@@ -498,13 +543,15 @@ impl<'v> Renderer<'v> {
             (Blend::Composite, Classification::Post) => {
                 let light = Self::light(settings, &frame.view);
                 let lighting = settings.shading.then_some((&settings.phong, light));
-                let post = PostClassifier::new(self.volume, &classifier, lighting);
+                let post = PostClassifier::new(&self.volume, &classifier, lighting)
+                    .with_mask(self.non_finite.as_ref());
                 render(&Shader::Post(&post))
             }
             (blend, _) => render(&Shader::Projection {
-                volume: self.volume,
+                volume: &self.volume,
                 blend,
                 classifier: &classifier,
+                mask: self.non_finite.as_ref(),
             }),
         }
     }
@@ -526,9 +573,12 @@ impl<'v> Renderer<'v> {
             return self.render_bricks(settings, frame, image, progress);
         }
         let start = Instant::now();
-        let macrocells = self.macrocells.get_or_init(|| Macrocells::new(self.volume));
+        let macrocells = self
+            .macrocells
+            .get_or_init(|| Macrocells::new(&self.volume));
         intensity::render(
-            self.volume,
+            &self.volume,
+            self.non_finite.as_ref(),
             macrocells,
             self.value_range,
             &frame.view,
@@ -559,13 +609,16 @@ impl<'v> Renderer<'v> {
         let start = Instant::now();
         let classifier = self.classifier(settings);
         let voxels = (self.packed_voxels)
-            .get_or_init(|| post_cast::packed_voxels(self.volume, &gradients(self.volume)));
+            .get_or_init(|| post_cast::packed_voxels(&self.volume, &gradients(&self.volume)));
         let scene = post_cast::PackedScene {
             voxels,
-            macrocells: self.macrocells.get_or_init(|| Macrocells::new(self.volume)),
+            macrocells: self
+                .macrocells
+                .get_or_init(|| Macrocells::new(&self.volume)),
             classifier: &classifier,
             lighting: (settings.shading)
                 .then(|| (&settings.phong, Self::light(settings, &frame.view))),
+            mask: self.non_finite.as_ref(),
         };
         let (view, sampling) = (&frame.view, &frame.sampling);
         post_cast::render_packed(&scene, view, sampling, settings.background, image, progress);
@@ -591,8 +644,15 @@ impl<'v> Renderer<'v> {
         if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
             // Drop the old bricks before building the new ones.
             let lit = guard.take().map(|s| s.lit).unwrap_or_default();
-            let macrocells = self.macrocells.get_or_init(|| Macrocells::new(self.volume));
-            let bricks = ClassifiedBricks::new(self.volume, macrocells, &classifier);
+            let macrocells = self
+                .macrocells
+                .get_or_init(|| Macrocells::new(&self.volume));
+            let bricks = ClassifiedBricks::with_mask(
+                &self.volume,
+                macrocells,
+                &classifier,
+                self.non_finite.as_ref(),
+            );
             *guard = Some(FastState {
                 classifier,
                 bricks,
@@ -605,7 +665,7 @@ impl<'v> Renderer<'v> {
         let t2 = Instant::now();
         let light = Self::light(settings, &frame.view);
         let lighting = Lighting::new(
-            self.volume,
+            &self.volume,
             &state.bricks,
             &state.classifier,
             settings.shading.then_some((&settings.phong, &light)),
