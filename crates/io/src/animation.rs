@@ -8,7 +8,8 @@
 //! its first frame), `.gif` a looping GIF (256 colours per frame, chosen
 //! by NeuQuant). Nothing appears at the output until
 //! [`Animation::finish`]: a failed or abandoned animation leaves no file
-//! (a sequence removes the frames it wrote).
+//! (a sequence keeps its frames as temporary files and renames them all
+//! at the end, so an interrupted run leaves none of them).
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -16,9 +17,9 @@ use std::path::{Path, PathBuf};
 
 use volray_core::Image;
 
-use crate::atomic::AtomicFile;
+use crate::atomic::{AtomicFile, PendingFile, publish_all};
 use crate::error::IoError;
-use crate::png::{BitDepth, quantize_8, write_png};
+use crate::png::{BitDepth, quantize_8, write_png_pending};
 
 /// How an animation is stored.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -71,7 +72,8 @@ pub fn sequence_path(pattern: &Path, index: usize) -> Option<PathBuf> {
 enum Sink {
     Apng(Box<png::Writer<BufWriter<File>>>, AtomicFile),
     Gif(Box<gif::Encoder<BufWriter<File>>>, AtomicFile),
-    Sequence(Vec<PathBuf>),
+    /// The frames written so far, published together by `finish`.
+    Sequence(Vec<PendingFile>),
 }
 
 /// An animation being written.
@@ -203,8 +205,7 @@ impl Animation {
             Sink::Sequence(written) => {
                 let file =
                     sequence_path(&path, self.written).expect("the kind checked the pattern");
-                write_png(&file, image, BitDepth::Eight)?;
-                written.push(file);
+                written.push(write_png_pending(&file, image, BitDepth::Eight)?);
             }
         }
         self.written += 1;
@@ -244,22 +245,7 @@ impl Animation {
                 file.commit()?;
                 Ok(vec![path.clone()])
             }
-            Sink::Sequence(written) => Ok(written),
-        }
-    }
-}
-
-impl Drop for Animation {
-    /// An unfinished sequence removes the frames it wrote ([`finish`]
-    /// takes them out first); APNG and GIF temporary files delete
-    /// themselves.
-    ///
-    /// [`finish`]: Animation::finish
-    fn drop(&mut self) {
-        if let Sink::Sequence(written) = &self.sink {
-            for f in written {
-                let _ = std::fs::remove_file(f);
-            }
+            Sink::Sequence(written) => publish_all(written),
         }
     }
 }
@@ -392,5 +378,29 @@ mod tests {
         assert!(a.push(&Image::new(3, 3, [0.0; 4])).is_err());
         assert!(Animation::create(&dir.path().join("u.mp4"), 4, 3, 1, 10.0).is_err());
         assert!(Animation::create(&dir.path().join("u.gif"), 4, 3, 1, 0.0).is_err());
+    }
+
+    #[test]
+    fn a_sequence_appears_all_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("s_%d.png");
+        // An earlier run's frame 0 stays as it was until the new sequence
+        // is complete: a run stopped half way (Ctrl-C) must not leave a mix.
+        let old = dir.path().join("s_0.png");
+        std::fs::write(&old, b"earlier frame").unwrap();
+        let mut a = Animation::create(&p, 4, 3, 3, 10.0).unwrap();
+        a.push(&frame(0.0)).unwrap();
+        a.push(&frame(1.0)).unwrap();
+        let during = names(dir.path());
+        assert_eq!(std::fs::read(&old).unwrap(), b"earlier frame");
+        assert!(!during.contains(&"s_1.png".to_string()), "{during:?}");
+        // The frames wait as listed temporary files, which a signal
+        // handler would delete.
+        let temps: Vec<&String> = during.iter().filter(|n| n.ends_with(".tmp")).collect();
+        assert_eq!(temps.len(), 2, "{during:?}");
+        a.push(&frame(0.5)).unwrap();
+        assert_eq!(a.finish().unwrap().len(), 3);
+        assert_eq!(names(dir.path()), ["s_0.png", "s_1.png", "s_2.png"]);
+        assert_ne!(std::fs::read(&old).unwrap(), b"earlier frame");
     }
 }

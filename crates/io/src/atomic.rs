@@ -1,8 +1,14 @@
 //! Atomic file replacement: a destination is either left as it was or
 //! replaced by the complete new contents, never half written.
+//!
+//! Every temporary file is also listed in a process-wide registry while it
+//! lives, so that a process stopped by a signal (Ctrl-C) can delete them
+//! before it exits ([`remove_unfinished_files`]): destructors do not run
+//! when a process exits from a signal handler.
 
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 use crate::error::IoError;
 
@@ -30,6 +36,23 @@ pub fn write_atomically(
     file.commit()
 }
 
+/// Writes a complete temporary file for `path` through `write`, like
+/// [`write_atomically`], but leaves it unpublished: [`PendingFile::publish`]
+/// or [`publish_all`] puts it in place later. For outputs made of several
+/// files (PNG sequences) that must appear together or not at all.
+pub(crate) fn write_pending(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<PendingFile, IoError> {
+    let mut file = AtomicFile::create(path)?;
+    {
+        let mut out = BufWriter::new(file.file());
+        write(&mut out).map_err(|e| IoError::os(path, "write", e))?;
+        out.flush().map_err(|e| IoError::os(path, "write", e))?;
+    }
+    file.into_pending()
+}
+
 /// A file being written that appears at its path only when complete: for
 /// outputs written piece by piece (animations), where
 /// [`write_atomically`]'s single closure does not fit.
@@ -42,6 +65,9 @@ pub struct AtomicFile {
     tmp: tempfile::NamedTempFile,
     path: PathBuf,
     dir: PathBuf,
+    /// Listed in the registry; dropped (unlisted) after `tmp` is renamed
+    /// or deleted, as fields drop in declaration order.
+    _registered: Registered,
 }
 
 impl AtomicFile {
@@ -60,13 +86,20 @@ impl AtomicFile {
             use std::os::unix::fs::PermissionsExt;
             builder.permissions(std::fs::Permissions::from_mode(0o666));
         }
+        // Created and listed under the registry's lock, so that a signal
+        // handler never misses a temporary file that exists.
+        let mut live = registry();
         let tmp = builder
             .tempfile_in(&dir)
             .map_err(|e| IoError::os(path, "create a temporary file for", e))?;
+        live.push(tmp.path().to_path_buf());
+        let registered = Registered(tmp.path().to_path_buf());
+        drop(live);
         Ok(AtomicFile {
             tmp,
             path: path.to_path_buf(),
             dir,
+            _registered: registered,
         })
     }
 
@@ -80,6 +113,23 @@ impl AtomicFile {
         &self.path
     }
 
+    /// Syncs the contents to disk and closes the temporary file without
+    /// publishing it: it stays listed (and is deleted on a signal or when
+    /// the [`PendingFile`] is dropped), holding no file descriptor, so that
+    /// a sequence of many frames can wait for its last one.
+    pub(crate) fn into_pending(self) -> Result<PendingFile, IoError> {
+        self.tmp
+            .as_file()
+            .sync_all()
+            .map_err(|e| IoError::os(&self.path, "sync", e))?;
+        Ok(PendingFile {
+            tmp: self.tmp.into_temp_path(),
+            path: self.path,
+            dir: self.dir,
+            _registered: self._registered,
+        })
+    }
+
     /// Syncs the contents to disk and renames the temporary file over the
     /// destination.
     pub fn commit(self) -> Result<(), IoError> {
@@ -88,14 +138,120 @@ impl AtomicFile {
             .as_file()
             .sync_all()
             .map_err(|e| IoError::os(&path, "sync", e))?;
-        // On failure the PersistError holds the temporary file; dropping it
-        // deletes the file.
-        self.tmp
-            .persist(&path)
-            .map_err(|e| IoError::os(&path, "replace", e.error))?;
+        // Renamed under the registry's lock: a signal handler waits for the
+        // rename, then finds the file either published whole or still
+        // listed as temporary. On failure the PersistError holds the
+        // temporary file; dropping it deletes the file.
+        let live = registry();
+        let persisted = self.tmp.persist(&path);
+        drop(live);
+        persisted.map_err(|e| IoError::os(&path, "replace", e.error))?;
         sync_dir(&self.dir);
         Ok(())
     }
+}
+
+/// A complete, closed temporary file waiting to be renamed to its path
+/// (see [`write_pending`]); dropping it deletes the temporary file.
+#[derive(Debug)]
+pub(crate) struct PendingFile {
+    tmp: tempfile::TempPath,
+    path: PathBuf,
+    dir: PathBuf,
+    /// Dropped (unlisted) after `tmp`, as in [`AtomicFile`].
+    _registered: Registered,
+}
+
+/// Renames every pending file to its path, in order, under the registry's
+/// lock: a signal handler waits for the whole set, so an interrupted run
+/// leaves either all of them published or none (the temporary files of
+/// the rest are deleted). Stops at the first failure; the files not yet
+/// renamed are then deleted.
+pub(crate) fn publish_all(files: Vec<PendingFile>) -> Result<Vec<PathBuf>, IoError> {
+    let mut published = Vec::with_capacity(files.len());
+    // Unlisting takes the lock, so the entries are dropped after it is
+    // released; so are the files not renamed after a failure.
+    let mut entries = Vec::with_capacity(files.len());
+    let mut failure = None;
+    let mut dirs: Vec<PathBuf> = Vec::new();
+    {
+        let _live = registry();
+        let mut rest = files.into_iter();
+        for file in rest.by_ref() {
+            let PendingFile {
+                tmp,
+                path,
+                dir,
+                _registered,
+            } = file;
+            entries.push(_registered);
+            if let Err(e) = tmp.persist(&path) {
+                // The PersistError holds the temporary path; dropped below.
+                failure = Some((IoError::os(&path, "replace", e.error), e.path));
+                break;
+            }
+            if !dirs.contains(&dir) {
+                dirs.push(dir);
+            }
+            published.push(path);
+        }
+        let unrenamed: Vec<PendingFile> = rest.collect();
+        drop(_live);
+        drop(unrenamed);
+    }
+    drop(entries);
+    for dir in &dirs {
+        sync_dir(dir);
+    }
+    match failure {
+        Some((error, tmp)) => {
+            drop(tmp);
+            Err(error)
+        }
+        None => Ok(published),
+    }
+}
+
+/// The temporary files of the live [`AtomicFile`]s.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn registry() -> MutexGuard<'static, Vec<PathBuf>> {
+    // A panic elsewhere while holding the lock leaves a list still valid.
+    LIVE.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// An [`AtomicFile`]'s entry in the registry, unlisted when dropped.
+#[derive(Debug)]
+struct Registered(PathBuf);
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        let mut live = registry();
+        if let Some(i) = live.iter().position(|p| *p == self.0) {
+            live.swap_remove(i);
+        }
+    }
+}
+
+/// Deletes the temporary file of every [`AtomicFile`] still being
+/// written, and returns how many it deleted: for a process about to exit
+/// without running destructors (on a signal, or when standard output is
+/// closed), so that it leaves no partial output behind.
+///
+/// The registry stays locked afterwards, so that no other thread can start
+/// or publish a file between this call and the exit: call it only right
+/// before `std::process::exit`. Any other thread that then tries to create
+/// or commit an [`AtomicFile`] waits for the exit.
+pub fn remove_unfinished_files() -> usize {
+    let live = registry();
+    let mut removed = 0;
+    for path in live.iter() {
+        if std::fs::remove_file(path).is_ok() {
+            removed += 1;
+        }
+    }
+    std::mem::forget(live);
+    removed
 }
 
 /// The directory `path` will be created in, checked to exist, with `path`
@@ -152,6 +308,26 @@ mod tests {
             .collect();
         names.sort();
         names
+    }
+
+    fn listed(tmp: &Path) -> bool {
+        registry().iter().any(|p| p == tmp)
+    }
+
+    #[test]
+    fn temporary_files_are_listed_while_they_live() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut committed = AtomicFile::create(&dir.path().join("a.bin")).unwrap();
+        committed.file().write_all(b"a").unwrap();
+        let tmp_a = committed.tmp.path().to_path_buf();
+        let dropped = AtomicFile::create(&dir.path().join("b.bin")).unwrap();
+        let tmp_b = dropped.tmp.path().to_path_buf();
+        assert!(tmp_a.exists() && tmp_b.exists());
+        assert!(listed(&tmp_a) && listed(&tmp_b));
+        committed.commit().unwrap();
+        drop(dropped);
+        assert!(!listed(&tmp_a) && !listed(&tmp_b));
+        assert_eq!(entries(dir.path()), ["a.bin"]);
     }
 
     #[test]

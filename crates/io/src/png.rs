@@ -11,7 +11,7 @@ use std::path::Path;
 
 use volray_core::Image;
 
-use crate::atomic::write_atomically;
+use crate::atomic::{PendingFile, write_pending};
 use crate::error::IoError;
 
 /// Bits per channel of a written PNG.
@@ -44,8 +44,18 @@ pub fn quantize_16(c: f32) -> u16 {
 const PNG_MAX_SIDE: usize = (1 << 31) - 1;
 
 /// Writes `image` to `path` as an RGB PNG of the given bit depth, top row
-/// first, atomically (see [`write_atomically`]).
+/// first, atomically (see [`write_atomically`](crate::write_atomically)).
 pub fn write_png(path: &Path, image: &Image, depth: BitDepth) -> Result<(), IoError> {
+    crate::atomic::publish_all(vec![write_png_pending(path, image, depth)?]).map(|_| ())
+}
+
+/// Encodes `image` as [`write_png`] does into a complete temporary file
+/// for `path`, published later (frames of a PNG sequence).
+pub(crate) fn write_png_pending(
+    path: &Path,
+    image: &Image,
+    depth: BitDepth,
+) -> Result<PendingFile, IoError> {
     let (width, height) = (image.width(), image.height());
     let side_ok = |n: usize| (1..=PNG_MAX_SIDE).contains(&n);
     if !side_ok(width) || !side_ok(height) {
@@ -79,7 +89,7 @@ pub fn write_png(path: &Path, image: &Image, depth: BitDepth) -> Result<(), IoEr
         }
     }
 
-    write_atomically(path, |w| {
+    write_pending(path, |w| {
         // Sides were checked to be at most 2^31 − 1, so they fit in u32.
         let mut encoder = ::png::Encoder::new(w, width as u32, height as u32);
         encoder.set_color(::png::ColorType::Rgb);
