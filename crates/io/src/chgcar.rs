@@ -40,6 +40,7 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{check_held, format_bytes};
 use crate::periodic_cell;
 use crate::text_reader::{TextReader, number, parse_number};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -105,6 +106,20 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
                     Content::ChargeTimesVolume => 1.0 / p.volume,
                     Content::Unscaled(_) => 1.0,
                 };
+                // The block, and a copy with the periodic planes added.
+                let closed = ng.iter().map(|&n| n as u128 + 1).product::<u128>();
+                let peak = (count as u128 + closed) * 4;
+                check_held(
+                    path,
+                    &format!("NGX NGY NGZ {} {} {}", ng[0], ng[1], ng[2]),
+                    count as u128,
+                    peak,
+                    &format!(
+                        "{} as f32 with the closed periodic copy",
+                        format_bytes(peak)
+                    ),
+                    opts.max_memory,
+                )?;
                 let mut data = Vec::with_capacity(count);
                 r.tokens(count, &what, |_, t| {
                     data.push((number(t, "grid value")? * scale) as f32);
@@ -212,6 +227,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             DVec3::ZERO,
             ["a", "b", "c"],
             "angstrom",
+            opts.max_memory,
         )
         .map_err(|e| IoError::invalid(path, format!("lattice: {e}")))?;
         info.notes.push(note);

@@ -33,6 +33,7 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{F32_BYTES, check_dims};
 use crate::periodic_cell;
 use crate::text_reader::{TextReader, integer, number};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -270,6 +271,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     }
 
+    check_dims(path, "N1 x N2 x N3", &counts, F32_BYTES, opts.max_memory)?;
     let mut data = Vec::with_capacity(points);
     r.tokens(total, "the grid", |i, t| {
         if i % per_point == frame {
@@ -290,6 +292,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             origin,
             ["axis 3", "axis 2", "axis 1"],
             unit,
+            opts.max_memory,
         )
         .map_err(|e| invalid(format!("axis steps: {e}")))?;
         info.notes.push(note);

@@ -51,6 +51,7 @@ use self::prescan::{Prescan, prescan};
 use self::stack::{Stack, stack, volumes};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
+use crate::limits::{F32_BYTES, check_volume_size};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// A directory with more entries than this is refused before any is read
@@ -86,7 +87,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
                 return Err(IoError::invalid(path, format!("DICOM: {reason}")));
             }
         };
-        read_multiframe(path, header, opts.frame, FileInfo::new(""))
+        read_multiframe(path, header, opts.frame, opts.max_memory, FileInfo::new(""))
     }
 }
 
@@ -96,6 +97,7 @@ fn read_multiframe(
     path: &Path,
     header: FileHeader,
     volume: Option<usize>,
+    max_memory: u64,
     mut info: FileInfo,
 ) -> Result<Loaded, IoError> {
     let format = header
@@ -137,11 +139,27 @@ fn read_multiframe(
     let names = |i: usize| format!("frame {}", frames[i]);
     let grid = geometry(path, &planes, &names, &header, &mut info)?;
 
+    // Every frame is held twice (the parsed element and the decoded
+    // samples) beside the f32 volume: bound them all by the limit.
+    let stored = format
+        .float
+        .map_or(format.sample_bytes(), |b| usize::from(b / 8));
+    check_volume_size(
+        path,
+        "Rows x Columns x NumberOfFrames",
+        &[
+            format.rows as u64,
+            format.columns as u64,
+            header.frames as u64,
+        ],
+        2 * stored as u64 + F32_BYTES,
+        max_memory,
+    )?;
     let bytes = read_all(path)?;
     let obj = parse_whole(path, &bytes)?;
     drop(bytes);
     let decoded = decode(path, &obj, &format, header.frames)?;
-    let mut data = allocate(path, &format, grid.order.len())?;
+    let mut data = allocate(path, &format, grid.order.len(), max_memory)?;
     for &k in &grid.order {
         frame_values(&decoded, frames[k], &format, &planes[k], &mut data);
     }
@@ -263,7 +281,8 @@ fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             let header = files.pop().expect("one file");
             let path = header.path.clone();
             let volume = if count == 1 { opts.frame } else { None };
-            let mut loaded = read_multiframe(&path, header, volume, FileInfo::new(""))?;
+            let mut loaded =
+                read_multiframe(&path, header, volume, opts.max_memory, FileInfo::new(""))?;
             if count > 1 {
                 loaded.info.notes.extend(info.notes);
             } else {
@@ -329,7 +348,7 @@ fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             (e, _) => e,
         })?;
 
-    let mut data = allocate(dir, &format, files.len())?;
+    let mut data = allocate(dir, &format, files.len(), opts.max_memory)?;
     for &k in &grid.order {
         let h = &files[k];
         let bytes = read_all(&h.path)?;
@@ -471,13 +490,21 @@ fn check_pixel_data(header: &FileHeader, format: &ImageFormat) -> Result<(), IoE
     }
 }
 
-/// The output buffer for `slices` slices of `format`.
-fn allocate(path: &Path, format: &ImageFormat, slices: usize) -> Result<Vec<f32>, IoError> {
-    let n = format
-        .rows
-        .checked_mul(format.columns)
-        .and_then(|n| n.checked_mul(slices))
-        .ok_or_else(|| IoError::invalid(path, "volume too large to address"))?;
+/// The output buffer for `slices` slices of `format`, refused if it would
+/// take more than `max_memory`.
+fn allocate(
+    path: &Path,
+    format: &ImageFormat,
+    slices: usize,
+    max_memory: u64,
+) -> Result<Vec<f32>, IoError> {
+    let n = check_volume_size(
+        path,
+        "Columns x Rows x slices",
+        &[format.columns as u64, format.rows as u64, slices as u64],
+        F32_BYTES,
+        max_memory,
+    )?;
     let mut data = Vec::new();
     data.try_reserve_exact(n).map_err(|_| {
         IoError::invalid(

@@ -31,6 +31,7 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{check_held, count_values, format_bytes};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
 /// A dataset may decode to at most this many times the file's length
@@ -139,6 +140,21 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         )));
     }
 
+    // The f32 volume, and one slab of f64 values (at most a plane's worth
+    // beyond SLAB_SAMPLES) while reading.
+    let shape_dims: Vec<u64> = shape.iter().map(|&n| n as u64).collect();
+    count_values(&file_path, "shape", &shape_dims)?;
+    let slab_values = dims[1] * dims[2] * slab_planes(dims[1] * dims[2], 1).min(dims[0]);
+    let peak = voxels as u128 * 4 + slab_values as u128 * 8;
+    check_held(
+        &file_path,
+        &format!("dataset shape {shape:?}"),
+        voxels as u128,
+        peak,
+        &format!("{} as f32 and an f64 slab", format_bytes(peak)),
+        opts.max_memory,
+    )?;
+
     let mut info = FileInfo::new(stored_type(&dataset, &descriptor));
     info.frames = frames;
     info.frame = frame;
@@ -186,7 +202,7 @@ fn read_volume(
         .and_then(|c| c.get(usize::from(series)).copied())
         .unwrap_or(1)
         .max(1);
-    let slab = (SLAB_SAMPLES / plane / chunk0).max(1) * chunk0;
+    let slab = slab_planes(plane, chunk0);
     let mut data = vec![0.0f32; voxels];
     let mut x0 = 0;
     while x0 < n0 {
@@ -203,6 +219,18 @@ fn read_volume(
         x0 = x1;
     }
     Ok(data)
+}
+
+/// Planes of the first axis read at once: whole chunks adding up to about
+/// [`SLAB_SAMPLES`], or, where one chunk is larger than that, as many
+/// planes as fit [`SLAB_SAMPLES`] (at least one), so that a header's chunk
+/// size cannot make the scratch buffer large.
+fn slab_planes(plane: usize, chunk0: usize) -> usize {
+    if plane.saturating_mul(chunk0) <= SLAB_SAMPLES {
+        (SLAB_SAMPLES / plane / chunk0).max(1) * chunk0
+    } else {
+        (SLAB_SAMPLES / plane).max(1)
+    }
 }
 
 /// Spacing and origin from the dataset's attributes (see the module docs).

@@ -9,8 +9,18 @@ use crate::error::IoError;
 /// Samples decoded per chunk: bounds the scratch memory beside the output.
 const CHUNK_SAMPLES: usize = 1 << 16;
 
-/// Opens `path` for reading and returns it with its length in bytes.
+/// Opens `path` for reading and returns it with its length in bytes; a
+/// path that is not a regular file (a directory, a FIFO, a device) is
+/// refused without being opened.
 pub(crate) fn open_input(path: &Path) -> Result<(File, u64), IoError> {
+    // Checked before opening too: opening a FIFO for reading blocks until
+    // a writer comes, so a header naming one as its data file would hang.
+    let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, "open", e))?;
+    if !meta.is_file() {
+        return Err(IoError::NotAFile {
+            path: path.to_path_buf(),
+        });
+    }
     let file = File::open(path).map_err(|e| IoError::os(path, "open", e))?;
     let meta = file
         .metadata()

@@ -44,6 +44,8 @@
 //! the lines and field values of NRRD and MetaImage headers, and
 //! `payload.rs` their data (skips, encodings, multi-file lists) within the
 //! file's bounds; [`inflate_exact`] inflates to a declared size;
+//! [`check_volume_size`] (`limits.rs`) checks a header's dimensions for
+//! overflow and against [`ReadOptions::max_memory`] (`--max-memory`);
 //! `text_reader.rs` streams numbers out of text formats and text data;
 //! `periodic_cell.rs` resamples skewed periodic cells.
 //!
@@ -90,6 +92,7 @@ mod geometry;
 #[cfg(feature = "hdf5")]
 mod hdf5;
 mod input;
+mod limits;
 mod metaimage;
 mod mrc;
 mod nifti;
@@ -114,12 +117,16 @@ use volray_core::Volume;
 
 pub use self::png::{BitDepth, quantize_8, quantize_16, write_png};
 pub use animation::{Animation, AnimationKind, sequence_path};
-pub use atomic::{AtomicFile, write_atomically};
+pub use atomic::{AtomicFile, remove_unfinished_files, write_atomically};
 pub use compress::{Compression, inflate_exact};
 pub use dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
 pub use error::IoError;
 pub use exr::write_exr;
 pub use geometry::grid_to_volume;
+pub use limits::{
+    FALLBACK_MAX_MEMORY, check_memory, check_volume_size, count_values, default_max_memory,
+    format_bytes, parse_size,
+};
 pub use npy::{read_npy, write_npy};
 pub use nrrd::write_nrrd;
 pub use raw::{RawOptions, read_raw, write_raw};
@@ -313,7 +320,7 @@ impl FromStr for VolumeFormat {
 }
 
 /// How to read a file: everything a reader may need beyond the path.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct ReadOptions {
     /// Read as this format, whatever the name and content say (`--format`).
     pub format: Option<VolumeFormat>,
@@ -327,6 +334,23 @@ pub struct ReadOptions {
     /// Which named array of a file holding several (`--array`): VTK point
     /// or cell data arrays.
     pub array: Option<String>,
+    /// The most bytes the decoded volume and the reader's whole-payload
+    /// buffers may take (`--max-memory`): a header asking for more is
+    /// refused before anything is allocated (see [`check_volume_size`]).
+    /// Default: [`default_max_memory`], half the physical memory.
+    pub max_memory: u64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            format: None,
+            raw: None,
+            frame: None,
+            array: None,
+            max_memory: default_max_memory(),
+        }
+    }
 }
 
 /// A volume read from a file, with what the file said about it.
@@ -430,7 +454,7 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     match format {
         VolumeFormat::Raw => match &opts.raw {
             Some(raw) => {
-                let volume = read_raw(path, raw)?;
+                let volume = raw::read_raw_limited(path, raw, opts.max_memory)?;
                 let info = FileInfo::new(format!("{} ({}-endian)", raw.dtype, raw.endian));
                 Ok(Loaded {
                     volume,
@@ -443,7 +467,7 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             }),
         },
         VolumeFormat::Npy => {
-            let (volume, info) = npy::read_npy_with_info(path)?;
+            let (volume, info) = npy::read_npy_with_info(path, opts.max_memory)?;
             Ok(Loaded {
                 volume,
                 format,

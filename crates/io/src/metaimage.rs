@@ -27,6 +27,7 @@ use crate::dtype::{DType, Endian};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{F32_BYTES, check_frame_dims};
 use crate::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
 use crate::text_header::Field;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -225,6 +226,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         payload::check_region(&region, per_file, &layout, notes)?;
         regions.push(region);
     }
+    check_frame_dims(
+        path,
+        "MetaImage field DimSize =",
+        &dims,
+        frames,
+        F32_BYTES,
+        opts.max_memory,
+    )?;
     let data = payload::read_regions(&regions, per_file, &layout, select)?;
 
     info.length_unit = geometry.unit.clone();

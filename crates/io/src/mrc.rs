@@ -33,6 +33,7 @@ use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::{open_input, read_exact_at, read_samples};
+use crate::limits::{F32_BYTES, check_dims};
 use crate::periodic_cell;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
@@ -119,7 +120,7 @@ fn show_bytes(b: &[u8]) -> String {
 }
 
 /// Reads the CCP4/MRC map at `path` (see the module docs).
-pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> {
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let invalid = |reason: String| IoError::invalid(path, reason);
     let (mut file, file_len) = open_input(path)?;
     if file_len < HEADER_LEN as u64 {
@@ -298,6 +299,7 @@ pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> 
     }
     // The file holds the data, so these sizes fit in u64 and usize.
     let end = end as u64;
+    check_dims(path, "NX NY NZ", &dims, F32_BYTES, opts.max_memory)?;
     let count = count as usize;
     if file_len > end {
         notes.push(format!("{} bytes after the data ignored", file_len - end));
@@ -336,7 +338,15 @@ pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> 
     let names = ["X", "Y", "Z"];
     for a in 0..3 {
         let (c, n) = (f64::from(cell[a]), m[a]);
-        if c.is_finite() && c > 0.0 && n > 0 {
+        if !c.is_finite() {
+            return Err(invalid(format!(
+                "CELLA {} {} {}: the cell length along {} is not finite",
+                cell[0], cell[1], cell[2], names[a]
+            )));
+        }
+        // A cell of 0 (unset, common in tomography) gives no voxel size:
+        // 1 angstrom, as UCSF Chimera uses.
+        if c > 0.0 && n > 0 {
             voxel[a] = c / f64::from(n);
         } else {
             notes.push(format!(
@@ -382,7 +392,13 @@ pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> 
         f64::from(origin_field[1]),
         f64::from(origin_field[2]),
     );
-    let use_origin_field = map_stamp && origin_xyz != DVec3::ZERO && origin_xyz.is_finite();
+    if map_stamp && !origin_xyz.is_finite() {
+        return Err(invalid(format!(
+            "ORIGIN {} {} {} is not finite",
+            origin_field[0], origin_field[1], origin_field[2]
+        )));
+    }
+    let use_origin_field = map_stamp && origin_xyz != DVec3::ZERO;
     let origin = if use_origin_field {
         if imod && imod_flags & IMOD_ORIGIN_INVERTED != 0 {
             origin_xyz = -origin_xyz;
@@ -447,9 +463,16 @@ pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> 
             )));
         }
         let axis_names = axis_of.map(|a| names[a]);
-        let (volume, note) =
-            periodic_cell::resample(dims, &data, steps, origin, axis_names, "angstrom")
-                .map_err(|e| invalid(format!("CELLB: {e}")))?;
+        let (volume, note) = periodic_cell::resample(
+            dims,
+            &data,
+            steps,
+            origin,
+            axis_names,
+            "angstrom",
+            opts.max_memory,
+        )
+        .map_err(|e| invalid(format!("CELLB: {e}")))?;
         notes.push(note);
         volume
     } else {

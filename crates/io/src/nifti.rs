@@ -32,6 +32,7 @@ use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::{open_input, read_exact_at};
+use crate::limits::{F32_BYTES, check_frame_dims};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 use crate::compress::MAX_DEFLATE_RATIO;
@@ -659,6 +660,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 
     // The samples, in bounded chunks. A gzip stream grows the output as
     // data arrives, so a lying header fails at the end of the stream.
+    let mut dims = layout.dims.to_vec();
+    if layout.frames > 1 {
+        dims.push(layout.frames);
+    }
+    check_frame_dims(
+        path,
+        "NIfTI field \"dim\"",
+        &dims,
+        layout.frames,
+        F32_BYTES,
+        opts.max_memory,
+    )?;
     let count = layout.count;
     let size = layout.dtype.size();
     let mut data = Vec::with_capacity(if data_source.is_gzip() {

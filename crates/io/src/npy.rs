@@ -26,6 +26,7 @@ use crate::atomic::write_atomically;
 use crate::dtype::{DType, Endian, extend_f32, f16_to_f32};
 use crate::error::IoError;
 use crate::input::{open_input, read_exact_at, read_samples};
+use crate::limits::{F32_BYTES, check_dims};
 
 const MAGIC: &[u8; 6] = b"\x93NUMPY";
 
@@ -47,11 +48,15 @@ const ALIGN: usize = 64;
 /// The header is checked against the file's length before anything is
 /// allocated, and the file must end exactly where the data does.
 pub fn read_npy(path: &Path) -> Result<Volume, IoError> {
-    read_npy_with_info(path).map(|(v, _)| v)
+    read_npy_with_info(path, crate::default_max_memory()).map(|(v, _)| v)
 }
 
-/// [`read_npy`], with the header's fields for `volray info`.
-pub(crate) fn read_npy_with_info(path: &Path) -> Result<(Volume, FileInfo), IoError> {
+/// [`read_npy`], with the header's fields for `volray info`, refusing a
+/// shape whose `f32` volume would take more than `max_memory` bytes.
+pub(crate) fn read_npy_with_info(
+    path: &Path,
+    max_memory: u64,
+) -> Result<(Volume, FileInfo), IoError> {
     let (mut file, file_len) = open_input(path)?;
     let header = read_header(path, &mut file, file_len)?;
     let [nx, ny, nz] = header.shape;
@@ -59,7 +64,7 @@ pub(crate) fn read_npy_with_info(path: &Path) -> Result<(Volume, FileInfo), IoEr
         return Err(IoError::volume(path, VolumeError::TooThin(nx, ny, nz)));
     }
     // read_header checked count · size against the file, so no overflow.
-    let count = nx * ny * nz;
+    let count = check_dims(path, "shape", &header.shape, F32_BYTES, max_memory)?;
     let elem = header.elem;
     let decode = |bytes: &[u8], out: &mut Vec<f32>| elem.decode(bytes, out);
     let data = if header.fortran_order {

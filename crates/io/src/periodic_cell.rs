@@ -16,6 +16,8 @@
 use volray_core::Volume;
 use volray_core::glam::{DMat3, DVec3};
 
+use crate::limits::format_bytes;
+
 /// Cosine tolerance for "orthogonal", the same as `grid_to_volume`'s:
 /// headers written in single precision carry cosines good to about 1e-7.
 const COS_TOLERANCE: f64 = 1e-4;
@@ -56,7 +58,8 @@ pub(crate) fn angles(steps: [DVec3; 3]) -> [f64; 3] {
 /// cell's bounding box. Returns the volume and a note saying what was
 /// done, naming the index axes `names` (as the file does) and lengths in
 /// `unit`. The steps must be linearly independent and `data` must hold
-/// `dims[0]·dims[1]·dims[2]` values.
+/// `dims[0]·dims[1]·dims[2]` values. The resampled grid and `data`
+/// together must fit `max_memory` bytes (`--max-memory`).
 pub(crate) fn resample(
     dims: [usize; 3],
     data: &[f32],
@@ -64,6 +67,7 @@ pub(crate) fn resample(
     origin: DVec3,
     names: [&str; 3],
     unit: &str,
+    max_memory: u64,
 ) -> Result<(Volume, String), String> {
     let cell = DMat3::from_cols(
         steps[0] * dims[0] as f64,
@@ -122,6 +126,14 @@ pub(crate) fn resample(
     if total > 16.0 * MAX_GROWTH * points + 4096.0 {
         return Err(format!(
             "the cell's bounding box would need {nx}x{ny}x{nz} samples, far more than the file's {points} points"
+        ));
+    }
+    let held = (total + data.len() as f64) * 4.0;
+    if held > max_memory as f64 {
+        return Err(format!(
+            "resampling onto {nx}x{ny}x{nz} points beside the file's {points} takes {} as f32, more than --max-memory {}",
+            format_bytes(held as u128),
+            format_bytes(u128::from(max_memory))
         ));
     }
     let mut out = Vec::with_capacity(nx * ny * nz);
@@ -239,6 +251,7 @@ mod tests {
             origin,
             ["a", "b", "c"],
             "angstrom",
+            u64::MAX,
         )
         .unwrap();
         assert!(note.contains("angle(a, b) 120.000"), "{note}");
@@ -271,7 +284,16 @@ mod tests {
     fn outside_samples_are_periodic_images() {
         let (dims, steps) = hexagonal();
         let data: Vec<f32> = ramp(dims).iter().map(|v| (v * 0.37).sin()).collect();
-        let (v, _) = resample(dims, &data, steps, DVec3::ZERO, ["a", "b", "c"], "bohr").unwrap();
+        let (v, _) = resample(
+            dims,
+            &data,
+            steps,
+            DVec3::ZERO,
+            ["a", "b", "c"],
+            "bohr",
+            u64::MAX,
+        )
+        .unwrap();
         let (lo, hi) = v.bounds();
         let cell = [
             steps[0] * dims[0] as f64,
@@ -333,6 +355,7 @@ mod tests {
             DVec3::ZERO,
             ["a", "b", "c"],
             "angstrom",
+            u64::MAX,
         )
         .unwrap();
         assert!(v.len() as f64 <= MAX_GROWTH * 64.0 * 1.5, "{}", v.len());
@@ -344,7 +367,8 @@ mod tests {
                 flat,
                 DVec3::ZERO,
                 ["a", "b", "c"],
-                "bohr"
+                "bohr",
+                u64::MAX
             )
             .is_err()
         );

@@ -13,6 +13,7 @@ use crate::atomic::write_atomically;
 use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::input::{open_input, read_samples};
+use crate::limits::{F32_BYTES, check_dims, default_max_memory};
 
 /// The layout of a raw file.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,6 +56,16 @@ impl RawOptions {
 /// need, before anything is allocated; the read never goes past that
 /// length. The volume has `opts.spacing` and its origin at zero.
 pub fn read_raw(path: &Path, opts: &RawOptions) -> Result<Volume, IoError> {
+    read_raw_limited(path, opts, default_max_memory())
+}
+
+/// [`read_raw`], refusing a layout whose `f32` volume would take more than
+/// `max_memory` bytes (`--max-memory`).
+pub(crate) fn read_raw_limited(
+    path: &Path,
+    opts: &RawOptions,
+    max_memory: u64,
+) -> Result<Volume, IoError> {
     let [nx, ny, nz] = opts.dims;
     if nx < 2 || ny < 2 || nz < 2 {
         return Err(IoError::volume(path, VolumeError::TooThin(nx, ny, nz)));
@@ -84,6 +95,7 @@ pub fn read_raw(path: &Path, opts: &RawOptions) -> Result<Volume, IoError> {
             expected,
         });
     }
+    check_dims(path, "--dims", &opts.dims, F32_BYTES, max_memory)?;
 
     let mut data = Vec::with_capacity(count);
     let (dtype, endian) = (opts.dtype, opts.endian);

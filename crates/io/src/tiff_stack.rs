@@ -36,6 +36,7 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{F32_BYTES, check_dims};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// A compressed page may decode to more bytes than the file holds; a stack
@@ -230,6 +231,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             )
         })?;
     check_budget(path, dims, voxels, sample, file_len)?;
+    // The f32 volume, beside one decoded page at a time.
+    check_dims(
+        path,
+        "ImageWidth x ImageLength x pages",
+        &dims,
+        F32_BYTES,
+        opts.max_memory,
+    )?;
 
     let mut data = Vec::with_capacity(voxels);
     for z in 0..shape.slices {
@@ -658,6 +667,12 @@ fn list_indices(indices: &[usize]) -> String {
 /// stays one; a short or corrupt file is bad input.
 fn tiff_error(path: &Path, what: &str, error: TiffError) -> IoError {
     match error {
+        // An offset from the file that cannot be sought to (2^63 or more)
+        // fails in the operating system, but the file is what is wrong.
+        TiffError::IoError(e) if e.kind() == ErrorKind::InvalidInput => IoError::invalid(
+            path,
+            format!("TIFF {what}: an offset in the file lies beyond any file's end ({e})"),
+        ),
         TiffError::IoError(e) if e.kind() != ErrorKind::UnexpectedEof => {
             IoError::os(path, "read", e)
         }

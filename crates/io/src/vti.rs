@@ -32,6 +32,7 @@ use crate::dtype::{DType, bytes_to_f32};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{F32_BYTES, check_file_held, check_memory};
 use crate::vtk_arrays::{
     ArrayEntry, Association, cell_centres, cell_dims, no_match, not_scalar, rank, record_choice,
 };
@@ -42,6 +43,8 @@ use structure::{DataArray, Format, Structure, join, parse, type_name};
 /// Reads the VTK XML image data file at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (mut file, len) = open_input(path)?;
+    // The file is held whole (its XML locates the arrays' bytes).
+    check_file_held(path, len, opts.max_memory)?;
     let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
     file.read_to_end(&mut bytes)
         .map_err(|e| IoError::os(path, "read", e))?;
@@ -84,8 +87,25 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         .iter()
         .try_fold(1usize, |n, &d| n.checked_mul(d))
         .ok_or_else(|| {
-            IoError::invalid(path, "WholeExtent is too large: the point count overflows")
+            IoError::invalid(
+                path,
+                format!(
+                    "WholeExtent {} is too large: the point count overflows",
+                    join(&s.whole)
+                ),
+            )
         })?;
+    // Each piece's stored bytes and its f32 values are held together, and
+    // several pieces are assembled into a copy of the whole.
+    let stored = first.arrays[chosen].dtype.size() as u64;
+    let copies = if s.pieces.len() > 1 { 2 } else { 1 };
+    check_memory(
+        path,
+        &format!("WholeExtent {}", join(&s.whole)),
+        whole_count as u128,
+        stored + copies * F32_BYTES,
+        opts.max_memory,
+    )?;
 
     // Decode the chosen array of every piece (each bounded by the file).
     let mut blocks = Vec::with_capacity(s.pieces.len());

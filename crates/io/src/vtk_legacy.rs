@@ -27,6 +27,7 @@ use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::geometry::grid_to_volume;
 use crate::input::open_input;
+use crate::limits::{F32_BYTES, check_memory};
 use crate::vtk_arrays::{
     ArrayEntry, Association, cell_centres, cell_dims, no_match, not_scalar, rank, record_choice,
 };
@@ -108,6 +109,8 @@ struct Scan<'a> {
     best: Option<Best>,
     /// Sample type names of the entries, for `stored_type`.
     types: Vec<String>,
+    /// `--max-memory`: the array decoded must fit it.
+    max_memory: u64,
 }
 
 /// Reads the legacy VTK file at `path` (see the module documentation).
@@ -179,6 +182,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         tuples: Vec::new(),
         best: None,
         types: Vec::new(),
+        max_memory: opts.max_memory,
     };
 
     while let Some(word) = lx.next_token()? {
@@ -265,7 +269,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
                 info.header.push((word, format!("{name} {count}")));
                 for _ in 0..count {
                     if let Some(spec) = field_array(&mut lx, Association::Point, &mut info)? {
-                        array_values(&mut lx, encoding, &spec, false)?;
+                        array_values(&mut lx, encoding, &spec, None)?;
                     }
                 }
                 info.notes
@@ -491,7 +495,7 @@ fn attribute<R: std::io::BufRead + std::io::Seek>(
                 Encoding::Binary => (SampleType::Number(DType::U8), "unsigned_char"),
             };
             let table = spec(name, assoc, 4, false, type_name.into(), sample, size);
-            return array_values(lx, encoding, &table, false).map(|_| ());
+            return array_values(lx, encoding, &table, None).map(|_| ());
         }
         "vectors" | "normals" => simple(lx, word, assoc, 3, n, info)?,
         "tensors" => simple(lx, word, assoc, 9, n, info)?,
@@ -624,7 +628,8 @@ fn take<R: std::io::BufRead + std::io::Seek>(
     let rank = rank(&spec.entry, scan.request);
     let better = rank.filter(|&r| scan.best.as_ref().is_none_or(|b| r < b.rank));
     let usable = spec.entry.components == 1 && spec.tuples == n;
-    let mut values = array_values(lx, encoding, &spec, better.is_some() && usable)?;
+    let decode = (better.is_some() && usable).then_some(scan.max_memory);
+    let mut values = array_values(lx, encoding, &spec, decode)?;
     if spec.ascii_colour
         && let Some(values) = values.as_mut()
     {
@@ -646,13 +651,14 @@ fn take<R: std::io::BufRead + std::io::Seek>(
     Ok(())
 }
 
-/// Reads (`decode`) or skips the values of one array, then any METADATA
-/// block after it. The size is checked against the rest of the file first.
+/// Reads (`decode` holds the memory limit, `--max-memory`) or skips the
+/// values of one array, then any METADATA block after it. The size is
+/// checked against the rest of the file first, then against the limit.
 fn array_values<R: std::io::BufRead + std::io::Seek>(
     lx: &mut Lexer<R>,
     encoding: Encoding,
     spec: &ArraySpec,
-    decode: bool,
+    decode: Option<u64>,
 ) -> Result<Option<Vec<f32>>, IoError> {
     let name = &spec.entry.name;
     let count = spec
@@ -679,7 +685,14 @@ fn array_values<R: std::io::BufRead + std::io::Seek>(
                     ),
                 ));
             }
-            if decode {
+            if let Some(max_memory) = decode {
+                check_memory(
+                    lx.path(),
+                    &format!("array \"{name}\""),
+                    count as u128,
+                    F32_BYTES,
+                    max_memory,
+                )?;
                 Some(binary_values(lx, spec.sample, count)?)
             } else {
                 lx.skip(bytes)?;
@@ -697,7 +710,16 @@ fn array_values<R: std::io::BufRead + std::io::Seek>(
                     ),
                 ));
             }
-            let mut out = decode.then(|| Vec::with_capacity(count));
+            if let Some(max_memory) = decode {
+                check_memory(
+                    lx.path(),
+                    &format!("array \"{name}\""),
+                    count as u128,
+                    F32_BYTES,
+                    max_memory,
+                )?;
+            }
+            let mut out = decode.map(|_| Vec::with_capacity(count));
             for i in 0..count {
                 let t = lx.next_token()?.ok_or_else(|| {
                     IoError::invalid(

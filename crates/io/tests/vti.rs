@@ -277,7 +277,15 @@ fn lying_extents_are_refused_before_allocating() {
         "Piece Extent=\"0 3 0 2 0 4\"",
         "Piece Extent=\"0 99999 0 99999 0 99999\"",
     );
+    // The limit on memory refuses the extent first; without one, the
+    // block header's size is checked against the extent before allocating.
     let msg = error_for(&b);
+    assert!(msg.contains("exceed --max-memory"), "{msg}");
+    let unlimited = ReadOptions {
+        max_memory: u64::MAX,
+        ..ReadOptions::default()
+    };
+    let msg = refused_file("bad.vti", &b, &unlimited);
     assert!(
         msg.contains("header declares 240 bytes, but its extent and type need 4000000000000"),
         "{msg}"

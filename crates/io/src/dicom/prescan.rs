@@ -11,6 +11,9 @@
 
 use std::io::Read;
 
+use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
+use dicom_dictionary_std::StandardDataDictionary;
+use dicom_object::Tag;
 use flate2::read::DeflateDecoder;
 
 /// The transfer syntaxes whose data set encoding differs from explicit VR
@@ -79,8 +82,9 @@ const EXPLICIT_LE: Encoding = Encoding {
 
 /// Walks `bytes`, the start of a DICOM file (or all of it if `whole`),
 /// and checks every element length. With `stop_at_pixel_data` the walk
-/// ends at the first top-level element of group 7FE0 (the header reader
-/// wants only what comes before the pixels).
+/// ends at the first top-level element from (7FE0,0008) on, where the
+/// header parse stops (the header reader wants only what comes before the
+/// pixels).
 pub(super) fn prescan(
     bytes: &[u8],
     whole: bool,
@@ -299,6 +303,33 @@ fn element_header(bytes: &[u8], pos: usize, enc: Encoding) -> Option<Header> {
     }
 }
 
+/// The size of one value of a binary VR (PS3.5 Table 6.2-1), whose
+/// values' length must be a multiple of it. The parser reads
+/// `length / size` values of such an element but moves on by `length`,
+/// so a length that is not a multiple leaves it reading the next element
+/// header from the wrong place: at a "length" made of other bytes, which
+/// it allocates before reading (found by fuzzing, docs/robustness.md).
+fn value_size(vr: [u8; 2]) -> Option<usize> {
+    match &vr {
+        b"US" | b"SS" | b"OW" => Some(2),
+        b"AT" | b"FL" | b"OF" | b"SL" | b"UL" | b"OL" => Some(4),
+        b"FD" | b"OD" | b"SV" | b"UV" | b"OV" => Some(8),
+        _ => None,
+    }
+}
+
+/// The VR the parser gives an element in implicit VR: OW for pixel and
+/// overlay data, else the dictionary's (the first of its choices), else
+/// UN (as `dicom-encoding`'s implicit VR decoder does).
+fn implicit_vr(tag: (u16, u16)) -> [u8; 2] {
+    if tag == (0x7fe0, 0x0010) || (tag.0 >> 8 == 0x60 && tag.1 == 0x3000) {
+        return *b"OW";
+    }
+    StandardDataDictionary
+        .by_tag(Tag(tag.0, tag.1))
+        .map_or(*b"UN", |entry| entry.vr().relaxed().to_bytes())
+}
+
 /// Whether `vr` is one of the VRs of PS3.5 §6.2 (the parser reads any
 /// other as UN).
 fn known_vr(vr: [u8; 2]) -> bool {
@@ -455,15 +486,19 @@ impl Walker<'_> {
                 }
                 _ => {}
             }
-            let is_pixel_data = depth == 0 && header.tag.0 == 0x7fe0;
-            if is_pixel_data {
+            if depth == 0 && matches!(header.tag, (0x7fe0, 0x0008 | 0x0009 | 0x0010)) {
                 self.pixel_data = Some(PixelData {
                     element: header.tag.1,
                     length: (header.length != UNDEFINED).then_some(header.length),
                 });
-                if self.stop_at_pixel_data {
-                    return Err(Stop::PixelData(pos));
-                }
+            }
+            // The header parse (`read_until(FloatPixelData)`) stops at the
+            // first top-level tag from (7FE0,0008) on, and reads every one
+            // before it, (7FE0,0001) and (7FE0,0002) included: the walk
+            // must check those too, since a deflated data set is parsed
+            // whole (found by fuzzing, docs/robustness.md).
+            if self.stop_at_pixel_data && depth == 0 && header.tag >= (0x7fe0, 0x0008) {
+                return Err(Stop::PixelData(pos));
             }
             if header.length == UNDEFINED {
                 // A sequence (SQ, or any implicit VR / UN element of undefined
@@ -491,6 +526,17 @@ impl Walker<'_> {
                         return Err(Stop::NeedMore);
                     }
                     return Err(Stop::Error(length_error(header, pos, end)));
+                }
+                let vr = header.vr.unwrap_or_else(|| implicit_vr(header.tag));
+                if let Some(size) = value_size(vr)
+                    && !len.is_multiple_of(size)
+                {
+                    return Err(Stop::Error(format!(
+                        "element ({:04X},{:04X}) at byte {pos} is {} ({size}-byte values) but declares {len} bytes, not a multiple of {size}",
+                        header.tag.0,
+                        header.tag.1,
+                        String::from_utf8_lossy(&vr)
+                    )));
                 }
                 if header.vr == Some(*b"SQ")
                     || (header.vr.is_none() && self.defined_sequence(value, len, enc))
@@ -661,6 +707,70 @@ mod tests {
                 "{cut}"
             );
         }
+    }
+
+    #[test]
+    fn binary_values_must_fill_whole_values() {
+        // Explicit VR: FD holds 8-byte values, so 2 bytes (the fuzz
+        // finding, tests/fuzz_regressions.rs) or 12 are refused, 16 not.
+        for (len, ok) in [(2usize, false), (12, false), (16, true), (0, true)] {
+            let mut ds = explicit(0x0008, 0x0060, b"FD", &vec![0; len]);
+            ds.extend(explicit(0x0028, 0x0010, b"US", &3u16.to_le_bytes()));
+            let result = prescan(&file(EXPLICIT, &ds), true, false);
+            match result {
+                Ok(_) => assert!(ok, "{len}"),
+                Err(err) => {
+                    assert!(!ok, "{len}: {err}");
+                    assert!(
+                        err.contains("(0008,0060)")
+                            && err.contains(&format!("declares {len} bytes, not a multiple of 8")),
+                        "{err}"
+                    );
+                }
+            }
+        }
+        // Implicit VR: the VR is the dictionary's, Rows (0028,0010) is US.
+        let mut ds = item_header((0x0028, 0x0010), 3);
+        ds.extend([3, 0, 0]);
+        let err = prescan(&file(IMPLICIT_VR_LE, &ds), true, false).unwrap_err();
+        assert!(err.contains("is US (2-byte values)"), "{err}");
+        let mut ds = item_header((0x0028, 0x0010), 2);
+        ds.extend([3, 0]);
+        assert!(prescan(&file(IMPLICIT_VR_LE, &ds), true, false).is_ok());
+        // A tag the dictionary does not know is UN: any length.
+        let mut ds = item_header((0x0009, 0x1001), 3);
+        ds.extend([3, 0, 0]);
+        assert!(prescan(&file(IMPLICIT_VR_LE, &ds), true, false).is_ok());
+    }
+
+    #[test]
+    fn header_walk_stops_where_the_header_parse_does() {
+        // An extended offset table (7FE0,0001) before the pixel data is
+        // read by the header parse, so it is checked, not taken for the
+        // pixel data.
+        let mut ds = explicit(0x0028, 0x0010, b"US", &3u16.to_le_bytes());
+        ds.extend(long(0x7fe0, 0x0001, b"OV", 8));
+        ds.extend([0; 8]);
+        let pixels_at = file(EXPLICIT, &ds).len();
+        ds.extend(long(0x7fe0, 0x0010, b"OW", 4));
+        ds.extend([1, 0, 2, 0]);
+        let f = file(EXPLICIT, &ds);
+        let Prescan::Done(head) = prescan(&f, true, true).unwrap() else {
+            panic!("whole file needs no more")
+        };
+        assert_eq!(head.end, pixels_at);
+        assert_eq!(
+            head.pixel_data,
+            Some(PixelData {
+                element: 0x0010,
+                length: Some(4)
+            })
+        );
+        // The same table declaring more bytes than the file holds.
+        let mut ds = long(0x7fe0, 0x0001, b"OV", 0x4000_0000);
+        ds.extend([0; 16]);
+        let err = prescan(&file(EXPLICIT, &ds), true, true).unwrap_err();
+        assert!(err.contains("(7FE0,0001)"), "{err}");
     }
 
     #[test]

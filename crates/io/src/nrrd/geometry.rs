@@ -320,6 +320,22 @@ impl Geometry {
             .get("axis maxs")
             .map(|v| Field::nrrd(path, "axis maxs").numbers(v, dim))
             .transpose()?;
+        // NaN is NRRD's "not known" (the spacing then defaults); an
+        // infinite spacing or bound is no value at all.
+        for (field, values) in [
+            ("spacings", &spacings),
+            ("axis mins", &mins),
+            ("axis maxs", &maxs),
+        ] {
+            if let Some(v) = values.iter().flatten().find(|v| v.is_infinite()) {
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "NRRD field \"{field}\": {v} is not a finite number (nan means not known)"
+                    ),
+                ));
+            }
+        }
         let centers = match header.get("centers") {
             Some(v) => {
                 let c: Vec<String> = Field::nrrd(path, "centers")
