@@ -163,6 +163,9 @@ impl FractalParams {
         Ok(params)
     }
 
+    /// The smallest and largest `sigma` [`validate`](Self::validate) takes.
+    pub const SIGMA_RANGE: (f64, f64) = (1e-30, 1e30);
+
     /// Checks every parameter, returning the first problem as a message
     /// (for [`DataError::Invalid`]).
     pub fn validate(&self) -> Result<(), String> {
@@ -182,9 +185,15 @@ impl FractalParams {
                 self.dimension
             ));
         }
-        if !(self.sigma > 0.0 && self.sigma.is_finite()) {
+        // The field is a sum of displacements of a few sigma stored as f32
+        // (largest 3.4e38): beyond 1e30 (or below 1e-30, where the ramp and
+        // threshold arithmetic underflows) it overflows to infinities or
+        // collapses to zeros.
+        if !(Self::SIGMA_RANGE.0..=Self::SIGMA_RANGE.1).contains(&self.sigma) {
             return Err(format!(
-                "sigma must be positive and finite, got {}",
+                "sigma must be between {:e} and {:e} (the field is stored as 32-bit floats), got {}",
+                Self::SIGMA_RANGE.0,
+                Self::SIGMA_RANGE.1,
                 self.sigma
             ));
         }
@@ -316,8 +325,21 @@ mod tests {
         assert!(err("fractal:9,dim=2.99").ends_with("got 2.99"));
         assert_eq!(
             err("fractal:9,sigma=0"),
-            "fractal:9,sigma=0: sigma must be positive and finite, got 0"
+            "fractal:9,sigma=0: sigma must be between 1e-30 and 1e30 (the field is stored \
+             as 32-bit floats), got 0"
         );
+        // Past f32's range the field would be all infinities or zeros.
+        assert!(err("fractal:5,sigma=1e300").contains("sigma must be between"));
+        assert!(err("fractal:5,sigma=1e-31").contains("sigma must be between"));
+        for sigma in [1e-30, 1e30] {
+            let p = FractalParams {
+                size: 5,
+                sigma,
+                ..FractalParams::default()
+            };
+            let v = generate(&p).unwrap();
+            assert!(v.count_non_finite() == 0, "sigma {sigma}");
+        }
         assert_eq!(
             err("fractal:9,ramp=0"),
             "fractal:9,ramp=0: ramp must be above 0 and at most 1 (a fraction of the half \
