@@ -19,7 +19,7 @@
 
 use crate::cli::RenderArgs;
 use crate::error::CliError;
-use crate::render::{load, progress_bar};
+use crate::render::{load, progress_bar, render_failure, renderer_for};
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
@@ -36,8 +36,8 @@ pub fn turntable(
     frames: usize,
 ) -> Result<(), CliError> {
     let input = load(&args.input, args.view.log)?;
-    let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
-    let renderer = Renderer::new(&input.volume).map_err(fail)?;
+    let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
+    let renderer = renderer_for(&args.view, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
     for i in 0..frames {
         let image = writer.render(pool, &renderer, &turntable_frame(base, i, frames));
@@ -69,8 +69,7 @@ pub fn series(
     let mut extent = Extent::default();
     for spec in specs {
         let input = load_one(args, spec)?;
-        let renderer = Renderer::new(&input.volume)
-            .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+        let renderer = renderer_for(&args.view, &input)?;
         extent.add(renderer.value_range(), input.volume.bounds());
         if base.gradient_opacity.is_some() {
             let max = pool.install(|| renderer.max_gradient());
@@ -83,8 +82,8 @@ pub fn series(
     let mut writer = Writer::new(args, &settings, specs.len())?;
     for spec in specs {
         let input = load_one(args, spec)?;
-        let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
-        let renderer = Renderer::new(&input.volume).map_err(fail)?;
+        let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
+        let renderer = renderer_for(&args.view, &input)?;
         let image = writer.render(pool, &renderer, &settings);
         writer.push(&image.map_err(fail)?)?;
     }

@@ -15,7 +15,7 @@ mod vtk;
 
 use crate::cli::BenchArgs;
 use crate::error::CliError;
-use crate::render::{settings, thread_pool};
+use crate::render::{render_failure, renderer_for, settings, thread_pool};
 use std::path::Path;
 use std::time::{Duration, Instant};
 use volray_core::{Camera, FrameTimes, Image, Method, RenderSettings, Renderer};
@@ -30,7 +30,31 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             }
             peers::run(args, dir)
         }
-        None => one_volume(args),
+        None => {
+            if let Some(json) = &args.json {
+                let input = args.input.input.as_deref().unwrap_or(crate::input::DEMO);
+                let tf: Vec<&Path> = args.view.tf.iter().map(|p| p.as_path()).collect();
+                crate::overwrite::refuse_overwriting_inputs(
+                    std::slice::from_ref(json),
+                    &[input.to_string()],
+                    &tf,
+                )?;
+            }
+            // clap's `requires = "peers"` lapses when a view option that
+            // conflicts with --peers is given; refuse here as well.
+            for (given, flag) in [
+                (args.cases.is_some(), "--cases"),
+                (args.vs_vtk, "--vs-vtk"),
+                (args.peers_python.is_some(), "--peers-python"),
+            ] {
+                if given {
+                    return Err(CliError::input(format!(
+                        "{flag} applies to the peer benchmark: give --peers DIR"
+                    )));
+                }
+            }
+            one_volume(args)
+        }
     }
 }
 
@@ -154,12 +178,12 @@ fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
     let input = crate::render::load(&args.input, args.view.log)?;
     let base = settings(&args.view)?;
     let pool = thread_pool(args.view.threads)?;
-    let fail = |e: volray_core::RenderError| CliError::input(format!("{}: {e}", input.name));
+    let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
 
     let median_s = pool.install(|| {
-        let renderer = Renderer::new(&input.volume).map_err(fail)?;
+        let renderer = renderer_for(&args.view, &input)?;
         let [nx, ny, nz] = input.volume.dims();
-        println!(
+        outln!(
             "volray bench: {} ({nx}x{ny}x{nz}), {}x{} pixels, step {} voxel, {} threads, {} path",
             input.name,
             base.width,
@@ -172,7 +196,7 @@ fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
                 "reference"
             },
         );
-        println!(
+        outln!(
             "{:>6} {:>11} {:>9} {:>15} {:>10}",
             "frame", "classify ms", "bin ms", "shade+cast ms", "total ms"
         );
@@ -183,22 +207,22 @@ fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
                 frame.to_string()
             };
             match t.parts {
-                Some(p) => println!(
+                Some(p) => outln!(
                     "{name:>6} {:>11.2} {:>9.2} {:>15.2} {:>10.2}",
                     ms(p.classify),
                     ms(p.bin),
                     ms(p.cast),
                     t.wall * 1e3
                 ),
-                None => println!("{name:>6} {:>48.2}", t.wall * 1e3),
+                None => outln!("{name:>6} {:>48.2}", t.wall * 1e3),
             }
         };
         let (_, timed) = time_frames(&renderer, &base, args.frames, row).map_err(fail)?;
         let total = median(timed.iter().map(|t| t.wall).collect());
-        println!("{:>6} {:>48.2}", "median", total * 1e3);
+        outln!("{:>6} {:>48.2}", "median", total * 1e3);
         let frame = renderer.prepare(&base).map_err(fail)?;
         let samples = nominal_samples(&frame);
-        println!(
+        outln!(
             "nominal samples per second: {:.3e} ({samples} samples per frame, before skipping and early termination)",
             samples as f64 / total
         );

@@ -3,6 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
+use volray_core::render::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
 use volray_data::fractal::FractalParams;
 
 #[derive(Debug, Parser)]
@@ -11,7 +12,8 @@ use volray_data::fractal::FractalParams;
     version,
     about = "Ray-casting volume renderer (Ramesh & Athithan 1993, after Levoy 1988)",
     long_about = "Ray-casting volume renderer (Ramesh & Athithan 1993, after Levoy 1988).\n\n\
-        Exit codes: 0 success, 1 bad input or arguments, 2 I/O failure."
+        Exit codes: 0 success, 1 bad input or arguments, 2 I/O failure, \
+        130 interrupted (Ctrl-C; 128 + the signal for SIGTERM and SIGHUP)."
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -51,7 +53,7 @@ pub struct PaperArgs {
     #[arg(long)]
     pub quick: bool,
     /// Worker threads [default: one per core]; Table 1 reports the count.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..), allow_hyphen_values = true)]
     pub threads: Option<u16>,
 }
 
@@ -90,17 +92,22 @@ pub struct HydrogenArgs {
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub n: u32,
     /// Orbital quantum number, 0 to n − 1.
-    #[arg(long, value_name = "L")]
+    #[arg(long, value_name = "L", allow_hyphen_values = true)]
     pub l: u32,
     /// Magnetic quantum number, −l to l.
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub m: i32,
     /// Points per side of the grid.
-    #[arg(long, value_name = "N", default_value_t = 50)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 50,
+        allow_hyphen_values = true
+    )]
     pub grid: usize,
     /// Half-width R of the cube [−R, R]³ in Bohr radii [default: the
     /// radius that holds 99.5% of the radial probability].
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
     pub extent: Option<f64>,
     /// The real orbital chemists use (p_x, p_y, d_xy, ...: cos mφ for m > 0,
     /// sin |m|φ for m < 0) instead of the complex e^{imφ} one.
@@ -115,27 +122,27 @@ pub struct HydrogenArgs {
 #[derive(Debug, Args)]
 pub struct FractalArgs {
     /// Points per side: 2^k + 1 (3, 5, 9, ..., 1025).
-    #[arg(long, value_name = "N", default_value_t = FractalParams::default().size)]
+    #[arg(long, value_name = "N", default_value_t = FractalParams::default().size, allow_hyphen_values = true)]
     pub size: usize,
     /// Fractal dimension D of the field's graph, 3 ≤ D < 4 (Hurst H = 4 − D).
-    #[arg(long, value_name = "D", default_value_t = FractalParams::default().dimension)]
+    #[arg(long, value_name = "D", default_value_t = FractalParams::default().dimension, allow_hyphen_values = true)]
     pub dimension: f64,
     /// Standard deviation of the corner values (the coarsest displacements).
-    #[arg(long, value_name = "SIGMA", default_value_t = FractalParams::default().sigma)]
+    #[arg(long, value_name = "SIGMA", default_value_t = FractalParams::default().sigma, allow_hyphen_values = true)]
     pub sigma: f64,
     /// Random seed: the same seed gives the same bytes on any machine.
-    #[arg(long, value_name = "SEED", default_value_t = FractalParams::default().seed)]
+    #[arg(long, value_name = "SEED", default_value_t = FractalParams::default().seed, allow_hyphen_values = true)]
     pub seed: u64,
     /// Post-processing: the fraction of the half width over which the
     /// field is ramped down to 0 at the boundary sphere (0 < R ≤ 1).
-    #[arg(long, value_name = "R", default_value_t = FractalParams::default().ramp)]
+    #[arg(long, value_name = "R", default_value_t = FractalParams::default().ramp, allow_hyphen_values = true)]
     pub ramp: f64,
     /// Post-processing: subtracted from the field scaled to [0, 1] (after
     /// the ramp) before negatives are set to 0 (0 ≤ T < 1).
     #[arg(long, value_name = "T", default_value_t = FractalParams::default().threshold, allow_hyphen_values = true)]
     pub threshold: f64,
     /// Skip the post-processing: write the raw midpoint-displacement field.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["ramp", "threshold"])]
     pub raw_field: bool,
     /// Voss's successive random additions: displace every point at every
     /// level, for better statistics.
@@ -154,7 +161,7 @@ pub struct InfoArgs {
     pub input: InputArgs,
 
     /// Histogram bins.
-    #[arg(long, value_name = "N", default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    #[arg(long, value_name = "N", default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=1000), allow_hyphen_values = true)]
     pub bins: u16,
 
     /// Print the description as JSON instead of text.
@@ -172,7 +179,7 @@ pub struct InputArgs {
     pub input: Option<String>,
 
     /// Raw files: points along x, y and z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_dims, help_heading = "Raw files")]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_dims, allow_hyphen_values = true, help_heading = "Raw files")]
     pub dims: Option<[usize; 3]>,
 
     /// Raw files: the sample type.
@@ -190,7 +197,7 @@ pub struct InputArgs {
     /// Voxel spacing in world units along x, y and z, replacing what the
     /// file says [default: the file's spacing; 1,1,1 for raw and .npy
     /// files; built-in sources have their own].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_positive_vec3)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_spacing, allow_hyphen_values = true)]
     pub spacing: Option<[f64; 3]>,
 
     /// Read the file as this format, whatever its name and content say
@@ -203,20 +210,28 @@ pub struct InputArgs {
 
     /// Which volume of a file that holds several, from 0: a 4-D NIfTI,
     /// NRRD or MetaImage time point, a cube file's orbital, ... [default: 0].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub frame: Option<usize>,
 
     /// Which named array of a VTK file (.vtk, .vti) [default: the active
     /// scalars, else the first array].
     #[arg(long, value_name = "NAME")]
     pub array: Option<String>,
+
+    /// The most memory the volume may take, read and rendered: bytes, or
+    /// a number with K, M, G or T (powers of 1024), e.g. 512M, 4G, 1.5GiB.
+    /// A file whose header asks for more, or a volume whose rendering may
+    /// need more, is refused before anything is allocated [default: half
+    /// the physical memory].
+    #[arg(long, value_name = "SIZE", value_parser = volray_io::parse_size, allow_hyphen_values = true)]
+    pub max_memory: Option<u64>,
 }
 
 /// How to render a frame.
 #[derive(Debug, Args)]
 pub struct ViewArgs {
     /// Image size: W (square) or WxH, in pixels.
-    #[arg(long, value_name = "W|WxH", default_value = "480", value_parser = parse_size)]
+    #[arg(long, value_name = "W|WxH", default_value = "480", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: (usize, usize),
 
     /// View point, world coordinates [default: on the +x axis through the
@@ -230,21 +245,16 @@ pub struct ViewArgs {
     pub look_at: Option<[f64; 3]>,
 
     /// Up direction.
-    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,1", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,1", value_parser = parse_direction, allow_hyphen_values = true)]
     pub up: [f64; 3],
 
     /// Sample spacing along the rays, in voxels (of the smallest spacing).
-    #[arg(
-        long,
-        value_name = "S",
-        default_value_t = 1.0,
-        allow_hyphen_values = true
-    )]
+    #[arg(long, value_name = "S", default_value = "1", value_parser = parse_step, allow_hyphen_values = true)]
     pub step: f64,
 
     /// The paper's opacity ramp: α = p + t·(q − p) over the normalised value
     /// t, with 0 ≤ p < q ≤ 1 [default: 0,0.5]. Conflicts with an opacity in --tf.
-    #[arg(long, value_name = "P,Q", value_parser = parse_pair, allow_hyphen_values = true)]
+    #[arg(long, value_name = "P,Q", value_parser = parse_opacity, allow_hyphen_values = true)]
     pub opacity: Option<(f32, f32)>,
 
     /// Transfer function JSON: {"domain": [lo, hi], "opacity": [[t, a], ...],
@@ -285,20 +295,15 @@ pub struct ViewArgs {
     pub specular: [f32; 3],
 
     /// Specular exponent n.
-    #[arg(
-        long,
-        value_name = "N",
-        default_value_t = 10.0,
-        allow_hyphen_values = true
-    )]
+    #[arg(long, value_name = "N", default_value = "10", value_parser = parse_shininess, allow_hyphen_values = true)]
     pub shininess: f32,
 
     /// Direction towards the light at infinity [default: a headlight, L = V].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true)]
     pub light: Option<[f64; 3]>,
 
     /// Colour of the light, C_s.
-    #[arg(long, value_name = "R,G,B", default_value = "1,1,1", value_parser = parse_rgb)]
+    #[arg(long, value_name = "R,G,B", default_value = "1,1,1", value_parser = parse_rgb, allow_hyphen_values = true)]
     pub light_color: [f32; 3],
 
     /// No lighting: voxels take their material colour.
@@ -306,7 +311,7 @@ pub struct ViewArgs {
     pub no_shading: bool,
 
     /// The opaque background colour, components in [0, 1].
-    #[arg(long, value_name = "R,G,B", default_value = "0,0,0", value_parser = parse_rgb)]
+    #[arg(long, value_name = "R,G,B", default_value = "0,0,0", value_parser = parse_background, allow_hyphen_values = true)]
     pub background: [f32; 3],
 
     /// Use the reference path (the paper's back-to-front compositing, no
@@ -315,7 +320,7 @@ pub struct ViewArgs {
     pub reference: bool,
 
     /// Worker threads [default: one per core].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..), allow_hyphen_values = true)]
     pub threads: Option<u16>,
 
     /// How the samples along a ray make the pixel: composite (the paper's
@@ -371,6 +376,18 @@ pub struct ViewArgs {
     #[arg(long, help_heading = "Rendering options")]
     pub jitter: bool,
 
+    /// NaN and infinite voxel values: refuse the volume (naming their
+    /// count), or render them as empty space: no opacity, not counted by
+    /// mip/minip/average; the value window is the finite values'.
+    #[arg(
+        long,
+        value_enum,
+        value_name = "refuse|transparent",
+        default_value = "refuse",
+        help_heading = "Rendering options"
+    )]
+    pub nonfinite: NonFiniteMode,
+
     /// Perspective projection with this vertical field of view in degrees
     /// (0 < FOV < 180) [default: orthographic]. Without --view the eye
     /// stands where the volume's bounding sphere just fills the view.
@@ -402,6 +419,15 @@ pub struct ViewArgs {
     /// region planes, in world coordinates rather than voxels).
     #[arg(long, value_name = "X0,X1,Y0,Y1,Z0,Z1", value_parser = parse_crop, allow_hyphen_values = true, help_heading = "Camera")]
     pub crop: Option<([f64; 3], [f64; 3])>,
+}
+
+/// `--nonfinite`: what to do with NaN and infinite voxel values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum NonFiniteMode {
+    /// Refuse the volume.
+    Refuse,
+    /// Render them as empty space.
+    Transparent,
 }
 
 /// `--blend`: how a ray's samples make its pixel.
@@ -441,18 +467,18 @@ pub struct RenderArgs {
     pub output: PathBuf,
 
     /// Bits per channel of a PNG.
-    #[arg(long, value_name = "8|16", default_value = "8", value_parser = parse_bit_depth)]
+    #[arg(long, value_name = "8|16", default_value = "8", value_parser = parse_bit_depth, allow_hyphen_values = true)]
     pub bit_depth: u8,
 
     /// Render FRAMES views into an animation, the view point orbiting the
     /// up vector (azimuth --azimuth + 360·i/FRAMES for frame i) with the
     /// window fitted to the bounding sphere so the picture keeps its scale.
-    #[arg(long, value_name = "FRAMES", value_parser = clap::value_parser!(u32).range(1..=100_000), help_heading = "Animations")]
+    #[arg(long, value_name = "FRAMES", value_parser = clap::value_parser!(u32).range(1..=100_000), allow_hyphen_values = true, help_heading = "Animations")]
     pub turntable: Option<u32>,
 
     /// Frames per second of an animation, in (0, 100] [default: 24]; GIF
     /// keeps the delay in hundredths of a second.
-    #[arg(long, value_name = "FPS", value_parser = parse_fps, help_heading = "Animations")]
+    #[arg(long, value_name = "FPS", value_parser = parse_fps, allow_hyphen_values = true, help_heading = "Animations")]
     pub fps: Option<f64>,
 
     #[command(flatten)]
@@ -466,15 +492,15 @@ pub struct BenchArgs {
 
     /// Timed frames after one warm-up; each turns the camera by a further
     /// half degree about the up axis, so no frame reuses view-dependent work.
-    #[arg(long, value_name = "N", default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000), allow_hyphen_values = true)]
     pub frames: u32,
 
     /// Instead of INPUT, time the peer benchmark's six workloads from the
     /// raw float32 volumes and JSON sidecars in DIR (made by the peers'
     /// make_volumes.py), each exactly as the peers define it: view along
     /// +x, step 0.5 voxel, their transfer functions and shading. The view
-    /// options other than --threads do not apply.
-    #[arg(long, value_name = "DIR")]
+    /// options other than --threads do not apply, and are refused.
+    #[arg(long, value_name = "DIR", conflicts_with_all = PEERS_IGNORE)]
     pub peers: Option<PathBuf>,
 
     /// With --peers: only these workloads, each NAME:W (the volume
@@ -505,6 +531,74 @@ pub struct BenchArgs {
     pub view: ViewArgs,
 }
 
+/// The options `bench --peers` does not use: the workloads fix their own
+/// input, view and transfer functions.
+const PEERS_IGNORE: [&str; 41] = [
+    "max_memory",
+    "nonfinite",
+    "dims",
+    "dtype",
+    "endian",
+    "spacing",
+    "format",
+    "frame",
+    "array",
+    "size",
+    "view",
+    "look_at",
+    "up",
+    "step",
+    "opacity",
+    "tf",
+    "preset",
+    "colormap",
+    "range",
+    "ambient",
+    "diffuse",
+    "specular",
+    "shininess",
+    "light",
+    "light_color",
+    "no_shading",
+    "background",
+    "reference",
+    "blend",
+    "iso",
+    "iso_thickness",
+    "log",
+    "gradient_opacity",
+    "post_classification",
+    "jitter",
+    "perspective",
+    "zoom",
+    "azimuth",
+    "elevation",
+    "clip",
+    "crop",
+];
+
+/// A clap error as one line: its first, with the arguments it lists on the
+/// lines below when the first ends in a colon ("the following required
+/// arguments were not provided:"), so that the line names the flag.
+pub fn one_line_error(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let mut lines = text.lines();
+    let first = lines
+        .next()
+        .unwrap_or("error: invalid arguments")
+        .trim_end();
+    match first.strip_suffix(':') {
+        Some(head) => {
+            let listed: Vec<&str> = lines
+                .take_while(|l| l.starts_with("  "))
+                .map(str::trim)
+                .collect();
+            format!("{head}: {}", listed.join(", "))
+        }
+        None => first.to_string(),
+    }
+}
+
 fn numbers<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>, String> {
     s.split(',')
         .map(|part| {
@@ -522,28 +616,111 @@ fn finite(values: Vec<f64>) -> Result<Vec<f64>, String> {
     }
 }
 
+/// Finite and within `f32`'s range, for values the renderer keeps as `f32`.
+fn finite_f32(values: Vec<f64>) -> Result<Vec<f64>, String> {
+    let values = finite(values)?;
+    match values.iter().find(|v| v.abs() > f32::MAX as f64) {
+        Some(v) => Err(format!("{v} is beyond the range of 32-bit floats")),
+        None => Ok(values),
+    }
+}
+
 pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     let v = finite(numbers::<f64>(s, "number")?)?;
     <[f64; 3]>::try_from(v).map_err(|v| format!("expected X,Y,Z (three numbers), got {}", v.len()))
 }
 
-fn parse_positive_vec3(s: &str) -> Result<[f64; 3], String> {
+/// The smallest and largest voxel spacing `--spacing` takes, and the most
+/// one axis's may exceed another's: beyond these the world box's squared
+/// extents leave `f64`, or a ray along the coarse axis would take more
+/// samples of the fine one than the renderer allows.
+const SPACING_LIMITS: (f64, f64) = (1e-30, 1e30);
+const MAX_SPACING_RATIO: f64 = 1e6;
+
+fn parse_spacing(s: &str) -> Result<[f64; 3], String> {
     let v = parse_vec3(s)?;
     if v.iter().any(|x| *x <= 0.0) {
         return Err("every component must be positive".into());
     }
+    let (lo, hi) = SPACING_LIMITS;
+    if let Some(x) = v.iter().find(|x| !(lo..=hi).contains(*x)) {
+        return Err(format!("{x} is outside {lo:e} to {hi:e}"));
+    }
+    let (min, max) = (
+        v.iter().copied().fold(f64::MAX, f64::min),
+        v.iter().copied().fold(0.0, f64::max),
+    );
+    if max / min > MAX_SPACING_RATIO {
+        return Err(format!(
+            "the largest spacing {max} is more than {MAX_SPACING_RATIO:e} times the smallest {min}"
+        ));
+    }
     Ok(v)
 }
 
+/// A direction (`--up`, `--light`, a clip plane's normal): not zero, and
+/// with a length whose square `f64` holds, so that it can be normalised.
+fn direction(v: [f64; 3]) -> Result<[f64; 3], String> {
+    let largest = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if largest == 0.0 {
+        return Err("a direction must not be zero".into());
+    }
+    if !(1e-100..=1e100).contains(&largest) {
+        return Err(format!(
+            "the direction {},{},{} is too short or too long to normalise (components from 1e-100 to 1e100)",
+            v[0], v[1], v[2]
+        ));
+    }
+    Ok(v)
+}
+
+fn parse_direction(s: &str) -> Result<[f64; 3], String> {
+    direction(parse_vec3(s)?)
+}
+
+/// The fewest points per axis a volume spans (two make one cell).
+const MIN_POINTS: usize = 2;
+
 fn parse_dims(s: &str) -> Result<[usize; 3], String> {
     let v = numbers::<usize>(s, "point count")?;
-    <[usize; 3]>::try_from(v).map_err(|v| format!("expected X,Y,Z (three counts), got {}", v.len()))
+    let dims = <[usize; 3]>::try_from(v)
+        .map_err(|v| format!("expected X,Y,Z (three counts), got {}", v.len()))?;
+    match dims.iter().find(|n| **n < MIN_POINTS) {
+        Some(n) => Err(format!(
+            "every axis needs at least {MIN_POINTS} points to span a volume, got {n}"
+        )),
+        None => Ok(dims),
+    }
 }
 
 fn parse_pair(s: &str) -> Result<(f32, f32), String> {
     match finite(numbers::<f64>(s, "number")?)?[..] {
         [p, q] => Ok((p as f32, q as f32)),
         ref v => Err(format!("expected P,Q (two numbers), got {}", v.len())),
+    }
+}
+
+/// The paper's opacity ramp `p,q`: opacities, `0 <= p < q <= 1`.
+fn parse_opacity(s: &str) -> Result<(f32, f32), String> {
+    match parse_pair(s)? {
+        (p, q) if 0.0 <= p && p < q && q <= 1.0 => Ok((p, q)),
+        (p, q) => Err(format!("P,Q = {p},{q} needs 0 <= p < q <= 1")),
+    }
+}
+
+/// `--step`: a positive number of voxels.
+fn parse_step(s: &str) -> Result<f64, String> {
+    match parse_number(s)? {
+        v if v > 0.0 => Ok(v),
+        v => Err(format!("step {v} must be a positive number of voxels")),
+    }
+}
+
+/// `--shininess`: the Phong exponent, finite and non-negative.
+fn parse_shininess(s: &str) -> Result<f32, String> {
+    match finite_f32(vec![parse_number(s)?])?[..] {
+        [v] if v >= 0.0 => Ok(v as f32),
+        ref v => Err(format!("shininess {} must be non-negative", v[0])),
     }
 }
 
@@ -555,15 +732,33 @@ fn parse_range(s: &str) -> Result<(f64, f64), String> {
     }
 }
 
-/// One value for all three channels, or r,g,b.
+/// One value for all three channels, or r,g,b: reflection coefficients
+/// and colours, finite and non-negative.
 pub fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
-    match finite(numbers::<f64>(s, "number")?)?[..] {
-        [v] => Ok([v as f32; 3]),
-        [r, g, b] => Ok([r as f32, g as f32, b as f32]),
-        ref v => Err(format!(
-            "expected one value or R,G,B, got {} values",
-            v.len()
+    let rgb = match finite_f32(numbers::<f64>(s, "number")?)?[..] {
+        [v] => [v as f32; 3],
+        [r, g, b] => [r as f32, g as f32, b as f32],
+        ref v => {
+            return Err(format!(
+                "expected one value or R,G,B, got {} values",
+                v.len()
+            ));
+        }
+    };
+    match rgb.iter().find(|c| **c < 0.0) {
+        Some(c) => Err(format!("{c} is negative; components must be 0 or more")),
+        None => Ok(rgb),
+    }
+}
+
+/// `--background`: an opaque colour, components in [0, 1].
+fn parse_background(s: &str) -> Result<[f32; 3], String> {
+    let rgb = parse_rgb(s)?;
+    match rgb.iter().find(|c| **c > 1.0) {
+        Some(c) => Err(format!(
+            "{c} is above 1; background components lie in [0, 1]"
         )),
+        None => Ok(rgb),
     }
 }
 
@@ -580,6 +775,16 @@ pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
     };
     if w == 0 || h == 0 {
         return Err(format!("image size {w}x{h} must be at least 1x1"));
+    }
+    if w.max(h) > MAX_IMAGE_SIDE {
+        return Err(format!(
+            "image {w}x{h}: each side must be between 1 and {MAX_IMAGE_SIDE} pixels"
+        ));
+    }
+    if w * h > MAX_IMAGE_PIXELS {
+        return Err(format!(
+            "image {w}x{h} has more than {MAX_IMAGE_PIXELS} pixels"
+        ));
     }
     Ok((w, h))
 }
@@ -674,7 +879,7 @@ fn parse_clip(s: &str) -> Result<([f64; 3], [f64; 3]), String> {
         [_, _, _, nx, ny, nz] if nx == 0.0 && ny == 0.0 && nz == 0.0 => {
             Err("the normal NX,NY,NZ must not be zero".into())
         }
-        [x, y, z, nx, ny, nz] => Ok(([x, y, z], [nx, ny, nz])),
+        [x, y, z, nx, ny, nz] => Ok(([x, y, z], direction([nx, ny, nz])?)),
         ref v => Err(format!(
             "expected X,Y,Z,NX,NY,NZ (a point and a normal, six numbers), got {}",
             v.len()
@@ -734,7 +939,7 @@ mod tests {
         assert_eq!(parse_dims("4,5,6"), Ok([4, 5, 6]));
         assert!(parse_dims("4,-5,6").is_err());
         assert_eq!(parse_pair("0.1,0.9"), Ok((0.1, 0.9)));
-        assert!(parse_positive_vec3("1,0,1").is_err());
+        assert!(parse_spacing("1,0,1").is_err());
         assert_eq!(parse_bit_depth("16"), Ok(16));
         assert_eq!(
             parse_cases("fractal_129:480, hydrogen_421:120"),

@@ -5,10 +5,15 @@ use crate::cli::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 use crate::error::CliError;
 use std::path::Path;
 use volray_core::Volume;
+use volray_data::DataError;
 use volray_data::fractal::FractalParams;
 use volray_data::hydrogen::HydrogenParams;
 
 pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
+    match &args.kind {
+        GenerateKind::Hydrogen(h) => check_hydrogen(h)?,
+        GenerateKind::Fractal(f) => check_fractal(f)?,
+    }
     let (volume, output) = match &args.kind {
         GenerateKind::Hydrogen(h) => (
             volray_data::hydrogen::generate(&hydrogen_params(h))?,
@@ -33,6 +38,118 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
         o.y,
         o.z
     );
+    Ok(())
+}
+
+/// Checks each option against the library's own rules, one at a time with
+/// the others at valid values, so that the error names the flag.
+fn check_hydrogen(a: &HydrogenArgs) -> Result<(), CliError> {
+    let base = HydrogenParams {
+        n: 1,
+        l: 0,
+        m: 0,
+        grid: 2,
+        extent: None,
+        real: a.real,
+    };
+    for (flag, params) in [
+        ("--n", HydrogenParams { n: a.n, ..base }),
+        (
+            "--l",
+            HydrogenParams {
+                n: a.n,
+                l: a.l,
+                ..base
+            },
+        ),
+        (
+            "--m",
+            HydrogenParams {
+                n: a.n,
+                l: a.l,
+                m: a.m,
+                ..base
+            },
+        ),
+        (
+            "--grid",
+            HydrogenParams {
+                grid: a.grid,
+                ..base
+            },
+        ),
+        (
+            "--extent",
+            HydrogenParams {
+                extent: a.extent,
+                ..base
+            },
+        ),
+    ] {
+        params.validate().map_err(|e| match e {
+            DataError::Invalid { message, .. } => CliError::input(format!("{flag}: {message}")),
+            e => CliError::input(format!("{flag}: {e}")),
+        })?;
+    }
+    Ok(())
+}
+
+/// The largest `--sigma` (and the inverse of the smallest): the field is a
+/// sum of displacements of a few sigma and is stored as `f32`, which
+/// overflows to infinity near 3.4e38 and flushes to 0 below 1e-38.
+const SIGMA_LIMIT: f64 = 1e30;
+
+/// As [`check_hydrogen`], for the fractal's options.
+fn check_fractal(a: &FractalArgs) -> Result<(), CliError> {
+    let base = FractalParams::default();
+    for (flag, params) in [
+        (
+            "--size",
+            FractalParams {
+                size: a.size,
+                ..base
+            },
+        ),
+        (
+            "--dimension",
+            FractalParams {
+                dimension: a.dimension,
+                ..base
+            },
+        ),
+        (
+            "--sigma",
+            FractalParams {
+                sigma: a.sigma,
+                ..base
+            },
+        ),
+        (
+            "--ramp",
+            FractalParams {
+                ramp: a.ramp,
+                ..base
+            },
+        ),
+        (
+            "--threshold",
+            FractalParams {
+                threshold: a.threshold,
+                ..base
+            },
+        ),
+    ] {
+        params
+            .validate()
+            .map_err(|message| CliError::input(format!("{flag}: {message}")))?;
+    }
+    if !(1.0 / SIGMA_LIMIT..=SIGMA_LIMIT).contains(&a.sigma) {
+        return Err(CliError::input(format!(
+            "--sigma: {} is outside {:e} to {SIGMA_LIMIT:e}: the field is stored as 32-bit floats",
+            a.sigma,
+            1.0 / SIGMA_LIMIT
+        )));
+    }
     Ok(())
 }
 

@@ -50,7 +50,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             );
             out["notes"] = json!(i.notes);
         }
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("JSON of plain values")
         );
@@ -58,41 +58,43 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     }
 
     let unit_suffix = unit.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
-    println!("input:     {}", input.name);
-    println!("format:    {format}");
+    outln!("input:     {}", input.name);
+    outln!("format:    {format}");
     if let Some(i) = info {
-        println!("stored as: {}", i.stored_type);
+        outln!("stored as: {}", i.stored_type);
         if i.frames > 1 {
-            println!("frame:     {} of {} (--frame)", i.frame, i.frames);
+            outln!("frame:     {} of {} (--frame)", i.frame, i.frames);
         }
         if !i.arrays.is_empty() {
-            println!(
+            outln!(
                 "arrays:    {} (read: {})",
                 i.arrays.join(", "),
                 i.array.as_deref().unwrap_or("-")
             );
         }
     }
-    println!("dims:      {nx} x {ny} x {nz} ({} points)", v.len());
-    println!("spacing:   {}, {}, {}{unit_suffix}", s.x, s.y, s.z);
-    println!("origin:    {}, {}, {}{unit_suffix}", o.x, o.y, o.z);
+    outln!("dims:      {nx} x {ny} x {nz} ({} points)", v.len());
+    outln!("spacing:   {}, {}, {}{unit_suffix}", s.x, s.y, s.z);
+    outln!("origin:    {}, {}, {}{unit_suffix}", o.x, o.y, o.z);
     let e = v.extent();
-    println!("extent:    {}, {}, {}{unit_suffix}", e.x, e.y, e.z);
+    outln!("extent:    {}, {}, {}{unit_suffix}", e.x, e.y, e.z);
     match &hist {
-        None => println!("values:    no finite values"),
+        None => outln!("values:    no finite values"),
         Some(h) => {
-            println!(
+            outln!(
                 "values:    min {}, max {}, mean {:.6e}",
-                h.min, h.max, h.mean
+                h.min,
+                h.max,
+                h.mean
             );
             if h.non_finite > 0 {
-                println!("           {} non-finite (NaN or infinite)", h.non_finite);
+                outln!("           {} non-finite (NaN or infinite)", h.non_finite);
             }
-            println!("histogram: ({} bins)", h.counts.len());
+            outln!("histogram: ({} bins)", h.counts.len());
             let peak = h.counts.iter().copied().max().unwrap_or(1).max(1);
             for (b, &c) in h.counts.iter().enumerate() {
                 let bar = (c * 40).div_ceil(peak) as usize;
-                println!(
+                outln!(
                     "  [{:>12.5e}, {:>12.5e}{} {:<40} {c}",
                     h.edge(b),
                     h.edge(b + 1),
@@ -104,15 +106,15 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     }
     if let Some(i) = info {
         if !i.header.is_empty() {
-            println!("header (as written):");
+            outln!("header (as written):");
             for (k, val) in &i.header {
-                println!("  {k}: {val}");
+                outln!("  {k}: {val}");
             }
         }
         if !i.notes.is_empty() {
-            println!("how it was read:");
+            outln!("how it was read:");
             for n in &i.notes {
-                println!("  - {n}");
+                outln!("  - {n}");
             }
         }
     }

@@ -17,10 +17,15 @@ pub struct Input {
     pub name: String,
     /// The file's format and what its header said, if it came from a file.
     pub file: Option<(VolumeFormat, FileInfo)>,
+    /// `--max-memory` (or its default), which rendering must fit too.
+    pub max_memory: u64,
 }
 
 pub fn load(args: &InputArgs) -> Result<Input, CliError> {
     let spec = args.input.as_deref().unwrap_or(DEMO);
+    let max_memory = args
+        .max_memory
+        .unwrap_or_else(volray_io::default_max_memory);
     let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
     let file_flags = args.format.is_some() || args.frame.is_some() || args.array.is_some();
     let (volume, file) = if volray_data::is_source_spec(spec) {
@@ -29,6 +34,14 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
                 "{spec}: --dims, --dtype, --endian, --format, --frame and --array apply to files only, not to built-in sources"
             )));
         }
+        let n = source_points(spec)? as u64;
+        volray_io::check_volume_size(
+            Path::new(spec),
+            "points per side",
+            &[n, n, n],
+            4,
+            max_memory,
+        )?;
         (volray_data::generate(spec)?, None)
     } else {
         let path = PathBuf::from(spec);
@@ -39,6 +52,17 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
             ),
             None => None,
         };
+        // Raw layout flags on a file that names another format (`a.npy
+        // --dtype u8`) are misplaced, not a raw file missing its --dims.
+        if raw_flags
+            && format.is_none()
+            && let Some(named) = VolumeFormat::from_path(&path).filter(|f| *f != VolumeFormat::Raw)
+        {
+            return Err(CliError::input(format!(
+                "{spec}: --dims, --dtype and --endian describe raw files; this is a {} file (give --format raw to read it as raw)",
+                named.description()
+            )));
+        }
         let raw = if raw_flags || format == Some(VolumeFormat::Raw) {
             Some(raw_options(args, &path)?)
         } else {
@@ -49,6 +73,7 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
             raw,
             frame: args.frame,
             array: args.array.clone(),
+            max_memory,
         };
         let loaded = volray_io::read(&path, &opts)?;
         (loaded.volume, Some((loaded.format, loaded.info)))
@@ -63,6 +88,28 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
         volume,
         name: spec.to_string(),
         file,
+        max_memory,
+    })
+}
+
+/// Points per side of the cube grid the built-in source `spec` samples,
+/// parsed as the source itself parses it (every built-in source is an
+/// N³ grid), so that its size is checked before it is generated.
+fn source_points(spec: &str) -> Result<usize, CliError> {
+    use volray_data::{
+        SourceSpec, blobs::Blobs, fractal::FractalParams, hydrogen::HydrogenParams,
+        marschner_lobb::MarschnerLobb, sphere::Sphere, torus::Torus,
+    };
+    let parsed = SourceSpec::parse(spec)?;
+    Ok(match parsed.name.as_str() {
+        "marschner-lobb" => MarschnerLobb::from_spec(&parsed)?.n,
+        "blobs" => Blobs::from_spec(&parsed)?.n,
+        "sphere" => Sphere::from_spec(&parsed)?.n,
+        "torus" => Torus::from_spec(&parsed)?.n,
+        "hydrogen" => HydrogenParams::from_spec(&parsed)?.grid,
+        "fractal" => FractalParams::from_spec(&parsed)?.size,
+        // A source added later: its volume is checked when rendered.
+        _ => 2,
     })
 }
 

@@ -2,6 +2,10 @@
 //! `volray-io` and `volray-data` for the input, `volray-core` to render,
 //! `volray-io` again for the PNG.
 
+// First, so that its `outln!` macro reaches every module below.
+#[macro_use]
+mod output;
+
 mod animate;
 mod bench;
 mod cli;
@@ -9,6 +13,9 @@ mod error;
 mod generate;
 mod info;
 mod input;
+mod interrupt;
+mod memory;
+mod overwrite;
 mod paper;
 mod render;
 
@@ -31,15 +38,14 @@ fn main() -> ExitCode {
                     ExitCode::from(1)
                 }
                 _ => {
-                    // One line: clap's first, without its usage block.
-                    let text = e.render().to_string();
-                    let first = text.lines().next().unwrap_or("invalid arguments");
-                    eprintln!("volray: {first}");
+                    // One line, naming the argument, without the usage block.
+                    eprintln!("volray: {}", cli::one_line_error(&e));
                     ExitCode::from(1)
                 }
             };
         }
     };
+    interrupt::install();
     let result = match &cli.command {
         Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),

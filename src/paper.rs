@@ -22,7 +22,7 @@ pub fn run(args: &PaperArgs) -> Result<(), CliError> {
         Sizes::PAPER
     };
     let pool = thread_pool(args.threads)?;
-    pool.install(|| volray_paper::make(&items, &args.out, &sizes, &mut |line| println!("{line}")))
+    pool.install(|| volray_paper::make(&items, &args.out, &sizes, &mut |line| outln!("{line}")))
         .map_err(|e: PaperError| {
             if e.is_io_failure() {
                 CliError::io(e.to_string())

@@ -2,16 +2,17 @@
 //! with `--turntable` or several inputs, an animation (`animate.rs`).
 
 use crate::animate;
-use crate::cli::{BlendMode, InputArgs, RenderArgs, ViewArgs};
+use crate::cli::{BlendMode, InputArgs, NonFiniteMode, RenderArgs, ViewArgs};
 use crate::error::CliError;
 use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use volray_core::camera::CameraError;
 use volray_core::glam::DVec3;
 use volray_core::{
-    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, Phong, Projection,
-    RenderSettings, Renderer, TransferFunction, colormap, presets,
+    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, NonFinite, Phong, Projection,
+    RenderError, RenderSettings, Renderer, TransferFunction, colormap, presets,
 };
 use volray_io::{Animation, AnimationKind, BitDepth};
 
@@ -25,9 +26,12 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         ));
     }
     let settings = settings(&args.view)?;
-    for spec in &specs {
-        check_output(&args.output, spec)?;
-    }
+    check_output(&args.output)?;
+    crate::overwrite::refuse_overwriting_inputs(
+        &output_files(args, kind, specs.len()),
+        &specs,
+        &args.view.tf.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
+    )?;
     let pool = thread_pool(args.view.threads)?;
     match (kind, args.turntable) {
         (OutputKind::Animation, Some(frames)) => {
@@ -46,12 +50,11 @@ fn still(
     kind: OutputKind,
 ) -> Result<(), CliError> {
     let input = load(&args.input, args.view.log)?;
-    let renderer = Renderer::new(&input.volume)
-        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+    let renderer = renderer_for(&args.view, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let image = pool
         .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
-        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+        .map_err(|e| render_failure(&args.view, &input.name, e))?;
     bar.finish_and_clear();
 
     match kind {
@@ -184,18 +187,21 @@ fn output_kind(
     }
 }
 
-/// Refuses, before any work, an output that would overwrite the input
-/// `spec` or that cannot be written where it is asked for.
-fn check_output(output: &Path, spec: &str) -> Result<(), CliError> {
-    if !volray_data::is_source_spec(spec)
-        && let (Ok(a), Ok(b)) = (PathBuf::from(spec).canonicalize(), output.canonicalize())
-        && a == b
-    {
-        return Err(CliError::input(format!(
-            "{}: the output is the input file; refusing to overwrite it",
-            output.display()
-        )));
+/// The files the run will write: OUTPUT, or each frame's file of a PNG
+/// sequence.
+fn output_files(args: &RenderArgs, kind: OutputKind, inputs: usize) -> Vec<PathBuf> {
+    let frames = args.turntable.map_or(inputs, |n| n as usize);
+    match AnimationKind::from_path(&args.output) {
+        Some(AnimationKind::PngSequence) if kind == OutputKind::Animation => (0..frames)
+            .filter_map(|i| volray_io::sequence_path(&args.output, i))
+            .collect(),
+        _ => vec![args.output.clone()],
     }
+}
+
+/// Refuses, before any work, an output that cannot be written where it is
+/// asked for (overwriting an input is refused by `overwrite.rs`).
+fn check_output(output: &Path) -> Result<(), CliError> {
     let dir = match output.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -216,14 +222,44 @@ fn check_output(output: &Path, spec: &str) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The largest `--tf` file read: a transfer function is a few hundred
+/// points; this bounds what a wrong path (a device, a huge file) costs.
+const TF_MAX_BYTES: u64 = 16 << 20;
+
+/// Reads a `--tf` file: a regular file of at most [`TF_MAX_BYTES`].
+fn read_tf_file(path: &Path) -> Result<String, CliError> {
+    use std::io::Read;
+    let name = path.display();
+    let meta = std::fs::metadata(path)
+        .map_err(|e| CliError::io(format!("--tf {name}: cannot read: {e}")))?;
+    if !meta.is_file() {
+        return Err(CliError::input(format!("--tf {name}: not a regular file")));
+    }
+    if meta.len() > TF_MAX_BYTES {
+        return Err(CliError::input(format!(
+            "--tf {name}: {} bytes is too large for a transfer function (at most {TF_MAX_BYTES})",
+            meta.len()
+        )));
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(TF_MAX_BYTES).read_to_string(&mut text))
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::InvalidData => CliError::input(format!(
+                "--tf {name}: not UTF-8 text (a JSON file is expected)"
+            )),
+            _ => CliError::io(format!("--tf {name}: cannot read: {e}")),
+        })?;
+    Ok(text)
+}
+
 /// The render settings the view arguments describe.
 pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
     let transfer_function = match &view.tf {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::io(format!("{}: cannot read: {e}", path.display())))?;
+            let text = read_tf_file(path)?;
             TransferFunction::from_json(&text)
-                .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?
+                .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?
         }
         None => TransferFunction::default(),
     };
@@ -357,8 +393,53 @@ fn camera(view: &ViewArgs) -> Camera {
     }
 }
 
+/// The renderer of `input`'s volume, its non-finite values refused or
+/// rendered as empty space as `--nonfinite` says, refused if rendering it
+/// may need more than `--max-memory` (see `memory.rs`). A refusal is one
+/// line naming the input and the count, and the way out.
+pub fn renderer_for<'v>(view: &ViewArgs, input: &'v Input) -> Result<Renderer<'v>, CliError> {
+    crate::memory::check_render(view, input)?;
+    let (name, volume) = (&input.name, &input.volume);
+    let mode = match view.nonfinite {
+        NonFiniteMode::Refuse => NonFinite::Refuse,
+        NonFiniteMode::Transparent => NonFinite::Transparent,
+    };
+    Renderer::with_non_finite(volume, mode).map_err(|e| match e {
+        RenderError::NonFinite { .. } => CliError::input(format!(
+            "{name}: {e}; use --nonfinite transparent to render them as empty space"
+        )),
+        e => render_failure(view, name, e),
+    })
+}
+
+/// A failure to render `name` as one line, naming the flag whose value
+/// caused it where one did: a camera that cannot be posed (the view point
+/// on the view reference, the up vector along the view direction, a point
+/// beyond `f64`), or a step too fine for the volume.
+pub fn render_failure(view: &ViewArgs, name: &str, e: RenderError) -> CliError {
+    let flag = match &e {
+        RenderError::Camera(CameraError::NoDirection(_)) if view.view.is_some() => Some("--view"),
+        RenderError::Camera(CameraError::NoDirection(_)) => Some("--look-at"),
+        RenderError::Camera(CameraError::UpParallel { .. }) => Some("--up"),
+        RenderError::Camera(CameraError::NotFinite(what, _)) => match *what {
+            "view point" if view.view.is_some() => Some("--view"),
+            "view reference" if view.look_at.is_some() => Some("--look-at"),
+            "up" => Some("--up"),
+            _ => None,
+        },
+        // The core names the setting ("step 1e-12 voxels is too small ...").
+        RenderError::Setting(message) if message.starts_with("step ") => Some("--step"),
+        _ => None,
+    };
+    match flag {
+        Some(flag) => CliError::input(format!("{name}: {flag}: {e}")),
+        None => CliError::input(format!("{name}: {e}")),
+    }
+}
+
 /// `--blend`, checked against the options that only compositing uses:
-/// a projection shows the interpolated scalar, with no opacity to shape.
+/// a projection shows the interpolated scalar, with no opacity to shape
+/// and no lighting.
 fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
     let (blend, name) = match view.blend {
         BlendMode::Composite => (Blend::Composite, "composite"),
@@ -377,6 +458,7 @@ fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
             (view.iso.is_some(), "--iso"),
             (view.gradient_opacity.is_some(), "--gradient-opacity"),
             (view.post_classification, "--post-classification"),
+            (view.opacity.is_some(), "--opacity"),
         ] {
             if given {
                 return Err(CliError::input(format!(
@@ -385,7 +467,35 @@ fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
             }
         }
     }
+    let unlit = if blend.is_projection() {
+        Some(format!("--blend {name} is unshaded"))
+    } else if view.no_shading {
+        Some("--no-shading turns the lighting off".to_string())
+    } else {
+        None
+    };
+    if let (Some(why), Some(flag)) = (unlit, lighting_flag(view)) {
+        return Err(CliError::input(format!(
+            "{flag} sets the lighting, but {why}: leave {flag} out"
+        )));
+    }
     Ok(blend)
+}
+
+/// The first lighting option given a value other than its default (the
+/// library's, which `--help` shows), if any.
+fn lighting_flag(view: &ViewArgs) -> Option<&'static str> {
+    let lit = Phong::default();
+    [
+        (view.ambient != lit.ambient, "--ambient"),
+        (view.diffuse != lit.diffuse, "--diffuse"),
+        (view.specular != lit.specular, "--specular"),
+        (view.shininess != lit.shininess, "--shininess"),
+        (view.light_color != lit.light_color, "--light-color"),
+        (view.light.is_some(), "--light"),
+    ]
+    .into_iter()
+    .find_map(|(given, flag)| given.then_some(flag))
 }
 
 /// `--iso VALUE --iso-thickness R`; with `--log` the value is in the data's

@@ -198,7 +198,7 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
         Some(cases) => cases.0.clone(),
         None => CASES.iter().map(|(d, w)| (d.to_string(), *w)).collect(),
     };
-    println!(
+    outln!(
         "volray bench --peers {}: {} workloads, {threads} threads, 1 warm-up + {} timed frames each, turned 0.5° apart",
         dir.display(),
         cases.len(),
@@ -277,7 +277,7 @@ fn nominal(row: &Row) -> f64 {
 
 fn print_row(row: &Row, threads: usize) {
     let [bin, cast] = row.parts;
-    print!(
+    let head = format!(
         "  {:<13} {:>5}² t={threads}: median {:.4} s, {:.3e} samples/s (bin {bin:.2} + shade and cast {cast:.2} ms; {} bricks, classified once in {:.1} ms)",
         row.dataset,
         row.window,
@@ -287,27 +287,27 @@ fn print_row(row: &Row, threads: usize) {
         row.classify_ms,
     );
     match &row.vtk {
-        Some(v) => println!(
-            "; VTK {:.4} s: VTK/volray {:.2}x",
+        Some(v) => outln!(
+            "{head}; VTK {:.4} s: VTK/volray {:.2}x",
             v.median_s,
             v.median_s / row.median_s
         ),
-        None => println!(),
+        None => outln!("{head}"),
     }
 }
 
 /// The closing table, in Markdown.
 fn print_table(rows: &[Row], threads: usize) {
-    println!();
+    outln!();
     let vtk = rows.iter().any(|r| r.vtk.is_some());
     if vtk {
-        println!(
+        outln!(
             "| dataset, window | volray median s | samples/s (nominal) | VTK fixed-point median s | VTK / volray | image vs VTK: mean abs diff (levels of 255) |"
         );
-        println!("|---|---|---|---|---|---|");
+        outln!("|---|---|---|---|---|---|");
     } else {
-        println!("| dataset, window | volray median s | samples/s (nominal) |");
-        println!("|---|---|---|");
+        outln!("| dataset, window | volray median s | samples/s (nominal) |");
+        outln!("|---|---|---|");
     }
     for r in rows {
         let name = format!(
@@ -319,7 +319,7 @@ fn print_table(rows: &[Row], threads: usize) {
         );
         let volray = format!("{:.4} | {:.3e}", r.median_s, nominal(r) / r.median_s);
         match &r.vtk {
-            Some(v) => println!(
+            Some(v) => outln!(
                 "| {name} | {volray} | {:.4} | {:.2} | {:.2} (means {:.1} vs {:.1}) |",
                 v.median_s,
                 v.median_s / r.median_s,
@@ -327,7 +327,7 @@ fn print_table(rows: &[Row], threads: usize) {
                 v.mean_volray,
                 v.mean_vtk
             ),
-            None => println!("| {name} | {volray} |"),
+            None => outln!("| {name} | {volray} |"),
         }
     }
 }

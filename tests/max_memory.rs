@@ -1,0 +1,133 @@
+//! `--max-memory` through the binary: files whose header needs more are
+//! refused before reading (exit 1, naming the flag), built-in sources by
+//! their spec, and volumes whose rendering may need more before rendering.
+
+mod common;
+
+use common::{stderr, volray};
+
+const NRRD: &str = "crates/io/tests/fixtures/nrrd/f32_lps.nrrd"; // 4x3x5 f32: 240 bytes
+
+fn refused(args: &[&str], want: &[&str]) {
+    let out = volray(args);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    for w in want {
+        assert!(err.contains(w), "{args:?}: {err}\n  wanted: {w}");
+    }
+}
+
+#[test]
+fn info_obeys_the_limit_exactly() {
+    refused(
+        &["info", "--max-memory", "239", NRRD],
+        &[
+            "f32_lps.nrrd",
+            "\"sizes\" 4 3 5",
+            "exceed --max-memory 239 bytes",
+        ],
+    );
+    let out = volray(&["info", "--max-memory", "240", NRRD]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = volray(&[
+        "info",
+        "--max-memory",
+        "1K",
+        "crates/io/tests/fixtures/vtk/vti_binary.vti",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("--max-memory 1 KiB"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn sizes_are_parsed_or_refused() {
+    for bad in ["0", "-1", "1.5", "4X", "G", ""] {
+        refused(&["info", "--max-memory", bad, NRRD], &["--max-memory"]);
+    }
+    for good in ["1G", "1.5GiB", "512m", "4096"] {
+        let out = volray(&["info", "--max-memory", good, NRRD]);
+        assert!(out.status.success(), "{good}: {}", stderr(&out));
+    }
+}
+
+#[test]
+fn built_in_sources_and_rendering_obey_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("x.png");
+    let png = png.to_str().unwrap();
+    // 512^3 f32 is 512 MiB: refused from the spec, before generating.
+    refused(
+        &["render", "blobs:512", "--max-memory", "100M", "-o", png],
+        &[
+            "blobs:512",
+            "points per side 512 512 512",
+            "512 MiB",
+            "--max-memory 100 MiB",
+        ],
+    );
+    refused(
+        &["info", "hydrogen:2,1,0,grid=300", "--max-memory", "100M"],
+        &["points per side 300 300 300"],
+    );
+    // blobs:33 is 144 KiB; rendering it (bricks, a 16x16 frame) needs more.
+    refused(
+        &[
+            "render",
+            "blobs:33",
+            "--size",
+            "16",
+            "--max-memory",
+            "200K",
+            "-o",
+            png,
+        ],
+        &[
+            "blobs:33: rendering 33x33x33 voxels",
+            "more than --max-memory 200 KiB",
+        ],
+    );
+    assert!(!dir.path().join("x.png").exists());
+    let out = volray(&[
+        "render",
+        "blobs:33",
+        "--size",
+        "16",
+        "--max-memory",
+        "2M",
+        "-o",
+        png,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // A projection needs the volume and the frame only.
+    let out = volray(&[
+        "render",
+        "blobs:33",
+        "--size",
+        "16",
+        "--blend",
+        "mip",
+        "--max-memory",
+        "200K",
+        "-o",
+        png,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    refused(
+        &[
+            "bench",
+            "blobs:33",
+            "--size",
+            "16",
+            "--frames",
+            "1",
+            "--max-memory",
+            "200K",
+        ],
+        &["rendering 33x33x33 voxels"],
+    );
+}
