@@ -1,0 +1,23 @@
+//! Fuzzes the reader of VASP CHGCAR/CHG.
+//! The first byte chooses `--frame` (bits 0-2).
+#![no_main]
+
+use std::sync::OnceLock;
+
+use libfuzzer_sys::fuzz_target;
+use volray_fuzz::{Harness, frame_choice, split_control};
+use volray_io::VolumeFormat;
+
+static HARNESS: OnceLock<Harness> = OnceLock::new();
+
+fuzz_target!(|data: &[u8]| {
+    let harness = HARNESS.get_or_init(|| Harness::new("chgcar", &[]));
+    let (control, file) = split_control(data);
+    harness.read(
+        "CHGCAR",
+        file,
+        VolumeFormat::Chgcar,
+        frame_choice(control),
+        None,
+    );
+});

@@ -1,0 +1,40 @@
+//! Fuzzes the HDF5 reader (through libhdf5; cargo feature `hdf5`).
+//! The first byte chooses `--frame` (bits 0-2) and the dataset (bits 4-7,
+//! one of the names the seed files hold, or none that exists).
+#![no_main]
+
+use std::sync::OnceLock;
+
+use libfuzzer_sys::fuzz_target;
+use volray_fuzz::{Harness, frame_choice, read_path, split_control};
+use volray_io::VolumeFormat;
+
+static HARNESS: OnceLock<Harness> = OnceLock::new();
+
+const DATASETS: [&str; 16] = [
+    "/fields/density",
+    "/u8",
+    "/i16_be",
+    "/u32",
+    "/i64",
+    "/f64",
+    "/gzip_u16",
+    "/series",
+    "/bad_spacing",
+    "/text",
+    "/fields/labels",
+    "/meta/plane",
+    "/fields",
+    "/",
+    "/missing",
+    "/fields/density/x",
+];
+
+fuzz_target!(|data: &[u8]| {
+    let harness = HARNESS.get_or_init(|| Harness::new("hdf5", &[]));
+    let (control, file) = split_control(data);
+    let path = harness.put("input.h5", file);
+    let dataset = DATASETS[usize::from(control >> 4)];
+    let target = path.with_file_name(format!("input.h5:{dataset}"));
+    read_path(&target, VolumeFormat::Hdf5, frame_choice(control), None);
+});

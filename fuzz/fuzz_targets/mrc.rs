@@ -1,0 +1,15 @@
+//! Fuzzes the reader of CCP4/MRC maps.
+#![no_main]
+
+use std::sync::OnceLock;
+
+use libfuzzer_sys::fuzz_target;
+use volray_fuzz::Harness;
+use volray_io::VolumeFormat;
+
+static HARNESS: OnceLock<Harness> = OnceLock::new();
+
+fuzz_target!(|data: &[u8]| {
+    let harness = HARNESS.get_or_init(|| Harness::new("mrc", &[]));
+    harness.read("input.mrc", data, VolumeFormat::Mrc, None, None);
+});
