@@ -130,8 +130,9 @@ impl Cases {
 
     /// Text edits of a header: each `(from, to)` replaces the first
     /// `from` (which must be there) in `bytes`.
-    fn edits(&mut self, file: &str, bytes: &[u8], edits: &[(&str, &str, Expect)]) {
-        for &(from, to, expect) in edits {
+    fn edits<S: AsRef<str>>(&mut self, file: &str, bytes: &[u8], edits: &[(S, S, Expect)]) {
+        for (from, to, expect) in edits {
+            let (from, to, expect) = (from.as_ref(), to.as_ref(), *expect);
             self.one(
                 &format!("{file}: '{from}' -> '{to}'"),
                 file,
@@ -336,10 +337,6 @@ fn nrrd_cases() -> Cases {
     ] {
         edits.push((from.to_string(), to.to_string(), Expect::Bad));
     }
-    let edits: Vec<(&str, &str, Expect)> = edits
-        .iter()
-        .map(|(a, b, e)| (a.as_str(), b.as_str(), *e))
-        .collect();
     c.edits(f, &bytes, &edits);
     c.flips(f, &bytes, header_end, 4, 2);
 
@@ -486,10 +483,6 @@ fn metaimage_cases() -> Cases {
     ] {
         edits.push((from.to_string(), to.to_string(), Expect::Bad));
     }
-    let edits: Vec<(&str, &str, Expect)> = edits
-        .iter()
-        .map(|(a, b, e)| (a.as_str(), b.as_str(), *e))
-        .collect();
     c.edits(f, &bytes, &edits);
     c.flips(f, &bytes, header_end, 4, 3);
 
@@ -761,10 +754,6 @@ fn vtk_cases() -> Cases {
         } else {
             edits.push(("BINARY".into(), "BINARX".into(), Expect::Bad));
         }
-        let edits: Vec<(&str, &str, Expect)> = edits
-            .iter()
-            .map(|(a, b, e)| (a.as_str(), b.as_str(), *e))
-            .collect();
         c.edits(f, &bytes, &edits);
         c.flips(f, &bytes, header_end, 2, 5);
     }
