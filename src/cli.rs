@@ -3,7 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
-use volray_core::render::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+use volray_core::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
 use volray_data::fractal::FractalParams;
 
 #[derive(Debug, Parser)]

@@ -10,9 +10,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use volray_core::camera::CameraError;
 use volray_core::glam::DVec3;
+use volray_core::transfer::{colormap, presets};
 use volray_core::{
     Blend, Camera, Classification, ClipPlane, IsoSurface, Method, NonFinite, Phong, Projection,
-    RenderError, RenderSettings, Renderer, TransferFunction, colormap, presets,
+    RenderError, RenderSettings, Renderer, TransferFunction,
 };
 use volray_io::{Animation, AnimationKind, BitDepth};
 

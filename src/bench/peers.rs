@@ -24,8 +24,8 @@ use crate::cli::BenchArgs;
 use crate::error::CliError;
 use crate::render::thread_pool;
 use std::path::Path;
+use volray_core::PiecewiseLinear;
 use volray_core::glam::DVec3;
-use volray_core::transfer_function::PiecewiseLinear;
 use volray_core::{Camera, Phong, RenderSettings, Renderer, TransferFunction, Volume};
 use volray_io::{DType, Endian, RawOptions};
 

@@ -14,7 +14,7 @@
 //!   ([`NonFiniteMask`]). Every path reads the copy, so no NaN can reach
 //!   an interpolation, a gradient or a bound; the mask decides what counts.
 //! - **Gradients** are the ordinary central differences
-//!   ([`crate::gradient`]) of the cleaned copy: a masked voxel reads as the
+//!   ([`crate::kernels::gradient`]) of the cleaned copy: a masked voxel reads as the
 //!   bottom of the value range. This was chosen over one-sided differences
 //!   at masked neighbours (as at the grid's faces) because "empty space" is
 //!   what a masked voxel stands for: an object bordering a masked region
@@ -53,7 +53,7 @@
 //! the bottom of the finite range, which can only widen it.
 
 use crate::bricks::{BRICK, BrickGrid};
-use crate::trilinear::corners;
+use crate::kernels::trilinear::corners;
 use crate::volume::Volume;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;

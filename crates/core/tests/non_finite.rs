@@ -3,9 +3,9 @@
 //! checked against closed forms, against the same data with those voxels
 //! cut away, and the fast paths against the reference.
 
+use volray_core::PiecewiseLinear;
 use volray_core::camera::{Camera, Projection};
 use volray_core::glam::DVec3;
-use volray_core::transfer_function::PiecewiseLinear;
 use volray_core::{
     Blend, Classification, ClipPlane, Image, IsoSurface, Method, NonFinite, RenderError,
     RenderSettings, Renderer, TransferFunction, Volume,

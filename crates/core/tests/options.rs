@@ -2,10 +2,10 @@
 //! blend modes (maximum, minimum, average), post-classification, jitter,
 //! the crop box and clip planes, perspective, and which path renders what.
 
+use volray_core::PiecewiseLinear;
 use volray_core::camera::{Camera, Projection, View};
 use volray_core::glam::DVec3;
-use volray_core::ray::GridFrame;
-use volray_core::transfer_function::PiecewiseLinear;
+use volray_core::sampling::grid::GridFrame;
 use volray_core::{
     Blend, Classification, ClipPlane, Image, Method, RenderSettings, Renderer, TransferFunction,
     Volume,

@@ -1,4 +1,4 @@
-//! Post-classified compositing on its fast path ([`volray_core::post_cast`]),
+//! Post-classified compositing on its fast path ([`volray_core::cpu::post`]),
 //! held to the reference path (the oracle) within 1/255 per channel: a
 //! smooth ball, the Marschner–Lobb signal and a step edge; views along an
 //! axis, oblique and in perspective (the eye outside and inside the
@@ -8,13 +8,13 @@
 //! the brick walk skipping empty bricks and still finding small features
 //! behind them and on brick faces, and the routing.
 
+use volray_core::LightGeometry;
+use volray_core::bricks::macrocells::Macrocells;
 use volray_core::camera::{Camera, Projection, View};
-use volray_core::classify::Classifier;
+use volray_core::cpu::post::{self as post_cast, PostScene, PostWork};
 use volray_core::glam::DVec3;
-use volray_core::gradient::gradients;
-use volray_core::macrocells::Macrocells;
-use volray_core::post_cast::{self, PostScene, PostWork};
-use volray_core::shading::LightGeometry;
+use volray_core::kernels::gradient::gradients;
+use volray_core::transfer::classifier::Classifier;
 use volray_core::{
     Classification, ClipPlane, Image, IsoSurface, Method, RenderSettings, Renderer,
     TransferFunction, Volume,
@@ -351,10 +351,8 @@ fn a_uniform_medium_has_the_closed_form_colour_on_the_fast_path() {
     let (alpha, c, bg) = (0.3f64, [0.9, 0.5, 0.2], [0.1, 0.2, 1.0]);
     let constant = TransferFunction {
         domain: None,
-        opacity: Some(volray_core::transfer_function::PiecewiseLinear::constant([
-            alpha as f32,
-        ])),
-        color: Some(volray_core::transfer_function::PiecewiseLinear::constant(c)),
+        opacity: Some(volray_core::PiecewiseLinear::constant([alpha as f32])),
+        color: Some(volray_core::PiecewiseLinear::constant(c)),
     };
     for (step, k) in [(1.0, 11), (0.5, 21)] {
         for shading in [false, true] {

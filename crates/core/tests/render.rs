@@ -1,9 +1,9 @@
 //! End-to-end properties of the renderer: closed forms, the reference path
 //! as oracle for the fast path, thread invariance and geometry.
 
+use volray_core::PiecewiseLinear;
 use volray_core::camera::{Camera, OrthographicView};
 use volray_core::glam::DVec3;
-use volray_core::transfer_function::PiecewiseLinear;
 use volray_core::{Image, Method, RenderSettings, Renderer, TransferFunction, Volume};
 
 fn render(volume: &Volume, settings: &RenderSettings) -> Image {

@@ -219,7 +219,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 
     let (w, h) = (first.width as usize, first.height as usize);
     let dims = [w, h, shape.slices];
-    let voxels = volray_core::volume::checked_point_count(dims)
+    let voxels = volray_core::checked_point_count(dims)
         .filter(|&n| n.checked_mul(4).is_some())
         .ok_or_else(|| {
             IoError::invalid(

@@ -41,8 +41,8 @@
 //!   129³ → 480². The window is the diameter of the ramp's sphere, where
 //!   the cloud ends ([`crate::orbitals::inscribed_ball_camera`]).
 
+use volray_core::PiecewiseLinear;
 use volray_core::glam::DVec3;
-use volray_core::transfer_function::PiecewiseLinear;
 use volray_core::{Image, Method, Phong, RenderSettings, Renderer, TransferFunction, Volume};
 use volray_data::fractal::{FractalParams, generate};
 

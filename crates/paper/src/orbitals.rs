@@ -196,7 +196,7 @@ pub fn panel_settings(
         transfer_function: TransferFunction {
             domain: top_window(volume, TOP_SHARE),
             opacity: None,
-            color: volray_core::colormap::colormap(COLORMAP),
+            color: volray_core::transfer::colormap::colormap(COLORMAP),
         },
         phong: phong(),
         method,

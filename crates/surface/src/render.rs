@@ -22,8 +22,8 @@
 
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
+use volray_core::LightGeometry;
 use volray_core::camera::OrthographicView;
-use volray_core::shading::LightGeometry;
 use volray_core::{Camera, Image, Phong};
 
 use crate::SurfaceError;

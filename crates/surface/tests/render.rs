@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use volray_core::shading::LightGeometry;
+use volray_core::LightGeometry;
 use volray_data::hydrogen::SphericalHarmonic;
 use volray_surface::glam::{DVec3, Vec3};
 use volray_surface::{

@@ -3,7 +3,7 @@
 //!
 //! It depends on the data alone, so it is computed once per volume. Tested
 //! against a transfer function's zero-opacity ranges
-//! ([`crate::classify::Classifier::is_transparent_between`]), it rules
+//! ([`crate::transfer::classifier::Classifier::is_transparent_between`]), it rules
 //! out most empty bricks without classifying their voxels one by one.
 
 use crate::bricks::{BrickGrid, SIDE, slot_coords};

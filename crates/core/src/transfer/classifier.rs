@@ -3,7 +3,7 @@
 //! The paper's default is opacity proportional to intensity on a
 //! sub-interval `[p, q]` of [0, 1]:
 //! `α = p + (f − fmin)/(fmax − fmin)·(q − p)`. A transfer function (see
-//! [`crate::transfer_function`]) may replace the ramp and add a colour. Both
+//! [`crate::transfer::function`]) may replace the ramp and add a colour. Both
 //! use the normalised scalar `t = (f − lo)/(hi − lo)`; for a constant volume
 //! (`hi = lo`) `t` is 0 everywhere, so nothing divides by zero.
 //!
@@ -14,15 +14,15 @@
 //!
 //! Two options make opacity depend on the gradient as well as the value
 //! ([`Classifier::opacity_at`]): Levoy's isovalue contours
-//! ([`crate::iso`]), which replace the value's opacity by eq. 3 of Levoy
+//! ([`crate::transfer::iso`]), which replace the value's opacity by eq. 3 of Levoy
 //! 1988 with `α_v` the opacity at the isovalue, and gradient-magnitude
-//! opacity ([`crate::gradient_opacity`]), which multiplies it by a ramp of
+//! opacity ([`crate::transfer::gradient_opacity`]), which multiplies it by a ramp of
 //! `|∇f|`. Both act on the unit opacity, before the step correction.
 
-use crate::gradient::magnitude;
-use crate::gradient_opacity::GradientOpacity;
-use crate::iso::{IsoContour, IsoSurface};
-use crate::transfer_function::{PiecewiseLinear, TransferFunction};
+use crate::kernels::gradient::magnitude;
+use crate::transfer::function::{PiecewiseLinear, TransferFunction};
+use crate::transfer::gradient_opacity::GradientOpacity;
+use crate::transfer::iso::{IsoContour, IsoSurface};
 
 /// How opacity is assigned before the step correction.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,7 +69,7 @@ impl Classifier {
     /// The same classifier drawing Levoy's isovalue contour of `iso`
     /// instead of the value's opacity, with `α_v` from [`Self::iso_alpha`]. `voxel_size` is the smallest grid spacing
     /// (the unit of the thickness) and `max_gradient` the largest world
-    /// gradient magnitude of the volume ([`crate::gradient::max_magnitude`]),
+    /// gradient magnitude of the volume ([`crate::kernels::gradient::max_magnitude`]),
     /// which bounds the contour for [`Self::is_transparent_between`].
     pub fn with_iso(mut self, iso: IsoSurface, voxel_size: f32, max_gradient: f32) -> Self {
         let alpha = self.iso_alpha(iso.value);
@@ -79,7 +79,7 @@ impl Classifier {
 
     /// The same classifier with opacity multiplied by the ramp of
     /// `|∇f|/max_gradient` from 0 at `lo` to 1 at `hi`
-    /// ([`crate::gradient_opacity`]).
+    /// ([`crate::transfer::gradient_opacity`]).
     pub fn with_gradient_opacity(mut self, (lo, hi): (f32, f32), max_gradient: f32) -> Self {
         self.gradient_opacity = Some(GradientOpacity::new((lo, hi), max_gradient));
         self

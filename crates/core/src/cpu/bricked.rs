@@ -3,12 +3,12 @@
 //! for orthographic and perspective views.
 //!
 //! For each pixel the ray walks its tile's list of occupied bricks (see
-//! [`crate::tiles`]) front to back. In each brick it finds the samples `k`
+//! [`crate::cpu::tiles`]) front to back. In each brick it finds the samples `k`
 //! (the same as the reference's, see [`crate::sampling`]: `t = k·step`
 //! from the image plane for parallel rays, from the eye in perspective)
 //! whose positions lie in the box of the brick's occupied cells, and for
 //! each sample in an occupied cell it interpolates the brick's lit voxels
-//! (see [`crate::shade_bricks`]) trilinearly and composites. Everything
+//! (see [`crate::cpu::lit_bricks`]) trilinearly and composites. Everything
 //! else contributes exactly nothing: a sample outside these boxes, or in a
 //! cell whose eight corners are transparent, has opacity 0. A sample on a
 //! face shared by two bricks is taken once, by the first.
@@ -41,14 +41,14 @@
 //! SIMD: positions and colours are `f32x4` (x, y, z or r, g, b, α in the
 //! lanes); the eight corners of a cell are eight 16-byte loads.
 
+use crate::bricks::occupied::ClassifiedBricks;
 use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
 use crate::camera::View;
-use crate::classified::ClassifiedBricks;
+use crate::cpu::lit_bricks::{Lighting, LitBricks};
+use crate::cpu::tiles::{TILE, TileBins};
 use crate::image::Image;
-use crate::jitter;
 use crate::sampling::Sampling;
-use crate::shade_bricks::{Lighting, LitBricks};
-use crate::tiles::{TILE, TileBins};
+use crate::sampling::jitter;
 use glam::{DVec3, Vec4};
 use rayon::prelude::*;
 use wide::f32x4;
@@ -206,7 +206,7 @@ struct Scene<'a> {
 }
 
 /// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
-/// as the rays reach them (see [`crate::shade_bricks`]), binned into
+/// as the rays reach them (see [`crate::cpu::lit_bricks`]), binned into
 /// `bins`, through `view` (either projection) with samples where
 /// `sampling` says, into `image` (the view's size). `progress` is called
 /// with the number of pixels finished, a tile at a time.
@@ -270,7 +270,7 @@ fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
 }
 
 /// A sample number counted from a ray's base, as the `i32` the ray caster
-/// counts in (a ray has at most [`crate::render::MAX_SAMPLES_PER_RAY`]
+/// counts in (a ray has at most [`crate::renderer::MAX_SAMPLES_PER_RAY`]
 /// samples in the grid, and its base is near them).
 fn relative(k: i64, base: i64) -> i32 {
     (k.saturating_sub(base)).clamp(i32::MIN as i64, i32::MAX as i64) as i32
@@ -549,7 +549,7 @@ impl RayState {
     };
 }
 
-/// Front-to-back compositing of one ray (see [`crate::composite`]): the
+/// Front-to-back compositing of one ray (see [`crate::kernels::composite`]): the
 /// colour so far in lanes r, g, b, and the transmittance `T = Π(1 − αᵢ)`.
 #[derive(Clone, Copy)]
 struct Accumulator {
@@ -580,7 +580,7 @@ impl Accumulator {
 
 /// `⌈x⌉` and `⌊x⌋` for `|x| < 2³¹` without a library call (SSE2 has no
 /// rounding instruction). Sample numbers are far smaller: a ray has at most
-/// [`crate::render::MAX_SAMPLES_PER_RAY`] samples on either side of the
+/// [`crate::renderer::MAX_SAMPLES_PER_RAY`] samples on either side of the
 /// image plane (of its base sample, in perspective, which lies level with
 /// the grid's centre).
 #[inline]

@@ -1,7 +1,7 @@
 //! Blend modes: how the samples along a ray make the pixel.
 //!
 //! [`Blend::Composite`] is the paper's: classified, shaded samples
-//! composited with the transparency formula (see [`crate::composite`]).
+//! composited with the transparency formula (see [`crate::kernels::composite`]).
 //! The others are projections of the interpolated *scalar* along the ray,
 //! as VTK's `vtkVolumeMapper` blend modes MAXIMUM_INTENSITY,
 //! MINIMUM_INTENSITY and AVERAGE_INTENSITY: the maximum, the minimum or the
@@ -14,7 +14,7 @@
 //! pixel's grey level is the ray's maximum. A ray with no sample shows the
 //! background.
 
-use crate::classify::Classifier;
+use crate::transfer::classifier::Classifier;
 
 /// How a ray's samples combine into its pixel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -97,8 +97,8 @@ pub fn projection_color(classifier: &Classifier, f: f32) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::OpacityMap;
-    use crate::transfer_function::PiecewiseLinear;
+    use crate::transfer::classifier::OpacityMap;
+    use crate::transfer::function::PiecewiseLinear;
 
     #[test]
     fn projections_of_known_samples() {

@@ -27,15 +27,18 @@
 //!   shrinks by the factor, the perspective `tan(fov/2)` likewise (VTK
 //!   narrows the view angle; the eye does not move).
 //! - **Azimuth and elevation** orbit the eye about the reference with VTK's
-//!   conventions ([`pose`](crate::pose) has the details and the signs).
+//!   conventions ([`pose`] has the details and the signs).
 //! - **Bounds**: frame this box rather than the volume's, so that a series
 //!   of volumes is framed alike.
 //!
 //! [`Camera::default()`] is the paper's view: orthographic, on the +x axis
 //! through the volume's centre looking along −x, up +z, the box fitted.
 
-use crate::perspective::PerspectiveView;
-use crate::pose::Pose;
+pub mod perspective;
+pub mod pose;
+
+use crate::camera::perspective::PerspectiveView;
+use crate::camera::pose::Pose;
 use glam::DVec3;
 use thiserror::Error;
 

@@ -2,28 +2,28 @@
 //!
 //! The paper (after Levoy 1988) classifies and shades every voxel, then
 //! interpolates the colours and opacities along the rays
-//! (pre-classification, [`crate::stage1`]). Post-classification
+//! (pre-classification, [`crate::reference::stage1`]). Post-classification
 //! interpolates the scalar and the gradient at each sample instead, then
 //! classifies and shades the sample (Engel et al., *Real-Time Volume
 //! Graphics*, 2006, §4.4): a transfer function with sharp features is then
 //! resolved at the sampling rate rather than blurred over a cell, at the
 //! cost of classifying and shading every sample. The gradient at a sample
 //! is the trilinear interpolation of the voxels' central-difference
-//! gradients ([`crate::gradient`]), as GPU ray casters sample a gradient
+//! gradients ([`crate::kernels::gradient`]), as GPU ray casters sample a gradient
 //! volume.
 //!
 //! A sample's colour and opacity follow the very formulas of a voxel's in
-//! [`crate::stage1`]: the lit colour ([`crate::shading`]) times the
+//! [`crate::reference::stage1`]: the lit colour ([`crate::kernels::phong`]) times the
 //! material colour, clamped to [0, 1], and the classifier's
 //! [`Classifier::opacity_at`], step-corrected. So on data where
 //! interpolation commutes with classification (a uniform medium) both give
 //! the same picture.
 
-use crate::classify::Classifier;
-use crate::gradient::gradients;
+use crate::kernels::gradient::gradients;
+use crate::kernels::phong::{LightGeometry, Phong};
+use crate::kernels::trilinear::{scalar_reference, vector_reference};
 use crate::non_finite::NonFiniteMask;
-use crate::shading::{LightGeometry, Phong};
-use crate::trilinear::{scalar_reference, vector_reference};
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{DVec4, Vec3};
 
@@ -94,8 +94,8 @@ impl<'a> PostClassifier<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::OpacityMap;
-    use crate::transfer_function::PiecewiseLinear;
+    use crate::transfer::classifier::OpacityMap;
+    use crate::transfer::function::PiecewiseLinear;
     use glam::DVec3;
 
     #[test]

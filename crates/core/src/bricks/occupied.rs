@@ -6,7 +6,7 @@
 //! a non-zero opacity; the others hold no sample that could add to a ray
 //! (trilinear interpolation of eight zero opacities is exactly zero), so
 //! they are neither stored nor visited. The min/max macro-cell grid rules
-//! out most of them at once (see [`crate::macrocells`]); the rest are
+//! out most of them at once (see [`crate::bricks::macrocells`]); the rest are
 //! classified voxel by voxel, with the voxel's gradient where the opacity
 //! depends on it (an iso-surface, gradient-magnitude opacity). Inside an occupied brick a mask marks the
 //! occupied *cells* (any of the eight corners with non-zero opacity), so
@@ -22,13 +22,13 @@
 //! each frame recomputes it exactly from the voxel's value.
 //!
 //! All of this depends on the volume and the classifier only: the light,
-//! which follows the camera, is applied per frame by [`crate::shade_bricks`].
+//! which follows the camera, is applied per frame by [`crate::cpu::lit_bricks`].
 
+use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot, slot_coords};
-use crate::classify::Classifier;
-use crate::gradient::gradient_at;
-use crate::macrocells::Macrocells;
+use crate::kernels::gradient::gradient_at;
 use crate::non_finite::NonFiniteMask;
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use rayon::prelude::*;
 
@@ -266,10 +266,10 @@ fn cell_bounds(cells: &[u64; CELLS / 64]) -> ([u8; 3], [u8; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::OpacityMap;
-    use crate::gradient::max_magnitude;
-    use crate::iso::IsoSurface;
-    use crate::transfer_function::PiecewiseLinear;
+    use crate::kernels::gradient::max_magnitude;
+    use crate::transfer::classifier::OpacityMap;
+    use crate::transfer::function::PiecewiseLinear;
+    use crate::transfer::iso::IsoSurface;
     use glam::DVec3;
 
     /// Opacity zero below t = 0.5, a ramp above it.
@@ -344,7 +344,7 @@ mod tests {
         }
         assert_eq!(quantise_normal([0.0; 3]), [0; 3]);
         assert_eq!(quantise_normal([0.0, -1e-10, 0.0]), [0, -32767, 0]);
-        // As in [`crate::shading`], a gradient whose square underflows has no normal.
+        // As in [`crate::kernels::phong`], a gradient whose square underflows has no normal.
         assert_eq!(quantise_normal([0.0, -1e-30, 0.0]), [0; 3]);
     }
 

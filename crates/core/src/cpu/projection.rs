@@ -1,5 +1,5 @@
 //! The fast path of the intensity projections (maximum, minimum, average;
-//! see [`crate::blend`]): the reference's samples, in `f32`, skipping what
+//! see [`crate::kernels::projection`]): the reference's samples, in `f32`, skipping what
 //! cannot change the result.
 //!
 //! Each ray takes the samples [`crate::sampling`] gives it (any view,
@@ -9,7 +9,7 @@
 //!
 //! - **Macro-cell skipping.** A trilinear sample lies between the smallest
 //!   and the largest of its cell's eight voxels, so no sample in a brick
-//!   whose largest voxel ([`crate::macrocells`]) is at most the running
+//!   whose largest voxel ([`crate::bricks::macrocells`]) is at most the running
 //!   maximum can raise it: the ray jumps to the first sample past the
 //!   brick (Parker et al., "Interactive ray tracing for volume
 //!   visualization", IEEE TVCG 1999, use the same min/max bound for
@@ -26,15 +26,15 @@
 //! counts no sample shows the background. The bricks' ranges, of the
 //! cleaned volume, still bound every counted sample.
 
-use crate::blend::{Blend, projection_color};
 use crate::bricks::BRICK;
+use crate::bricks::macrocells::Macrocells;
 use crate::camera::View;
-use crate::classify::Classifier;
 use crate::image::Image;
-use crate::macrocells::Macrocells;
+use crate::kernels::projection::{Blend, projection_color};
+use crate::kernels::trilinear::sample_scalar;
 use crate::non_finite::NonFiniteMask;
 use crate::sampling::{PixelSamples, Sampling};
-use crate::trilinear::sample_scalar;
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::Vec3;
 use rayon::prelude::*;

@@ -1,7 +1,7 @@
 //! Where the camera stands and which way it faces: the view point, the view
 //! reference and the screen axes, after the camera's azimuth and elevation
 //! orbits. Both projections ([`OrthographicView`](crate::camera::OrthographicView)
-//! and [`PerspectiveView`](crate::perspective::PerspectiveView)) start from here.
+//! and [`PerspectiveView`](crate::camera::perspective::PerspectiveView)) start from here.
 //!
 //! The orbits follow VTK's `vtkCamera` (checked against VTK 9.7.2):
 //!

@@ -2,7 +2,7 @@
 //!
 //! `C_β = C_s,β·k_a,β + C_s,β·[k_d,β (N·L) + k_s,β (N·H)^n]` with
 //! `H = (V + L)/|V + L|` (Ramesh & Athithan 1993, after Levoy 1988), where
-//! `N` is the unit gradient (see [`crate::gradient`]), `L` the unit direction
+//! `N` is the unit gradient (see [`crate::kernels::gradient`]), `L` the unit direction
 //! towards a light at infinity, `V` the unit direction towards the viewer
 //! and `C_s` the light's colour. The material colour from the transfer
 //! function multiplies the lit colour; with the default white material the

@@ -1,7 +1,7 @@
 //! Jittered ray starts: a per-pixel offset of the sample planes against
 //! wood-grain artifacts.
 //!
-//! Without jitter every ray samples at `t = k·step` (see [`crate::ray`]):
+//! Without jitter every ray samples at `t = k·step` (see [`crate::sampling::grid`]):
 //! neighbouring rays sample the same depths, so the error of a coarse step
 //! shows as bands that follow the sample planes ("wood grain"). Jitter moves
 //! pixel (col, row)'s samples to `t = (k + u)·step` with `u` in [0, 1), which

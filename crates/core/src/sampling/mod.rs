@@ -5,9 +5,9 @@
 //! A pixel's world ray `p(t) = o + t·d` ([`View::pixel_ray`]) is sampled at
 //! `t = (k + u)·step` for the integers `k` whose `t` lies in the ray's
 //! interval: where it is inside the grid ([`GridFrame::span`]), cut by the
-//! crop box and the clip planes ([`crate::clipping`]), and, for a
+//! crop box and the clip planes ([`crate::sampling::clipping`]), and, for a
 //! perspective ray, in front of the eye (`t ≥ 0`). `u` is 0, or the pixel's
-//! jitter offset ([`crate::jitter`]). Without options this is exactly
+//! jitter offset ([`crate::sampling::jitter`]). Without options this is exactly
 //! [`GridFrame::ray`]: the samples lie on planes parallel to the image,
 //! `t = k·step` from it. Samples within a millionth of a step of the
 //! interval's ends count as inside, as there.
@@ -15,10 +15,13 @@
 //! Both paths take their samples from here (the fast path for its rays'
 //! exact ranges), so they sample the very same points.
 
+pub mod clipping;
+pub mod grid;
+pub mod jitter;
+
 use crate::camera::View;
-use crate::clipping::Clipping;
-use crate::jitter;
-use crate::ray::{GridFrame, clamp_to_grid};
+use crate::sampling::clipping::Clipping;
+use crate::sampling::grid::{GridFrame, clamp_to_grid};
 use glam::DVec3;
 
 /// The sample positions of one frame's rays.

@@ -12,6 +12,9 @@
 //! beyond the volume repeat the last voxel, which no clamped sample can tell
 //! apart from the voxel itself.
 
+pub mod macrocells;
+pub mod occupied;
+
 /// Cells along each edge of a brick.
 pub const BRICK: usize = 8;
 /// Voxels along each edge of a brick (the cells' corners).

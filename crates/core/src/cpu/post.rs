@@ -1,16 +1,16 @@
 //! The fast path of post-classified compositing: the reference's samples
-//! (see [`crate::post_classification`]), in `f32`, front to back, skipping
+//! (see [`crate::reference::post`]), in `f32`, front to back, skipping
 //! the bricks that are transparent whatever their samples.
 //!
 //! Each ray takes the samples [`crate::sampling`] gives it (orthographic or
 //! perspective, cropped, clipped, jittered), walks the 8³-cell bricks of
 //! [`crate::bricks`] it crosses in order, and in every brick that may be
 //! visible takes each sample: it interpolates the scalar and the voxels'
-//! central-difference gradients ([`crate::gradient`]) trilinearly, then
+//! central-difference gradients ([`crate::kernels::gradient`]) trilinearly, then
 //! classifies and shades the sample with the formulas of
-//! [`crate::post_classification`] (the classifier's opacity and material,
+//! [`crate::reference::post`] (the classifier's opacity and material,
 //! Phong lighting for the frame's one light geometry, the colour clamped
-//! to [0, 1]) and composites it front to back ([`crate::composite`]). The
+//! to [0, 1]) and composites it front to back ([`crate::kernels::composite`]). The
 //! ray stops once its transmittance is below
 //! [`TERMINATION_TRANSMITTANCE`], as on the bricked fast path.
 //!
@@ -25,10 +25,10 @@
 //!
 //! **Skipping.** A trilinear sample lies between the smallest and the
 //! largest of its cell's voxels, so every sample of a brick has a value in
-//! the brick's range ([`crate::macrocells`]); if
+//! the brick's range ([`crate::bricks::macrocells`]); if
 //! [`Classifier::is_transparent_between`] says that range gets zero
 //! opacity at every gradient (with Levoy's contour and gradient-magnitude
-//! opacity too, see [`crate::classify`]), no sample of the brick can add
+//! opacity too, see [`crate::transfer::classifier`]), no sample of the brick can add
 //! anything and the ray steps over it. In `f32` the interpolated value may
 //! stray past the range by rounding, by at most `7.5·ε·max(|lo|, |hi|)`
 //! (three nested lerps, each off by at most `2u·|b − a| + u·|result|`,
@@ -61,7 +61,7 @@
 //! (the same arithmetic, lane by lane, as separate scalar and vector
 //! lerps, so the same values). It costs 16 bytes per voxel, four times the
 //! volume itself. (A bricked copy, each brick's 9³ corner voxels together
-//! as in [`crate::classified`], 22.8 bytes per voxel, measured no faster:
+//! as in [`crate::bricks::occupied`], 22.8 bytes per voxel, measured no faster:
 //! the cost is in the arithmetic, not the cache.)
 //!
 //! **Non-finite voxels** rendered as empty space ([`crate::non_finite`]):
@@ -74,17 +74,17 @@
 //! whatever thread runs it (rows in parallel), so the image is
 //! bit-identical for any thread count.
 
+use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid};
 use crate::camera::View;
-use crate::classify::Classifier;
-use crate::composite::FrontToBack;
+use crate::cpu::bricked::TERMINATION_TRANSMITTANCE;
 use crate::image::Image;
-use crate::macrocells::Macrocells;
+use crate::kernels::composite::FrontToBack;
+use crate::kernels::phong::{LightGeometry, Phong};
 use crate::non_finite::NonFiniteMask;
-use crate::ray::clamp_to_grid;
-use crate::raycast::TERMINATION_TRANSMITTANCE;
+use crate::sampling::grid::clamp_to_grid;
 use crate::sampling::{PixelSamples, Sampling};
-use crate::shading::{LightGeometry, Phong};
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -99,7 +99,7 @@ pub const RANGE_MARGIN: f32 = 16.0;
 /// What one frame's rays read.
 pub struct PostScene<'a> {
     pub volume: &'a Volume,
-    /// The world gradient of every voxel ([`crate::gradient::gradients`]).
+    /// The world gradient of every voxel ([`crate::kernels::gradient::gradients`]).
     pub gradients: &'a [[f32; 3]],
     /// The volume's min/max bricks.
     pub macrocells: &'a Macrocells,
@@ -125,7 +125,7 @@ pub struct PackedScene<'a> {
 }
 
 /// Every voxel's world gradient (from `gradients`, see
-/// [`crate::gradient::gradients`]) and scalar as the lanes
+/// [`crate::kernels::gradient::gradients`]) and scalar as the lanes
 /// `(gx, gy, gz, f)`, x fastest: what [`render_packed`] reads.
 pub fn packed_voxels(volume: &Volume, gradients: &[[f32; 3]]) -> Vec<f32x4> {
     assert_eq!(gradients.len(), volume.len());
@@ -504,14 +504,14 @@ impl Rays<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::OpacityMap;
-    use crate::iso::IsoSurface;
-    use crate::transfer_function::PiecewiseLinear;
+    use crate::transfer::classifier::OpacityMap;
+    use crate::transfer::function::PiecewiseLinear;
+    use crate::transfer::iso::IsoSurface;
 
     #[test]
     fn packed_voxels_interpolate_to_the_scalar_and_the_gradient_of_the_reference() {
-        use crate::gradient::gradients;
-        use crate::trilinear::{sample_scalar, vector_reference};
+        use crate::kernels::gradient::gradients;
+        use crate::kernels::trilinear::{sample_scalar, vector_reference};
         use glam::DVec3;
         // Values from a hash of the index: nothing a layout bug could hide behind.
         let volume = Volume::from_fn([7, 5, 6], DVec3::new(1.0, 0.5, 2.0), DVec3::ZERO, |p| {

@@ -7,12 +7,12 @@
 //! `f64`, and make the pixel from them by the frame's [`Shader`]:
 //!
 //! - pre-classified (the paper's): interpolate the voxels' colours and
-//!   opacities ([`crate::stage1`]) trilinearly, drape the opaque background
+//!   opacities ([`crate::reference::stage1`]) trilinearly, drape the opaque background
 //!   behind them as the last sample, and composite back to front with the
 //!   paper's formula;
 //! - post-classified: interpolate the scalar and the gradient, classify and
-//!   shade each sample ([`crate::post_classification`]), composite alike;
-//! - a projection (maximum, minimum, average; [`crate::blend`]): project the
+//!   shade each sample ([`crate::reference::post`]), composite alike;
+//! - a projection (maximum, minimum, average; [`crate::kernels::projection`]): project the
 //!   interpolated scalar and show it through the colour map.
 //!
 //! Non-finite voxels rendered as empty space ([`crate::non_finite`]) have
@@ -21,16 +21,19 @@
 //!
 //! No shortcuts: no early termination, no empty-space skipping.
 
-use crate::blend::{Blend, ScalarProjection, projection_color};
+pub mod post;
+pub mod stage1;
+
 use crate::camera::View;
-use crate::classify::Classifier;
-use crate::composite::back_to_front;
 use crate::image::Image;
+use crate::kernels::composite::back_to_front;
+use crate::kernels::projection::{Blend, ScalarProjection, projection_color};
+use crate::kernels::trilinear::{sample_reference, scalar_reference};
 use crate::non_finite::NonFiniteMask;
-use crate::post_classification::PostClassifier;
+use crate::reference::post::PostClassifier;
+use crate::reference::stage1::ShadedVolume;
 use crate::sampling::Sampling;
-use crate::stage1::ShadedVolume;
-use crate::trilinear::{sample_reference, scalar_reference};
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;

@@ -44,11 +44,11 @@
 //! left out: no sample of theirs is taken.
 
 use crate::bricks::BRICK;
+use crate::bricks::occupied::ClassifiedBricks;
+use crate::camera::perspective::PerspectiveView;
 use crate::camera::{OrthographicView, View};
-use crate::classified::ClassifiedBricks;
-use crate::perspective::PerspectiveView;
-use crate::ray::GridFrame;
 use crate::sampling::Sampling;
+use crate::sampling::grid::GridFrame;
 use glam::DVec3;
 
 /// Tile edge in pixels.
@@ -287,11 +287,11 @@ fn tile_rect([c0, c1, r0, r1]: [f64; 4], width: usize, height: usize) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bricks::macrocells::Macrocells;
+    use crate::bricks::occupied::ClassifiedBricks;
     use crate::camera::Camera;
-    use crate::classified::ClassifiedBricks;
-    use crate::classify::{Classifier, OpacityMap};
-    use crate::clipping::Clipping;
-    use crate::macrocells::Macrocells;
+    use crate::sampling::clipping::Clipping;
+    use crate::transfer::classifier::{Classifier, OpacityMap};
     use crate::volume::Volume;
 
     #[test]

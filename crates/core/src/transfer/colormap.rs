@@ -15,7 +15,7 @@
 //! which are rounded to 8 bits and wobble by a level between its table
 //! entries).
 
-use crate::transfer_function::PiecewiseLinear;
+use crate::transfer::function::PiecewiseLinear;
 
 /// Samples per map: enough that linear interpolation between them stays
 /// within a quantisation level of the continuous map (tested).

@@ -3,7 +3,7 @@
 //!
 //! M. Levoy, "Display of surfaces from volume data", *IEEE CG&A* 8(3),
 //! 1988, eq. 3: for the isovalue `f_v` with opacity `α_v` (see
-//! [`crate::classify::Classifier::iso_alpha`]: an opacity table's value at
+//! [`crate::transfer::classifier::Classifier::iso_alpha`]: an opacity table's value at
 //! `f_v`, or the ramp's top `q`) and a transition region `r` voxels thick,
 //!
 //! ```text
@@ -86,7 +86,7 @@ impl IsoContour {
     }
 
     /// Eq. 3: the unit opacity of value `f` where the world gradient has
-    /// magnitude `gradient` (see [`crate::gradient::magnitude`]).
+    /// magnitude `gradient` (see [`crate::kernels::gradient::magnitude`]).
     #[inline]
     pub fn opacity(&self, f: f32, gradient: f32) -> f32 {
         let distance = (f - self.value).abs();

@@ -3,8 +3,8 @@
 //!
 //! The light follows the camera (a headlight by default), so this cannot
 //! be kept across frames; everything it reads can (see
-//! [`crate::classified`]). It is the model of [`crate::shading`] and
-//! [`crate::stage1`] on the stored normals: two-sided (the normal turned to
+//! [`crate::bricks::occupied`]). It is the model of [`crate::kernels::phong`] and
+//! [`crate::reference::stage1`] on the stored normals: two-sided (the normal turned to
 //! face the viewer), `C = Cs·(ka + kd·max(N·L, 0) + ks·max(N·H, 0)^n)` times
 //! the material colour, clamped to [0, 1], with ambient light only where
 //! the gradient is zero (a zero normal makes every dot product zero). Every
@@ -16,10 +16,10 @@
 //! the result is `f32` RGBA per slot, ready for the ray caster to load
 //! without conversion.
 
+use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, UNIT, Voxel};
 use crate::bricks::{SIDE, SLOTS, slot_coords};
-use crate::classified::{ClassifiedBricks, NORMAL_UNIT, UNIT, Voxel};
-use crate::classify::Classifier;
-use crate::shading::{LightGeometry, Phong};
+use crate::kernels::phong::{LightGeometry, Phong};
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use std::sync::{RwLock, RwLockReadGuard};
 use wide::bytemuck::cast;
@@ -297,7 +297,7 @@ impl FrameLight {
 /// The material colour function of one classifier, as a sum of clamped
 /// ramps: `f(t) = v₀ + Σᵢ (vᵢ₊₁ − vᵢ)·clamp((t − tᵢ)/(tᵢ₊₁ − tᵢ), 0, 1)`,
 /// a step where `tᵢ₊₁ = tᵢ` (the value after the jump, as
-/// [`crate::transfer_function::PiecewiseLinear::eval`] takes it). It
+/// [`crate::transfer::function::PiecewiseLinear::eval`] takes it). It
 /// equals the piecewise-linear function exactly, up to rounding, and needs
 /// no search for the segment, so four voxels go through it at once.
 struct Material {
@@ -354,9 +354,9 @@ impl Material {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classified::quantise_normal;
-    use crate::classify::OpacityMap;
-    use crate::transfer_function::PiecewiseLinear;
+    use crate::bricks::occupied::quantise_normal;
+    use crate::transfer::classifier::OpacityMap;
+    use crate::transfer::function::PiecewiseLinear;
     use glam::Vec3;
 
     #[test]

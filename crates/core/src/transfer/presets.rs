@@ -8,8 +8,8 @@
 //! ParaView/3D Slicer presets ("CT-Bone", "CT-Muscle", "MR-Default")
 //! without copying their exact numbers.
 
-use crate::colormap::colormap;
-use crate::transfer_function::{PiecewiseLinear, TransferFunction};
+use crate::transfer::colormap::colormap;
+use crate::transfer::function::{PiecewiseLinear, TransferFunction};
 
 /// The names `--preset` accepts.
 pub const NAMES: [&str; 4] = ["ct-bone", "ct-soft-tissue", "mr", "electron-density"];
@@ -91,7 +91,7 @@ pub fn preset(name: &str) -> Option<TransferFunction> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::Classifier;
+    use crate::transfer::classifier::Classifier;
 
     #[test]
     fn every_preset_exists() {

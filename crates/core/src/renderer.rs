@@ -7,10 +7,10 @@
 //! the rays, lighting each brick as the rays first reach it.
 //!
 //! **Routing.** [`Method::Fast`] asks for the fast paths: the bricked ray
-//! caster ([`crate::raycast`]) renders views composited from
-//! pre-classified voxels (the paper's method), and [`crate::intensity`]
+//! caster ([`crate::cpu::bricked`]) renders views composited from
+//! pre-classified voxels (the paper's method), and [`crate::cpu::projection`]
 //! renders the projection blend modes (maximum, minimum, average), and
-//! [`crate::post_cast`] views composited from post-classified samples
+//! [`crate::cpu::post`] views composited from post-classified samples
 //! (interpolate the scalar and the gradient, then classify and shade,
 //! skipping transparent bricks); all take either projection and any crop
 //! box, clip planes and jitter. [`Method::Reference`] runs the reference
@@ -22,29 +22,30 @@
 //! [`NonFinite::Transparent`] renders them as empty space, from a cleaned
 //! copy and a mask (see [`crate::non_finite`] for the exact rules).
 
-use crate::blend::Blend;
+use crate::bricks::macrocells::Macrocells;
+use crate::bricks::occupied::ClassifiedBricks;
 use crate::camera::{Camera, CameraError, View};
-use crate::classified::ClassifiedBricks;
-use crate::classify::Classifier;
-use crate::clipping::{ClipPlane, Clipping};
-use crate::gradient::{gradients, max_magnitude};
-use crate::gradient_opacity::GradientOpacity;
+use crate::cpu::lit_bricks::{Lighting, LitBricks};
+use crate::cpu::projection as intensity;
+use crate::cpu::tiles::TileBins;
+use crate::cpu::{bricked, post as post_cast};
 use crate::image::Image;
-use crate::intensity;
-use crate::iso::IsoSurface;
-use crate::macrocells::Macrocells;
+use crate::kernels::gradient::{gradients, max_magnitude};
+use crate::kernels::phong::{LightGeometry, Phong};
+use crate::kernels::projection::Blend;
 use crate::non_finite::{NonFinite, NonFiniteMask};
-use crate::post_classification::{Classification, PostClassifier};
-use crate::ray::GridFrame;
+use crate::reference;
 use crate::reference::Shader;
+use crate::reference::post::{Classification, PostClassifier};
+use crate::reference::stage1::{ShadedVolume, shade_and_classify};
+use crate::sampling::clipping::{ClipPlane, Clipping};
+use crate::sampling::grid::GridFrame;
 use crate::sampling::{PixelSamples, Sampling};
-use crate::shade_bricks::{Lighting, LitBricks};
-use crate::shading::{LightGeometry, Phong};
-use crate::stage1::{ShadedVolume, shade_and_classify};
-use crate::tiles::TileBins;
-use crate::transfer_function::TransferFunction;
+use crate::transfer::classifier::Classifier;
+use crate::transfer::function::TransferFunction;
+use crate::transfer::gradient_opacity::GradientOpacity;
+use crate::transfer::iso::IsoSurface;
 use crate::volume::Volume;
-use crate::{post_cast, raycast, reference};
 use glam::DVec3;
 use std::borrow::Cow;
 use std::sync::{Mutex, OnceLock};
@@ -556,7 +557,7 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// The fast paths: the projections' ([`crate::intensity`]),
+    /// The fast paths: the projections' ([`crate::cpu::projection`]),
     /// post-classified compositing's ([`Self::render_post`]), or the
     /// bricked ray caster's ([`Self::render_bricks`]).
     fn render_fast(
@@ -595,7 +596,7 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// Post-classified compositing ([`crate::post_cast`]), from the
+    /// Post-classified compositing ([`crate::cpu::post`]), from the
     /// volume's packed gradients and values and its min/max bricks (both
     /// computed on the first frame that needs them, and kept); all its time
     /// counts as `cast`.
@@ -671,7 +672,7 @@ impl<'v> Renderer<'v> {
             settings.shading.then_some((&settings.phong, &light)),
         );
         state.lit.next_frame(state.bricks.len());
-        raycast::render(
+        bricked::render(
             &state.bricks,
             &state.lit,
             &lighting,

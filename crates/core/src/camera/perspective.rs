@@ -17,8 +17,8 @@
 //! from the view reference, so with the default one (the box's centre) the
 //! framing does not change as the camera orbits.
 
+use crate::camera::pose::Pose;
 use crate::camera::{Camera, CameraError, Projection, check_size};
-use crate::pose::Pose;
 use glam::DVec3;
 
 /// A framed perspective view.

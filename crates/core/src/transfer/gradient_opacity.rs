@@ -47,7 +47,7 @@ impl GradientOpacity {
     }
 
     /// The factor opacity is multiplied by where the world gradient has
-    /// magnitude `gradient` (see [`crate::gradient::magnitude`]).
+    /// magnitude `gradient` (see [`crate::kernels::gradient::magnitude`]).
     #[inline]
     pub fn factor(&self, gradient: f32) -> f32 {
         ((gradient * self.inv_max - self.lo) * self.inv_width).clamp(0.0, 1.0)

@@ -1,17 +1,17 @@
 //! Stage 1 of the paper: every voxel gets a colour (shading) and an
 //! opacity (classification) before any ray is cast.
 //!
-//! The colour is the lit colour of [`crate::shading`] times the material
-//! colour of [`crate::classify`], clamped to [0, 1]; the opacity is the
+//! The colour is the lit colour of [`crate::kernels::phong`] times the material
+//! colour of [`crate::transfer::classifier`], clamped to [0, 1]; the opacity is the
 //! classified opacity of the voxel's value and gradient
 //! ([`Classifier::opacity_at`]) corrected for the sampling step. Stage 2
 //! interpolates these per-voxel values along the rays (pre-classification,
 //! as in the paper and Levoy 1988). This is the reference path's stage 1, over every
-//! voxel, dense; the fast path's is [`crate::classified`] (view-independent,
-//! kept across frames) and [`crate::shade_bricks`] (the light, per frame).
+//! voxel, dense; the fast path's is [`crate::bricks::occupied`] (view-independent,
+//! kept across frames) and [`crate::cpu::lit_bricks`] (the light, per frame).
 
-use crate::classify::Classifier;
-use crate::shading::{LightGeometry, Phong};
+use crate::kernels::phong::{LightGeometry, Phong};
+use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -24,7 +24,7 @@ pub struct ShadedVolume {
 }
 
 /// Shades and classifies every voxel of `volume`. `gradients` are the
-/// volume's (see [`crate::gradient`]); `lighting` is `None` for unlit
+/// volume's (see [`crate::kernels::gradient`]); `lighting` is `None` for unlit
 /// rendering (the colour is the material colour).
 pub fn shade_and_classify(
     volume: &Volume,
@@ -58,11 +58,11 @@ pub fn shade_and_classify(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::OpacityMap;
-    use crate::classify::correct_opacity;
-    use crate::gradient::{gradients, max_magnitude};
-    use crate::iso::IsoSurface;
-    use crate::transfer_function::PiecewiseLinear;
+    use crate::kernels::gradient::{gradients, max_magnitude};
+    use crate::transfer::classifier::OpacityMap;
+    use crate::transfer::classifier::correct_opacity;
+    use crate::transfer::function::PiecewiseLinear;
+    use crate::transfer::iso::IsoSurface;
     use glam::DVec3;
 
     #[test]

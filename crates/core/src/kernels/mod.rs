@@ -1,0 +1,7 @@
+//! Per-sample maths, the one copy every path calls.
+
+pub mod composite;
+pub mod gradient;
+pub mod phong;
+pub mod projection;
+pub mod trilinear;
