@@ -243,6 +243,6 @@ fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
 
 /// Samples the rays of `frame` would take without skipping or early
 /// termination.
-fn nominal_samples(frame: &volray_core::renderer::Frame) -> usize {
+fn nominal_samples(frame: &volray_core::Frame) -> usize {
     frame.nominal_samples()
 }

@@ -414,28 +414,60 @@ pub fn renderer_for<'v>(view: &ViewArgs, input: &'v Input) -> Result<Renderer<'v
 }
 
 /// A failure to render `name` as one line, naming the flag whose value
-/// caused it where one did: a camera that cannot be posed (the view point
-/// on the view reference, the up vector along the view direction, a point
-/// beyond `f64`), or a step too fine for the volume.
+/// caused it: the core's errors say which setting, by variant.
 pub fn render_failure(view: &ViewArgs, name: &str, e: RenderError) -> CliError {
-    let flag = match &e {
-        RenderError::Camera(CameraError::NoDirection(_)) if view.view.is_some() => Some("--view"),
-        RenderError::Camera(CameraError::NoDirection(_)) => Some("--look-at"),
-        RenderError::Camera(CameraError::UpParallel { .. }) => Some("--up"),
-        RenderError::Camera(CameraError::NotFinite(what, _)) => match *what {
-            "view point" if view.view.is_some() => Some("--view"),
-            "view reference" if view.look_at.is_some() => Some("--look-at"),
-            "up" => Some("--up"),
-            _ => None,
-        },
-        // The core names the setting ("step 1e-12 voxels is too small ...").
-        RenderError::Setting(message) if message.starts_with("step ") => Some("--step"),
-        _ => None,
-    };
-    match flag {
+    match flag_of(view, &e) {
         Some(flag) => CliError::input(format!("{name}: {flag}: {e}")),
         None => CliError::input(format!("{name}: {e}")),
     }
+}
+
+/// The flag whose value a core error is about, if one is.
+fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<&'static str> {
+    use volray_core::{CameraPoint, Orbit, Reflection, SettingError as S};
+    let flag = match e {
+        RenderError::NonFinite { .. } => "--nonfinite",
+        RenderError::Camera(c) => match c {
+            CameraError::NoDirection(_) if view.view.is_some() => "--view",
+            CameraError::NoDirection(_) => "--look-at",
+            CameraError::UpParallel { .. } => "--up",
+            CameraError::NotFinite(CameraPoint::ViewPoint, _) if view.view.is_some() => "--view",
+            CameraError::NotFinite(CameraPoint::ViewReference, _) if view.look_at.is_some() => {
+                "--look-at"
+            }
+            CameraError::NotFinite(CameraPoint::Up, _) => "--up",
+            // A default point beyond f64: the volume's bounds are to blame.
+            CameraError::NotFinite(..) => return None,
+            CameraError::FieldOfView(_) => "--perspective",
+            CameraError::Zoom(_) => "--zoom",
+            CameraError::Angle(Orbit::Azimuth, _) => "--azimuth",
+            CameraError::Angle(Orbit::Elevation, _) => "--elevation",
+            CameraError::EmptyImage { .. } => "--size",
+            CameraError::Bounds { .. } | CameraError::WrongProjection { .. } => return None,
+        },
+        RenderError::Setting(s) => match s {
+            S::ImageSide { .. } | S::ImagePixels { .. } => "--size",
+            S::Step(_) | S::StepTooSmall { .. } => "--step",
+            S::OpacityRamp { .. } => "--opacity",
+            S::Reflection { term, .. } => match term {
+                Reflection::Ambient => "--ambient",
+                Reflection::Diffuse => "--diffuse",
+                Reflection::Specular => "--specular",
+                Reflection::LightColor => "--light-color",
+            },
+            S::Shininess(_) => "--shininess",
+            S::Background(_) => "--background",
+            S::LightDirection(_) => "--light",
+            S::Crop { .. } => "--crop",
+            S::ClipPoint(_) | S::ClipNormal(_) => "--clip",
+            S::IsoValue(_) => "--iso",
+            S::IsoThickness(_) => "--iso-thickness",
+            S::GradientOpacity { .. } => "--gradient-opacity",
+            // Set by a series from its volumes, not by a flag.
+            S::GradientOpacityMax(_) => return None,
+        },
+    };
+    Some(flag)
 }
 
 /// `--blend`, checked against the options that only compositing uses:

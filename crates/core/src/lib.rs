@@ -37,6 +37,8 @@
 pub mod bricks;
 pub mod camera;
 pub mod cpu;
+mod error;
+mod frame;
 pub mod histogram;
 pub mod image;
 pub mod kernels;
@@ -44,21 +46,26 @@ pub mod non_finite;
 pub mod reference;
 pub mod renderer;
 pub mod sampling;
+mod settings;
 pub mod transfer;
 pub mod volume;
 
-pub use camera::{Camera, CameraError, Fit, OrthographicView, Projection, View};
+pub use camera::{
+    Camera, CameraError, CameraPoint, Fit, Orbit, OrthographicView, Projection, View,
+};
+pub use error::{ImageSide, Reflection, RenderError, SettingError};
+pub use frame::Frame;
 pub use glam;
 pub use histogram::Histogram;
 pub use image::Image;
 pub use kernels::phong::{LightGeometry, Phong};
-pub use kernels::projection::Blend;
 pub use non_finite::{NonFinite, NonFiniteMask};
-pub use reference::post::Classification;
-pub use renderer::{
-    FrameTimes, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, Method, RenderError, RenderSettings, Renderer,
-};
+pub use renderer::{FrameTimes, Renderer};
 pub use sampling::clipping::ClipPlane;
+pub use settings::{
+    Blend, Classification, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_SAMPLES_PER_RAY, Method,
+    RenderSettings,
+};
 pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;
 pub use volume::{Volume, VolumeError, checked_point_count};

@@ -24,237 +24,27 @@
 
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::occupied::ClassifiedBricks;
-use crate::camera::{Camera, CameraError, View};
+use crate::camera::View;
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::projection as intensity;
 use crate::cpu::tiles::TileBins;
 use crate::cpu::{bricked, post as post_cast};
+use crate::error::RenderError;
+use crate::frame::Frame;
 use crate::image::Image;
 use crate::kernels::gradient::{gradients, max_magnitude};
-use crate::kernels::phong::{LightGeometry, Phong};
-use crate::kernels::projection::Blend;
+use crate::kernels::phong::LightGeometry;
 use crate::non_finite::{NonFinite, NonFiniteMask};
 use crate::reference;
 use crate::reference::Shader;
-use crate::reference::post::{Classification, PostClassifier};
+use crate::reference::post::PostClassifier;
 use crate::reference::stage1::{ShadedVolume, shade_and_classify};
-use crate::sampling::clipping::{ClipPlane, Clipping};
-use crate::sampling::grid::GridFrame;
-use crate::sampling::{PixelSamples, Sampling};
+use crate::settings::{Blend, Classification, Method, RenderSettings};
 use crate::transfer::classifier::Classifier;
-use crate::transfer::function::TransferFunction;
-use crate::transfer::gradient_opacity::GradientOpacity;
-use crate::transfer::iso::IsoSurface;
 use crate::volume::Volume;
-use glam::DVec3;
 use std::borrow::Cow;
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
-use thiserror::Error;
-
-/// Largest image side, in pixels.
-pub const MAX_IMAGE_SIDE: usize = 16384;
-/// Largest image, in pixels (8192², a 1 GiB frame buffer).
-pub const MAX_IMAGE_PIXELS: usize = 1 << 26;
-/// Largest number of samples one ray may take: a smaller step is refused
-/// rather than left to run for hours.
-pub const MAX_SAMPLES_PER_RAY: f64 = 1.0e6;
-
-/// Why a frame could not be rendered.
-#[derive(Debug, Error, Clone, PartialEq)]
-pub enum RenderError {
-    #[error("{count} of {total} values are not finite (NaN or infinite)")]
-    NonFinite { count: usize, total: usize },
-    #[error("{0}")]
-    Setting(String),
-    #[error(transparent)]
-    Camera(#[from] CameraError),
-}
-
-/// Which stage 2 to run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Method {
-    /// Front to back, early ray termination, empty-space skipping, in
-    /// parallel; every option has a fast path (see the module docs).
-    #[default]
-    Fast,
-    /// The paper's back-to-front compositing in `f64`, and every other
-    /// option: the oracle.
-    Reference,
-}
-
-/// Everything that decides a frame, besides the volume.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RenderSettings {
-    pub width: usize,
-    pub height: usize,
-    pub camera: Camera,
-    /// Distance between samples along a ray, in voxels: units of the
-    /// smallest grid spacing (the paper's step is 1, errata 8).
-    pub step: f64,
-    /// The paper's opacity sub-interval `[p, q]`, used when the transfer
-    /// function has no opacity.
-    pub opacity_ramp: (f32, f32),
-    pub transfer_function: TransferFunction,
-    pub phong: Phong,
-    /// `false`: no lighting, voxels take their material colour.
-    pub shading: bool,
-    /// Direction *towards* the light at infinity; `None`: a headlight (`L = V`).
-    pub light_direction: Option<DVec3>,
-    /// The opaque background, the last sample of every ray.
-    pub background: [f32; 3],
-    pub method: Method,
-    /// How the samples make the pixel: composite (the paper's) or a
-    /// projection of the scalar.
-    pub blend: Blend,
-    /// Classify voxels (the paper's) or samples.
-    pub classification: Classification,
-    /// Offset each pixel's samples by a per-pixel fraction of a step.
-    pub jitter: bool,
-    /// Render only what every plane keeps.
-    pub clip_planes: Vec<ClipPlane>,
-    /// Render only what lies in this world box `(lo, hi)`.
-    pub crop: Option<(DVec3, DVec3)>,
-    /// Levoy's isovalue contour instead of the value's opacity (`None`: off).
-    pub iso: Option<IsoSurface>,
-    /// Opacity times a ramp of `|∇f|` from 0 at `LO` to 1 at `HI`,
-    /// fractions of the volume's largest gradient magnitude (`None`: off).
-    pub gradient_opacity: Option<(f32, f32)>,
-    /// The gradient magnitude (world units) the `gradient_opacity`
-    /// fractions are fractions of; `None`: the volume's own largest. A
-    /// series of volumes shares the largest of them all, as it shares one
-    /// value window.
-    pub gradient_opacity_max: Option<f32>,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            width: 480,
-            height: 480,
-            camera: Camera::default(),
-            step: 1.0,
-            opacity_ramp: (0.0, 0.5),
-            transfer_function: TransferFunction::default(),
-            phong: Phong::default(),
-            shading: true,
-            light_direction: None,
-            background: [0.0; 3],
-            method: Method::Fast,
-            blend: Blend::Composite,
-            classification: Classification::Pre,
-            jitter: false,
-            clip_planes: Vec::new(),
-            crop: None,
-            iso: None,
-            gradient_opacity: None,
-            gradient_opacity_max: None,
-        }
-    }
-}
-
-fn setting(message: String) -> RenderError {
-    RenderError::Setting(message)
-}
-
-impl RenderSettings {
-    /// Checks every setting, naming the one that is wrong.
-    pub fn validate(&self) -> Result<(), RenderError> {
-        for (name, n) in [("width", self.width), ("height", self.height)] {
-            if n == 0 || n > MAX_IMAGE_SIDE {
-                return Err(setting(format!(
-                    "image {name} {n} must be between 1 and {MAX_IMAGE_SIDE} pixels"
-                )));
-            }
-        }
-        if self.width * self.height > MAX_IMAGE_PIXELS {
-            return Err(setting(format!(
-                "image {}x{} has more than {MAX_IMAGE_PIXELS} pixels",
-                self.width, self.height
-            )));
-        }
-        if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(setting(format!(
-                "step {} must be a positive number of voxels",
-                self.step
-            )));
-        }
-        let (p, q) = self.opacity_ramp;
-        if !(0.0 <= p && p < q && q <= 1.0) {
-            return Err(setting(format!(
-                "opacity ramp p,q = {p},{q} needs 0 <= p < q <= 1"
-            )));
-        }
-        let ph = &self.phong;
-        for (name, c) in [
-            ("ambient", ph.ambient),
-            ("diffuse", ph.diffuse),
-            ("specular", ph.specular),
-            ("light colour", ph.light_color),
-        ] {
-            if c.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-                return Err(setting(format!(
-                    "{name} {c:?} must be finite and non-negative"
-                )));
-            }
-        }
-        if !(ph.shininess.is_finite() && ph.shininess >= 0.0) {
-            return Err(setting(format!(
-                "shininess {} must be finite and non-negative",
-                ph.shininess
-            )));
-        }
-        if self.background.iter().any(|v| !(0.0..=1.0).contains(v)) {
-            return Err(setting(format!(
-                "background {:?} must be in [0, 1]",
-                self.background
-            )));
-        }
-        if let Some(l) = self.light_direction
-            && !(l.is_finite() && l.length() > 0.0)
-        {
-            return Err(setting(format!(
-                "light direction {l} must be a finite, non-zero vector"
-            )));
-        }
-        if let Some((lo, hi)) = self.crop
-            && !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all())
-        {
-            return Err(setting(format!(
-                "crop box {lo} .. {hi} must be finite with low < high on every axis"
-            )));
-        }
-        for plane in &self.clip_planes {
-            if !plane.point.is_finite() {
-                return Err(setting(format!(
-                    "clip plane point {} must be finite",
-                    plane.point
-                )));
-            }
-            let length = plane.normal.length();
-            if !(length.is_finite() && length > 0.0) {
-                return Err(setting(format!(
-                    "clip plane normal {} must be a finite, non-zero vector",
-                    plane.normal
-                )));
-            }
-        }
-        if let Some(iso) = &self.iso {
-            iso.validate().map_err(setting)?;
-        }
-        if let Some(range) = self.gradient_opacity {
-            GradientOpacity::validate(range).map_err(setting)?;
-        }
-        if let Some(max) = self.gradient_opacity_max
-            && !(max.is_finite() && max > 0.0)
-        {
-            return Err(setting(format!(
-                "gradient-opacity maximum {max} must be a finite gradient magnitude above 0"
-            )));
-        }
-        Ok(())
-    }
-}
 
 /// A volume ready to render. Its value range is found once; the fast
 /// path's view-independent work (the min/max macro-cells, and the occupied
@@ -415,44 +205,7 @@ impl<'v> Renderer<'v> {
 
     /// Validates `settings` and frames the view.
     pub fn prepare(&self, settings: &RenderSettings) -> Result<Frame, RenderError> {
-        settings.validate()?;
-        let view = View::frame(
-            &settings.camera,
-            self.volume.bounds(),
-            settings.width,
-            settings.height,
-        )?;
-        let step = settings.step * self.volume.spacing().min_element();
-        let samples = self.volume.extent().length() / step;
-        if samples > MAX_SAMPLES_PER_RAY {
-            return Err(setting(format!(
-                "step {} voxels is too small for this volume: a ray would take up to {samples:.0} samples (limit {MAX_SAMPLES_PER_RAY:.0})",
-                settings.step
-            )));
-        }
-        let grid = GridFrame {
-            dims: self.volume.dims(),
-            origin: self.volume.origin(),
-            spacing: self.volume.spacing(),
-        };
-        let clipping = Clipping {
-            crop: settings.crop,
-            // Unit normals: the planes' arithmetic stays in range.
-            planes: (settings.clip_planes.iter())
-                .map(|p| ClipPlane {
-                    point: p.point,
-                    normal: p.normal.normalize(),
-                })
-                .collect(),
-        };
-        let sampling = Sampling {
-            grid,
-            step,
-            clipping,
-            jitter: settings.jitter,
-            from_eye: matches!(view, View::Perspective(_)),
-        };
-        Ok(Frame { view, sampling })
+        Frame::new(settings, &self.volume)
     }
 
     /// The classifier `settings` describe for this volume.
@@ -689,31 +442,5 @@ impl<'v> Renderer<'v> {
         times.cast = t3 - t2;
         times.bricks = state.bricks.len();
         times
-    }
-}
-
-/// A validated, framed view of a volume.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Frame {
-    pub view: View,
-    /// Where each pixel's ray takes its samples (the grid, the step in
-    /// world units, the crop box and clip planes, jitter).
-    pub sampling: Sampling,
-}
-
-impl Frame {
-    /// The samples of pixel (`col`, `row`), or `None` if its ray takes none.
-    pub fn samples(&self, col: usize, row: usize) -> Option<PixelSamples> {
-        self.sampling.pixel(&self.view, col, row)
-    }
-
-    /// Samples all rays take together, before skipping and early
-    /// termination (a measure of a frame's work).
-    pub fn nominal_samples(&self) -> usize {
-        (0..self.view.height())
-            .flat_map(|row| (0..self.view.width()).map(move |col| (col, row)))
-            .filter_map(|(col, row)| self.samples(col, row))
-            .map(|s| s.count())
-            .sum()
     }
 }

@@ -5,7 +5,8 @@
 use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
 use volray_core::{
-    Image, IsoSurface, Method, RenderError, RenderSettings, Renderer, TransferFunction, Volume,
+    Image, IsoSurface, Method, RenderError, RenderSettings, Renderer, SettingError,
+    TransferFunction, Volume,
 };
 
 /// The fast and the reference image of one frame, which must agree within
@@ -214,14 +215,16 @@ fn classification_settings_are_validated() {
             ..RenderSettings::default()
         },
     ];
-    for settings in bad {
-        match renderer.render(&settings) {
-            Err(RenderError::Setting(message)) => {
-                assert!(
-                    message.starts_with("iso ") || message.starts_with("gradient opacity"),
-                    "{message}"
-                )
-            }
+    let want = [
+        SettingError::IsoThickness(0.0),
+        SettingError::IsoValue(f32::NAN),
+        SettingError::GradientOpacity { lo: 0.6, hi: 0.2 },
+        SettingError::GradientOpacity { lo: 0.0, hi: 1.5 },
+    ];
+    for (settings, want) in bad.iter().zip(want) {
+        match renderer.render(settings) {
+            // NaN != NaN: compare the messages.
+            Err(RenderError::Setting(got)) => assert_eq!(got.to_string(), want.to_string()),
             other => panic!("{settings:?}: {other:?}"),
         }
     }

@@ -27,19 +27,21 @@
 //!   shrinks by the factor, the perspective `tan(fov/2)` likewise (VTK
 //!   narrows the view angle; the eye does not move).
 //! - **Azimuth and elevation** orbit the eye about the reference with VTK's
-//!   conventions ([`pose`] has the details and the signs).
+//!   conventions (`pose.rs` has the details and the signs).
 //! - **Bounds**: frame this box rather than the volume's, so that a series
 //!   of volumes is framed alike.
 //!
 //! [`Camera::default()`] is the paper's view: orthographic, on the +x axis
 //! through the volume's centre looking along −x, up +z, the box fitted.
 
-pub mod perspective;
-pub mod pose;
+mod orthographic;
+mod perspective;
+mod pose;
 
-use crate::camera::perspective::PerspectiveView;
-use crate::camera::pose::Pose;
 use glam::DVec3;
+pub use orthographic::OrthographicView;
+pub use perspective::PerspectiveView;
+use std::fmt;
 use thiserror::Error;
 
 /// A camera that cannot frame a picture.
@@ -49,14 +51,14 @@ pub enum CameraError {
     NoDirection(DVec3),
     #[error("up vector {up} is parallel to the view direction {direction}")]
     UpParallel { up: DVec3, direction: DVec3 },
-    #[error("{0} vector {1} must be finite")]
-    NotFinite(&'static str, DVec3),
+    #[error("{0} {1} must be finite")]
+    NotFinite(CameraPoint, DVec3),
     #[error("field of view {0} must lie strictly between 0 and 180 degrees")]
     FieldOfView(f64),
     #[error("zoom {0} must be a finite number greater than 0")]
     Zoom(f64),
     #[error("{0} {1} must be a finite angle in degrees")]
-    Angle(&'static str, f64),
+    Angle(Orbit, f64),
     #[error(
         "frame bounds {lo} to {hi} must be finite, ordered (low ≤ high) and not a single point"
     )]
@@ -68,6 +70,43 @@ pub enum CameraError {
         camera: &'static str,
         view: &'static str,
     },
+}
+
+/// The camera's points and directions, as [`CameraError::NotFinite`] names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraPoint {
+    /// [`Camera::view_point`] (the eye).
+    ViewPoint,
+    /// [`Camera::look_at`], or the framed box's centre without one.
+    ViewReference,
+    /// [`Camera::up`].
+    Up,
+}
+
+impl fmt::Display for CameraPoint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            CameraPoint::ViewPoint => "view point",
+            CameraPoint::ViewReference => "view reference",
+            CameraPoint::Up => "up vector",
+        })
+    }
+}
+
+/// The camera's orbits, as [`CameraError::Angle`] names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Orbit {
+    Azimuth,
+    Elevation,
+}
+
+impl fmt::Display for Orbit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Orbit::Azimuth => "azimuth",
+            Orbit::Elevation => "elevation",
+        })
+    }
 }
 
 /// How rays leave the eye.
@@ -150,7 +189,10 @@ impl Camera {
         if !(self.zoom.is_finite() && self.zoom > 0.0) {
             return Err(CameraError::Zoom(self.zoom));
         }
-        for (name, angle) in [("azimuth", self.azimuth), ("elevation", self.elevation)] {
+        for (name, angle) in [
+            (Orbit::Azimuth, self.azimuth),
+            (Orbit::Elevation, self.elevation),
+        ] {
             if !angle.is_finite() {
                 return Err(CameraError::Angle(name, angle));
             }
@@ -254,107 +296,6 @@ impl View {
             View::Orthographic(v) => Some(v),
             View::Perspective(_) => None,
         }
-    }
-}
-
-/// A framed orthographic view: image size, screen axes and pixel size.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OrthographicView {
-    /// Unit direction of every ray, from the eye into the scene.
-    pub direction: DVec3,
-    /// Unit screen axes in world space.
-    pub right: DVec3,
-    pub up: DVec3,
-    /// The view reference: centre of the image, on the image plane.
-    pub centre: DVec3,
-    /// World size of one (square) pixel.
-    pub pixel_size: f64,
-    pub width: usize,
-    pub height: usize,
-}
-
-impl OrthographicView {
-    /// Frames the orthographic `camera` on the box `bounds` (the volume's,
-    /// unless the camera names its own) for a `width × height` image,
-    /// honouring its fit, zoom and orbits.
-    pub fn frame(
-        camera: &Camera,
-        bounds: (DVec3, DVec3),
-        width: usize,
-        height: usize,
-    ) -> Result<Self, CameraError> {
-        camera.validate()?;
-        check_size(width, height)?;
-        if camera.projection != Projection::Orthographic {
-            return Err(CameraError::WrongProjection {
-                camera: "perspective",
-                view: "orthographic",
-            });
-        }
-        let (lo, hi) = camera.framed_bounds(bounds);
-        let centre = camera.look_at.unwrap_or(0.5 * (lo + hi));
-        let diagonal = (hi - lo).length();
-        // Any distance gives the same parallel rays; this one keeps the
-        // default view point outside the volume.
-        let pose = Pose::new(camera, centre, 2.0 * diagonal.max(1.0))?;
-        let (right, up) = (pose.right, pose.up);
-
-        // Half-widths of the window about the centre.
-        let mut half = (0.0f64, 0.0f64);
-        match camera.fit {
-            Fit::Box => {
-                for corner in 0..8 {
-                    let p = DVec3::new(
-                        if corner & 1 == 0 { lo.x } else { hi.x },
-                        if corner & 2 == 0 { lo.y } else { hi.y },
-                        if corner & 4 == 0 { lo.z } else { hi.z },
-                    ) - centre;
-                    half.0 = half.0.max(p.dot(right).abs());
-                    half.1 = half.1.max(p.dot(up).abs());
-                }
-            }
-            Fit::Sphere => {
-                // The sphere's outline is a disc about the projection of
-                // the box's centre.
-                let radius = 0.5 * diagonal;
-                let offset = 0.5 * (lo + hi) - centre;
-                half = (
-                    offset.dot(right).abs() + radius,
-                    offset.dot(up).abs() + radius,
-                );
-            }
-        }
-        let pixel_size =
-            (2.0 * half.0 / width as f64).max(2.0 * half.1 / height as f64) / camera.zoom;
-        Ok(OrthographicView {
-            direction: pose.direction,
-            right,
-            up,
-            centre,
-            pixel_size,
-            width,
-            height,
-        })
-    }
-
-    /// World position of the centre of pixel (`col`, `row`), row 0 at the top,
-    /// on the image plane (through the view reference, normal to the rays).
-    #[inline]
-    pub fn pixel_centre(&self, col: usize, row: usize) -> DVec3 {
-        let u = (col as f64 + 0.5 - 0.5 * self.width as f64) * self.pixel_size;
-        let v = (row as f64 + 0.5 - 0.5 * self.height as f64) * self.pixel_size;
-        self.centre + u * self.right - v * self.up
-    }
-
-    /// Continuous image coordinates (column, row) where the ray through the
-    /// world point `p` crosses the image: pixel (c, r) covers
-    /// `[c, c+1) × [r, r+1)`.
-    pub fn project(&self, p: DVec3) -> (f64, f64) {
-        let d = p - self.centre;
-        (
-            d.dot(self.right) / self.pixel_size + 0.5 * self.width as f64,
-            -d.dot(self.up) / self.pixel_size + 0.5 * self.height as f64,
-        )
     }
 }
 

@@ -1,7 +1,7 @@
 //! Where the camera stands and which way it faces: the view point, the view
 //! reference and the screen axes, after the camera's azimuth and elevation
 //! orbits. Both projections ([`OrthographicView`](crate::camera::OrthographicView)
-//! and [`PerspectiveView`](crate::camera::perspective::PerspectiveView)) start from here.
+//! and [`PerspectiveView`](crate::camera::PerspectiveView)) start from here.
 //!
 //! The orbits follow VTK's `vtkCamera` (checked against VTK 9.7.2):
 //!
@@ -25,7 +25,7 @@
 //! sines and cosines, so quarter-turn orbits of an axis-aligned view stay
 //! exactly axis-aligned.
 
-use crate::camera::{Camera, CameraError};
+use crate::camera::{Camera, CameraError, CameraPoint};
 use glam::DVec3;
 
 /// A camera placed in the world: eye, reference and unit screen axes.
@@ -58,9 +58,9 @@ impl Pose {
             .view_point
             .unwrap_or(reference + DVec3::X * default_distance);
         for (name, v) in [
-            ("view point", view_point),
-            ("view reference", reference),
-            ("up", camera.up),
+            (CameraPoint::ViewPoint, view_point),
+            (CameraPoint::ViewReference, reference),
+            (CameraPoint::Up, camera.up),
         ] {
             if !v.is_finite() {
                 return Err(CameraError::NotFinite(name, v));

@@ -45,7 +45,7 @@
 
 use crate::bricks::BRICK;
 use crate::bricks::occupied::ClassifiedBricks;
-use crate::camera::perspective::PerspectiveView;
+use crate::camera::PerspectiveView;
 use crate::camera::{OrthographicView, View};
 use crate::sampling::Sampling;
 use crate::sampling::grid::GridFrame;

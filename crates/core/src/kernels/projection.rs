@@ -14,28 +14,8 @@
 //! pixel's grey level is the ray's maximum. A ray with no sample shows the
 //! background.
 
+use crate::settings::Blend;
 use crate::transfer::classifier::Classifier;
-
-/// How a ray's samples combine into its pixel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Blend {
-    /// Composite classified, shaded samples (the paper's).
-    #[default]
-    Composite,
-    /// Maximum intensity projection (MIP).
-    Maximum,
-    /// Minimum intensity projection (MinIP).
-    Minimum,
-    /// The mean value along the ray.
-    Average,
-}
-
-impl Blend {
-    /// Whether this projects the scalar instead of compositing.
-    pub fn is_projection(self) -> bool {
-        self != Blend::Composite
-    }
-}
 
 /// One ray's projection of its scalar samples: the running maximum,
 /// minimum or sum.

@@ -27,16 +27,6 @@ use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{DVec4, Vec3};
 
-/// Where classification happens.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Classification {
-    /// Classify and shade voxels, interpolate colours (the paper's).
-    #[default]
-    Pre,
-    /// Interpolate the scalar and the gradient, classify and shade samples.
-    Post,
-}
-
 /// Classifies and shades samples of one volume for one frame.
 pub struct PostClassifier<'a> {
     volume: &'a Volume,

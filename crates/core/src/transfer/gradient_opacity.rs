@@ -10,6 +10,8 @@
 //! `(m − lo)/(hi − lo)` between. Relative magnitudes keep the same `LO,HI`
 //! meaningful across data in any units.
 
+use crate::error::SettingError;
+
 /// The ramp of one volume: `factor(|∇f|)` in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GradientOpacity {
@@ -37,11 +39,9 @@ impl GradientOpacity {
     }
 
     /// Checks `0 <= lo < hi <= 1`.
-    pub fn validate((lo, hi): (f32, f32)) -> Result<(), String> {
+    pub fn validate((lo, hi): (f32, f32)) -> Result<(), SettingError> {
         if !(0.0 <= lo && lo < hi && hi <= 1.0) {
-            return Err(format!(
-                "gradient opacity LO,HI = {lo},{hi} needs 0 <= LO < HI <= 1 (fractions of the largest gradient magnitude)"
-            ));
+            return Err(SettingError::GradientOpacity { lo, hi });
         }
         Ok(())
     }

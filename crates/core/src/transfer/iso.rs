@@ -23,6 +23,8 @@
 //! in world units, and `r·|∇f|_voxel = (r·h)·|∇f|_world`, so the contour
 //! keeps the world width `r·h` and takes world gradients.
 
+use crate::error::SettingError;
+
 /// An iso-surface as the user gives it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IsoSurface {
@@ -35,15 +37,12 @@ pub struct IsoSurface {
 
 impl IsoSurface {
     /// Checks that the value is finite and the thickness finite and positive.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingError> {
         if !self.value.is_finite() {
-            return Err(format!("iso value {} must be finite", self.value));
+            return Err(SettingError::IsoValue(self.value));
         }
         if !(self.thickness.is_finite() && self.thickness > 0.0) {
-            return Err(format!(
-                "iso thickness {} must be a positive number of voxels",
-                self.thickness
-            ));
+            return Err(SettingError::IsoThickness(self.thickness));
         }
         Ok(())
     }
@@ -203,14 +202,25 @@ mod tests {
             thickness: 0.5,
         };
         assert!(ok.validate().is_ok());
-        for (value, thickness) in [
-            (f32::NAN, 1.0),
-            (1.0, 0.0),
-            (1.0, -1.0),
-            (1.0, f32::INFINITY),
-        ] {
-            let err = IsoSurface { value, thickness }.validate().unwrap_err();
-            assert!(err.starts_with("iso "), "{err}");
+        let err = IsoSurface {
+            value: f32::NAN,
+            thickness: 1.0,
+        }
+        .validate()
+        .unwrap_err();
+        assert!(
+            matches!(err, SettingError::IsoValue(v) if v.is_nan()),
+            "{err}"
+        );
+        for thickness in [0.0, -1.0, f32::INFINITY] {
+            let err = IsoSurface {
+                value: 1.0,
+                thickness,
+            }
+            .validate()
+            .unwrap_err();
+            assert_eq!(err, SettingError::IsoThickness(thickness));
+            assert!(err.to_string().starts_with("iso thickness "), "{err}");
         }
     }
 }

@@ -1,0 +1,111 @@
+//! What can go wrong rendering a frame, as values a caller can match on:
+//! which setting is out of range, its value and the bound, rather than a
+//! message to parse. Messages speak of the library's settings
+//! ([`RenderSettings`](crate::RenderSettings) fields), never of a command
+//! line's flags: a front end names its own flag by matching the variant.
+
+use crate::camera::CameraError;
+use glam::DVec3;
+use std::fmt;
+use thiserror::Error;
+
+/// Why a frame could not be rendered.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum RenderError {
+    /// The volume holds NaN or infinite values and they are refused
+    /// ([`NonFinite::Refuse`](crate::NonFinite::Refuse)).
+    #[error("{count} of {total} values are not finite (NaN or infinite)")]
+    NonFinite { count: usize, total: usize },
+    /// A setting is out of its range.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
+    /// The camera cannot frame a picture.
+    #[error(transparent)]
+    Camera(#[from] CameraError),
+}
+
+/// A render setting out of its range: which one, its value and the bound.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SettingError {
+    #[error("image {side} {value} must be between 1 and {max} pixels")]
+    ImageSide {
+        side: ImageSide,
+        value: usize,
+        max: usize,
+    },
+    #[error("image {width}x{height} has more than {max} pixels")]
+    ImagePixels {
+        width: usize,
+        height: usize,
+        max: usize,
+    },
+    #[error("step {0} must be a positive number of voxels")]
+    Step(f64),
+    /// A step so small that a ray would take more than `limit` samples.
+    #[error(
+        "step {step} voxels is too small for this volume: a ray would take up to {samples:.0} samples (limit {limit:.0})"
+    )]
+    StepTooSmall { step: f64, samples: f64, limit: f64 },
+    #[error("opacity ramp p,q = {p},{q} needs 0 <= p < q <= 1")]
+    OpacityRamp { p: f32, q: f32 },
+    #[error("{term} {value:?} must be finite and non-negative")]
+    Reflection { term: Reflection, value: [f32; 3] },
+    #[error("shininess {0} must be finite and non-negative")]
+    Shininess(f32),
+    #[error("background {0:?} must be in [0, 1]")]
+    Background([f32; 3]),
+    #[error("light direction {0} must be a finite, non-zero vector")]
+    LightDirection(DVec3),
+    #[error("crop box {lo} .. {hi} must be finite with low < high on every axis")]
+    Crop { lo: DVec3, hi: DVec3 },
+    #[error("clip plane point {0} must be finite")]
+    ClipPoint(DVec3),
+    #[error("clip plane normal {0} must be a finite, non-zero vector")]
+    ClipNormal(DVec3),
+    #[error("iso value {0} must be finite")]
+    IsoValue(f32),
+    #[error("iso thickness {0} must be a positive number of voxels")]
+    IsoThickness(f32),
+    #[error(
+        "gradient opacity LO,HI = {lo},{hi} needs 0 <= LO < HI <= 1 (fractions of the largest gradient magnitude)"
+    )]
+    GradientOpacity { lo: f32, hi: f32 },
+    #[error("gradient opacity maximum {0} must be a finite gradient magnitude above 0")]
+    GradientOpacityMax(f32),
+}
+
+/// Which side of the image [`SettingError::ImageSide`] is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageSide {
+    Width,
+    Height,
+}
+
+impl fmt::Display for ImageSide {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ImageSide::Width => "width",
+            ImageSide::Height => "height",
+        })
+    }
+}
+
+/// Which Phong coefficient [`SettingError::Reflection`] is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reflection {
+    Ambient,
+    Diffuse,
+    Specular,
+    LightColor,
+}
+
+impl fmt::Display for Reflection {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Reflection::Ambient => "ambient",
+            Reflection::Diffuse => "diffuse",
+            Reflection::Specular => "specular",
+            Reflection::LightColor => "light colour",
+        })
+    }
+}

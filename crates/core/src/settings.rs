@@ -1,0 +1,215 @@
+//! Everything that decides a frame besides the volume: [`RenderSettings`],
+//! with the choices of path ([`Method`]), blend mode ([`Blend`]) and
+//! classification ([`Classification`]), and the checks that name the
+//! setting that is out of range ([`SettingError`]).
+
+use crate::camera::Camera;
+use crate::error::{ImageSide, Reflection, SettingError};
+use crate::kernels::phong::Phong;
+use crate::sampling::clipping::ClipPlane;
+use crate::transfer::function::TransferFunction;
+use crate::transfer::gradient_opacity::GradientOpacity;
+use crate::transfer::iso::IsoSurface;
+use glam::DVec3;
+
+/// Largest image side, in pixels.
+pub const MAX_IMAGE_SIDE: usize = 16384;
+/// Largest image, in pixels (8192², a 1 GiB frame buffer).
+pub const MAX_IMAGE_PIXELS: usize = 1 << 26;
+/// Largest number of samples one ray may take: a smaller step is refused
+/// rather than left to run for hours.
+pub const MAX_SAMPLES_PER_RAY: f64 = 1.0e6;
+
+/// How a ray's samples combine into its pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Blend {
+    /// Composite classified, shaded samples (the paper's).
+    #[default]
+    Composite,
+    /// Maximum intensity projection (MIP).
+    Maximum,
+    /// Minimum intensity projection (MinIP).
+    Minimum,
+    /// The mean value along the ray.
+    Average,
+}
+
+impl Blend {
+    /// Whether this projects the scalar instead of compositing.
+    pub fn is_projection(self) -> bool {
+        self != Blend::Composite
+    }
+}
+
+/// Where classification happens.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Classification {
+    /// Classify and shade voxels, interpolate colours (the paper's).
+    #[default]
+    Pre,
+    /// Interpolate the scalar and the gradient, classify and shade samples.
+    Post,
+}
+
+/// Which stage 2 to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Front to back, early ray termination, empty-space skipping, in
+    /// parallel; every option has a fast path (see the module docs).
+    #[default]
+    Fast,
+    /// The paper's back-to-front compositing in `f64`, and every other
+    /// option: the oracle.
+    Reference,
+}
+
+/// Everything that decides a frame, besides the volume.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    pub width: usize,
+    pub height: usize,
+    pub camera: Camera,
+    /// Distance between samples along a ray, in voxels: units of the
+    /// smallest grid spacing (the paper's step is 1, errata 8).
+    pub step: f64,
+    /// The paper's opacity sub-interval `[p, q]`, used when the transfer
+    /// function has no opacity.
+    pub opacity_ramp: (f32, f32),
+    pub transfer_function: TransferFunction,
+    pub phong: Phong,
+    /// `false`: no lighting, voxels take their material colour.
+    pub shading: bool,
+    /// Direction *towards* the light at infinity; `None`: a headlight (`L = V`).
+    pub light_direction: Option<DVec3>,
+    /// The opaque background, the last sample of every ray.
+    pub background: [f32; 3],
+    pub method: Method,
+    /// How the samples make the pixel: composite (the paper's) or a
+    /// projection of the scalar.
+    pub blend: Blend,
+    /// Classify voxels (the paper's) or samples.
+    pub classification: Classification,
+    /// Offset each pixel's samples by a per-pixel fraction of a step.
+    pub jitter: bool,
+    /// Render only what every plane keeps.
+    pub clip_planes: Vec<ClipPlane>,
+    /// Render only what lies in this world box `(lo, hi)`.
+    pub crop: Option<(DVec3, DVec3)>,
+    /// Levoy's isovalue contour instead of the value's opacity (`None`: off).
+    pub iso: Option<IsoSurface>,
+    /// Opacity times a ramp of `|∇f|` from 0 at `LO` to 1 at `HI`,
+    /// fractions of the volume's largest gradient magnitude (`None`: off).
+    pub gradient_opacity: Option<(f32, f32)>,
+    /// The gradient magnitude (world units) the `gradient_opacity`
+    /// fractions are fractions of; `None`: the volume's own largest. A
+    /// series of volumes shares the largest of them all, as it shares one
+    /// value window.
+    pub gradient_opacity_max: Option<f32>,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 480,
+            height: 480,
+            camera: Camera::default(),
+            step: 1.0,
+            opacity_ramp: (0.0, 0.5),
+            transfer_function: TransferFunction::default(),
+            phong: Phong::default(),
+            shading: true,
+            light_direction: None,
+            background: [0.0; 3],
+            method: Method::Fast,
+            blend: Blend::Composite,
+            classification: Classification::Pre,
+            jitter: false,
+            clip_planes: Vec::new(),
+            crop: None,
+            iso: None,
+            gradient_opacity: None,
+            gradient_opacity_max: None,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Checks every setting, naming the one that is wrong.
+    pub fn validate(&self) -> Result<(), SettingError> {
+        use SettingError as E;
+        for (side, value) in [
+            (ImageSide::Width, self.width),
+            (ImageSide::Height, self.height),
+        ] {
+            if value == 0 || value > MAX_IMAGE_SIDE {
+                return Err(E::ImageSide {
+                    side,
+                    value,
+                    max: MAX_IMAGE_SIDE,
+                });
+            }
+        }
+        if self.width * self.height > MAX_IMAGE_PIXELS {
+            return Err(E::ImagePixels {
+                width: self.width,
+                height: self.height,
+                max: MAX_IMAGE_PIXELS,
+            });
+        }
+        if !(self.step.is_finite() && self.step > 0.0) {
+            return Err(E::Step(self.step));
+        }
+        let (p, q) = self.opacity_ramp;
+        if !(0.0 <= p && p < q && q <= 1.0) {
+            return Err(E::OpacityRamp { p, q });
+        }
+        let ph = &self.phong;
+        for (term, value) in [
+            (Reflection::Ambient, ph.ambient),
+            (Reflection::Diffuse, ph.diffuse),
+            (Reflection::Specular, ph.specular),
+            (Reflection::LightColor, ph.light_color),
+        ] {
+            if value.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(E::Reflection { term, value });
+            }
+        }
+        if !(ph.shininess.is_finite() && ph.shininess >= 0.0) {
+            return Err(E::Shininess(ph.shininess));
+        }
+        if self.background.iter().any(|v| !(0.0..=1.0).contains(v)) {
+            return Err(E::Background(self.background));
+        }
+        if let Some(l) = self.light_direction
+            && !(l.is_finite() && l.length() > 0.0)
+        {
+            return Err(E::LightDirection(l));
+        }
+        if let Some((lo, hi)) = self.crop
+            && !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all())
+        {
+            return Err(E::Crop { lo, hi });
+        }
+        for plane in &self.clip_planes {
+            if !plane.point.is_finite() {
+                return Err(E::ClipPoint(plane.point));
+            }
+            let length = plane.normal.length();
+            if !(length.is_finite() && length > 0.0) {
+                return Err(E::ClipNormal(plane.normal));
+            }
+        }
+        if let Some(iso) = &self.iso {
+            iso.validate()?;
+        }
+        if let Some(range) = self.gradient_opacity {
+            GradientOpacity::validate(range)?;
+        }
+        if let Some(max) = self.gradient_opacity_max
+            && !(max.is_finite() && max > 0.0)
+        {
+            return Err(E::GradientOpacityMax(max));
+        }
+        Ok(())
+    }
+}
