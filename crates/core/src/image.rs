@@ -68,6 +68,11 @@ impl Image {
         &mut self.pixels
     }
 
+    /// The pixels, row-major, giving up the image.
+    pub fn into_pixels(self) -> Vec<[f32; 4]> {
+        self.pixels
+    }
+
     /// Largest absolute difference over all pixels and channels, or `None`
     /// when the sizes differ.
     pub fn max_abs_diff(&self, other: &Image) -> Option<f32> {

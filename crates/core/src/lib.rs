@@ -43,6 +43,7 @@ pub mod histogram;
 pub mod image;
 pub mod kernels;
 pub mod non_finite;
+mod partial;
 pub mod reference;
 pub mod renderer;
 pub mod sampling;
@@ -60,6 +61,7 @@ pub use histogram::Histogram;
 pub use image::Image;
 pub use kernels::phong::{LightGeometry, Phong};
 pub use non_finite::{NonFinite, NonFiniteMask};
+pub use partial::{PartialImage, PartialPixels};
 pub use renderer::{FrameTimes, Renderer};
 pub use sampling::clipping::ClipPlane;
 pub use settings::{

@@ -53,7 +53,7 @@
 //! the bottom of the finite range, which can only widen it.
 
 use crate::bricks::{BRICK, BrickGrid};
-use crate::kernels::trilinear::corners;
+use crate::kernels::trilinear::weights;
 use crate::volume::Volume;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -162,7 +162,7 @@ impl NonFiniteMask {
     /// weight in it.
     #[inline]
     pub fn skips(&self, p: DVec3) -> bool {
-        corners(p.to_array(), self.dims)
+        weights(p.to_array(), self.dims)
             .iter()
             .any(|&(index, w)| w != 0.0 && self.contains(index))
     }

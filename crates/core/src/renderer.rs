@@ -32,9 +32,12 @@ use crate::cpu::{bricked, post as post_cast};
 use crate::error::RenderError;
 use crate::frame::Frame;
 use crate::image::Image;
+use crate::kernels::composite::PartialPixel;
 use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
+use crate::kernels::projection::projection_color;
 use crate::non_finite::{NonFinite, NonFiniteMask};
+use crate::partial::{PartialImage, PartialPixels};
 use crate::reference;
 use crate::reference::Shader;
 use crate::reference::post::PostClassifier;
@@ -168,39 +171,77 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<Image, RenderError> {
-        let frame = self.prepare(settings)?;
-        match settings.method {
-            Method::Fast => {
-                let mut image = Image::new(settings.width, settings.height, [0.0; 4]);
-                self.render_fast(settings, &frame, &mut image, progress);
-                Ok(image)
-            }
-            Method::Reference => Ok(self.render_reference(settings, &frame, progress)),
-        }
+        let partial = self.render_partial(settings, progress)?;
+        Ok(self.finish(settings, partial))
     }
 
-    /// Renders one frame into `image` (reallocated only if its size is not
-    /// the frame's), and says where the time went. On the bricked fast path
-    /// the parts are timed; a projection, a post-classified frame, or a
-    /// frame on the reference path counts all its time as `cast`.
+    /// Renders one frame as a partial image: premultiplied colour and
+    /// transmittance, or projected values, without the background (see
+    /// [`PartialImage`]). [`Self::finish`] makes it the frame
+    /// [`Self::render`] gives; partial images of pieces of a volume
+    /// [`combine`](PartialImage::combine) first.
+    pub fn render_partial(
+        &self,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<PartialImage, RenderError> {
+        let frame = self.prepare(settings)?;
+        Ok(match settings.method {
+            Method::Fast => {
+                let mut partial = self.blank(settings, Vec::new());
+                self.render_fast(settings, &frame, &mut partial, progress);
+                partial
+            }
+            Method::Reference => self.render_reference(settings, &frame, progress),
+        })
+    }
+
+    /// The finished frame of `partial` (rendered with `settings`): over the
+    /// background, projected values through the colour map.
+    pub fn finish(&self, settings: &RenderSettings, partial: PartialImage) -> Image {
+        let classifier = self.classifier(settings);
+        partial.finish(settings.background, |f| projection_color(&classifier, f))
+    }
+
+    /// Renders one frame into `image` (its buffer reused when it is the
+    /// frame's size), and says where the time went. On the bricked fast
+    /// path the parts are timed; a projection, a post-classified frame, or
+    /// a frame on the reference path counts all its time as `cast`.
     pub fn render_into(
         &self,
         settings: &RenderSettings,
         image: &mut Image,
     ) -> Result<FrameTimes, RenderError> {
         let frame = self.prepare(settings)?;
-        if settings.method == Method::Reference {
-            let start = Instant::now();
-            *image = self.render_reference(settings, &frame, &|_| {});
-            return Ok(FrameTimes {
-                cast: start.elapsed(),
-                ..FrameTimes::default()
-            });
+        let start = Instant::now();
+        let (partial, times) = match settings.method {
+            Method::Reference => {
+                let partial = self.render_reference(settings, &frame, &|_| {});
+                (partial, None)
+            }
+            Method::Fast => {
+                let buffer = std::mem::replace(image, Image::new(0, 0, [0.0; 4])).into_pixels();
+                let mut partial = self.blank(settings, buffer);
+                let times = self.render_fast(settings, &frame, &mut partial, &|_| {});
+                (partial, Some(times))
+            }
+        };
+        *image = self.finish(settings, partial);
+        Ok(times.unwrap_or(FrameTimes {
+            cast: start.elapsed(),
+            ..FrameTimes::default()
+        }))
+    }
+
+    /// The partial image a fast frame of `settings` is rendered into:
+    /// composited in `buffer`'s allocation (its old pixels are left, as the
+    /// fast casters write every pixel), or no sample projected.
+    fn blank(&self, settings: &RenderSettings, buffer: Vec<[f32; 4]>) -> PartialImage {
+        let (width, height) = (settings.width, settings.height);
+        match settings.blend {
+            Blend::Composite => PartialImage::reusing(width, height, buffer),
+            blend => PartialImage::projection(width, height, blend),
         }
-        if (image.width(), image.height()) != (settings.width, settings.height) {
-            *image = Image::new(settings.width, settings.height, [0.0; 4]);
-        }
-        Ok(self.render_fast(settings, &frame, image, &|_| {}))
     }
 
     /// Validates `settings` and frames the view.
@@ -209,7 +250,7 @@ impl<'v> Renderer<'v> {
     }
 
     /// The classifier `settings` describe for this volume.
-    fn classifier(&self, settings: &RenderSettings) -> Classifier {
+    pub(crate) fn classifier(&self, settings: &RenderSettings) -> Classifier {
         let mut classifier = Classifier::from_transfer_function(
             &settings.transfer_function,
             self.value_range,
@@ -279,22 +320,15 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         frame: &Frame,
         progress: &(dyn Fn(usize) + Sync),
-    ) -> Image {
-        let classifier = self.classifier(settings);
-        let render = |shader: &Shader| {
-            reference::render(
-                shader,
-                &frame.view,
-                &frame.sampling,
-                settings.background,
-                progress,
-            )
-        };
+    ) -> PartialImage {
+        let render =
+            |shader: &Shader| reference::render(shader, &frame.view, &frame.sampling, progress);
         match (settings.blend, settings.classification) {
             (Blend::Composite, Classification::Pre) => {
                 render(&Shader::Pre(&self.stage1(settings, &frame.view)))
             }
             (Blend::Composite, Classification::Post) => {
+                let classifier = self.classifier(settings);
                 let light = Self::light(settings, &frame.view);
                 let lighting = settings.shading.then_some((&settings.phong, light));
                 let post = PostClassifier::new(&self.volume, &classifier, lighting)
@@ -304,48 +338,49 @@ impl<'v> Renderer<'v> {
             (blend, _) => render(&Shader::Projection {
                 volume: &self.volume,
                 blend,
-                classifier: &classifier,
                 mask: self.non_finite.as_ref(),
             }),
         }
     }
 
-    /// The fast paths: the projections' ([`crate::cpu::projection`]),
-    /// post-classified compositing's ([`Self::render_post`]), or the
-    /// bricked ray caster's ([`Self::render_bricks`]).
+    /// The fast paths into `partial` (as [`Self::blank`] made it): the
+    /// projections' ([`crate::cpu::projection`]), post-classified
+    /// compositing's ([`Self::render_post`]), or the bricked ray caster's
+    /// ([`Self::render_bricks`]).
     fn render_fast(
         &self,
         settings: &RenderSettings,
         frame: &Frame,
-        image: &mut Image,
+        partial: &mut PartialImage,
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
-        if !settings.blend.is_projection() {
-            if settings.classification == Classification::Post {
-                return self.render_post(settings, frame, image, progress);
+        let pixels = match partial.pixels_mut() {
+            PartialPixels::Composite(pixels) => pixels,
+            PartialPixels::Projection { blend, pixels } => {
+                let start = Instant::now();
+                let macrocells = self
+                    .macrocells
+                    .get_or_init(|| Macrocells::new(&self.volume));
+                intensity::render(
+                    &self.volume,
+                    self.non_finite.as_ref(),
+                    macrocells,
+                    self.value_range,
+                    &frame.view,
+                    &frame.sampling,
+                    *blend,
+                    pixels,
+                    progress,
+                );
+                return FrameTimes {
+                    cast: start.elapsed(),
+                    ..FrameTimes::default()
+                };
             }
-            return self.render_bricks(settings, frame, image, progress);
-        }
-        let start = Instant::now();
-        let macrocells = self
-            .macrocells
-            .get_or_init(|| Macrocells::new(&self.volume));
-        intensity::render(
-            &self.volume,
-            self.non_finite.as_ref(),
-            macrocells,
-            self.value_range,
-            &frame.view,
-            &frame.sampling,
-            settings.blend,
-            &self.classifier(settings),
-            settings.background,
-            image,
-            progress,
-        );
-        FrameTimes {
-            cast: start.elapsed(),
-            ..FrameTimes::default()
+        };
+        match settings.classification {
+            Classification::Post => self.render_post(settings, frame, pixels, progress),
+            Classification::Pre => self.render_bricks(settings, frame, pixels, progress),
         }
     }
 
@@ -357,14 +392,14 @@ impl<'v> Renderer<'v> {
         &self,
         settings: &RenderSettings,
         frame: &Frame,
-        image: &mut Image,
+        pixels: &mut [PartialPixel],
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
         let start = Instant::now();
         let classifier = self.classifier(settings);
         let voxels = (self.packed_voxels)
             .get_or_init(|| post_cast::packed_voxels(&self.volume, &gradients(&self.volume)));
-        let scene = post_cast::PackedScene {
+        let scene = post_cast::Scene {
             voxels,
             macrocells: self
                 .macrocells
@@ -375,7 +410,7 @@ impl<'v> Renderer<'v> {
             mask: self.non_finite.as_ref(),
         };
         let (view, sampling) = (&frame.view, &frame.sampling);
-        post_cast::render_packed(&scene, view, sampling, settings.background, image, progress);
+        post_cast::render(&scene, view, sampling, pixels, progress);
         FrameTimes {
             cast: start.elapsed(),
             ..FrameTimes::default()
@@ -388,7 +423,7 @@ impl<'v> Renderer<'v> {
         &self,
         settings: &RenderSettings,
         frame: &Frame,
-        image: &mut Image,
+        pixels: &mut [PartialPixel],
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
         let mut times = FrameTimes::default();
@@ -432,8 +467,7 @@ impl<'v> Renderer<'v> {
             &bins,
             &frame.sampling,
             &frame.view,
-            settings.background,
-            image,
+            pixels,
             progress,
         );
         let t3 = Instant::now();

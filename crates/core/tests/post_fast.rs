@@ -1,20 +1,15 @@
-//! Post-classified compositing on its fast path ([`volray_core::cpu::post`]),
+//! Post-classified compositing on its fast path (`cpu/post.rs`),
 //! held to the reference path (the oracle) within 1/255 per channel: a
 //! smooth ball, the Marschner–Lobb signal and a step edge; views along an
 //! axis, oblique and in perspective (the eye outside and inside the
 //! volume); steps of 0.5 and 1; lit and unlit; crop boxes, clip planes and
 //! jitter; Levoy's iso-surfaces and gradient-magnitude opacity;
-//! anisotropic spacing. Also: bit-identical images for any thread count,
-//! the brick walk skipping empty bricks and still finding small features
-//! behind them and on brick faces, and the routing.
+//! anisotropic spacing. Also: bit-identical images for any thread count.
+//! (The brick walk's skipping is tested in `cpu/post.rs`, where its work
+//! counts can be seen.)
 
-use volray_core::LightGeometry;
-use volray_core::bricks::macrocells::Macrocells;
-use volray_core::camera::{Camera, Projection, View};
-use volray_core::cpu::post::{self as post_cast, PostScene, PostWork};
+use volray_core::camera::{Camera, Projection};
 use volray_core::glam::DVec3;
-use volray_core::kernels::gradient::gradients;
-use volray_core::transfer::classifier::Classifier;
 use volray_core::{
     Classification, ClipPlane, Image, IsoSurface, Method, RenderSettings, Renderer,
     TransferFunction, Volume,
@@ -401,158 +396,4 @@ fn images_are_bit_identical_for_any_thread_count() {
             .collect();
         assert!(images[0] == images[1] && images[1] == images[2], "{view}");
     }
-}
-
-/// 48³ of nothing but three small dense features: a 3³ block deep behind
-/// empty bricks (seen along −x, the eye is on +x), a single voxel on a
-/// brick corner, and a 2-voxel rod lying in a brick face.
-fn sparse() -> Volume {
-    let n = 48;
-    Volume::from_fn([n, n, n], DVec3::ONE, DVec3::ZERO, |p| {
-        let (x, y, z) = (p.x as usize, p.y as usize, p.z as usize);
-        let block = (3..6).contains(&x) && (30..33).contains(&y) && (10..13).contains(&z);
-        let corner = (x, y, z) == (16, 16, 24);
-        let rod = x == 8 && y == 40 && (20..22).contains(&z);
-        if block || corner || rod { 1.0 } else { 0.0 }
-    })
-    .unwrap()
-}
-
-/// Renders `settings` with [`post_cast::render`] directly, to see its work.
-fn post_cast_work(renderer: &Renderer, settings: &RenderSettings) -> (Image, PostWork, usize) {
-    let volume = renderer.volume();
-    let frame = renderer.prepare(settings).unwrap();
-    let mut classifier = Classifier::from_transfer_function(
-        &settings.transfer_function,
-        renderer.value_range(),
-        settings.opacity_ramp,
-        settings.step as f32,
-    );
-    if let Some(iso) = settings.iso {
-        let voxel_size = volume.spacing().min_element() as f32;
-        classifier = classifier.with_iso(iso, voxel_size, renderer.max_gradient());
-    }
-    let grads = gradients(volume);
-    let macrocells = Macrocells::new(volume);
-    let light = LightGeometry::headlight((-frame.view.direction()).as_vec3());
-    let scene = PostScene {
-        volume,
-        gradients: &grads,
-        macrocells: &macrocells,
-        classifier: &classifier,
-        lighting: Some((&settings.phong, light)),
-    };
-    let mut image = Image::new(settings.width, settings.height, [0.0; 4]);
-    let work = post_cast::render(
-        &scene,
-        &frame.view,
-        &frame.sampling,
-        settings.background,
-        &mut image,
-        &|_| {},
-    );
-    (image, work, frame.nominal_samples())
-}
-
-#[test]
-fn empty_bricks_are_skipped_and_small_features_behind_them_are_found() {
-    let volume = sparse();
-    let renderer = Renderer::new(&volume).unwrap();
-    let cameras = [
-        Camera::default(),
-        Camera {
-            view_point: Some(DVec3::new(100.0, 30.0, 45.0)),
-            ..Camera::default()
-        },
-        Camera {
-            projection: Projection::Perspective { fov_degrees: 50.0 },
-            azimuth: 20.0,
-            elevation: -15.0,
-            ..Camera::default()
-        },
-    ];
-    for camera in cameras {
-        // The paper's ramp from 0: the empty bricks (all 0, the minimum)
-        // are transparent; a dense voxel's opacity is 0.9.
-        let s = RenderSettings {
-            width: 96,
-            height: 96,
-            camera,
-            step: 0.5,
-            opacity_ramp: (0.0, 0.9),
-            classification: Classification::Post,
-            ..RenderSettings::default()
-        };
-        let (image, work, nominal) = post_cast_work(&renderer, &s);
-        // The renderer's fast path is this very function.
-        assert!(image == renderer.render(&s).unwrap(), "{camera:?}");
-        let slow = renderer.render(&reference(&s)).unwrap();
-        assert!(
-            image.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0,
-            "{camera:?}"
-        );
-        // Most samples lie in empty bricks and are never interpolated.
-        println!("{camera:?}: {work:?} of {nominal} nominal samples");
-        assert!(work.bricks_skipped > 10_000, "{work:?}");
-        assert!(work.samples * 10 < nominal as u64, "{work:?} of {nominal}");
-        // Each feature shows where its centre projects.
-        let view = View::frame(&camera, volume.bounds(), 96, 96).unwrap();
-        for centre in [
-            DVec3::new(4.0, 31.0, 11.0),
-            DVec3::new(16.0, 16.0, 24.0),
-            DVec3::new(8.0, 40.0, 20.5),
-        ] {
-            let (c, r) = view.project(centre).unwrap();
-            let alpha = image.get(c as usize, r as usize)[3];
-            assert!(
-                alpha > 0.3,
-                "{camera:?}: feature at {centre} has alpha {alpha}"
-            );
-        }
-    }
-}
-
-#[test]
-fn bricks_near_an_isovalue_are_visited_and_far_ones_skipped() {
-    // With an iso-surface, a brick is skipped only if its values lie
-    // farther from the isovalue than the contour can reach at the
-    // volume's steepest gradient. The steepest is at the block's corners,
-    // |∇f| = |(½, ½, ½)| = √3/2 per voxel, so a contour 0.5 voxels thick
-    // reaches 0.43 from the isovalue 0.5: the empty bricks (all 0) are
-    // skipped, and the features' bricks are not.
-    let volume = sparse();
-    let renderer = Renderer::new(&volume).unwrap();
-    assert!((renderer.max_gradient() - 0.75f32.sqrt()).abs() < 1e-6);
-    let s = RenderSettings {
-        width: 64,
-        height: 64,
-        step: 0.5,
-        classification: Classification::Post,
-        iso: Some(IsoSurface {
-            value: 0.5,
-            thickness: 0.5,
-        }),
-        ..RenderSettings::default()
-    };
-    let (fast, work, nominal) = post_cast_work(&renderer, &s);
-    assert!(fast == renderer.render(&s).unwrap());
-    let slow = renderer.render(&reference(&s)).unwrap();
-    assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
-    assert!(slow.pixels().iter().filter(|p| p[3] > 0.3).count() >= 4);
-    println!("iso: {work:?} of {nominal} nominal samples");
-    assert!(work.bricks_skipped > 1000, "{work:?}");
-    assert!(work.samples * 10 < nominal as u64, "{work:?} of {nominal}");
-    // A contour reaching every value (a thickness of 100 voxels) rules
-    // out no brick.
-    let thick = RenderSettings {
-        iso: Some(IsoSurface {
-            value: 0.5,
-            thickness: 100.0,
-        }),
-        ..s
-    };
-    let (fast, work, _) = post_cast_work(&renderer, &thick);
-    assert_eq!(work.bricks_skipped, 0);
-    let slow = renderer.render(&reference(&thick)).unwrap();
-    assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
 }

@@ -32,7 +32,7 @@
 //! the volume's boundary, or in any brick when something is cut away.
 //!
 //! The ray stops once its transmittance is below
-//! [`TERMINATION_TRANSMITTANCE`]: colours are in [0, 1], so what lies
+//! [`TERMINATION_TRANSMITTANCE`](crate::kernels::composite::TERMINATION_TRANSMITTANCE): colours are in [0, 1], so what lies
 //! behind could change the pixel by at most that much, well under 1/255.
 //! Each pixel is computed from its own ray alone, by the same arithmetic
 //! whatever thread runs it, so the image is bit-identical for any thread
@@ -46,15 +46,13 @@ use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
 use crate::camera::View;
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::{TILE, TileBins};
-use crate::image::Image;
+use crate::kernels::composite::{FrontToBack, PartialPixel};
+use crate::kernels::trilinear::{corners, interpolate};
 use crate::sampling::Sampling;
 use crate::sampling::jitter;
 use glam::{DVec3, Vec4};
 use rayon::prelude::*;
 use wide::f32x4;
-
-/// Rays stop when less than this fraction of light gets through.
-pub const TERMINATION_TRANSMITTANCE: f32 = 1.0 / 1024.0;
 
 /// Slack, in samples, around each box's range of samples: a sample on a
 /// box face is found whatever the rounding (it is clamped into the box, so
@@ -84,7 +82,6 @@ struct Rays<'a> {
     /// exact ranges (something is cut away).
     clipped: bool,
     geometry: Geometry,
-    background: [f32; 3],
 }
 
 /// Where the rays start and which way they run.
@@ -218,25 +215,24 @@ pub fn render(
     bins: &TileBins,
     sampling: &Sampling,
     view: &View,
-    background: [f32; 3],
-    image: &mut Image,
+    pixels: &mut [PartialPixel],
     progress: &(dyn Fn(usize) + Sync),
 ) {
     let width = view.width();
-    assert_eq!((image.width(), image.height()), (width, view.height()));
+    assert_eq!(pixels.len(), width * view.height());
     let scene = Scene {
         boxes: (0..bricks.len()).map(|n| cell_box(bricks, n)).collect(),
         cells: &bricks.cells,
         lit,
         lighting,
     };
-    let rays = Rays::new(sampling, view, background);
+    let rays = Rays::new(sampling, view);
     // Each tile's rows, as slices of the image rows: the tiles are then
     // independent pieces of work, small enough to balance the threads.
-    let mut tiles: Vec<Vec<&mut [[f32; 4]]>> = (0..bins.tiles_x * bins.tiles_y)
+    let mut tiles: Vec<Vec<&mut [PartialPixel]>> = (0..bins.tiles_x * bins.tiles_y)
         .map(|_| Vec::with_capacity(TILE))
         .collect();
-    for (row, pixels) in image.pixels_mut().chunks_mut(width).enumerate() {
+    for (row, pixels) in pixels.chunks_mut(width).enumerate() {
         for (tx, segment) in pixels.chunks_mut(TILE).enumerate() {
             tiles[(row / TILE) * bins.tiles_x + tx].push(segment);
         }
@@ -277,7 +273,7 @@ fn relative(k: i64, base: i64) -> i32 {
 }
 
 impl<'a> Rays<'a> {
-    fn new(sampling: &'a Sampling, view: &'a View, background: [f32; 3]) -> Self {
+    fn new(sampling: &'a Sampling, view: &'a View) -> Self {
         let grid = &sampling.grid;
         let geometry = match view {
             View::Orthographic(v) => {
@@ -307,7 +303,6 @@ impl<'a> Rays<'a> {
             view,
             clipped: sampling.clipping.is_active(),
             geometry,
-            background,
         }
     }
 
@@ -319,7 +314,7 @@ impl<'a> Rays<'a> {
         list: &[u32],
         tx: usize,
         ty: usize,
-        rows: &mut [&mut [[f32; 4]]],
+        rows: &mut [&mut [PartialPixel]],
     ) {
         let cols = tx * TILE..tx * TILE + rows[0].len();
         let count = cols.len() * rows.len();
@@ -363,7 +358,7 @@ impl<'a> Rays<'a> {
         }
         for (i, state) in states.iter().enumerate() {
             let (c, r) = (i % cols.len(), i / cols.len());
-            rows[r][c] = state.acc.finish(self.background).to_array();
+            rows[r][c] = state.acc.partial();
         }
     }
 
@@ -473,13 +468,14 @@ struct Segment {
 /// voxels and occupied `cells`. Returns whether the ray has terminated.
 #[inline]
 fn march(
-    acc: &mut Accumulator,
+    acc: &mut FrontToBack,
     lit: &[[f32; 4]; SLOTS],
     cells: &[u64; 8],
     segment: &Segment,
 ) -> bool {
     let last_cell = f32x4::splat((BRICK - 1) as f32);
-    let (mut color, mut transmittance) = (acc.color, acc.transmittance);
+    // A copy in registers for the loop.
+    let mut ray = *acc;
     let mut p = segment.origin + segment.delta * f32x4::splat(segment.first as f32);
     let mut terminated = false;
     // A count down: an inclusive range costs a flag test per sample.
@@ -497,27 +493,14 @@ fn march(
             continue;
         }
         let [fx, fy, fz, _] = (here - f32x4::from_i32x4(c)).to_array();
-        let s = slot(i, j, l);
-        let v = |o: usize| f32x4::new(lit[s + o]);
-        let lerp = |a: f32x4, b: f32x4, t: f32| a + (b - a) * f32x4::splat(t);
-        let (dy, dz) = (SIDE, SIDE * SIDE);
-        let y0 = lerp(lerp(v(0), v(1), fx), lerp(v(dy), v(dy + 1), fx), fy);
-        let y1 = lerp(
-            lerp(v(dz), v(dz + 1), fx),
-            lerp(v(dy + dz), v(dy + dz + 1), fx),
-            fy,
-        );
-        let sample = lerp(y0, y1, fz);
-        // Front to back: C += T·α·c, T ·= 1 − α.
-        let alpha = sample.as_array()[3];
-        color += sample * f32x4::splat(transmittance * alpha);
-        transmittance *= 1.0 - alpha;
-        if transmittance < TERMINATION_TRANSMITTANCE {
+        let voxels = corners(|s| f32x4::new(lit[s]), slot(i, j, l), SIDE, SIDE * SIDE);
+        ray.add(interpolate(voxels, [fx, fy, fz]));
+        if ray.is_opaque() {
             terminated = true;
             break;
         }
     }
-    (acc.color, acc.transmittance) = (color, transmittance);
+    *acc = ray;
     terminated
 }
 
@@ -527,7 +510,7 @@ struct RayState {
     /// Index-space position of the ray's sample 0 (for parallel rays on
     /// the image plane, `t = 0`; see [`Stepping::base`]).
     origin: f32x4,
-    acc: Accumulator,
+    acc: FrontToBack,
     /// The first sample not yet taken (a perspective ray's first is the
     /// first ahead of the eye).
     next: i32,
@@ -542,40 +525,11 @@ struct RayState {
 impl RayState {
     const EMPTY: RayState = RayState {
         origin: f32x4::ZERO,
-        acc: Accumulator::NEW,
+        acc: FrontToBack::NEW,
         next: i32::MIN,
         exact: None,
         done: false,
     };
-}
-
-/// Front-to-back compositing of one ray (see [`crate::kernels::composite`]): the
-/// colour so far in lanes r, g, b, and the transmittance `T = Π(1 − αᵢ)`.
-#[derive(Clone, Copy)]
-struct Accumulator {
-    color: f32x4,
-    transmittance: f32,
-}
-
-impl Accumulator {
-    /// Nothing composited yet.
-    const NEW: Accumulator = Accumulator {
-        color: f32x4::ZERO,
-        transmittance: 1.0,
-    };
-
-    /// The final colour over the opaque `background`, with the volume's
-    /// accumulated opacity in `w`.
-    fn finish(&self, background: [f32; 3]) -> Vec4 {
-        let [r, g, b, _] = self.color.to_array();
-        let t = self.transmittance;
-        Vec4::new(
-            r + t * background[0],
-            g + t * background[1],
-            b + t * background[2],
-            1.0 - t,
-        )
-    }
 }
 
 /// `⌈x⌉` and `⌊x⌋` for `|x| < 2³¹` without a library call (SSE2 has no

@@ -18,7 +18,7 @@
 
 use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, UNIT, Voxel};
 use crate::bricks::{SIDE, SLOTS, slot_coords};
-use crate::kernels::phong::{LightGeometry, Phong};
+use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use std::sync::{RwLock, RwLockReadGuard};
@@ -221,43 +221,6 @@ struct FrameLight {
     half: [f32x4; 3],
 }
 
-/// The highlight exponent: whole numbers by repeated squaring, which is
-/// faster than `powf` and as exact.
-#[derive(Debug, Clone, Copy)]
-enum Exponent {
-    Whole(u32),
-    Real(f32),
-}
-
-impl Exponent {
-    fn new(n: f32) -> Self {
-        if n.fract() == 0.0 && (0.0..=1024.0).contains(&n) {
-            Exponent::Whole(n as u32)
-        } else {
-            Exponent::Real(n)
-        }
-    }
-
-    /// `x^n` for `x` in [0, 1].
-    #[inline]
-    fn raise(self, x: f32x4) -> f32x4 {
-        match self {
-            Exponent::Whole(mut n) => {
-                let (mut result, mut power) = (f32x4::ONE, x);
-                while n > 0 {
-                    if n & 1 == 1 {
-                        result *= power;
-                    }
-                    power *= power;
-                    n >>= 1;
-                }
-                result
-            }
-            Exponent::Real(n) => f32x4::new(x.to_array().map(|x| x.powf(n))),
-        }
-    }
-}
-
 impl FrameLight {
     fn new(phong: &Phong, light: &LightGeometry) -> Self {
         let cs = phong.light_color;
@@ -279,17 +242,20 @@ impl FrameLight {
     #[inline]
     fn lit(&self, x: f32x4, y: f32x4, z: f32x4) -> [f32x4; 3] {
         let dot = |d: [f32x4; 3]| x * d[0] + y * d[1] + z * d[2];
-        // Two-sided: turn the normal to face the viewer.
-        let facing = dot(self.to_viewer)
-            .simd_lt(f32x4::ZERO)
-            .select(-f32x4::ONE, f32x4::ONE);
-        let n_dot_l = (dot(self.to_light) * facing).fast_max(f32x4::ZERO);
-        let n_dot_h = (dot(self.half) * facing).fast_max(f32x4::ZERO);
-        // No highlight where the light is behind the surface.
-        let lit_side = n_dot_l.simd_gt(f32x4::ZERO);
-        let highlight = lit_side.select(self.shininess.raise(n_dot_h), f32x4::ZERO);
+        let (diffuse, highlight) = two_sided(
+            dot(self.to_viewer),
+            dot(self.to_light),
+            dot(self.half),
+            self.shininess,
+        );
         std::array::from_fn(|c| {
-            self.ambient[c] + self.diffuse[c] * n_dot_l + self.specular[c] * highlight
+            reflect(
+                self.ambient[c],
+                self.diffuse[c],
+                self.specular[c],
+                diffuse,
+                highlight,
+            )
         })
     }
 }

@@ -12,7 +12,7 @@
 //! Phong lighting for the frame's one light geometry, the colour clamped
 //! to [0, 1]) and composites it front to back ([`crate::kernels::composite`]). The
 //! ray stops once its transmittance is below
-//! [`TERMINATION_TRANSMITTANCE`], as on the bricked fast path.
+//! [`TERMINATION_TRANSMITTANCE`](crate::kernels::composite::TERMINATION_TRANSMITTANCE), as on the bricked fast path.
 //!
 //! **Brick walk.** The ray visits the bricks in the order it crosses them,
 //! by the 3-D digital differential analyser of J. Amanatides and A. Woo, "A
@@ -77,16 +77,15 @@
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid};
 use crate::camera::View;
-use crate::cpu::bricked::TERMINATION_TRANSMITTANCE;
-use crate::image::Image;
-use crate::kernels::composite::FrontToBack;
-use crate::kernels::phong::{LightGeometry, Phong};
+use crate::kernels::composite::{EMPTY, FrontToBack, PartialPixel};
+use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
+use crate::kernels::trilinear::{cell_of, corners, interpolate};
 use crate::non_finite::NonFiniteMask;
 use crate::sampling::grid::clamp_to_grid;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
 use wide::f32x4;
@@ -96,28 +95,17 @@ use wide::f32x4;
 /// far rounding can carry a trilinear sample past its voxels' range.
 pub const RANGE_MARGIN: f32 = 16.0;
 
-/// What one frame's rays read.
-pub struct PostScene<'a> {
-    pub volume: &'a Volume,
-    /// The world gradient of every voxel ([`crate::kernels::gradient::gradients`]).
-    pub gradients: &'a [[f32; 3]],
-    /// The volume's min/max bricks.
-    pub macrocells: &'a Macrocells,
-    pub classifier: &'a Classifier,
-    /// The Phong coefficients and the frame's light; `None`: unlit, each
-    /// sample takes its material colour.
-    pub lighting: Option<(&'a Phong, LightGeometry)>,
-}
-
-/// What one frame's rays read, with the scalars and gradients packed
-/// ([`packed_voxels`], made once per volume).
-pub struct PackedScene<'a> {
+/// What one frame's rays read: the scalars and gradients packed
+/// ([`packed_voxels`], made once per volume), and the frame's classifier
+/// and light.
+pub struct Scene<'a> {
     /// Every voxel's `(gx, gy, gz, f)`, x fastest.
     pub voxels: &'a [f32x4],
     /// The volume's min/max bricks.
     pub macrocells: &'a Macrocells,
     pub classifier: &'a Classifier,
-    /// As [`PostScene::lighting`].
+    /// The Phong coefficients and the frame's light; `None`: unlit, each
+    /// sample takes its material colour.
     pub lighting: Option<(&'a Phong, LightGeometry)>,
     /// The samples to pass over, where `voxels` are those of a cleaned
     /// volume ([`crate::non_finite`]); `None`: every sample counts.
@@ -126,7 +114,7 @@ pub struct PackedScene<'a> {
 
 /// Every voxel's world gradient (from `gradients`, see
 /// [`crate::kernels::gradient::gradients`]) and scalar as the lanes
-/// `(gx, gy, gz, f)`, x fastest: what [`render_packed`] reads.
+/// `(gx, gy, gz, f)`, x fastest: what [`render`] reads.
 pub fn packed_voxels(volume: &Volume, gradients: &[[f32; 3]]) -> Vec<f32x4> {
     assert_eq!(gradients.len(), volume.len());
     (gradients.par_iter().zip(volume.data()))
@@ -251,64 +239,36 @@ impl TransparentValues {
     }
 }
 
-/// Renders `scene` through `view`, sampling as `sampling` says, over the
-/// opaque `background`, into `image` (the view's size). `progress` is
-/// called with the number of pixels finished, a row at a time. Packs the
-/// scalars and gradients first; [`render_packed`] takes them ready.
+/// Renders `scene` through `view`, sampling as `sampling` says, into
+/// `pixels` (the view's partial pixels, row-major). `progress` is called
+/// with the number of pixels finished, a row at a time.
 pub fn render(
-    scene: &PostScene,
+    scene: &Scene,
     view: &View,
     sampling: &Sampling,
-    background: [f32; 3],
-    image: &mut Image,
-    progress: &(dyn Fn(usize) + Sync),
-) -> PostWork {
-    let voxels = packed_voxels(scene.volume, scene.gradients);
-    let scene = PackedScene {
-        voxels: &voxels,
-        macrocells: scene.macrocells,
-        classifier: scene.classifier,
-        lighting: scene.lighting,
-        mask: None,
-    };
-    render_packed(&scene, view, sampling, background, image, progress)
-}
-
-/// [`render`], from scalars and gradients already packed.
-pub fn render_packed(
-    scene: &PackedScene,
-    view: &View,
-    sampling: &Sampling,
-    background: [f32; 3],
-    image: &mut Image,
+    pixels: &mut [PartialPixel],
     progress: &(dyn Fn(usize) + Sync),
 ) -> PostWork {
     let dims = scene.macrocells.grid.dims;
     assert_eq!(scene.voxels.len(), dims.iter().product::<usize>());
-    assert_eq!(
-        (image.width(), image.height()),
-        (view.width(), view.height())
-    );
+    assert_eq!(pixels.len(), view.width() * view.height());
     let rays = Rays {
         scene,
         grid: scene.macrocells.grid,
         transparent: transparent_bricks(scene.macrocells, scene.classifier),
         values: TransparentValues::new(scene.classifier, value_range(scene.macrocells)),
     };
-    let background = Vec3::from(background);
     let width = view.width();
-    image
-        .pixels_mut()
+    pixels
         .par_chunks_mut(width)
         .enumerate()
         .map(|(row, pixels)| {
             let mut work = PostWork::default();
             for (col, pixel) in pixels.iter_mut().enumerate() {
-                let rgba = match sampling.pixel(view, col, row) {
-                    Some(ray) => rays.cast(&ray, &mut work).finish(background),
-                    None => background.extend(0.0),
+                *pixel = match sampling.pixel(view, col, row) {
+                    Some(ray) => rays.cast(&ray, &mut work).partial(),
+                    None => EMPTY,
                 };
-                *pixel = rgba.to_array();
             }
             progress(pixels.len());
             work
@@ -321,7 +281,7 @@ pub fn render_packed(
 
 /// The frame's rays.
 struct Rays<'a> {
-    scene: &'a PackedScene<'a>,
+    scene: &'a Scene<'a>,
     grid: BrickGrid,
     /// [`transparent_bricks`], by brick index.
     transparent: Vec<bool>,
@@ -348,7 +308,7 @@ impl Rays<'_> {
     /// brick in the order the ray crosses them.
     fn cast(&self, ray: &PixelSamples, work: &mut PostWork) -> FrontToBack {
         let dims = self.grid.dims;
-        let mut acc = FrontToBack::new();
+        let mut acc = FrontToBack::NEW;
         // Positions count from the first sample (near the volume, even for
         // a far perspective eye), so `f32` loses nothing to a far origin.
         let start = ray.origin + ray.t(ray.first) * ray.direction;
@@ -451,8 +411,6 @@ impl Rays<'_> {
         let last_cell = hi.map(|h| h - 1);
         let uses_gradient = classifier.uses_gradient();
         let (sy, sz) = (nx, nx * ny);
-        // Gradient and value interpolate together: (gx, gy, gz, f).
-        let lerp4 = |a: f32x4, b: f32x4, t: f32| a + (b - a) * f32x4::splat(t);
         for k in ks {
             if skipped(k) {
                 continue;
@@ -460,19 +418,11 @@ impl Rays<'_> {
             work.samples += 1;
             let n = (k - positions.first) as f32;
             let p = (positions.start + positions.delta * n).clamp(box_lo, box_hi);
-            // `p` ≥ 0, so truncation is the floor.
-            let c = [
-                (p.x as usize).min(last_cell[0]),
-                (p.y as usize).min(last_cell[1]),
-                (p.z as usize).min(last_cell[2]),
-            ];
-            let (fx, fy, fz) = (p.x - c[0] as f32, p.y - c[1] as f32, p.z - c[2] as f32);
+            let (c, offsets) = cell_of(p, last_cell);
             let base = c[0] + sy * c[1] + sz * c[2];
-            let [x, y, z, f] = {
-                let v = |i: usize| lerp4(voxels[i], voxels[i + 1], fx);
-                let [c00, c10, c01, c11] = [base, base + sy, base + sz, base + sy + sz].map(v);
-                lerp4(lerp4(c00, c10, fy), lerp4(c01, c11, fy), fz).to_array()
-            };
+            // Gradient and value interpolate together: (gx, gy, gz, f).
+            let [x, y, z, f] =
+                interpolate(corners(|i| voxels[i], base, sy, sz), offsets).to_array();
             let g = [x, y, z];
             // A sample of zero opacity adds exactly nothing: not shaded.
             if self.values.contains(f) {
@@ -486,14 +436,13 @@ impl Rays<'_> {
             if alpha == 0.0 {
                 continue;
             }
-            let material = Vec3::from(classifier.material(f));
-            let lit = match &scene.lighting {
-                Some((phong, light)) => Vec3::from(phong.shade(Vec3::from(g), light)),
-                None => Vec3::ONE,
-            };
-            let color = (lit * material).clamp(Vec3::ZERO, Vec3::ONE);
-            acc.add(Vec4::from((color, alpha)));
-            if acc.transmittance() < TERMINATION_TRANSMITTANCE {
+            let lighting = scene
+                .lighting
+                .as_ref()
+                .map(|(phong, light)| (*phong, light));
+            let [r, g, b] = lit_colour(lighting, Vec3::from(g), classifier.material(f));
+            acc.add(f32x4::new([r, g, b, alpha]));
+            if acc.is_opaque() {
                 return true;
             }
         }
@@ -511,7 +460,7 @@ mod tests {
     #[test]
     fn packed_voxels_interpolate_to_the_scalar_and_the_gradient_of_the_reference() {
         use crate::kernels::gradient::gradients;
-        use crate::kernels::trilinear::{sample_scalar, vector_reference};
+        use crate::kernels::trilinear::{reference, sample_scalar};
         use glam::DVec3;
         // Values from a hash of the index: nothing a layout bug could hide behind.
         let volume = Volume::from_fn([7, 5, 6], DVec3::new(1.0, 0.5, 2.0), DVec3::ZERO, |p| {
@@ -529,25 +478,24 @@ mod tests {
             ([x, y, z], f),
             (grads[3 + 7 * (2 + 5 * 4)], volume.get(3, 2, 4))
         );
-        // The lerp chain of `march`, on the packed lanes.
-        let lerp4 = |a: f32x4, b: f32x4, t: f32| a + (b - a) * f32x4::splat(t);
+        // The interpolation of `march`, on the packed lanes.
         let mut s = 0.618_034_f64;
         for _ in 0..500 {
             let p = Vec3::from(std::array::from_fn(|a| {
                 s = (s * 9301.0 + 0.49297).fract();
                 (s * (dims[a] - 1) as f64) as f32
             }));
-            let c = [0, 1, 2].map(|a| (p[a] as usize).min(dims[a] - 2));
+            let (c, offsets) = cell_of(p, dims.map(|n| n - 2));
             let (sy, sz) = (dims[0], dims[0] * dims[1]);
             let base = c[0] + sy * c[1] + sz * c[2];
-            let v = |i: usize| lerp4(voxels[i], voxels[i + 1], p.x - c[0] as f32);
-            let [c00, c10, c01, c11] = [base, base + sy, base + sz, base + sy + sz].map(v);
-            let (fy, fz) = (p.y - c[1] as f32, p.z - c[2] as f32);
-            let [x, y, z, f] = lerp4(lerp4(c00, c10, fy), lerp4(c01, c11, fy), fz).to_array();
+            let [x, y, z, f] =
+                interpolate(corners(|i| voxels[i], base, sy, sz), offsets).to_array();
             // The value lane is the scalar lerps' value to the last bit.
             let scalar = sample_scalar(volume.data(), dims, p);
             assert_eq!(f.to_bits(), scalar.to_bits(), "{p}");
-            let want = vector_reference(&grads, dims, [p.x, p.y, p.z].map(f64::from));
+            let want = reference([p.x, p.y, p.z].map(f64::from), dims, DVec3::ZERO, |i| {
+                Vec3::from(grads[i]).as_dvec3()
+            });
             let got = DVec3::new(x as f64, y as f64, z as f64);
             assert!(
                 (got - want).abs().max_element() < 1e-4,
@@ -635,5 +583,163 @@ mod tests {
         );
         let v = TransparentValues::new(&none, (0.0, 1.0));
         assert!(v.contains(0.0) && v.contains(0.5) && v.contains(1.0));
+    }
+
+    use crate::camera::View;
+    use crate::camera::{Camera, Projection};
+    use crate::image::Image;
+    use crate::kernels::gradient::gradients;
+    use crate::partial::{PartialImage, PartialPixels};
+    use crate::renderer::Renderer;
+    use crate::settings::{Classification, Method, RenderSettings};
+    use glam::DVec3;
+
+    fn on_the_reference(settings: &RenderSettings) -> RenderSettings {
+        RenderSettings {
+            method: Method::Reference,
+            ..settings.clone()
+        }
+    }
+
+    /// 48³ of nothing but three small dense features: a 3³ block deep behind
+    /// empty bricks (seen along −x, the eye is on +x), a single voxel on a
+    /// brick corner, and a 2-voxel rod lying in a brick face.
+    fn sparse() -> Volume {
+        let n = 48;
+        Volume::from_fn([n, n, n], DVec3::ONE, DVec3::ZERO, |p| {
+            let (x, y, z) = (p.x as usize, p.y as usize, p.z as usize);
+            let block = (3..6).contains(&x) && (30..33).contains(&y) && (10..13).contains(&z);
+            let corner = (x, y, z) == (16, 16, 24);
+            let rod = x == 8 && y == 40 && (20..22).contains(&z);
+            if block || corner || rod { 1.0 } else { 0.0 }
+        })
+        .unwrap()
+    }
+
+    /// Renders `settings` with [`render`] directly, to see its work.
+    fn post_cast_work(renderer: &Renderer, settings: &RenderSettings) -> (Image, PostWork, usize) {
+        let volume = renderer.volume();
+        let frame = renderer.prepare(settings).unwrap();
+        let classifier = renderer.classifier(settings);
+        let voxels = packed_voxels(volume, &gradients(volume));
+        let macrocells = Macrocells::new(volume);
+        let light = LightGeometry::headlight((-frame.view.direction()).as_vec3());
+        let scene = Scene {
+            voxels: &voxels,
+            macrocells: &macrocells,
+            classifier: &classifier,
+            lighting: Some((&settings.phong, light)),
+            mask: None,
+        };
+        let mut partial = PartialImage::composite(settings.width, settings.height);
+        let PartialPixels::Composite(pixels) = partial.pixels_mut() else {
+            unreachable!()
+        };
+        let work = render(&scene, &frame.view, &frame.sampling, pixels, &|_| {});
+        let image = renderer.finish(settings, partial);
+        (image, work, frame.nominal_samples())
+    }
+
+    #[test]
+    fn empty_bricks_are_skipped_and_small_features_behind_them_are_found() {
+        let volume = sparse();
+        let renderer = Renderer::new(&volume).unwrap();
+        let cameras = [
+            Camera::default(),
+            Camera {
+                view_point: Some(DVec3::new(100.0, 30.0, 45.0)),
+                ..Camera::default()
+            },
+            Camera {
+                projection: Projection::Perspective { fov_degrees: 50.0 },
+                azimuth: 20.0,
+                elevation: -15.0,
+                ..Camera::default()
+            },
+        ];
+        for camera in cameras {
+            // The paper's ramp from 0: the empty bricks (all 0, the minimum)
+            // are transparent; a dense voxel's opacity is 0.9.
+            let s = RenderSettings {
+                width: 96,
+                height: 96,
+                camera,
+                step: 0.5,
+                opacity_ramp: (0.0, 0.9),
+                classification: Classification::Post,
+                ..RenderSettings::default()
+            };
+            let (image, work, nominal) = post_cast_work(&renderer, &s);
+            // The renderer's fast path is this very function.
+            assert!(image == renderer.render(&s).unwrap(), "{camera:?}");
+            let slow = renderer.render(&on_the_reference(&s)).unwrap();
+            assert!(
+                image.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0,
+                "{camera:?}"
+            );
+            // Most samples lie in empty bricks and are never interpolated.
+            println!("{camera:?}: {work:?} of {nominal} nominal samples");
+            assert!(work.bricks_skipped > 10_000, "{work:?}");
+            assert!(work.samples * 10 < nominal as u64, "{work:?} of {nominal}");
+            // Each feature shows where its centre projects.
+            let view = View::frame(&camera, volume.bounds(), 96, 96).unwrap();
+            for centre in [
+                DVec3::new(4.0, 31.0, 11.0),
+                DVec3::new(16.0, 16.0, 24.0),
+                DVec3::new(8.0, 40.0, 20.5),
+            ] {
+                let (c, r) = view.project(centre).unwrap();
+                let alpha = image.get(c as usize, r as usize)[3];
+                assert!(
+                    alpha > 0.3,
+                    "{camera:?}: feature at {centre} has alpha {alpha}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn bricks_near_an_isovalue_are_visited_and_far_ones_skipped() {
+        // With an iso-surface, a brick is skipped only if its values lie
+        // farther from the isovalue than the contour can reach at the
+        // volume's steepest gradient. The steepest is at the block's corners,
+        // |∇f| = |(½, ½, ½)| = √3/2 per voxel, so a contour 0.5 voxels thick
+        // reaches 0.43 from the isovalue 0.5: the empty bricks (all 0) are
+        // skipped, and the features' bricks are not.
+        let volume = sparse();
+        let renderer = Renderer::new(&volume).unwrap();
+        assert!((renderer.max_gradient() - 0.75f32.sqrt()).abs() < 1e-6);
+        let s = RenderSettings {
+            width: 64,
+            height: 64,
+            step: 0.5,
+            classification: Classification::Post,
+            iso: Some(IsoSurface {
+                value: 0.5,
+                thickness: 0.5,
+            }),
+            ..RenderSettings::default()
+        };
+        let (fast, work, nominal) = post_cast_work(&renderer, &s);
+        assert!(fast == renderer.render(&s).unwrap());
+        let slow = renderer.render(&on_the_reference(&s)).unwrap();
+        assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
+        assert!(slow.pixels().iter().filter(|p| p[3] > 0.3).count() >= 4);
+        println!("iso: {work:?} of {nominal} nominal samples");
+        assert!(work.bricks_skipped > 1000, "{work:?}");
+        assert!(work.samples * 10 < nominal as u64, "{work:?} of {nominal}");
+        // A contour reaching every value (a thickness of 100 voxels) rules
+        // out no brick.
+        let thick = RenderSettings {
+            iso: Some(IsoSurface {
+                value: 0.5,
+                thickness: 100.0,
+            }),
+            ..s
+        };
+        let (fast, work, _) = post_cast_work(&renderer, &thick);
+        assert_eq!(work.bricks_skipped, 0);
+        let slow = renderer.render(&on_the_reference(&thick)).unwrap();
+        assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
     }
 }

@@ -29,13 +29,11 @@
 use crate::bricks::BRICK;
 use crate::bricks::macrocells::Macrocells;
 use crate::camera::View;
-use crate::image::Image;
-use crate::kernels::projection::projection_color;
+use crate::kernels::projection::Projected;
 use crate::kernels::trilinear::sample_scalar;
 use crate::non_finite::NonFiniteMask;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::settings::Blend;
-use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -56,8 +54,8 @@ struct Scene<'a> {
 }
 
 /// Renders the projection `blend` (not [`Blend::Composite`]) of `volume`
-/// through `view`, sampling as `sampling` says, coloured by `classifier`
-/// over the opaque `background`, into `image` (the view's size).
+/// through `view`, sampling as `sampling` says, into `pixels` (the view's
+/// projections, row-major).
 /// `macrocells` are the volume's and `range` its `(min, max)`. `progress`
 /// is called with the number of pixels finished, a row at a time. With a
 /// `mask`, `volume` is the cleaned copy and the samples the mask skips are
@@ -71,15 +69,10 @@ pub fn render(
     view: &View,
     sampling: &Sampling,
     blend: Blend,
-    classifier: &Classifier,
-    background: [f32; 3],
-    image: &mut Image,
+    pixels: &mut [Projected],
     progress: &(dyn Fn(usize) + Sync),
 ) {
-    assert_eq!(
-        (image.width(), image.height()),
-        (view.width(), view.height())
-    );
+    assert_eq!(pixels.len(), view.width() * view.height());
     let scene = Scene {
         volume,
         mask,
@@ -88,29 +81,24 @@ pub fn render(
         range,
     };
     let width = view.width();
-    image
-        .pixels_mut()
+    pixels
         .par_chunks_mut(width)
         .enumerate()
         .for_each(|(row, pixels)| {
             for (col, pixel) in pixels.iter_mut().enumerate() {
-                let value = sampling
-                    .pixel(view, col, row)
-                    .and_then(|ray| scene.project(&ray));
-                let rgba = match value {
-                    Some(f) => Vec3::from(projection_color(classifier, f)).extend(1.0),
-                    None => Vec3::from(background).extend(0.0),
+                *pixel = match sampling.pixel(view, col, row) {
+                    Some(ray) => scene.project(&ray),
+                    None => Projected::empty(blend),
                 };
-                *pixel = rgba.to_array();
             }
             progress(pixels.len());
         });
 }
 
 impl Scene<'_> {
-    /// The projected value of one ray's samples (it has at least one), or
-    /// `None` if the mask skips them all.
-    fn project(&self, ray: &PixelSamples) -> Option<f32> {
+    /// The projection of one ray's samples (it has at least one; the mask
+    /// may skip them all).
+    fn project(&self, ray: &PixelSamples) -> Projected {
         let dims = self.volume.dims();
         let data = self.volume.data();
         let top = Vec3::new(
@@ -145,7 +133,10 @@ impl Scene<'_> {
                             (sum + sample_scalar(data, dims, p) as f64, count + 1)
                         }),
                 };
-                return (count > 0).then(|| (sum / count as f64) as f32);
+                return Projected {
+                    value: sum,
+                    count: count as u64,
+                };
             }
         };
         let largest = if sign > 0.0 {
@@ -193,7 +184,14 @@ impl Scene<'_> {
         // Without a mask every ray counts a sample (no brick's bound is
         // below −∞, the best before the first); with one, every sample may
         // have been skipped, and the ray shows the background.
-        counted.then_some(sign * best)
+        if counted {
+            Projected {
+                value: f64::from(sign * best),
+                count: 1,
+            }
+        } else {
+            Projected::empty(self.blend)
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 
 pub mod composite;
 pub mod gradient;
+pub mod lanes;
 pub mod phong;
 pub mod projection;
 pub mod trilinear;

@@ -19,6 +19,7 @@
 //! **Zero gradient.** Where `|∇f| = 0` the normal is undefined (errata 1):
 //! such voxels get the ambient term only.
 
+use crate::kernels::lanes::Lanes;
 use glam::Vec3;
 
 /// Phong reflection coefficients and the light, per colour channel (r, g, b).
@@ -83,45 +84,103 @@ impl Phong {
     pub fn shade(&self, gradient: Vec3, light: &LightGeometry) -> [f32; 3] {
         let len = gradient.length();
         let (diffuse, highlight) = if len > 0.0 && len.is_finite() {
-            let mut n = gradient / len;
-            if n.dot(light.to_viewer) < 0.0 {
-                n = -n;
-            }
-            let n_dot_l = n.dot(light.to_light).max(0.0);
-            let highlight = if n_dot_l > 0.0 {
-                highlight_power(n.dot(light.half).max(0.0), self.shininess)
-            } else {
-                0.0
-            };
-            (n_dot_l, highlight)
+            let n = gradient / len;
+            two_sided(
+                n.dot(light.to_viewer),
+                n.dot(light.to_light),
+                n.dot(light.half),
+                Exponent::new(self.shininess),
+            )
         } else {
             (0.0, 0.0)
         };
         std::array::from_fn(|c| {
             self.light_color[c]
-                * (self.ambient[c] + self.diffuse[c] * diffuse + self.specular[c] * highlight)
+                * reflect(
+                    self.ambient[c],
+                    self.diffuse[c],
+                    self.specular[c],
+                    diffuse,
+                    highlight,
+                )
         })
     }
 }
 
-/// `x^n` for `x` in [0, 1]: a whole exponent up to 1024 by repeated
-/// squaring (several times faster than `powf`; relative error below about
-/// `n·2⁻²³`, as `x`'s own rounding is raised to the `n`; the bricked fast
-/// path raises the same way), any other by `powf`.
+/// The colour of a voxel or a sample: the lit colour of its `gradient`
+/// under `lighting` ([`Phong::shade`]; white where unlit) times its
+/// `material` colour, clamped to [0, 1].
 #[inline]
-pub fn highlight_power(x: f32, n: f32) -> f32 {
-    if n.fract() == 0.0 && (0.0..=1024.0).contains(&n) {
-        let (mut result, mut power, mut n) = (1.0f32, x, n as u32);
-        while n > 0 {
-            if n & 1 == 1 {
-                result *= power;
-            }
-            power *= power;
-            n >>= 1;
+pub fn lit_colour(
+    lighting: Option<(&Phong, &LightGeometry)>,
+    gradient: Vec3,
+    material: [f32; 3],
+) -> [f32; 3] {
+    let lit = match lighting {
+        Some((phong, light)) => Vec3::from(phong.shade(gradient, light)),
+        None => Vec3::ONE,
+    };
+    (lit * Vec3::from(material))
+        .clamp(Vec3::ZERO, Vec3::ONE)
+        .to_array()
+}
+
+/// The two-sided Phong terms `(max(N·L, 0), max(N·H, 0)^n)` of a normal
+/// `N` from its dot products with the viewer `V`, the light `L` and the
+/// half vector `H` (any common scale): the normal is first turned to face
+/// the viewer, and where the light is behind the surface (`N·L ≤ 0`) there
+/// is no highlight. A zero normal gets `(0, 0)`: ambient light only.
+#[inline(always)]
+pub fn two_sided<T: Lanes>(n_dot_v: T, n_dot_l: T, n_dot_h: T, exponent: Exponent) -> (T, T) {
+    let facing = n_dot_v.facing();
+    let diffuse = (n_dot_l * facing).max_zero();
+    let highlight = diffuse.where_positive(|| exponent.raise((n_dot_h * facing).max_zero()));
+    (diffuse, highlight)
+}
+
+/// One channel of the reflected light, `ka + kd·diffuse + ks·highlight`
+/// (the light's colour `Cs` is in the coefficients, or multiplies after).
+#[inline(always)]
+pub fn reflect<T: Lanes>(ka: T, kd: T, ks: T, diffuse: T, highlight: T) -> T {
+    ka + kd * diffuse + ks * highlight
+}
+
+/// The highlight exponent `n`: whole numbers up to 1024 by repeated
+/// squaring (several times faster than `powf`; relative error below about
+/// `n·2⁻²³`, as `x`'s own rounding is raised to the `n`), any other by
+/// `powf`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exponent {
+    Whole(u32),
+    Real(f32),
+}
+
+impl Exponent {
+    pub fn new(n: f32) -> Self {
+        if n.fract() == 0.0 && (0.0..=1024.0).contains(&n) {
+            Exponent::Whole(n as u32)
+        } else {
+            Exponent::Real(n)
         }
-        result
-    } else {
-        x.powf(n)
+    }
+
+    /// `x^n` for `x` in [0, 1].
+    #[inline(always)]
+    pub fn raise<T: Lanes>(self, x: T) -> T {
+        match self {
+            Exponent::Whole(mut n) => {
+                let (mut result, mut power) = (T::ONE, x);
+                while n > 0 {
+                    if n & 1 == 1 {
+                        result = result * power;
+                    }
+                    power = power * power;
+                    n >>= 1;
+                }
+                result
+            }
+            Exponent::Real(n) => x.powf(n),
+        }
     }
 }
 
@@ -197,17 +256,17 @@ mod tests {
     }
 
     #[test]
-    fn highlight_power_is_powf_for_whole_and_real_exponents() {
+    fn the_exponent_is_powf_for_whole_and_real_exponents() {
         for n in [0.0f32, 1.0, 2.0, 7.0, 10.0, 64.0, 1000.0, 7.5, 0.3] {
             for i in 0..=64 {
                 let x = i as f32 / 64.0;
-                let (got, want) = (highlight_power(x, n), x.powf(n));
+                let (got, want) = (Exponent::new(n).raise(x), x.powf(n));
                 assert!(
                     (got - want).abs() <= (n.max(1.0) * 1.2e-7 + 1e-6) * want + 1e-37,
                     "{x}^{n}: {got} vs {want}"
                 );
             }
         }
-        assert_eq!(highlight_power(0.0, 0.0), 1.0);
+        assert_eq!(Exponent::new(0.0).raise(0.0f32), 1.0);
     }
 }

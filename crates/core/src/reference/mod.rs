@@ -7,13 +7,18 @@
 //! `f64`, and make the pixel from them by the frame's [`Shader`]:
 //!
 //! - pre-classified (the paper's): interpolate the voxels' colours and
-//!   opacities ([`crate::reference::stage1`]) trilinearly, drape the opaque background
-//!   behind them as the last sample, and composite back to front with the
-//!   paper's formula;
+//!   opacities ([`crate::reference::stage1`]) trilinearly and composite
+//!   back to front with the paper's formula
+//!   ([`crate::kernels::composite::back_to_front`]);
 //! - post-classified: interpolate the scalar and the gradient, classify and
 //!   shade each sample ([`crate::reference::post`]), composite alike;
-//! - a projection (maximum, minimum, average; [`crate::kernels::projection`]): project the
-//!   interpolated scalar and show it through the colour map.
+//! - a projection (maximum, minimum, average;
+//!   [`crate::kernels::projection`]): project the interpolated scalar.
+//!
+//! The result is a partial image ([`PartialImage`]): the paper drapes the
+//! opaque background behind the samples as the last one, which is applied
+//! when the image is finished, as on every path (and projected values go
+//! through the colour map there).
 //!
 //! Non-finite voxels rendered as empty space ([`crate::non_finite`]) have
 //! zero opacity in stage 1; post-classified and projected samples that a
@@ -25,18 +30,17 @@ pub mod post;
 pub mod stage1;
 
 use crate::camera::View;
-use crate::image::Image;
 use crate::kernels::composite::back_to_front;
-use crate::kernels::projection::{ScalarProjection, projection_color};
-use crate::kernels::trilinear::{sample_reference, scalar_reference};
+use crate::kernels::projection::Projected;
+use crate::kernels::trilinear;
 use crate::non_finite::NonFiniteMask;
+use crate::partial::{PartialImage, PartialPixels};
 use crate::reference::post::PostClassifier;
 use crate::reference::stage1::ShadedVolume;
 use crate::sampling::Sampling;
 use crate::settings::Blend;
-use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
-use glam::{DVec3, Vec3};
+use glam::DVec4;
 use rayon::prelude::*;
 
 /// What a ray's samples are made of, and how they make the pixel.
@@ -47,76 +51,92 @@ pub enum Shader<'a> {
     /// Samples classified and shaded after interpolation, composited.
     Post(&'a PostClassifier<'a>),
     /// The interpolated scalar, projected by `blend` (not
-    /// [`Blend::Composite`]) and coloured by `classifier`.
+    /// [`Blend::Composite`]).
     Projection {
         volume: &'a Volume,
         blend: Blend,
-        classifier: &'a Classifier,
         /// Samples this skips are not counted ([`crate::non_finite`]).
         mask: Option<&'a NonFiniteMask>,
     },
 }
 
-/// Renders `view` with `shader`, sampling as `sampling` says, over the
-/// opaque `background`. `progress` is called with the number of pixels
-/// finished, a row at a time.
+/// Renders `view` with `shader`, sampling as `sampling` says, into a
+/// partial image (the background is applied when it is finished).
+/// `progress` is called with the number of pixels finished, a row at a
+/// time.
 pub fn render(
     shader: &Shader,
     view: &View,
     sampling: &Sampling,
-    background: [f32; 3],
     progress: &(dyn Fn(usize) + Sync),
-) -> Image {
+) -> PartialImage {
     let (width, height) = (view.width(), view.height());
-    let bg = DVec3::from(background.map(f64::from));
     let dims = sampling.grid.dims;
-    let mut image = Image::new(width, height, [0.0; 4]);
-    image
-        .pixels_mut()
-        .par_chunks_mut(width)
-        .enumerate()
-        .for_each(|(row, pixels)| {
-            let mut samples = Vec::new();
-            for (col, pixel) in pixels.iter_mut().enumerate() {
-                // Index-space positions of the ray's samples, nearest first.
-                let positions = (sampling.pixel(view, col, row).into_iter())
-                    .flat_map(|r| (r.first..=r.last).map(move |k| r.position(k, dims).to_array()));
-                let rgba = match shader {
-                    Shader::Pre(shaded) => {
-                        samples.clear();
-                        samples
-                            .extend(positions.map(|p| sample_reference(&shaded.voxels, dims, p)));
-                        back_to_front(&samples, bg)
-                    }
-                    Shader::Post(post) => {
-                        samples.clear();
-                        samples.extend(positions.map(|p| post.sample(p)));
-                        back_to_front(&samples, bg)
-                    }
-                    Shader::Projection {
-                        volume,
-                        blend,
-                        classifier,
-                        mask,
-                    } => {
-                        let mut projection = ScalarProjection::new(*blend);
-                        for p in positions {
-                            if mask.is_some_and(|m| m.skips(p.into())) {
-                                continue;
-                            }
-                            projection.add(scalar_reference(volume.data(), dims, p));
-                        }
-                        match projection.value() {
-                            Some(f) => Vec3::from(projection_color(classifier, f as f32))
-                                .as_dvec3()
-                                .extend(1.0),
-                            None => bg.extend(0.0),
-                        }
-                    }
+    // Index-space positions of the samples of pixel (col, row), nearest first.
+    let positions = |col: usize, row: usize| {
+        (sampling.pixel(view, col, row).into_iter())
+            .flat_map(move |r| (r.first..=r.last).map(move |k| r.position(k, dims).to_array()))
+    };
+    // Each row of pixels from its own rays, rows in parallel.
+    fn rows<P: Send>(
+        pixels: &mut [P],
+        width: usize,
+        progress: &(dyn Fn(usize) + Sync),
+        pixel: impl Fn(usize, usize) -> P + Sync,
+    ) {
+        pixels
+            .par_chunks_mut(width)
+            .enumerate()
+            .for_each(|(row, out)| {
+                for (col, p) in out.iter_mut().enumerate() {
+                    *p = pixel(col, row);
+                }
+                progress(out.len());
+            });
+    }
+    match shader {
+        Shader::Pre(_) | Shader::Post(_) => {
+            let mut image = PartialImage::composite(width, height);
+            let PartialPixels::Composite(pixels) = image.pixels_mut() else {
+                unreachable!("a composite image")
+            };
+            rows(pixels, width, progress, |col, row| {
+                let samples: Vec<DVec4> = match shader {
+                    Shader::Pre(shaded) => positions(col, row)
+                        .map(|p| {
+                            trilinear::reference(p, dims, DVec4::ZERO, |i| {
+                                shaded.voxels[i].as_dvec4()
+                            })
+                        })
+                        .collect(),
+                    Shader::Post(post) => positions(col, row).map(|p| post.sample(p)).collect(),
+                    Shader::Projection { .. } => unreachable!("a composite shader"),
                 };
-                *pixel = rgba.as_vec4().to_array();
-            }
-            progress(pixels.len());
-        });
-    image
+                back_to_front(&samples).as_vec4().to_array()
+            });
+            image
+        }
+        &Shader::Projection {
+            volume,
+            blend,
+            mask,
+        } => {
+            let mut image = PartialImage::projection(width, height, blend);
+            let PartialPixels::Projection { pixels, .. } = image.pixels_mut() else {
+                unreachable!("a projection image")
+            };
+            rows(pixels, width, progress, |col, row| {
+                let mut projection = Projected::empty(blend);
+                for p in positions(col, row) {
+                    if mask.is_some_and(|m| m.skips(p.into())) {
+                        continue;
+                    }
+                    let f = trilinear::reference(p, dims, 0.0, |i| volume.data()[i] as f64);
+                    projection.add(blend, f);
+                }
+                projection
+            });
+            image
+        }
+    }
 }

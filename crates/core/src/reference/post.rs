@@ -20,12 +20,12 @@
 //! the same picture.
 
 use crate::kernels::gradient::gradients;
-use crate::kernels::phong::{LightGeometry, Phong};
-use crate::kernels::trilinear::{scalar_reference, vector_reference};
+use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
+use crate::kernels::trilinear;
 use crate::non_finite::NonFiniteMask;
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
-use glam::{DVec4, Vec3};
+use glam::{DVec3, DVec4, Vec3};
 
 /// Classifies and shades samples of one volume for one frame.
 pub struct PostClassifier<'a> {
@@ -67,15 +67,15 @@ impl<'a> PostClassifier<'a> {
             return DVec4::ZERO;
         }
         let dims = self.volume.dims();
-        let f = scalar_reference(self.volume.data(), dims, p) as f32;
-        let g = vector_reference(&self.gradients, dims, p).as_vec3();
-        let material = Vec3::from(self.classifier.material(f));
-        let lit = match &self.lighting {
-            Some((phong, light)) => Vec3::from(phong.shade(g, light)),
-            None => Vec3::ONE,
-        };
-        let color = (lit * material).clamp(Vec3::ZERO, Vec3::ONE);
-        color
+        let data = self.volume.data();
+        let f = trilinear::reference(p, dims, 0.0, |i| data[i] as f64) as f32;
+        let g = trilinear::reference(p, dims, DVec3::ZERO, |i| {
+            Vec3::from(self.gradients[i]).as_dvec3()
+        })
+        .as_vec3();
+        let lighting = self.lighting.as_ref().map(|(phong, light)| (*phong, light));
+        let color = lit_colour(lighting, g, self.classifier.material(f));
+        Vec3::from(color)
             .extend(self.classifier.opacity_at(f, g.to_array()))
             .as_dvec4()
     }

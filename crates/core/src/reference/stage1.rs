@@ -10,7 +10,7 @@
 //! voxel, dense; the fast path's is [`crate::bricks::occupied`] (view-independent,
 //! kept across frames) and [`crate::cpu::lit_bricks`] (the light, per frame).
 
-use crate::kernels::phong::{LightGeometry, Phong};
+use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{Vec3, Vec4};
@@ -40,13 +40,8 @@ pub fn shade_and_classify(
         .zip(gradients.par_chunks(slice))
         .for_each(|((out, values), grads)| {
             for ((o, &f), g) in out.iter_mut().zip(values).zip(grads) {
-                let material = Vec3::from(classifier.material(f));
-                let lit = match lighting {
-                    Some((phong, light)) => Vec3::from(phong.shade(Vec3::from(*g), light)),
-                    None => Vec3::ONE,
-                };
-                let color = (lit * material).clamp(Vec3::ZERO, Vec3::ONE);
-                *o = color.extend(classifier.opacity_at(f, *g));
+                let color = lit_colour(lighting, Vec3::from(*g), classifier.material(f));
+                *o = Vec3::from(color).extend(classifier.opacity_at(f, *g));
             }
         });
     ShadedVolume {
