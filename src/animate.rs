@@ -37,7 +37,7 @@ pub fn turntable(
 ) -> Result<(), CliError> {
     let input = load(&args.input, args.view.log)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
-    let renderer = renderer_for(&args.view, &input)?;
+    let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
     for i in 0..frames {
         let image = writer.render(pool, &renderer, &turntable_frame(base, i, frames));
@@ -69,7 +69,7 @@ pub fn series(
     let mut extent = Extent::default();
     for spec in specs {
         let input = load_one(args, spec)?;
-        let renderer = renderer_for(&args.view, &input)?;
+        let renderer = renderer_for(&args.view, base, &input)?;
         extent.add(renderer.value_range(), input.volume.bounds());
         if base.gradient_opacity.is_some() {
             let max = pool.install(|| renderer.max_gradient());
@@ -83,7 +83,7 @@ pub fn series(
     for spec in specs {
         let input = load_one(args, spec)?;
         let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
-        let renderer = renderer_for(&args.view, &input)?;
+        let renderer = renderer_for(&args.view, &settings, &input)?;
         let image = writer.render(pool, &renderer, &settings);
         writer.push(&image.map_err(fail)?)?;
     }

@@ -181,7 +181,7 @@ fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
 
     let median_s = pool.install(|| {
-        let renderer = renderer_for(&args.view, &input)?;
+        let renderer = renderer_for(&args.view, &base, &input)?;
         let [nx, ny, nz] = input.volume.dims();
         outln!(
             "volray bench: {} ({nx}x{ny}x{nz}), {}x{} pixels, step {} voxel, {} threads, {} path",

@@ -51,7 +51,7 @@ fn still(
     kind: OutputKind,
 ) -> Result<(), CliError> {
     let input = load(&args.input, args.view.log)?;
-    let renderer = renderer_for(&args.view, &input)?;
+    let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let image = pool
         .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
@@ -398,8 +398,12 @@ fn camera(view: &ViewArgs) -> Camera {
 /// rendered as empty space as `--nonfinite` says, refused if rendering it
 /// may need more than `--max-memory` (see `memory.rs`). A refusal is one
 /// line naming the input and the count, and the way out.
-pub fn renderer_for<'v>(view: &ViewArgs, input: &'v Input) -> Result<Renderer<'v>, CliError> {
-    crate::memory::check_render(view, input)?;
+pub fn renderer_for<'v>(
+    view: &ViewArgs,
+    settings: &RenderSettings,
+    input: &'v Input,
+) -> Result<Renderer<'v>, CliError> {
+    crate::memory::check_render(view, settings, input)?;
     let (name, volume) = (&input.name, &input.volume);
     let mode = match view.nonfinite {
         NonFiniteMode::Refuse => NonFinite::Refuse,

@@ -68,6 +68,17 @@ pub enum NonFinite {
     Transparent,
 }
 
+/// Bytes a volume of `dims` voxels with non-finite values needs beside
+/// itself to render them as empty space: the cleaned copy (`f32`), the mask
+/// (a bit a voxel) and its per-brick flags (see [`NonFiniteMask`]).
+pub(crate) fn bytes(dims: [usize; 3]) -> u128 {
+    let voxels: u128 = dims.iter().map(|&n| n as u128).product();
+    let bricks = BrickGrid::new(dims.map(|n| n.max(2))).len() as u128;
+    voxels * size_of::<f32>() as u128
+        + voxels.div_ceil(64) * size_of::<u64>() as u128
+        + bricks * size_of::<bool>() as u128
+}
+
 /// The non-finite voxels of a volume, and which bricks lie near them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NonFiniteMask {

@@ -10,6 +10,9 @@ use crate::bricks::{BrickGrid, SIDE, slot_coords};
 use crate::volume::Volume;
 use rayon::prelude::*;
 
+/// Bytes each brick takes in [`Macrocells`].
+pub(crate) const BYTES_PER_BRICK: usize = size_of::<(f32, f32)>();
+
 /// `(min, max)` of the values of every brick's voxels, faces included.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Macrocells {

@@ -32,6 +32,19 @@ use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use rayon::prelude::*;
 
+/// Bytes one occupied brick takes, for the memory bound
+/// ([`crate::memory`]): its [`SLOTS`] voxels and its entries in every
+/// per-brick list of [`ClassifiedBricks`] (and the flag each brick gets
+/// while they are found).
+pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize = SLOTS * size_of::<Voxel>()
+    + size_of::<[usize; 3]>()
+    + size_of::<[u64; CELLS / 64]>()
+    + size_of::<([u8; 3], [u8; 3])>()
+    + size_of::<[u64; SLOTS.div_ceil(64)]>();
+/// Bytes every brick, occupied or not, takes in [`ClassifiedBricks`]
+/// (`slot_of`, and the occupancy flag while classifying).
+pub(crate) const BYTES_PER_BRICK: usize = size_of::<u32>() + size_of::<bool>();
+
 /// Units of a `u16` colour or opacity: 65535 is 1.
 pub const UNIT: f32 = 65535.0;
 /// Units of an `i16` normal component: 32767 is 1.

@@ -54,6 +54,12 @@ use glam::{DVec3, Vec4};
 use rayon::prelude::*;
 use wide::f32x4;
 
+/// Bytes one occupied brick takes while a frame is cast (its cell box).
+pub(crate) const FRAME_BYTES_PER_OCCUPIED_BRICK: usize = size_of::<CellBox>();
+/// Bytes one tile takes while a frame is cast (its rows of pixels).
+pub(crate) const FRAME_BYTES_PER_TILE: usize =
+    size_of::<Vec<&mut [PartialPixel]>>() + TILE * size_of::<&mut [PartialPixel]>();
+
 /// Slack, in samples, around each box's range of samples: a sample on a
 /// box face is found whatever the rounding (it is clamped into the box, so
 /// at most this far from where it belongs).

@@ -25,6 +25,11 @@ use std::sync::{RwLock, RwLockReadGuard};
 use wide::bytemuck::cast;
 use wide::{f32x4, i16x8, i32x4, i32x8};
 
+/// Bytes one occupied brick takes in [`LitBricks`] once lit: its lock and
+/// its lit voxels.
+pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize =
+    size_of::<RwLock<LitBrick>>() + size_of::<[[f32; 4]; SLOTS]>();
+
 /// The frame's lit bricks, each lit the first time a ray needs it.
 ///
 /// Lighting a brick just before its rays cross it keeps its voxels in the

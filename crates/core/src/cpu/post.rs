@@ -90,6 +90,11 @@ use rayon::prelude::*;
 use std::ops::Range;
 use wide::f32x4;
 
+/// Bytes per voxel of the packed values and gradients ([`packed_voxels`]).
+pub(crate) const BYTES_PER_VOXEL: usize = size_of::<f32x4>();
+/// Bytes per brick of a frame's transparency flags ([`transparent_bricks`]).
+pub(crate) const FRAME_BYTES_PER_BRICK: usize = size_of::<bool>();
+
 /// A brick's value range is widened by this many `f32::EPSILON` of its
 /// largest magnitude before the transparency test: twice the bound on how
 /// far rounding can carry a trilinear sample past its voxels' range.

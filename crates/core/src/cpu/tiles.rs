@@ -51,6 +51,16 @@ use crate::sampling::Sampling;
 use crate::sampling::grid::GridFrame;
 use glam::DVec3;
 
+/// Bytes one occupied brick takes while a frame is binned, beside its
+/// entries in the tiles' lists ([`BYTES_PER_ENTRY`] each): its depth and
+/// its tile rectangle.
+pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize =
+    size_of::<(f64, u32)>() + size_of::<Option<[usize; 4]>>();
+/// Bytes of one brick's entry in one tile's list.
+pub(crate) const BYTES_PER_ENTRY: usize = size_of::<u32>();
+/// Bytes per tile: its list's start, and its count while binning.
+pub(crate) const BYTES_PER_TILE: usize = 2 * size_of::<u32>();
+
 /// Tile edge in pixels.
 pub const TILE: usize = 16;
 

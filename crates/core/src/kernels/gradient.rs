@@ -14,6 +14,9 @@
 use crate::volume::Volume;
 use rayon::prelude::*;
 
+/// Bytes per voxel of [`gradients`].
+pub const BYTES_PER_VOXEL: usize = size_of::<[f32; 3]>();
+
 /// World-space gradient of `volume` at every voxel, x fastest.
 pub fn gradients(volume: &Volume) -> Vec<[f32; 3]> {
     let [nx, ny, _] = volume.dims();

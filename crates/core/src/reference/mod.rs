@@ -43,6 +43,9 @@ use crate::volume::Volume;
 use glam::DVec4;
 use rayon::prelude::*;
 
+/// Bytes of one sample of a ray being composited.
+pub(crate) const BYTES_PER_SAMPLE: usize = size_of::<DVec4>();
+
 /// What a ray's samples are made of, and how they make the pixel.
 pub enum Shader<'a> {
     /// The voxels' colours and opacities (stage 1), interpolated and

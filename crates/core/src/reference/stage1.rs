@@ -16,6 +16,9 @@ use crate::volume::Volume;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+/// Bytes per voxel of a [`ShadedVolume`].
+pub(crate) const BYTES_PER_VOXEL: usize = size_of::<Vec4>();
+
 /// Per-voxel colour and opacity: `(r, g, b, α)` with α per sample, x fastest.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShadedVolume {
