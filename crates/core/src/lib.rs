@@ -5,17 +5,57 @@
 //! after M. Levoy, "Display of surfaces from volume data", *IEEE CG&A* 8(3),
 //! 1988.
 //!
-//! Where things are (one concept per file):
+//! ## The pipeline, as the default (fast) path runs
 //!
-//! | folder | what |
+//! ```text
+//!  Volume ──► Renderer::new ─ value range; NaN/∞ refused or masked ─────── renderer.rs, non_finite.rs
+//!    │
+//!    │ once per volume and transfer function (kept across frames)
+//!    ├─► min/max of each 8³-cell brick ──────────────────────────────────── bricks/macrocells.rs
+//!    └─► occupied bricks: per voxel slot, unit normal and opacity ───────── bricks/occupied.rs
+//!          (transfer function: transfer/classifier.rs; gradient: kernels/gradient.rs)
+//!
+//!  per frame
+//!    RenderSettings checked, camera framed, each ray's samples ─────────── frame.rs, settings.rs
+//!          (camera/ ─ the view; sampling/ ─ t = (k + u)·step, crop, clip planes, jitter)
+//!    occupied bricks binned into 16² tiles, front to back ──────────────── cpu/tiles.rs
+//!    per tile, in parallel, brick by brick front to back ───────────────── cpu/bricked.rs
+//!      ├─ light the brick's voxels (once per frame) ────────────────────── cpu/lit_bricks.rs
+//!      │    (kernels/phong.rs: two-sided Phong × material colour)
+//!      └─ each ray: trilinear sample, composite front to back, stop ───── kernels/trilinear.rs,
+//!           when T < 1/1024                                               kernels/composite.rs
+//!    ──► PartialImage: premultiplied colour and transmittance per pixel ─ partial.rs
+//!    ──► finish: over the background ──► Image ───────────────────────── image.rs
+//! ```
+//!
+//! The other paths share every step they can: post-classified frames
+//! (`cpu/post.rs`: interpolate the scalar and the gradient, then classify
+//! and shade each sample, walking the bricks each ray crosses) and the
+//! projections (`cpu/projection.rs`: maximum, minimum, average of the
+//! scalar, skipping bricks that cannot change the result) take the same
+//! samples and call the same kernels; the **reference path**
+//! (`reference/`, [`Method::Reference`]) is the paper's algorithm as
+//! written, every voxel classified and shaded, every sample composited
+//! back to front in `f64`, and is the oracle every fast path is tested
+//! against (within 1/255 per channel). Partial images of pieces of a
+//! volume combine front to back ([`PartialImage::combine`]) before the
+//! background is applied, which is how tiles, ranks of a cluster or GPU
+//! passes can share one frame. [`MemoryBound`] says, before anything is
+//! allocated, how much memory a frame will take.
+//!
+//! ## Where things are
+//!
+//! | folder or file | what |
 //! |---|---|
-//! | [`camera`] | the camera: pose, orthographic and perspective views, framing |
+//! | [`camera`] | the camera: pose and orbits, orthographic and perspective views, framing |
 //! | [`transfer`] | values to colour and opacity: the classifier, transfer-function JSON, colour maps, presets, iso-surfaces, gradient opacity |
-//! | [`sampling`] | which samples each pixel's ray takes: the sample grid, crop and clip planes, jitter |
-//! | [`kernels`] | per-sample maths every path calls: trilinear interpolation, gradients, Phong, compositing, projections |
-//! | `bricks` | the fast path's view-independent store: bricks, min/max macro-cells, occupied bricks |
-//! | `reference` | the oracle: the paper's algorithm as written, every option, `f64` |
-//! | `cpu` | the fast path: tiles, the lit-brick cache, the casters |
+//! | [`sampling`] | which samples each pixel's ray takes: the grid in the world, crop box and clip planes, jitter |
+//! | [`kernels`] | per-sample maths, the one copy every path calls (and a GPU port mirrors): trilinear interpolation, gradients, Phong, compositing, projections |
+//! | `bricks/` | the fast path's view-independent store: the brick grid, min/max macro-cells, occupied bricks |
+//! | `cpu/` | the fast path on the CPU: tiles, the lit-brick cache, the three casters |
+//! | `reference/` | the oracle: the paper's stage 1 and back-to-front compositing, every option |
+//! | `renderer.rs`, `settings.rs`, `frame.rs`, `error.rs` | the [`Renderer`] (caches, routing, timing), [`RenderSettings`], a checked and framed [`Frame`], typed errors |
+//! | `volume.rs`, `image.rs`, `partial.rs`, `memory.rs`, `non_finite.rs`, `histogram.rs` | [`Volume`], [`Image`], [`PartialImage`], [`MemoryBound`], [`NonFinite`], [`Histogram`] |
 //!
 //! ```
 //! use volray_core::{Renderer, RenderSettings, Volume, glam::DVec3};
@@ -34,23 +74,23 @@
 //! assert!(centre[0] > 0.5 && corner == [0.0, 0.0, 0.0, 0.0]);
 //! ```
 
-pub mod bricks;
+mod bricks;
 pub mod camera;
-pub mod cpu;
+mod cpu;
 mod error;
 mod frame;
-pub mod histogram;
-pub mod image;
+mod histogram;
+mod image;
 pub mod kernels;
 mod memory;
-pub mod non_finite;
+mod non_finite;
 mod partial;
-pub mod reference;
-pub mod renderer;
+mod reference;
+mod renderer;
 pub mod sampling;
 mod settings;
 pub mod transfer;
-pub mod volume;
+mod volume;
 
 pub use camera::{
     Camera, CameraError, CameraPoint, Fit, Orbit, OrthographicView, Projection, View,

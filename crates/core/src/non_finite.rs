@@ -1,56 +1,6 @@
 //! Non-finite voxel values (NaN, ±∞): refused, or rendered as empty space.
 //!
-//! Real files hold them: masked regions written as NaN, divisions by zero,
-//! overflowed densities. By default the renderer refuses such a volume
-//! ([`NonFinite::Refuse`], naming the count). With
-//! [`NonFinite::Transparent`] a non-finite voxel contributes no opacity,
-//! exactly as follows.
-//!
-//! - **The value window** (`fmin`, `fmax`) is that of the finite values
-//!   ([`Volume::value_range`]), as are `volray info`'s range and histogram.
-//! - **Cleaned copy.** The renderer works on a copy of the volume whose
-//!   non-finite voxels hold the *fill* value, the smallest finite value
-//!   `fmin` (0 if there is none), and keeps a bitmask of them
-//!   ([`NonFiniteMask`]). Every path reads the copy, so no NaN can reach
-//!   an interpolation, a gradient or a bound; the mask decides what counts.
-//! - **Gradients** are the ordinary central differences
-//!   ([`crate::kernels::gradient`]) of the cleaned copy: a masked voxel reads as the
-//!   bottom of the value range. This was chosen over one-sided differences
-//!   at masked neighbours (as at the grid's faces) because "empty space" is
-//!   what a masked voxel stands for: an object bordering a masked region
-//!   then has a surface there, whose normal points into the empty space
-//!   and is lit like any boundary between data and air, the usual meaning of
-//!   the lowest value (air in CT, vacuum in densities). One-sided differences
-//!   would instead see only the object's inside, leaving the edge of a flat
-//!   region with no normal (ambient light only). It also keeps one gradient
-//!   code for every path, so the reference and the fast paths agree by
-//!   construction. The largest gradient magnitude (for `--gradient-opacity`
-//!   and `--iso`) is that of these gradients.
-//! - **Pre-classification** (the paper's, reference and bricked fast
-//!   path): a masked voxel's opacity is 0. Its colour is what the cleaned
-//!   copy gives it (the fill value's material, lit by its gradient); as
-//!   colours and opacities are interpolated separately (the paper's
-//!   method), that colour tints the samples in the cells next to it, as any
-//!   transparent voxel's does, and the opacity fades to 0 across those
-//!   cells.
-//! - **Post-classification, the projections (maximum, minimum, average)
-//!   and post-classified iso-surfaces**: a sample is *skipped* (no opacity;
-//!   not counted by the maximum, minimum or mean) exactly when a masked
-//!   voxel has a non-zero trilinear weight in it, that is, when
-//!   interpolating the original data there would not give a finite number.
-//!   A sample on a grid plane takes no weight from the voxels off it, so a
-//!   sample on a finite voxel next to a masked one counts. A ray with no
-//!   counted sample shows the background.
-//!
-//! The skip test is made on the reference's `f64` sample position
-//! ([`crate::sampling::PixelSamples::position`]) on every path, so the fast
-//! paths, which interpolate in `f32`, skip the very samples the reference
-//! skips (an `f32` position a rounding error across a grid plane could
-//! otherwise decide the other way). The fast paths test only in bricks
-//! near a masked voxel ([`NonFiniteMask::near`]); a volume without
-//! non-finite values has no mask and pays nothing. Empty-space skipping
-//! stays conservative: a brick's value range now includes the fill value,
-//! the bottom of the finite range, which can only widen it.
+//! The rules are documented on [`NonFinite`], what a caller chooses.
 
 use crate::bricks::{BRICK, BrickGrid};
 use crate::kernels::trilinear::weights;
@@ -59,6 +9,58 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// What the renderer does with a volume holding NaN or infinite values.
+///
+/// Real files hold them: masked regions written as NaN, divisions by zero,
+/// overflowed densities. By default the renderer refuses such a volume
+/// ([`NonFinite::Refuse`], naming the count). With
+/// [`NonFinite::Transparent`] a non-finite voxel contributes no opacity,
+/// exactly as follows.
+///
+/// - **The value window** (`fmin`, `fmax`) is that of the finite values
+///   ([`Volume::value_range`]), as are the range and histogram a front end reports.
+/// - **Cleaned copy.** The renderer works on a copy of the volume whose
+///   non-finite voxels hold the *fill* value, the smallest finite value
+///   `fmin` (0 if there is none), and keeps a bitmask of them
+///   ([`NonFiniteMask`]). Every path reads the copy, so no NaN can reach
+///   an interpolation, a gradient or a bound; the mask decides what counts.
+/// - **Gradients** are the ordinary central differences
+///   ([`crate::kernels::gradient`]) of the cleaned copy: a masked voxel reads as the
+///   bottom of the value range. This was chosen over one-sided differences
+///   at masked neighbours (as at the grid's faces) because "empty space" is
+///   what a masked voxel stands for: an object bordering a masked region
+///   then has a surface there, whose normal points into the empty space
+///   and is lit like any boundary between data and air, the usual meaning of
+///   the lowest value (air in CT, vacuum in densities). One-sided differences
+///   would instead see only the object's inside, leaving the edge of a flat
+///   region with no normal (ambient light only). It also keeps one gradient
+///   code for every path, so the reference and the fast paths agree by
+///   construction. The largest gradient magnitude (for gradient opacity
+///   and iso-surfaces) is that of these gradients.
+/// - **Pre-classification** (the paper's, reference and bricked fast
+///   path): a masked voxel's opacity is 0. Its colour is what the cleaned
+///   copy gives it (the fill value's material, lit by its gradient); as
+///   colours and opacities are interpolated separately (the paper's
+///   method), that colour tints the samples in the cells next to it, as any
+///   transparent voxel's does, and the opacity fades to 0 across those
+///   cells.
+/// - **Post-classification, the projections (maximum, minimum, average)
+///   and post-classified iso-surfaces**: a sample is *skipped* (no opacity;
+///   not counted by the maximum, minimum or mean) exactly when a masked
+///   voxel has a non-zero trilinear weight in it, that is, when
+///   interpolating the original data there would not give a finite number.
+///   A sample on a grid plane takes no weight from the voxels off it, so a
+///   sample on a finite voxel next to a masked one counts. A ray with no
+///   counted sample shows the background.
+///
+/// The skip test is made on the reference's `f64` sample position
+/// ([`PixelSamples::position`](crate::sampling::PixelSamples::position)) on every path, so the fast
+/// paths, which interpolate in `f32`, skip the very samples the reference
+/// skips (an `f32` position a rounding error across a grid plane could
+/// otherwise decide the other way). The fast paths test only in bricks
+/// near a masked voxel ([`NonFiniteMask::near`]); a volume without
+/// non-finite values has no mask and pays nothing. Empty-space skipping
+/// stays conservative: a brick's value range now includes the fill value,
+/// the bottom of the finite range, which can only widen it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum NonFinite {
     /// Refuse the volume, naming the count.

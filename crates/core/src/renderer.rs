@@ -20,7 +20,7 @@
 //! **Non-finite values.** [`Renderer::new`] refuses a volume with NaN or
 //! infinite values; [`Renderer::with_non_finite`] with
 //! [`NonFinite::Transparent`] renders them as empty space, from a cleaned
-//! copy and a mask (see [`crate::non_finite`] for the exact rules).
+//! copy and a mask (see [`NonFinite`](crate::NonFinite) for the exact rules).
 
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::occupied::ClassifiedBricks;
@@ -115,7 +115,7 @@ impl<'v> Renderer<'v> {
     /// Prepares `volume`, whose non-finite values are refused
     /// ([`RenderError::NonFinite`]) or rendered as empty space, as `mode`
     /// says. Rendered as empty space, they cost a cleaned copy of the
-    /// volume and a bit per voxel (see [`crate::non_finite`]); a volume
+    /// volume and a bit per voxel (see [`NonFinite`](crate::NonFinite)); a volume
     /// without them is used as it is, whatever `mode`.
     pub fn with_non_finite(volume: &'v Volume, mode: NonFinite) -> Result<Self, RenderError> {
         let count = volume.count_non_finite();
@@ -436,7 +436,7 @@ impl<'v> Renderer<'v> {
             let macrocells = self
                 .macrocells
                 .get_or_init(|| Macrocells::new(&self.volume));
-            let bricks = ClassifiedBricks::with_mask(
+            let bricks = ClassifiedBricks::new(
                 &self.volume,
                 macrocells,
                 &classifier,

@@ -202,7 +202,7 @@ impl Volume {
     /// finite value in the volume, the bottom of the scale, so that they
     /// show as the lowest value (yt leaves them `−inf` or NaN and masks
     /// them). NaN stays NaN and `+∞` stays `+∞` (the renderer refuses
-    /// both, or renders them as empty space: [`crate::non_finite`]). A volume with no positive finite value is refused.
+    /// both, or renders them as empty space: [`NonFinite`](crate::NonFinite)). A volume with no positive finite value is refused.
     pub fn to_log10(&self) -> Result<Volume, VolumeError> {
         let smallest = self
             .data

@@ -46,11 +46,6 @@ impl BrickGrid {
         self.bricks.iter().product()
     }
 
-    /// Always false: a volume has at least one cell.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Linear index of brick `b`, x fastest.
     #[inline]
     pub fn index(&self, b: [usize; 3]) -> usize {

@@ -64,7 +64,7 @@
 //! as in [`crate::bricks::occupied`], 22.8 bytes per voxel, measured no faster:
 //! the cost is in the arithmetic, not the cache.)
 //!
-//! **Non-finite voxels** rendered as empty space ([`crate::non_finite`]):
+//! **Non-finite voxels** rendered as empty space ([`NonFinite`](crate::NonFinite)):
 //! the scene's voxels are the cleaned copy's, and in a brick near a masked
 //! voxel each sample is first tested by the reference's rule on the
 //! reference's `f64` position, and passed over if skipped. Other bricks,
@@ -113,7 +113,7 @@ pub struct Scene<'a> {
     /// sample takes its material colour.
     pub lighting: Option<(&'a Phong, LightGeometry)>,
     /// The samples to pass over, where `voxels` are those of a cleaned
-    /// volume ([`crate::non_finite`]); `None`: every sample counts.
+    /// volume ([`NonFinite`](crate::NonFinite)); `None`: every sample counts.
     pub mask: Option<&'a NonFiniteMask>,
 }
 

@@ -20,7 +20,7 @@
 //! The average visits every sample. Each pixel is computed from its own
 //! ray alone, so the image is the same for any thread count.
 //!
-//! Non-finite voxels rendered as empty space ([`crate::non_finite`]): in a
+//! Non-finite voxels rendered as empty space ([`NonFinite`](crate::NonFinite)): in a
 //! brick near one, each sample is tested by the reference's rule, on the
 //! reference's `f64` position, and not counted if skipped; a ray that
 //! counts no sample shows the background. The bricks' ranges, of the

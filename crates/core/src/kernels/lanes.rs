@@ -9,7 +9,6 @@ use wide::f32x4;
 
 /// `f32` arithmetic, on one value or on each SIMD lane.
 pub trait Lanes: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
-    const ZERO: Self;
     const ONE: Self;
 
     /// `x` in every lane.
@@ -31,7 +30,6 @@ pub trait Lanes: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = S
 }
 
 impl Lanes for f32 {
-    const ZERO: f32 = 0.0;
     const ONE: f32 = 1.0;
 
     #[inline(always)]
@@ -61,7 +59,6 @@ impl Lanes for f32 {
 }
 
 impl Lanes for f32x4 {
-    const ZERO: f32x4 = f32x4::ZERO;
     const ONE: f32x4 = f32x4::ONE;
 
     #[inline(always)]

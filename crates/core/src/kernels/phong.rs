@@ -1,4 +1,4 @@
-//! Stage 1 shading: the paper's Phong colour model, per voxel.
+//! Shading: the paper's Phong colour model, per voxel or per sample.
 //!
 //! `C_β = C_s,β·k_a,β + C_s,β·[k_d,β (N·L) + k_s,β (N·H)^n]` with
 //! `H = (V + L)/|V + L|` (Ramesh & Athithan 1993, after Levoy 1988), where
@@ -18,6 +18,14 @@
 //!
 //! **Zero gradient.** Where `|∇f| = 0` the normal is undefined (errata 1):
 //! such voxels get the ambient term only.
+//!
+//! **One copy.** The model is written once, over [`Lanes`]: [`two_sided`]
+//! (the diffuse and highlight terms from the normal's dot products) and
+//! [`reflect`] (`ka + kd·diffuse + ks·highlight`), with the highlight's
+//! [`Exponent`]. [`Phong::shade`] calls them on one gradient (the reference
+//! path, post-classified samples, the surface renderer of Figure 1c); the
+//! fast path's lighting calls them on four quantised normals at a time,
+//! with `C_s` multiplied into the coefficients once per frame.
 
 use crate::kernels::lanes::Lanes;
 use glam::Vec3;

@@ -20,7 +20,7 @@
 //! when the image is finished, as on every path (and projected values go
 //! through the colour map there).
 //!
-//! Non-finite voxels rendered as empty space ([`crate::non_finite`]) have
+//! Non-finite voxels rendered as empty space ([`NonFinite`](crate::NonFinite)) have
 //! zero opacity in stage 1; post-classified and projected samples that a
 //! non-finite voxel weighs in are skipped.
 //!
@@ -58,7 +58,7 @@ pub enum Shader<'a> {
     Projection {
         volume: &'a Volume,
         blend: Blend,
-        /// Samples this skips are not counted ([`crate::non_finite`]).
+        /// Samples this skips are not counted ([`NonFinite`](crate::NonFinite)).
         mask: Option<&'a NonFiniteMask>,
     },
 }

@@ -33,7 +33,7 @@ pub struct PostClassifier<'a> {
     gradients: Vec<[f32; 3]>,
     classifier: &'a Classifier,
     lighting: Option<(&'a Phong, LightGeometry)>,
-    /// Samples this skips are empty ([`crate::non_finite`]).
+    /// Samples this skips are empty ([`NonFinite`](crate::NonFinite)).
     mask: Option<&'a NonFiniteMask>,
 }
 

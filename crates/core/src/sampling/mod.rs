@@ -7,10 +7,12 @@
 //! interval: where it is inside the grid ([`GridFrame::span`]), cut by the
 //! crop box and the clip planes ([`crate::sampling::clipping`]), and, for a
 //! perspective ray, in front of the eye (`t ≥ 0`). `u` is 0, or the pixel's
-//! jitter offset ([`crate::sampling::jitter`]). Without options this is exactly
-//! [`GridFrame::ray`]: the samples lie on planes parallel to the image,
-//! `t = k·step` from it. Samples within a millionth of a step of the
-//! interval's ends count as inside, as there.
+//! jitter offset ([`crate::sampling::jitter`]). Without options the samples
+//! of parallel rays lie on planes parallel to the image, `t = k·step` from
+//! it (sample 0 the nearest to the eye, errata 4): neighbouring rays sample
+//! the same depths, which avoids the wood-grain pattern that per-ray start
+//! offsets cause. Samples within a millionth of a step of the interval's
+//! ends count as inside.
 //!
 //! Both paths take their samples from here (the fast path for its rays'
 //! exact ranges), so they sample the very same points.
@@ -150,28 +152,108 @@ mod tests {
         View::Orthographic(OrthographicView::frame(&camera, bounds, 20, 16).unwrap())
     }
 
+    /// Samples without options of the default view (along −x) through
+    /// pixel (`col`, `row`) of an `size` image of a grid with `dims` and
+    /// `spacing`, `step` apart.
+    fn axis_ray(
+        dims: [usize; 3],
+        spacing: DVec3,
+        size: (usize, usize),
+        (col, row): (usize, usize),
+        step: f64,
+    ) -> (View, Option<PixelSamples>) {
+        let grid = GridFrame {
+            dims,
+            origin: DVec3::new(-3.0, 1.0, 2.0),
+            spacing,
+        };
+        let extent = DVec3::new(
+            (dims[0] - 1) as f64,
+            (dims[1] - 1) as f64,
+            (dims[2] - 1) as f64,
+        ) * spacing;
+        let bounds = (grid.origin, grid.origin + extent);
+        let view = View::frame(&Camera::default(), bounds, size.0, size.1).unwrap();
+        let s = Sampling {
+            grid,
+            step,
+            clipping: Clipping::default(),
+            jitter: false,
+            from_eye: false,
+        };
+        let samples = s.pixel(&view, col, row);
+        (view, samples)
+    }
+
     #[test]
-    fn without_options_the_samples_are_the_grid_rays() {
+    fn an_axis_view_samples_every_voxel_plane() {
+        // 11 points along x at unit spacing: a step of 1 gives 11 samples,
+        // a step of 0.5 gives 21, from the eye (+x side) backwards.
+        for (step, count) in [(1.0, 11), (0.5, 21), (0.25, 41)] {
+            let (_, ray) = axis_ray([11, 6, 6], DVec3::ONE, (8, 8), (3, 4), step);
+            let ray = ray.unwrap();
+            assert_eq!(ray.count(), count, "step {step}");
+            assert!((ray.position(ray.first, [11, 6, 6]).x - 10.0).abs() < 1e-9);
+            assert!(ray.position(ray.last, [11, 6, 6]).x.abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn anisotropic_spacing_maps_world_to_index() {
+        let dims = [5, 9, 3];
+        let spacing = DVec3::new(2.0, 0.5, 4.0);
+        let (view, ray) = axis_ray(dims, spacing, (16, 32), (0, 0), 0.5);
+        let ray = ray.unwrap();
+        // 8 world units along x at 0.5 per sample: 17 samples.
+        assert_eq!(ray.count(), 17);
+        let p = ray.position(ray.first, dims);
+        let world = view.pixel_ray(0, 0).0;
+        assert!(((world.y - 1.0) / 0.5 - p.y).abs() < 1e-9);
+        assert!(((world.z - 2.0) / 4.0 - p.z).abs() < 1e-9);
+    }
+
+    #[test]
+    fn without_options_the_samples_lie_on_planes_k_steps_from_the_image() {
+        // Every ray's samples are t = k·step for the k whose t lies in its
+        // span through the grid (within a millionth of a step), and rays
+        // that miss the grid, or graze it between samples, have none.
         let (view, s) = (oblique(), sampling(false, Clipping::default(), false));
-        let ortho = view.as_orthographic().unwrap();
+        let step = s.step;
         let mut hits = 0;
         for row in 0..16 {
             for col in 0..20 {
-                let ours = s.pixel(&view, col, row);
-                let grid_ray = grid().ray(ortho, col, row, 0.4);
-                assert_eq!(
-                    ours.map(|r| (r.first, r.last)),
-                    grid_ray.map(|r| (r.first, r.last))
-                );
-                if let (Some(a), Some(b)) = (ours, grid_ray) {
-                    hits += 1;
-                    for k in a.first..=a.last {
-                        assert_eq!(a.position(k, grid().dims), b.position(k, grid().dims));
+                let (o, d) = view.pixel_ray(col, row);
+                let span = grid().span(o, d);
+                let Some(ray) = s.pixel(&view, col, row) else {
+                    if let Some((enter, exit)) = span {
+                        assert!((enter / step).ceil() > (exit / step).floor() + 0.5);
                     }
+                    continue;
+                };
+                hits += 1;
+                let (enter, exit) = span.unwrap();
+                assert_eq!(
+                    (ray.first, ray.last),
+                    ((enter / step).ceil() as i64, (exit / step).floor() as i64)
+                );
+                assert_eq!(ray.offset, 0.0);
+                for k in [ray.first, ray.last] {
+                    let world = o + ray.t(k) * d;
+                    let index = (world - grid().origin) / grid().spacing;
+                    assert!((ray.position(k, grid().dims) - index).abs().max_element() < 1e-9);
                 }
             }
         }
-        assert!(hits > 100);
+        assert!(hits > 100, "{hits}");
+        // A view beside the grid misses it.
+        let View::Orthographic(o) = view else {
+            unreachable!()
+        };
+        let beside = View::Orthographic(OrthographicView {
+            centre: o.centre + DVec3::new(0.0, 100.0, 0.0),
+            ..o
+        });
+        assert!((0..16).all(|row| (0..20).all(|col| s.pixel(&beside, col, row).is_none())));
     }
 
     #[test]

@@ -1,4 +1,14 @@
-//! Transfer functions: values to colour and opacity.
+//! Transfer functions: a voxel's or a sample's value (and gradient) to its
+//! material colour and opacity.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`classifier`] | the [`Classifier`](classifier::Classifier) every path uses: the paper's opacity ramp or a table, the colour, the step correction, the exact zero-opacity test of empty-space skipping |
+//! | [`function`] | piecewise-linear functions and the transfer-function JSON |
+//! | [`colormap`] | named colour maps (viridis, magma, ..., cool-to-warm) |
+//! | [`presets`] | transfer functions for CT, MR and electron densities |
+//! | [`iso`] | Levoy's isovalue contours (1988, eq. 3) |
+//! | [`gradient_opacity`] | opacity scaled by a ramp of the gradient magnitude |
 
 pub mod classifier;
 pub mod colormap;
