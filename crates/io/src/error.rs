@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 use volray_core::VolumeError;
 
-use crate::dtype::DType;
+use crate::shared::dtype::DType;
 
 /// Why a volume could not be read or an image could not be written.
 #[derive(Debug, Error)]

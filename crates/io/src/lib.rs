@@ -18,36 +18,42 @@
 //! into operating-system failures and bad input. Readers check every
 //! header against the file's length before allocating.
 //!
-//! The format comes from `--format`, else the file name
+//! The format comes from [`ReadOptions::format`], else the file name
 //! ([`VolumeFormat::from_path`]), else its magic number
-//! ([`VolumeFormat::sniff`]). One module per format:
+//! ([`VolumeFormat::sniff`]). One module per format, under `formats/`:
 //!
 //! | format | module | notes |
 //! |---|---|---|
-//! | raw | `raw.rs` | layout from [`RawOptions`] |
-//! | NumPy `.npy` | `npy.rs` | `a[x, y, z]`; C order transposed |
-//! | NRRD `.nrrd`, `.nhdr` | `nrrd/` | raw, gzip, ascii, hex; detached and multi-file data; space directions; 4-D frames |
-//! | MetaImage `.mha`, `.mhd` | `metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
-//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `nifti.rs` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
-//! | legacy VTK `.vtk` | `vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
-//! | VTK XML `.vti` | `vti/` | ascii, base64, appended, zlib; Direction; pieces |
-//! | DICOM directory or `.dcm` | `dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose |
-//! | TIFF stacks `.tif` | `tiff_stack.rs` | pages are z; ImageJ spacing; hyperstack frames |
-//! | HDF5 `file.h5:/dataset` | `hdf5.rs` | cargo feature `hdf5`; `a[x, y, z]`, `a[t, x, y, z]` |
-//! | Gaussian cube `.cube` | `cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled |
-//! | CCP4/MRC `.map`, `.mrc` | `mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin |
-//! | VASP CHGCAR/CHG | `chgcar.rs` | divided by the cell volume; periodic plane added; spin blocks as frames |
+//! | raw | `formats/raw.rs` | layout from [`RawOptions`] |
+//! | NumPy `.npy` | `formats/npy.rs` | `a[x, y, z]`; C order transposed |
+//! | NRRD `.nrrd`, `.nhdr` | `formats/nrrd/` | raw, gzip, ascii, hex; detached and multi-file data; space directions; 4-D frames |
+//! | MetaImage `.mha`, `.mhd` | `formats/metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
+//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti.rs` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
+//! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
+//! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib; Direction; pieces |
+//! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose |
+//! | TIFF stacks `.tif` | `formats/tiff.rs` | pages are z; ImageJ spacing; hyperstack frames |
+//! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | cargo feature `hdf5`; `a[x, y, z]`, `a[t, x, y, z]` |
+//! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled |
+//! | CCP4/MRC `.map`, `.mrc` | `formats/mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin |
+//! | VASP CHGCAR/CHG | `formats/chgcar/` | divided by the cell volume; periodic plane added; spin blocks as frames |
 //!
-//! Shared pieces: [`grid_to_volume`] (`geometry.rs`) maps a file's grid
-//! (origin and one step vector per index axis) onto the axis-aligned
-//! volume, reordering and flipping axes exactly; `text_header.rs` reads
-//! the lines and field values of NRRD and MetaImage headers, and
-//! `payload.rs` their data (skips, encodings, multi-file lists) within the
-//! file's bounds; [`inflate_exact`] inflates to a declared size;
-//! [`check_volume_size`] (`limits.rs`) checks a header's dimensions for
-//! overflow and against [`ReadOptions::max_memory`] (`--max-memory`);
-//! `text_reader.rs` streams numbers out of text formats and text data;
-//! `periodic_cell.rs` resamples skewed periodic cells.
+//! What the readers share is under `shared/` (its module docs list each
+//! piece and who uses it): [`grid_to_volume`] (`shared/geometry.rs`) maps
+//! a file's grid (origin and one step vector per index axis) onto the
+//! axis-aligned volume, reordering and flipping axes exactly;
+//! `shared/text_header.rs` reads the lines and field values of NRRD and
+//! MetaImage headers, and `shared/payload.rs` their data (skips,
+//! encodings, multi-file lists) within the file's bounds;
+//! [`inflate_exact`] (`shared/compress.rs`) inflates to a declared size;
+//! [`check_volume_size`] (`shared/limits.rs`) checks a header's dimensions
+//! for overflow and against [`ReadOptions::max_memory`];
+//! `shared/text_reader.rs` streams numbers out of text formats and text
+//! data; `shared/periodic_cell.rs` resamples skewed periodic cells;
+//! `shared/vtk_arrays.rs` chooses the array of a VTK file.
+//!
+//! Images are written by `images/` (`png.rs`, `exr.rs`, `animation.rs`),
+//! every file through `atomic.rs`.
 //!
 //! # Example
 //!
@@ -79,35 +85,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod animation;
 mod atomic;
-mod chgcar;
-mod compress;
-mod cube;
-mod dicom;
-mod dtype;
 mod error;
-mod exr;
-mod geometry;
-#[cfg(feature = "hdf5")]
-mod hdf5;
-mod input;
-mod limits;
-mod metaimage;
-mod mrc;
-mod nifti;
-mod npy;
-mod nrrd;
-mod payload;
-mod periodic_cell;
-mod png;
-mod raw;
-mod text_header;
-mod text_reader;
-mod tiff_stack;
-mod vti;
-mod vtk_arrays;
-mod vtk_legacy;
+mod formats;
+mod images;
+mod shared;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -115,21 +97,21 @@ use std::str::FromStr;
 
 use volray_core::Volume;
 
-pub use self::png::{BitDepth, quantize_8, quantize_16, write_png};
-pub use animation::{Animation, AnimationKind, sequence_path};
 pub use atomic::{AtomicFile, remove_unfinished_files, write_atomically};
-pub use compress::{Compression, inflate_exact};
-pub use dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
 pub use error::IoError;
-pub use exr::write_exr;
-pub use geometry::grid_to_volume;
-pub use limits::{
+pub use formats::npy::{read_npy, write_npy};
+pub use formats::nrrd::write_nrrd;
+pub use formats::raw::{RawOptions, read_raw, write_raw};
+pub use images::animation::{Animation, AnimationKind, sequence_path};
+pub use images::exr::write_exr;
+pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
+pub use shared::compress::{Compression, inflate_exact};
+pub use shared::dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
+pub use shared::geometry::grid_to_volume;
+pub use shared::limits::{
     FALLBACK_MAX_MEMORY, check_memory, check_volume_size, count_values, default_max_memory,
     format_bytes, parse_size,
 };
-pub use npy::{read_npy, write_npy};
-pub use nrrd::write_nrrd;
-pub use raw::{RawOptions, read_raw, write_raw};
 
 /// The volume file formats volray reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -454,7 +436,7 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     match format {
         VolumeFormat::Raw => match &opts.raw {
             Some(raw) => {
-                let volume = raw::read_raw_limited(path, raw, opts.max_memory)?;
+                let volume = formats::raw::read_raw_limited(path, raw, opts.max_memory)?;
                 let info = FileInfo::new(format!("{} ({}-endian)", raw.dtype, raw.endian));
                 Ok(Loaded {
                     volume,
@@ -467,24 +449,24 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             }),
         },
         VolumeFormat::Npy => {
-            let (volume, info) = npy::read_npy_with_info(path, opts.max_memory)?;
+            let (volume, info) = formats::npy::read_npy_with_info(path, opts.max_memory)?;
             Ok(Loaded {
                 volume,
                 format,
                 info,
             })
         }
-        VolumeFormat::Nrrd => nrrd::read(path, opts),
-        VolumeFormat::MetaImage => metaimage::read(path, opts),
-        VolumeFormat::Nifti => nifti::read(path, opts),
-        VolumeFormat::VtkLegacy => vtk_legacy::read(path, opts),
-        VolumeFormat::Vti => vti::read(path, opts),
-        VolumeFormat::Dicom => dicom::read(path, opts),
-        VolumeFormat::Tiff => tiff_stack::read(path, opts),
+        VolumeFormat::Nrrd => formats::nrrd::read(path, opts),
+        VolumeFormat::MetaImage => formats::metaimage::read(path, opts),
+        VolumeFormat::Nifti => formats::nifti::read(path, opts),
+        VolumeFormat::VtkLegacy => formats::vtk_legacy::read(path, opts),
+        VolumeFormat::Vti => formats::vti::read(path, opts),
+        VolumeFormat::Dicom => formats::dicom::read(path, opts),
+        VolumeFormat::Tiff => formats::tiff::read(path, opts),
         VolumeFormat::Hdf5 => read_hdf5(path, opts),
-        VolumeFormat::Cube => cube::read(path, opts),
-        VolumeFormat::Mrc => mrc::read(path, opts),
-        VolumeFormat::Chgcar => chgcar::read(path, opts),
+        VolumeFormat::Cube => formats::cube::read(path, opts),
+        VolumeFormat::Mrc => formats::mrc::read(path, opts),
+        VolumeFormat::Chgcar => formats::chgcar::read(path, opts),
     }
 }
 
@@ -504,7 +486,7 @@ pub fn split_hdf5_path(path: &Path) -> Option<(PathBuf, String)> {
 
 #[cfg(feature = "hdf5")]
 fn read_hdf5(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    hdf5::read(path, opts)
+    formats::hdf5::read(path, opts)
 }
 
 #[cfg(not(feature = "hdf5"))]
@@ -533,7 +515,7 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
         return Ok(VolumeFormat::Raw);
     }
     let mut head = Vec::with_capacity(1024);
-    let (file, _) = input::open_input(path)?;
+    let (file, _) = shared::input::open_input(path)?;
     use std::io::Read;
     file.take(1024)
         .read_to_end(&mut head)
