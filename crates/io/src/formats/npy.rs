@@ -21,12 +21,12 @@ use std::path::Path;
 
 use volray_core::{Volume, VolumeError};
 
-use crate::FileInfo;
 use crate::atomic::write_atomically;
 use crate::error::IoError;
 use crate::shared::dtype::{DType, Endian, extend_f32, f16_to_f32};
 use crate::shared::input::{open_input, read_exact_at, read_samples};
 use crate::shared::limits::{F32_BYTES, check_dims};
+use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 const MAGIC: &[u8; 6] = b"\x93NUMPY";
 
@@ -51,12 +51,20 @@ pub fn read_npy(path: &Path) -> Result<Volume, IoError> {
     read_npy_with_info(path, crate::default_max_memory()).map(|(v, _)| v)
 }
 
+/// Reads the `.npy` file at `path` (see [`read_npy`]) within
+/// `opts.max_memory`.
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let (volume, info) = read_npy_with_info(path, opts.max_memory)?;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Npy,
+        info,
+    })
+}
+
 /// [`read_npy`], with the header's fields for `volray info`, refusing a
 /// shape whose `f32` volume would take more than `max_memory` bytes.
-pub(crate) fn read_npy_with_info(
-    path: &Path,
-    max_memory: u64,
-) -> Result<(Volume, FileInfo), IoError> {
+fn read_npy_with_info(path: &Path, max_memory: u64) -> Result<(Volume, FileInfo), IoError> {
     let (mut file, file_len) = open_input(path)?;
     let header = read_header(path, &mut file, file_len)?;
     let [nx, ny, nz] = header.shape;

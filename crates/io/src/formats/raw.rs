@@ -14,6 +14,7 @@ use crate::error::IoError;
 use crate::shared::dtype::{DType, Endian, extend_f32};
 use crate::shared::input::{open_input, read_samples};
 use crate::shared::limits::{F32_BYTES, check_dims, default_max_memory};
+use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// The layout of a raw file.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,13 +60,26 @@ pub fn read_raw(path: &Path, opts: &RawOptions) -> Result<Volume, IoError> {
     read_raw_limited(path, opts, default_max_memory())
 }
 
+/// Reads the raw file at `path` with the layout `opts.raw` gives; a file
+/// without one is of unknown format (see [`crate::read`]).
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let Some(raw) = &opts.raw else {
+        return Err(IoError::UnknownFormat {
+            path: path.to_path_buf(),
+        });
+    };
+    let volume = read_raw_limited(path, raw, opts.max_memory)?;
+    let info = FileInfo::new(format!("{} ({}-endian)", raw.dtype, raw.endian));
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Raw,
+        info,
+    })
+}
+
 /// [`read_raw`], refusing a layout whose `f32` volume would take more than
 /// `max_memory` bytes (`--max-memory`).
-pub(crate) fn read_raw_limited(
-    path: &Path,
-    opts: &RawOptions,
-    max_memory: u64,
-) -> Result<Volume, IoError> {
+fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<Volume, IoError> {
     let [nx, ny, nz] = opts.dims;
     if nx < 2 || ny < 2 || nz < 2 {
         return Err(IoError::volume(path, VolumeError::TooThin(nx, ny, nz)));

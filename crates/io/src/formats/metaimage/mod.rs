@@ -32,6 +32,17 @@ use crate::shared::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
 use crate::shared::text_header::Field;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
+/// Whether the first bytes of a file, as text, look like a MetaImage
+/// header: `ObjectType` or `NDims` among the first 4 lines' keys, in a
+/// file that is not XML (see [`super::vti::sniff_text`]).
+pub(crate) fn sniff_text(text: &str) -> bool {
+    !super::vti::starts_as_xml(text)
+        && text.lines().take(4).any(|l| {
+            let key = l.split('=').next().unwrap_or("").trim();
+            matches!(key, "ObjectType" | "NDims")
+        })
+}
+
 /// The fields MetaIO reads for an image; any other is noted as ignored.
 const KNOWN: [&str; 36] = [
     "Comment",

@@ -40,6 +40,18 @@ use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 use blocks::{base64_block, raw_block};
 use structure::{DataArray, Format, Structure, join, parse, type_name};
 
+/// Whether the first bytes of a file, as text, start an XML file.
+pub(crate) fn starts_as_xml(text: &str) -> bool {
+    let text = text.trim_start();
+    text.starts_with("<?xml") || text.starts_with("<VTKFile")
+}
+
+/// Whether the first bytes of a file, as text, look like VTK XML image
+/// data: XML that mentions `ImageData`.
+pub(crate) fn sniff_text(text: &str) -> bool {
+    starts_as_xml(text) && text.contains("ImageData")
+}
+
 /// Reads the VTK XML image data file at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (mut file, len) = open_input(path)?;
