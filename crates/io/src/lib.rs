@@ -28,7 +28,7 @@
 //! | NumPy `.npy` | `formats/npy.rs` | `a[x, y, z]`; C order transposed |
 //! | NRRD `.nrrd`, `.nhdr` | `formats/nrrd/` | raw, gzip, ascii, hex; detached and multi-file data; space directions; 4-D frames |
 //! | MetaImage `.mha`, `.mhd` | `formats/metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
-//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti.rs` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
+//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
 //! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib; Direction; pieces |
 //! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose |
