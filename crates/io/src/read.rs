@@ -118,22 +118,16 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         });
     }
     if opts.frame.is_some() && !spec.frames {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "--frame does not apply to {} files: they hold one volume",
-                spec.description
-            ),
-        ));
+        return Err(IoError::FrameNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
     }
     if opts.array.is_some() && !spec.arrays {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "--array applies to VTK files only, not to {} files",
-                spec.description
-            ),
-        ));
+        return Err(IoError::ArrayNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
     }
     (spec.read)(path, opts)
 }
@@ -196,10 +190,12 @@ mod tests {
         let err = read_volume(&upper, Some(&opts)).unwrap_err();
         assert!(!err.is_io_failure());
         assert!(
-            err.to_string().ends_with(
-                "raw options (--dims, --dtype, --endian) do not apply to NumPy .npy files"
-            ),
+            err.to_string()
+                .ends_with("raw layout options do not apply to NumPy .npy files"),
             "{err}"
+        );
+        assert!(
+            matches!(err, IoError::RawOptionsNotApplicable { format, .. } if format == "NumPy .npy")
         );
 
         // A .npy file under another name is known by its magic, unless a

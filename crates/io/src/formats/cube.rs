@@ -246,11 +246,15 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
     let frame = opts.frame.unwrap_or(0);
     if frame >= per_point {
-        return Err(invalid(format!(
-            "--frame {frame}, but the file holds {per_point} {} per point (frames 0 to {})",
-            if natoms < 0 { "orbital(s)" } else { "value(s)" },
-            per_point - 1
-        )));
+        return Err(IoError::frame_out_of_range(
+            path,
+            frame,
+            format!(
+                "the file holds {per_point} {} per point (frames 0 to {})",
+                if natoms < 0 { "orbital(s)" } else { "value(s)" },
+                per_point - 1
+            ),
+        ));
     }
     info.frames = per_point;
     info.frame = frame;
@@ -294,7 +298,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             unit,
             opts.max_memory,
         )
-        .map_err(|e| invalid(format!("axis steps: {e}")))?;
+        .map_err(|e| e.at(path, "axis steps"))?;
         info.notes.push(note);
         volume
     } else {
@@ -401,13 +405,14 @@ mod tests {
         let bad = format!("{HEAD}0 1 2 3 4 5 6 seven\n");
         let err = read_text(&bad, None).unwrap_err().to_string();
         assert!(err.contains("line 8: grid value: \"seven\""), "{err}");
-        let err = read_text(&format!("{HEAD}0 1 2 3 4 5 6 7\n"), Some(1))
-            .unwrap_err()
-            .to_string();
+        let err = read_text(&format!("{HEAD}0 1 2 3 4 5 6 7\n"), Some(1)).unwrap_err();
         assert!(
-            err.contains("--frame 1, but the file holds 1 value(s) per point (frames 0 to 0)"),
+            err.to_string().contains(
+                "frame 1 is out of range: the file holds 1 value(s) per point (frames 0 to 0)"
+            ),
             "{err}"
         );
+        assert!(matches!(err, IoError::FrameOutOfRange { frame: 1, .. }));
     }
 
     #[test]

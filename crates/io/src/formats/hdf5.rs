@@ -115,9 +115,13 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
     let frame = opts.frame.unwrap_or(0);
     if frame >= frames {
-        return Err(what(format!(
-            "--frame {frame} is out of range: the dataset holds {frames} volume(s) along its first axis, numbered from 0"
-        )));
+        return Err(IoError::frame_out_of_range(
+            &file_path,
+            frame,
+            format!(
+                "HDF5 dataset \"{name}\" holds {frames} volume(s) along its first axis, numbered from 0"
+            ),
+        ));
     }
     if dims.iter().any(|&n| n < 2) {
         return Err(what(format!(

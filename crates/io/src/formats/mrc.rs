@@ -472,7 +472,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             "angstrom",
             opts.max_memory,
         )
-        .map_err(|e| invalid(format!("CELLB: {e}")))?;
+        .map_err(|e| e.at(path, "CELLB"))?;
         notes.push(note);
         volume
     } else {

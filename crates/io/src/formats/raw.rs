@@ -109,7 +109,7 @@ fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<V
             expected,
         });
     }
-    check_dims(path, "--dims", &opts.dims, F32_BYTES, max_memory)?;
+    check_dims(path, "raw layout dims", &opts.dims, F32_BYTES, max_memory)?;
 
     let mut data = Vec::with_capacity(count);
     let (dtype, endian) = (opts.dtype, opts.endian);
@@ -204,7 +204,17 @@ mod tests {
         assert!(msg.contains("data.raw"), "{msg}");
         assert!(msg.contains("1000 bytes"), "{msg}");
         assert!(msg.contains("4000 bytes"), "{msg}");
-        assert!(msg.contains("--dims 10,10,10 with --dtype f32"), "{msg}");
+        assert!(msg.contains("raw layout 10x10x10 f32 needs"), "{msg}");
+        assert!(matches!(
+            err,
+            IoError::RawSizeMismatch {
+                dims: [10, 10, 10],
+                dtype: DType::F32,
+                actual: 1000,
+                expected: 4000,
+                ..
+            }
+        ));
 
         // A longer file is refused as well.
         let p = write(dir.path(), "long.raw", &[0u8; 9]);
@@ -234,7 +244,7 @@ mod tests {
             assert!(matches!(err, IoError::DimsOverflow { .. }), "{err}");
             let msg = err.to_string();
             assert!(
-                msg.contains(&format!("{},{},{}", dims[0], dims[1], dims[2])),
+                msg.contains(&format!("{}x{}x{}", dims[0], dims[1], dims[2])),
                 "{msg}"
             );
         }

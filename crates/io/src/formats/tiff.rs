@@ -191,10 +191,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.frames = shape.channels * shape.times;
     let frame = opts.frame.unwrap_or(0);
     if frame >= info.frames {
-        return Err(IoError::invalid(
+        return Err(IoError::frame_out_of_range(
             path,
+            frame,
             format!(
-                "--frame {frame} is out of range: the stack holds {} volume(s) ({} channel(s) x {} time point(s)), numbered from 0",
+                "the stack holds {} volume(s) ({} channel(s) x {} time point(s)), numbered from 0",
                 info.frames, shape.channels, shape.times
             ),
         ));

@@ -217,13 +217,10 @@ pub(crate) fn check_held(
     if bytes <= u128::from(max_memory) {
         return Ok(());
     }
-    Err(IoError::invalid(
+    Err(IoError::over_memory_limit(
         path,
-        format!(
-            "{what} ({} values, {held}) exceed --max-memory {}",
-            format_count(values),
-            format_bytes(u128::from(max_memory))
-        ),
+        format!("{what} ({} values, {held}) exceed", format_count(values)),
+        max_memory,
     ))
 }
 
@@ -234,13 +231,13 @@ pub fn check_file_held(path: &Path, len: u64, max_memory: u64) -> Result<(), IoE
     if len <= max_memory {
         return Ok(());
     }
-    Err(IoError::invalid(
+    Err(IoError::over_memory_limit(
         path,
         format!(
-            "the file is {} and is read whole: more than --max-memory {}",
-            format_bytes(u128::from(len)),
-            format_bytes(u128::from(max_memory))
+            "the file is {} and is read whole: more than",
+            format_bytes(u128::from(len))
         ),
+        max_memory,
     ))
 }
 
@@ -258,8 +255,9 @@ pub fn check_file_held(path: &Path, len: u64, max_memory: u64) -> Result<(), IoE
 /// ).unwrap_err();
 /// assert_eq!(
 ///     err.to_string(),
-///     "a.nrrd: sizes 4000 4000 4000 (6.4e10 values, 238 GiB as f32) exceed --max-memory 12 GiB"
+///     "a.nrrd: sizes 4000 4000 4000 (6.4e10 values, 238 GiB as f32) exceed the memory limit of 12 GiB"
 /// );
+/// assert!(matches!(err, volray_io::IoError::OverMemoryLimit { limit, .. } if limit == 12 << 30));
 /// ```
 pub fn check_volume_size(
     path: &Path,
@@ -402,8 +400,9 @@ mod tests {
         let err = check_volume_size(p, "sizes", &[10, 10, 10], 4, 3999).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "v.nrrd: sizes 10 10 10 (1000 values, 3.9 KiB as f32) exceed --max-memory 3.9 KiB"
+            "v.nrrd: sizes 10 10 10 (1000 values, 3.9 KiB as f32) exceed the memory limit of 3.9 KiB"
         );
+        assert!(matches!(err, IoError::OverMemoryLimit { limit: 3999, .. }));
         assert!(!err.is_io_failure());
         let err = check_volume_size(p, "dim", &[10, 10, 10], 6, 5999).unwrap_err();
         assert!(err.to_string().contains("at 6 bytes a value"), "{err}");

@@ -321,8 +321,9 @@ impl FrameSelect {
     }
 }
 
-/// The volume `--frame` asks for (`requested`, default 0) of a file that
-/// holds `frames`; refused if there is no such volume.
+/// The volume [`ReadOptions::frame`](crate::ReadOptions::frame) asks for
+/// (`requested`, default 0) of a file that holds `frames`; refused if there
+/// is no such volume.
 pub(crate) fn chosen_frame(
     path: &Path,
     requested: Option<usize>,
@@ -330,10 +331,11 @@ pub(crate) fn chosen_frame(
 ) -> Result<usize, IoError> {
     let frame = requested.unwrap_or(0);
     if frame >= frames {
-        return Err(IoError::invalid(
+        return Err(IoError::frame_out_of_range(
             path,
+            frame,
             format!(
-                "--frame {frame} but the file holds {frames} volume{} (frames 0 to {})",
+                "the file holds {frames} volume{} (frames 0 to {})",
                 if frames == 1 { "" } else { "s" },
                 frames.saturating_sub(1)
             ),

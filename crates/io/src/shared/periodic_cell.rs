@@ -13,9 +13,12 @@
 //!
 //! [`grid_to_volume`]: crate::grid_to_volume
 
+use std::path::Path;
+
 use volray_core::Volume;
 use volray_core::glam::{DMat3, DVec3};
 
+use crate::error::IoError;
 use crate::shared::limits::format_bytes;
 
 /// Cosine tolerance for "orthogonal", the same as `grid_to_volume`'s:
@@ -26,6 +29,30 @@ const COS_TOLERANCE: f64 = 1e-4;
 /// (the bounding box of a very skewed cell is much larger than the cell;
 /// beyond this the spacing grows instead).
 const MAX_GROWTH: f64 = 8.0;
+
+/// Why a grid cannot be resampled.
+#[derive(Debug)]
+pub(crate) enum ResampleError {
+    /// The cell's geometry does not allow it; the reason says why.
+    Cell(String),
+    /// The resampled grid beside the file's points would take more than
+    /// `limit` bytes; `need` says how much, up to the limit (as
+    /// [`IoError::OverMemoryLimit`] has it).
+    Memory { need: String, limit: u64 },
+}
+
+impl ResampleError {
+    /// The error about the file `path`, led by the header `field` that
+    /// gave the cell.
+    pub(crate) fn at(self, path: &Path, field: &str) -> IoError {
+        match self {
+            ResampleError::Cell(reason) => IoError::invalid(path, format!("{field}: {reason}")),
+            ResampleError::Memory { need, limit } => {
+                IoError::over_memory_limit(path, format!("{field}: {need}"), limit)
+            }
+        }
+    }
+}
 
 /// True if two of the step vectors are not orthogonal.
 pub(crate) fn is_skewed(steps: [DVec3; 3]) -> bool {
@@ -59,7 +86,7 @@ pub(crate) fn angles(steps: [DVec3; 3]) -> [f64; 3] {
 /// done, naming the index axes `names` (as the file does) and lengths in
 /// `unit`. The steps must be linearly independent and `data` must hold
 /// `dims[0]·dims[1]·dims[2]` values. The resampled grid and `data`
-/// together must fit `max_memory` bytes (`--max-memory`).
+/// together must fit `max_memory` bytes.
 pub(crate) fn resample(
     dims: [usize; 3],
     data: &[f32],
@@ -68,7 +95,7 @@ pub(crate) fn resample(
     names: [&str; 3],
     unit: &str,
     max_memory: u64,
-) -> Result<(Volume, String), String> {
+) -> Result<(Volume, String), ResampleError> {
     let cell = DMat3::from_cols(
         steps[0] * dims[0] as f64,
         steps[1] * dims[1] as f64,
@@ -77,7 +104,9 @@ pub(crate) fn resample(
     let volume = cell.determinant().abs();
     let to_grid = DMat3::from_cols(steps[0], steps[1], steps[2]);
     if !(volume.is_finite() && volume > 0.0) || to_grid.determinant() == 0.0 {
-        return Err("the cell vectors are linearly dependent (the cell has no volume)".into());
+        return Err(ResampleError::Cell(
+            "the cell vectors are linearly dependent (the cell has no volume)".into(),
+        ));
     }
     let to_grid = to_grid.inverse();
 
@@ -103,10 +132,10 @@ pub(crate) fn resample(
         h *= (box_points / (MAX_GROWTH * points)).cbrt();
     }
     if !(extent.is_finite() && h.is_finite() && h > 0.0) {
-        return Err(format!(
+        return Err(ResampleError::Cell(format!(
             "the cell's bounding box ({}, {}, {}) cannot be sampled",
             extent.x, extent.y, extent.z
-        ));
+        )));
     }
     let mut out_dims = [0usize; 3];
     let mut spacing = DVec3::ZERO;
@@ -124,17 +153,19 @@ pub(crate) fn resample(
     // multiply the count by at most 2.5^3 < 16: a safety net only.
     let total = nx as f64 * ny as f64 * nz as f64;
     if total > 16.0 * MAX_GROWTH * points + 4096.0 {
-        return Err(format!(
+        return Err(ResampleError::Cell(format!(
             "the cell's bounding box would need {nx}x{ny}x{nz} samples, far more than the file's {points} points"
-        ));
+        )));
     }
     let held = (total + data.len() as f64) * 4.0;
     if held > max_memory as f64 {
-        return Err(format!(
-            "resampling onto {nx}x{ny}x{nz} points beside the file's {points} takes {} as f32, more than --max-memory {}",
-            format_bytes(held as u128),
-            format_bytes(u128::from(max_memory))
-        ));
+        return Err(ResampleError::Memory {
+            need: format!(
+                "resampling onto {nx}x{ny}x{nz} points beside the file's {points} takes {} as f32, more than",
+                format_bytes(held as u128)
+            ),
+            limit: max_memory,
+        });
     }
     let mut out = Vec::with_capacity(nx * ny * nz);
     let sample = |p: DVec3| -> f32 {
@@ -194,7 +225,7 @@ pub(crate) fn resample(
     let volume = Volume::new(out_dims, out)
         .and_then(|v| v.with_spacing(spacing))
         .and_then(|v| v.with_origin(lo))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| ResampleError::Cell(e.to_string()))?;
     Ok((volume, note))
 }
 

@@ -88,7 +88,7 @@ pub(crate) fn no_match(path: &Path, entries: &[ArrayEntry], request: Option<&str
         format!("the file holds {}", describe(entries))
     };
     match request {
-        Some(req) => IoError::invalid(path, format!("no array named \"{req}\" (--array): {held}")),
+        Some(req) => IoError::no_such_array(path, req, held),
         None => IoError::invalid(
             path,
             format!("no one-component point or cell array to render: {held}"),
@@ -98,28 +98,26 @@ pub(crate) fn no_match(path: &Path, entries: &[ArrayEntry], request: Option<&str
 
 /// The error for a chosen array that is not a scalar.
 pub(crate) fn not_scalar(path: &Path, entry: &ArrayEntry, entries: &[ArrayEntry]) -> IoError {
-    let scalars: Vec<&ArrayEntry> = entries.iter().filter(|e| e.components == 1).collect();
-    let hint = if scalars.is_empty() {
-        "the file holds no one-component arrays".to_string()
-    } else {
-        format!(
-            "pick a one-component array with --array ({})",
-            scalars
-                .iter()
-                .map(|e| e.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    };
-    IoError::invalid(
-        path,
-        format!(
-            "{} array \"{}\" has {} components: volray renders scalar arrays; {hint}",
-            entry.association.name(),
-            entry.name,
-            entry.components
-        ),
-    )
+    let array = format!(
+        "{} array \"{}\" has {} components",
+        entry.association.name(),
+        entry.name,
+        entry.components
+    );
+    let scalars: Vec<&str> = entries
+        .iter()
+        .filter(|e| e.components == 1)
+        .map(|e| e.name.as_str())
+        .collect();
+    if scalars.is_empty() {
+        return IoError::invalid(
+            path,
+            format!(
+                "{array}: volray renders scalar arrays; the file holds no one-component arrays"
+            ),
+        );
+    }
+    IoError::array_not_scalar(path, array, scalars.join(", "))
 }
 
 /// "point arrays a (float), b (3 components, float); cell arrays c (double)".

@@ -165,10 +165,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
 
     let Some(chosen) = chosen else {
-        return Err(IoError::invalid(
+        return Err(IoError::frame_out_of_range(
             path,
+            wanted,
             format!(
-                "--frame {wanted}, but the file holds {frames} density block(s) (frames 0 to {})",
+                "the file holds {frames} density block(s) (frames 0 to {})",
                 frames - 1
             ),
         ));
@@ -229,7 +230,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             "angstrom",
             opts.max_memory,
         )
-        .map_err(|e| IoError::invalid(path, format!("lattice: {e}")))?;
+        .map_err(|e| e.at(path, "lattice"))?;
         info.notes.push(note);
         volume
     } else {

@@ -251,13 +251,10 @@ fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             .enumerate()
             .map(|(i, files)| describe_series(i, files))
             .collect();
-        return Err(IoError::invalid(
+        return Err(IoError::frame_needed(
             dir,
-            format!(
-                "directory holds {} DICOM series; pick one with --frame N: {}",
-                series.len(),
-                listed.join("; ")
-            ),
+            format!("directory holds {} DICOM series", series.len()),
+            listed.join("; "),
         ));
     }
     let count = series.len();
@@ -530,13 +527,15 @@ fn parse_whole(path: &Path, bytes: &[u8]) -> Result<dicom_object::DefaultDicomOb
     header::parse(bytes, false).map_err(|r| IoError::invalid(path, format!("DICOM: {r}")))
 }
 
-/// Checks `--frame` against `count` choices of `what`.
+/// Checks the frame asked for ([`ReadOptions::frame`]) against `count`
+/// choices of `what`.
 fn pick(path: &Path, frame: Option<usize>, count: usize, what: &str) -> Result<usize, IoError> {
     let n = frame.unwrap_or(0);
     if n >= count {
-        return Err(IoError::invalid(
+        return Err(IoError::frame_out_of_range(
             path,
-            format!("--frame {n} is out of range: there are {count} {what}, numbered from 0"),
+            n,
+            format!("there are {count} {what}, numbered from 0"),
         ));
     }
     Ok(n)

@@ -121,10 +121,11 @@ impl Layout {
         };
         let frame_index = frame.unwrap_or(0);
         if frame_index >= frames {
-            return Err(IoError::invalid(
+            return Err(IoError::frame_out_of_range(
                 path,
+                frame_index,
                 format!(
-                    "--frame {frame_index} is out of range: the file holds {frames} volume{} (dim[4]), numbered from 0",
+                    "the file holds {frames} volume{} (dim[4]), numbered from 0",
                     if frames == 1 { "" } else { "s" }
                 ),
             ));
