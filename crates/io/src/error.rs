@@ -10,6 +10,7 @@
 //! [`IoError::FrameOutOfRange`], [`IoError::OverMemoryLimit`], ...), so
 //! that a command-line tool can say which of its flags set it by matching
 //! on the variant.
+//!
 //! An underlying `std::io::Error` is part of the message, not a
 //! [`source`](std::error::Error::source), so printing an error chain never
 //! repeats it.

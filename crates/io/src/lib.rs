@@ -15,8 +15,10 @@
 //! through [`write_atomically`] or [`AtomicFile`], so a failed write never
 //! leaves a half-written file. Errors are [`IoError`]s: one-line messages
 //! that name the file and the field, split by [`IoError::is_io_failure`]
-//! into operating-system failures and bad input. Readers check every
-//! header against the file's length before allocating.
+//! into operating-system failures and bad input; an error a reader option
+//! caused (a frame out of range, the memory limit) has a variant of its
+//! own, so that a caller can name the option its own way. Readers check
+//! every header against the file's length before allocating.
 //!
 //! The format comes from [`ReadOptions::format`], else the file name
 //! ([`VolumeFormat::from_path`]), else its magic number

@@ -17,21 +17,25 @@ use crate::{IoError, RawOptions};
 /// How to read a file: everything a reader may need beyond the path.
 #[derive(Debug, Clone)]
 pub struct ReadOptions {
-    /// Read as this format, whatever the name and content say (`--format`).
+    /// Read as this format, whatever the name and content say (the CLI's
+    /// `--format`).
     pub format: Option<VolumeFormat>,
-    /// The layout of a raw file (`--dims`, `--dtype`, `--endian`, `--spacing`).
+    /// The layout of a raw file (the CLI's `--dims`, `--dtype`, `--endian`,
+    /// `--spacing`).
     pub raw: Option<RawOptions>,
-    /// Which volume of a file holding several, counted from 0 (`--frame`):
-    /// the 4th dimension of NIfTI, NRRD, MetaImage and HDF5, the orbital of
-    /// a cube file, the frame set of a TIFF stack, the density block of a
-    /// CHGCAR (0 total, 1 magnetisation).
+    /// Which volume of a file holding several, counted from 0 (the CLI's
+    /// `--frame`): the 4th dimension of NIfTI, NRRD, MetaImage and HDF5,
+    /// the orbital of a cube file, the frame set of a TIFF stack, the
+    /// density block of a CHGCAR (0 total, 1 magnetisation), the series of
+    /// a DICOM directory.
     pub frame: Option<usize>,
-    /// Which named array of a file holding several (`--array`): VTK point
-    /// or cell data arrays.
+    /// Which named array of a file holding several (the CLI's `--array`):
+    /// VTK point or cell data arrays.
     pub array: Option<String>,
     /// The most bytes the decoded volume and the reader's whole-payload
-    /// buffers may take (`--max-memory`): a header asking for more is
-    /// refused before anything is allocated (see [`check_volume_size`](crate::check_volume_size)).
+    /// buffers may take (the CLI's `--max-memory`): a header asking for
+    /// more is refused before anything is allocated (see
+    /// [`check_volume_size`](crate::check_volume_size)).
     /// Default: [`default_max_memory`], half the physical memory.
     pub max_memory: u64,
 }
