@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use volray_io::{IoError, VolumeFormat, format_bytes};
+
 #[derive(Debug)]
 pub struct CliError {
     pub code: u8,
@@ -33,18 +35,136 @@ impl fmt::Display for CliError {
     }
 }
 
-impl From<volray_io::IoError> for CliError {
-    fn from(e: volray_io::IoError) -> Self {
+impl From<IoError> for CliError {
+    fn from(e: IoError) -> Self {
+        let message = naming_flags(&e);
         if e.is_io_failure() {
-            CliError::io(e.to_string())
+            CliError::io(message)
         } else {
-            CliError::input(e.to_string())
+            CliError::input(message)
         }
+    }
+}
+
+/// `e`'s message, naming the flags that set the reader option it is about
+/// where volray-io names the option (`frame 5` becomes `--frame 5`, `the
+/// memory limit of 4 GiB` becomes `--max-memory 4 GiB`).
+fn naming_flags(e: &IoError) -> String {
+    let file = e.path().display();
+    match e {
+        IoError::RawSizeMismatch {
+            dims: [x, y, z],
+            dtype,
+            actual,
+            expected,
+            ..
+        } => format!(
+            "{file}: file is {actual} bytes but --dims {x},{y},{z} with --dtype {dtype} need {expected} bytes"
+        ),
+        IoError::DimsOverflow {
+            dims: [x, y, z],
+            dtype,
+            ..
+        } => format!(
+            "{file}: --dims {x},{y},{z} with --dtype {dtype} describe more bytes than this machine can address"
+        ),
+        IoError::UnknownFormat { .. } => format!(
+            "{file}: unknown volume format (known by extension or content: {}); raw data needs --dims (and --dtype, --endian, --spacing as needed), or name the format with --format",
+            VolumeFormat::KNOWN
+        ),
+        IoError::RawOptionsNotApplicable { format, .. } => {
+            format!(
+                "{file}: raw options (--dims, --dtype, --endian) do not apply to {format} files"
+            )
+        }
+        IoError::FrameNotApplicable { format, .. } => {
+            format!("{file}: --frame does not apply to {format} files: they hold one volume")
+        }
+        IoError::FrameOutOfRange { frame, held, .. } => {
+            format!("{file}: --frame {frame} is out of range: {held}")
+        }
+        IoError::FrameNeeded { held, choices, .. } => {
+            format!("{file}: {held}; pick one with --frame N: {choices}")
+        }
+        IoError::ArrayNotApplicable { format, .. } => {
+            format!("{file}: --array applies to VTK files only, not to {format} files")
+        }
+        IoError::NoSuchArray { name, held, .. } => {
+            format!("{file}: no array named \"{name}\" (--array): {held}")
+        }
+        IoError::ArrayNotScalar { array, scalars, .. } => format!(
+            "{file}: {array}: volray renders scalar arrays; pick a one-component array with --array ({scalars})"
+        ),
+        IoError::OverMemoryLimit { need, limit, .. } => format!(
+            "{file}: {need} --max-memory {}",
+            format_bytes(u128::from(*limit))
+        ),
+        IoError::Os { .. }
+        | IoError::NotAFile { .. }
+        | IoError::Truncated { .. }
+        | IoError::NoSuchDirectory { .. }
+        | IoError::BadDestination { .. }
+        | IoError::Volume { .. }
+        | IoError::Npy { .. }
+        | IoError::Invalid { .. }
+        | IoError::ImageSize { .. } => e.to_string(),
     }
 }
 
 impl From<volray_data::DataError> for CliError {
     fn from(e: volray_data::DataError) -> Self {
         CliError::input(e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+    use volray_io::{DType, RawOptions, ReadOptions};
+
+    #[test]
+    fn io_errors_name_the_flags() {
+        let dir = tempfile::tempdir().unwrap();
+        let raw = dir.path().join("data.raw");
+        std::fs::write(&raw, [0u8; 1000]).unwrap();
+        let read = |opts: ReadOptions| CliError::from(volray_io::read(&raw, &opts).unwrap_err());
+        let err = read(ReadOptions {
+            raw: Some(RawOptions::new([10, 10, 10], DType::F32)),
+            ..ReadOptions::default()
+        });
+        assert_eq!(err.code, 1);
+        assert_eq!(
+            err.message,
+            format!(
+                "{}: file is 1000 bytes but --dims 10,10,10 with --dtype f32 need 4000 bytes",
+                raw.display()
+            )
+        );
+        let err = read(ReadOptions::default());
+        assert!(err.message.contains("raw data needs --dims"), "{err}");
+        assert!(err.message.ends_with("with --format"), "{err}");
+
+        let frame = CliError::from(IoError::FrameOutOfRange {
+            path: "a.nii".into(),
+            frame: 5,
+            held: "the file holds 2 volumes (dim[4]), numbered from 0".into(),
+        });
+        assert_eq!(
+            frame.message,
+            "a.nii: --frame 5 is out of range: the file holds 2 volumes (dim[4]), numbered from 0"
+        );
+        let memory = volray_io::check_volume_size(Path::new("a.nrrd"), "sizes", &[10; 3], 4, 3999)
+            .unwrap_err();
+        assert_eq!(
+            CliError::from(memory).message,
+            "a.nrrd: sizes 10 10 10 (1000 values, 3.9 KiB as f32) exceed --max-memory 3.9 KiB"
+        );
+        // Errors no option caused read as volray-io writes them.
+        let os =
+            volray_io::read(&dir.path().join("gone.npy"), &ReadOptions::default()).unwrap_err();
+        let text = os.to_string();
+        let err = CliError::from(os);
+        assert_eq!((err.code, err.message), (2, text));
     }
 }

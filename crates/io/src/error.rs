@@ -2,7 +2,15 @@
 //!
 //! Every message is one line that starts with the file it is about
 //! (`Path::display`) followed by the problem, e.g.
-//! `data.raw: file is 1000 bytes but --dims 10,10,10 with --dtype f32 need 4000 bytes`.
+//! `data.raw: file is 1000 bytes but raw layout 10x10x10 f32 needs 4000 bytes`.
+//!
+//! Messages speak of the reader's own options ([`ReadOptions`]), never of
+//! a command line's flags. An error a reader option caused has a variant
+//! of its own carrying the option's value ([`IoError::RawSizeMismatch`],
+//! [`IoError::FrameOutOfRange`], [`IoError::OverMemoryLimit`], ...), so
+//! that a command-line tool can say which of its flags set it by matching
+//! on the variant.
+//!
 //! An underlying `std::io::Error` is part of the message, not a
 //! [`source`](std::error::Error::source), so printing an error chain never
 //! repeats it.
@@ -13,7 +21,9 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 use volray_core::VolumeError;
 
-use crate::dtype::DType;
+#[cfg(doc)]
+use crate::ReadOptions;
+use crate::shared::dtype::DType;
 
 /// Why a volume could not be read or an image could not be written.
 #[derive(Debug, Error)]
@@ -47,9 +57,10 @@ pub enum IoError {
     #[error("{}: cannot write: {reason}", path.display())]
     BadDestination { path: PathBuf, reason: String },
 
-    /// Raw data whose length does not match the dimensions and sample type.
+    /// Raw data whose length does not match the raw layout's dimensions
+    /// and sample type ([`ReadOptions::raw`]).
     #[error(
-        "{}: file is {actual} bytes but --dims {},{},{} with --dtype {dtype} need {expected} bytes",
+        "{}: file is {actual} bytes but raw layout {}x{}x{} {dtype} needs {expected} bytes",
         path.display(), dims[0], dims[1], dims[2]
     )]
     RawSizeMismatch {
@@ -60,9 +71,9 @@ pub enum IoError {
         expected: u64,
     },
 
-    /// Dimensions so large that the byte count overflows.
+    /// Raw layout dimensions so large that the byte count overflows.
     #[error(
-        "{}: --dims {},{},{} with --dtype {dtype} describe more bytes than this machine can address",
+        "{}: raw layout {}x{}x{} {dtype} describes more bytes than this machine can address",
         path.display(), dims[0], dims[1], dims[2]
     )]
     DimsOverflow {
@@ -79,23 +90,86 @@ pub enum IoError {
     #[error("{}: {reason}", path.display())]
     Npy { path: PathBuf, reason: String },
 
-    /// A malformed, inconsistent or unsupported file of a known format, or
-    /// a reader option (`--frame`, `--array`) the file cannot satisfy.
+    /// A malformed, inconsistent or unsupported file of a known format.
     /// `reason` names the field and the value, e.g.
     /// `NRRD field "sizes": 3 values for dimension 4`.
     #[error("{}: {reason}", path.display())]
     Invalid { path: PathBuf, reason: String },
 
-    /// No reader is known for the file and no raw layout was given.
+    /// No reader is known for the file and no raw layout was given
+    /// ([`ReadOptions::raw`], [`ReadOptions::format`]).
     #[error(
-        "{}: unknown volume format (known by extension or content: {}); raw data needs --dims (and --dtype, --endian, --spacing as needed), or name the format with --format",
+        "{}: unknown volume format (known by extension or content: {}); raw data needs a raw layout (dimensions, and sample type, byte order, spacing as needed), or name the format",
         path.display(), crate::VolumeFormat::KNOWN
     )]
     UnknownFormat { path: PathBuf },
 
-    /// Raw layout options given for a file whose format carries its own layout.
-    #[error("{}: raw options (--dims, --dtype, --endian) do not apply to {format} files", path.display())]
+    /// A raw layout ([`ReadOptions::raw`]) given for a file whose format
+    /// carries its own layout.
+    #[error("{}: raw layout options do not apply to {format} files", path.display())]
     RawOptionsNotApplicable { path: PathBuf, format: &'static str },
+
+    /// A frame ([`ReadOptions::frame`]) chosen in a file whose format holds
+    /// one volume.
+    #[error("{}: frame selection does not apply to {format} files: they hold one volume", path.display())]
+    FrameNotApplicable { path: PathBuf, format: &'static str },
+
+    /// A frame ([`ReadOptions::frame`]) the file does not hold. `held` says
+    /// what it holds, e.g. `the file holds 2 volumes (dim[4]), numbered from 0`.
+    #[error("{}: frame {frame} is out of range: {held}", path.display())]
+    FrameOutOfRange {
+        path: PathBuf,
+        frame: usize,
+        held: String,
+    },
+
+    /// A file holding several volumes none of which is read without a
+    /// frame ([`ReadOptions::frame`]): `held` says what it holds (`directory
+    /// holds 2 DICOM series`), `choices` lists them by frame number.
+    #[error("{}: {held}; choose one by its frame number: {choices}", path.display())]
+    FrameNeeded {
+        path: PathBuf,
+        held: String,
+        choices: String,
+    },
+
+    /// A named array ([`ReadOptions::array`]) chosen in a file whose format
+    /// has none.
+    #[error("{}: array selection applies to VTK files only, not to {format} files", path.display())]
+    ArrayNotApplicable { path: PathBuf, format: &'static str },
+
+    /// A named array ([`ReadOptions::array`]) the file does not hold; `held`
+    /// lists what it holds.
+    #[error("{}: no array named \"{name}\": {held}", path.display())]
+    NoSuchArray {
+        path: PathBuf,
+        name: String,
+        held: String,
+    },
+
+    /// A named array ([`ReadOptions::array`]) that is not a scalar, in a
+    /// file that holds one-component arrays: `array` says which and how
+    /// many components it has (`point array "v" has 3 components`),
+    /// `scalars` names the one-component arrays.
+    #[error(
+        "{}: {array}: volray renders scalar arrays; pick a one-component array ({scalars})",
+        path.display()
+    )]
+    ArrayNotScalar {
+        path: PathBuf,
+        array: String,
+        scalars: String,
+    },
+
+    /// Data that would take more memory than [`ReadOptions::max_memory`]
+    /// (or the limit a caller gave). `need` says what needs it, up to the
+    /// limit: `sizes 4000 4000 4000 (6.4e10 values, 238 GiB as f32) exceed`.
+    #[error("{}: {need} the memory limit of {}", path.display(), crate::format_bytes(u128::from(*limit)))]
+    OverMemoryLimit {
+        path: PathBuf,
+        need: String,
+        limit: u64,
+    },
 
     /// An image that PNG cannot hold (a side of 0 or more than 2^31 − 1 pixels).
     #[error(
@@ -132,6 +206,13 @@ impl IoError {
             | IoError::Invalid { .. }
             | IoError::UnknownFormat { .. }
             | IoError::RawOptionsNotApplicable { .. }
+            | IoError::FrameNotApplicable { .. }
+            | IoError::FrameOutOfRange { .. }
+            | IoError::FrameNeeded { .. }
+            | IoError::ArrayNotApplicable { .. }
+            | IoError::NoSuchArray { .. }
+            | IoError::ArrayNotScalar { .. }
+            | IoError::OverMemoryLimit { .. }
             | IoError::ImageSize { .. } => false,
         }
     }
@@ -151,6 +232,13 @@ impl IoError {
             | IoError::Invalid { path, .. }
             | IoError::UnknownFormat { path }
             | IoError::RawOptionsNotApplicable { path, .. }
+            | IoError::FrameNotApplicable { path, .. }
+            | IoError::FrameOutOfRange { path, .. }
+            | IoError::FrameNeeded { path, .. }
+            | IoError::ArrayNotApplicable { path, .. }
+            | IoError::NoSuchArray { path, .. }
+            | IoError::ArrayNotScalar { path, .. }
+            | IoError::OverMemoryLimit { path, .. }
             | IoError::ImageSize { path, .. } => path,
         }
     }
@@ -176,24 +264,66 @@ impl IoError {
     /// parser's multi-line message) are escaped, so the message stays one
     /// line.
     pub fn invalid(path: &Path, reason: impl Into<String>) -> Self {
-        let reason: String = reason.into();
-        let reason = if reason.chars().any(char::is_control) {
-            reason
-                .chars()
-                .map(|c| {
-                    if c.is_control() {
-                        c.escape_default().to_string()
-                    } else {
-                        c.to_string()
-                    }
-                })
-                .collect()
-        } else {
-            reason
-        };
         IoError::Invalid {
             path: path.to_path_buf(),
-            reason,
+            reason: one_line(reason),
+        }
+    }
+
+    // The variants a reader option causes, their text from the file made
+    // one line as [`IoError::invalid`] does.
+
+    /// [`IoError::FrameOutOfRange`]: `frame` is not among what the file
+    /// holds, which `held` says.
+    pub(crate) fn frame_out_of_range(path: &Path, frame: usize, held: impl Into<String>) -> Self {
+        IoError::FrameOutOfRange {
+            path: path.to_path_buf(),
+            frame,
+            held: one_line(held),
+        }
+    }
+
+    /// [`IoError::FrameNeeded`].
+    pub(crate) fn frame_needed(
+        path: &Path,
+        held: impl Into<String>,
+        choices: impl Into<String>,
+    ) -> Self {
+        IoError::FrameNeeded {
+            path: path.to_path_buf(),
+            held: one_line(held),
+            choices: one_line(choices),
+        }
+    }
+
+    /// [`IoError::NoSuchArray`].
+    pub(crate) fn no_such_array(path: &Path, name: &str, held: impl Into<String>) -> Self {
+        IoError::NoSuchArray {
+            path: path.to_path_buf(),
+            name: one_line(name),
+            held: one_line(held),
+        }
+    }
+
+    /// [`IoError::ArrayNotScalar`].
+    pub(crate) fn array_not_scalar(
+        path: &Path,
+        array: impl Into<String>,
+        scalars: impl Into<String>,
+    ) -> Self {
+        IoError::ArrayNotScalar {
+            path: path.to_path_buf(),
+            array: one_line(array),
+            scalars: one_line(scalars),
+        }
+    }
+
+    /// [`IoError::OverMemoryLimit`]: `need` says what exceeds `limit`.
+    pub(crate) fn over_memory_limit(path: &Path, need: impl Into<String>, limit: u64) -> Self {
+        IoError::OverMemoryLimit {
+            path: path.to_path_buf(),
+            need: one_line(need),
+            limit,
         }
     }
 
@@ -203,6 +333,23 @@ impl IoError {
             error,
         }
     }
+}
+
+/// `text` with its control characters escaped (`\n`, `\u{1b}`): one line.
+fn one_line(text: impl Into<String>) -> String {
+    let text: String = text.into();
+    if !text.chars().any(char::is_control) {
+        return text;
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -229,6 +376,16 @@ mod tests {
             IoError::UnknownFormat {
                 path: "v.dat".into(),
             },
+            IoError::frame_out_of_range(
+                Path::new("a.nii"),
+                5,
+                "the file holds 2 volumes (dim[4]), numbered from 0",
+            ),
+            IoError::over_memory_limit(
+                Path::new("a.nrrd"),
+                "sizes 10 10 10 (1000 values, 3.9 KiB as f32) exceed",
+                4 << 30,
+            ),
         ];
         for e in &errors {
             let msg = e.to_string();
@@ -238,11 +395,20 @@ mod tests {
         }
         assert_eq!(
             errors[1].to_string(),
-            "data.raw: file is 1000 bytes but --dims 10,10,10 with --dtype f32 need 4000 bytes"
+            "data.raw: file is 1000 bytes but raw layout 10x10x10 f32 needs 4000 bytes"
         );
+
         assert_eq!(
             errors[0].to_string(),
             "a/b.raw: cannot open: No such file or directory"
+        );
+        assert_eq!(
+            errors[5].to_string(),
+            "a.nii: frame 5 is out of range: the file holds 2 volumes (dim[4]), numbered from 0"
+        );
+        assert_eq!(
+            errors[6].to_string(),
+            "a.nrrd: sizes 10 10 10 (1000 values, 3.9 KiB as f32) exceed the memory limit of 4 GiB"
         );
     }
 
@@ -251,6 +417,11 @@ mod tests {
         // A name with a newline, a parser's multi-line message: still one line.
         let e = IoError::invalid(Path::new("f.vti"), "a\nb\tc\u{1b}");
         assert_eq!(e.to_string(), "f.vti: a\\nb\\tc\\u{1b}");
+        let e = IoError::no_such_array(Path::new("f.vtk"), "a\nb", "the file holds \"c\rd\"");
+        assert_eq!(
+            e.to_string(),
+            "f.vtk: no array named \"a\\nb\": the file holds \"c\\rd\""
+        );
         let plain = IoError::invalid(Path::new("f"), "x \"y\" é");
         assert_eq!(plain.to_string(), "f: x \"y\" é");
         assert!(!plain.is_io_failure());

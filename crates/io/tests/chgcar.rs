@@ -9,7 +9,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{check_resampled, has_note, refused_file, with_frame};
+use common::{assert_frame_out_of_range, check_resampled, has_note, refused_file, with_frame};
 use volray_core::Volume;
 use volray_core::glam::{DMat3, DVec3};
 use volray_io::{IoError, Loaded, VolumeFormat, read};
@@ -102,12 +102,7 @@ fn spin_polarised_frames() {
         "frame 1 of 2 is the magnetisation density (spin up - spin down)"
     ));
     let err = load(&fixture("CHGCAR_spin"), Some(2)).unwrap_err();
-    assert!(!err.is_io_failure());
-    assert!(
-        err.to_string()
-            .ends_with("--frame 2, but the file holds 2 density block(s) (frames 0 to 1)"),
-        "{err}"
-    );
+    assert_frame_out_of_range(&err, 2, "the file holds 2 density block(s) (frames 0 to 1)");
 }
 
 #[test]
@@ -251,10 +246,10 @@ fn malformed_variants_of_a_real_file() {
     );
     let e = error_of("CHG", "", None);
     assert!(e.contains("where the system name should be"), "{e}");
-    // --frame past the end.
+    // A frame past the end.
     let e = error_of("CHGCAR", &good, Some(1));
     assert!(
-        e.ends_with("--frame 1, but the file holds 1 density block(s) (frames 0 to 0)"),
+        e.ends_with("frame 1 is out of range: the file holds 1 density block(s) (frames 0 to 0)"),
         "{e}"
     );
 }

@@ -12,10 +12,10 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{assert_note, frame, refused};
+use common::{assert_frame_out_of_range, assert_note, error_about, frame, refused};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
-use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
     common::fixture("dicom", name)
@@ -163,9 +163,18 @@ fn sagittal_series_is_reordered_to_world_axes() {
 
 #[test]
 fn several_series_are_listed_then_picked_by_frame() {
-    let msg = error("two_series", &ReadOptions::default());
+    let err = error_about(
+        &fixture("two_series"),
+        &ReadOptions::default(),
+        &fixture("two_series"),
+    );
     assert!(
-        msg.contains("directory holds 2 DICOM series; pick one with --frame N: 0: SeriesNumber 1, CT \"series B\", 2 file(s), UID "),
+        matches!(&err, IoError::FrameNeeded { held, .. } if held == "directory holds 2 DICOM series"),
+        "{err}"
+    );
+    let msg = err.to_string();
+    assert!(
+        msg.contains("directory holds 2 DICOM series; choose one by its frame number: 0: SeriesNumber 1, CT \"series B\", 2 file(s), UID "),
         "{msg}"
     );
     assert!(
@@ -179,11 +188,8 @@ fn several_series_are_listed_then_picked_by_frame() {
     assert_note(&b, "series 0 of 2 read");
     let a = load("two_series", &frame(1));
     check(&a.volume, 3, |v| v as f32, &UNIT);
-    let msg = error("two_series", &frame(2));
-    assert!(
-        msg.contains("--frame 2 is out of range: there are 2 series"),
-        "{msg}"
-    );
+    let err = read(&fixture("two_series"), &frame(2)).unwrap_err();
+    assert_frame_out_of_range(&err, 2, "there are 2 series");
 }
 
 #[test]
@@ -255,11 +261,8 @@ fn enhanced_time_series_volumes_by_frame() {
         assert_eq!((l.info.frames, l.info.frame), (2, t));
         assert_note(&l, &format!("volume {t} of 2 read"));
     }
-    let msg = error("enhanced_4d.dcm", &frame(2));
-    assert!(
-        msg.contains("--frame 2 is out of range: there are 2 volume(s)"),
-        "{msg}"
-    );
+    let err = read(&fixture("enhanced_4d.dcm"), &frame(2)).unwrap_err();
+    assert_frame_out_of_range(&err, 2, "there are 2 volume(s)");
 }
 
 #[test]

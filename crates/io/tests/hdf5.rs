@@ -25,7 +25,7 @@ fn without_the_feature_the_reader_says_how_to_get_it() {
 #[cfg(feature = "hdf5")]
 mod with_hdf5 {
     use super::*;
-    use common::{check_voxels, error_about, frame, ramp, refused_at};
+    use common::{assert_frame_out_of_range, check_voxels, error_about, frame, ramp, refused_at};
     use volray_core::Volume;
     use volray_core::glam::DVec3;
     use volray_io::{Loaded, VolumeFormat, read};
@@ -114,10 +114,12 @@ mod with_hdf5 {
             assert_eq!(l.volume.spacing(), DVec3::new(0.2, 0.3, 0.4));
             assert_eq!(l.info.length_unit.as_deref(), Some("um"));
         }
-        let msg = error("many.h5:/series", &frame(3));
-        assert!(
-            msg.contains("--frame 3 is out of range: the dataset holds 3 volume(s)"),
-            "{msg}"
+        let file = fixture("many.h5");
+        let err = error_about(&fixture("many.h5:/series"), &frame(3), &file);
+        assert_frame_out_of_range(
+            &err,
+            3,
+            "HDF5 dataset \"/series\" holds 3 volume(s) along its first axis",
         );
     }
 

@@ -1,4 +1,4 @@
-//! `--max-memory` ([`ReadOptions::max_memory`]) in every reader, and
+//! The memory limit ([`ReadOptions::max_memory`]) in every reader, and
 //! headers whose dimensions overflow.
 //!
 //! For each format a valid fixture is read with the limit at exactly the
@@ -15,12 +15,13 @@ mod common;
 use std::fs;
 use std::path::Path;
 
-use common::{fixture, refused};
-use volray_io::{Loaded, ReadOptions, read};
+use common::{fixture, refused_error};
+use volray_io::{IoError, Loaded, ReadOptions, read};
 
 /// Reads `path` with `base`'s options: with the limit at `need(&loaded)`
-/// bytes it reads, with one byte less it is refused naming `field` and
-/// `--max-memory`. Returns the limit found.
+/// bytes it reads, with one byte less it is refused
+/// ([`IoError::OverMemoryLimit`]) naming `field` and the limit. Returns the
+/// limit found.
 fn limit_is_exact(
     path: &Path,
     base: ReadOptions,
@@ -35,10 +36,20 @@ fn limit_is_exact(
     };
     let again = read(path, &at(need)).unwrap_or_else(|e| panic!("limit {need}: {e}"));
     assert_eq!(again.volume, loaded.volume);
-    let msg = refused(path, &at(need - 1));
-    assert!(msg.contains(field), "{msg}\n  wanted field: {field}");
-    assert!(msg.contains("--max-memory"), "{msg}");
+    assert_over_limit(&refused_error(path, &at(need - 1)), field, need - 1);
     need
+}
+
+/// Asserts that `err` is the refusal of data over the memory limit `limit`,
+/// its message naming `field` and the limit.
+fn assert_over_limit(err: &IoError, field: &str, limit: u64) {
+    assert!(
+        matches!(err, IoError::OverMemoryLimit { limit: l, .. } if *l == limit),
+        "{err}"
+    );
+    let msg = err.to_string();
+    assert!(msg.contains(field), "{msg}\n  wanted field: {field}");
+    assert!(msg.contains("the memory limit of"), "{msg}");
 }
 
 /// 4 bytes a voxel: the streaming readers hold the f32 volume only.
@@ -55,7 +66,10 @@ fn raw_and_npy() {
         raw: Some(volray_io::RawOptions::new([4, 3, 5], volray_io::DType::U16)),
         ..ReadOptions::default()
     };
-    assert_eq!(limit_is_exact(&p, raw, f32_volume, "--dims 4 3 5"), 240);
+    assert_eq!(
+        limit_is_exact(&p, raw, f32_volume, "raw layout dims 4 3 5"),
+        240
+    );
 
     let npy = fixture("", "fortran_f4.npy");
     limit_is_exact(&npy, ReadOptions::default(), f32_volume, "shape");
@@ -273,9 +287,7 @@ fn hdf5() {
     assert_eq!(read(&p, &at(need)).unwrap().volume, l.volume);
     let err = common::error_about(&p, &at(need - 1), &file);
     assert!(!err.is_io_failure());
-    let msg = err.to_string();
-    assert!(msg.contains("dataset shape [4, 3, 5]"), "{msg}");
-    assert!(msg.contains("--max-memory"), "{msg}");
+    assert_over_limit(&err, "dataset shape [4, 3, 5]", need - 1);
 }
 
 // ---- dimensions whose product overflows, per header format ----
@@ -292,7 +304,7 @@ fn overflowing_dims_are_refused_in_every_header() {
     let h = HUGE.to_string();
     let dims3 = format!("{h} {h} {h}");
 
-    // raw: the layout comes from --dims.
+    // raw: the layout comes from the raw options.
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("v.raw");
     fs::write(&p, [0u8; 8]).unwrap();
@@ -301,7 +313,12 @@ fn overflowing_dims_are_refused_in_every_header() {
         raw: Some(volray_io::RawOptions::new([n, n, n], volray_io::DType::F32)),
         ..ReadOptions::default()
     };
-    assert!(refused(&p, &raw).contains(&format!("--dims {h},{h},{h}")));
+    let err = refused_error(&p, &raw);
+    assert!(matches!(err, IoError::DimsOverflow { .. }), "{err}");
+    assert!(
+        err.to_string()
+            .contains(&format!("raw layout {h}x{h}x{h} f32"))
+    );
 
     // .npy
     let dict = format!("{{'descr': '<f4', 'fortran_order': True, 'shape': ({h}, {h}, {h}), }}");

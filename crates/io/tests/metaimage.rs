@@ -11,8 +11,8 @@ use std::fs;
 use std::path::PathBuf;
 
 use common::{
-    Grid, check_voxels, check_world, error_about, frame, has_note, header_value, ramp, refuse,
-    replace, scrambled,
+    Grid, assert_frame_out_of_range, check_voxels, check_world, error_about, frame, has_note,
+    header_value, ramp, refuse, replace, scrambled,
 };
 use volray_core::Volume;
 use volray_core::glam::DVec3;
@@ -151,11 +151,11 @@ fn four_d_series_picks_frames() {
     let l = load("series4d.mha");
     assert_eq!(l.info.frame, 0);
     let err = read(&path, &frame(3)).unwrap_err();
-    assert!(!err.is_io_failure());
+    assert_frame_out_of_range(&err, 3, "the file holds 3 volumes (frames 0 to 2)");
     assert_eq!(
         err.to_string(),
         format!(
-            "{}: --frame 3 but the file holds 3 volumes (frames 0 to 2)",
+            "{}: frame 3 is out of range: the file holds 3 volumes (frames 0 to 2)",
             path.display()
         )
     );
@@ -414,11 +414,7 @@ fn bad_fields_name_field_and_value() {
     );
 
     let err = read(&fixture("f32.mha"), &frame(1)).unwrap_err();
-    assert!(
-        err.to_string()
-            .ends_with("--frame 1 but the file holds 1 volume (frames 0 to 0)"),
-        "{err}"
-    );
+    assert_frame_out_of_range(&err, 1, "the file holds 1 volume (frames 0 to 0)");
 }
 
 #[test]

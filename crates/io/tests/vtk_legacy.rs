@@ -166,6 +166,7 @@ fn several_arrays_default_and_by_name() {
         for name in ["nope", "point:cells"] {
             let err = read_with(file, Some(name)).unwrap_err();
             assert!(!err.is_io_failure());
+            assert!(matches!(&err, IoError::NoSuchArray { .. }), "{err}");
             let msg = err.to_string();
             assert!(
                 msg.contains(&format!("no array named \"{name}\""))

@@ -236,12 +236,30 @@ pub fn error_about(path: &Path, opts: &ReadOptions, about: &Path) -> IoError {
     err
 }
 
+/// Asserts that `err` is the refusal of a frame the file does not hold
+/// ([`IoError::FrameOutOfRange`] for `frame`, bad input), its message
+/// saying `frame {frame} is out of range: {held}`.
+pub fn assert_frame_out_of_range(err: &IoError, frame: usize, held: &str) {
+    assert!(
+        matches!(err, IoError::FrameOutOfRange { frame: f, .. } if *f == frame),
+        "{err}"
+    );
+    assert!(!err.is_io_failure(), "{err}");
+    let want = format!("frame {frame} is out of range: {held}");
+    assert!(err.to_string().contains(&want), "{err}\n  wanted: {want}");
+}
+
 /// Reads `path`, which must be refused as bad input (not an I/O failure)
-/// with a one-line message that starts with the path; returns the message.
-pub fn refused(path: &Path, opts: &ReadOptions) -> String {
+/// with a one-line message that starts with the path; returns the error.
+pub fn refused_error(path: &Path, opts: &ReadOptions) -> IoError {
     let err = error_about(path, opts, path);
     assert!(!err.is_io_failure(), "{err}");
-    err.to_string()
+    err
+}
+
+/// [`refused_error`]'s message.
+pub fn refused(path: &Path, opts: &ReadOptions) -> String {
+    refused_error(path, opts).to_string()
 }
 
 /// Writes `bytes` as `name` in `dir` and expects [`refused`].

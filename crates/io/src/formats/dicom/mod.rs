@@ -1,0 +1,582 @@
+//! DICOM volumes: a directory of single-slice files (CT, MR, ...) or one
+//! multi-frame file (enhanced CT/MR, RT dose).
+//!
+//! A directory: every file in it that parses as DICOM and holds pixel data
+//! is read (others are skipped and counted in a note; subdirectories are
+//! not searched); the files are grouped by SeriesInstanceUID. Several
+//! series are refused with a list, unless `--frame N` picks series N in
+//! the order of (SeriesNumber, SeriesInstanceUID). The slices are sorted
+//! along their normal by ImagePositionPatient ([`stack`]); they must share
+//! Rows, Columns, sample layout, orientation and PixelSpacing, and be
+//! equally spaced (gaps within 1 % of their mean; smaller variations are
+//! noted). Slices without any position are ordered by InstanceNumber and
+//! spaced by SpacingBetweenSlices or SliceThickness (or 1 mm), with a note.
+//!
+//! A multi-frame file: frame positions come from the per-frame functional
+//! groups (enhanced images), from GridFrameOffsetVector (RT dose), or from
+//! SpacingBetweenSlices. Frames that repeat positions (a time series)
+//! form several volumes: volume `v` is the `v`-th occurrence of each
+//! position in frame order, picked with `--frame`. A file holding a single
+//! slice is refused with a hint to pass its directory.
+//!
+//! Values: the stored bits (BitsStored, HighBit, PixelRepresentation) times
+//! RescaleSlope plus RescaleIntercept (per frame where the functional
+//! groups give them), or times DoseGridScaling for RT dose. World
+//! coordinates are the DICOM patient coordinates (LPS: +x towards the
+//! patient's left, +y posterior, +z head) in mm, mapped to the volume by
+//! [`grid_to_volume`]: column index along the row direction,
+//! row index along the column direction, slices along the normal.
+//!
+//! Compressed pixel data is decoded by `dicom-pixeldata` (RLE and JPEG
+//! baseline, extended and lossless in this build); other transfer syntaxes
+//! (JPEG 2000, JPEG-LS, ...) are refused with their name. Before anything
+//! is parsed, every element length is checked against the file
+//! ([`prescan`]), and before the volume is allocated every file's pixel
+//! data is checked to be able to hold what its header declares.
+
+mod header;
+mod pixels;
+mod prescan;
+mod stack;
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::Path;
+
+use volray_core::glam::DVec3;
+
+use self::header::{FileHeader, HeaderError, ImageFormat, Plane, read_all, read_header};
+use self::pixels::{decode, frame_values, transfer_syntax_name};
+use self::prescan::{Prescan, prescan};
+use self::stack::{Stack, stack, volumes};
+use crate::error::IoError;
+use crate::shared::geometry::grid_to_volume;
+use crate::shared::limits::{F32_BYTES, check_volume_size};
+use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+
+/// A directory with more entries than this is refused before any is read
+/// (a CT series has hundreds to a few thousand slices).
+const MAX_DIRECTORY_ENTRIES: usize = 100_000;
+
+/// Encapsulated (compressed) pixel data may decode to at most this many
+/// times the file's length (or [`SMALL_FILE_ALLOWANCE`]): RLE inflates at
+/// most 64:1 and JPEG far less on real images, so a header declaring more
+/// is lying.
+const MAX_INFLATION: u64 = crate::shared::compress::MAX_DEFLATE_RATIO;
+const SMALL_FILE_ALLOWANCE: u64 = 64 << 20;
+
+/// Skipped file names listed in a note, at most.
+const LISTED: usize = 5;
+
+/// Reads the DICOM volume at `path`: a directory of slices or one
+/// multi-frame file.
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    if path.is_dir() {
+        read_directory(path, opts)
+    } else {
+        let header = match read_header(path) {
+            Ok(Some(h)) => h,
+            Ok(None) => {
+                return Err(IoError::invalid(
+                    path,
+                    "not a DICOM file: no DICM magic at byte 128",
+                ));
+            }
+            Err(HeaderError::Io(e)) => return Err(e),
+            Err(HeaderError::Bad(reason)) => {
+                return Err(IoError::invalid(path, format!("DICOM: {reason}")));
+            }
+        };
+        read_multiframe(path, header, opts.frame, opts.max_memory, FileInfo::new(""))
+    }
+}
+
+/// Reads the volume `volume` (default 0) of the multi-frame file whose
+/// header is `header`. `info` may carry notes from a directory scan.
+fn read_multiframe(
+    path: &Path,
+    header: FileHeader,
+    volume: Option<usize>,
+    max_memory: u64,
+    mut info: FileInfo,
+) -> Result<Loaded, IoError> {
+    let format = header
+        .format
+        .clone()
+        .map_err(|r| IoError::invalid(path, format!("DICOM: {r}")))?;
+    check_pixel_data(&header, &format)?;
+    if header.frames == 1 {
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map(|p| p.display().to_string())
+            .unwrap_or_else(|| ".".into());
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "this DICOM file holds a single slice: pass the directory that holds the whole series ({dir}) to read a volume"
+            ),
+        ));
+    }
+    let groups = volumes(&header.planes).map_err(|r| IoError::invalid(path, r))?;
+    info.frames = groups.len();
+    let v = pick(
+        path,
+        volume,
+        groups.len(),
+        "volume(s) (frames repeating the same positions)",
+    )?;
+    info.frame = v;
+    if groups.len() > 1 {
+        info.notes.push(format!(
+            "volume {v} of {} read: frames {}",
+            groups.len(),
+            list(&groups[v], |f| f.to_string())
+        ));
+    }
+    let frames = &groups[v];
+    let planes: Vec<Plane> = frames.iter().map(|&f| header.planes[f].clone()).collect();
+    let names = |i: usize| format!("frame {}", frames[i]);
+    let grid = geometry(path, &planes, &names, &header, &mut info)?;
+
+    // Every frame is held twice (the parsed element and the decoded
+    // samples) beside the f32 volume: bound them all by the limit.
+    let stored = format
+        .float
+        .map_or(format.sample_bytes(), |b| usize::from(b / 8));
+    check_volume_size(
+        path,
+        "Rows x Columns x NumberOfFrames",
+        &[
+            format.rows as u64,
+            format.columns as u64,
+            header.frames as u64,
+        ],
+        2 * stored as u64 + F32_BYTES,
+        max_memory,
+    )?;
+    let bytes = read_all(path)?;
+    let obj = parse_whole(path, &bytes)?;
+    drop(bytes);
+    let decoded = decode(path, &obj, &format, header.frames)?;
+    let mut data = allocate(path, &format, grid.order.len(), max_memory)?;
+    for &k in &grid.order {
+        frame_values(&decoded, frames[k], &format, &planes[k], &mut data);
+    }
+    finish(path, &header, &format, grid, data, info)
+}
+
+/// Reads the series in directory `dir` (see the module documentation).
+fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let mut entries = Vec::new();
+    let listing = fs::read_dir(dir).map_err(|e| IoError::os(dir, "read directory", e))?;
+    for entry in listing {
+        let entry = entry.map_err(|e| IoError::os(dir, "read directory", e))?;
+        entries.push(entry.path());
+        if entries.len() > MAX_DIRECTORY_ENTRIES {
+            return Err(IoError::invalid(
+                dir,
+                format!(
+                    "directory holds more than {MAX_DIRECTORY_ENTRIES} entries: too many for one DICOM series"
+                ),
+            ));
+        }
+    }
+    entries.sort();
+
+    let mut images: Vec<FileHeader> = Vec::new();
+    let mut not_dicom = Vec::new();
+    let mut unreadable = Vec::new();
+    let mut no_pixels = Vec::new();
+    let mut subdirectories = 0;
+    for p in &entries {
+        let name = file_name(p);
+        if p.is_dir() {
+            subdirectories += 1;
+            continue;
+        }
+        match read_header(p) {
+            Ok(None) => not_dicom.push(name),
+            Ok(Some(h)) if h.pixel_data.is_none() => no_pixels.push(name),
+            Ok(Some(h)) => images.push(h),
+            Err(HeaderError::Bad(reason)) => unreadable.push(format!("{name}: {reason}")),
+            Err(HeaderError::Io(e)) => return Err(e),
+        }
+    }
+    let mut skipped = Vec::new();
+    if !not_dicom.is_empty() {
+        skipped.push(format!(
+            "{} file(s) not DICOM ({})",
+            not_dicom.len(),
+            list(&not_dicom, |s| s.clone())
+        ));
+    }
+    if !no_pixels.is_empty() {
+        skipped.push(format!(
+            "{} DICOM file(s) without pixel data ({})",
+            no_pixels.len(),
+            list(&no_pixels, |s| s.clone())
+        ));
+    }
+    if !unreadable.is_empty() {
+        skipped.push(format!(
+            "{} unreadable DICOM file(s) ({})",
+            unreadable.len(),
+            list(&unreadable, |s| s.clone())
+        ));
+    }
+    if subdirectories > 0 {
+        skipped.push(format!("{subdirectories} subdirectory(ies) not searched"));
+    }
+    let skipped = (!skipped.is_empty()).then(|| format!("skipped {}", skipped.join("; ")));
+    // Errors about the series carry what was skipped: a skipped file may
+    // be the reason.
+    let with_skips = |reason: String| match &skipped {
+        Some(s) => IoError::invalid(dir, format!("{reason} ({s})")),
+        None => IoError::invalid(dir, reason),
+    };
+    if images.is_empty() {
+        return Err(with_skips("no DICOM image files in this directory".into()));
+    }
+
+    let mut by_series: BTreeMap<(i64, String), Vec<FileHeader>> = BTreeMap::new();
+    for h in images {
+        let key = (h.series_number.unwrap_or(i64::MAX), h.series_uid.clone());
+        by_series.entry(key).or_default().push(h);
+    }
+    let series: Vec<Vec<FileHeader>> = by_series.into_values().collect();
+    if series.len() > 1 && opts.frame.is_none() {
+        let listed: Vec<String> = series
+            .iter()
+            .enumerate()
+            .map(|(i, files)| describe_series(i, files))
+            .collect();
+        return Err(IoError::frame_needed(
+            dir,
+            format!("directory holds {} DICOM series", series.len()),
+            listed.join("; "),
+        ));
+    }
+    let count = series.len();
+    let s = pick(dir, opts.frame, count, "series")?;
+    let mut files = series.into_iter().nth(s).expect("picked in range");
+    let mut info = FileInfo::new("");
+    info.frames = count;
+    info.frame = s;
+    if let Some(note) = skipped.clone() {
+        info.notes.push(note);
+    }
+    if count > 1 {
+        info.notes.push(format!(
+            "series {s} of {count} read: {}",
+            describe_series(s, &files)
+        ));
+    }
+
+    if files.iter().any(|h| h.frames > 1) {
+        if files.len() == 1 {
+            let header = files.pop().expect("one file");
+            let path = header.path.clone();
+            let volume = if count == 1 { opts.frame } else { None };
+            let mut loaded =
+                read_multiframe(&path, header, volume, opts.max_memory, FileInfo::new(""))?;
+            if count > 1 {
+                loaded.info.notes.extend(info.notes);
+            } else {
+                loaded.info.notes.splice(0..0, info.notes);
+            }
+            return Ok(loaded);
+        }
+        return Err(with_skips(format!(
+            "series {} mixes multi-frame files with others: pass one multi-frame file instead of the directory",
+            files[0].series_uid
+        )));
+    }
+
+    let first = &files[0];
+    let format = first
+        .format
+        .clone()
+        .map_err(|r| IoError::invalid(&first.path, format!("DICOM: {r}")))?;
+    for h in &files {
+        let f = h
+            .format
+            .as_ref()
+            .map_err(|r| IoError::invalid(&h.path, format!("DICOM: {r}")))?;
+        if *f != format {
+            return Err(IoError::invalid(
+                dir,
+                format!(
+                    "{} is {}x{} {} ({}) but {} is {}x{} {} ({}): every slice of a series must have the same size and sample layout",
+                    file_name(&h.path),
+                    f.columns,
+                    f.rows,
+                    f.describe(),
+                    f.photometric,
+                    file_name(&first.path),
+                    format.columns,
+                    format.rows,
+                    format.describe(),
+                    format.photometric
+                ),
+            ));
+        }
+        check_pixel_data(h, f)?;
+    }
+    if files.len() < 2 {
+        return Err(with_skips(format!(
+            "series {} has 1 slice ({}): a volume needs at least 2",
+            files[0].series_uid,
+            file_name(&files[0].path)
+        )));
+    }
+    if files.iter().all(|h| h.planes[0].position.is_none()) {
+        // Without positions, InstanceNumber orders the slices (stable: by
+        // file name among equal numbers).
+        files.sort_by_key(|h| h.instance_number.unwrap_or(i64::MAX));
+    }
+    let planes: Vec<Plane> = files.iter().map(|h| h.planes[0].clone()).collect();
+    let names = |i: usize| file_name(&files[i].path);
+    let grid =
+        geometry(dir, &planes, &names, &files[0], &mut info).map_err(|e| match (e, &skipped) {
+            (IoError::Invalid { path, reason }, Some(s)) => {
+                IoError::invalid(&path, format!("{reason} ({s})"))
+            }
+            (e, _) => e,
+        })?;
+
+    let mut data = allocate(dir, &format, files.len(), opts.max_memory)?;
+    for &k in &grid.order {
+        let h = &files[k];
+        let bytes = read_all(&h.path)?;
+        let obj = parse_whole(&h.path, &bytes)?;
+        drop(bytes);
+        let decoded = decode(&h.path, &obj, &format, 1)?;
+        frame_values(&decoded, 0, &format, &planes[k], &mut data);
+    }
+    let header = &files[grid.order[0]];
+    finish(dir, header, &format, grid, data, info)
+}
+
+/// The stack's grid: from the positions if the planes have them, else in
+/// the given order with SpacingBetweenSlices, SliceThickness or 1 mm.
+fn geometry(
+    path: &Path,
+    planes: &[Plane],
+    names: &dyn Fn(usize) -> String,
+    first: &FileHeader,
+    info: &mut FileInfo,
+) -> Result<Stack, IoError> {
+    if let Some(note) = &first.geometry_note {
+        info.notes.push(note.clone());
+    }
+    if planes.iter().any(|p| p.position.is_some()) {
+        let grid = stack(planes, names).map_err(|r| IoError::invalid(path, r))?;
+        info.notes.extend(grid.notes.iter().cloned());
+        return Ok(grid);
+    }
+    let ps = planes[0].pixel_spacing.unwrap_or([1.0, 1.0]);
+    let (gap, source) = match (first.slice_spacing, first.slice_thickness) {
+        (Some(s), _) if s > 0.0 => (s, "SpacingBetweenSlices"),
+        (_, Some(t)) if t > 0.0 => (t, "SliceThickness"),
+        _ => (1.0, "a default"),
+    };
+    info.notes.push(format!(
+        "no ImagePositionPatient: slices in InstanceNumber (or frame) order, {gap} mm apart from {source}, on world axes from the origin"
+    ));
+    Ok(Stack {
+        order: (0..planes.len()).collect(),
+        steps: [DVec3::X * ps[1], DVec3::Y * ps[0], DVec3::Z * gap],
+        origin: DVec3::ZERO,
+        notes: Vec::new(),
+    })
+}
+
+/// Builds the volume and fills in the rest of `info`.
+fn finish(
+    path: &Path,
+    header: &FileHeader,
+    format: &ImageFormat,
+    grid: Stack,
+    data: Vec<f32>,
+    mut info: FileInfo,
+) -> Result<Loaded, IoError> {
+    info.stored_type = format!(
+        "{} ({})",
+        format.describe(),
+        transfer_syntax_name(&header.transfer_syntax)
+    );
+    info.header = header.fields.clone();
+    if let Some(note) = &header.scaling_note {
+        info.notes.push(note.clone());
+    }
+    if header.planes.iter().any(|p| p.pixel_spacing.is_none()) {
+        info.notes
+            .push("no PixelSpacing: 1 mm between rows and between columns assumed".into());
+    }
+    if format.photometric == "MONOCHROME1" {
+        info.notes.push(
+            "PhotometricInterpretation MONOCHROME1 (low values display white): values kept as stored, not inverted".into(),
+        );
+    }
+    info.notes.push(
+        "world coordinates are DICOM patient coordinates (LPS: +x to the patient's left, +y posterior, +z head), in mm".into(),
+    );
+    info.length_unit = Some("mm".into());
+    let dims = [format.columns, format.rows, grid.order.len()];
+    let volume = grid_to_volume(path, dims, data, grid.steps, grid.origin, &mut info)?;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Dicom,
+        info,
+    })
+}
+
+/// Checks that `header`'s pixel data can hold what it declares, before
+/// anything is allocated for it: native data by its length, compressed
+/// data by a bound on its compression ratio.
+fn check_pixel_data(header: &FileHeader, format: &ImageFormat) -> Result<(), IoError> {
+    let path = &header.path;
+    let sample_bytes = match format.float {
+        Some(bits) => usize::from(bits / 8),
+        None => format.sample_bytes(),
+    };
+    let need = format
+        .rows
+        .checked_mul(format.columns)
+        .and_then(|n| n.checked_mul(header.frames))
+        .and_then(|n| n.checked_mul(sample_bytes))
+        .ok_or_else(|| {
+            IoError::invalid(
+                path,
+                format!(
+                    "Rows {} x Columns {} x {} frame(s) is too large to address",
+                    format.rows, format.columns, header.frames
+                ),
+            )
+        })?;
+    let Some(pixel_data) = header.pixel_data else {
+        return Err(IoError::invalid(path, "DICOM file has no pixel data"));
+    };
+    let element = format!("(7FE0,{:04X})", pixel_data.element);
+    match pixel_data.length {
+        Some(len) if (len as usize) < need => Err(IoError::invalid(
+            path,
+            format!(
+                "pixel data {element} holds {len} bytes, but Rows {} x Columns {} x {} frame(s) x {} byte(s) need {need}",
+                format.rows, format.columns, header.frames, sample_bytes
+            ),
+        )),
+        Some(_) => Ok(()),
+        None => {
+            let budget = header
+                .file_len
+                .saturating_mul(MAX_INFLATION)
+                .max(SMALL_FILE_ALLOWANCE);
+            if need as u64 > budget {
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "compressed pixel data would decode to {need} bytes (Rows {} x Columns {} x {} frame(s)), more than a {}-byte file can hold",
+                        format.rows, format.columns, header.frames, header.file_len
+                    ),
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// The output buffer for `slices` slices of `format`, refused if it would
+/// take more than `max_memory`.
+fn allocate(
+    path: &Path,
+    format: &ImageFormat,
+    slices: usize,
+    max_memory: u64,
+) -> Result<Vec<f32>, IoError> {
+    let n = check_volume_size(
+        path,
+        "Columns x Rows x slices",
+        &[format.columns as u64, format.rows as u64, slices as u64],
+        F32_BYTES,
+        max_memory,
+    )?;
+    let mut data = Vec::new();
+    data.try_reserve_exact(n).map_err(|_| {
+        IoError::invalid(
+            path,
+            format!(
+                "cannot allocate {}x{}x{slices} voxels",
+                format.columns, format.rows
+            ),
+        )
+    })?;
+    Ok(data)
+}
+
+/// Parses the whole file `bytes` after checking every element length.
+fn parse_whole(path: &Path, bytes: &[u8]) -> Result<dicom_object::DefaultDicomObject, IoError> {
+    match prescan(bytes, true, false) {
+        Ok(Prescan::Done(_)) => {}
+        Ok(Prescan::NeedMore) => {
+            return Err(IoError::invalid(path, "DICOM: file ends inside an element"));
+        }
+        Err(reason) => return Err(IoError::invalid(path, format!("DICOM: {reason}"))),
+    }
+    header::parse(bytes, false).map_err(|r| IoError::invalid(path, format!("DICOM: {r}")))
+}
+
+/// Checks the frame asked for ([`ReadOptions::frame`]) against `count`
+/// choices of `what`.
+fn pick(path: &Path, frame: Option<usize>, count: usize, what: &str) -> Result<usize, IoError> {
+    let n = frame.unwrap_or(0);
+    if n >= count {
+        return Err(IoError::frame_out_of_range(
+            path,
+            n,
+            format!("there are {count} {what}, numbered from 0"),
+        ));
+    }
+    Ok(n)
+}
+
+fn describe_series(index: usize, files: &[FileHeader]) -> String {
+    let h = &files[0];
+    let number = h
+        .series_number
+        .map(|n| format!("SeriesNumber {n}, "))
+        .unwrap_or_default();
+    let description = if h.series_description.is_empty() {
+        String::new()
+    } else {
+        format!(" \"{}\"", h.series_description)
+    };
+    format!(
+        "{index}: {number}{}{description}, {} file(s), UID {}",
+        if h.modality.is_empty() {
+            "?"
+        } else {
+            &h.modality
+        },
+        files.len(),
+        h.series_uid
+    )
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// Up to [`LISTED`] items, then how many more.
+fn list<T>(items: &[T], show: impl Fn(&T) -> String) -> String {
+    let shown: Vec<String> = items.iter().take(LISTED).map(show).collect();
+    let more = items.len().saturating_sub(LISTED);
+    if more > 0 {
+        format!("{}, and {more} more", shown.join(", "))
+    } else {
+        shown.join(", ")
+    }
+}

@@ -1,0 +1,241 @@
+//! What a NIfTI header says about the samples: their type (`datatype`),
+//! how the frames lie in the data (`dim`, `vox_offset`), checked into a
+//! [`Layout`], and the scaling of the values read (`scl_slope`,
+//! `scl_inter`).
+
+use std::path::Path;
+
+use super::header::Header;
+use crate::FileInfo;
+use crate::error::IoError;
+use crate::shared::dtype::DType;
+
+/// The sample type of NIfTI datatype `code`, or why it is refused.
+fn sample_type(code: i64) -> Result<(DType, &'static str), String> {
+    Ok(match code {
+        2 => (DType::U8, "uint8"),
+        4 => (DType::I16, "int16"),
+        8 => (DType::I32, "int32"),
+        16 => (DType::F32, "float32"),
+        64 => (DType::F64, "float64"),
+        256 => (DType::I8, "int8"),
+        512 => (DType::U16, "uint16"),
+        768 => (DType::U32, "uint32"),
+        1024 => (DType::I64, "int64"),
+        1280 => (DType::U64, "uint64"),
+        _ => {
+            let what = match code {
+                1 => "binary (1 bit per voxel)",
+                32 => "complex64",
+                128 => "RGB24",
+                1536 => "float128",
+                1792 => "complex128",
+                2048 => "complex256",
+                2304 => "RGBA32",
+                _ => {
+                    return Err(format!(
+                        "NIfTI field \"datatype\" is {code}: not a NIfTI data type"
+                    ));
+                }
+            };
+            return Err(format!(
+                "NIfTI field \"datatype\" is {code} ({what}): volray reads scalar volumes of integers, float32 or float64 only"
+            ));
+        }
+    })
+}
+
+/// The data layout the header describes, checked.
+pub(super) struct Layout {
+    pub(super) dims: [usize; 3],
+    pub(super) count: usize,
+    pub(super) dtype: DType,
+    pub(super) type_name: &'static str,
+    pub(super) frames: usize,
+    pub(super) frame: usize,
+    pub(super) frame_bytes: u64,
+    pub(super) vox_offset: u64,
+}
+
+impl Layout {
+    pub(super) fn of(
+        path: &Path,
+        header: &Header,
+        frame: Option<usize>,
+    ) -> Result<Layout, IoError> {
+        let (dtype, type_name) =
+            sample_type(header.datatype).map_err(|reason| IoError::invalid(path, reason))?;
+        let dim = header.dim;
+        let ndim = dim[0];
+        if !(1..=7).contains(&ndim) {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "NIfTI field \"dim[0]\" is {ndim}: the number of dimensions must be 1 to 7"
+                ),
+            ));
+        }
+        let ndim = ndim as usize;
+        if ndim < 3 {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "NIfTI field \"dim[0]\" is {ndim}: volray renders 3-D volumes, not {ndim}-D images"
+                ),
+            ));
+        }
+        for (a, &d) in dim.iter().enumerate().take(ndim + 1).skip(1) {
+            if d < 1 {
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "NIfTI field \"dim[{a}]\" is {d}: every used dimension must be at least 1"
+                    ),
+                ));
+            }
+        }
+        if let Some(a) = (5..=ndim).find(|&a| dim[a] > 1) {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "NIfTI field \"dim[{a}]\" is {}: {ndim}-D data (beyond a 4th dimension of volumes) is not supported",
+                    dim[a]
+                ),
+            ));
+        }
+        let to_usize = |a: usize| usize::try_from(dim[a]).ok();
+        let dims = [1, 2, 3].map(|a| to_usize(a).unwrap_or(usize::MAX));
+        if dims.iter().any(|&n| n < 2) {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "NIfTI field \"dim\" gives {}x{}x{} voxels: every axis needs at least 2",
+                    dim[1], dim[2], dim[3]
+                ),
+            ));
+        }
+        let frames = if ndim >= 4 {
+            to_usize(4).unwrap_or(usize::MAX)
+        } else {
+            1
+        };
+        let frame_index = frame.unwrap_or(0);
+        if frame_index >= frames {
+            return Err(IoError::frame_out_of_range(
+                path,
+                frame_index,
+                format!(
+                    "the file holds {frames} volume{} (dim[4]), numbered from 0",
+                    if frames == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        let count = dims[0]
+            .checked_mul(dims[1])
+            .and_then(|n| n.checked_mul(dims[2]))
+            .ok_or_else(|| too_big(path, header))?;
+        let frame_bytes = (count as u64)
+            .checked_mul(dtype.size() as u64)
+            .ok_or_else(|| too_big(path, header))?;
+        let v = header.vox_offset;
+        if !(v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v < 2f64.powi(62)) {
+            return Err(IoError::invalid(
+                path,
+                format!("NIfTI field \"vox_offset\" is {v}: it must be a whole number of bytes"),
+            ));
+        }
+        Ok(Layout {
+            dims,
+            count,
+            dtype,
+            type_name,
+            frames,
+            frame: frame_index,
+            frame_bytes,
+            vox_offset: v as u64,
+        })
+    }
+
+    /// Bytes from the start of the data file through the last frame.
+    pub(super) fn total_bytes(&self, start: u64) -> Option<u64> {
+        self.frame_bytes
+            .checked_mul(self.frames as u64)?
+            .checked_add(start)
+    }
+
+    /// Bytes from the start of the data file through the wanted frame.
+    pub(super) fn bytes_through_frame(&self, start: u64) -> Option<u64> {
+        self.frame_bytes
+            .checked_mul(self.frame as u64 + 1)?
+            .checked_add(start)
+    }
+}
+
+/// The `dim` field as written, for messages.
+pub(super) fn dim_text(header: &Header) -> String {
+    header
+        .ints("dim")
+        .iter()
+        .map(|d| d.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+pub(super) fn too_big(path: &Path, header: &Header) -> IoError {
+    IoError::invalid(
+        path,
+        format!(
+            "NIfTI field \"dim\" is {}: the data size overflows",
+            dim_text(header)
+        ),
+    )
+}
+
+/// Applies `scl_slope`/`scl_inter` (nifti1.h: `y = scl_slope · x + scl_inter`
+/// unless `scl_slope` is 0; nibabel also treats a NaN or infinite slope as
+/// "no scaling").
+pub(super) fn apply_scaling(header: &Header, data: &mut [f32], info: &mut FileInfo) {
+    let (slope, inter) = (header.scl_slope, header.scl_inter);
+    if slope == 0.0 || !slope.is_finite() {
+        if slope != 0.0 || (inter != 0.0 && !inter.is_nan()) {
+            info.notes.push(format!(
+                "scl_slope {slope} means no scaling; scl_inter {inter} ignored"
+            ));
+        }
+        return;
+    }
+    let inter = if inter.is_finite() {
+        inter
+    } else {
+        info.notes
+            .push(format!("scl_inter {inter} is not finite: taken as 0"));
+        0.0
+    };
+    if slope == 1.0 && inter == 0.0 {
+        return;
+    }
+    for v in data.iter_mut() {
+        *v = (f64::from(*v) * slope + inter) as f32;
+    }
+    info.notes.push(format!(
+        "values scaled: value = {slope} * stored + {inter} (scl_slope, scl_inter)"
+    ));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn datatypes() {
+        assert_eq!(sample_type(512).unwrap(), (DType::U16, "uint16"));
+        assert_eq!(sample_type(1280).unwrap(), (DType::U64, "uint64"));
+        assert!(sample_type(128).unwrap_err().contains("RGB24"));
+        assert!(sample_type(1792).unwrap_err().contains("complex128"));
+        assert!(
+            sample_type(3)
+                .unwrap_err()
+                .contains("not a NIfTI data type")
+        );
+    }
+}

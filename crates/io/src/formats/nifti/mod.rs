@@ -1,0 +1,228 @@
+//! NIfTI-1 and NIfTI-2 volumes: `.nii`, `.nii.gz` and `.hdr`/`.img` pairs.
+//!
+//! [`read`] runs in the order of the file: `source.rs` opens it (plain or
+//! gzip, and the `.img` beside a `.hdr`), `header.rs` parses the 348-byte
+//! NIfTI-1 or 540-byte NIfTI-2 header in either byte order, `data.rs`
+//! checks what it says about the samples (type, dimensions, frames,
+//! offset) and scales the values read, and `geometry.rs` places the grid
+//! in the world. A gzip file is inflated as a stream, so a header that
+//! lies about the data size runs into the end of the stream instead of
+//! making volray allocate what it claims.
+//!
+//! Interpretation, following the NIfTI-1 standard (nifti1.h) and nibabel:
+//! - values are `scl_slope · stored + scl_inter` when `scl_slope` is
+//!   finite and non-zero (0 or NaN means "no scaling");
+//! - world coordinates (RAS+, as nibabel's affine) come from the sform
+//!   (`srow_x/y/z`) if `sform_code > 0`, else from the qform quaternion if
+//!   `qform_code > 0` (nifti1.h "method 2"), else from `pixdim` alone
+//!   ("method 1", origin at 0); they go through [`grid_to_volume`];
+//! - `xyzt_units` names the length unit (m, mm, µm), which is reported, not
+//!   converted;
+//! - a 4-D file holds `dim[4]` volumes and `--frame` picks one; 5-D and
+//!   higher data (any `dim[5..]` above 1) are refused, as are complex, RGB,
+//!   bit and 128-bit float samples.
+
+mod data;
+mod geometry;
+mod header;
+mod source;
+
+use std::path::Path;
+
+use self::data::{Layout, apply_scaling, dim_text, too_big};
+use self::geometry::{geometry, length_unit};
+use self::header::{detect_version, parse_header};
+use self::source::{Source, image_path};
+use crate::error::IoError;
+use crate::shared::compress::MAX_DEFLATE_RATIO;
+use crate::shared::dtype::extend_f32;
+use crate::shared::geometry::grid_to_volume;
+use crate::shared::limits::{F32_BYTES, check_frame_dims};
+use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+
+/// Samples decoded per read: bounds the scratch buffer beside the output.
+const CHUNK_SAMPLES: usize = 1 << 16;
+
+/// Reads the NIfTI file at `path` (see the module documentation).
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let (mut source, file_len) = Source::open(path)?;
+    let header_source_gz = source.is_gzip();
+
+    // The header: 4 bytes tell the layout and byte order, then the rest.
+    let mut first4 = [0u8; 4];
+    source
+        .fill(path, &mut first4, 0, 348)
+        .map_err(|e| short_header(path, e))?;
+    let (version, endian) = detect_version(path, first4)?;
+    let len = version.header_len();
+    let mut bytes = vec![0u8; len];
+    bytes[..4].copy_from_slice(&first4);
+    source
+        .fill(path, &mut bytes[4..], 4, len as u64)
+        .map_err(|e| short_header(path, e))?;
+    let header = parse_header(path, &bytes, version, endian)?;
+
+    let layout = Layout::of(path, &header, opts.frame)?;
+    let mut info = FileInfo::new(format!("{} ({}-endian)", layout.type_name, endian));
+    info.header = header
+        .fields
+        .iter()
+        .map(|(n, v)| (n.to_string(), v.display()))
+        .collect();
+    info.frames = layout.frames;
+    info.frame = layout.frame;
+    info.length_unit = length_unit(header.xyzt_units).map(str::to_string);
+    info.notes.push(format!(
+        "{} header, {} ({}-endian{})",
+        version.name(),
+        if header.single_file {
+            "data in the same file"
+        } else {
+            "header/image pair"
+        },
+        endian,
+        if header_source_gz { ", gzip" } else { "" }
+    ));
+    if layout.frames > 1 && opts.frame.is_none() {
+        info.notes.push(format!(
+            "the file holds {} volumes (dim[4]); volume 0 was read (choose one with --frame)",
+            layout.frames
+        ));
+    }
+    if header.bitpix != 8 * layout.dtype.size() as i64 {
+        info.notes.push(format!(
+            "bitpix {} disagrees with datatype {} ({}); the datatype was used",
+            header.bitpix, header.datatype, layout.type_name
+        ));
+    }
+
+    // Where the samples are: after the header (and its extensions) in a
+    // single file, from vox_offset in the .img of a pair.
+    let data_path;
+    let (mut data_source, data_len, mut pos) = if header.single_file {
+        data_path = path.to_path_buf();
+        (source, file_len, len as u64)
+    } else {
+        data_path = image_path(path)?;
+        let (s, l) = Source::open(&data_path)?;
+        info.notes
+            .push(format!("samples read from {}", data_path.display()));
+        (s, l, 0)
+    };
+    let mut data_start = layout.vox_offset;
+    if header.single_file && data_start == 0 {
+        // Some writers leave vox_offset at 0 in a single file; nifti1_io
+        // then reads the data right after the header and its 4-byte
+        // extension flag.
+        data_start = pos + 4;
+        info.notes.push(format!(
+            "vox_offset 0 in a single file: data read from byte {data_start}, after the header"
+        ));
+    }
+    if data_start < pos {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "NIfTI field \"vox_offset\" is {}: the data cannot start inside the {}-byte header",
+                header.vox_offset, len
+            ),
+        ));
+    }
+    // Everything the header implies must be there: all frames for a plain
+    // file (checked against its length before allocating), up to the
+    // wanted frame for a gzip stream (bounded by the deflate ratio).
+    let needed_all = layout
+        .total_bytes(data_start)
+        .ok_or_else(|| too_big(path, &header))?;
+    let needed = layout
+        .bytes_through_frame(data_start)
+        .ok_or_else(|| too_big(path, &header))?;
+    if data_source.is_gzip() {
+        if needed > data_len.saturating_mul(MAX_DEFLATE_RATIO) {
+            return Err(IoError::invalid(
+                &data_path,
+                format!(
+                    "the NIfTI header implies {needed} bytes of data, more than a {data_len}-byte gzip file can hold (dim {})",
+                    dim_text(&header)
+                ),
+            ));
+        }
+    } else if data_len < needed_all {
+        return Err(IoError::invalid(
+            &data_path,
+            format!(
+                "file is {data_len} bytes, but the NIfTI header (vox_offset {}, dim {}, {}) implies {needed_all}",
+                header.vox_offset,
+                dim_text(&header),
+                layout.type_name
+            ),
+        ));
+    }
+
+    // Header extensions sit between the header and vox_offset in a single
+    // file; their flag is the 4 bytes after the header.
+    if header.single_file && data_start >= pos + 4 {
+        let mut extender = [0u8; 4];
+        data_source.fill(&data_path, &mut extender, pos, needed)?;
+        pos += 4;
+        if extender[0] != 0 {
+            info.notes.push(format!(
+                "header extensions ({} bytes before vox_offset) ignored",
+                data_start - pos
+            ));
+        }
+    }
+    let frame_start = data_start + layout.frame_bytes * layout.frame as u64;
+    data_source.skip(&data_path, frame_start - pos, pos, needed)?;
+
+    // The samples, in bounded chunks. A gzip stream grows the output as
+    // data arrives, so a lying header fails at the end of the stream.
+    let mut dims = layout.dims.to_vec();
+    if layout.frames > 1 {
+        dims.push(layout.frames);
+    }
+    check_frame_dims(
+        path,
+        "NIfTI field \"dim\"",
+        &dims,
+        layout.frames,
+        F32_BYTES,
+        opts.max_memory,
+    )?;
+    let count = layout.count;
+    let size = layout.dtype.size();
+    let mut data = Vec::with_capacity(if data_source.is_gzip() {
+        count.min(CHUNK_SAMPLES)
+    } else {
+        count
+    });
+    let mut chunk = vec![0u8; count.min(CHUNK_SAMPLES) * size];
+    let mut done = 0;
+    while done < count {
+        let n = (count - done).min(CHUNK_SAMPLES);
+        let at = frame_start + (done * size) as u64;
+        data_source.fill(&data_path, &mut chunk[..n * size], at, needed)?;
+        extend_f32(&mut data, &chunk[..n * size], layout.dtype, endian);
+        done += n;
+    }
+
+    apply_scaling(&header, &mut data, &mut info);
+    let (steps, origin) = geometry(path, &header, &mut info)?;
+    let volume = grid_to_volume(path, layout.dims, data, steps, origin, &mut info)?;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Nifti,
+        info,
+    })
+}
+
+/// A header cut short reads as a bad file, whatever the source.
+fn short_header(path: &Path, e: IoError) -> IoError {
+    match e {
+        IoError::Truncated { read, .. } => IoError::invalid(
+            path,
+            format!("file ends after {read} bytes, inside the NIfTI header"),
+        ),
+        other => other,
+    }
+}

@@ -1,0 +1,222 @@
+//! Reading a volume: [`read`] and what it takes ([`ReadOptions`]) and
+//! gives ([`Loaded`], [`FileInfo`]). It finds the file's format (named,
+//! else by file name, else by content), checks that the options given
+//! apply to it, and hands the file to the format's reader (all from
+//! [`FORMATS`](crate::formats::FORMATS)).
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use volray_core::Volume;
+
+use crate::formats::VolumeFormat;
+use crate::shared::input::open_input;
+use crate::shared::limits::default_max_memory;
+use crate::{IoError, RawOptions};
+
+/// How to read a file: everything a reader may need beyond the path.
+#[derive(Debug, Clone)]
+pub struct ReadOptions {
+    /// Read as this format, whatever the name and content say (the CLI's
+    /// `--format`).
+    pub format: Option<VolumeFormat>,
+    /// The layout of a raw file (the CLI's `--dims`, `--dtype`, `--endian`,
+    /// `--spacing`).
+    pub raw: Option<RawOptions>,
+    /// Which volume of a file holding several, counted from 0 (the CLI's
+    /// `--frame`): the 4th dimension of NIfTI, NRRD, MetaImage and HDF5,
+    /// the orbital of a cube file, the frame set of a TIFF stack, the
+    /// density block of a CHGCAR (0 total, 1 magnetisation), the series of
+    /// a DICOM directory.
+    pub frame: Option<usize>,
+    /// Which named array of a file holding several (the CLI's `--array`):
+    /// VTK point or cell data arrays.
+    pub array: Option<String>,
+    /// The most bytes the decoded volume and the reader's whole-payload
+    /// buffers may take (the CLI's `--max-memory`): a header asking for
+    /// more is refused before anything is allocated (see
+    /// [`check_volume_size`](crate::check_volume_size)).
+    /// Default: [`default_max_memory`], half the physical memory.
+    pub max_memory: u64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            format: None,
+            raw: None,
+            frame: None,
+            array: None,
+            max_memory: default_max_memory(),
+        }
+    }
+}
+
+/// A volume read from a file, with what the file said about it.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub volume: Volume,
+    pub format: VolumeFormat,
+    pub info: FileInfo,
+}
+
+/// What a file's header said and how the reader used it, for `volray info`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FileInfo {
+    /// The stored sample type as the file names it, e.g. `"int16 (big-endian)"`.
+    pub stored_type: String,
+    /// The header's fields as written, in file order (`key`, `value`).
+    pub header: Vec<(String, String)>,
+    /// What was done to the data beyond decoding: scaling applied
+    /// (`scl_slope`, Rescale Slope, cell volume), axes reordered or
+    /// flipped, cell data turned into points, units converted, header
+    /// fields ignored.
+    pub notes: Vec<String>,
+    /// The unit of spacing and origin, as the file gives it (`"mm"`,
+    /// `"bohr"`, `"angstrom"`), if it gives one.
+    pub length_unit: Option<String>,
+    /// How many volumes the file holds (4th dimension, orbitals, arrays);
+    /// 1 for most files.
+    pub frames: usize,
+    /// Which of them was read.
+    pub frame: usize,
+    /// The named arrays the file holds (VTK), if any, and the one read.
+    pub arrays: Vec<String>,
+    pub array: Option<String>,
+}
+
+impl FileInfo {
+    /// A `FileInfo` for a file holding one volume of `stored_type`.
+    pub fn new(stored_type: impl Into<String>) -> Self {
+        FileInfo {
+            stored_type: stored_type.into(),
+            frames: 1,
+            ..FileInfo::default()
+        }
+    }
+}
+
+/// Reads the volume at `path` (see [`read`]): the volume only.
+pub fn read_volume(path: &Path, raw: Option<&RawOptions>) -> Result<Volume, IoError> {
+    let opts = ReadOptions {
+        raw: raw.cloned(),
+        ..ReadOptions::default()
+    };
+    read(path, &opts).map(|l| l.volume)
+}
+
+/// Reads the volume at `path`.
+///
+/// The format is `opts.format` if given, else the one the file name
+/// announces ([`VolumeFormat::from_path`]), else the one its first bytes
+/// show ([`VolumeFormat::sniff`]); a directory is a DICOM series. Raw
+/// layout options apply to raw files only. An HDF5 dataset is named as
+/// `file.h5:/group/dataset`.
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let format = detect(path, opts)?;
+    let spec = format.spec();
+    if opts.raw.is_some() && format != VolumeFormat::Raw {
+        return Err(IoError::RawOptionsNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    if opts.frame.is_some() && !spec.frames {
+        return Err(IoError::FrameNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    if opts.array.is_some() && !spec.arrays {
+        return Err(IoError::ArrayNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    (spec.read)(path, opts)
+}
+
+/// Splits `file.h5:/group/dataset` into the file and the dataset path,
+/// if `path` has that shape and is not itself an existing file.
+pub fn split_hdf5_path(path: &Path) -> Option<(PathBuf, String)> {
+    if path.exists() {
+        return None;
+    }
+    let s = path.to_str()?;
+    let lower = s.to_ascii_lowercase();
+    [".h5:", ".hdf5:", ".he5:"].iter().find_map(|ext| {
+        let at = lower.find(ext)? + ext.len() - 1;
+        Some((PathBuf::from(&s[..at]), s[at + 1..].to_string()))
+    })
+}
+
+/// The format to read `path` as: see [`read`].
+fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
+    if let Some(format) = opts.format {
+        return Ok(format);
+    }
+    if split_hdf5_path(path).is_some() {
+        return Ok(VolumeFormat::Hdf5);
+    }
+    if path.is_dir() {
+        return Ok(VolumeFormat::Dicom);
+    }
+    if let Some(format) = VolumeFormat::from_path(path) {
+        return Ok(format);
+    }
+    if opts.raw.is_some() {
+        return Ok(VolumeFormat::Raw);
+    }
+    let mut head = Vec::with_capacity(1024);
+    let (file, _) = open_input(path)?;
+    file.take(1024)
+        .read_to_end(&mut head)
+        .map_err(|e| IoError::os(path, "read", e))?;
+    VolumeFormat::sniff(&head).ok_or_else(|| IoError::UnknownFormat {
+        path: path.to_path_buf(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DType, write_npy};
+
+    #[test]
+    fn dispatch_by_extension() {
+        let dir = tempfile::tempdir().unwrap();
+        let v = Volume::new([2, 2, 3], (0..12).map(|i| i as f32).collect()).unwrap();
+        let upper = dir.path().join("V.NPY");
+        write_npy(&upper, &v).unwrap();
+        assert_eq!(read_volume(&upper, None).unwrap(), v);
+
+        let opts = RawOptions::new([2, 2, 3], DType::F32);
+        let err = read_volume(&upper, Some(&opts)).unwrap_err();
+        assert!(!err.is_io_failure());
+        assert!(
+            err.to_string()
+                .ends_with("raw layout options do not apply to NumPy .npy files"),
+            "{err}"
+        );
+        assert!(
+            matches!(err, IoError::RawOptionsNotApplicable { format, .. } if format == "NumPy .npy")
+        );
+
+        // A .npy file under another name is known by its magic, unless a
+        // raw layout is given; a file with neither is refused.
+        let renamed = dir.path().join("v.bin");
+        std::fs::copy(&upper, &renamed).unwrap();
+        assert_eq!(read_volume(&renamed, None).unwrap(), v);
+        let err = read_volume(&renamed, Some(&opts)).unwrap_err();
+        assert!(matches!(err, IoError::RawSizeMismatch { .. }), "{err}");
+        let unknown = dir.path().join("v.dat");
+        std::fs::write(&unknown, [7u8; 48]).unwrap();
+        let err = read_volume(&unknown, None).unwrap_err();
+        assert!(matches!(err, IoError::UnknownFormat { .. }), "{err}");
+        assert!(err.to_string().starts_with(&unknown.display().to_string()));
+
+        // Missing .npy file: an I/O failure.
+        let err = read_volume(&dir.path().join("gone.npy"), None).unwrap_err();
+        assert!(err.is_io_failure());
+    }
+}

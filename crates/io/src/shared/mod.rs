@@ -1,0 +1,27 @@
+//! What several readers share: sample types, decompression, opening
+//! files, the memory limit, geometry, and the parsing pieces common to a
+//! family of formats.
+//!
+//! | module | what | used by |
+//! |---|---|---|
+//! | `dtype.rs` | sample types and byte orders, bytes → `f32` | every binary reader |
+//! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM, HDF5 |
+//! | `input.rs` | opening input files, reading samples in bounded chunks | every reader |
+//! | `limits.rs` | the memory limit and the size checks before allocating | every reader |
+//! | `geometry.rs` | a file's grid (origin, step vectors) → the axis-aligned volume | every reader with geometry |
+//! | `text_header.rs` | header lines and field values | NRRD, MetaImage |
+//! | `payload.rs` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
+//! | `text_reader.rs` | numbers streamed out of text | cube, CHGCAR, text data of NRRD and MetaImage |
+//! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |
+//! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
+
+pub(crate) mod compress;
+pub(crate) mod dtype;
+pub(crate) mod geometry;
+pub(crate) mod input;
+pub(crate) mod limits;
+pub(crate) mod payload;
+pub(crate) mod periodic_cell;
+pub(crate) mod text_header;
+pub(crate) mod text_reader;
+pub(crate) mod vtk_arrays;
