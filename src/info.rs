@@ -63,11 +63,15 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     if let Some(i) = info {
         outln!("stored as: {}", i.stored_type);
         if i.frames > 1 {
-            outln!("frame:     {} of {} (--frame)", i.frame, i.frames);
+            outln!(
+                "frame:     {} of {} (--frame picks another)",
+                i.frame,
+                i.frames
+            );
         }
         if !i.arrays.is_empty() {
             outln!(
-                "arrays:    {} (read: {})",
+                "arrays:    {} (read: {}; --array picks another)",
                 i.arrays.join(", "),
                 i.array.as_deref().unwrap_or("-")
             );

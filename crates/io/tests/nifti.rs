@@ -228,8 +228,10 @@ fn four_d_files_pick_a_frame() {
         check_world("frames4d", &l, &ALIGNED, |i, j, k| {
             (ramp(i, j, k) + 1000 * t as i64) as f32
         });
-        assert!(!has_note(&l, "choose one with --frame"));
+        assert!(!has_note(&l, "volume 0 was read"));
     }
+    // Without a frame asked for, the note says which was read.
+    assert!(has_note(&load("frames4d.nii.gz"), "volume 0 was read"));
     let err = read(&fixture("frames4d.nii.gz"), &frame(3)).unwrap_err();
     assert_frame_out_of_range(&err, 3, "the file holds 3 volumes (dim[4])");
 

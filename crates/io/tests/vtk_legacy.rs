@@ -140,12 +140,7 @@ fn several_arrays_default_and_by_name() {
             "{}",
             l.info.stored_type
         );
-        assert!(
-            l.info
-                .notes
-                .iter()
-                .any(|n| n.contains("chosen with --array"))
-        );
+        assert!(l.info.notes.iter().any(|n| n.contains("the one asked for")));
 
         // Cell data becomes a grid of cell centres.
         for name in ["cells", "cell:cells"] {

@@ -155,9 +155,9 @@ pub(crate) fn record_choice(
     info.arrays = entries.iter().map(|e| e.name.clone()).collect();
     info.array = Some(chosen.name.clone());
     let why = match request {
-        Some(_) => "chosen with --array",
+        Some(_) => "the one asked for",
         None if chosen.active_scalars => "the active scalars",
-        None => "the first one-component array; choose another with --array",
+        None => "the first one-component array",
     };
     info.notes.push(format!(
         "read {} data array \"{}\" ({why})",

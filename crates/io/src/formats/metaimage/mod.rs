@@ -151,7 +151,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let frame = payload::chosen_frame(path, opts.frame, frames)?;
     let select = if ndims == 4 {
         notes.push(format!(
-            "4-D image: volume {frame} of {frames} along the 4th axis read (--frame picks another)"
+            "4-D image: volume {frame} of {frames} along the 4th axis read"
         ));
         FrameSelect {
             stride: dims[0] * dims[1] * dims[2],

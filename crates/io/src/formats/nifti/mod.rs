@@ -85,7 +85,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     ));
     if layout.frames > 1 && opts.frame.is_none() {
         info.notes.push(format!(
-            "the file holds {} volumes (dim[4]); volume 0 was read (choose one with --frame)",
+            "the file holds {} volumes (dim[4]); volume 0 was read",
             layout.frames
         ));
     }

@@ -103,7 +103,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
     if let Some(f) = geometry.frame_axis {
         notes.push(format!(
-            "4-D file: volume {frame} of {frames} along axis {f}{} read (--frame picks another)",
+            "4-D file: volume {frame} of {frames} along axis {f}{} read",
             geometry
                 .kinds
                 .as_ref()
