@@ -35,7 +35,6 @@ use crate::image::Image;
 use crate::kernels::composite::PartialPixel;
 use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
-use crate::kernels::projection::projection_color;
 use crate::non_finite::{NonFinite, NonFiniteMask};
 use crate::partial::{PartialImage, PartialPixels};
 use crate::reference;
@@ -200,7 +199,7 @@ impl<'v> Renderer<'v> {
     /// background, projected values through the colour map.
     pub fn finish(&self, settings: &RenderSettings, partial: PartialImage) -> Image {
         let classifier = self.classifier(settings);
-        partial.finish(settings.background, |f| projection_color(&classifier, f))
+        partial.finish(settings.background, |f| classifier.projection_colour(f))
     }
 
     /// Renders one frame into `image` (its buffer reused when it is the
@@ -436,12 +435,10 @@ impl<'v> Renderer<'v> {
             let macrocells = self
                 .macrocells
                 .get_or_init(|| Macrocells::new(&self.volume));
-            let bricks = ClassifiedBricks::new(
-                &self.volume,
-                macrocells,
-                &classifier,
-                self.non_finite.as_ref(),
-            );
+            let mask = self.non_finite.as_ref();
+            let bricks = ClassifiedBricks::new(&self.volume, macrocells, &classifier, |v| {
+                mask.is_some_and(|m| m.contains(v))
+            });
             *guard = Some(FastState {
                 classifier,
                 bricks,

@@ -5,6 +5,7 @@
 
 use crate::camera::Camera;
 use crate::error::{ImageSide, Reflection, SettingError};
+pub use crate::kernels::blend::Blend;
 use crate::kernels::phong::Phong;
 use crate::sampling::clipping::ClipPlane;
 use crate::transfer::function::TransferFunction;
@@ -19,27 +20,6 @@ pub const MAX_IMAGE_PIXELS: usize = 1 << 26;
 /// Largest number of samples one ray may take: a smaller step is refused
 /// rather than left to run for hours.
 pub const MAX_SAMPLES_PER_RAY: f64 = 1.0e6;
-
-/// How a ray's samples combine into its pixel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Blend {
-    /// Composite classified, shaded samples (the paper's).
-    #[default]
-    Composite,
-    /// Maximum intensity projection (MIP).
-    Maximum,
-    /// Minimum intensity projection (MinIP).
-    Minimum,
-    /// The mean value along the ray.
-    Average,
-}
-
-impl Blend {
-    /// Whether this projects the scalar instead of compositing.
-    pub fn is_projection(self) -> bool {
-        self != Blend::Composite
-    }
-}
 
 /// Where classification happens.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

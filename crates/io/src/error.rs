@@ -23,7 +23,7 @@ use volray_core::VolumeError;
 
 #[cfg(doc)]
 use crate::ReadOptions;
-use crate::shared::dtype::DType;
+use crate::dtype::DType;
 
 /// Why a volume could not be read or an image could not be written.
 #[derive(Debug, Error)]

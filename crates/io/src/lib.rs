@@ -54,6 +54,7 @@
 //! data; `shared/periodic_cell.rs` resamples skewed periodic cells;
 //! `shared/vtk_arrays.rs` chooses the array of a VTK file.
 //!
+//! Sample types and byte orders ([`DType`], [`Endian`]) are in `dtype.rs`.
 //! Images are written by `images/` (`png.rs`, `exr.rs`, `animation.rs`),
 //! every file through `atomic.rs`.
 //!
@@ -88,6 +89,7 @@
 //! ```
 
 mod atomic;
+mod dtype;
 mod error;
 mod formats;
 mod images;
@@ -95,6 +97,7 @@ mod read;
 mod shared;
 
 pub use atomic::{AtomicFile, remove_unfinished_files, write_atomically};
+pub use dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
 pub use error::IoError;
 pub use formats::VolumeFormat;
 pub use formats::npy::{read_npy, write_npy};
@@ -105,7 +108,6 @@ pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
 pub use read::{FileInfo, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
 pub use shared::compress::{Compression, inflate_exact};
-pub use shared::dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
 pub use shared::geometry::grid_to_volume;
 pub use shared::limits::{
     FALLBACK_MAX_MEMORY, check_memory, check_volume_size, count_values, default_max_memory,

@@ -27,7 +27,6 @@
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot, slot_coords};
 use crate::kernels::gradient::gradient_at;
-use crate::non_finite::NonFiniteMask;
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use rayon::prelude::*;
@@ -106,16 +105,15 @@ pub struct ClassifiedBricks {
 
 impl ClassifiedBricks {
     /// Classifies `volume` brick by brick; `macrocells` are its value
-    /// ranges. For a cleaned volume, its `mask`ed voxels (non-finite in the
+    /// ranges. For a cleaned volume, the voxels `masked` says (non-finite in the
     /// original, see [`NonFinite`](crate::NonFinite)) get zero opacity.
     pub fn new(
         volume: &Volume,
         macrocells: &Macrocells,
         classifier: &Classifier,
-        mask: Option<&NonFiniteMask>,
+        masked: impl Fn(usize) -> bool + Sync,
     ) -> Self {
         let grid = macrocells.grid;
-        let masked = |v: usize| mask.is_some_and(|m| m.contains(v));
         let data = volume.data();
         let [nx, ny, _] = grid.dims;
         let coords = |v: usize| (v % nx, (v / nx) % ny, v / (nx * ny));
@@ -291,7 +289,7 @@ mod tests {
         data[12 + 30 * (3 + 10 * 20)] = 1.0;
         let v = Volume::new([30, 10, 25], data).unwrap();
         let c = threshold();
-        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, None);
+        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, |_| false);
         assert_eq!(b.occupied, vec![[1, 0, 2]]);
         assert_eq!(b.slot_of[b.grid.index([1, 0, 2])], 0);
         assert_eq!(b.slot_of.iter().filter(|&&s| s != EMPTY).count(), 1);
@@ -326,7 +324,7 @@ mod tests {
         let mut data = vec![0.0f32; 20 * 5 * 5];
         data[8 + 20 * (2 + 5 * 2)] = 1.0;
         let v = Volume::new([20, 5, 5], data).unwrap();
-        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &threshold(), None);
+        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &threshold(), |_| false);
         assert_eq!(b.occupied, vec![[0, 0, 0], [1, 0, 0]]);
     }
 
@@ -338,7 +336,7 @@ mod tests {
             (0.6 + 0.03 * (1.5 * p.x + 4.0 * p.y)) as f32
         })
         .unwrap();
-        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &threshold(), None);
+        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &threshold(), |_| false);
         assert!(b.len() > 0);
         let want = DVec3::new(1.5, 4.0, 0.0).normalize() * NORMAL_UNIT as f64;
         for v in &b.voxels {
@@ -370,7 +368,7 @@ mod tests {
             thickness: 2.0,
         };
         let c = base.with_iso(iso, 1.0, max_magnitude(&v));
-        let b = ClassifiedBricks::new(&v, &m, &c, None);
+        let b = ClassifiedBricks::new(&v, &m, &c, |_| false);
         let mut skipped_by_range = 0;
         for i in 0..m.grid.len() {
             let brick = m.grid.coords(i);

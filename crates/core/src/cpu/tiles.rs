@@ -308,7 +308,7 @@ mod tests {
         // tile; the four bricks along x share it, nearest (largest x) first.
         let v = Volume::new([33, 33, 33], vec![1.0; 33 * 33 * 33]).unwrap();
         let c = Classifier::new((0.0, 1.0), OpacityMap::Ramp { p: 0.1, q: 0.5 }, None, 1.0);
-        let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, None);
+        let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, |_| false);
         assert_eq!(bricks.len(), 64);
         let sampling = Sampling {
             grid: GridFrame {
@@ -401,7 +401,7 @@ mod tests {
             .with_origin(DVec3::new(-3.0, 2.0, 1.0))
             .unwrap();
         let c = Classifier::new((0.0, 1.0), OpacityMap::Ramp { p: 0.0, q: 0.5 }, None, 1.0);
-        let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, None);
+        let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, |_| false);
         let all = bricks.grid.len();
         assert!(
             bricks.len() > all / 4 && bricks.len() < all,

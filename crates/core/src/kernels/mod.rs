@@ -8,9 +8,11 @@
 //! | [`gradient`] | central differences (errata 1), in world units |
 //! | [`phong`] | the paper's Phong model, two-sided, on one normal or four |
 //! | [`composite`] | front-to-back and back-to-front compositing, partial pixels and `over` |
-//! | [`projection`] | the running maximum, minimum or mean of a ray's scalar samples, and their colour |
+//! | [`blend`] | how a ray's samples make its pixel: composited, or a projection of the scalar |
+//! | [`projection`] | the running maximum, minimum or mean of a ray's scalar samples, merged across pieces of a ray |
 //! | [`lanes`] | the number type kernels are written over: `f32` or `wide::f32x4` |
 
+pub mod blend;
 pub mod composite;
 pub mod gradient;
 pub mod lanes;

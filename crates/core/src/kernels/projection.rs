@@ -1,21 +1,8 @@
-//! Blend modes: how the samples along a ray make the pixel.
-//!
-//! [`Blend::Composite`] is the paper's: classified, shaded samples
-//! composited with the transparency formula (see [`crate::kernels::composite`]).
-//! The others are projections of the interpolated *scalar* along the ray,
-//! as VTK's `vtkVolumeMapper` blend modes MAXIMUM_INTENSITY,
-//! MINIMUM_INTENSITY and AVERAGE_INTENSITY: the maximum, the minimum or the
-//! mean of the values at the ray's samples (inside the cropped and clipped
-//! part of the volume). The value is then shown through the colour map:
-//! the pixel is the classifier's colour of the value's normalised scalar
-//! `t`, opaque, with no shading and no opacity. Without a colour function
-//! the map is grey, `t` clamped to [0, 1] (a white map would show nothing
-//! but the volume's silhouette), so with `--range 0,1` a maximum intensity
-//! pixel's grey level is the ray's maximum. A ray with no sample shows the
-//! background.
+//! Projections of the scalar along a ray (maximum, minimum, average; see
+//! [`Blend`]): the running value of a ray, or of a piece of it, and how
+//! pieces merge.
 
-use crate::settings::Blend;
-use crate::transfer::classifier::Classifier;
+use crate::kernels::blend::Blend;
 
 /// One ray's projection of its scalar samples so far: the running
 /// maximum, minimum or sum, and how many samples it took. The same for a
@@ -83,20 +70,9 @@ impl Projected {
     }
 }
 
-/// The pixel colour of projected value `f`: the classifier's colour map of
-/// `f`'s normalised scalar, grey without one.
-pub fn projection_color(classifier: &Classifier, f: f32) -> [f32; 3] {
-    match classifier.color() {
-        Some(_) => classifier.material(f),
-        None => [classifier.normalise(f).clamp(0.0, 1.0); 3],
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::transfer::classifier::OpacityMap;
-    use crate::transfer::function::PiecewiseLinear;
 
     #[test]
     fn projections_of_known_samples() {
@@ -122,21 +98,5 @@ mod tests {
                 assert_eq!(b.merge(blend, a), whole, "{blend:?} cut {cut}");
             }
         }
-    }
-
-    #[test]
-    fn colour_is_the_map_of_the_normalised_value() {
-        let ramp = OpacityMap::Ramp { p: 0.0, q: 0.5 };
-        let grey = Classifier::new((2.0, 6.0), ramp.clone(), None, 1.0);
-        assert_eq!(projection_color(&grey, 3.0), [0.25; 3]);
-        assert_eq!(projection_color(&grey, 9.0), [1.0; 3]);
-        assert_eq!(projection_color(&grey, 0.0), [0.0; 3]);
-        let red_blue = PiecewiseLinear::new(
-            "color",
-            vec![(0.0, [1.0, 0.0, 0.0]), (1.0, [0.0, 0.0, 1.0])],
-        )
-        .unwrap();
-        let mapped = Classifier::new((2.0, 6.0), ramp, Some(red_blue), 1.0);
-        assert_eq!(projection_color(&mapped, 3.0), [0.75, 0.0, 0.25]);
     }
 }

@@ -220,6 +220,16 @@ impl Classifier {
         (self.lo, self.inv_range)
     }
 
+    /// The pixel colour of a projected value `f` (maximum, minimum or
+    /// average intensity, see [`Blend`](crate::Blend)): the colour map of
+    /// `f`'s normalised scalar, grey without one (`t` clamped to [0, 1]).
+    pub fn projection_colour(&self, f: f32) -> [f32; 3] {
+        match self.color() {
+            Some(_) => self.material(f),
+            None => [self.normalise(f).clamp(0.0, 1.0); 3],
+        }
+    }
+
     /// The colour function, if any (white without one).
     pub fn color(&self) -> Option<&PiecewiseLinear<3>> {
         self.color.as_ref()
@@ -448,5 +458,21 @@ mod tests {
             .with_iso(iso, 1.0, 4.0)
             .with_gradient_opacity((0.25, 0.75), 4.0);
         assert!((both.opacity_at(4.5, [2.0, 0.0, 0.0]) - 0.7 * 0.75 * 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_projected_value_takes_the_colour_map_of_its_normalised_value() {
+        let ramp = OpacityMap::Ramp { p: 0.0, q: 0.5 };
+        let grey = Classifier::new((2.0, 6.0), ramp.clone(), None, 1.0);
+        assert_eq!(grey.projection_colour(3.0), [0.25; 3]);
+        assert_eq!(grey.projection_colour(9.0), [1.0; 3]);
+        assert_eq!(grey.projection_colour(0.0), [0.0; 3]);
+        let red_blue = PiecewiseLinear::new(
+            "color",
+            vec![(0.0, [1.0, 0.0, 0.0]), (1.0, [0.0, 0.0, 1.0])],
+        )
+        .unwrap();
+        let mapped = Classifier::new((2.0, 6.0), ramp, Some(red_blue), 1.0);
+        assert_eq!(mapped.projection_colour(3.0), [0.75, 0.0, 0.25]);
     }
 }

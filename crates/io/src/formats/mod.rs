@@ -49,7 +49,7 @@ use std::fmt;
 use std::path::Path;
 use std::str::FromStr;
 
-use crate::shared::dtype::ParseNameError;
+use crate::dtype::ParseNameError;
 use crate::{IoError, Loaded, ReadOptions};
 
 /// The volume file formats volray reads.

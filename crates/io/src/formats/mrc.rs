@@ -29,8 +29,8 @@ use std::path::Path;
 
 use volray_core::glam::DVec3;
 
+use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian, extend_f32};
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::{open_input, read_exact_at, read_samples};
 use crate::shared::limits::{F32_BYTES, check_dims};

@@ -22,8 +22,8 @@ use std::path::Path;
 use volray_core::{Volume, VolumeError};
 
 use crate::atomic::write_atomically;
+use crate::dtype::{DType, Endian, extend_f32, f16_to_f32};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian, extend_f32, f16_to_f32};
 use crate::shared::input::{open_input, read_exact_at, read_samples};
 use crate::shared::limits::{F32_BYTES, check_dims};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};

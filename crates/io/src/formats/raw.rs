@@ -10,8 +10,8 @@ use volray_core::glam::DVec3;
 use volray_core::{Volume, VolumeError};
 
 use crate::atomic::write_atomically;
+use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian, extend_f32};
 use crate::shared::input::{open_input, read_samples};
 use crate::shared::limits::{F32_BYTES, check_dims, default_max_memory};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};

@@ -4,7 +4,6 @@
 //!
 //! | module | what | used by |
 //! |---|---|---|
-//! | `dtype.rs` | sample types and byte orders, bytes → `f32` | every binary reader |
 //! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM, HDF5 |
 //! | `input.rs` | opening input files, reading samples in bounded chunks | every reader |
 //! | `limits.rs` | the memory limit and the size checks before allocating | every reader |
@@ -16,7 +15,6 @@
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
 
 pub(crate) mod compress;
-pub(crate) mod dtype;
 pub(crate) mod geometry;
 pub(crate) mod input;
 pub(crate) mod limits;

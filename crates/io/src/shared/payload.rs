@@ -18,8 +18,8 @@ use std::path::{Path, PathBuf};
 
 use flate2::read::{MultiGzDecoder, ZlibDecoder};
 
+use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian, extend_f32};
 use crate::shared::input::{open_input, read_samples};
 use crate::shared::text_reader::TextReader;
 

@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 use volray_core::glam::DVec3;
 
 use self::header::Header;
+use crate::dtype::{DType, Endian};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian};
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
 use crate::shared::limits::{F32_BYTES, check_frame_dims};

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use super::header::Header;
 use crate::FileInfo;
+use crate::dtype::DType;
 use crate::error::IoError;
-use crate::shared::dtype::DType;
 
 /// The sample type of NIfTI datatype `code`, or why it is refused.
 fn sample_type(code: i64) -> Result<(DType, &'static str), String> {

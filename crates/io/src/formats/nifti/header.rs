@@ -7,8 +7,8 @@
 
 use std::path::Path;
 
+use crate::dtype::Endian;
 use crate::error::IoError;
-use crate::shared::dtype::Endian;
 
 /// The two header layouts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -13,9 +13,9 @@ use base64::Engine;
 use base64::engine::DecodePaddingMode;
 use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
 
+use crate::dtype::Endian;
 use crate::error::IoError;
 use crate::shared::compress::{Compression, inflate_exact};
-use crate::shared::dtype::Endian;
 
 /// How a file frames its binary data (`VTKFile` attributes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

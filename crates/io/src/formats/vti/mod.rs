@@ -28,8 +28,8 @@ use std::path::Path;
 
 use volray_core::glam::{DMat3, DVec3};
 
+use crate::dtype::{DType, bytes_to_f32};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, bytes_to_f32};
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
 use crate::shared::limits::{F32_BYTES, check_file_held, check_memory};

@@ -11,8 +11,8 @@ use volray_core::glam::{DMat3, DVec3};
 
 use super::blocks::BlockFormat;
 use crate::FileInfo;
+use crate::dtype::{DType, Endian};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian};
 use crate::shared::vtk_arrays::{ArrayEntry, Association};
 
 /// Where an array's values are.

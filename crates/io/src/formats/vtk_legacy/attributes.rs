@@ -7,8 +7,8 @@
 use super::lexer::Lexer;
 use super::values::{Encoding, SampleType, array_values, parse_type};
 use crate::FileInfo;
+use crate::dtype::DType;
 use crate::error::IoError;
-use crate::shared::dtype::DType;
 use crate::shared::vtk_arrays::{ArrayEntry, Association, rank};
 
 /// One array's description, as its header words give it.

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use super::attributes::ArraySpec;
 use super::lexer::Lexer;
+use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
-use crate::shared::dtype::{DType, Endian, extend_f32};
 use crate::shared::limits::{F32_BYTES, check_memory};
 
 /// Samples decoded per read of BINARY data.
