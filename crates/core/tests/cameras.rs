@@ -2,12 +2,16 @@
 //! from where they move the eye, zoom magnifies about the image centre, and
 //! a framing box makes different volumes frame alike. Both stage-2 paths.
 
+mod common;
+
+use common::{both_paths, tf};
 use volray_core::camera::{Camera, Fit};
 use volray_core::glam::DVec3;
-use volray_core::{Image, Method, RenderSettings, Renderer, TransferFunction, Volume};
+use volray_core::{Image, RenderSettings, Renderer, Volume};
 
-/// Two Gaussian blobs off the centre, no symmetry, on a non-cubic grid.
-fn blobs() -> Volume {
+/// Two Gaussian blobs off the centre, no symmetry, on a non-cubic grid (in
+/// world units from its corner: not `common::blobs`).
+fn two_blobs() -> Volume {
     let origin = DVec3::new(-1.0, 2.0, 0.5);
     Volume::from_fn([14, 11, 17], DVec3::new(0.2, 0.25, 0.15), origin, |p| {
         let u = p - origin;
@@ -18,29 +22,20 @@ fn blobs() -> Volume {
     .unwrap()
 }
 
-fn tf() -> TransferFunction {
-    TransferFunction::from_json(
-        r#"{"opacity": [[0, 0], [0.2, 0], [1, 0.8]],
-            "color": [[0, 0.2, 0.3, 0.9], [1, 0.9, 0.4, 0.1]]}"#,
-    )
-    .unwrap()
-}
-
-/// Renders `camera` on both paths at `w × h`.
+/// Renders `camera` on both paths at `w × h`: the fast image, then the
+/// reference.
 fn render(volume: &Volume, camera: Camera, w: usize, h: usize) -> [Image; 2] {
     let renderer = Renderer::new(volume).unwrap();
-    [Method::Fast, Method::Reference].map(|method| {
-        renderer
-            .render(&RenderSettings {
-                width: w,
-                height: h,
-                camera,
-                transfer_function: tf(),
-                method,
-                ..RenderSettings::default()
-            })
-            .unwrap()
-    })
+    let settings = RenderSettings {
+        width: w,
+        height: h,
+        camera,
+        transfer_function: tf(r#"{"opacity": [[0, 0], [0.2, 0], [1, 0.8]],
+            "color": [[0, 0.2, 0.3, 0.9], [1, 0.9, 0.4, 0.1]]}"#),
+        ..RenderSettings::default()
+    };
+    let (fast, reference) = both_paths(&renderer, &settings);
+    [fast, reference]
 }
 
 fn lit_pixels(image: &Image) -> usize {
@@ -49,7 +44,7 @@ fn lit_pixels(image: &Image) -> usize {
 
 #[test]
 fn orbits_render_the_view_from_where_they_move_the_eye() {
-    let volume = blobs();
+    let volume = two_blobs();
     let (lo, hi) = volume.bounds();
     let centre = 0.5 * (lo + hi);
     // Azimuth 90 from the default +x eye: the view from +y (VTK).
@@ -106,7 +101,7 @@ fn orbits_render_the_view_from_where_they_move_the_eye() {
 fn zoom_two_is_the_centre_of_a_picture_twice_as_large() {
     // Same pixel size, same image plane, the same pixel centres: the
     // zoomed picture is the middle of the unzoomed one, sample for sample.
-    let volume = blobs();
+    let volume = two_blobs();
     let camera = Camera {
         view_point: Some(DVec3::new(9.0, -4.0, 6.0)),
         ..Camera::default()
@@ -139,7 +134,7 @@ fn a_framing_box_frames_different_volumes_alike() {
     // A volume and its copy shifted inside a common box: with the box as
     // the frame, the copy's picture is the original's shifted by whole
     // pixels.
-    let volume = blobs();
+    let volume = two_blobs();
     let (lo, hi) = volume.bounds();
     let shift = DVec3::new(0.0, 0.5, -0.5);
     let moved = Volume::from_fn(

@@ -2,30 +2,19 @@
 //! contours and gradient-magnitude opacity, on both paths (the fast path
 //! held to the reference within 1/255), and their settings.
 
+mod common;
+
+use common::{assert_within_a_level, both_paths, tf};
 use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
-use volray_core::{
-    Image, IsoSurface, Method, RenderError, RenderSettings, Renderer, SettingError,
-    TransferFunction, Volume,
-};
+use volray_core::{Image, IsoSurface, RenderError, RenderSettings, Renderer, SettingError, Volume};
 
 /// The fast and the reference image of one frame, which must agree within
 /// 1/255 per channel.
-fn both_paths(renderer: &Renderer, settings: &RenderSettings, what: &str) -> (Image, Image) {
-    let fast = renderer.render(settings).unwrap();
-    let reference = renderer
-        .render(&RenderSettings {
-            method: Method::Reference,
-            ..settings.clone()
-        })
-        .unwrap();
-    let diff = fast.max_abs_diff(&reference).unwrap();
-    assert!(diff <= 1.0 / 255.0, "{what}: fast vs reference {diff}");
+fn agreeing_paths(renderer: &Renderer, settings: &RenderSettings, what: &str) -> (Image, Image) {
+    let (fast, reference) = both_paths(renderer, settings);
+    assert_within_a_level(&fast, &reference, what);
     (fast, reference)
-}
-
-fn tf(json: &str) -> TransferFunction {
-    TransferFunction::from_json(json).unwrap()
 }
 
 /// The distance from the centre of [−1, 1]³ on `n`³ voxels.
@@ -57,7 +46,7 @@ fn an_iso_surface_of_a_distance_field_is_a_hollow_shell() {
         background: [0.0, 0.0, 0.2],
         ..RenderSettings::default()
     };
-    let (_, image) = both_paths(&renderer, &settings, "default view");
+    let (_, image) = agreeing_paths(&renderer, &settings, "default view");
     let alpha = |col, row| image.get(col, row)[3];
     // Through the centre the ray crosses the shell twice, and sees nothing
     // of the inside (a value threshold at 0.6 would fill the ball).
@@ -106,7 +95,7 @@ fn an_iso_surface_of_a_distance_field_is_a_hollow_shell() {
                 step,
                 ..settings.clone()
             };
-            both_paths(&renderer, &s, &format!("{camera:?} step {step}"));
+            agreeing_paths(&renderer, &s, &format!("{camera:?} step {step}"));
         }
     }
     let stretched = Volume::from_fn(
@@ -117,7 +106,7 @@ fn an_iso_surface_of_a_distance_field_is_a_hollow_shell() {
     )
     .unwrap();
     let renderer = Renderer::new(&stretched).unwrap();
-    let (_, image) = both_paths(&renderer, &settings, "anisotropic");
+    let (_, image) = agreeing_paths(&renderer, &settings, "anisotropic");
     assert!(image.pixels().iter().any(|p| p[3] > 0.2));
 }
 
@@ -167,13 +156,13 @@ fn gradient_opacity_hides_uniform_regions_and_keeps_the_edge() {
         transfer_function: tf(r#"{"opacity": [[0, 0.5]]}"#),
         ..RenderSettings::default()
     };
-    let (_, without) = both_paths(&renderer, &plain, "no gradient opacity");
+    let (_, without) = agreeing_paths(&renderer, &plain, "no gradient opacity");
     assert!(without.pixels().iter().all(|p| p[3] > 0.99));
     let settings = RenderSettings {
         gradient_opacity: Some((0.1, 0.5)),
         ..plain.clone()
     };
-    let (_, image) = both_paths(&renderer, &settings, "gradient opacity");
+    let (_, image) = agreeing_paths(&renderer, &settings, "gradient opacity");
     for row in 0..16 {
         for col in (0..12).chain(18..32) {
             assert_eq!(image.get(col, row), [0.0; 4], "{col},{row}");

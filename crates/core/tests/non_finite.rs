@@ -3,7 +3,12 @@
 //! checked against closed forms, against the same data with those voxels
 //! cut away, and the fast paths against the reference.
 
-use volray_core::PiecewiseLinear;
+mod common;
+
+use common::{
+    assert_uniform_medium, assert_within_a_level, colorful, constant_tf, grey_unit_window,
+    on_the_reference, uniform_medium,
+};
 use volray_core::camera::{Camera, Projection};
 use volray_core::glam::DVec3;
 use volray_core::{
@@ -11,63 +16,13 @@ use volray_core::{
     RenderSettings, Renderer, TransferFunction, Volume,
 };
 
-fn reference(settings: &RenderSettings) -> RenderSettings {
-    RenderSettings {
-        method: Method::Reference,
-        ..settings.clone()
-    }
-}
-
 fn transparent(volume: &Volume) -> Renderer<'_> {
     Renderer::with_non_finite(volume, NonFinite::Transparent).unwrap()
 }
 
-fn constant_tf(alpha: f32, color: [f32; 3]) -> TransferFunction {
-    TransferFunction {
-        domain: None,
-        opacity: Some(PiecewiseLinear::constant([alpha])),
-        color: Some(PiecewiseLinear::constant(color)),
-    }
-}
-
-fn colorful() -> TransferFunction {
-    TransferFunction::from_json(
-        r#"{"opacity": [[0, 0], [0.1, 0], [0.6, 0.4], [1, 0.9]],
-            "color": [[0, 0.23, 0.299, 0.754], [0.5, 0.865, 0.865, 0.865], [1, 0.706, 0.016, 0.15]]}"#,
-    )
-    .unwrap()
-}
-
-/// Grey levels `t = f` for values in [0, 1], for the projections.
-fn grey_unit_window() -> TransferFunction {
-    TransferFunction {
-        domain: Some((0.0, 1.0)),
-        opacity: None,
-        color: None,
-    }
-}
-
-/// Three Gaussian blobs over the grid (values in about [0, 1]): smooth,
-/// no symmetry, empty space around them.
+/// `common::blobs` on `dims` unit voxels from the world origin.
 fn blobs(dims: [usize; 3]) -> Volume {
-    let centres = [
-        (DVec3::new(0.3, 0.4, 0.5), 0.18, 1.0),
-        (DVec3::new(0.7, 0.6, 0.3), 0.12, 0.7),
-        (DVec3::new(0.5, 0.25, 0.75), 0.08, 0.9),
-    ];
-    let top = DVec3::new(
-        (dims[0] - 1) as f64,
-        (dims[1] - 1) as f64,
-        (dims[2] - 1) as f64,
-    );
-    Volume::from_fn(dims, DVec3::ONE, DVec3::ZERO, |p| {
-        let u = p / top;
-        centres
-            .iter()
-            .map(|(c, w, h)| h * (-(u - *c).length_squared() / (2.0 * w * w)).exp())
-            .sum::<f64>() as f32
-    })
-    .unwrap()
+    common::blobs(dims, DVec3::ONE, DVec3::ZERO)
 }
 
 /// `volume` with the voxels `hole(i, j, k)` names set to its value.
@@ -150,7 +105,7 @@ fn a_non_finite_slab_in_a_uniform_medium_leaves_the_shorter_medium() {
     // - post-classified (and in any mode a non-finite voxel weighs in a
     //   sample), those two are skipped: (1 − α_s)^14.
     // Lit, the medium has no gradient: ambient light only, 0.1 c.
-    let medium = Volume::new([11, 7, 5], vec![3.0; 11 * 7 * 5]).unwrap();
+    let medium = uniform_medium();
     let volume = with_holes(&medium, |i, j, k| {
         (4..=6).contains(&i).then(|| non_finite(i, j, k))
     });
@@ -184,16 +139,8 @@ fn a_non_finite_slab_in_a_uniform_medium_leaves_the_shorter_medium() {
                         Method::Fast => 1.0 / 255.0,
                     };
                     let image = renderer.render(&settings).unwrap();
-                    for px in image.pixels() {
-                        for ch in 0..3 {
-                            let want = light * c[ch] as f64 * (1.0 - keep) + bg[ch] as f64 * keep;
-                            assert!(
-                                (px[ch] as f64 - want).abs() < tol,
-                                "{classification:?} step {step} {method:?}: {px:?} vs {want}"
-                            );
-                        }
-                        assert!((px[3] as f64 - (1.0 - keep)).abs() < tol);
-                    }
+                    let what = format!("{classification:?} step {step} {method:?}");
+                    assert_uniform_medium(&image, light, c, bg, keep, tol, &what);
                     checked += 1;
                 }
             }
@@ -344,15 +291,14 @@ fn fast_paths_match_the_reference_with_non_finite_regions_in_every_mode() {
                 ..settings.clone()
             };
             let fast = renderer.render(&settings).unwrap();
-            let slow = renderer.render(&reference(&settings)).unwrap();
-            let diff = fast.max_abs_diff(&slow).unwrap();
+            let slow = renderer.render(&on_the_reference(&settings)).unwrap();
+            let diff = assert_within_a_level(&fast, &slow, &format!("{name}, {camera:?}"));
             worst = worst.max(diff);
-            assert!(diff <= 1.0 / 255.0, "{name}, {camera:?}: {diff}");
             assert!(
                 slow.pixels().iter().any(|p| p[3] > 0.2),
                 "{name}: the image is empty"
             );
-            let plain = unmasked.render(&reference(&settings)).unwrap();
+            let plain = unmasked.render(&on_the_reference(&settings)).unwrap();
             changed = changed.max(plain.max_abs_diff(&slow).unwrap());
         }
         println!("{name}: masking changed the picture by {changed}");

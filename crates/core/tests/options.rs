@@ -2,6 +2,12 @@
 //! blend modes (maximum, minimum, average), post-classification, jitter,
 //! the crop box and clip planes, perspective, and which path renders what.
 
+mod common;
+
+use common::{
+    Cut, assert_uniform_medium, assert_within_a_level, blobs, both_paths, colorful, constant_tf,
+    grey_unit_window, on_the_reference, render_on_threads, uniform_medium,
+};
 use volray_core::PiecewiseLinear;
 use volray_core::camera::{Camera, Projection, View};
 use volray_core::glam::DVec3;
@@ -10,68 +16,6 @@ use volray_core::{
     Blend, Classification, ClipPlane, Image, Method, RenderSettings, Renderer, TransferFunction,
     Volume,
 };
-
-fn reference(settings: &RenderSettings) -> RenderSettings {
-    RenderSettings {
-        method: Method::Reference,
-        ..settings.clone()
-    }
-}
-
-/// The fast and the reference image of one frame.
-fn both_paths(renderer: &Renderer, settings: &RenderSettings) -> (Image, Image) {
-    assert_eq!(settings.method, Method::Fast);
-    let fast = renderer.render(settings).unwrap();
-    let reference = renderer.render(&reference(settings)).unwrap();
-    (fast, reference)
-}
-
-fn constant_tf(alpha: f32, color: [f32; 3]) -> TransferFunction {
-    TransferFunction {
-        domain: None,
-        opacity: Some(PiecewiseLinear::constant([alpha])),
-        color: Some(PiecewiseLinear::constant(color)),
-    }
-}
-
-/// Grey levels `t = f` for values in [0, 1].
-fn grey_unit_window() -> TransferFunction {
-    TransferFunction {
-        domain: Some((0.0, 1.0)),
-        opacity: None,
-        color: None,
-    }
-}
-
-fn colorful() -> TransferFunction {
-    TransferFunction::from_json(
-        r#"{"opacity": [[0, 0], [0.1, 0], [0.6, 0.4], [1, 0.9]],
-            "color": [[0, 0.23, 0.299, 0.754], [0.5, 0.865, 0.865, 0.865], [1, 0.706, 0.016, 0.15]]}"#,
-    )
-    .unwrap()
-}
-
-/// Three Gaussian blobs on [0, 1]³ scaled to the grid: smooth, no symmetry.
-fn blobs(dims: [usize; 3], spacing: DVec3, origin: DVec3) -> Volume {
-    let centres = [
-        (DVec3::new(0.3, 0.4, 0.5), 0.18, 1.0),
-        (DVec3::new(0.7, 0.6, 0.3), 0.12, 0.7),
-        (DVec3::new(0.5, 0.25, 0.75), 0.08, 0.9),
-    ];
-    let extent = DVec3::new(
-        (dims[0] - 1) as f64,
-        (dims[1] - 1) as f64,
-        (dims[2] - 1) as f64,
-    ) * spacing;
-    Volume::from_fn(dims, spacing, origin, |p| {
-        let u = (p - origin) / extent;
-        centres
-            .iter()
-            .map(|(c, w, h)| h * (-(u - *c).length_squared() / (2.0 * w * w)).exp())
-            .sum::<f64>() as f32
-    })
-    .unwrap()
-}
 
 /// A ball of radius `r` about `centre` with a soft edge one voxel wide.
 fn ball(n: usize, r: f64, centre: DVec3) -> Volume {
@@ -292,19 +236,13 @@ fn fast_projections_match_the_reference_with_every_option() {
                     background: [0.1, 0.1, 0.3],
                     ..RenderSettings::default()
                 };
-                let in_pool = |threads: usize| {
-                    let pool = rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()
-                        .unwrap();
-                    pool.install(|| renderer.render(&settings).unwrap())
-                };
+                let in_pool = |threads| render_on_threads(&renderer, &settings, threads);
                 let (fast, fast_2) = (in_pool(1), in_pool(2));
                 assert!(fast == fast_2);
-                let slow = renderer.render(&reference(&settings)).unwrap();
-                let diff = max_diff(&fast, &slow);
+                let slow = renderer.render(&on_the_reference(&settings)).unwrap();
+                let diff =
+                    assert_within_a_level(&fast, &slow, &format!("{camera:?} {blend:?} {jitter}"));
                 worst = worst.max(diff);
-                assert!(diff <= 1.0 / 255.0, "{camera:?} {blend:?} {jitter}: {diff}");
                 let (hit, missed) = (
                     fast.pixels().iter().filter(|p| p[3] == 1.0).count(),
                     fast.pixels().iter().filter(|p| p[3] == 0.0).count(),
@@ -367,7 +305,7 @@ fn maximum_projection_finds_single_voxels_behind_brighter_bricks() {
             ..RenderSettings::default()
         };
         let fast = renderer.render(&settings).unwrap();
-        let slow = renderer.render(&reference(&settings)).unwrap();
+        let slow = renderer.render(&on_the_reference(&settings)).unwrap();
         // f32 against f64 interpolation.
         assert!(max_diff(&fast, &slow) < 1e-5);
         // Each spot shows at (nearly) its full height where its centre
@@ -428,7 +366,7 @@ fn skipping_resumes_at_the_first_sample_past_a_skipped_brick() {
                 ..RenderSettings::default()
             };
             let fast = renderer.render(&settings).unwrap();
-            let slow = renderer.render(&reference(&settings)).unwrap();
+            let slow = renderer.render(&on_the_reference(&settings)).unwrap();
             assert!(max_diff(&fast, &slow) < 1e-5, "{blend:?} {camera:?}");
             // The wall shows through everywhere it is seen.
             let wall = if flip { 0.1 } else { 0.9 };
@@ -520,9 +458,6 @@ fn a_clip_plane_equals_the_equivalent_crop() {
     }
 }
 
-/// A crop box and clip planes.
-type Cut = (Option<(DVec3, DVec3)>, Vec<ClipPlane>);
-
 #[test]
 fn fast_path_matches_the_reference_with_crops_clip_planes_and_jitter() {
     let volume = blobs(
@@ -590,12 +525,8 @@ fn fast_path_matches_the_reference_with_crops_clip_planes_and_jitter() {
                     ..RenderSettings::default()
                 };
                 let (fast, reference) = both_paths(&renderer, &settings);
-                let diff = max_diff(&fast, &reference);
-                worst = worst.max(diff);
-                assert!(
-                    diff <= 1.0 / 255.0,
-                    "{camera:?} {crop:?} {planes:?} {jitter}: {diff}"
-                );
+                let what = format!("{camera:?} {crop:?} {planes:?} {jitter}");
+                worst = worst.max(assert_within_a_level(&fast, &reference, &what));
                 assert!(reference.pixels().iter().any(|p| p[3] > 0.3));
             }
         }
@@ -624,14 +555,8 @@ fn jitter_is_deterministic_and_stays_close_to_the_plain_image_of_a_smooth_volume
         jitter: true,
         ..plain.clone()
     };
-    for settings in [jittered.clone(), reference(&jittered)] {
-        let in_pool = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| renderer.render(&settings).unwrap())
-        };
+    for settings in [jittered.clone(), on_the_reference(&jittered)] {
+        let in_pool = |threads| render_on_threads(&renderer, &settings, threads);
         let (one, two, again) = (in_pool(1), in_pool(2), in_pool(2));
         assert!(one == two && two == again, "{:?}", settings.method);
         let unjittered = renderer
@@ -658,7 +583,7 @@ fn post_classification_of_a_uniform_medium_has_the_closed_form_colour() {
     // of colour c and opacity α_s = 1 − (1 − α)^step along each ray give
     // c(1 − (1 − α_s)^K) + bg(1 − α_s)^K. Lit, the uniform medium has no
     // gradient, so only the ambient term lights it.
-    let volume = Volume::new([11, 7, 5], vec![3.0; 11 * 7 * 5]).unwrap();
+    let volume = uniform_medium();
     let renderer = Renderer::new(&volume).unwrap();
     let (alpha, c, bg) = (0.3f64, [0.9, 0.5, 0.2], [0.1, 0.2, 1.0]);
     for (step, k) in [(1.0, 11), (0.5, 21), (0.25, 41)] {
@@ -680,16 +605,7 @@ fn post_classification_of_a_uniform_medium_has_the_closed_form_colour() {
             let keep = (1.0 - alpha).powf(step * k as f64);
             let light = if shading { 0.1 } else { 1.0 };
             let image = renderer.render(&settings).unwrap();
-            for px in image.pixels() {
-                for ch in 0..3 {
-                    let want = light * c[ch] as f64 * (1.0 - keep) + bg[ch] as f64 * keep;
-                    assert!(
-                        (px[ch] as f64 - want).abs() < 1e-5,
-                        "step {step}: {px:?} vs {want}"
-                    );
-                }
-                assert!((px[3] as f64 - (1.0 - keep)).abs() < 1e-5);
-            }
+            assert_uniform_medium(&image, light, c, bg, keep, 1e-5, &format!("step {step}"));
         }
     }
 }
@@ -782,7 +698,7 @@ fn perspective_shows_a_near_ball_larger_than_the_same_ball_far_away() {
         // tests/post_fast.rs).
         let view = View::frame(&camera, volume.bounds(), 64, 64).unwrap();
         let mut counts = Vec::new();
-        for settings in [settings.clone(), reference(&settings)] {
+        for settings in [settings.clone(), on_the_reference(&settings)] {
             let image = renderer.render(&settings).unwrap();
             let mut count = 0;
             for row in 0..64 {

@@ -5,101 +5,23 @@
 //! anisotropic spacing; opaque plates whose picture depends on the order
 //! the bricks are composited in; and thread invariance.
 
-use volray_core::camera::{Camera, Projection, View};
+mod common;
+
+use common::{
+    assert_matches, assert_within_a_level, both_paths, looking, on_brick_boundaries, perspective,
+    render_on_threads, scattered_voxels, sparse_tf, tf,
+};
+use volray_core::camera::{Camera, View};
 use volray_core::glam::DVec3;
-use volray_core::{ClipPlane, Image, Method, RenderSettings, Renderer, TransferFunction, Volume};
+use volray_core::{ClipPlane, Image, RenderSettings, Renderer, Volume};
 
-/// The fast and the reference image of one frame, after checking that the
-/// frame does run on the fast path.
-fn both_paths(renderer: &Renderer, settings: &RenderSettings) -> (Image, Image) {
-    assert_eq!(settings.method, Method::Fast);
-    let fast = renderer.render(settings).unwrap();
-    let reference = renderer
-        .render(&RenderSettings {
-            method: Method::Reference,
-            ..settings.clone()
-        })
-        .unwrap();
-    (fast, reference)
-}
+/// The fewest pixels of opacity above 0.2 the reference must show for a
+/// comparison to count.
+const SHOWN: usize = 4;
 
-/// Asserts the fast path equals the reference within 1/255, and that the
-/// reference shows something (so that the comparison means something).
-fn assert_matches(renderer: &Renderer, settings: &RenderSettings, what: &str) -> f32 {
-    let (fast, reference) = both_paths(renderer, settings);
-    let diff = fast.max_abs_diff(&reference).unwrap();
-    assert!(diff <= 1.0 / 255.0, "{what}: {diff}");
-    let shown = reference.pixels().iter().filter(|p| p[3] > 0.2).count();
-    assert!(shown >= 4, "{what}: the image is (nearly) empty");
-    diff
-}
-
-fn perspective(fov_degrees: f64) -> Camera {
-    Camera {
-        projection: Projection::Perspective { fov_degrees },
-        ..Camera::default()
-    }
-}
-
-/// A camera at `eye` looking at `at`, world units.
-fn looking(eye: DVec3, at: DVec3, fov_degrees: f64) -> Camera {
-    Camera {
-        view_point: Some(eye),
-        look_at: Some(at),
-        ..perspective(fov_degrees)
-    }
-}
-
-fn tf(json: &str) -> TransferFunction {
-    TransferFunction::from_json(json).unwrap()
-}
-
-/// Opacity zero below t = 0.3: most of a sparse volume is empty space.
-fn sparse_tf() -> TransferFunction {
-    tf(r#"{"opacity": [[0, 0], [0.3, 0], [1, 0.9]],
-           "color": [[0, 0.2, 0.3, 0.8], [0.5, 0.9, 0.9, 0.9], [1, 0.8, 0.1, 0.1]]}"#)
-}
-
-/// Features on brick faces, edges and corners (bricks are 8 cells wide): a
-/// plate on the face x = 16, a rod along the edge y = z = 8, single voxels
-/// at brick corners, and a faint blob crossing several bricks.
-fn on_brick_boundaries(dims: [usize; 3], spacing: DVec3) -> Volume {
-    Volume::from_fn(dims, spacing, DVec3::ZERO, |p| {
-        let q = p / spacing;
-        let (x, y, z) = (q.x.round(), q.y.round(), q.z.round());
-        let plate = x == 16.0 && (2.0..=13.0).contains(&y) && (3.0..=12.0).contains(&z);
-        let rod = y == 8.0 && z == 8.0 && x >= 4.0;
-        let corners = [(8.0, 8.0, 8.0), (24.0, 16.0, 8.0), (32.0, 0.0, 16.0)].contains(&(x, y, z));
-        let blob = 0.6
-            * (-((q.x - 20.0).powi(2) + (q.y - 9.0).powi(2) + (q.z - 7.0).powi(2)) / 18.0).exp();
-        if plate || rod || corners {
-            1.0
-        } else {
-            blob as f32
-        }
-    })
-    .unwrap()
-}
-
-/// Three Gaussian blobs, smooth and without symmetry, filling the grid.
+/// `common::blobs` on `dims` points of `spacing` from the world origin.
 fn blobs(dims: [usize; 3], spacing: DVec3) -> Volume {
-    let extent = DVec3::new(
-        (dims[0] - 1) as f64,
-        (dims[1] - 1) as f64,
-        (dims[2] - 1) as f64,
-    ) * spacing;
-    let centres = [
-        (DVec3::new(0.3, 0.4, 0.5), 0.18, 1.0),
-        (DVec3::new(0.7, 0.6, 0.3), 0.12, 0.7),
-        (DVec3::new(0.5, 0.25, 0.75), 0.08, 0.9),
-    ];
-    Volume::from_fn(dims, spacing, DVec3::ZERO, |p| {
-        let u = p / extent;
-        (centres.iter())
-            .map(|(c, w, h)| h * (-(u - *c).length_squared() / (2.0 * w * w)).exp())
-            .sum::<f64>() as f32
-    })
-    .unwrap()
+    common::blobs(dims, spacing, DVec3::ZERO)
 }
 
 /// The world point at index-space position `i` of `volume`.
@@ -194,7 +116,7 @@ fn perspective_views_of_features_on_brick_boundaries_match_the_reference() {
         for step in [1.0, 0.5] {
             let settings = base_settings(camera, step);
             let what = format!("{what}, step {step}");
-            worst = worst.max(assert_matches(&renderer, &settings, &what));
+            worst = worst.max(assert_matches(&renderer, &settings, &what, SHOWN));
         }
     }
     println!("largest fast-vs-reference difference: {worst:.6}");
@@ -217,7 +139,7 @@ fn anisotropic_grids_in_perspective_match_the_reference() {
                     ..base_settings(camera, step)
                 };
                 let what = format!("{:?}: {what}, step {step}", volume.dims());
-                assert_matches(&renderer, &settings, &what);
+                assert_matches(&renderer, &settings, &what, SHOWN);
             }
         }
     }
@@ -267,11 +189,8 @@ fn crops_clip_planes_and_jitter_in_perspective_match_the_reference() {
                 };
                 // Some cuts leave nothing in front of an inner eye.
                 let (fast, reference) = both_paths(&renderer, &settings);
-                let diff = fast.max_abs_diff(&reference).unwrap();
-                assert!(
-                    diff <= 1.0 / 255.0,
-                    "{what}, {options}, step {step}: {diff}"
-                );
+                let what = format!("{what}, {options}, step {step}");
+                assert_within_a_level(&fast, &reference, &what);
                 cases += reference.pixels().iter().any(|p| p[3] > 0.2) as usize;
             }
         }
@@ -345,18 +264,7 @@ fn the_nearer_of_two_opaque_plates_hides_the_other_from_either_side() {
 fn scattered_voxels_in_a_large_empty_volume_match_in_perspective() {
     // A few bright voxels through 50³ (partial last bricks): most rays
     // cross several occupied bricks separated by empty ones.
-    let n = 50;
-    let mut data = vec![0.0f32; n * n * n];
-    let mut s = 0.123_456_789f64;
-    for _ in 0..80 {
-        let mut c = [0usize; 3];
-        for a in &mut c {
-            s = (s * 9301.0 + 0.492_97).fract();
-            *a = (s * n as f64) as usize;
-        }
-        data[c[0] + n * (c[1] + n * c[2])] = 1.0;
-    }
-    let volume = Volume::new([n, n, n], data).unwrap();
+    let volume = scattered_voxels(50, 80);
     let renderer = Renderer::new(&volume).unwrap();
     let c = centre(&volume);
     for (what, camera) in [
@@ -373,7 +281,7 @@ fn scattered_voxels_in_a_large_empty_volume_match_in_perspective() {
                 height: 47,
                 ..base_settings(camera, step)
             };
-            assert_matches(&renderer, &settings, &format!("{what}, step {step}"));
+            assert_matches(&renderer, &settings, &format!("{what}, step {step}"), SHOWN);
         }
     }
 }
@@ -397,7 +305,7 @@ fn the_eye_far_away_with_a_narrow_view_matches_the_reference() {
         transfer_function: sparse_tf(),
         ..RenderSettings::default()
     };
-    assert_matches(&renderer, &settings, "far eye");
+    assert_matches(&renderer, &settings, "far eye", SHOWN);
 }
 
 #[test]
@@ -409,16 +317,7 @@ fn perspective_frames_are_bit_identical_for_any_thread_count() {
             jitter: true,
             ..base_settings(camera, 0.5)
         };
-        let images: Vec<Image> = [1, 2, 7]
-            .iter()
-            .map(|&n| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .unwrap();
-                pool.install(|| renderer.render(&settings).unwrap())
-            })
-            .collect();
+        let images = [1, 2, 7].map(|n| render_on_threads(&renderer, &settings, n));
         assert!(images[0] == images[1] && images[1] == images[2], "{what}");
     }
 }

@@ -8,41 +8,29 @@
 //! (The brick walk's skipping is tested in `cpu/post.rs`, where its work
 //! counts can be seen.)
 
+mod common;
+
+use common::{
+    Cut, assert_uniform_medium, constant_tf, looking, render_on_threads, tf, uniform_medium,
+};
 use volray_core::camera::{Camera, Projection};
 use volray_core::glam::DVec3;
 use volray_core::{
-    Classification, ClipPlane, Image, IsoSurface, Method, RenderSettings, Renderer,
-    TransferFunction, Volume,
+    Classification, ClipPlane, IsoSurface, RenderSettings, Renderer, TransferFunction, Volume,
 };
 
-fn reference(settings: &RenderSettings) -> RenderSettings {
-    RenderSettings {
-        method: Method::Reference,
-        ..settings.clone()
-    }
-}
-
-/// Asserts the fast path equals the reference within 1/255 per channel and
-/// that the reference shows something; returns the largest difference.
+/// `common::assert_matches` for a post-classified frame: the fast path
+/// within 1/255 per channel of the reference, which shows at least 10
+/// pixels; returns the largest difference.
 fn assert_matches(renderer: &Renderer, settings: &RenderSettings, what: &str) -> f32 {
     assert_eq!(settings.classification, Classification::Post);
-    assert_eq!(settings.method, Method::Fast);
-    let fast = renderer.render(settings).unwrap();
-    let slow = renderer.render(&reference(settings)).unwrap();
-    let diff = fast.max_abs_diff(&slow).unwrap();
-    assert!(diff <= 1.0 / 255.0, "{what}: {diff}");
-    let shown = slow.pixels().iter().filter(|p| p[3] > 0.2).count();
-    assert!(shown >= 10, "{what}: the image is (nearly) empty");
-    diff
-}
-
-fn tf(json: &str) -> TransferFunction {
-    TransferFunction::from_json(json).unwrap()
+    common::assert_matches(renderer, settings, what, 10)
 }
 
 /// Opacity zero below t = 0.25, so that empty bricks are skipped, a bump
-/// and a plateau; colours from blue through grey to red.
-fn colorful() -> TransferFunction {
+/// and a plateau; colours from blue through grey to red (not
+/// `common::colorful`).
+fn bump_and_plateau() -> TransferFunction {
     tf(
         r#"{"opacity": [[0, 0], [0.25, 0], [0.5, 0.35], [0.7, 0.15], [1, 0.8]],
            "color": [[0, 0.23, 0.3, 0.75], [0.5, 0.87, 0.87, 0.87], [1, 0.7, 0.02, 0.15]]}"#,
@@ -133,7 +121,7 @@ fn settings(camera: Camera, step: f64, shading: bool) -> RenderSettings {
         step,
         shading,
         classification: Classification::Post,
-        transfer_function: colorful(),
+        transfer_function: bump_and_plateau(),
         background: [0.1, 0.1, 0.3],
         ..RenderSettings::default()
     }
@@ -180,9 +168,6 @@ fn the_default_ramp_and_a_sharp_table_match_the_reference() {
         }
     }
 }
-
-/// A crop box and clip planes.
-type Cut = (Option<(DVec3, DVec3)>, Vec<ClipPlane>);
 
 #[test]
 fn crops_clip_planes_and_jitter_match_the_reference() {
@@ -292,17 +277,11 @@ fn anisotropic_grids_and_eyes_inside_the_volume_match_the_reference() {
     })
     .unwrap();
     let renderer = Renderer::new(&volume).unwrap();
-    let look = |eye: DVec3, at: DVec3, fov_degrees: f64| Camera {
-        view_point: Some(eye),
-        look_at: Some(at),
-        projection: Projection::Perspective { fov_degrees },
-        ..Camera::default()
-    };
     let cameras = [
         ("orthographic", Camera::default()),
         (
             "eye inside",
-            look(
+            looking(
                 DVec3::new(14.0, 22.0, 11.0),
                 DVec3::new(30.0, 40.0, 5.0),
                 70.0,
@@ -310,7 +289,7 @@ fn anisotropic_grids_and_eyes_inside_the_volume_match_the_reference() {
         ),
         (
             "eye on a brick corner",
-            look(
+            looking(
                 DVec3::new(8.0, 16.0, 4.8),
                 DVec3::new(20.0, 25.0, 13.0),
                 90.0,
@@ -318,7 +297,7 @@ fn anisotropic_grids_and_eyes_inside_the_volume_match_the_reference() {
         ),
         (
             "eye far away",
-            look(
+            looking(
                 DVec3::new(900.0, -700.0, 400.0),
                 DVec3::new(18.0, 25.0, 13.0),
                 3.0,
@@ -341,14 +320,10 @@ fn a_uniform_medium_has_the_closed_form_colour_on_the_fast_path() {
     // K = 10/step + 1 samples of colour c and opacity α_s = 1 − (1 − α)^step
     // give c(1 − (1 − α_s)^K) + bg(1 − α_s)^K; lit, the medium has no
     // gradient, so only the ambient 0.1 lights it.
-    let volume = Volume::new([11, 7, 5], vec![3.0; 11 * 7 * 5]).unwrap();
+    let volume = uniform_medium();
     let renderer = Renderer::new(&volume).unwrap();
     let (alpha, c, bg) = (0.3f64, [0.9, 0.5, 0.2], [0.1, 0.2, 1.0]);
-    let constant = TransferFunction {
-        domain: None,
-        opacity: Some(volray_core::PiecewiseLinear::constant([alpha as f32])),
-        color: Some(volray_core::PiecewiseLinear::constant(c)),
-    };
+    let constant = constant_tf(alpha as f32, c);
     for (step, k) in [(1.0, 11), (0.5, 21)] {
         for shading in [false, true] {
             let s = RenderSettings {
@@ -363,13 +338,9 @@ fn a_uniform_medium_has_the_closed_form_colour_on_the_fast_path() {
             };
             let keep = (1.0 - alpha).powf(step * k as f64);
             let light = if shading { 0.1 } else { 1.0 };
-            for px in renderer.render(&s).unwrap().pixels() {
-                for ch in 0..3 {
-                    let want = light * c[ch] as f64 * (1.0 - keep) + bg[ch] as f64 * keep;
-                    assert!((px[ch] as f64 - want).abs() < 1e-5, "{px:?} vs {want}");
-                }
-                assert!((px[3] as f64 - (1.0 - keep)).abs() < 1e-5);
-            }
+            let image = renderer.render(&s).unwrap();
+            let what = format!("step {step}, lit {shading}");
+            assert_uniform_medium(&image, light, c, bg, keep, 1e-5, &what);
         }
     }
 }
@@ -384,16 +355,7 @@ fn images_are_bit_identical_for_any_thread_count() {
             gradient_opacity: Some((0.05, 0.5)),
             ..settings(camera, 0.6, true)
         };
-        let images: Vec<Image> = [1, 2, 3]
-            .into_iter()
-            .map(|threads| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                pool.install(|| renderer.render(&s).unwrap())
-            })
-            .collect();
+        let images = [1, 2, 3].map(|threads| render_on_threads(&renderer, &s, threads));
         assert!(images[0] == images[1] && images[1] == images[2], "{view}");
     }
 }

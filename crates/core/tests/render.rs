@@ -1,63 +1,24 @@
 //! End-to-end properties of the renderer: closed forms, the reference path
 //! as oracle for the fast path, thread invariance and geometry.
 
-use volray_core::PiecewiseLinear;
+mod common;
+
+use common::{
+    assert_uniform_medium, assert_within_a_level, both_paths, colorful, constant_tf,
+    render_on_threads, uniform_medium,
+};
 use volray_core::camera::{Camera, OrthographicView};
 use volray_core::glam::DVec3;
 use volray_core::{Image, Method, RenderSettings, Renderer, TransferFunction, Volume};
 
+/// `settings` rendered by a new renderer of `volume`.
 fn render(volume: &Volume, settings: &RenderSettings) -> Image {
     Renderer::new(volume).unwrap().render(settings).unwrap()
 }
 
-fn both_paths(volume: &Volume, settings: &RenderSettings) -> (Image, Image) {
-    let renderer = Renderer::new(volume).unwrap();
-    let fast = renderer.render(settings).unwrap();
-    let reference = renderer
-        .render(&RenderSettings {
-            method: Method::Reference,
-            ..settings.clone()
-        })
-        .unwrap();
-    (fast, reference)
-}
-
-fn constant_tf(alpha: f32, color: [f32; 3]) -> TransferFunction {
-    TransferFunction {
-        domain: None,
-        opacity: Some(PiecewiseLinear::constant([alpha])),
-        color: Some(PiecewiseLinear::constant(color)),
-    }
-}
-
-/// Three Gaussian blobs, no symmetry: a volume with structure everywhere.
+/// `common::blobs` on `dims` points of `spacing` from (−2, 5, 1).
 fn blobs(dims: [usize; 3], spacing: DVec3) -> Volume {
-    let centres = [
-        (DVec3::new(0.3, 0.4, 0.5), 0.18, 1.0),
-        (DVec3::new(0.7, 0.6, 0.3), 0.12, 0.7),
-        (DVec3::new(0.5, 0.25, 0.75), 0.08, 0.9),
-    ];
-    let extent = DVec3::new(
-        (dims[0] - 1) as f64,
-        (dims[1] - 1) as f64,
-        (dims[2] - 1) as f64,
-    ) * spacing;
-    Volume::from_fn(dims, spacing, DVec3::new(-2.0, 5.0, 1.0), |p| {
-        let u = (p - DVec3::new(-2.0, 5.0, 1.0)) / extent;
-        centres
-            .iter()
-            .map(|(c, w, h)| h * (-(u - *c).length_squared() / (2.0 * w * w)).exp())
-            .sum::<f64>() as f32
-    })
-    .unwrap()
-}
-
-fn colorful() -> TransferFunction {
-    TransferFunction::from_json(
-        r#"{"opacity": [[0, 0], [0.1, 0], [0.6, 0.4], [1, 0.9]],
-            "color": [[0, 0.23, 0.299, 0.754], [0.5, 0.865, 0.865, 0.865], [1, 0.706, 0.016, 0.15]]}"#,
-    )
-    .unwrap()
+    common::blobs(dims, spacing, DVec3::new(-2.0, 5.0, 1.0))
 }
 
 #[test]
@@ -74,7 +35,7 @@ fn all_transparent_volume_gives_exactly_the_background() {
         },
         ..RenderSettings::default()
     };
-    let (fast, reference) = both_paths(&volume, &settings);
+    let (fast, reference) = both_paths(&Renderer::new(&volume).unwrap(), &settings);
     for image in [fast, reference] {
         for px in image.pixels() {
             assert_eq!(*px, [0.2, 0.4, 0.6, 0.0]);
@@ -87,7 +48,7 @@ fn uniform_medium_has_the_closed_form_colour() {
     // 11 points along x: every ray of the default view (along −x) takes
     // K = 10/step + 1 samples of colour c and per-voxel opacity α, so the
     // pixel is c(1 − (1 − α_s)^K) + bg(1 − α_s)^K with α_s = 1 − (1 − α)^step.
-    let volume = Volume::new([11, 7, 5], vec![3.0; 11 * 7 * 5]).unwrap();
+    let volume = uniform_medium();
     let (alpha, c, bg) = (0.3f64, [0.9, 0.5, 0.2], [0.1, 0.2, 1.0]);
     for (step, k) in [(1.0, 11), (0.5, 21), (0.25, 41)] {
         let settings = RenderSettings {
@@ -100,20 +61,9 @@ fn uniform_medium_has_the_closed_form_colour() {
             ..RenderSettings::default()
         };
         let keep = (1.0 - alpha).powf(step * k as f64);
-        let want: Vec<f64> = (0..3)
-            .map(|i| c[i] as f64 * (1.0 - keep) + bg[i] as f64 * keep)
-            .collect();
-        let (fast, reference) = both_paths(&volume, &settings);
+        let (fast, reference) = both_paths(&Renderer::new(&volume).unwrap(), &settings);
         for (image, tol) in [(reference, 1e-5), (fast, 1.0 / 255.0)] {
-            for px in image.pixels() {
-                for ch in 0..3 {
-                    assert!(
-                        (px[ch] as f64 - want[ch]).abs() < tol,
-                        "step {step}: {px:?} vs {want:?}"
-                    );
-                }
-                assert!((px[3] as f64 - (1.0 - keep)).abs() < tol);
-            }
+            assert_uniform_medium(&image, 1.0, c, bg, keep, tol, &format!("step {step}"));
         }
     }
 }
@@ -152,7 +102,7 @@ fn constant_volume_with_shading_gets_ambient_light_only() {
         ..RenderSettings::default()
     };
     // The fast path stores colours in 16 bits: half a step is 7.6e-6.
-    let (fast, reference) = both_paths(&volume, &settings);
+    let (fast, reference) = both_paths(&Renderer::new(&volume).unwrap(), &settings);
     for (image, tol) in [(reference, 1e-6), (fast, 1e-5)] {
         for px in image.pixels() {
             assert!(
@@ -205,10 +155,9 @@ fn fast_path_matches_the_reference_within_one_level() {
                     background: [0.1, 0.1, 0.3],
                     ..RenderSettings::default()
                 };
-                let (fast, reference) = both_paths(volume, &settings);
-                let diff = fast.max_abs_diff(&reference).unwrap();
-                worst = worst.max(diff);
-                assert!(diff <= 1.0 / 255.0, "{camera:?} step {step}: {diff}");
+                let (fast, reference) = both_paths(&Renderer::new(volume).unwrap(), &settings);
+                let what = format!("{camera:?} step {step}");
+                worst = worst.max(assert_within_a_level(&fast, &reference, &what));
             }
         }
     }
@@ -240,16 +189,7 @@ fn fast_path_is_bit_identical_for_any_thread_count() {
         ..RenderSettings::default()
     };
     let renderer = Renderer::new(&volume).unwrap();
-    let images: Vec<Image> = [1, 2, 7]
-        .iter()
-        .map(|&n| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .unwrap();
-            pool.install(|| renderer.render(&settings).unwrap())
-        })
-        .collect();
+    let images = [1, 2, 7].map(|n| render_on_threads(&renderer, &settings, n));
     assert!(images[0].pixels().iter().any(|p| p[3] > 0.5));
     assert!(images[0] == images[1] && images[1] == images[2]);
 }
