@@ -137,18 +137,7 @@ fn a_framing_box_frames_different_volumes_alike() {
     let volume = two_blobs();
     let (lo, hi) = volume.bounds();
     let shift = DVec3::new(0.0, 0.5, -0.5);
-    let moved = Volume::from_fn(
-        volume.dims(),
-        volume.spacing(),
-        volume.origin() + shift,
-        |p| {
-            let u = p - shift - volume.origin();
-            let a = (-(u - DVec3::new(0.8, 1.0, 1.5)).length_squared() / 0.3).exp();
-            let b = 0.7 * (-(u - DVec3::new(2.0, 1.6, 0.7)).length_squared() / 0.1).exp();
-            (a + b) as f32
-        },
-    )
-    .unwrap();
+    let moved = volume.clone().with_origin(volume.origin() + shift).unwrap();
     // The box spans both; 8 × 8 world units over 64 px: 1/8 unit pixels.
     let frame = (
         DVec3::new(lo.x, lo.y, -4.0),

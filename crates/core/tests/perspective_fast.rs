@@ -29,11 +29,6 @@ fn at_index(volume: &Volume, i: DVec3) -> DVec3 {
     volume.origin() + i * volume.spacing()
 }
 
-fn centre(volume: &Volume) -> DVec3 {
-    let (lo, hi) = volume.bounds();
-    0.5 * (lo + hi)
-}
-
 /// The cameras every volume is seen through: the default eye (the bounding
 /// sphere fills the view) at several fields of view, oblique orbits (one
 /// zoomed, so that only part of the volume is in view), the eye just
@@ -41,7 +36,7 @@ fn centre(volume: &Volume) -> DVec3 {
 /// the volume (at its centre, off centre, exactly on a brick corner, on a
 /// brick face), looking along an axis and obliquely.
 fn cameras(volume: &Volume) -> Vec<(String, Camera)> {
-    let c = centre(volume);
+    let c = volume.centre();
     let (lo, hi) = volume.bounds();
     let index = |x: f64, y: f64, z: f64| at_index(volume, DVec3::new(x, y, z));
     let mut cameras = Vec::new();
@@ -149,7 +144,7 @@ fn anisotropic_grids_in_perspective_match_the_reference() {
 fn crops_clip_planes_and_jitter_in_perspective_match_the_reference() {
     let volume = blobs([37, 26, 45], DVec3::new(1.0, 2.0, 0.6));
     let renderer = Renderer::new(&volume).unwrap();
-    let c = centre(&volume);
+    let c = volume.centre();
     let (lo, hi) = volume.bounds();
     let crop = (
         lo + 0.2 * (hi - lo),
@@ -266,7 +261,7 @@ fn scattered_voxels_in_a_large_empty_volume_match_in_perspective() {
     // cross several occupied bricks separated by empty ones.
     let volume = scattered_voxels(50, 80);
     let renderer = Renderer::new(&volume).unwrap();
-    let c = centre(&volume);
+    let c = volume.centre();
     for (what, camera) in [
         ("default eye", perspective(35.0)),
         (
@@ -294,7 +289,7 @@ fn the_eye_far_away_with_a_narrow_view_matches_the_reference() {
     // would be off by a hundredth of a voxel, 0.017 in colour).
     let volume = blobs([30, 33, 27], DVec3::ONE);
     let renderer = Renderer::new(&volume).unwrap();
-    let c = centre(&volume);
+    let c = volume.centre();
     let distance: f64 = 1.0e6;
     let fov = 2.0 * (25.0 / distance).atan().to_degrees();
     let away = DVec3::new(1500.0, -900.0, 1000.0).normalize();
