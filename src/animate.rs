@@ -19,7 +19,7 @@
 
 use crate::cli::RenderArgs;
 use crate::error::CliError;
-use crate::render::{load, progress_bar, render_failure, renderer_for};
+use crate::session::{load, progress_bar, render_failure, renderer_for};
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};

@@ -15,7 +15,8 @@ mod vtk;
 
 use crate::cli::BenchArgs;
 use crate::error::CliError;
-use crate::render::{render_failure, renderer_for, settings, thread_pool};
+use crate::render::settings;
+use crate::session::{load, render_failure, renderer_for, thread_pool};
 use std::path::Path;
 use std::time::{Duration, Instant};
 use volray_core::{Camera, FrameTimes, Image, Method, RenderSettings, Renderer};
@@ -175,7 +176,7 @@ pub fn write_json(path: &Path, rows: &[JsonRow]) -> Result<(), CliError> {
 
 /// `volray bench INPUT`: the frames of one volume.
 fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
-    let input = crate::render::load(&args.input, args.view.log)?;
+    let input = load(&args.input, args.view.log)?;
     let base = settings(&args.view)?;
     let pool = thread_pool(args.view.threads)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);

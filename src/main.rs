@@ -18,6 +18,7 @@ mod memory;
 mod overwrite;
 mod paper;
 mod render;
+mod session;
 
 use clap::Parser;
 use clap::error::ErrorKind;

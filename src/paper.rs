@@ -3,7 +3,7 @@
 
 use crate::cli::{PaperArgs, PaperItem};
 use crate::error::CliError;
-use crate::render::thread_pool;
+use crate::session::thread_pool;
 use volray_paper::{Item, PaperError, Sizes};
 
 pub fn run(args: &PaperArgs) -> Result<(), CliError> {

@@ -2,18 +2,16 @@
 //! with `--turntable` or several inputs, an animation (`animate.rs`).
 
 use crate::animate;
-use crate::cli::{BlendMode, InputArgs, NonFiniteMode, RenderArgs, ViewArgs};
+use crate::cli::{BlendMode, RenderArgs, ViewArgs};
 use crate::error::CliError;
-use crate::input::{self, Input};
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
+use crate::input;
+use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
 use std::path::{Path, PathBuf};
-use volray_core::camera::CameraError;
 use volray_core::glam::DVec3;
 use volray_core::transfer::{colormap, presets};
 use volray_core::{
-    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, NonFinite, Phong, Projection,
-    RenderError, RenderSettings, Renderer, TransferFunction,
+    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, Phong, Projection,
+    RenderSettings, TransferFunction,
 };
 use volray_io::{Animation, AnimationKind, BitDepth};
 
@@ -96,34 +94,6 @@ fn animation_reason(args: &RenderArgs) -> Result<Option<&'static str>, CliError>
         (Some(_), true) => Ok(Some("--turntable")),
         (None, false) => Ok(Some("several inputs")),
         (None, true) => Ok(None),
-    }
-}
-
-/// Reads the volume `args` name and, with `--log`, takes its log10.
-pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
-    let mut input = input::load(args)?;
-    if log {
-        input.volume = input
-            .volume
-            .to_log10()
-            .map_err(|e| CliError::input(format!("--log: {}: {e}", input.name)))?;
-    }
-    Ok(input)
-}
-
-/// A progress bar on a terminal for work of at least 256² pixels, else a
-/// hidden one.
-pub fn progress_bar(pixels: u64) -> ProgressBar {
-    if std::io::stderr().is_terminal() && pixels >= 256 * 256 {
-        let bar = ProgressBar::new(pixels);
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent}% ({eta} left)")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
     }
 }
 
@@ -394,86 +364,6 @@ fn camera(view: &ViewArgs) -> Camera {
     }
 }
 
-/// The renderer of `input`'s volume, its non-finite values refused or
-/// rendered as empty space as `--nonfinite` says, refused if rendering it
-/// may need more than `--max-memory` (see `memory.rs`). A refusal is one
-/// line naming the input and the count, and the way out.
-pub fn renderer_for<'v>(
-    view: &ViewArgs,
-    settings: &RenderSettings,
-    input: &'v Input,
-) -> Result<Renderer<'v>, CliError> {
-    crate::memory::check_render(view, settings, input)?;
-    let (name, volume) = (&input.name, &input.volume);
-    let mode = match view.nonfinite {
-        NonFiniteMode::Refuse => NonFinite::Refuse,
-        NonFiniteMode::Transparent => NonFinite::Transparent,
-    };
-    Renderer::with_non_finite(volume, mode).map_err(|e| match e {
-        RenderError::NonFinite { .. } => CliError::input(format!(
-            "{name}: {e}; use --nonfinite transparent to render them as empty space"
-        )),
-        e => render_failure(view, name, e),
-    })
-}
-
-/// A failure to render `name` as one line, naming the flag whose value
-/// caused it: the core's errors say which setting, by variant.
-pub fn render_failure(view: &ViewArgs, name: &str, e: RenderError) -> CliError {
-    match flag_of(view, &e) {
-        Some(flag) => CliError::input(format!("{name}: {flag}: {e}")),
-        None => CliError::input(format!("{name}: {e}")),
-    }
-}
-
-/// The flag whose value a core error is about, if one is.
-fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<&'static str> {
-    use volray_core::{CameraPoint, Orbit, Reflection, SettingError as S};
-    let flag = match e {
-        RenderError::NonFinite { .. } => "--nonfinite",
-        RenderError::Camera(c) => match c {
-            CameraError::NoDirection(_) if view.view.is_some() => "--view",
-            CameraError::NoDirection(_) => "--look-at",
-            CameraError::UpParallel { .. } => "--up",
-            CameraError::NotFinite(CameraPoint::ViewPoint, _) if view.view.is_some() => "--view",
-            CameraError::NotFinite(CameraPoint::ViewReference, _) if view.look_at.is_some() => {
-                "--look-at"
-            }
-            CameraError::NotFinite(CameraPoint::Up, _) => "--up",
-            // A default point beyond f64: the volume's bounds are to blame.
-            CameraError::NotFinite(..) => return None,
-            CameraError::FieldOfView(_) => "--perspective",
-            CameraError::Zoom(_) => "--zoom",
-            CameraError::Angle(Orbit::Azimuth, _) => "--azimuth",
-            CameraError::Angle(Orbit::Elevation, _) => "--elevation",
-            CameraError::EmptyImage { .. } => "--size",
-            CameraError::Bounds { .. } | CameraError::WrongProjection { .. } => return None,
-        },
-        RenderError::Setting(s) => match s {
-            S::ImageSide { .. } | S::ImagePixels { .. } => "--size",
-            S::Step(_) | S::StepTooSmall { .. } => "--step",
-            S::OpacityRamp { .. } => "--opacity",
-            S::Reflection { term, .. } => match term {
-                Reflection::Ambient => "--ambient",
-                Reflection::Diffuse => "--diffuse",
-                Reflection::Specular => "--specular",
-                Reflection::LightColor => "--light-color",
-            },
-            S::Shininess(_) => "--shininess",
-            S::Background(_) => "--background",
-            S::LightDirection(_) => "--light",
-            S::Crop { .. } => "--crop",
-            S::ClipPoint(_) | S::ClipNormal(_) => "--clip",
-            S::IsoValue(_) => "--iso",
-            S::IsoThickness(_) => "--iso-thickness",
-            S::GradientOpacity { .. } => "--gradient-opacity",
-            // Set by a series from its volumes, not by a flag.
-            S::GradientOpacityMax(_) => return None,
-        },
-    };
-    Some(flag)
-}
-
 /// `--blend`, checked against the options that only compositing uses:
 /// a projection shows the interpolated scalar, with no opacity to shape
 /// and no lighting.
@@ -560,17 +450,6 @@ fn iso(view: &ViewArgs) -> Result<Option<IsoSurface>, CliError> {
         value,
         thickness: view.iso_thickness.unwrap_or(1.0),
     }))
-}
-
-/// A pool of `threads` workers (default: one per core).
-pub fn thread_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, CliError> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n as usize);
-    }
-    builder
-        .build()
-        .map_err(|e| CliError::io(format!("cannot start worker threads: {e}")))
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ use super::vtk::Harness;
 use super::{JsonRow, Timed, median, ms, time_frames, write_json};
 use crate::cli::BenchArgs;
 use crate::error::CliError;
-use crate::render::thread_pool;
+use crate::session::thread_pool;
 use std::path::Path;
 use volray_core::PiecewiseLinear;
 use volray_core::glam::DVec3;
