@@ -15,8 +15,8 @@ mod vtk;
 
 use crate::cli::BenchArgs;
 use crate::error::CliError;
-use crate::render::settings;
 use crate::session::{load, render_failure, renderer_for, thread_pool};
+use crate::settings::settings;
 use std::path::Path;
 use std::time::{Duration, Instant};
 use volray_core::{Camera, FrameTimes, Image, Method, RenderSettings, Renderer};

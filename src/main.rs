@@ -19,6 +19,7 @@ mod overwrite;
 mod paper;
 mod render;
 mod session;
+mod settings;
 
 use clap::Parser;
 use clap::error::ErrorKind;

@@ -64,7 +64,7 @@ mod tests {
             crate::cli::Command::Render(r) => r.view,
             _ => unreachable!(),
         };
-        let settings = crate::render::settings(&view).unwrap();
+        let settings = crate::settings::settings(&view).unwrap();
         render_bytes(dims, DVec3::ONE, &settings, &view)
     }
 

@@ -1,0 +1,362 @@
+//! The render settings the flags describe: the transfer function put
+//! together from `--tf`, `--preset`, `--colormap`, `--range` and `--log`,
+//! the camera, `--blend` checked against the options only compositing
+//! uses, Levoy's `--iso` contour, and the rest as they are; then checked
+//! by volray-core, so that a bad combination is refused before any work.
+
+use crate::cli::{BlendMode, ViewArgs};
+use crate::error::CliError;
+use std::path::Path;
+use volray_core::glam::DVec3;
+use volray_core::transfer::{colormap, presets};
+use volray_core::{
+    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, Phong, Projection,
+    RenderSettings, TransferFunction,
+};
+
+/// The largest `--tf` file read: a transfer function is a few hundred
+/// points; this bounds what a wrong path (a device, a huge file) costs.
+const TF_MAX_BYTES: u64 = 16 << 20;
+
+/// Reads a `--tf` file: a regular file of at most [`TF_MAX_BYTES`].
+fn read_tf_file(path: &Path) -> Result<String, CliError> {
+    use std::io::Read;
+    let name = path.display();
+    let meta = std::fs::metadata(path)
+        .map_err(|e| CliError::io(format!("--tf {name}: cannot read: {e}")))?;
+    if !meta.is_file() {
+        return Err(CliError::input(format!("--tf {name}: not a regular file")));
+    }
+    if meta.len() > TF_MAX_BYTES {
+        return Err(CliError::input(format!(
+            "--tf {name}: {} bytes is too large for a transfer function (at most {TF_MAX_BYTES})",
+            meta.len()
+        )));
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(TF_MAX_BYTES).read_to_string(&mut text))
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::InvalidData => CliError::input(format!(
+                "--tf {name}: not UTF-8 text (a JSON file is expected)"
+            )),
+            _ => CliError::io(format!("--tf {name}: cannot read: {e}")),
+        })?;
+    Ok(text)
+}
+
+/// The render settings the view arguments describe.
+pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
+    let transfer_function = match &view.tf {
+        Some(path) => {
+            let text = read_tf_file(path)?;
+            TransferFunction::from_json(&text)
+                .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?
+        }
+        None => TransferFunction::default(),
+    };
+    let from = if view.tf.is_some() {
+        "--tf"
+    } else {
+        "--preset"
+    };
+    let mut transfer_function = match &view.preset {
+        Some(_) if view.tf.is_some() => {
+            return Err(CliError::input(
+                "--preset conflicts with --tf: give one of them",
+            ));
+        }
+        Some(name) => presets::preset(name).ok_or_else(|| {
+            CliError::input(format!(
+                "--preset: unknown preset '{name}': expected one of {}",
+                presets::NAMES.join(", ")
+            ))
+        })?,
+        None => transfer_function,
+    };
+    if view.opacity.is_some() && transfer_function.opacity.is_some() {
+        return Err(CliError::input(format!(
+            "--opacity conflicts with the opacity function in {from}: give one of them"
+        )));
+    }
+    if let Some(name) = &view.colormap {
+        if view.tf.is_some() && transfer_function.color.is_some() {
+            return Err(CliError::input(
+                "--colormap conflicts with the colour function in --tf: give one of them",
+            ));
+        }
+        transfer_function.color = Some(colormap::colormap(name).ok_or_else(|| {
+            CliError::input(format!(
+                "--colormap: unknown colour map '{name}': expected one of {}",
+                colormap::NAMES.join(", ")
+            ))
+        })?);
+    }
+    if let Some(range) = view.range {
+        if transfer_function.domain.is_some() {
+            return Err(CliError::input(format!(
+                "--range conflicts with the value domain fixed by {from}: give one of them"
+            )));
+        }
+        transfer_function.domain = Some(range);
+    }
+    if view.log
+        && let Some((lo, hi)) = transfer_function.domain
+    {
+        // The window is given in the data's units; the renderer sees log10.
+        let from = if view.range.is_some() {
+            "--range"
+        } else {
+            from
+        };
+        if lo <= 0.0 {
+            return Err(CliError::input(format!(
+                "{from}: with --log the value window is in the data's own units and must be positive, but LO is {lo}"
+            )));
+        }
+        transfer_function.domain = Some((lo.log10(), hi.log10()));
+    }
+    let settings = RenderSettings {
+        width: view.size.0,
+        height: view.size.1,
+        camera: camera(view),
+        step: view.step,
+        opacity_ramp: view
+            .opacity
+            .unwrap_or(RenderSettings::default().opacity_ramp),
+        transfer_function,
+        phong: Phong {
+            ambient: view.ambient,
+            diffuse: view.diffuse,
+            specular: view.specular,
+            shininess: view.shininess,
+            light_color: view.light_color,
+        },
+        shading: !view.no_shading,
+        light_direction: view.light.map(DVec3::from),
+        background: view.background,
+        method: if view.reference {
+            Method::Reference
+        } else {
+            Method::Fast
+        },
+        blend: blend(view)?,
+        classification: if view.post_classification {
+            Classification::Post
+        } else {
+            Classification::Pre
+        },
+        jitter: view.jitter,
+        clip_planes: (view.clip.iter())
+            .map(|&(point, normal)| ClipPlane {
+                point: DVec3::from(point),
+                normal: DVec3::from(normal),
+            })
+            .collect(),
+        crop: view.crop.map(|(lo, hi)| (DVec3::from(lo), DVec3::from(hi))),
+        iso: iso(view)?,
+        gradient_opacity: view.gradient_opacity,
+        gradient_opacity_max: None,
+    };
+    settings
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    settings
+        .camera
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    Ok(settings)
+}
+
+/// The camera of the view options.
+fn camera(view: &ViewArgs) -> Camera {
+    Camera {
+        view_point: view.view.map(DVec3::from),
+        look_at: view.look_at.map(DVec3::from),
+        up: DVec3::from(view.up),
+        projection: match view.perspective {
+            Some(fov_degrees) => Projection::Perspective { fov_degrees },
+            None => Projection::Orthographic,
+        },
+        zoom: view.zoom,
+        azimuth: view.azimuth,
+        elevation: view.elevation,
+        ..Camera::default()
+    }
+}
+
+/// `--blend`, checked against the options that only compositing uses:
+/// a projection shows the interpolated scalar, with no opacity to shape
+/// and no lighting.
+fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
+    let (blend, name) = match view.blend {
+        BlendMode::Composite => (Blend::Composite, "composite"),
+        BlendMode::Iso if view.iso.is_none() => {
+            return Err(CliError::input(
+                "--blend iso needs the isovalue: give --iso VALUE",
+            ));
+        }
+        BlendMode::Iso => (Blend::Composite, "iso"),
+        BlendMode::Mip => (Blend::Maximum, "mip"),
+        BlendMode::Minip => (Blend::Minimum, "minip"),
+        BlendMode::Average => (Blend::Average, "average"),
+    };
+    if blend.is_projection() {
+        for (given, flag) in [
+            (view.iso.is_some(), "--iso"),
+            (view.gradient_opacity.is_some(), "--gradient-opacity"),
+            (view.post_classification, "--post-classification"),
+            (view.opacity.is_some(), "--opacity"),
+        ] {
+            if given {
+                return Err(CliError::input(format!(
+                    "{flag} shapes the opacity of --blend composite; --blend {name} projects the interpolated value and has none"
+                )));
+            }
+        }
+    }
+    let unlit = if blend.is_projection() {
+        Some(format!("--blend {name} is unshaded"))
+    } else if view.no_shading {
+        Some("--no-shading turns the lighting off".to_string())
+    } else {
+        None
+    };
+    if let (Some(why), Some(flag)) = (unlit, lighting_flag(view)) {
+        return Err(CliError::input(format!(
+            "{flag} sets the lighting, but {why}: leave {flag} out"
+        )));
+    }
+    Ok(blend)
+}
+
+/// The first lighting option given a value other than its default (the
+/// library's, which `--help` shows), if any.
+fn lighting_flag(view: &ViewArgs) -> Option<&'static str> {
+    let lit = Phong::default();
+    [
+        (view.ambient != lit.ambient, "--ambient"),
+        (view.diffuse != lit.diffuse, "--diffuse"),
+        (view.specular != lit.specular, "--specular"),
+        (view.shininess != lit.shininess, "--shininess"),
+        (view.light_color != lit.light_color, "--light-color"),
+        (view.light.is_some(), "--light"),
+    ]
+    .into_iter()
+    .find_map(|(given, flag)| given.then_some(flag))
+}
+
+/// `--iso VALUE --iso-thickness R`; with `--log` the value is in the data's
+/// units, like `--range`.
+fn iso(view: &ViewArgs) -> Result<Option<IsoSurface>, CliError> {
+    let Some(value) = view.iso else {
+        return match view.iso_thickness {
+            Some(_) => Err(CliError::input(
+                "--iso-thickness is the half-width of the --iso shell: give --iso VALUE too",
+            )),
+            None => Ok(None),
+        };
+    };
+    let value = if view.log {
+        if value <= 0.0 {
+            return Err(CliError::input(format!(
+                "--iso: with --log the isovalue is in the data's own units and must be positive, but it is {value}"
+            )));
+        }
+        (value as f64).log10() as f32
+    } else {
+        value
+    };
+    Ok(Some(IsoSurface {
+        value,
+        thickness: view.iso_thickness.unwrap_or(1.0),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::{Cli, Command, RenderArgs};
+    use clap::Parser;
+
+    #[test]
+    fn command_line_defaults_are_the_library_defaults() {
+        // The defaults are written twice, for `--help` and in volray-core:
+        // they must say the same.
+        let cli = Cli::try_parse_from(["volray", "render", "-o", "x.png"]).unwrap();
+        let Command::Render(args) = cli.command else {
+            panic!("not a render command")
+        };
+        assert_eq!(settings(&args.view).unwrap(), RenderSettings::default());
+    }
+
+    fn parse(args: &[&str]) -> RenderArgs {
+        let all = [&["volray", "render", "-o", "x.png"][..], args].concat();
+        match Cli::try_parse_from(all).unwrap().command {
+            Command::Render(args) => args,
+            _ => panic!("not a render command"),
+        }
+    }
+
+    #[test]
+    fn options_reach_the_settings() {
+        let args = parse(&[
+            "--perspective",
+            "40",
+            "--zoom",
+            "2",
+            "--azimuth",
+            "-30",
+            "--elevation",
+            "15",
+            "--clip",
+            "1,2,3,0,0,-2",
+            "--crop",
+            "-1,1,-2,2,-3,3",
+            "--jitter",
+            "--iso",
+            "100",
+            "--iso-thickness",
+            "2",
+            "--log",
+            "--range",
+            "1,1000",
+            "--gradient-opacity",
+            "0.1,0.9",
+        ]);
+        let s = settings(&args.view).unwrap();
+        assert_eq!(
+            s.camera.projection,
+            Projection::Perspective { fov_degrees: 40.0 }
+        );
+        assert_eq!(
+            (s.camera.zoom, s.camera.azimuth, s.camera.elevation),
+            (2.0, -30.0, 15.0)
+        );
+        assert_eq!(
+            s.clip_planes,
+            [ClipPlane {
+                point: DVec3::new(1.0, 2.0, 3.0),
+                normal: DVec3::new(0.0, 0.0, -2.0)
+            }]
+        );
+        assert_eq!(
+            s.crop,
+            Some((DVec3::new(-1.0, -2.0, -3.0), DVec3::new(1.0, 2.0, 3.0)))
+        );
+        assert!(s.jitter);
+        // --log: the window and the isovalue were given in the data's units.
+        assert_eq!(s.transfer_function.domain, Some((0.0, 3.0)));
+        assert_eq!(
+            s.iso,
+            Some(IsoSurface {
+                value: 2.0,
+                thickness: 2.0
+            })
+        );
+        assert_eq!(s.gradient_opacity, Some((0.1, 0.9)));
+        assert_eq!(s.blend, Blend::Composite);
+        let mip = parse(&["--blend", "minimum"]);
+        assert_eq!(settings(&mip.view).unwrap().blend, Blend::Minimum);
+    }
+}
