@@ -17,8 +17,8 @@
 //!   for their ranges and bounds, then to render), so a long series never
 //!   has to fit in memory.
 
-use crate::cli::RenderArgs;
 use crate::error::CliError;
+use crate::flags::RenderArgs;
 use crate::session::{load, progress_bar, render_failure, renderer_for};
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
@@ -35,7 +35,7 @@ pub fn turntable(
     pool: &ThreadPool,
     frames: usize,
 ) -> Result<(), CliError> {
-    let input = load(&args.input, args.view.log)?;
+    let input = load(&args.input, args.view.look.log)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
@@ -94,7 +94,7 @@ pub fn series(
 fn load_one(args: &RenderArgs, spec: &str) -> Result<crate::input::Input, CliError> {
     let mut input = args.input.clone();
     input.input = Some(spec.to_string());
-    load(&input, args.view.log)
+    load(&input, args.view.look.log)
 }
 
 /// The value range, the bounds and (for gradient opacity) the largest
@@ -154,11 +154,11 @@ impl Writer {
     /// in `settings`.
     fn new(args: &RenderArgs, settings: &RenderSettings, frames: usize) -> Result<Self, CliError> {
         let animation = Animation::create(
-            &args.output,
+            &args.out.output,
             settings.width,
             settings.height,
             frames,
-            args.fps.unwrap_or(DEFAULT_FPS),
+            args.animation.fps.unwrap_or(DEFAULT_FPS),
         )?;
         let bar = progress_bar((frames * settings.width * settings.height) as u64);
         Ok(Writer { animation, bar })

@@ -1,8 +1,8 @@
 //! `volray generate`: write a generated volume (hydrogen density, fractal
 //! cloud) to a file, in the format its extension names.
 
-use crate::cli::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 use crate::error::CliError;
+use crate::flags::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 use std::path::Path;
 use volray_core::Volume;
 use volray_data::DataError;

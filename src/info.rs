@@ -1,7 +1,7 @@
 //! `volray info`: what a volume file holds and how volray reads it.
 
-use crate::cli::InfoArgs;
 use crate::error::CliError;
+use crate::flags::InfoArgs;
 use crate::input;
 use serde_json::json;
 use volray_core::Histogram;

@@ -1,7 +1,7 @@
 //! The INPUT argument: a built-in source spec or a volume file.
 
-use crate::cli::InputArgs;
 use crate::error::CliError;
+use crate::flags::InputArgs;
 use std::path::{Path, PathBuf};
 use volray_core::Volume;
 use volray_core::glam::DVec3;

@@ -8,8 +8,8 @@ mod output;
 
 mod animate;
 mod bench;
-mod cli;
 mod error;
+mod flags;
 mod generate;
 mod info;
 mod input;
@@ -21,31 +21,13 @@ mod render;
 mod session;
 mod settings;
 
-use clap::Parser;
-use clap::error::ErrorKind;
-use cli::{Cli, Command};
+use flags::Command;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match flags::parse() {
         Ok(cli) => cli,
-        Err(e) => {
-            return match e.kind() {
-                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-                    let _ = e.print();
-                    ExitCode::SUCCESS
-                }
-                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-                    let _ = e.print();
-                    ExitCode::from(1)
-                }
-                _ => {
-                    // One line, naming the argument, without the usage block.
-                    eprintln!("volray: {}", cli::one_line_error(&e));
-                    ExitCode::from(1)
-                }
-            };
-        }
+        Err(code) => return code,
     };
     interrupt::install();
     let result = match &cli.command {

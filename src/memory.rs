@@ -5,8 +5,8 @@
 //! less), the frame, and a cleaned copy with `--nonfinite transparent`.
 //! Beside it the CLI counts what it adds: a 16-bit PNG's quantised pixels.
 
-use crate::cli::{NonFiniteMode, ViewArgs};
 use crate::error::CliError;
+use crate::flags::{NonFiniteMode, ViewArgs};
 use crate::input::Input;
 use volray_core::{MemoryBound, NonFinite, RenderSettings};
 use volray_io::format_bytes;
@@ -19,7 +19,7 @@ pub fn render_bytes(
     settings: &RenderSettings,
     view: &ViewArgs,
 ) -> u128 {
-    let mode = match view.nonfinite {
+    let mode = match view.sampling.nonfinite {
         NonFiniteMode::Refuse => NonFinite::Refuse,
         NonFiniteMode::Transparent => NonFinite::Transparent,
     };
@@ -44,8 +44,8 @@ pub fn check_render(
     Err(CliError::input(format!(
         "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels may take up to {}, more than --max-memory {} (raise it, or use a smaller grid)",
         input.name,
-        view.size.0,
-        view.size.1,
+        view.camera.size.0,
+        view.camera.size.1,
         format_bytes(need),
         format_bytes(u128::from(input.max_memory))
     )))
@@ -54,14 +54,14 @@ pub fn check_render(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cli::Cli;
+    use crate::flags::{Cli, Command};
     use clap::Parser;
     use volray_core::glam::DVec3;
 
     fn bytes(args: &[&str], dims: [usize; 3]) -> u128 {
         let argv = [&["volray", "render", "-o", "x.png"], args].concat();
         let view = match Cli::parse_from(argv).command {
-            crate::cli::Command::Render(r) => r.view,
+            Command::Render(r) => r.view,
             _ => unreachable!(),
         };
         let settings = crate::settings::settings(&view).unwrap();

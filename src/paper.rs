@@ -1,8 +1,8 @@
 //! `volray paper`: the paper's figures and Table 1 into a directory, made
 //! by `volray-paper`.
 
-use crate::cli::{PaperArgs, PaperItem};
 use crate::error::CliError;
+use crate::flags::{PaperArgs, PaperItem};
 use crate::session::thread_pool;
 use volray_paper::{Item, PaperError, Sizes};
 

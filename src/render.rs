@@ -2,8 +2,8 @@
 //! with `--turntable` or several inputs, an animation (`animate.rs`).
 
 use crate::animate;
-use crate::cli::RenderArgs;
 use crate::error::CliError;
+use crate::flags::RenderArgs;
 use crate::input;
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
 use crate::settings::settings;
@@ -14,21 +14,27 @@ use volray_io::{Animation, AnimationKind, BitDepth};
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let specs = specs(args);
     let animation = animation_reason(args)?;
-    let kind = output_kind(&args.output, args.bit_depth, animation)?;
-    if args.fps.is_some() && animation.is_none() {
+    let kind = output_kind(&args.out.output, args.out.bit_depth, animation)?;
+    if args.animation.fps.is_some() && animation.is_none() {
         return Err(CliError::input(
             "--fps applies to animations: give --turntable FRAMES or several inputs",
         ));
     }
     let settings = settings(&args.view)?;
-    check_output(&args.output)?;
+    check_output(&args.out.output)?;
     crate::overwrite::refuse_overwriting_inputs(
         &output_files(args, kind, specs.len()),
         &specs,
-        &args.view.tf.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
+        &args
+            .view
+            .look
+            .tf
+            .iter()
+            .map(|p| p.as_path())
+            .collect::<Vec<_>>(),
     )?;
     let pool = thread_pool(args.view.threads)?;
-    match (kind, args.turntable) {
+    match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(frames)) => {
             animate::turntable(args, &settings, &pool, frames as usize)
         }
@@ -44,7 +50,7 @@ fn still(
     pool: &rayon::ThreadPool,
     kind: OutputKind,
 ) -> Result<(), CliError> {
-    let input = load(&args.input, args.view.log)?;
+    let input = load(&args.input, args.view.look.log)?;
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let image = pool
@@ -53,11 +59,11 @@ fn still(
     bar.finish_and_clear();
 
     match kind {
-        OutputKind::Png(depth) => volray_io::write_png(&args.output, &image, depth)?,
-        OutputKind::Exr => volray_io::write_exr(&args.output, &image)?,
+        OutputKind::Png(depth) => volray_io::write_png(&args.out.output, &image, depth)?,
+        OutputKind::Exr => volray_io::write_exr(&args.out.output, &image)?,
         OutputKind::Gif => {
             let mut gif = Animation::create(
-                &args.output,
+                &args.out.output,
                 image.width(),
                 image.height(),
                 1,
@@ -75,7 +81,7 @@ fn still(
 fn specs(args: &RenderArgs) -> Vec<String> {
     let first = args.input.input.as_deref().unwrap_or(input::DEMO);
     std::iter::once(first.to_string())
-        .chain(args.series.iter().cloned())
+        .chain(args.animation.series.iter().cloned())
         .collect()
 }
 
@@ -83,7 +89,7 @@ fn specs(args: &RenderArgs) -> Vec<String> {
 /// `None` for a single frame. A turntable of a series is refused: which
 /// frame would turn how far is not obvious.
 fn animation_reason(args: &RenderArgs) -> Result<Option<&'static str>, CliError> {
-    match (args.turntable, args.series.is_empty()) {
+    match (args.animation.turntable, args.animation.series.is_empty()) {
         (Some(_), false) => Err(CliError::input(
             "--turntable renders one volume: give one input, or several inputs without --turntable",
         )),
@@ -157,12 +163,12 @@ fn output_kind(
 /// The files the run will write: OUTPUT, or each frame's file of a PNG
 /// sequence.
 fn output_files(args: &RenderArgs, kind: OutputKind, inputs: usize) -> Vec<PathBuf> {
-    let frames = args.turntable.map_or(inputs, |n| n as usize);
-    match AnimationKind::from_path(&args.output) {
+    let frames = args.animation.turntable.map_or(inputs, |n| n as usize);
+    match AnimationKind::from_path(&args.out.output) {
         Some(AnimationKind::PngSequence) if kind == OutputKind::Animation => (0..frames)
-            .filter_map(|i| volray_io::sequence_path(&args.output, i))
+            .filter_map(|i| volray_io::sequence_path(&args.out.output, i))
             .collect(),
-        _ => vec![args.output.clone()],
+        _ => vec![args.out.output.clone()],
     }
 }
 

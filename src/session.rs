@@ -4,8 +4,8 @@
 //! saying which flag a render error is about. `render.rs`, `animate.rs`,
 //! `bench.rs` and `paper.rs` share these.
 
-use crate::cli::{InputArgs, NonFiniteMode, ViewArgs};
 use crate::error::CliError;
+use crate::flags::{InputArgs, NonFiniteMode, ViewArgs};
 use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -51,7 +51,7 @@ pub fn renderer_for<'v>(
 ) -> Result<Renderer<'v>, CliError> {
     crate::memory::check_render(view, settings, input)?;
     let (name, volume) = (&input.name, &input.volume);
-    let mode = match view.nonfinite {
+    let mode = match view.sampling.nonfinite {
         NonFiniteMode::Refuse => NonFinite::Refuse,
         NonFiniteMode::Transparent => NonFinite::Transparent,
     };
@@ -78,11 +78,15 @@ fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<&'static str> {
     let flag = match e {
         RenderError::NonFinite { .. } => "--nonfinite",
         RenderError::Camera(c) => match c {
-            CameraError::NoDirection(_) if view.view.is_some() => "--view",
+            CameraError::NoDirection(_) if view.camera.view.is_some() => "--view",
             CameraError::NoDirection(_) => "--look-at",
             CameraError::UpParallel { .. } => "--up",
-            CameraError::NotFinite(CameraPoint::ViewPoint, _) if view.view.is_some() => "--view",
-            CameraError::NotFinite(CameraPoint::ViewReference, _) if view.look_at.is_some() => {
+            CameraError::NotFinite(CameraPoint::ViewPoint, _) if view.camera.view.is_some() => {
+                "--view"
+            }
+            CameraError::NotFinite(CameraPoint::ViewReference, _)
+                if view.camera.look_at.is_some() =>
+            {
                 "--look-at"
             }
             CameraError::NotFinite(CameraPoint::Up, _) => "--up",

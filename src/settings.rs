@@ -4,8 +4,8 @@
 //! uses, Levoy's `--iso` contour, and the rest as they are; then checked
 //! by volray-core, so that a bad combination is refused before any work.
 
-use crate::cli::{BlendMode, ViewArgs};
 use crate::error::CliError;
+use crate::flags::{BlendMode, CameraArgs, LookArgs, ViewArgs};
 use std::path::Path;
 use volray_core::glam::DVec3;
 use volray_core::transfer::{colormap, presets};
@@ -13,6 +13,144 @@ use volray_core::{
     Blend, Camera, Classification, ClipPlane, IsoSurface, Method, Phong, Projection,
     RenderSettings, TransferFunction,
 };
+
+/// The render settings the view arguments describe.
+pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
+    let ViewArgs {
+        camera: cam,
+        look,
+        sampling,
+        threads: _,
+    } = view;
+    let transfer_function = transfer_function(look)?;
+    let settings = RenderSettings {
+        width: cam.size.0,
+        height: cam.size.1,
+        camera: camera(cam),
+        step: sampling.step,
+        opacity_ramp: look
+            .opacity
+            .unwrap_or(RenderSettings::default().opacity_ramp),
+        transfer_function,
+        phong: Phong {
+            ambient: look.ambient,
+            diffuse: look.diffuse,
+            specular: look.specular,
+            shininess: look.shininess,
+            light_color: look.light_color,
+        },
+        shading: !look.no_shading,
+        light_direction: look.light.map(DVec3::from),
+        background: look.background,
+        method: if sampling.reference {
+            Method::Reference
+        } else {
+            Method::Fast
+        },
+        blend: blend(look)?,
+        classification: if look.post_classification {
+            Classification::Post
+        } else {
+            Classification::Pre
+        },
+        jitter: sampling.jitter,
+        clip_planes: (cam.clip.iter())
+            .map(|&(point, normal)| ClipPlane {
+                point: DVec3::from(point),
+                normal: DVec3::from(normal),
+            })
+            .collect(),
+        crop: (cam.crop).map(|(lo, hi)| (DVec3::from(lo), DVec3::from(hi))),
+        iso: iso(look)?,
+        gradient_opacity: look.gradient_opacity,
+        gradient_opacity_max: None,
+    };
+    settings
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    settings
+        .camera
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    Ok(settings)
+}
+
+/// The transfer function of `--tf` or `--preset` (else the default), with
+/// `--colormap`'s colours and `--range`'s window, each refused where it
+/// would replace what `--tf` or a CT preset fixes; with `--log` the window
+/// is converted from the data's units.
+fn transfer_function(look: &LookArgs) -> Result<TransferFunction, CliError> {
+    let transfer_function = match &look.tf {
+        Some(path) => {
+            let text = read_tf_file(path)?;
+            TransferFunction::from_json(&text)
+                .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?
+        }
+        None => TransferFunction::default(),
+    };
+    let from = if look.tf.is_some() {
+        "--tf"
+    } else {
+        "--preset"
+    };
+    let mut transfer_function = match &look.preset {
+        Some(_) if look.tf.is_some() => {
+            return Err(CliError::input(
+                "--preset conflicts with --tf: give one of them",
+            ));
+        }
+        Some(name) => presets::preset(name).ok_or_else(|| {
+            CliError::input(format!(
+                "--preset: unknown preset '{name}': expected one of {}",
+                presets::NAMES.join(", ")
+            ))
+        })?,
+        None => transfer_function,
+    };
+    if look.opacity.is_some() && transfer_function.opacity.is_some() {
+        return Err(CliError::input(format!(
+            "--opacity conflicts with the opacity function in {from}: give one of them"
+        )));
+    }
+    if let Some(name) = &look.colormap {
+        if look.tf.is_some() && transfer_function.color.is_some() {
+            return Err(CliError::input(
+                "--colormap conflicts with the colour function in --tf: give one of them",
+            ));
+        }
+        transfer_function.color = Some(colormap::colormap(name).ok_or_else(|| {
+            CliError::input(format!(
+                "--colormap: unknown colour map '{name}': expected one of {}",
+                colormap::NAMES.join(", ")
+            ))
+        })?);
+    }
+    if let Some(range) = look.range {
+        if transfer_function.domain.is_some() {
+            return Err(CliError::input(format!(
+                "--range conflicts with the value domain fixed by {from}: give one of them"
+            )));
+        }
+        transfer_function.domain = Some(range);
+    }
+    if look.log
+        && let Some((lo, hi)) = transfer_function.domain
+    {
+        // The window is given in the data's units; the renderer sees log10.
+        let from = if look.range.is_some() {
+            "--range"
+        } else {
+            from
+        };
+        if lo <= 0.0 {
+            return Err(CliError::input(format!(
+                "{from}: with --log the value window is in the data's own units and must be positive, but LO is {lo}"
+            )));
+        }
+        transfer_function.domain = Some((lo.log10(), hi.log10()));
+    }
+    Ok(transfer_function)
+}
 
 /// The largest `--tf` file read: a transfer function is a few hundred
 /// points; this bounds what a wrong path (a device, a huge file) costs.
@@ -45,142 +183,19 @@ fn read_tf_file(path: &Path) -> Result<String, CliError> {
     Ok(text)
 }
 
-/// The render settings the view arguments describe.
-pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
-    let transfer_function = match &view.tf {
-        Some(path) => {
-            let text = read_tf_file(path)?;
-            TransferFunction::from_json(&text)
-                .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?
-        }
-        None => TransferFunction::default(),
-    };
-    let from = if view.tf.is_some() {
-        "--tf"
-    } else {
-        "--preset"
-    };
-    let mut transfer_function = match &view.preset {
-        Some(_) if view.tf.is_some() => {
-            return Err(CliError::input(
-                "--preset conflicts with --tf: give one of them",
-            ));
-        }
-        Some(name) => presets::preset(name).ok_or_else(|| {
-            CliError::input(format!(
-                "--preset: unknown preset '{name}': expected one of {}",
-                presets::NAMES.join(", ")
-            ))
-        })?,
-        None => transfer_function,
-    };
-    if view.opacity.is_some() && transfer_function.opacity.is_some() {
-        return Err(CliError::input(format!(
-            "--opacity conflicts with the opacity function in {from}: give one of them"
-        )));
-    }
-    if let Some(name) = &view.colormap {
-        if view.tf.is_some() && transfer_function.color.is_some() {
-            return Err(CliError::input(
-                "--colormap conflicts with the colour function in --tf: give one of them",
-            ));
-        }
-        transfer_function.color = Some(colormap::colormap(name).ok_or_else(|| {
-            CliError::input(format!(
-                "--colormap: unknown colour map '{name}': expected one of {}",
-                colormap::NAMES.join(", ")
-            ))
-        })?);
-    }
-    if let Some(range) = view.range {
-        if transfer_function.domain.is_some() {
-            return Err(CliError::input(format!(
-                "--range conflicts with the value domain fixed by {from}: give one of them"
-            )));
-        }
-        transfer_function.domain = Some(range);
-    }
-    if view.log
-        && let Some((lo, hi)) = transfer_function.domain
-    {
-        // The window is given in the data's units; the renderer sees log10.
-        let from = if view.range.is_some() {
-            "--range"
-        } else {
-            from
-        };
-        if lo <= 0.0 {
-            return Err(CliError::input(format!(
-                "{from}: with --log the value window is in the data's own units and must be positive, but LO is {lo}"
-            )));
-        }
-        transfer_function.domain = Some((lo.log10(), hi.log10()));
-    }
-    let settings = RenderSettings {
-        width: view.size.0,
-        height: view.size.1,
-        camera: camera(view),
-        step: view.step,
-        opacity_ramp: view
-            .opacity
-            .unwrap_or(RenderSettings::default().opacity_ramp),
-        transfer_function,
-        phong: Phong {
-            ambient: view.ambient,
-            diffuse: view.diffuse,
-            specular: view.specular,
-            shininess: view.shininess,
-            light_color: view.light_color,
-        },
-        shading: !view.no_shading,
-        light_direction: view.light.map(DVec3::from),
-        background: view.background,
-        method: if view.reference {
-            Method::Reference
-        } else {
-            Method::Fast
-        },
-        blend: blend(view)?,
-        classification: if view.post_classification {
-            Classification::Post
-        } else {
-            Classification::Pre
-        },
-        jitter: view.jitter,
-        clip_planes: (view.clip.iter())
-            .map(|&(point, normal)| ClipPlane {
-                point: DVec3::from(point),
-                normal: DVec3::from(normal),
-            })
-            .collect(),
-        crop: view.crop.map(|(lo, hi)| (DVec3::from(lo), DVec3::from(hi))),
-        iso: iso(view)?,
-        gradient_opacity: view.gradient_opacity,
-        gradient_opacity_max: None,
-    };
-    settings
-        .validate()
-        .map_err(|e| CliError::input(e.to_string()))?;
-    settings
-        .camera
-        .validate()
-        .map_err(|e| CliError::input(e.to_string()))?;
-    Ok(settings)
-}
-
-/// The camera of the view options.
-fn camera(view: &ViewArgs) -> Camera {
+/// The camera of the camera options (their image size aside).
+fn camera(cam: &CameraArgs) -> Camera {
     Camera {
-        view_point: view.view.map(DVec3::from),
-        look_at: view.look_at.map(DVec3::from),
-        up: DVec3::from(view.up),
-        projection: match view.perspective {
+        view_point: cam.view.map(DVec3::from),
+        look_at: cam.look_at.map(DVec3::from),
+        up: DVec3::from(cam.up),
+        projection: match cam.perspective {
             Some(fov_degrees) => Projection::Perspective { fov_degrees },
             None => Projection::Orthographic,
         },
-        zoom: view.zoom,
-        azimuth: view.azimuth,
-        elevation: view.elevation,
+        zoom: cam.zoom,
+        azimuth: cam.azimuth,
+        elevation: cam.elevation,
         ..Camera::default()
     }
 }
@@ -188,10 +203,10 @@ fn camera(view: &ViewArgs) -> Camera {
 /// `--blend`, checked against the options that only compositing uses:
 /// a projection shows the interpolated scalar, with no opacity to shape
 /// and no lighting.
-fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
-    let (blend, name) = match view.blend {
+fn blend(look: &LookArgs) -> Result<Blend, CliError> {
+    let (blend, name) = match look.blend {
         BlendMode::Composite => (Blend::Composite, "composite"),
-        BlendMode::Iso if view.iso.is_none() => {
+        BlendMode::Iso if look.iso.is_none() => {
             return Err(CliError::input(
                 "--blend iso needs the isovalue: give --iso VALUE",
             ));
@@ -203,10 +218,10 @@ fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
     };
     if blend.is_projection() {
         for (given, flag) in [
-            (view.iso.is_some(), "--iso"),
-            (view.gradient_opacity.is_some(), "--gradient-opacity"),
-            (view.post_classification, "--post-classification"),
-            (view.opacity.is_some(), "--opacity"),
+            (look.iso.is_some(), "--iso"),
+            (look.gradient_opacity.is_some(), "--gradient-opacity"),
+            (look.post_classification, "--post-classification"),
+            (look.opacity.is_some(), "--opacity"),
         ] {
             if given {
                 return Err(CliError::input(format!(
@@ -217,12 +232,12 @@ fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
     }
     let unlit = if blend.is_projection() {
         Some(format!("--blend {name} is unshaded"))
-    } else if view.no_shading {
+    } else if look.no_shading {
         Some("--no-shading turns the lighting off".to_string())
     } else {
         None
     };
-    if let (Some(why), Some(flag)) = (unlit, lighting_flag(view)) {
+    if let (Some(why), Some(flag)) = (unlit, lighting_flag(look)) {
         return Err(CliError::input(format!(
             "{flag} sets the lighting, but {why}: leave {flag} out"
         )));
@@ -232,15 +247,15 @@ fn blend(view: &ViewArgs) -> Result<Blend, CliError> {
 
 /// The first lighting option given a value other than its default (the
 /// library's, which `--help` shows), if any.
-fn lighting_flag(view: &ViewArgs) -> Option<&'static str> {
+fn lighting_flag(look: &LookArgs) -> Option<&'static str> {
     let lit = Phong::default();
     [
-        (view.ambient != lit.ambient, "--ambient"),
-        (view.diffuse != lit.diffuse, "--diffuse"),
-        (view.specular != lit.specular, "--specular"),
-        (view.shininess != lit.shininess, "--shininess"),
-        (view.light_color != lit.light_color, "--light-color"),
-        (view.light.is_some(), "--light"),
+        (look.ambient != lit.ambient, "--ambient"),
+        (look.diffuse != lit.diffuse, "--diffuse"),
+        (look.specular != lit.specular, "--specular"),
+        (look.shininess != lit.shininess, "--shininess"),
+        (look.light_color != lit.light_color, "--light-color"),
+        (look.light.is_some(), "--light"),
     ]
     .into_iter()
     .find_map(|(given, flag)| given.then_some(flag))
@@ -248,16 +263,16 @@ fn lighting_flag(view: &ViewArgs) -> Option<&'static str> {
 
 /// `--iso VALUE --iso-thickness R`; with `--log` the value is in the data's
 /// units, like `--range`.
-fn iso(view: &ViewArgs) -> Result<Option<IsoSurface>, CliError> {
-    let Some(value) = view.iso else {
-        return match view.iso_thickness {
+fn iso(look: &LookArgs) -> Result<Option<IsoSurface>, CliError> {
+    let Some(value) = look.iso else {
+        return match look.iso_thickness {
             Some(_) => Err(CliError::input(
                 "--iso-thickness is the half-width of the --iso shell: give --iso VALUE too",
             )),
             None => Ok(None),
         };
     };
-    let value = if view.log {
+    let value = if look.log {
         if value <= 0.0 {
             return Err(CliError::input(format!(
                 "--iso: with --log the isovalue is in the data's own units and must be positive, but it is {value}"
@@ -269,14 +284,14 @@ fn iso(view: &ViewArgs) -> Result<Option<IsoSurface>, CliError> {
     };
     Ok(Some(IsoSurface {
         value,
-        thickness: view.iso_thickness.unwrap_or(1.0),
+        thickness: look.iso_thickness.unwrap_or(1.0),
     }))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cli::{Cli, Command, RenderArgs};
+    use crate::flags::{Cli, Command, RenderArgs};
     use clap::Parser;
 
     #[test]

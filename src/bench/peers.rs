@@ -20,8 +20,8 @@
 
 use super::vtk::Harness;
 use super::{JsonRow, Timed, median, ms, time_frames, write_json};
-use crate::cli::BenchArgs;
 use crate::error::CliError;
+use crate::flags::BenchArgs;
 use crate::session::thread_pool;
 use std::path::Path;
 use volray_core::PiecewiseLinear;

@@ -1,0 +1,66 @@
+//! Where the volume comes from and how to read it: INPUT and the reading
+//! options (`--dims`, `--dtype`, `--endian`, `--spacing`, `--format`,
+//! `--frame`, `--array`, `--max-memory`), which `render`, `bench` and
+//! `info` share. `input.rs` (beside `main.rs`) reads the volume they
+//! describe.
+
+use super::parse::{parse_dims, parse_spacing};
+use clap::Args;
+
+/// Where the volume comes from and how to read it.
+#[derive(Debug, Clone, Args)]
+pub struct InputArgs {
+    /// A volume file or a built-in source spec such as
+    /// `marschner-lobb:41`, `blobs:64`, `sphere:64,radius=0.7`, `torus`
+    /// (see `volray-data`); default: the demo volume `blobs:64`.
+    /// A file whose name is a source's name needs a path, e.g. `./sphere`.
+    pub input: Option<String>,
+
+    /// Raw files: points along x, y and z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_dims, allow_hyphen_values = true, help_heading = "Raw files")]
+    pub dims: Option<[usize; 3]>,
+
+    /// Raw files: the sample type.
+    #[arg(
+        long,
+        value_name = "u8|i8|u16|i16|u32|i32|u64|i64|f16|f32|f64",
+        help_heading = "Raw files"
+    )]
+    pub dtype: Option<String>,
+
+    /// Raw files: the byte order.
+    #[arg(long, value_name = "little|big", help_heading = "Raw files")]
+    pub endian: Option<String>,
+
+    /// Voxel spacing in world units along x, y and z, replacing what the
+    /// file says [default: the file's spacing; 1,1,1 for raw and .npy
+    /// files; built-in sources have their own].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_spacing, allow_hyphen_values = true)]
+    pub spacing: Option<[f64; 3]>,
+
+    /// Read the file as this format, whatever its name and content say
+    /// [default: from the extension, else from the file's magic number].
+    #[arg(
+        long,
+        value_name = "raw|npy|nrrd|metaimage|nifti|vtk|vti|dicom|tiff|hdf5|cube|mrc|chgcar"
+    )]
+    pub format: Option<String>,
+
+    /// Which volume of a file that holds several, from 0: a 4-D NIfTI,
+    /// NRRD or MetaImage time point, a cube file's orbital, ... [default: 0].
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub frame: Option<usize>,
+
+    /// Which named array of a VTK file (.vtk, .vti) [default: the active
+    /// scalars, else the first array].
+    #[arg(long, value_name = "NAME")]
+    pub array: Option<String>,
+
+    /// The most memory the volume may take, read and rendered: bytes, or
+    /// a number with K, M, G or T (powers of 1024), e.g. 512M, 4G, 1.5GiB.
+    /// A file whose header asks for more, or a volume whose rendering may
+    /// need more, is refused before anything is allocated [default: half
+    /// the physical memory].
+    #[arg(long, value_name = "SIZE", value_parser = volray_io::parse_size, allow_hyphen_values = true)]
+    pub max_memory: Option<u64>,
+}

@@ -1,0 +1,145 @@
+//! The command line's flags, split by concern as ripgrep splits its own:
+//! each group of flags is a clap `Args` struct in its own module, and the
+//! subcommands' arguments flatten the groups they take. Nothing here
+//! renders; the modules beside `main.rs` turn these into library calls.
+//!
+//! - `input.rs`: INPUT and how to read it (render, bench, info);
+//! - `view.rs`: how to render a frame (render, bench), made of
+//!   `camera.rs` (the image size, the eye, the projection, clipping),
+//!   `look.rs` (classification, shading, blending) and `sampling.rs`
+//!   (the step, jitter, the path, non-finite values), and `--threads`;
+//! - `output.rs` and `animation.rs`: render's output file, and its
+//!   turntables and series;
+//! - `render.rs`, `bench.rs`, `info.rs`, `generate.rs`, `paper.rs`: each
+//!   subcommand's arguments (`bench.rs` also says which groups `--peers`
+//!   refuses);
+//! - `parse.rs`: the value parsers, and clap's errors on one line.
+
+mod animation;
+mod bench;
+mod camera;
+mod generate;
+mod info;
+mod input;
+mod look;
+mod output;
+mod paper;
+mod parse;
+mod render;
+mod sampling;
+mod view;
+
+pub use bench::BenchArgs;
+pub use camera::CameraArgs;
+pub use generate::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
+pub use info::InfoArgs;
+pub use input::InputArgs;
+pub use look::{BlendMode, LookArgs};
+pub use paper::{PaperArgs, PaperItem};
+pub use render::RenderArgs;
+pub use sampling::NonFiniteMode;
+pub use view::ViewArgs;
+
+use clap::error::ErrorKind;
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "volray",
+    version,
+    about = "Ray-casting volume renderer (Ramesh & Athithan 1993, after Levoy 1988)",
+    long_about = "Ray-casting volume renderer (Ramesh & Athithan 1993, after Levoy 1988).\n\n\
+        Exit codes: 0 success, 1 bad input or arguments, 2 I/O failure, \
+        130 interrupted (Ctrl-C; 128 + the signal for SIGTERM and SIGHUP)."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render a volume to an image (PNG, OpenEXR), or a turntable or a
+    /// series of volumes to an animation (animated PNG, GIF, numbered PNGs).
+    Render(RenderArgs),
+    /// Time frames of a volume: median of several views, each new.
+    Bench(BenchArgs),
+    /// Describe a volume: format, dims, spacing, origin, sample type, value
+    /// range, a histogram, and what the header said versus what was used.
+    Info(InfoArgs),
+    /// Write a generated volume to a file: a hydrogen-atom density or a
+    /// fractal cloud (the paper's two test data sets).
+    Generate(GenerateArgs),
+    /// Reproduce the paper's Figures 1a, 1b, 1c, 2a, 2b and Table 1 into a
+    /// directory (figure1a.png ... figure2b.png, table1.md).
+    Paper(PaperArgs),
+}
+
+/// The command line, parsed; or, when it asks for help or the version or
+/// is wrong, that printed (an error on one line, naming the argument,
+/// without the usage block) and the exit code to end with: 0 for help and
+/// the version, 1 otherwise.
+pub fn parse() -> Result<Cli, ExitCode> {
+    Cli::try_parse().map_err(|e| match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            let _ = e.print();
+            ExitCode::from(1)
+        }
+        _ => {
+            eprintln!("volray: {}", parse::one_line_error(&e));
+            ExitCode::from(1)
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blend_names_and_aliases() {
+        let blend = |name: &str| {
+            let cli = Cli::try_parse_from(["volray", "render", "-o", "x.png", "--blend", name])
+                .map_err(|e| e.to_string())?;
+            match cli.command {
+                Command::Render(args) => Ok(args.view.look.blend),
+                _ => Err("not render".to_string()),
+            }
+        };
+        assert_eq!(blend("mip"), Ok(BlendMode::Mip));
+        assert_eq!(blend("maximum"), Ok(BlendMode::Mip));
+        assert_eq!(blend("minimum"), Ok(BlendMode::Minip));
+        assert_eq!(blend("average"), Ok(BlendMode::Average));
+        assert!(blend("sum").is_err());
+    }
+
+    #[test]
+    fn several_inputs_and_repeated_clip_planes() {
+        let cli = Cli::try_parse_from([
+            "volray",
+            "render",
+            "a.cube",
+            "b.cube",
+            "c.cube",
+            "-o",
+            "x.gif",
+            "--clip",
+            "0,0,0,1,0,0",
+            "--clip",
+            "0,0,0,0,-1,0",
+        ])
+        .unwrap();
+        let Command::Render(args) = cli.command else {
+            panic!("not render")
+        };
+        assert_eq!(args.input.input.as_deref(), Some("a.cube"));
+        assert_eq!(args.animation.series, ["b.cube", "c.cube"]);
+        assert_eq!(args.view.camera.clip.len(), 2);
+        assert_eq!(args.view.camera.clip[1].1, [0.0, -1.0, 0.0]);
+    }
+}

@@ -1,0 +1,23 @@
+//! `volray render`'s flags, each group in its own module.
+
+use super::animation::AnimationArgs;
+use super::input::InputArgs;
+use super::output::OutputArgs;
+use super::view::ViewArgs;
+use clap::Args;
+
+/// `volray render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+
+    #[command(flatten)]
+    pub out: OutputArgs,
+
+    #[command(flatten)]
+    pub animation: AnimationArgs,
+
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
