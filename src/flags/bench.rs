@@ -1,9 +1,12 @@
-//! `volray bench`'s flags, and the flags `--peers` ignores.
+//! `volray bench`'s flags, and the flag groups `--peers` ignores.
 
+use super::camera::CameraArgs;
 use super::input::InputArgs;
+use super::look::LookArgs;
 use super::parse::{Cases, parse_cases};
+use super::sampling::SamplingArgs;
 use super::view::ViewArgs;
-use clap::Args;
+use clap::{Args, Command};
 use std::path::PathBuf;
 
 /// `volray bench`.
@@ -22,7 +25,7 @@ pub struct BenchArgs {
     /// make_volumes.py), each exactly as the peers define it: view along
     /// +x, step 0.5 voxel, their transfer functions and shading. The view
     /// options other than --threads do not apply, and are refused.
-    #[arg(long, value_name = "DIR", conflicts_with_all = PEERS_IGNORE)]
+    #[arg(long, value_name = "DIR", conflicts_with_all = peers_ignores())]
     pub peers: Option<PathBuf>,
 
     /// With --peers: only these workloads, each NAME:W (the volume
@@ -53,48 +56,111 @@ pub struct BenchArgs {
     pub view: ViewArgs,
 }
 
-/// The options `bench --peers` does not use: the workloads fix their own
-/// input, view and transfer functions.
-const PEERS_IGNORE: [&str; 41] = [
-    "max_memory",
-    "nonfinite",
-    "dims",
-    "dtype",
-    "endian",
-    "spacing",
-    "format",
-    "frame",
-    "array",
-    "size",
-    "view",
-    "look_at",
-    "up",
-    "step",
-    "opacity",
-    "tf",
-    "preset",
-    "colormap",
-    "range",
-    "ambient",
-    "diffuse",
-    "specular",
-    "shininess",
-    "light",
-    "light_color",
-    "no_shading",
-    "background",
-    "reference",
-    "blend",
-    "iso",
-    "iso_thickness",
-    "log",
-    "gradient_opacity",
-    "post_classification",
-    "jitter",
-    "perspective",
-    "zoom",
-    "azimuth",
-    "elevation",
-    "clip",
-    "crop",
+/// The flag groups `bench --peers` does not use: the workloads fix their
+/// own input, view and transfer functions (of the view, only `--threads`
+/// applies). Each group is given by the `Args` struct that defines it:
+/// its `augment_args`, which adds the group's flags to a command.
+const PEERS_IGNORE: [fn(Command) -> Command; 4] = [
+    <InputArgs as Args>::augment_args,
+    <CameraArgs as Args>::augment_args,
+    <LookArgs as Args>::augment_args,
+    <SamplingArgs as Args>::augment_args,
 ];
+
+/// The flags of the [`PEERS_IGNORE`] groups, which `--peers` conflicts
+/// with. Flag by flag rather than by group id, so that clap's error names
+/// the flag given, not every flag of its group; without INPUT, which
+/// `bench.rs` refuses with a message saying what `--peers` does instead.
+fn peers_ignores() -> Vec<clap::Id> {
+    PEERS_IGNORE
+        .iter()
+        .fold(Command::new("peers"), |cmd, group| group(cmd))
+        .get_arguments()
+        .filter(|arg| !arg.is_positional())
+        .map(|arg| arg.get_id().clone())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flags::Cli;
+    use crate::flags::parse::one_line_error;
+    use clap::error::ErrorKind;
+    use clap::{CommandFactory, Parser};
+
+    /// `volray bench` with `args`, parsed.
+    fn bench(args: &[&str]) -> Result<Cli, clap::Error> {
+        Cli::try_parse_from([&["volray", "bench"][..], args].concat())
+    }
+
+    /// The words that give `arg`: the flag, and a value it takes without
+    /// `--peers` (its default, or the first of a few shapes that fits).
+    fn given(arg: &clap::Arg) -> Vec<String> {
+        let flag = format!("--{}", arg.get_long().expect("a flag has a long name"));
+        if !arg.get_action().takes_values() {
+            return vec![flag];
+        }
+        let defaults = (arg.get_default_values().iter()).map(|v| v.to_string_lossy().into_owned());
+        let value = defaults
+            .chain(["1", "0,1", "2,2,2", "0,1,0,1,0,1"].map(String::from))
+            .find(|v| bench(&[&flag, v]).is_ok())
+            .unwrap_or_else(|| panic!("no sample value fits {flag}: add one here"));
+        vec![flag, value]
+    }
+
+    #[test]
+    fn peers_refuses_every_flag_of_the_groups_it_ignores() {
+        let mut cli = Cli::command();
+        cli.build();
+        let ignored = peers_ignores();
+        let flags: Vec<&clap::Arg> = (cli.find_subcommand("bench").unwrap().get_arguments())
+            .filter(|arg| ignored.contains(arg.get_id()))
+            .collect();
+        // The 41 flags of the list this replaced: all but INPUT of the
+        // input options, and all but --threads of the view options.
+        assert_eq!(flags.len(), 41);
+        for arg in flags {
+            let given = given(arg);
+            let given: Vec<&str> = given.iter().map(String::as_str).collect();
+            let peers = ["--peers", "dir"];
+            let named = arg.to_string();
+            for (args, message) in [
+                (
+                    [&peers[..], &given].concat(),
+                    format!("error: the argument '--peers <DIR>' cannot be used with '{named}'"),
+                ),
+                (
+                    [&given[..], &peers].concat(),
+                    format!("error: the argument '{named}' cannot be used with '--peers <DIR>'"),
+                ),
+            ] {
+                let e = bench(&args).expect_err(&named);
+                assert_eq!(e.kind(), ErrorKind::ArgumentConflict, "{args:?}");
+                assert_eq!(one_line_error(&e), message);
+            }
+        }
+    }
+
+    #[test]
+    fn peers_takes_the_flags_outside_those_groups() {
+        let all = [
+            "--peers",
+            "dir",
+            "--cases",
+            "a:8",
+            "--frames",
+            "3",
+            "--json",
+            "b.json",
+            "--vs-vtk",
+            "--peers-python",
+            "python3",
+            "--threads",
+            "2",
+        ];
+        assert!(bench(&all).is_ok());
+        // INPUT is refused after parsing, by bench.rs, which says why.
+        assert!(bench(&["sphere:8", "--peers", "dir"]).is_ok());
+    }
+}
