@@ -1,6 +1,27 @@
 //! `volray`: the command line. It parses arguments and calls the libraries:
 //! `volray-io` and `volray-data` for the input, `volray-core` to render,
 //! `volray-io` again for the PNG.
+//!
+//! Where things are:
+//!
+//! - `flags/`: every flag, one module per group (input, camera, look,
+//!   sampling, output, animation) and one per subcommand; `flags/mod.rs`
+//!   parses the command line and lists them all;
+//! - one module per subcommand: `render.rs` (one still image, and the
+//!   checks before any work) with `animate.rs` (turntables and series),
+//!   `bench.rs` (with `bench/peers.rs` and `bench/vtk.rs`), `info.rs`,
+//!   `generate.rs`, `paper.rs`;
+//! - what they share: `input.rs` (reading INPUT), `settings.rs` (the flags
+//!   as volray-core's `RenderSettings`), `session.rs` (loading, the
+//!   renderer, threads, progress, which flag a render error is about),
+//!   `memory.rs` (the `--max-memory` bound for rendering);
+//! - the process: `error.rs` (one-line errors and their exit codes: 0
+//!   success, 1 bad input, 2 I/O, 128 + the signal when interrupted),
+//!   `output.rs` (standard output), `overwrite.rs` (never writing over an
+//!   input), `interrupt.rs` (Ctrl-C and friends).
+//!
+//! This file only dispatches: parse, catch signals, run the subcommand,
+//! print its error on one line and exit with its code.
 
 // First, so that its `outln!` macro reaches every module below.
 #[macro_use]
