@@ -6,7 +6,7 @@
 //! Beside it the CLI counts what it adds: a 16-bit PNG's quantised pixels.
 
 use crate::error::CliError;
-use crate::flags::{NonFiniteMode, ViewArgs};
+use crate::flags::ViewArgs;
 use crate::input::Input;
 use volray_core::{MemoryBound, NonFinite, RenderSettings};
 use volray_io::format_bytes;
@@ -19,10 +19,7 @@ pub fn render_bytes(
     settings: &RenderSettings,
     view: &ViewArgs,
 ) -> u128 {
-    let mode = match view.sampling.nonfinite {
-        NonFiniteMode::Refuse => NonFinite::Refuse,
-        NonFiniteMode::Transparent => NonFinite::Transparent,
-    };
+    let mode = NonFinite::from(view.sampling.nonfinite);
     let bound = MemoryBound::new(dims, spacing, settings, mode).total();
     // A 16-bit PNG quantises the frame first: 8 bytes a pixel.
     bound + 8 * settings.width as u128 * settings.height as u128

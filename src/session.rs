@@ -5,7 +5,7 @@
 //! `bench.rs` and `paper.rs` share these.
 
 use crate::error::CliError;
-use crate::flags::{InputArgs, NonFiniteMode, ViewArgs};
+use crate::flags::{InputArgs, ViewArgs};
 use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -51,10 +51,7 @@ pub fn renderer_for<'v>(
 ) -> Result<Renderer<'v>, CliError> {
     crate::memory::check_render(view, settings, input)?;
     let (name, volume) = (&input.name, &input.volume);
-    let mode = match view.sampling.nonfinite {
-        NonFiniteMode::Refuse => NonFinite::Refuse,
-        NonFiniteMode::Transparent => NonFinite::Transparent,
-    };
+    let mode = NonFinite::from(view.sampling.nonfinite);
     Renderer::with_non_finite(volume, mode).map_err(|e| match e {
         RenderError::NonFinite { .. } => CliError::input(format!(
             "{name}: {e}; use --nonfinite transparent to render them as empty space"

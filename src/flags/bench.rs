@@ -23,8 +23,9 @@ pub struct BenchArgs {
     /// Instead of INPUT, time the peer benchmark's six workloads from the
     /// raw float32 volumes and JSON sidecars in DIR (made by the peers'
     /// make_volumes.py), each exactly as the peers define it: view along
-    /// +x, step 0.5 voxel, their transfer functions and shading. The view
-    /// options other than --threads do not apply, and are refused.
+    /// +x, step 0.5 voxel, their transfer functions and shading. The input,
+    /// camera, rendering and sampling options do not apply, and are
+    /// refused (--threads does).
     #[arg(long, value_name = "DIR", conflicts_with_all = peers_ignores())]
     pub peers: Option<PathBuf>,
 

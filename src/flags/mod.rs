@@ -37,7 +37,6 @@ pub use input::InputArgs;
 pub use look::{BlendMode, LookArgs};
 pub use paper::{PaperArgs, PaperItem};
 pub use render::RenderArgs;
-pub use sampling::NonFiniteMode;
 pub use view::ViewArgs;
 
 use clap::error::ErrorKind;

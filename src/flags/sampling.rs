@@ -47,3 +47,12 @@ pub enum NonFiniteMode {
     /// Render them as empty space.
     Transparent,
 }
+
+impl From<NonFiniteMode> for volray_core::NonFinite {
+    fn from(mode: NonFiniteMode) -> Self {
+        match mode {
+            NonFiniteMode::Refuse => volray_core::NonFinite::Refuse,
+            NonFiniteMode::Transparent => volray_core::NonFinite::Transparent,
+        }
+    }
+}
