@@ -110,6 +110,15 @@ impl PartialImage {
         &mut self.pixels
     }
 
+    /// The pixels of a composited frame, giving up the image; `None` for
+    /// a projection.
+    pub fn into_composite(self) -> Option<Vec<PartialPixel>> {
+        match self.pixels {
+            PartialPixels::Composite(pixels) => Some(pixels),
+            PartialPixels::Projection { .. } => None,
+        }
+    }
+
     /// Combines `self`, rendered from a piece of the volume in front, with
     /// `behind`, from a piece behind it (for projections the order does
     /// not matter): afterwards `self` is the partial image of both.

@@ -32,7 +32,7 @@ use crate::cpu::{bricked, post as post_cast};
 use crate::error::RenderError;
 use crate::frame::Frame;
 use crate::image::Image;
-use crate::kernels::composite::PartialPixel;
+use crate::kernels::composite::{Finish, PartialPixel};
 use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
 use crate::non_finite::{NonFinite, NonFiniteMask};
@@ -170,8 +170,9 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<Image, RenderError> {
-        let partial = self.render_partial(settings, progress)?;
-        Ok(self.finish(settings, partial))
+        let mut image = Image::new(0, 0, [0.0; 4]);
+        self.render_frame(settings, &mut image, progress)?;
+        Ok(image)
     }
 
     /// Renders one frame as a partial image: premultiplied colour and
@@ -188,7 +189,7 @@ impl<'v> Renderer<'v> {
         Ok(match settings.method {
             Method::Fast => {
                 let mut partial = self.blank(settings, Vec::new());
-                self.render_fast(settings, &frame, &mut partial, progress);
+                self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
                 partial
             }
             Method::Reference => self.render_reference(settings, &frame, progress),
@@ -211,17 +212,37 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         image: &mut Image,
     ) -> Result<FrameTimes, RenderError> {
+        self.render_frame(settings, image, &|_| {})
+    }
+
+    /// A whole frame into `image`'s buffer. A composited frame on a fast
+    /// path is finished by the casters, each ray over the background as
+    /// its last step ([`Finish::Over`]), with no second pass over the
+    /// pixels; the others are finished from their partial image.
+    fn render_frame(
+        &self,
+        settings: &RenderSettings,
+        image: &mut Image,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<FrameTimes, RenderError> {
         let frame = self.prepare(settings)?;
         let start = Instant::now();
         let (partial, times) = match settings.method {
-            Method::Reference => {
-                let partial = self.render_reference(settings, &frame, &|_| {});
-                (partial, None)
-            }
+            Method::Reference => (self.render_reference(settings, &frame, progress), None),
             Method::Fast => {
                 let buffer = std::mem::replace(image, Image::new(0, 0, [0.0; 4])).into_pixels();
                 let mut partial = self.blank(settings, buffer);
-                let times = self.render_fast(settings, &frame, &mut partial, &|_| {});
+                let finish = match settings.blend {
+                    Blend::Composite => Finish::Over(settings.background),
+                    _ => Finish::Partial,
+                };
+                let times = self.render_fast(settings, &frame, &mut partial, finish, progress);
+                if finish != Finish::Partial {
+                    let pixels = partial.into_composite().expect("a composited frame");
+                    *image = Image::from_pixels(settings.width, settings.height, pixels)
+                        .expect("the frame's size");
+                    return Ok(times);
+                }
                 (partial, Some(times))
             }
         };
@@ -351,6 +372,7 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         frame: &Frame,
         partial: &mut PartialImage,
+        finish: Finish,
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
         let pixels = match partial.pixels_mut() {
@@ -378,8 +400,8 @@ impl<'v> Renderer<'v> {
             }
         };
         match settings.classification {
-            Classification::Post => self.render_post(settings, frame, pixels, progress),
-            Classification::Pre => self.render_bricks(settings, frame, pixels, progress),
+            Classification::Post => self.render_post(settings, frame, pixels, finish, progress),
+            Classification::Pre => self.render_bricks(settings, frame, pixels, finish, progress),
         }
     }
 
@@ -392,6 +414,7 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         frame: &Frame,
         pixels: &mut [PartialPixel],
+        finish: Finish,
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
         let start = Instant::now();
@@ -409,7 +432,7 @@ impl<'v> Renderer<'v> {
             mask: self.non_finite.as_ref(),
         };
         let (view, sampling) = (&frame.view, &frame.sampling);
-        post_cast::render(&scene, view, sampling, pixels, progress);
+        post_cast::render(&scene, view, sampling, pixels, finish, progress);
         FrameTimes {
             cast: start.elapsed(),
             ..FrameTimes::default()
@@ -423,6 +446,7 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         frame: &Frame,
         pixels: &mut [PartialPixel],
+        finish: Finish,
         progress: &(dyn Fn(usize) + Sync),
     ) -> FrameTimes {
         let mut times = FrameTimes::default();
@@ -465,6 +489,7 @@ impl<'v> Renderer<'v> {
             &frame.sampling,
             &frame.view,
             pixels,
+            finish,
             progress,
         );
         let t3 = Instant::now();

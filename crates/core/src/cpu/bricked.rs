@@ -46,7 +46,7 @@ use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
 use crate::camera::View;
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::{TILE, TileBins};
-use crate::kernels::composite::{FrontToBack, PartialPixel};
+use crate::kernels::composite::{Finish, FrontToBack, PartialPixel};
 use crate::kernels::trilinear::{corners, interpolate};
 use crate::sampling::Sampling;
 use crate::sampling::jitter;
@@ -211,8 +211,9 @@ struct Scene<'a> {
 /// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
 /// as the rays reach them (see [`crate::cpu::lit_bricks`]), binned into
 /// `bins`, through `view` (either projection) with samples where
-/// `sampling` says, into `image` (the view's size). `progress` is called
-/// with the number of pixels finished, a tile at a time.
+/// `sampling` says, into `pixels` (the view's, row-major), each ray's
+/// partial pixel or the finished one as `finish` says. `progress` is
+/// called with the number of pixels finished, a tile at a time.
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     bricks: &ClassifiedBricks,
@@ -222,6 +223,7 @@ pub fn render(
     sampling: &Sampling,
     view: &View,
     pixels: &mut [PartialPixel],
+    finish: Finish,
     progress: &(dyn Fn(usize) + Sync),
 ) {
     let width = view.width();
@@ -245,7 +247,7 @@ pub fn render(
     }
     tiles.into_par_iter().enumerate().for_each(|(t, mut rows)| {
         let (tx, ty) = (t % bins.tiles_x, t / bins.tiles_x);
-        rays.tile(&scene, bins.list(tx, ty), tx, ty, &mut rows);
+        rays.tile(&scene, bins.list(tx, ty), (tx, ty), finish, &mut rows);
         progress(rows.iter().map(|r| r.len()).sum());
     });
 }
@@ -313,13 +315,13 @@ impl<'a> Rays<'a> {
     }
 
     /// Renders tile (`tx`, `ty`), whose bricks are `list`, into `rows`
-    /// (its rows of pixels, top to bottom).
+    /// (its rows of pixels, top to bottom), as `finish` says.
     fn tile(
         &self,
         scene: &Scene,
         list: &[u32],
-        tx: usize,
-        ty: usize,
+        (tx, ty): (usize, usize),
+        finish: Finish,
         rows: &mut [&mut [PartialPixel]],
     ) {
         let cols = tx * TILE..tx * TILE + rows[0].len();
@@ -364,7 +366,7 @@ impl<'a> Rays<'a> {
         }
         for (i, state) in states.iter().enumerate() {
             let (c, r) = (i % cols.len(), i / cols.len());
-            rows[r][c] = state.acc.partial();
+            rows[r][c] = finish.apply(state.acc.partial());
         }
     }
 

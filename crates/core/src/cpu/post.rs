@@ -77,7 +77,7 @@
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid};
 use crate::camera::View;
-use crate::kernels::composite::{EMPTY, FrontToBack, PartialPixel};
+use crate::kernels::composite::{EMPTY, Finish, FrontToBack, PartialPixel};
 use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
 use crate::kernels::trilinear::{cell_of, corners, interpolate};
 use crate::non_finite::NonFiniteMask;
@@ -245,13 +245,15 @@ impl TransparentValues {
 }
 
 /// Renders `scene` through `view`, sampling as `sampling` says, into
-/// `pixels` (the view's partial pixels, row-major). `progress` is called
-/// with the number of pixels finished, a row at a time.
+/// `pixels` (the view's, row-major), each ray's partial pixel or the
+/// finished one as `finish` says. `progress` is called with the number of
+/// pixels finished, a row at a time.
 pub fn render(
     scene: &Scene,
     view: &View,
     sampling: &Sampling,
     pixels: &mut [PartialPixel],
+    finish: Finish,
     progress: &(dyn Fn(usize) + Sync),
 ) -> PostWork {
     let dims = scene.macrocells.grid.dims;
@@ -270,10 +272,10 @@ pub fn render(
         .map(|(row, pixels)| {
             let mut work = PostWork::default();
             for (col, pixel) in pixels.iter_mut().enumerate() {
-                *pixel = match sampling.pixel(view, col, row) {
+                *pixel = finish.apply(match sampling.pixel(view, col, row) {
                     Some(ray) => rays.cast(&ray, &mut work).partial(),
                     None => EMPTY,
-                };
+                });
             }
             progress(pixels.len());
             work
@@ -640,7 +642,14 @@ mod tests {
         let PartialPixels::Composite(pixels) = partial.pixels_mut() else {
             unreachable!()
         };
-        let work = render(&scene, &frame.view, &frame.sampling, pixels, &|_| {});
+        let work = render(
+            &scene,
+            &frame.view,
+            &frame.sampling,
+            pixels,
+            Finish::Partial,
+            &|_| {},
+        );
         let image = renderer.finish(settings, partial);
         (image, work, frame.nominal_samples())
     }

@@ -117,6 +117,30 @@ pub fn over_background(p: PartialPixel, background: [f32; 3]) -> [f32; 4] {
     ]
 }
 
+/// What a caster writes for each ray: its partial pixel, for a compositor
+/// to combine with others, or, where the ray is the whole story (one
+/// process renders the whole volume), the finished pixel over the
+/// background, applied as the ray's last step so that the frame needs no
+/// second pass over its pixels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Finish {
+    /// `[r, g, b, T]`, no background.
+    Partial,
+    /// [`over_background`] of the partial pixel.
+    Over([f32; 3]),
+}
+
+impl Finish {
+    /// The pixel written for a ray whose partial pixel is `p`.
+    #[inline]
+    pub fn apply(self, p: PartialPixel) -> [f32; 4] {
+        match self {
+            Finish::Partial => p,
+            Finish::Over(background) => over_background(p, background),
+        }
+    }
+}
+
 /// The paper's back-to-front compositing of `samples` (r, g, b, α),
 /// nearest first, in `f64`: the premultiplied colour in `xyz` and the
 /// transmittance `Π(1 − αᵢ)` in `w` (the partial pixel; the background is
