@@ -290,6 +290,12 @@ impl<'v> Renderer<'v> {
         classifier
     }
 
+    /// The volume's min/max bricks, found on the first frame that needs them.
+    fn macrocells(&self) -> &Macrocells {
+        self.macrocells
+            .get_or_init(|| Macrocells::new(&self.volume))
+    }
+
     /// The volume's largest gradient magnitude (world units), found once.
     pub fn max_gradient(&self) -> f32 {
         *self
@@ -379,9 +385,7 @@ impl<'v> Renderer<'v> {
             PartialPixels::Composite(pixels) => pixels,
             PartialPixels::Projection { blend, pixels } => {
                 let start = Instant::now();
-                let macrocells = self
-                    .macrocells
-                    .get_or_init(|| Macrocells::new(&self.volume));
+                let macrocells = self.macrocells();
                 intensity::render(
                     &self.volume,
                     self.non_finite.as_ref(),
@@ -423,9 +427,7 @@ impl<'v> Renderer<'v> {
             .get_or_init(|| post_cast::packed_voxels(&self.volume, &gradients(&self.volume)));
         let scene = post_cast::Scene {
             voxels,
-            macrocells: self
-                .macrocells
-                .get_or_init(|| Macrocells::new(&self.volume)),
+            macrocells: self.macrocells(),
             classifier: &classifier,
             lighting: (settings.shading)
                 .then(|| (&settings.phong, Self::light(settings, &frame.view))),
@@ -456,9 +458,7 @@ impl<'v> Renderer<'v> {
         if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
             // Drop the old bricks before building the new ones.
             let lit = guard.take().map(|s| s.lit).unwrap_or_default();
-            let macrocells = self
-                .macrocells
-                .get_or_init(|| Macrocells::new(&self.volume));
+            let macrocells = self.macrocells();
             let mask = self.non_finite.as_ref();
             let bricks = ClassifiedBricks::new(&self.volume, macrocells, &classifier, |v| {
                 mask.is_some_and(|m| m.contains(v))
