@@ -112,4 +112,4 @@ pub use settings::{
 };
 pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;
-pub use volume::{Volume, VolumeError, checked_point_count};
+pub use volume::{Sample, SampleType, Samples, Volume, VolumeError, checked_point_count};

@@ -205,7 +205,7 @@ fn oblique_affine_keeps_index_axes_and_says_so() {
     assert_eq!(l.volume.dims(), SHAPE);
     assert!((l.volume.spacing() - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-6);
     assert!((l.volume.origin() - DVec3::new(5.0, 6.0, 7.0)).length() < 1e-6);
-    for (n, &value) in l.volume.data().iter().enumerate() {
+    for (n, &value) in l.volume.values().iter().enumerate() {
         let (i, j, k) = (n % 4, (n / 4) % 3, n / 12);
         assert_eq!(value, typed("f32", ramp(i, j, k)));
     }

@@ -26,9 +26,9 @@
 
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot, slot_coords};
-use crate::kernels::gradient::gradient_at;
+use crate::kernels::gradient::Differences;
 use crate::transfer::classifier::Classifier;
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
 use rayon::prelude::*;
 
 /// Bytes one occupied brick takes, for the memory bound
@@ -113,8 +113,24 @@ impl ClassifiedBricks {
         classifier: &Classifier,
         masked: impl Fn(usize) -> bool + Sync,
     ) -> Self {
+        crate::with_samples!(volume.samples(), |data| Self::classify(
+            Differences::new(data, volume),
+            data,
+            macrocells,
+            classifier,
+            &masked
+        ))
+    }
+
+    /// [`Self::new`] on samples `data` of type `T`.
+    fn classify<T: Sample>(
+        differences: Differences<T>,
+        data: &[T],
+        macrocells: &Macrocells,
+        classifier: &Classifier,
+        masked: &(impl Fn(usize) -> bool + Sync),
+    ) -> Self {
         let grid = macrocells.grid;
-        let data = volume.data();
         let [nx, ny, _] = grid.dims;
         let coords = |v: usize| (v % nx, (v / nx) % ny, v / (nx * ny));
         // The gradient is computed here only where the opacity needs it;
@@ -125,11 +141,11 @@ impl ClassifiedBricks {
             }
             let gradient = if classifier.uses_gradient() {
                 let (x, y, z) = coords(v);
-                gradient_at(volume, x, y, z)
+                differences.at(x, y, z)
             } else {
                 [0.0; 3]
             };
-            quantise(classifier.opacity_at(data[v], gradient))
+            quantise(classifier.opacity_at(data[v].to_f32(), gradient))
         };
         let is_occupied: Vec<bool> = (0..grid.len())
             .into_par_iter()
@@ -162,11 +178,11 @@ impl ClassifiedBricks {
                 for (s, [i, j, k]) in slot_coords().enumerate() {
                     let v = grid.voxel_of_slot(b, [i, j, k]);
                     let (x, y, z) = coords(v);
-                    let gradient = gradient_at(volume, x, y, z);
+                    let gradient = differences.at(x, y, z);
                     let alpha = if masked(v) {
                         0.0
                     } else {
-                        classifier.opacity_at(data[v], gradient)
+                        classifier.opacity_at(data[v].to_f32(), gradient)
                     };
                     voxels[s] = Voxel {
                         normal: quantise_normal(gradient),
@@ -269,7 +285,7 @@ fn cell_bounds(cells: &[u64; CELLS / 64]) -> ([u8; 3], [u8; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels::gradient::max_magnitude;
+    use crate::kernels::gradient::{gradient_at, max_magnitude};
     use crate::transfer::classifier::OpacityMap;
     use crate::transfer::function::PiecewiseLinear;
     use crate::transfer::iso::IsoSurface;
@@ -376,7 +392,7 @@ mod tests {
                 .map(|s| {
                     let n = m.grid.voxel_of_slot(brick, s);
                     let (x, y, z) = (n % 40, (n / 40) % 40, n / 1600);
-                    quantise(c.opacity_at(v.data()[n], gradient_at(&v, x, y, z)))
+                    quantise(c.opacity_at(v.samples().get(n), gradient_at(&v, x, y, z)))
                 })
                 .collect();
             let visible = alphas.iter().any(|a| *a > 0);

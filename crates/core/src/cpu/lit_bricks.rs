@@ -17,10 +17,10 @@
 //! without conversion.
 
 use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, UNIT, Voxel};
-use crate::bricks::{SIDE, SLOTS, slot_coords};
+use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
 use crate::transfer::classifier::Classifier;
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
 use std::sync::{RwLock, RwLockReadGuard};
 use wide::bytemuck::cast;
 use wide::{f32x4, i16x8, i32x4, i32x8};
@@ -123,19 +123,10 @@ impl<'a> Lighting<'a> {
     pub fn shade(&self, n: usize, out: &mut [[f32; 4]; SLOTS]) {
         let (bricks, b) = (self.bricks, self.bricks.occupied[n]);
         let voxels = &bricks.voxels[n * SLOTS..][..SLOTS];
-        let data = self.volume.data();
-        // The slots' values: rows of slots along x are rows of the volume,
-        // the last voxel repeated past its end.
         let mut values = [0.0f32; SLOTS];
-        for s in slot_coords().step_by(SIDE) {
-            let start = bricks.grid.voxel_of_slot(b, s);
-            let end = bricks.grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
-            let row = &data[start..=end];
-            let first = SIDE * (s[1] + SIDE * s[2]);
-            for (i, v) in values[first..first + SIDE].iter_mut().enumerate() {
-                *v = row[i.min(row.len() - 1)];
-            }
-        }
+        crate::with_samples!(self.volume.samples(), |data| {
+            slot_values(data, &bricks.grid, b, &mut values)
+        });
         // Four slots at a time, one per SIMD lane.
         let mut group = |slots: [usize; 4], lanes: usize| {
             let colours = shade4(
@@ -158,6 +149,21 @@ impl<'a> Lighting<'a> {
         }
         // The last slot (SLOTS = 4·182 + 1), in every lane.
         group([SLOTS - 1; 4], 1);
+    }
+}
+
+/// The values of brick `b`'s slots, from the volume's samples `data`: rows
+/// of slots along x are rows of the volume, the last voxel repeated past
+/// its end.
+fn slot_values<T: Sample>(data: &[T], grid: &BrickGrid, b: [usize; 3], values: &mut [f32; SLOTS]) {
+    for s in slot_coords().step_by(SIDE) {
+        let start = grid.voxel_of_slot(b, s);
+        let end = grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
+        let row = &data[start..=end];
+        let first = SIDE * (s[1] + SIDE * s[2]);
+        for (i, v) in values[first..first + SIDE].iter_mut().enumerate() {
+            *v = row[i.min(row.len() - 1)].to_f32();
+        }
     }
 }
 

@@ -184,7 +184,7 @@ mod tests {
         let v =
             grid_to_volume(Path::new("f"), dims, data.clone(), steps, origin, &mut info).unwrap();
         let [nx, ny, _] = v.dims();
-        for (n, &value) in v.data().iter().enumerate() {
+        for (n, &value) in v.values().iter().enumerate() {
             let (i, j, k) = (n % nx, (n / nx) % ny, n / (nx * ny));
             let old = value as usize;
             let (a, b, c) = (
