@@ -104,7 +104,7 @@ pub use kernels::phong::{LightGeometry, Phong};
 pub use memory::MemoryBound;
 pub use non_finite::{NonFinite, NonFiniteMask};
 pub use partial::{PartialImage, PartialPixels};
-pub use renderer::{FrameTimes, Renderer};
+pub use renderer::{DEFAULT_CACHE_BUDGET, FrameTimes, Renderer};
 pub use sampling::clipping::ClipPlane;
 pub use settings::{
     Blend, Classification, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_SAMPLES_PER_RAY, Method,
