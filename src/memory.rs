@@ -12,7 +12,9 @@ use crate::error::CliError;
 use crate::flags::ViewArgs;
 use crate::input::Input;
 use volray_core::glam::DVec3;
-use volray_core::{DEFAULT_CACHE_BUDGET, MemoryBound, NonFinite, RenderSettings, SampleType};
+use volray_core::{
+    DEFAULT_CACHE_BUDGET, MemoryBound, Method, NonFinite, RenderSettings, SampleType,
+};
 use volray_io::format_bytes;
 
 /// An upper bound on the bytes rendering one frame of a volume of `dims`
@@ -45,11 +47,26 @@ pub fn cache_budget(
     let need = render_bytes(grid, settings, view, 0);
     if need > limit {
         let [nx, ny, nz] = volume.dims();
+        let what = format!(
+            "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels",
+            input.name, view.camera.size.0, view.camera.size.1
+        );
+        // The oracle is dense: say so where the default path would fit.
+        let fast = RenderSettings {
+            method: Method::Fast,
+            ..settings.clone()
+        };
+        let fast_need = render_bytes(grid, &fast, view, 0);
+        if settings.method == Method::Reference && fast_need <= limit {
+            return Err(CliError::input(format!(
+                "{what} on the reference path (--reference) may take up to {}, more than --max-memory {}; the default path takes at most {}: leave out --reference",
+                format_bytes(need),
+                format_bytes(limit),
+                format_bytes(fast_need)
+            )));
+        }
         return Err(CliError::input(format!(
-            "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels may take up to {}, more than --max-memory {} (raise it, or use a smaller grid)",
-            input.name,
-            view.camera.size.0,
-            view.camera.size.1,
+            "{what} may take up to {}, more than --max-memory {} (raise it, or use a smaller grid)",
             format_bytes(need),
             format_bytes(limit)
         )));
@@ -165,8 +182,20 @@ mod budget_tests {
         let tight = input(volume.clone(), without + 100_000);
         assert_eq!(cache_budget(&view, &settings, &tight).unwrap(), 100_000);
         // Below them: refused, naming the limit.
-        let short = input(volume, without - 1);
+        let short = input(volume.clone(), without - 1);
         let err = cache_budget(&view, &settings, &short).unwrap_err();
         assert!(err.message.contains("more than --max-memory"), "{err}");
+        // The reference path is dense (28 bytes a voxel more): refused
+        // where the default path fits, saying so.
+        let reference = RenderSettings {
+            method: Method::Reference,
+            ..settings.clone()
+        };
+        let err = cache_budget(&view, &reference, &tight).unwrap_err();
+        assert!(
+            err.message.contains("on the reference path (--reference)")
+                && err.message.contains("leave out --reference"),
+            "{err}"
+        );
     }
 }
