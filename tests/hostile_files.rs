@@ -1243,7 +1243,6 @@ fn chgcar_cases() -> Cases {
 
 // ---------------------------------------------------------------- HDF5
 
-#[cfg(feature = "hdf5")]
 fn hdf5_cases() -> Cases {
     let mut c = Cases::new("hdf5");
     let f = "one.h5";
@@ -1380,7 +1379,6 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         cube_cases(),
         mrc_cases(),
         chgcar_cases(),
-        #[cfg(feature = "hdf5")]
         hdf5_cases(),
     ];
     for g in groups {

@@ -17,7 +17,6 @@
 pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
-#[cfg(feature = "hdf5")]
 pub(crate) mod hdf5;
 pub(crate) mod metaimage;
 pub(crate) mod mrc;
@@ -28,22 +27,6 @@ pub(crate) mod raw;
 pub(crate) mod tiff;
 pub(crate) mod vti;
 pub(crate) mod vtk_legacy;
-
-/// Without the `hdf5` feature, HDF5 files are still recognised, and
-/// refused with a message saying how to build volray to read them.
-#[cfg(not(feature = "hdf5"))]
-pub(crate) mod hdf5 {
-    use std::path::Path;
-
-    use crate::{IoError, Loaded, ReadOptions};
-
-    pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> {
-        Err(IoError::invalid(
-            path,
-            "this volray was built without HDF5 support: rebuild with `cargo build --release --features hdf5` (needs Debian's libhdf5-dev)",
-        ))
-    }
-}
 
 use std::fmt;
 use std::path::Path;
@@ -76,7 +59,7 @@ pub enum VolumeFormat {
     Dicom,
     /// Multi-page TIFF stacks (`.tif`, `.tiff`).
     Tiff,
-    /// An HDF5 dataset, `file.h5:/path/to/dataset` (cargo feature `hdf5`).
+    /// An HDF5 dataset, `file.h5:/path/to/dataset`.
     Hdf5,
     /// Gaussian cube (`.cube`, `.cub`).
     Cube,
