@@ -1271,6 +1271,69 @@ fn hdf5_cases() -> Cases {
     c
 }
 
+// ---------------------------------------------------------------- MINC2
+
+fn minc_cases() -> Cases {
+    let mut c = Cases::new("minc");
+    for f in ["ramp_i16.mnc", "series_u8.mnc"] {
+        let bytes = fixture(&format!("minc/{f}"));
+        let n = bytes.len();
+        for (what, at) in [
+            ("empty", 0),
+            ("cut at 100 bytes", 100),
+            ("cut in the middle", n / 2),
+            ("one byte short", n - 1),
+        ] {
+            c.one(
+                &format!("{f}: {what}"),
+                f,
+                bytes[..at].to_vec(),
+                Expect::Bad,
+            );
+        }
+        c.one(
+            &format!("{f}: wrong magic"),
+            f,
+            put(&bytes, 1, b"XDF"),
+            Expect::Bad,
+        );
+        // Names the reader looks up, made unknown: a dimension nobody
+        // declared, the image's dataset gone.
+        c.one(
+            &format!("{f}: an unknown dimension"),
+            f,
+            replace(&bytes, "yspace,xspace", "yspace,qspace"),
+            Expect::Bad,
+        );
+        c.one(
+            &format!("{f}: no image-max"),
+            f,
+            replace(&bytes, "image-max", "image-mox"),
+            Expect::Either,
+        );
+        // Bytes flipped through the metadata: read or refused, never a crash.
+        for k in 0..6 {
+            let at = 96 + k * (n / 2 - 96) / 6;
+            let mut flipped = bytes.clone();
+            flipped[at] ^= 0xa5;
+            flipped[at + 1] = 0xff;
+            c.one(
+                &format!("{f}: bytes {at}-{} flipped", at + 1),
+                f,
+                flipped,
+                Expect::Either,
+            );
+        }
+    }
+    c.one(
+        "old.mnc: MINC1 (netCDF)",
+        "old.mnc",
+        b"CDF\x01\0\0\0\0".to_vec(),
+        Expect::Bad,
+    );
+    c
+}
+
 // -------------------------------------------------------------- running
 
 /// What one run of a case did wrong, if anything.
@@ -1380,6 +1443,7 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         mrc_cases(),
         chgcar_cases(),
         hdf5_cases(),
+        minc_cases(),
     ];
     for g in groups {
         all.extend(g.list);

@@ -52,6 +52,9 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let h5 = h5::open(&file_path)?;
     let fail = |reason: String| IoError::invalid(&file_path, reason);
     let root = h5.file.root();
+    if dataset_path.is_none() && h5.file.group("minc-2.0").is_ok() {
+        return super::minc::read(&file_path, opts);
+    }
 
     let (name, dataset) = match &dataset_path {
         Some(name) => {

@@ -19,6 +19,7 @@ pub(crate) mod cube;
 pub(crate) mod dicom;
 pub(crate) mod hdf5;
 pub(crate) mod metaimage;
+pub(crate) mod minc;
 pub(crate) mod mrc;
 pub(crate) mod nifti;
 pub(crate) mod npy;
@@ -67,6 +68,8 @@ pub enum VolumeFormat {
     Mrc,
     /// VASP CHGCAR / CHG (by file name).
     Chgcar,
+    /// MINC2 (`.mnc`): HDF5 in libminc's layout.
+    Minc,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -316,6 +319,20 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         arrays: false,
         read: chgcar::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Minc,
+        name: "minc",
+        description: "MINC2",
+        extensions: &["mnc"],
+        name_stems: &[],
+        known_as: ".mnc",
+        // HDF5's magic is the HDF5 row's; a MINC2 file under another name
+        // is handed over by the HDF5 reader.
+        magic: Magic::NONE,
+        frames: true,
+        arrays: false,
+        read: minc::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -564,14 +581,14 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 13);
-        assert_eq!(VolumeFormat::ALL[12], VolumeFormat::Chgcar);
+        assert_eq!(VolumeFormat::ALL.len(), 14);
+        assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
     #[test]

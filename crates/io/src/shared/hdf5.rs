@@ -204,6 +204,28 @@ pub(crate) fn read_rows(
     Ok(values)
 }
 
+/// Reads a whole small dataset (an attribute-like array: a slice's
+/// minimum and maximum) as `f64`s, at most `max` of them.
+pub(crate) fn read_small(dataset: &Dataset, max: usize) -> Result<Vec<f64>, String> {
+    let n: u64 = dataset
+        .shape()
+        .map_err(|e| format!("unreadable shape: {e}"))?
+        .iter()
+        .try_fold(1u64, |a, &b| a.checked_mul(b))
+        .unwrap_or(u64::MAX);
+    if n > max as u64 {
+        return Err(format!("holds {n} values, more than the {max} expected"));
+    }
+    numeric_type(dataset)?;
+    let values = dataset
+        .read_f64()
+        .map_err(|e| format!("cannot read: {e}"))?;
+    if values.len() as u64 != n {
+        return Err(format!("gave {} values, expected {n}", values.len()));
+    }
+    Ok(values)
+}
+
 /// An attribute's values as numbers, if it is numeric.
 pub(crate) fn numbers(value: &AttrValue) -> Option<Vec<f64>> {
     use AttrValue as A;
