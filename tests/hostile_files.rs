@@ -1271,6 +1271,48 @@ fn hdf5_cases() -> Cases {
     c
 }
 
+// ------------------------------------------------------------ 2-D images
+
+/// Images, not volumes: `info` describes them (exit 0), `render` refuses
+/// them (exit 1); damaged ones are refused by both.
+fn flat_cases() -> Cases {
+    let mut c = Cases::new("2-D");
+    let f = "image.nrrd";
+    let bytes = fixture(&format!("flat/{f}"));
+    let end = after(&bytes, "\n\n");
+    c.truncations(f, &bytes, end, Expect::Bad, Expect::Bad);
+    c.edits(
+        f,
+        &bytes,
+        &[
+            ("sizes: 5 4", "sizes: 5 400000000", Expect::Bad),
+            ("sizes: 5 4", "sizes: 5 0", Expect::Bad),
+            ("(0.5,0) (0,0.25)", "(nan,0) (0,0.25)", Expect::Either),
+            ("space dimension: 2", "space dimension: 7", Expect::Bad),
+        ],
+    );
+    let f = "image.mha";
+    let bytes = fixture(&format!("flat/{f}"));
+    let end = after(&bytes, "ElementDataFile = LOCAL\n");
+    c.truncations(f, &bytes, end, Expect::Bad, Expect::Bad);
+    c.edits(
+        f,
+        &bytes,
+        &[
+            ("DimSize = 5 4", "DimSize = 5 4000000000", Expect::Bad),
+            (
+                "TransformMatrix = 1 0 0 1",
+                "TransformMatrix = 1 0 0",
+                Expect::Bad,
+            ),
+        ],
+    );
+    let f = "image.nii";
+    let bytes = fixture(&format!("flat/{f}"));
+    c.truncations(f, &bytes, 348, Expect::Bad, Expect::Bad);
+    c
+}
+
 // ---------------------------------------------------------------- MINC2
 
 fn minc_cases() -> Cases {
@@ -1444,6 +1486,7 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         chgcar_cases(),
         hdf5_cases(),
         minc_cases(),
+        flat_cases(),
     ];
     for g in groups {
         all.extend(g.list);

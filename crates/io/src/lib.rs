@@ -106,7 +106,7 @@ pub use formats::raw::{RawOptions, read_raw, write_raw};
 pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
-pub use read::{FileInfo, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
+pub use read::{FileInfo, FlatImage, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
 pub use shared::compress::{Compression, inflate_exact};
 pub use shared::geometry::grid_to_volume;
 pub use shared::limits::{
