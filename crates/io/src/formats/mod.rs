@@ -288,7 +288,10 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         extensions: &["cube", "cub"],
         name_stems: &[],
         known_as: ".cube",
-        magic: Magic::NONE,
+        magic: Magic {
+            text: Some(cube::sniff_text),
+            ..Magic::NONE
+        },
         frames: true,
         arrays: false,
         read: cube::read,
@@ -314,7 +317,10 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
             "chgcar", "chg", "aeccar0", "aeccar1", "aeccar2", "parchg", "elfcar", "locpot",
         ],
         known_as: "CHGCAR/CHG",
-        magic: Magic::NONE,
+        magic: Magic {
+            text: Some(chgcar::sniff_text),
+            ..Magic::NONE
+        },
         frames: true,
         arrays: false,
         read: chgcar::read,
