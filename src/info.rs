@@ -73,7 +73,12 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
                 h.max,
                 h.mean
             );
-            if h.non_finite > 0 {
+            if h.non_finite > 0 && info.is_some_and(|i| i.nan_is_empty) {
+                outln!(
+                    "           {} NaN: space the file does not cover, rendered as empty",
+                    h.non_finite
+                );
+            } else if h.non_finite > 0 {
                 outln!("           {} non-finite (NaN or infinite)", h.non_finite);
             }
             outln!("histogram: ({} bins)", h.counts.len());
@@ -198,4 +203,5 @@ fn add_file_json(out: &mut Value, i: &FileInfo) {
             .collect::<Vec<_>>()
     );
     out["notes"] = json!(i.notes);
+    out["nan_is_empty"] = json!(i.nan_is_empty);
 }

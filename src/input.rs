@@ -3,8 +3,8 @@
 use crate::error::CliError;
 use crate::flags::InputArgs;
 use std::path::{Path, PathBuf};
-use volray_core::Volume;
 use volray_core::glam::DVec3;
+use volray_core::{NonFinite, Volume};
 use volray_io::{
     DType, Endian, FileInfo, FlatImage, IoError, RawOptions, ReadOptions, VolumeFormat,
 };
@@ -21,6 +21,19 @@ pub struct Input {
     pub file: Option<(VolumeFormat, FileInfo)>,
     /// `--max-memory` (or its default), which rendering must fit too.
     pub max_memory: u64,
+}
+
+impl Input {
+    /// How rendering treats NaN and infinite values: as `--nonfinite`
+    /// says, except that NaN values the file marks as space it does not
+    /// cover (the box of a skewed crystallographic map, resampled) are
+    /// always empty space.
+    pub fn non_finite(&self, requested: NonFinite) -> NonFinite {
+        match &self.file {
+            Some((_, info)) if info.nan_is_empty => NonFinite::Transparent,
+            _ => requested,
+        }
+    }
 }
 
 /// What `volray info` describes: a volume, or a file holding one image

@@ -12,14 +12,14 @@ use volray_core::{MemoryBound, NonFinite, RenderSettings};
 use volray_io::format_bytes;
 
 /// An upper bound on the bytes rendering one frame of a volume of `dims`
-/// voxels `spacing` apart with `settings` takes, the volume included.
+/// voxels `spacing` apart with `settings` and non-finite values handled
+/// as `mode` says takes, the volume included.
 pub fn render_bytes(
     dims: [usize; 3],
     spacing: volray_core::glam::DVec3,
     settings: &RenderSettings,
-    view: &ViewArgs,
+    mode: NonFinite,
 ) -> u128 {
-    let mode = NonFinite::from(view.sampling.nonfinite);
     let bound = MemoryBound::new(dims, spacing, settings, mode).total();
     // A 16-bit PNG quantises the frame first: 8 bytes a pixel.
     bound + 8 * settings.width as u128 * settings.height as u128
@@ -33,7 +33,8 @@ pub fn check_render(
     input: &Input,
 ) -> Result<(), CliError> {
     let volume = &input.volume;
-    let need = render_bytes(volume.dims(), volume.spacing(), settings, view);
+    let mode = input.non_finite(view.sampling.nonfinite.into());
+    let need = render_bytes(volume.dims(), volume.spacing(), settings, mode);
     if need <= u128::from(input.max_memory) {
         return Ok(());
     }
@@ -62,7 +63,7 @@ mod tests {
             _ => unreachable!(),
         };
         let settings = crate::settings::settings(&view).unwrap();
-        render_bytes(dims, DVec3::ONE, &settings, &view)
+        render_bytes(dims, DVec3::ONE, &settings, view.sampling.nonfinite.into())
     }
 
     #[test]

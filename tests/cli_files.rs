@@ -404,3 +404,26 @@ fn info_describes_a_2d_image_that_render_refuses() {
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("pass the directory of the series"));
 }
+
+#[test]
+fn a_skewed_map_of_part_of_a_cell_renders_with_empty_space_around_its_box() {
+    // A monoclinic (beta 110) map of 4 x 3 x 5 points of an 8 x 9 x 10 cell
+    // (crates/io/tests/fixtures/make_crystal_map_fixtures.py): resampled,
+    // NaN outside the map's box, which renders as empty space without
+    // --nonfinite.
+    let map = "crates/io/tests/fixtures/mrc/part_monoclinic.ccp4";
+    let out = volray(&["info", map]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    for expect in [
+        "NaN: space the file does not cover, rendered as empty",
+        "not periodic, so only its own box is resampled",
+    ] {
+        assert!(text.contains(expect), "missing {expect:?} in\n{text}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("map.png");
+    let out = volray(&["render", map, "--size", "32", "-o", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(fs::metadata(&png).unwrap().len() > 0);
+}

@@ -1186,6 +1186,38 @@ fn mrc_cases() -> Cases {
         );
     }
     c.flips(f, &bytes, 1024, 4, 8);
+    // A skewed map of part of a cell, its box resampled: cells that make
+    // the box huge, flat or degenerate.
+    let f = "part_triclinic.ccp4";
+    let bytes = fixture(&format!("mrc/{f}"));
+    c.truncations(f, &bytes, 1024, Expect::Bad, Expect::Bad);
+    for (what, offset, value, expect) in [
+        ("angle beta 179.9", 56, f32le(179.9), Expect::Either),
+        (
+            "angles 1 1 1 (a flat cell)",
+            52,
+            [f32le(1.0), f32le(1.0), f32le(1.0)].concat(),
+            Expect::Either,
+        ),
+        (
+            "angles 60 60 179 (no cell)",
+            52,
+            [f32le(60.0), f32le(60.0), f32le(179.0)].concat(),
+            Expect::Either,
+        ),
+        ("cell a 1e30", 40, f32le(1e30), Expect::Either),
+        ("cell c 1e-30", 48, f32le(1e-30), Expect::Either),
+        ("mx 1", 28, i32le(1), Expect::Either),
+        ("nz 1 (one section)", 8, i32le(1), Expect::Either),
+    ] {
+        c.one(
+            &format!("{f}: {what}"),
+            f,
+            put(&bytes, offset, &value),
+            expect,
+        );
+    }
+    c.flips(f, &bytes, 1024, 4, 8);
     c
 }
 

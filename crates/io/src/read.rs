@@ -123,6 +123,10 @@ pub struct FileInfo {
     /// The named arrays the file holds (VTK), if any, and the one read.
     pub arrays: Vec<String>,
     pub array: Option<String>,
+    /// The volume's NaN values are space the file does not cover (the
+    /// box of a skewed CCP4 map resampled onto an axis-aligned grid):
+    /// to be rendered as empty space, not refused.
+    pub nan_is_empty: bool,
 }
 
 impl FileInfo {
