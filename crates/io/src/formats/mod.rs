@@ -66,7 +66,7 @@ pub enum VolumeFormat {
     Cube,
     /// CCP4 / MRC maps (`.map`, `.mrc`, `.ccp4`).
     Mrc,
-    /// VASP CHGCAR / CHG (by file name).
+    /// VASP CHGCAR / CHG and their kin (by file name or content).
     Chgcar,
     /// MINC2 (`.mnc`): HDF5 in libminc's layout.
     Minc,

@@ -4,7 +4,7 @@
 //!
 //! | module | what | used by |
 //! |---|---|---|
-//! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM, HDF5 |
+//! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM; its ratio bound: HDF5 |
 //! | `input.rs` | opening input files, reading samples in bounded chunks | every reader |
 //! | `limits.rs` | the memory limit and the size checks before allocating | every reader |
 //! | `hdf5.rs` | HDF5 files opened, attributes read, numeric datasets read in slabs (pure Rust) | HDF5, MINC2 |
