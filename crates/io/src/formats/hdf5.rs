@@ -29,8 +29,8 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::hdf5::{
-    self as h5, check_size, chunk_along, numbers, numeric_type, read_rows, slab_rows, sorted_attrs,
-    text,
+    self as h5, Reading, check_size, chunk_along, numbers, numeric_type, read_rows, slab_rows,
+    sorted_attrs, text,
 };
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
@@ -127,12 +127,15 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let voxels = check_size(
         &file_path,
         &format!("dataset shape {shape:?}"),
-        &shape,
-        sample.size,
+        Reading {
+            shape: &shape,
+            frames,
+            sample_size: sample.size,
+            scratch,
+        },
         h5.len,
-        scratch,
         opts.max_memory,
-    )? / frames.max(1);
+    )?;
 
     let attrs = sorted_attrs(dataset.attrs());
     let mut info = FileInfo::new(sample.name.clone());

@@ -115,20 +115,33 @@ pub(crate) fn shape(dataset: &Dataset) -> Result<Vec<usize>, String> {
         .collect()
 }
 
-/// Checks that `values` samples of `sample_size` bytes could come out of
-/// a file of `file_len` bytes (at most [`MAX_INFLATION`] times its length,
-/// or [`SMALL_FILE_ALLOWANCE`]), and that the f32 volume plus a scratch of
-/// `scratch` f64s fits `max_memory`. `what` names the dataset's shape for
-/// messages.
+/// What reading a dataset takes: its shape, the volumes it holds, bytes
+/// per stored sample, and the samples read at once (the scratch).
+pub(crate) struct Reading<'s> {
+    pub shape: &'s [usize],
+    pub frames: usize,
+    pub sample_size: usize,
+    pub scratch: usize,
+}
+
+/// Checks that a dataset `reading` describes could come out of a file of
+/// `file_len` bytes (at most [`MAX_INFLATION`] times its length, or
+/// [`SMALL_FILE_ALLOWANCE`]), and that one volume of it as f32, beside
+/// the scratch (stored and as f64), fits `max_memory`. Returns the
+/// samples of one volume. `what` names the shape for messages.
 pub(crate) fn check_size(
     path: &Path,
     what: &str,
-    dims: &[usize],
-    sample_size: usize,
+    reading: Reading,
     file_len: u64,
-    scratch: usize,
     max_memory: u64,
 ) -> Result<usize, IoError> {
+    let Reading {
+        shape: dims,
+        frames,
+        sample_size,
+        scratch,
+    } = reading;
     let dims64: Vec<u64> = dims.iter().map(|&n| n as u64).collect();
     let values = count_values(path, what, &dims64)?;
     let budget = file_len
@@ -143,16 +156,17 @@ pub(crate) fn check_size(
             ),
         ));
     }
-    let peak = values as u128 * 4 + scratch as u128 * (8 + sample_size as u128);
+    let volume = values / frames.max(1);
+    let peak = volume as u128 * 4 + scratch as u128 * (8 + sample_size as u128);
     check_held(
         path,
         what,
-        values as u128,
+        volume as u128,
         peak,
         &format!("{} as f32 and an f64 slab", format_bytes(peak)),
         max_memory,
     )?;
-    Ok(values)
+    Ok(volume)
 }
 
 /// Rows of the first axis read at once for rows of `row` samples: whole
