@@ -28,10 +28,7 @@ use volray_core::glam::DVec3;
 
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::hdf5::{
-    self as h5, Reading, check_size, chunk_along, numbers, numeric_type, read_rows, slab_rows,
-    sorted_attrs, text,
-};
+use crate::shared::hdf5::{self as h5, Slabs, numbers, numeric_type, sorted_attrs, text};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
 /// The search for datasets stops after this many objects or this depth
@@ -116,23 +113,16 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     }
     let series = frames > 1 || shape.len() == 4;
-    let plane = dims[1].saturating_mul(dims[2]);
-    // A 3-D dataset is read in slabs of its first axis; a frame of a
-    // series is one row of the 4-D dataset, read whole.
-    let scratch = if series {
-        dims[0].saturating_mul(plane)
-    } else {
-        plane.saturating_mul(slab_rows(plane, chunk_along(&dataset, 0)).min(dims[0]))
-    };
-    let voxels = check_size(
+    let slabs = Slabs::new(
+        &dataset,
+        &shape,
+        frames,
+        series.then_some(frame),
+        sample.size,
+    );
+    let voxels = slabs.check(
         &file_path,
         &format!("dataset shape {shape:?}"),
-        Reading {
-            shape: &shape,
-            frames,
-            sample_size: sample.size,
-            scratch,
-        },
         h5.len,
         opts.max_memory,
     )?;
@@ -152,7 +142,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
     let (spacing, origin) = geometry(&attrs, series, &mut info).map_err(what)?;
 
-    let data = read_volume(&dataset, dims, series, frame, voxels).map_err(what)?;
+    let data = read_volume(&slabs, dims, voxels).map_err(what)?;
     let steps = [
         DVec3::X * spacing.x,
         DVec3::Y * spacing.y,
@@ -166,37 +156,21 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     })
 }
 
-/// Reads volume `frame` of `dataset` (3-D, or 4-D when `series`) into an
-/// x-fastest buffer, one slab of the first axis at a time.
-fn read_volume(
-    dataset: &Dataset,
-    dims: [usize; 3],
-    series: bool,
-    frame: usize,
-    voxels: usize,
-) -> Result<Vec<f32>, String> {
-    let [n0, n1, _] = dims;
-    let plane = dims[1] * dims[2];
+/// Reads one volume into an x-fastest buffer: the dataset's first axis
+/// is x, its last (fastest in the file) z.
+fn read_volume(slabs: &Slabs, dims: [usize; 3], voxels: usize) -> Result<Vec<f32>, String> {
+    let [n0, n1, n2] = dims;
     let mut data = vec![0.0f32; voxels];
-    // part[(dx, y, z)] at dx·plane + y·n2 + z goes to x0 + dx + n0·(y + n1·z).
-    let mut place = |x0: usize, part: &[f64]| {
+    // Sample (x, y, z) at C-order index x·n1·n2 + y·n2 + z goes to
+    // x + n0·(y + n1·z).
+    slabs.read(|first, part| {
         for (i, &v) in part.iter().enumerate() {
-            let (dx, yz) = (i / plane, i % plane);
-            let (y, z) = (yz / dims[2], yz % dims[2]);
-            data[x0 + dx + n0 * (y + n1 * z)] = v as f32;
+            let at = first + i;
+            let (x, yz) = (at / (n1 * n2), at % (n1 * n2));
+            let (y, z) = (yz / n2, yz % n2);
+            data[x + n0 * (y + n1 * z)] = v as f32;
         }
-    };
-    if series {
-        place(0, &read_rows(dataset, frame, 1, voxels)?);
-    } else {
-        let slab = slab_rows(plane, chunk_along(dataset, 0));
-        let mut x0 = 0;
-        while x0 < n0 {
-            let x1 = (x0 + slab).min(n0);
-            place(x0, &read_rows(dataset, x0, x1 - x0, plane)?);
-            x0 = x1;
-        }
-    }
+    })?;
     Ok(data)
 }
 

@@ -29,8 +29,7 @@ use volray_core::glam::DVec3;
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::hdf5::{
-    self as h5, Reading, check_size, chunk_along, numbers, numeric_type, read_rows, read_small,
-    shown, slab_rows, sorted_attrs, text,
+    self as h5, Slabs, numbers, numeric_type, read_small, shown, sorted_attrs, text,
 };
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
@@ -93,21 +92,16 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     }
     let n = [shape[spatial], shape[spatial + 1], shape[spatial + 2]];
-    let plane = n[1].saturating_mul(n[2]);
-    let scratch = if frames > 1 || spatial == 1 {
-        n[0].saturating_mul(plane)
-    } else {
-        plane.saturating_mul(slab_rows(plane, chunk_along(&image, 0)).min(n[0]))
-    };
-    let voxels = check_size(
+    let slabs = Slabs::new(
+        &image,
+        &shape,
+        frames,
+        (spatial == 1).then_some(frame),
+        sample.size,
+    );
+    let voxels = slabs.check(
         path,
         &format!("image shape {shape:?}"),
-        Reading {
-            shape: &shape,
-            frames,
-            sample_size: sample.size,
-            scratch,
-        },
         h5.len,
         opts.max_memory,
     )?;
@@ -150,29 +144,17 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     // file's last axis, so the samples keep their order.
     let mut data = vec![0.0f32; voxels];
     let base = frame * voxels;
-    let mut put = |at: usize, part: &[f64]| {
-        for (i, &v) in part.iter().enumerate() {
-            let value = match &scaling {
-                Some(s) => s.real(base + at + i, v),
-                None => v,
-            };
-            data[at + i] = value as f32;
-        }
-    };
-    if spatial == 1 {
-        put(0, &read_rows(&image, frame, 1, voxels).map_err(what)?);
-    } else {
-        let slab = slab_rows(plane, chunk_along(&image, 0));
-        let mut i0 = 0;
-        while i0 < n[0] {
-            let i1 = (i0 + slab).min(n[0]);
-            put(
-                i0 * plane,
-                &read_rows(&image, i0, i1 - i0, plane).map_err(what)?,
-            );
-            i0 = i1;
-        }
-    }
+    slabs
+        .read(|at, part| {
+            for (i, &v) in part.iter().enumerate() {
+                let value = match &scaling {
+                    Some(s) => s.real(base + at + i, v),
+                    None => v,
+                };
+                data[at + i] = value as f32;
+            }
+        })
+        .map_err(what)?;
     let dims = [n[2], n[1], n[0]];
     let steps = [steps[2], steps[1], steps[0]];
     let volume = grid_to_volume(path, dims, data, steps, origin, &mut info)?;

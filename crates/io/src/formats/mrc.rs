@@ -450,44 +450,32 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let mut info = FileInfo::new(format!("{type_name} (MODE {mode}, {endian}-endian)"));
     info.header = header;
     info.length_unit = Some("angstrom".into());
-    let volume = if skewed {
+    // A skewed grid one point thick is an image: grid_to_volume says so.
+    let volume = if skewed && dims.iter().all(|&n| n >= 2) {
         let whole_cell = (0..3).all(|d| m[axis_of[d]] as i64 == dims[d] as i64);
-        let axis_names = axis_of.map(|a| names[a]);
-        let (volume, note) = if whole_cell {
-            periodic_cell::resample(
-                dims,
-                &data,
-                steps,
-                origin,
-                axis_names,
-                "angstrom",
-                opts.max_memory,
-            )
-        } else if dims.iter().all(|&n| n >= 2) {
+        let resample = if whole_cell {
+            periodic_cell::resample
+        } else {
             // A part of the cell, or more than one: the map's own box.
             info.nan_is_empty = true;
             notes.push(format!(
                 "the map's {} x {} x {} points are not the whole cell's MX MY MZ {} {} {} (in column, row, section order): not periodic, so only its own box is resampled",
                 dims[0], dims[1], dims[2], m[axis_of[0]], m[axis_of[1]], m[axis_of[2]]
             ));
-            periodic_cell::resample_box(
-                dims,
-                &data,
-                steps,
-                origin,
-                axis_names,
-                "angstrom",
-                opts.max_memory,
-            )
-        } else {
-            // One point thick: an image (grid_to_volume says so).
-            let volume = grid_to_volume(path, dims, data, steps, origin, &mut info)?;
-            Ok((volume, String::new()))
-        }
+            periodic_cell::resample_box
+        };
+        let axis_names = axis_of.map(|a| names[a]);
+        let (volume, note) = resample(
+            dims,
+            &data,
+            steps,
+            origin,
+            axis_names,
+            "angstrom",
+            opts.max_memory,
+        )
         .map_err(|e| e.at(path, "CELLB"))?;
-        if !note.is_empty() {
-            notes.push(note);
-        }
+        notes.push(note);
         volume
     } else {
         grid_to_volume(path, dims, data, steps, origin, &mut info)?

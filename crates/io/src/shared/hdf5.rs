@@ -115,65 +115,11 @@ pub(crate) fn shape(dataset: &Dataset) -> Result<Vec<usize>, String> {
         .collect()
 }
 
-/// What reading a dataset takes: its shape, the volumes it holds, bytes
-/// per stored sample, and the samples read at once (the scratch).
-pub(crate) struct Reading<'s> {
-    pub shape: &'s [usize],
-    pub frames: usize,
-    pub sample_size: usize,
-    pub scratch: usize,
-}
-
-/// Checks that a dataset `reading` describes could come out of a file of
-/// `file_len` bytes (at most [`MAX_INFLATION`] times its length, or
-/// [`SMALL_FILE_ALLOWANCE`]), and that one volume of it as f32, beside
-/// the scratch (stored and as f64), fits `max_memory`. Returns the
-/// samples of one volume. `what` names the shape for messages.
-pub(crate) fn check_size(
-    path: &Path,
-    what: &str,
-    reading: Reading,
-    file_len: u64,
-    max_memory: u64,
-) -> Result<usize, IoError> {
-    let Reading {
-        shape: dims,
-        frames,
-        sample_size,
-        scratch,
-    } = reading;
-    let dims64: Vec<u64> = dims.iter().map(|&n| n as u64).collect();
-    let values = count_values(path, what, &dims64)?;
-    let budget = file_len
-        .saturating_mul(MAX_INFLATION)
-        .max(SMALL_FILE_ALLOWANCE);
-    let bytes = (values as u64).saturating_mul(sample_size as u64);
-    if bytes > budget {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "{what} of {sample_size}-byte samples is {bytes} bytes, more than a {file_len}-byte file can hold even compressed"
-            ),
-        ));
-    }
-    let volume = values / frames.max(1);
-    let peak = volume as u128 * 4 + scratch as u128 * (8 + sample_size as u128);
-    check_held(
-        path,
-        what,
-        volume as u128,
-        peak,
-        &format!("{} as f32 and an f64 slab", format_bytes(peak)),
-        max_memory,
-    )?;
-    Ok(volume)
-}
-
 /// Rows of the first axis read at once for rows of `row` samples: whole
 /// chunks adding up to about [`SLAB_SAMPLES`], or, where one chunk is
 /// larger than that, as many rows as fit [`SLAB_SAMPLES`] (at least one),
 /// so that a header's chunk size cannot make the scratch buffer large.
-pub(crate) fn slab_rows(row: usize, chunk0: usize) -> usize {
+fn slab_rows(row: usize, chunk0: usize) -> usize {
     let row = row.max(1);
     let chunk0 = chunk0.max(1);
     if row.saturating_mul(chunk0) <= SLAB_SAMPLES {
@@ -184,7 +130,7 @@ pub(crate) fn slab_rows(row: usize, chunk0: usize) -> usize {
 }
 
 /// The dataset's chunk extent along axis `axis`, 1 if not chunked.
-pub(crate) fn chunk_along(dataset: &Dataset, axis: usize) -> usize {
+fn chunk_along(dataset: &Dataset, axis: usize) -> usize {
     dataset
         .chunk_shape()
         .ok()
@@ -195,27 +141,136 @@ pub(crate) fn chunk_along(dataset: &Dataset, axis: usize) -> usize {
         .max(1)
 }
 
-/// Reads rows `first..first + count` of the first axis of `dataset` as
-/// `f64`s (C order), checking that the library returned as many values as
-/// the rows hold.
-pub(crate) fn read_rows(
-    dataset: &Dataset,
-    first: usize,
-    count: usize,
+/// How one volume of a dataset is read: the volume is the last three
+/// axes of its shape; a 3-D dataset is read in slabs of rows of its first
+/// axis (whole chunks at a time), a volume of a series (a 4-D dataset,
+/// `frame` chosen) as its one row of the first axis, whole.
+pub(crate) struct Slabs<'d> {
+    dataset: &'d Dataset,
+    shape: &'d [usize],
+    frames: usize,
+    sample_size: usize,
+    /// Rows of the volume's first axis, and samples per row.
+    rows: usize,
     row: usize,
-) -> Result<Vec<f64>, String> {
-    let values = dataset
-        .read_f64_rows(first as u64, count as u64)
-        .map_err(|e| format!("cannot read: {e}"))?;
-    if values.len() != count * row {
-        return Err(format!(
-            "cannot read: rows {first}..{} gave {} values, expected {}",
-            first + count,
-            values.len(),
-            count * row
-        ));
+    frame: Option<usize>,
+    slab: usize,
+}
+
+impl<'d> Slabs<'d> {
+    /// The reading of a dataset of `shape` (3 or 4 axes; the first of 4
+    /// holds `frames` volumes, of which `frame` is read) and samples of
+    /// `sample_size` bytes.
+    pub(crate) fn new(
+        dataset: &'d Dataset,
+        shape: &'d [usize],
+        frames: usize,
+        frame: Option<usize>,
+        sample_size: usize,
+    ) -> Self {
+        let volume = &shape[shape.len().saturating_sub(3)..];
+        let rows = volume.first().copied().unwrap_or(1);
+        let row = volume
+            .iter()
+            .skip(1)
+            .fold(1usize, |a, &n| a.saturating_mul(n));
+        Slabs {
+            dataset,
+            shape,
+            frames,
+            sample_size,
+            rows,
+            row,
+            frame,
+            slab: slab_rows(row, chunk_along(dataset, 0)),
+        }
     }
-    Ok(values)
+
+    /// Checks that the dataset could come out of a file of `file_len`
+    /// bytes (at most [`MAX_INFLATION`] times its length, or
+    /// [`SMALL_FILE_ALLOWANCE`]), and that one volume of it as f32, beside
+    /// the samples held at once (stored and as f64), fits `max_memory`.
+    /// Returns the samples of one volume. `what` names the shape for
+    /// messages.
+    pub(crate) fn check(
+        &self,
+        path: &Path,
+        what: &str,
+        file_len: u64,
+        max_memory: u64,
+    ) -> Result<usize, IoError> {
+        let dims64: Vec<u64> = self.shape.iter().map(|&n| n as u64).collect();
+        let values = count_values(path, what, &dims64)?;
+        let budget = file_len
+            .saturating_mul(MAX_INFLATION)
+            .max(SMALL_FILE_ALLOWANCE);
+        let sample_size = self.sample_size;
+        let bytes = (values as u64).saturating_mul(sample_size as u64);
+        if bytes > budget {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "{what} of {sample_size}-byte samples is {bytes} bytes, more than a {file_len}-byte file can hold even compressed"
+                ),
+            ));
+        }
+        let volume = values / self.frames.max(1);
+        let peak = volume as u128 * 4 + self.scratch() as u128 * (8 + sample_size as u128);
+        check_held(
+            path,
+            what,
+            volume as u128,
+            peak,
+            &format!("{} as f32 and an f64 slab", format_bytes(peak)),
+            max_memory,
+        )?;
+        Ok(volume)
+    }
+
+    /// The samples held at once.
+    pub(crate) fn scratch(&self) -> usize {
+        match self.frame {
+            Some(_) => self.rows.saturating_mul(self.row),
+            None => self.row.saturating_mul(self.slab.min(self.rows)),
+        }
+    }
+
+    /// Reads the volume, handing each slab to `take` with the C-order
+    /// index of its first sample within the volume.
+    pub(crate) fn read(&self, mut take: impl FnMut(usize, &[f64])) -> Result<(), String> {
+        if let Some(frame) = self.frame {
+            take(0, &self.rows_of(frame, 1, self.rows * self.row)?);
+            return Ok(());
+        }
+        let mut first = 0;
+        while first < self.rows {
+            let end = (first + self.slab).min(self.rows);
+            take(
+                first * self.row,
+                &self.rows_of(first, end - first, self.row)?,
+            );
+            first = end;
+        }
+        Ok(())
+    }
+
+    /// Rows `first..first + count` of the dataset's first axis, each of
+    /// `row` samples, checked to be as many as asked for.
+    fn rows_of(&self, first: usize, count: usize, row: usize) -> Result<Vec<f64>, String> {
+        let values = self
+            .dataset
+            .read_f64_rows(first as u64, count as u64)
+            .map_err(|e| format!("cannot read: {e}"))?;
+        if values.len() != count * row {
+            return Err(format!(
+                "cannot read: rows {first}..{} gave {} values, expected {}",
+                first + count,
+                values.len(),
+                count * row
+            ));
+        }
+        Ok(values)
+    }
 }
 
 /// Reads a whole small dataset (an attribute-like array: a slice's

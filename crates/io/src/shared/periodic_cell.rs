@@ -101,17 +101,12 @@ pub(crate) fn resample(
     unit: &str,
     max_memory: u64,
 ) -> Result<(Volume, String), ResampleError> {
-    let grid = Grid {
-        dims,
-        data,
-        steps,
-        origin,
-    };
+    let grid = Grid::new(dims, data, steps, origin);
     let (volume, described) = grid.resample(Extent::Periodic, max_memory)?;
-    let [alpha, beta, gamma] = angles(steps);
     let [a, b, c] = names;
     let note = format!(
-        "the grid axes are not orthogonal (angle({b}, {c}) {alpha:.3}, angle({a}, {c}) {beta:.3}, angle({a}, {b}) {gamma:.3} degrees): the grid was treated as one periodic cell of {} x {} x {} points ({a} x {b} x {c}) and resampled trilinearly onto {} covering the cell's bounding box; samples outside the cell are its periodic images",
+        "{}: the grid was treated as one periodic cell of {} x {} x {} points ({a} x {b} x {c}) and resampled trilinearly onto {} covering the cell's bounding box; samples outside the cell are its periodic images",
+        not_orthogonal(steps, names),
         dims[0],
         dims[1],
         dims[2],
@@ -140,17 +135,12 @@ pub(crate) fn resample_box(
             dims[0], dims[1], dims[2]
         )));
     }
-    let grid = Grid {
-        dims,
-        data,
-        steps,
-        origin,
-    };
+    let grid = Grid::new(dims, data, steps, origin);
     let (volume, described) = grid.resample(Extent::Box, max_memory)?;
-    let [alpha, beta, gamma] = angles(steps);
     let [a, b, c] = names;
     let note = format!(
-        "the grid axes are not orthogonal (angle({b}, {c}) {alpha:.3}, angle({a}, {c}) {beta:.3}, angle({a}, {b}) {gamma:.3} degrees) and the grid is not one whole periodic cell: its box of {} x {} x {} points ({a} x {b} x {c}), a parallelepiped, was resampled trilinearly onto {} covering the box; the {} samples outside the box are NaN (empty space, no data)",
+        "{} and the grid is not one whole periodic cell: its box of {} x {} x {} points ({a} x {b} x {c}), a parallelepiped, was resampled trilinearly onto {} covering the box; the {} samples outside the box are NaN (empty space, no data)",
+        not_orthogonal(steps, names),
         dims[0],
         dims[1],
         dims[2],
@@ -158,6 +148,16 @@ pub(crate) fn resample_box(
         volume.len() - described.inside,
     );
     Ok((volume, note))
+}
+
+/// "the grid axes are not orthogonal (angle(b, c) ..., ... degrees)", the
+/// axes named `names`.
+fn not_orthogonal(steps: [DVec3; 3], names: [&str; 3]) -> String {
+    let [alpha, beta, gamma] = angles(steps);
+    let [a, b, c] = names;
+    format!(
+        "the grid axes are not orthogonal (angle({b}, {c}) {alpha:.3}, angle({a}, {c}) {beta:.3}, angle({a}, {b}) {gamma:.3} degrees)"
+    )
 }
 
 /// A file's grid: `dims` points, index axis 0 fastest, axis `a` stepping
@@ -197,7 +197,16 @@ impl Described {
     }
 }
 
-impl Grid<'_> {
+impl<'d> Grid<'d> {
+    fn new(dims: [usize; 3], data: &'d [f32], steps: [DVec3; 3], origin: DVec3) -> Self {
+        Grid {
+            dims,
+            data,
+            steps,
+            origin,
+        }
+    }
+
     fn resample(
         &self,
         extent_kind: Extent,

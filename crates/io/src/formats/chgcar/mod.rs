@@ -57,16 +57,11 @@ enum Content {
 }
 
 fn content_of(path: &Path) -> Content {
-    let name = path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
     // Any word of the name: `LOCPOT`, `Li_LOCPOT`, `run3-ELFCAR.gz`.
-    let mut words = name.split(['.', '_', '-']);
-    if words.clone().any(|w| w == "locpot") {
+    let words = name_words(path);
+    if words.iter().any(|w| w == "locpot") {
         Content::Unscaled("LOCPOT holds the local potential in eV")
-    } else if words.any(|w| w == "elfcar") {
+    } else if words.iter().any(|w| w == "elfcar") {
         Content::Unscaled("ELFCAR holds the dimensionless electron localisation function")
     } else {
         Content::ChargeTimesVolume
@@ -76,13 +71,18 @@ fn content_of(path: &Path) -> Content {
 /// Whether `path`'s name says which VASP file it is (a word of it is
 /// one of the names the format table lists).
 fn named(path: &Path) -> bool {
+    let stems = VolumeFormat::Chgcar.spec().name_stems;
+    name_words(path).iter().any(|w| stems.contains(&w.as_str()))
+}
+
+/// The words of `path`'s file name, lower case, split at `.`, `_`, `-`.
+fn name_words(path: &Path) -> Vec<String> {
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let stems = VolumeFormat::Chgcar.spec().name_stems;
-    name.split(['.', '_', '-']).any(|w| stems.contains(&w))
+    name.split(['.', '_', '-']).map(str::to_string).collect()
 }
 
 /// The block of the file that was read, once found.
