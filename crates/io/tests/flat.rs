@@ -80,6 +80,20 @@ fn a_one_page_tiff() {
 }
 
 #[test]
+fn a_2d_hdf5_dataset() {
+    // h5py's /meta/plane: 4 x 3 float64 zeros (make_hdf5_fixtures.py).
+    let file = common::fixture("hdf5", "one.h5");
+    let spec = std::path::PathBuf::from(format!("{}:/meta/plane", file.display()));
+    let err = common::error_about(&spec, &ReadOptions::default(), &file);
+    let IoError::FlatImage { image, .. } = err else {
+        panic!("{err}")
+    };
+    assert_eq!(image.format, VolumeFormat::Hdf5);
+    assert_values(&image, 4, 3, |_, _| 0.0);
+    assert_eq!(image.info.stored_type, "float64 (little-endian)");
+}
+
+#[test]
 fn a_single_dicom_slice_names_its_directory() {
     let i = image("dicom/single.dcm");
     assert_eq!(i.format, VolumeFormat::Dicom);

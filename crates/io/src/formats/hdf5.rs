@@ -6,6 +6,8 @@
 //! file) is indexed `a[x, y, z]`, so the volume has dims `[n0, n1, n2]`
 //! and is transposed on reading. A 4-D dataset is a series `a[t, x, y, z]`
 //! and `--frame t` picks one volume (0 by default); only that volume is read.
+//! A 2-D dataset `a[x, y]` is an image: read, and refused as a volume with
+//! what it holds ([`IoError::FlatImage`]).
 //!
 //! Geometry from the dataset's attributes, each one value per dataset
 //! axis in dataset order (so axis 0 is x), or a single value for all
@@ -93,6 +95,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let sample = numeric_type(&dataset).map_err(what)?;
     let shape = h5::shape(&dataset).map_err(what)?;
     let (frames, dims) = match shape.as_slice() {
+        // A 2-D image a[x, y]: read, and described rather than rendered.
+        &[n0, n1] => (1, [n0, n1, 1]),
         &[n0, n1, n2] => (1, [n0, n1, n2]),
         &[t, n0, n1, n2] => (t, [n0, n1, n2]),
         other => {
