@@ -19,14 +19,14 @@ use volray_io::format_bytes;
 
 /// An upper bound on the bytes rendering one frame of a volume of `dims`
 /// voxels `spacing` apart, of samples of type `sample`, with `settings`
-/// takes, the volume included, with `cache_budget` bytes of brick caches.
+/// and non-finite values handled as `mode` says takes, the volume
+/// included, with `cache_budget` bytes of brick caches.
 pub fn render_bytes(
     (dims, spacing, sample): ([usize; 3], DVec3, SampleType),
     settings: &RenderSettings,
-    view: &ViewArgs,
+    mode: NonFinite,
     cache_budget: usize,
 ) -> u128 {
-    let mode = NonFinite::from(view.sampling.nonfinite);
     let bound = MemoryBound::new(dims, spacing, sample, settings, mode, cache_budget).total();
     // A 16-bit PNG quantises the frame first: 8 bytes a pixel.
     bound + 8 * settings.width as u128 * settings.height as u128
@@ -44,7 +44,8 @@ pub fn cache_budget(
     let volume = &input.volume;
     let limit = u128::from(input.max_memory);
     let grid = (volume.dims(), volume.spacing(), volume.sample_type());
-    let need = render_bytes(grid, settings, view, 0);
+    let mode = input.non_finite(view.sampling.nonfinite.into());
+    let need = render_bytes(grid, settings, mode, 0);
     if need > limit {
         let [nx, ny, nz] = volume.dims();
         let what = format!(
@@ -56,7 +57,7 @@ pub fn cache_budget(
             method: Method::Fast,
             ..settings.clone()
         };
-        let fast_need = render_bytes(grid, &fast, view, 0);
+        let fast_need = render_bytes(grid, &fast, mode, 0);
         if settings.method == Method::Reference && fast_need <= limit {
             return Err(CliError::input(format!(
                 "{what} on the reference path (--reference) may take up to {}, more than --max-memory {}; the default path takes at most {}: leave out --reference",
@@ -93,10 +94,11 @@ mod tests {
     fn bytes(args: &[&str], dims: [usize; 3]) -> u128 {
         let view = view(args);
         let settings = crate::settings::settings(&view).unwrap();
+        let mode = NonFinite::from(view.sampling.nonfinite);
         render_bytes(
             (dims, DVec3::ONE, SampleType::F32),
             &settings,
-            &view,
+            mode,
             usize::MAX,
         )
     }
@@ -171,7 +173,7 @@ mod budget_tests {
         let dims = [33, 33, 33];
         let volume = Volume::from_samples(dims, vec![7u16; 33 * 33 * 33]).unwrap();
         let grid = (dims, volume.spacing(), SampleType::U16);
-        let without = render_bytes(grid, &settings, &view, 0) as u64;
+        let without = render_bytes(grid, &settings, NonFinite::Refuse, 0) as u64;
         // Plenty of memory: the default budget.
         let roomy = input(volume.clone(), 1 << 40);
         assert_eq!(

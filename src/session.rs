@@ -10,7 +10,7 @@ use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use volray_core::camera::CameraError;
-use volray_core::{NonFinite, RenderError, RenderSettings, Renderer};
+use volray_core::{RenderError, RenderSettings, Renderer};
 
 /// Reads the volume `args` name and, with `--log`, takes its log10.
 pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
@@ -51,7 +51,7 @@ pub fn renderer_for<'v>(
 ) -> Result<Renderer<'v>, CliError> {
     let budget = crate::memory::cache_budget(view, settings, input)?;
     let (name, volume) = (&input.name, &input.volume);
-    let mode = NonFinite::from(view.sampling.nonfinite);
+    let mode = input.non_finite(view.sampling.nonfinite.into());
     let renderer = Renderer::with_non_finite(volume, mode).map_err(|e| match e {
         RenderError::NonFinite { .. } => CliError::input(format!(
             "{name}: {e}; use --nonfinite transparent to render them as empty space"
