@@ -38,6 +38,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             "input": input.name,
             "format": format,
             "dims": [nx, ny, nz],
+            "sample_type": v.sample_type().name(),
             "spacing": [s.x, s.y, s.z],
             "origin": [o.x, o.y, o.z],
             "length_unit": unit,
@@ -60,6 +61,16 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         print_stored(i);
     }
     outln!("dims:      {nx} x {ny} x {nz} ({} points)", v.len());
+    let kept = v.sample_type();
+    outln!(
+        "in memory: {} ({} a voxel, {})",
+        kept.name(),
+        match kept.bytes() {
+            1 => "1 byte".to_string(),
+            n => format!("{n} bytes"),
+        },
+        volray_io::format_bytes((kept.bytes() * v.len()) as u128)
+    );
     outln!("spacing:   {}, {}, {}{unit_suffix}", s.x, s.y, s.z);
     outln!("origin:    {}, {}, {}{unit_suffix}", o.x, o.y, o.z);
     let e = v.extent();

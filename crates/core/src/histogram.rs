@@ -1,7 +1,8 @@
 //! Value statistics of a volume: the range, mean and a histogram, for
 //! `volray info` and for choosing transfer functions.
 
-use crate::Volume;
+use crate::volume::Sample;
+use crate::{Volume, with_samples};
 
 /// Summary statistics over a volume's finite values.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,22 +27,11 @@ impl Histogram {
         let bins = bins.max(1);
         let (min, max) = volume.value_range()?;
         let mut counts = vec![0u64; bins];
-        let mut sum = 0.0f64;
-        let mut non_finite = 0u64;
         let width = (f64::from(max) - f64::from(min)) / bins as f64;
-        for v in volume.values().iter().copied() {
-            if !v.is_finite() {
-                non_finite += 1;
-                continue;
-            }
-            sum += f64::from(v);
-            let b = if width > 0.0 {
-                ((f64::from(v) - f64::from(min)) / width) as usize
-            } else {
-                0
-            };
-            counts[b.min(bins - 1)] += 1;
-        }
+        // Read in the volume's own type (no f32 copy of a 16-bit volume).
+        let (sum, non_finite) = with_samples!(volume.samples(), |data| {
+            accumulate(data, min, width, &mut counts)
+        });
         let finite = volume.len() as u64 - non_finite;
         Some(Histogram {
             min,
@@ -60,6 +50,27 @@ impl Histogram {
         }
         f64::from(self.min) + (f64::from(self.max) - f64::from(self.min)) * b as f64 / bins as f64
     }
+}
+
+/// Adds `data`'s finite values to `counts` (bins of `width` from `min`);
+/// returns their sum and the number of values that are not finite.
+fn accumulate<T: Sample>(data: &[T], min: f32, width: f64, counts: &mut [u64]) -> (f64, u64) {
+    let last = counts.len() - 1;
+    let (mut sum, mut non_finite) = (0.0f64, 0u64);
+    for v in data.iter().map(|v| v.to_f32()) {
+        if !v.is_finite() {
+            non_finite += 1;
+            continue;
+        }
+        sum += f64::from(v);
+        let b = if width > 0.0 {
+            ((f64::from(v) - f64::from(min)) / width) as usize
+        } else {
+            0
+        };
+        counts[b.min(last)] += 1;
+    }
+    (sum, non_finite)
 }
 
 #[cfg(test)]

@@ -1,9 +1,12 @@
-//! Sample types and byte orders of raw data, and their conversion to `f32`.
+//! Sample types and byte orders of raw data, and how they are kept in
+//! memory: 8- and 16-bit integers and `f32` as they are (a volume keeps its
+//! [`SampleType`]), everything else converted to `f32`.
 
 use std::fmt;
 use std::str::FromStr;
 
 use thiserror::Error;
+use volray_core::{Sample, SampleType, Samples};
 
 /// The type of one sample in a raw file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -50,6 +53,19 @@ impl DType {
             DType::U16 | DType::I16 | DType::F16 => 2,
             DType::U32 | DType::I32 | DType::F32 => 4,
             DType::U64 | DType::I64 | DType::F64 => 8,
+        }
+    }
+
+    /// The type a volume keeps samples of this type in: `u8`, `i8`, `u16`,
+    /// `i16` and `f32` as they are; 32- and 64-bit integers, `f16` and
+    /// `f64` as `f32` (rounded to nearest, as [`bytes_to_f32`] does).
+    pub fn stored(self) -> SampleType {
+        match self {
+            DType::U8 => SampleType::U8,
+            DType::I8 => SampleType::I8,
+            DType::U16 => SampleType::U16,
+            DType::I16 => SampleType::I16,
+            _ => SampleType::F32,
         }
     }
 
@@ -213,6 +229,103 @@ pub fn extend_f32(out: &mut Vec<f32>, bytes: &[u8], dtype: DType, endian: Endian
     }
 }
 
+/// A type a volume keeps samples in, decoded from a file's bytes.
+pub(crate) trait Stored: Sample {
+    /// Appends `bytes`, samples of `dtype` in `endian` order, to `out`.
+    /// `dtype.stored()` must be this type (`f32` takes every `dtype`).
+    fn extend(out: &mut Vec<Self>, bytes: &[u8], dtype: DType, endian: Endian);
+
+    /// A value the reader computed (a number read as text, a boolean, a
+    /// type kept as `f32`), converted with `as`: readers pick a type that
+    /// holds it exactly.
+    fn from_f64(v: f64) -> Self;
+}
+
+macro_rules! stored_integer {
+    ($t:ty, $dtype:ident) => {
+        impl Stored for $t {
+            fn extend(out: &mut Vec<Self>, bytes: &[u8], dtype: DType, endian: Endian) {
+                debug_assert_eq!(dtype, DType::$dtype);
+                const N: usize = std::mem::size_of::<$t>();
+                let conv = match endian {
+                    Endian::Little => <$t>::from_le_bytes,
+                    Endian::Big => <$t>::from_be_bytes,
+                };
+                out.extend(bytes.chunks_exact(N).map(|c| {
+                    let mut a = [0u8; N];
+                    a.copy_from_slice(c);
+                    conv(a)
+                }));
+            }
+
+            fn from_f64(v: f64) -> Self {
+                v as $t
+            }
+        }
+    };
+}
+
+stored_integer!(u8, U8);
+stored_integer!(i8, I8);
+stored_integer!(u16, U16);
+stored_integer!(i16, I16);
+
+impl Stored for f32 {
+    fn extend(out: &mut Vec<Self>, bytes: &[u8], dtype: DType, endian: Endian) {
+        extend_f32(out, bytes, dtype, endian);
+    }
+
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+}
+
+/// Runs `$body` with the type alias `$t` naming the Rust type of the
+/// [`SampleType`] `$stored`, and wraps the `Vec<$t>` the body gives (in a
+/// `Result`) into [`Samples`]: a reader written once over [`Stored`]
+/// keeps each type as it is.
+macro_rules! read_as_stored {
+    ($stored:expr, |$t:ident| $body:expr) => {{
+        use volray_core::{SampleType, Samples};
+        match $stored {
+            SampleType::U8 => {
+                type $t = u8;
+                $body.map(Samples::from)
+            }
+            SampleType::I8 => {
+                type $t = i8;
+                $body.map(Samples::from)
+            }
+            SampleType::U16 => {
+                type $t = u16;
+                $body.map(Samples::from)
+            }
+            SampleType::I16 => {
+                type $t = i16;
+                $body.map(Samples::from)
+            }
+            SampleType::F32 => {
+                type $t = f32;
+                $body.map(Samples::from)
+            }
+        }
+    }};
+}
+pub(crate) use read_as_stored;
+
+/// Decodes `bytes` (samples of `dtype` in `endian` order) into the type a
+/// volume keeps them in ([`DType::stored`]).
+pub fn bytes_to_samples(bytes: &[u8], dtype: DType, endian: Endian) -> Samples {
+    let decoded: Result<Samples, std::convert::Infallible> = read_as_stored!(dtype.stored(), |T| {
+        let mut out = Vec::with_capacity(bytes.len() / dtype.size());
+        <T as Stored>::extend(&mut out, bytes, dtype, endian);
+        Ok(out)
+    });
+    match decoded {
+        Ok(samples) => samples,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,6 +395,35 @@ mod tests {
                 assert_eq!(got, want, "{dtype} {endian}");
             }
         }
+    }
+
+    /// Samples kept in their own type decode to the same values as `f32`
+    /// decoding gives, for every type and byte order.
+    #[test]
+    fn stored_types_hold_what_f32_decoding_gives() {
+        let bytes: Vec<u8> = (0..64u32).map(|i| (i * 37 + 11) as u8).collect();
+        for endian in [Endian::Little, Endian::Big] {
+            for dtype in DType::ALL {
+                let samples = bytes_to_samples(&bytes, dtype, endian);
+                assert_eq!(samples.sample_type(), dtype.stored(), "{dtype}");
+                let want = bytes_to_f32(&bytes, dtype, endian);
+                let got = samples.to_f32_vec();
+                assert_eq!(got.len(), want.len(), "{dtype}");
+                for (g, w) in got.iter().zip(&want) {
+                    assert!(
+                        g.to_bits() == w.to_bits() || (g.is_nan() && w.is_nan()),
+                        "{dtype} {endian}"
+                    );
+                }
+            }
+        }
+        let kept: Vec<_> = DType::ALL.iter().map(|d| d.stored().name()).collect();
+        assert_eq!(
+            kept,
+            [
+                "u8", "i8", "u16", "i16", "f32", "f32", "f32", "f32", "f32", "f32", "f32"
+            ]
+        );
     }
 
     #[test]

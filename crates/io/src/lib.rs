@@ -106,7 +106,9 @@ mod read;
 mod shared;
 
 pub use atomic::{AtomicFile, remove_unfinished_files, write_atomically};
-pub use dtype::{DType, Endian, ParseNameError, bytes_to_f32, extend_f32, f16_to_f32};
+pub use dtype::{
+    DType, Endian, ParseNameError, bytes_to_f32, bytes_to_samples, extend_f32, f16_to_f32,
+};
 pub use error::IoError;
 pub use formats::VolumeFormat;
 pub use formats::npy::{read_npy, write_npy};

@@ -4,9 +4,11 @@
 //! For each format a valid fixture is read with the limit at exactly the
 //! bytes the reader holds (accepted) and one byte less (refused, naming the
 //! header field and the limit). What a reader holds is its documented
-//! rule: the `f32` volume (4 bytes a voxel) for the streaming readers, plus
-//! the whole-payload buffers of those that keep one (DICOM multi-frame,
-//! VTK XML, CHGCAR, HDF5). Then a header per format is written by hand
+//! rule: the volume in the type it keeps (1, 2 or 4 bytes a voxel) for the
+//! streaming readers, plus the whole-payload buffers of those that keep one
+//! (DICOM multi-frame, VTK XML, CHGCAR, HDF5) and the `f32` values a
+//! rescaling builds beside the stored ones (NIfTI's scl_slope, ImageJ's
+//! calibration). Then a header per format is written by hand
 //! with dimensions of 2^40 (or the format's largest) per axis, whose
 //! product overflows: each is refused in one line naming the value.
 
@@ -52,9 +54,9 @@ fn assert_over_limit(err: &IoError, field: &str, limit: u64) {
     assert!(msg.contains("the memory limit of"), "{msg}");
 }
 
-/// 4 bytes a voxel: the streaming readers hold the f32 volume only.
-fn f32_volume(l: &Loaded) -> u64 {
-    4 * l.volume.len() as u64
+/// The streaming readers hold the volume only, in the type it keeps.
+fn volume_bytes(l: &Loaded) -> u64 {
+    (l.volume.sample_type().bytes() * l.volume.len()) as u64
 }
 
 #[test]
@@ -66,17 +68,18 @@ fn raw_and_npy() {
         raw: Some(volray_io::RawOptions::new([4, 3, 5], volray_io::DType::U16)),
         ..ReadOptions::default()
     };
+    // 16-bit samples stay 16-bit: 2 bytes a voxel.
     assert_eq!(
-        limit_is_exact(&p, raw, f32_volume, "raw layout dims 4 3 5"),
-        240
+        limit_is_exact(&p, raw, volume_bytes, "raw layout dims 4 3 5"),
+        120
     );
 
     let npy = fixture("", "fortran_f4.npy");
-    limit_is_exact(&npy, ReadOptions::default(), f32_volume, "shape");
+    limit_is_exact(&npy, ReadOptions::default(), volume_bytes, "shape");
     limit_is_exact(
         &fixture("", "c_f4.npy"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "shape",
     );
 }
@@ -88,22 +91,22 @@ fn nrrd_and_metaimage() {
         limit_is_exact(
             &nrrd("f32_lps.nrrd"),
             ReadOptions::default(),
-            f32_volume,
+            volume_bytes,
             "NRRD field \"sizes\" 4 3 5"
         ),
         240
     );
-    // Compressed and detached: still the f32 volume only (streamed).
+    // Compressed and detached: still the volume only (streamed).
     limit_is_exact(
         &nrrd("u8_gzip.nrrd"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "\"sizes\"",
     );
     limit_is_exact(
         &nrrd("list.nhdr"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "\"sizes\"",
     );
     // A 4-D file: one volume of its frames is held.
@@ -113,7 +116,7 @@ fn nrrd_and_metaimage() {
     limit_is_exact(
         &four,
         common::frame(1),
-        f32_volume,
+        volume_bytes,
         &format!("one volume of {frames}"),
     );
 
@@ -121,13 +124,13 @@ fn nrrd_and_metaimage() {
     limit_is_exact(
         &mha("f32.mha"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "MetaImage field DimSize",
     );
     limit_is_exact(
         &mha("i16_zlib.mha"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "DimSize",
     );
 }
@@ -138,25 +141,25 @@ fn nifti() {
     limit_is_exact(
         &nii("f32.nii"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "NIfTI field \"dim\"",
     );
     limit_is_exact(
         &nii("f32.nii.gz"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "\"dim\"",
     );
     limit_is_exact(
         &nii("nifti2_i32.nii"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "\"dim\"",
     );
     limit_is_exact(
         &nii("frames4d.nii.gz"),
         common::frame(1),
-        f32_volume,
+        volume_bytes,
         "one volume of",
     );
 }
@@ -167,13 +170,13 @@ fn vtk_legacy_and_xml() {
     limit_is_exact(
         &vtk("legacy_f32.vtk"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "array \"",
     );
     limit_is_exact(
         &vtk("legacy_i16_ascii.vtk"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "array \"",
     );
 
@@ -198,17 +201,17 @@ fn dicom() {
     limit_is_exact(
         &dcm("ct"),
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "Columns x Rows x slices",
     );
     // Multi-frame, 16-bit samples: every frame held as parsed and as
-    // decoded (2 + 2 bytes) beside the f32 volume.
+    // decoded (2 + 2 bytes) beside the volume.
     let l = read(&dcm("enhanced_ct.dcm"), &ReadOptions::default()).unwrap();
     assert_eq!(common::header_value(&l, "BitsAllocated (0028,0100)"), "16");
     limit_is_exact(
         &dcm("enhanced_ct.dcm"),
         ReadOptions::default(),
-        |l| 8 * l.volume.len() as u64,
+        |l| 4 * l.volume.len() as u64 + volume_bytes(l),
         "Rows x Columns x NumberOfFrames",
     );
 }
@@ -219,17 +222,17 @@ fn tiff_cube_mrc_chgcar() {
     limit_is_exact(
         &tif,
         ReadOptions::default(),
-        f32_volume,
+        volume_bytes,
         "ImageWidth x ImageLength x pages",
     );
     let tif = fixture("tiff", "pillow_lzw_u16.tif");
-    limit_is_exact(&tif, ReadOptions::default(), f32_volume, "ImageWidth");
+    limit_is_exact(&tif, ReadOptions::default(), volume_bytes, "ImageWidth");
 
     let cube = fixture("cube", "ramp_bohr.cube");
-    limit_is_exact(&cube, ReadOptions::default(), f32_volume, "N1 x N2 x N3");
+    limit_is_exact(&cube, ReadOptions::default(), volume_bytes, "N1 x N2 x N3");
 
     let mrc = fixture("mrc", "mode2_f32.mrc");
-    limit_is_exact(&mrc, ReadOptions::default(), f32_volume, "NX NY NZ");
+    limit_is_exact(&mrc, ReadOptions::default(), volume_bytes, "NX NY NZ");
 
     // CHGCAR: the NG grid and its copy closed by the periodic planes, so
     // the volume is (NG + 1)^3 points.

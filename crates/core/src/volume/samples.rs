@@ -182,6 +182,28 @@ impl Samples {
     pub fn to_f32_vec(&self) -> Vec<f32> {
         with_samples!(self, |data| data.iter().map(|v| v.to_f32()).collect())
     }
+
+    /// Passes the samples to `f` as `f32`, in order, `chunk` at a time (the
+    /// last chunk may be shorter), converting through one scratch buffer
+    /// rather than a copy of them all; stops at `f`'s first error.
+    pub fn try_for_each_f32_chunk<E>(
+        &self,
+        chunk: usize,
+        mut f: impl FnMut(&[f32]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let chunk = chunk.max(1);
+        if let Samples::F32(data) = self {
+            return data.chunks(chunk).try_for_each(f);
+        }
+        let mut scratch = Vec::with_capacity(chunk);
+        with_samples!(self, |data| {
+            data.chunks(chunk).try_for_each(|c| {
+                scratch.clear();
+                scratch.extend(c.iter().map(|v| v.to_f32()));
+                f(&scratch)
+            })
+        })
+    }
 }
 
 impl From<Vec<f32>> for Samples {
@@ -239,6 +261,13 @@ mod tests {
         assert_eq!((s.sample_type(), s.len()), (SampleType::U16, 3));
         assert_eq!(s.get(1), 65535.0);
         assert_eq!(s.to_f32_vec(), vec![3.0, 65535.0, 0.0]);
+        let mut chunks = Vec::new();
+        let done: Result<(), ()> = s.try_for_each_f32_chunk(2, |c| {
+            chunks.push(c.to_vec());
+            Ok(())
+        });
+        assert_eq!(done, Ok(()));
+        assert_eq!(chunks, [vec![3.0, 65535.0], vec![0.0]]);
         assert_eq!(SampleType::U16.bytes(), 2);
         assert_eq!(SampleType::I8.name(), "i8");
     }

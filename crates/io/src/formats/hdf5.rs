@@ -28,6 +28,7 @@ use std::path::{Path, PathBuf};
 use hdf5_pure::{AttrValue, Dataset, Group};
 use volray_core::glam::DVec3;
 
+use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::hdf5::{self as h5, Slabs, numbers, numeric_type, sorted_attrs, text};
@@ -128,6 +129,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         &file_path,
         &format!("dataset shape {shape:?}"),
         h5.len,
+        sample.stored,
         opts.max_memory,
     )?;
 
@@ -146,7 +148,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
     let (spacing, origin) = geometry(&attrs, series, &mut info).map_err(what)?;
 
-    let data = read_volume(&slabs, dims, voxels).map_err(what)?;
+    let data =
+        read_as_stored!(sample.stored, |T| read_volume::<T>(&slabs, dims, voxels)).map_err(what)?;
     let steps = [
         DVec3::X * spacing.x,
         DVec3::Y * spacing.y,
@@ -162,9 +165,13 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 
 /// Reads one volume into an x-fastest buffer: the dataset's first axis
 /// is x, its last (fastest in the file) z.
-fn read_volume(slabs: &Slabs, dims: [usize; 3], voxels: usize) -> Result<Vec<f32>, String> {
+fn read_volume<T: Stored>(
+    slabs: &Slabs,
+    dims: [usize; 3],
+    voxels: usize,
+) -> Result<Vec<T>, String> {
     let [n0, n1, n2] = dims;
-    let mut data = vec![0.0f32; voxels];
+    let mut data = vec![T::default(); voxels];
     // Sample (x, y, z) at C-order index x·n1·n2 + y·n2 + z goes to
     // x + n0·(y + n1·z).
     slabs.read(|first, part| {
@@ -172,7 +179,8 @@ fn read_volume(slabs: &Slabs, dims: [usize; 3], voxels: usize) -> Result<Vec<f32
             let at = first + i;
             let (x, yz) = (at / (n1 * n2), at % (n1 * n2));
             let (y, z) = (yz / n2, yz % n2);
-            data[x + n0 * (y + n1 * z)] = v as f32;
+            // Exact for the integer types kept; `as f32` for the rest.
+            data[x + n0 * (y + n1 * z)] = T::from_f64(f64::from(v as f32));
         }
     })?;
     Ok(data)

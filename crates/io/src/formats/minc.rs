@@ -24,6 +24,7 @@
 use std::path::Path;
 
 use hdf5_pure::{AttrValue, Dataset, Group};
+use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
 use crate::error::IoError;
@@ -99,10 +100,12 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         (spatial == 1).then_some(frame),
         sample.size,
     );
+    // Scaled per slice by image-min/image-max: kept as f32.
     let voxels = slabs.check(
         path,
         &format!("image shape {shape:?}"),
         h5.len,
+        SampleType::F32,
         opts.max_memory,
     )?;
 

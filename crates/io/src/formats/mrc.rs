@@ -33,11 +33,11 @@ use std::path::Path;
 
 use volray_core::glam::DVec3;
 
-use crate::dtype::{DType, Endian, extend_f32};
+use crate::dtype::{DType, Endian, Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::{open_input, read_exact_at, read_samples};
-use crate::shared::limits::{F32_BYTES, check_dims};
+use crate::shared::limits::check_dims;
 use crate::shared::periodic_cell;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
@@ -303,7 +303,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
     // The file holds the data, so these sizes fit in u64 and usize.
     let end = end as u64;
-    check_dims(path, "NX NY NZ", &dims, F32_BYTES, opts.max_memory)?;
+    let kept = dtype.stored().bytes() as u64;
+    check_dims(path, "NX NY NZ", &dims, kept, opts.max_memory)?;
     let count = count as usize;
     if file_len > end {
         notes.push(format!("{} bytes after the data ignored", file_len - end));
@@ -435,17 +436,20 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     // The samples, streamed: column fastest.
     file.seek(SeekFrom::Start(offset))
         .map_err(|e| IoError::os(path, "seek in", e))?;
-    let mut data = Vec::with_capacity(count);
     let endian = h.endian;
-    read_samples(
-        path,
-        &mut file,
-        count,
-        dtype.size(),
-        offset,
-        |bytes, out| extend_f32(out, bytes, dtype, endian),
-        |values| data.extend_from_slice(values),
-    )?;
+    let data = read_as_stored!(dtype.stored(), |T| {
+        let mut data: Vec<T> = Vec::with_capacity(count);
+        read_samples(
+            path,
+            &mut file,
+            count,
+            dtype.size(),
+            offset,
+            |bytes, out| T::extend(out, bytes, dtype, endian),
+            |values| data.extend_from_slice(values),
+        )
+        .map(|()| data)
+    })?;
 
     let mut info = FileInfo::new(format!("{type_name} (MODE {mode}, {endian}-endian)"));
     info.header = header;
@@ -467,7 +471,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         let axis_names = axis_of.map(|a| names[a]);
         let (volume, note) = resample(
             dims,
-            &data,
+            &data.to_f32_vec(),
             steps,
             origin,
             axis_names,

@@ -19,13 +19,13 @@ use std::fmt::Write as _;
 use std::io::Read;
 use std::path::Path;
 
-use volray_core::{Volume, VolumeError};
+use volray_core::{SampleType, Volume, VolumeError};
 
 use crate::atomic::write_atomically;
-use crate::dtype::{DType, Endian, extend_f32, f16_to_f32};
+use crate::dtype::{DType, Endian, Stored, f16_to_f32, read_as_stored};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_exact_at, read_samples};
-use crate::shared::limits::{F32_BYTES, check_dims};
+use crate::shared::limits::check_dims;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 const MAGIC: &[u8; 6] = b"\x93NUMPY";
@@ -72,49 +72,16 @@ fn read_npy_with_info(path: &Path, max_memory: u64) -> Result<(Volume, FileInfo)
         return Err(IoError::volume(path, VolumeError::TooThin(nx, ny, nz)));
     }
     // read_header checked count · size against the file, so no overflow.
-    let count = check_dims(path, "shape", &header.shape, F32_BYTES, max_memory)?;
+    let stored = header.elem.stored();
+    let count = check_dims(
+        path,
+        "shape",
+        &header.shape,
+        stored.bytes() as u64,
+        max_memory,
+    )?;
+    let data = read_as_stored!(stored, |T| read_data::<T>(path, &mut file, &header, count))?;
     let elem = header.elem;
-    let decode = |bytes: &[u8], out: &mut Vec<f32>| elem.decode(bytes, out);
-    let data = if header.fortran_order {
-        let mut data = Vec::with_capacity(count);
-        read_samples(
-            path,
-            &mut file,
-            count,
-            elem.size(),
-            header.data_offset,
-            decode,
-            |v| data.extend_from_slice(v),
-        )?;
-        data
-    } else {
-        // C order: z fastest in the file. Scatter into x-fastest order.
-        let mut data = vec![0.0f32; count];
-        let (mut x, mut y, mut z) = (0usize, 0usize, 0usize);
-        read_samples(
-            path,
-            &mut file,
-            count,
-            elem.size(),
-            header.data_offset,
-            decode,
-            |values| {
-                for &v in values {
-                    data[x + nx * (y + ny * z)] = v;
-                    z += 1;
-                    if z == nz {
-                        z = 0;
-                        y += 1;
-                        if y == ny {
-                            y = 0;
-                            x += 1;
-                        }
-                    }
-                }
-            },
-        )?;
-        data
-    };
     let mut info = FileInfo::new(descr_name(elem));
     info.header = vec![
         ("descr".into(), descr_name(elem)),
@@ -133,8 +100,59 @@ fn read_npy_with_info(path: &Path, max_memory: u64) -> Result<(Volume, FileInfo)
         info.notes
             .push("C order: the array a[x, y, z] was transposed to x fastest".into());
     }
-    let volume = Volume::new(header.shape, data).map_err(|e| IoError::volume(path, e))?;
+    let volume = Volume::from_samples(header.shape, data).map_err(|e| IoError::volume(path, e))?;
     Ok((volume, info))
+}
+
+/// The `count` samples after the header, x fastest, as `T`.
+fn read_data<T: Stored>(
+    path: &Path,
+    file: &mut impl Read,
+    header: &Header,
+    count: usize,
+) -> Result<Vec<T>, IoError> {
+    let [nx, ny, nz] = header.shape;
+    let elem = header.elem;
+    let decode = |bytes: &[u8], out: &mut Vec<T>| elem.decode(bytes, out);
+    if header.fortran_order {
+        let mut data = Vec::with_capacity(count);
+        read_samples(
+            path,
+            file,
+            count,
+            elem.size(),
+            header.data_offset,
+            decode,
+            |v| data.extend_from_slice(v),
+        )?;
+        return Ok(data);
+    }
+    // C order: z fastest in the file. Scatter into x-fastest order.
+    let mut data = vec![T::default(); count];
+    let (mut x, mut y, mut z) = (0usize, 0usize, 0usize);
+    read_samples(
+        path,
+        file,
+        count,
+        elem.size(),
+        header.data_offset,
+        decode,
+        |values| {
+            for &v in values {
+                data[x + nx * (y + ny * z)] = v;
+                z += 1;
+                if z == nz {
+                    z = 0;
+                    y += 1;
+                    if y == ny {
+                        y = 0;
+                        x += 1;
+                    }
+                }
+            }
+        },
+    )?;
+    Ok(data)
 }
 
 /// Writes `volume` to `path` as a `.npy` file, atomically: format version
@@ -156,11 +174,11 @@ pub fn write_npy(path: &Path, volume: &Volume) -> Result<(), IoError> {
         w.write_all(&len.to_le_bytes())?;
         w.write_all(header.as_bytes())?;
         let mut buf = Vec::with_capacity(4 * 8192);
-        for chunk in volume.values().chunks(8192) {
+        volume.samples().try_for_each_f32_chunk(8192, |chunk| {
             buf.clear();
             buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
-            w.write_all(&buf)?;
-        }
+            w.write_all(&buf)
+        })?;
         Ok(())
     })
 }
@@ -200,7 +218,18 @@ impl Elem {
         }
     }
 
-    fn decode(self, bytes: &[u8], out: &mut Vec<f32>) {
+    /// The type a volume keeps these in: booleans as `u8`, 64-bit integers
+    /// and `f2` as `f32`, the rest as [`DType::stored`] says.
+    fn stored(self) -> SampleType {
+        match self {
+            Elem::Plain(d, _) => d.stored(),
+            Elem::Bool => SampleType::U8,
+            Elem::I64(_) | Elem::U64(_) | Elem::F16(_) => SampleType::F32,
+        }
+    }
+
+    /// Appends `bytes` decoded to `out`, of the type [`Elem::stored`] names.
+    fn decode<T: Stored>(self, bytes: &[u8], out: &mut Vec<T>) {
         fn words<const N: usize>(bytes: &[u8], e: Endian) -> impl Iterator<Item = [u8; N]> + '_ {
             bytes.chunks_exact(N).map(move |c| {
                 let mut a = [0u8; N];
@@ -212,11 +241,18 @@ impl Elem {
             })
         }
         match self {
-            Elem::Plain(d, e) => extend_f32(out, bytes, d, e),
-            Elem::Bool => out.extend(bytes.iter().map(|&b| if b != 0 { 1.0 } else { 0.0 })),
-            Elem::I64(e) => out.extend(words(bytes, e).map(|a| i64::from_le_bytes(a) as f32)),
-            Elem::U64(e) => out.extend(words(bytes, e).map(|a| u64::from_le_bytes(a) as f32)),
-            Elem::F16(e) => out.extend(words(bytes, e).map(|a| f16_to_f32(u16::from_le_bytes(a)))),
+            Elem::Plain(d, e) => T::extend(out, bytes, d, e),
+            Elem::Bool => out.extend(bytes.iter().map(|&b| T::from_f64(f64::from(b != 0)))),
+            // Rounded to f32 first (as before), then stored exactly as f32.
+            Elem::I64(e) => out.extend(
+                words(bytes, e).map(|a| T::from_f64(f64::from(i64::from_le_bytes(a) as f32))),
+            ),
+            Elem::U64(e) => out.extend(
+                words(bytes, e).map(|a| T::from_f64(f64::from(u64::from_le_bytes(a) as f32))),
+            ),
+            Elem::F16(e) => out.extend(
+                words(bytes, e).map(|a| T::from_f64(f64::from(f16_to_f32(u16::from_le_bytes(a))))),
+            ),
         }
     }
 }

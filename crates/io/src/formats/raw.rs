@@ -2,7 +2,8 @@
 //!
 //! A raw file holds `nx·ny·nz` samples of one [`DType`], x fastest
 //! (`index = x + nx·(y + ny·z)`), and nothing else: its length must be
-//! exactly `nx·ny·nz·size`.
+//! exactly `nx·ny·nz·size`. The volume keeps 8- and 16-bit integers and
+//! `f32` in their own type ([`DType::stored`]).
 
 use std::path::Path;
 
@@ -10,10 +11,10 @@ use volray_core::glam::DVec3;
 use volray_core::{Volume, VolumeError};
 
 use crate::atomic::write_atomically;
-use crate::dtype::{DType, Endian, extend_f32};
+use crate::dtype::{DType, Endian, Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_samples};
-use crate::shared::limits::{F32_BYTES, check_dims, default_max_memory};
+use crate::shared::limits::{check_dims, default_max_memory};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// The layout of a raw file.
@@ -77,8 +78,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     })
 }
 
-/// [`read_raw`], refusing a layout whose `f32` volume would take more than
-/// `max_memory` bytes (`--max-memory`).
+/// [`read_raw`], refusing a layout whose volume (in the type it keeps)
+/// would take more than `max_memory` bytes (`--max-memory`).
 fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<Volume, IoError> {
     let [nx, ny, nz] = opts.dims;
     if nx < 2 || ny < 2 || nz < 2 {
@@ -109,21 +110,26 @@ fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<V
             expected,
         });
     }
-    check_dims(path, "raw layout dims", &opts.dims, F32_BYTES, max_memory)?;
+    let stored = opts.dtype.stored();
+    let kept = stored.bytes() as u64;
+    check_dims(path, "raw layout dims", &opts.dims, kept, max_memory)?;
 
-    let mut data = Vec::with_capacity(count);
     let (dtype, endian) = (opts.dtype, opts.endian);
-    read_samples(
-        path,
-        &mut file,
-        count,
-        dtype.size(),
-        0,
-        |bytes, out| extend_f32(out, bytes, dtype, endian),
-        |values| data.extend_from_slice(values),
-    )?;
+    let samples = read_as_stored!(stored, |T| {
+        let mut data: Vec<T> = Vec::with_capacity(count);
+        read_samples(
+            path,
+            &mut file,
+            count,
+            dtype.size(),
+            0,
+            |bytes, out| T::extend(out, bytes, dtype, endian),
+            |values| data.extend_from_slice(values),
+        )
+        .map(|()| data)
+    })?;
 
-    Volume::new(opts.dims, data)
+    Volume::from_samples(opts.dims, samples)
         .and_then(|v| v.with_spacing(opts.spacing))
         .map_err(|e| IoError::volume(path, e))
 }
@@ -134,11 +140,11 @@ fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<V
 pub fn write_raw(path: &Path, volume: &Volume) -> Result<(), IoError> {
     write_atomically(path, |w| {
         let mut buf = Vec::with_capacity(4 * 4096);
-        for chunk in volume.values().chunks(4096) {
+        volume.samples().try_for_each_f32_chunk(4096, |chunk| {
             buf.clear();
             buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
-            w.write_all(&buf)?;
-        }
+            w.write_all(&buf)
+        })?;
         Ok(())
     })
 }

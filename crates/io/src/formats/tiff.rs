@@ -31,12 +31,15 @@ use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
+use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
+use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
 use crate::shared::limits::{F32_BYTES, check_dims};
+use crate::shared::rescale::rescale;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// A compressed page may decode to more bytes than the file holds; a stack
@@ -87,6 +90,18 @@ impl Sample {
     fn bytes(self) -> u64 {
         let (Sample::Uint(b) | Sample::Int(b) | Sample::Float(b)) = self;
         u64::from(b) / 8
+    }
+
+    /// The type the volume keeps: 8- and 16-bit integers as they are,
+    /// the rest as `f32`.
+    fn stored(self) -> SampleType {
+        match self {
+            Sample::Uint(8) => SampleType::U8,
+            Sample::Uint(16) => SampleType::U16,
+            Sample::Int(8) => SampleType::I8,
+            Sample::Int(16) => SampleType::I16,
+            _ => SampleType::F32,
+        }
     }
 }
 
@@ -225,43 +240,53 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             )
         })?;
     check_budget(path, dims, voxels, sample, file_len)?;
-    // The f32 volume, beside one decoded page at a time.
+    // The volume in its own type, beside one decoded page at a time; an
+    // ImageJ calibration builds the calibrated values beside it.
+    let (calibration, calibration_note) = imagej.as_ref().map_or((None, None), calibration);
+    let kept = sample.stored().bytes() as u64;
     check_dims(
         path,
         "ImageWidth x ImageLength x pages",
         &dims,
-        F32_BYTES,
+        kept + if calibration.is_some() { F32_BYTES } else { 0 },
         opts.max_memory,
     )?;
 
-    let mut data = Vec::with_capacity(voxels);
-    for z in 0..shape.slices {
-        let page = &pages[(t * shape.slices + z) * shape.channels + c];
-        let what = format!("page {}", page.ifd);
-        decoder
-            .seek_to_image(page.ifd)
-            .map_err(|e| tiff_error(path, &what, e))?;
-        let image = decoder
-            .read_image()
-            .map_err(|e| tiff_error(path, &what, e))?;
-        let before = data.len();
-        extend_samples(&mut data, image);
-        if data.len() - before != w * h {
-            return Err(IoError::invalid(
-                path,
-                format!(
-                    "TIFF {what} decoded to {} samples, but {w}x{h} pixels were declared",
-                    data.len() - before
-                ),
-            ));
+    let data = read_as_stored!(sample.stored(), |T| {
+        let mut data: Vec<T> = Vec::with_capacity(voxels);
+        for z in 0..shape.slices {
+            let page = &pages[(t * shape.slices + z) * shape.channels + c];
+            let what = format!("page {}", page.ifd);
+            decoder
+                .seek_to_image(page.ifd)
+                .map_err(|e| tiff_error(path, &what, e))?;
+            let image = decoder
+                .read_image()
+                .map_err(|e| tiff_error(path, &what, e))?;
+            let before = data.len();
+            extend_page(&mut data, image);
+            if data.len() - before != w * h {
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "TIFF {what} decoded to {} samples, but {w}x{h} pixels were declared",
+                        data.len() - before
+                    ),
+                ));
+            }
         }
-    }
+        Ok(data)
+    })?;
 
     let mut spacing = DVec3::ONE;
     let mut origin = DVec3::ZERO;
+    let data = match calibration {
+        Some((c0, c1)) => rescale(data, c1, c0),
+        None => data,
+    };
+    info.notes.extend(calibration_note);
     match &imagej {
         Some(ij) => {
-            calibrate(ij, &mut data, &mut info);
             imagej_geometry(
                 ij,
                 [x_resolution, y_resolution],
@@ -423,35 +448,32 @@ impl ImageJ {
     }
 }
 
-/// Applies ImageJ's linear calibration `value = c0 + c1·stored` (`cf=0`,
-/// ImageJ's `Calibration.STRAIGHT_LINE`).
-fn calibrate(ij: &ImageJ, data: &mut [f32], info: &mut FileInfo) {
+/// ImageJ's linear calibration `value = c0 + c1·stored` (`cf=0`, ImageJ's
+/// `Calibration.STRAIGHT_LINE`) as `(c0, c1)` when there is one to apply,
+/// and the note to give about it.
+fn calibration(ij: &ImageJ) -> (Option<(f64, f64)>, Option<String>) {
     let Some(cf) = ij.get("cf") else {
-        return;
+        return (None, None);
     };
     if cf != "0" {
-        info.notes.push(format!(
+        let note = format!(
             "ImageJ calibration function cf={cf} (not a straight line) ignored: stored values kept"
-        ));
-        return;
+        );
+        return (None, Some(note));
     }
     let (c0, c1) = (
         ij.number("c0").unwrap_or(0.0),
         ij.number("c1").unwrap_or(1.0),
     );
     if c0 == 0.0 && c1 == 1.0 {
-        return;
-    }
-    for v in data.iter_mut() {
-        *v = (c0 + c1 * f64::from(*v)) as f32;
+        return (None, None);
     }
     let unit = ij
         .get("vunit")
         .map(|u| format!(" ({u})"))
         .unwrap_or_default();
-    info.notes.push(format!(
-        "ImageJ calibration applied: value = {c0} + {c1} x stored{unit}"
-    ));
+    let note = format!("ImageJ calibration applied: value = {c0} + {c1} x stored{unit}");
+    (Some((c0, c1)), Some(note))
 }
 
 /// Spacing and origin from ImageJ's calibration: see the module docs.
@@ -569,20 +591,25 @@ fn greyscale(bits: u8, format: u32, photometric: Option<u32>) -> Result<Sample, 
     Ok(sample)
 }
 
-/// Appends a decoded page to `out` as `f32`.
-fn extend_samples(out: &mut Vec<f32>, image: DecodingResult) {
+/// Appends a decoded page to `out`, as `T`: the page's own type where
+/// [`Sample::stored`] keeps it, `f32` (rounded once, as `as f32` does)
+/// otherwise.
+fn extend_page<T: Stored>(out: &mut Vec<T>, image: DecodingResult) {
+    fn keep<T: Stored>(out: &mut Vec<T>, values: impl Iterator<Item = f32>) {
+        out.extend(values.map(|v| T::from_f64(f64::from(v))));
+    }
     match image {
-        DecodingResult::U8(v) => out.extend(v.into_iter().map(f32::from)),
-        DecodingResult::U16(v) => out.extend(v.into_iter().map(f32::from)),
-        DecodingResult::U32(v) => out.extend(v.into_iter().map(|x| x as f32)),
-        DecodingResult::U64(v) => out.extend(v.into_iter().map(|x| x as f32)),
-        DecodingResult::I8(v) => out.extend(v.into_iter().map(f32::from)),
-        DecodingResult::I16(v) => out.extend(v.into_iter().map(f32::from)),
-        DecodingResult::I32(v) => out.extend(v.into_iter().map(|x| x as f32)),
-        DecodingResult::I64(v) => out.extend(v.into_iter().map(|x| x as f32)),
-        DecodingResult::F16(v) => out.extend(v.into_iter().map(|x| x.to_f32())),
-        DecodingResult::F32(v) => out.extend(v),
-        DecodingResult::F64(v) => out.extend(v.into_iter().map(|x| x as f32)),
+        DecodingResult::U8(v) => keep(out, v.into_iter().map(f32::from)),
+        DecodingResult::U16(v) => keep(out, v.into_iter().map(f32::from)),
+        DecodingResult::U32(v) => keep(out, v.into_iter().map(|x| x as f32)),
+        DecodingResult::U64(v) => keep(out, v.into_iter().map(|x| x as f32)),
+        DecodingResult::I8(v) => keep(out, v.into_iter().map(f32::from)),
+        DecodingResult::I16(v) => keep(out, v.into_iter().map(f32::from)),
+        DecodingResult::I32(v) => keep(out, v.into_iter().map(|x| x as f32)),
+        DecodingResult::I64(v) => keep(out, v.into_iter().map(|x| x as f32)),
+        DecodingResult::F16(v) => keep(out, v.into_iter().map(|x| x.to_f32())),
+        DecodingResult::F32(v) => keep(out, v.into_iter()),
+        DecodingResult::F64(v) => keep(out, v.into_iter().map(|x| x as f32)),
     }
 }
 
@@ -686,6 +713,7 @@ fn tiff_error(path: &Path, what: &str, error: TiffError) -> IoError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use volray_core::Samples;
 
     #[test]
     fn imagej_description_fields() {
@@ -723,22 +751,18 @@ mod tests {
     #[test]
     fn calibration_is_linear_and_noted() {
         let ij = ImageJ::parse("ImageJ=1.53\ncf=0\nc0=-32768\nc1=1\nvunit=HU\n");
-        let mut info = FileInfo::default();
-        let mut data = vec![0.0, 32768.0, 65535.0];
-        calibrate(&ij, &mut data, &mut info);
-        assert_eq!(data, [-32768.0, 0.0, 32767.0]);
-        assert!(
-            info.notes[0].contains("-32768 + 1 x stored (HU)"),
-            "{:?}",
-            info.notes
-        );
+        let (scale, note) = calibration(&ij);
+        assert_eq!(scale, Some((-32768.0, 1.0)));
+        assert!(note.unwrap().contains("-32768 + 1 x stored (HU)"));
+        // A 16-bit stack calibrated to -32768..32767 stays 16-bit.
+        let data = rescale(Samples::U16(vec![0, 32768, 65535]), 1.0, -32768.0);
+        assert_eq!(data, Samples::I16(vec![-32768, 0, 32767]));
 
         let ij = ImageJ::parse("ImageJ=1.53\ncf=1\nc0=3\nc1=2\n");
-        let mut info = FileInfo::default();
-        let mut data = vec![5.0];
-        calibrate(&ij, &mut data, &mut info);
-        assert_eq!(data, [5.0]);
-        assert!(info.notes[0].contains("cf=1"), "{:?}", info.notes);
+        let (scale, note) = calibration(&ij);
+        assert_eq!(scale, None);
+        assert!(note.unwrap().contains("cf=1"));
+        assert_eq!(calibration(&ImageJ::parse("ImageJ=1.53\n")), (None, None));
     }
 
     #[test]

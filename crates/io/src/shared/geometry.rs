@@ -19,8 +19,8 @@
 
 use std::path::Path;
 
-use volray_core::Volume;
 use volray_core::glam::DVec3;
+use volray_core::{Samples, Volume, with_samples};
 
 use crate::FileInfo;
 use crate::error::IoError;
@@ -87,13 +87,21 @@ const COS_TOLERANCE: f64 = 1e-4;
 pub fn grid_to_volume(
     path: &Path,
     dims: [usize; 3],
-    data: Vec<f32>,
+    data: impl Into<Samples>,
     steps: [DVec3; 3],
     origin: DVec3,
     info: &mut FileInfo,
 ) -> Result<Volume, IoError> {
+    let data = data.into();
     if dims.contains(&1) && !dims.contains(&0) {
-        return Err(flat_image(path, dims, data, steps, origin, info));
+        return Err(flat_image(
+            path,
+            dims,
+            data.to_f32_vec(),
+            steps,
+            origin,
+            info,
+        ));
     }
     if !origin.is_finite() {
         return Err(IoError::invalid(
@@ -153,7 +161,7 @@ pub fn grid_to_volume(
             units[2].x, units[2].y, units[2].z,
             lengths[0], lengths[1], lengths[2],
         ));
-        return Volume::new(dims, data)
+        return Volume::from_samples(dims, data)
             .and_then(|v| v.with_spacing(DVec3::from(lengths)))
             .and_then(|v| v.with_origin(origin))
             .map_err(|e| IoError::volume(path, e));
@@ -187,9 +195,11 @@ pub fn grid_to_volume(
             "samples reordered so that x, y, z run along world +x, +y, +z ({})",
             map.join(", ")
         ));
-        reorder(&data, dims, world_axis, flipped)
+        with_samples!(&data, |values| Samples::from(reorder(
+            values, dims, world_axis, flipped
+        )))
     };
-    Volume::new(new_dims, data)
+    Volume::from_samples(new_dims, data)
         .and_then(|v| v.with_spacing(spacing))
         .and_then(|v| v.with_origin(new_origin))
         .map_err(|e| IoError::volume(path, e))
@@ -197,7 +207,12 @@ pub fn grid_to_volume(
 
 /// Permutes (and flips) the axes of `data`: old index axis `a` becomes new
 /// axis `world_axis[a]`, reversed where `flipped[a]`.
-fn reorder(data: &[f32], dims: [usize; 3], world_axis: [usize; 3], flipped: [bool; 3]) -> Vec<f32> {
+fn reorder<T: Copy>(
+    data: &[T],
+    dims: [usize; 3],
+    world_axis: [usize; 3],
+    flipped: [bool; 3],
+) -> Vec<T> {
     let old_strides = [1, dims[0], dims[0] * dims[1]];
     let mut new_dims = [0; 3];
     // Per new axis: the old stride and whether it runs backwards.

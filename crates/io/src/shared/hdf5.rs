@@ -8,6 +8,8 @@ use std::path::Path;
 
 use hdf5_pure::{AttrValue, DType as H5Type, Dataset, DatatypeByteOrder, File, ReadSeekSource};
 
+use volray_core::SampleType;
+
 use crate::error::IoError;
 use crate::shared::input::open_input;
 use crate::shared::limits::{check_held, count_values, format_bytes};
@@ -57,6 +59,9 @@ pub(crate) fn open(path: &Path) -> Result<H5File, IoError> {
 pub(crate) struct NumericType {
     pub size: usize,
     pub name: String,
+    /// The type a volume keeps: 8- and 16-bit integers as they are, the
+    /// rest as `f32`.
+    pub stored: SampleType,
 }
 
 /// The numeric type of `dataset`, or why it has none (`"type string is
@@ -65,17 +70,17 @@ pub(crate) fn numeric_type(dataset: &Dataset) -> Result<NumericType, String> {
     let kind = dataset
         .dtype()
         .map_err(|e| format!("unreadable type: {e}"))?;
-    let (size, name) = match kind {
-        H5Type::I8 => (1, "int8"),
-        H5Type::U8 => (1, "uint8"),
-        H5Type::I16 => (2, "int16"),
-        H5Type::U16 => (2, "uint16"),
-        H5Type::I32 => (4, "int32"),
-        H5Type::U32 => (4, "uint32"),
-        H5Type::F32 => (4, "float32"),
-        H5Type::I64 => (8, "int64"),
-        H5Type::U64 => (8, "uint64"),
-        H5Type::F64 => (8, "float64"),
+    let (size, name, stored) = match kind {
+        H5Type::I8 => (1, "int8", SampleType::I8),
+        H5Type::U8 => (1, "uint8", SampleType::U8),
+        H5Type::I16 => (2, "int16", SampleType::I16),
+        H5Type::U16 => (2, "uint16", SampleType::U16),
+        H5Type::I32 => (4, "int32", SampleType::F32),
+        H5Type::U32 => (4, "uint32", SampleType::F32),
+        H5Type::F32 => (4, "float32", SampleType::F32),
+        H5Type::I64 => (8, "int64", SampleType::F32),
+        H5Type::U64 => (8, "uint64", SampleType::F32),
+        H5Type::F64 => (8, "float64", SampleType::F32),
         other => {
             return Err(format!(
                 "type {other} is not numeric: volray reads integer and float datasets"
@@ -96,6 +101,7 @@ pub(crate) fn numeric_type(dataset: &Dataset) -> Result<NumericType, String> {
     Ok(NumericType {
         size,
         name: format!("{name}{order}"),
+        stored,
     })
 }
 
@@ -188,15 +194,16 @@ impl<'d> Slabs<'d> {
 
     /// Checks that the dataset could come out of a file of `file_len`
     /// bytes (at most [`MAX_INFLATION`] times its length, or
-    /// [`SMALL_FILE_ALLOWANCE`]), and that one volume of it as f32, beside
-    /// the samples held at once (stored and as f64), fits `max_memory`.
-    /// Returns the samples of one volume. `what` names the shape for
-    /// messages.
+    /// [`SMALL_FILE_ALLOWANCE`]), and that one volume of it as `kept`,
+    /// beside the samples held at once (stored and as f64), fits
+    /// `max_memory`. Returns the samples of one volume. `what` names the
+    /// shape for messages.
     pub(crate) fn check(
         &self,
         path: &Path,
         what: &str,
         file_len: u64,
+        kept: SampleType,
         max_memory: u64,
     ) -> Result<usize, IoError> {
         let dims64: Vec<u64> = self.shape.iter().map(|&n| n as u64).collect();
@@ -215,13 +222,14 @@ impl<'d> Slabs<'d> {
             ));
         }
         let volume = values / self.frames.max(1);
-        let peak = volume as u128 * 4 + self.scratch() as u128 * (8 + sample_size as u128);
+        let peak = volume as u128 * kept.bytes() as u128
+            + self.scratch() as u128 * (8 + sample_size as u128);
         check_held(
             path,
             what,
             volume as u128,
             peak,
-            &format!("{} as f32 and an f64 slab", format_bytes(peak)),
+            &format!("{} as {} and an f64 slab", format_bytes(peak), kept.name()),
             max_memory,
         )?;
         Ok(volume)

@@ -63,16 +63,17 @@ pub(crate) fn read_exact_at(
 
 /// Reads `count` samples of `item_size` bytes each from `reader`, never
 /// more, in chunks: `decode` turns each chunk (a whole number of samples)
-/// into `f32`s appended to its scratch vector, and `sink` receives them.
-/// `offset` is the position of the first sample in the file (for messages).
-pub(crate) fn read_samples(
+/// into values (`f32`, or the type a volume keeps) appended to its scratch
+/// vector, and `sink` receives them. `offset` is the position of the first
+/// sample in the file (for messages).
+pub(crate) fn read_samples<T>(
     path: &Path,
     reader: &mut impl Read,
     count: usize,
     item_size: usize,
     offset: u64,
-    mut decode: impl FnMut(&[u8], &mut Vec<f32>),
-    mut sink: impl FnMut(&[f32]),
+    mut decode: impl FnMut(&[u8], &mut Vec<T>),
+    mut sink: impl FnMut(&[T]),
 ) -> Result<(), IoError> {
     let expected = offset + (count as u64) * (item_size as u64);
     let chunk = CHUNK_SAMPLES.min(count);

@@ -12,6 +12,7 @@
 //! | `text_header.rs` | header lines and field values | NRRD, MetaImage |
 //! | `payload.rs` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
 //! | `text_reader.rs` | numbers streamed out of text | cube, CHGCAR, text data of NRRD and MetaImage |
+//! | `rescale.rs` | stored values rescaled (slope, intercept), kept in an integer type where exact | NIfTI, DICOM |
 //! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
 
@@ -22,6 +23,7 @@ pub(crate) mod input;
 pub(crate) mod limits;
 pub(crate) mod payload;
 pub(crate) mod periodic_cell;
+pub(crate) mod rescale;
 pub(crate) mod text_header;
 pub(crate) mod text_reader;
 pub(crate) mod vtk_arrays;

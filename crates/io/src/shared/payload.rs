@@ -18,10 +18,11 @@ use std::path::{Path, PathBuf};
 
 use flate2::read::{MultiGzDecoder, ZlibDecoder};
 
-use crate::dtype::{DType, Endian, extend_f32};
+use crate::dtype::{DType, Endian, Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_samples};
 use crate::shared::text_reader::TextReader;
+use volray_core::{SampleType, Samples};
 
 /// Deflate's largest compression ratio (RFC 1951: a 258-byte match costs
 /// at least two bits, so 1032 output bytes per input byte at most).
@@ -65,6 +66,17 @@ pub(crate) struct Layout {
     /// Bytes of the inflated stream to skip before the samples (NRRD
     /// `byte skip` with a compressed encoding).
     pub inflated_skip: u64,
+}
+
+impl Layout {
+    /// The type the volume keeps: the file's own ([`DType::stored`]), or
+    /// `f32` for numbers written as text.
+    pub(crate) fn stored(&self) -> SampleType {
+        match self.encoding {
+            Encoding::Text => SampleType::F32,
+            _ => self.dtype.stored(),
+        }
+    }
 }
 
 /// How far into a file the data starts, after the base position and any
@@ -306,7 +318,7 @@ impl FrameSelect {
         index: 0,
     };
 
-    fn keep_into(&self, first: usize, values: &[f32], out: &mut Vec<f32>) {
+    fn keep_into<T: Copy>(&self, first: usize, values: &[T], out: &mut Vec<T>) {
         if self.count == 1 {
             out.extend_from_slice(values);
         } else {
@@ -345,13 +357,26 @@ pub(crate) fn chosen_frame(
 }
 
 /// Reads `per_region` samples from each region in turn (all checked with
-/// [`check_region`] first), keeping those `frame` selects.
+/// [`check_region`] first), keeping those `frame` selects, in the type
+/// [`Layout::stored`] names.
 pub(crate) fn read_regions(
     regions: &[Region],
     per_region: usize,
     layout: &Layout,
     frame: FrameSelect,
-) -> Result<Vec<f32>, IoError> {
+) -> Result<Samples, IoError> {
+    read_as_stored!(layout.stored(), |T| read_regions_as::<T>(
+        regions, per_region, layout, frame
+    ))
+}
+
+/// [`read_regions`] as `T`.
+fn read_regions_as<T: Stored>(
+    regions: &[Region],
+    per_region: usize,
+    layout: &Layout,
+    frame: FrameSelect,
+) -> Result<Vec<T>, IoError> {
     let total = per_region.checked_mul(regions.len()).ok_or_else(|| {
         IoError::invalid(
             regions.first().map_or(Path::new(""), |r| r.path.as_path()),
@@ -367,7 +392,7 @@ pub(crate) fn read_regions(
     let mut out = Vec::with_capacity(capacity);
     let mut seen = 0usize;
     for region in regions {
-        let mut sink = |values: &[f32]| {
+        let mut sink = |values: &[T]| {
             frame.keep_into(seen, values, &mut out);
             seen += values.len();
         };
@@ -378,11 +403,11 @@ pub(crate) fn read_regions(
 
 /// Decodes the `samples` samples of one region, passing them to `sink` in
 /// chunks.
-fn read_region(
+fn read_region<T: Stored>(
     region: &Region,
     samples: usize,
     layout: &Layout,
-    sink: &mut dyn FnMut(&[f32]),
+    sink: &mut dyn FnMut(&[T]),
 ) -> Result<(), IoError> {
     let path = region.path.as_path();
     let (mut file, _) = open_input(path)?;
@@ -397,7 +422,7 @@ fn read_region(
             samples,
             dtype.size(),
             region.start,
-            |bytes, out| extend_f32(out, bytes, dtype, endian),
+            |bytes, out| T::extend(out, bytes, dtype, endian),
             |values| sink(values),
         ),
         Encoding::Gzip | Encoding::Zlib => {
@@ -443,13 +468,13 @@ fn read_full(reader: &mut dyn Read, buf: &mut [u8]) -> io::Result<usize> {
     Ok(done)
 }
 
-fn read_inflated(
+fn read_inflated<T: Stored>(
     path: &Path,
     name: &str,
     decoder: &mut dyn Read,
     samples: usize,
     layout: &Layout,
-    sink: &mut dyn FnMut(&[f32]),
+    sink: &mut dyn FnMut(&[T]),
 ) -> Result<(), IoError> {
     let skip = layout.inflated_skip;
     if skip > 0 {
@@ -484,7 +509,7 @@ fn read_inflated(
             ));
         }
         values.clear();
-        extend_f32(&mut values, buf, layout.dtype, layout.endian);
+        T::extend(&mut values, buf, layout.dtype, layout.endian);
         sink(&values);
         done += n;
     }
@@ -503,18 +528,18 @@ fn read_inflated(
 
 /// Reads `samples` decimal numbers separated by whitespace or commas;
 /// anything after them is ignored.
-fn read_text(
+fn read_text<T: Stored>(
     path: &Path,
     reader: impl BufRead,
     samples: usize,
-    sink: &mut dyn FnMut(&[f32]),
+    sink: &mut dyn FnMut(&[T]),
 ) -> Result<(), IoError> {
     let mut values = Vec::with_capacity(CHUNK.min(samples));
     TextReader::data_section(path, reader).tokens(samples, "the text data", |n, token| {
         let v: f64 = token
             .parse()
             .map_err(|_| format!("text value {} is \"{token}\", not a number", n + 1))?;
-        values.push(v as f32);
+        values.push(T::from_f64(v));
         if values.len() == CHUNK {
             sink(&values);
             values.clear();
@@ -526,12 +551,12 @@ fn read_text(
 }
 
 /// Reads `samples` samples written as hexadecimal byte pairs.
-fn read_hex(
+fn read_hex<T: Stored>(
     path: &Path,
     reader: &mut impl BufRead,
     samples: usize,
     layout: &Layout,
-    sink: &mut dyn FnMut(&[f32]),
+    sink: &mut dyn FnMut(&[T]),
 ) -> Result<(), IoError> {
     let size = layout.dtype.size();
     let total = samples * size;
@@ -576,7 +601,7 @@ fn read_hex(
                     done += 1;
                     if bytes.len() == chunk || done == total {
                         values.clear();
-                        extend_f32(&mut values, &bytes, layout.dtype, layout.endian);
+                        T::extend(&mut values, &bytes, layout.dtype, layout.endian);
                         sink(&values);
                         bytes.clear();
                     }
@@ -788,14 +813,18 @@ mod tests {
             count: 3,
             index: 1,
         };
-        let got = read_regions(std::slice::from_ref(&r), 12, &l, select).unwrap();
+        let got = read_regions(std::slice::from_ref(&r), 12, &l, select)
+            .unwrap()
+            .to_f32_vec();
         assert_eq!(got, [1.0, 4.0, 7.0, 10.0]);
         let select = FrameSelect {
             stride: 6,
             count: 2,
             index: 1,
         };
-        let got = read_regions(&[r.clone(), r], 12, &l, select).unwrap();
+        let got = read_regions(&[r.clone(), r], 12, &l, select)
+            .unwrap()
+            .to_f32_vec();
         assert_eq!(
             got,
             [
@@ -813,7 +842,9 @@ mod tests {
         let gz = gz.finish().unwrap();
         let r = region_of(dir.path(), "g", &gz);
         let mut l = layout(DType::U8, Encoding::Gzip);
-        let got = read_regions(std::slice::from_ref(&r), 100, &l, FrameSelect::ALL).unwrap();
+        let got = read_regions(std::slice::from_ref(&r), 100, &l, FrameSelect::ALL)
+            .unwrap()
+            .to_f32_vec();
         assert_eq!(got, (0..100).map(|v| v as f32).collect::<Vec<_>>());
         let err = read_regions(std::slice::from_ref(&r), 101, &l, FrameSelect::ALL).unwrap_err();
         assert!(
@@ -827,7 +858,9 @@ mod tests {
             "{err}"
         );
         l.inflated_skip = 10;
-        let got = read_regions(std::slice::from_ref(&r), 90, &l, FrameSelect::ALL).unwrap();
+        let got = read_regions(std::slice::from_ref(&r), 90, &l, FrameSelect::ALL)
+            .unwrap()
+            .to_f32_vec();
         assert_eq!(got[0], 10.0);
 
         // zlib, and gzip found by its magic where zlib is declared.
@@ -837,11 +870,15 @@ mod tests {
         let rz = region_of(dir.path(), "z", &z);
         let lz = layout(DType::U8, Encoding::Zlib);
         assert_eq!(
-            read_regions(&[rz], 100, &lz, FrameSelect::ALL).unwrap()[99],
+            read_regions(&[rz], 100, &lz, FrameSelect::ALL)
+                .unwrap()
+                .to_f32_vec()[99],
             99.0
         );
         assert_eq!(
-            read_regions(std::slice::from_ref(&r), 100, &lz, FrameSelect::ALL).unwrap()[99],
+            read_regions(std::slice::from_ref(&r), 100, &lz, FrameSelect::ALL)
+                .unwrap()
+                .to_f32_vec()[99],
             99.0
         );
 
@@ -869,7 +906,9 @@ mod tests {
         let r = region_of(dir.path(), "t", b" 1, 2.5\n-3e2\t4 trailing words");
         let l = layout(DType::F32, Encoding::Text);
         assert_eq!(
-            read_regions(std::slice::from_ref(&r), 4, &l, FrameSelect::ALL).unwrap(),
+            read_regions(std::slice::from_ref(&r), 4, &l, FrameSelect::ALL)
+                .unwrap()
+                .to_f32_vec(),
             [1.0, 2.5, -300.0, 4.0]
         );
         let err = read_regions(std::slice::from_ref(&r), 5, &l, FrameSelect::ALL).unwrap_err();
@@ -894,7 +933,9 @@ mod tests {
         let mut lh = layout(DType::I16, Encoding::Hex);
         lh.endian = Endian::Big;
         assert_eq!(
-            read_regions(&[h], 3, &lh, FrameSelect::ALL).unwrap(),
+            read_regions(&[h], 3, &lh, FrameSelect::ALL)
+                .unwrap()
+                .to_f32_vec(),
             [256.0, -129.0, 128.0]
         );
         let bad = region_of(dir.path(), "b", b"01zz");

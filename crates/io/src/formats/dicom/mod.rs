@@ -44,14 +44,16 @@ use std::fs;
 use std::path::Path;
 
 use volray_core::glam::DVec3;
+use volray_core::{Sample, Samples};
 
 use self::header::{FileHeader, HeaderError, ImageFormat, Plane, read_all, read_header};
-use self::pixels::{decode, frame_values, transfer_syntax_name};
+use self::pixels::{decode, frame_values, kept_type, transfer_syntax_name};
 use self::prescan::{Prescan, prescan};
 use self::stack::{Stack, stack, volumes};
+use crate::dtype::read_as_stored;
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::limits::{F32_BYTES, check_volume_size};
+use crate::shared::limits::check_volume_size;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// A directory with more entries than this is refused before any is read
@@ -142,17 +144,21 @@ fn read_multiframe(
             format.columns as u64,
             header.frames as u64,
         ],
-        2 * stored as u64 + F32_BYTES,
+        2 * stored as u64 + kept_type(&format, &planes).bytes() as u64,
         max_memory,
     )?;
     let bytes = read_all(path)?;
     let obj = parse_whole(path, &bytes)?;
     drop(bytes);
     let decoded = decode(path, &obj, &format, header.frames)?;
-    let mut data = allocate(path, &format, grid.order.len(), max_memory)?;
-    for &k in &grid.order {
-        frame_values(&decoded, frames[k], &format, &planes[k], &mut data);
-    }
+    let data = read_as_stored!(kept_type(&format, &planes), |T| {
+        allocate::<T>(path, &format, grid.order.len(), max_memory).map(|mut data| {
+            for &k in &grid.order {
+                frame_values(&decoded, frames[k], &format, &planes[k], &mut data);
+            }
+            data
+        })
+    })?;
     finish(path, &header, &format, grid, data, info)
 }
 
@@ -178,12 +184,13 @@ fn read_single_slice(
         origin: plane.position.unwrap_or(DVec3::ZERO),
         notes: Vec::new(),
     };
-    let mut data = allocate(path, &format, 1, max_memory)?;
+    let mut data: Vec<f32> = allocate(path, &format, 1, max_memory)?;
     let bytes = read_all(path)?;
     let obj = parse_whole(path, &bytes)?;
     drop(bytes);
     let decoded = decode(path, &obj, &format, 1)?;
     frame_values(&decoded, 0, &format, &plane, &mut data);
+    let data = Samples::from(data);
     match finish(path, &header, &format, grid, data, info) {
         Err(IoError::FlatImage { path, mut image }) => {
             let dir = path
@@ -380,15 +387,18 @@ fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             (e, _) => e,
         })?;
 
-    let mut data = allocate(dir, &format, files.len(), opts.max_memory)?;
-    for &k in &grid.order {
-        let h = &files[k];
-        let bytes = read_all(&h.path)?;
-        let obj = parse_whole(&h.path, &bytes)?;
-        drop(bytes);
-        let decoded = decode(&h.path, &obj, &format, 1)?;
-        frame_values(&decoded, 0, &format, &planes[k], &mut data);
-    }
+    let data = read_as_stored!(kept_type(&format, &planes), |T| {
+        let mut data = allocate::<T>(dir, &format, files.len(), opts.max_memory)?;
+        for &k in &grid.order {
+            let h = &files[k];
+            let bytes = read_all(&h.path)?;
+            let obj = parse_whole(&h.path, &bytes)?;
+            drop(bytes);
+            let decoded = decode(&h.path, &obj, &format, 1)?;
+            frame_values(&decoded, 0, &format, &planes[k], &mut data);
+        }
+        Ok::<_, IoError>(data)
+    })?;
     let header = &files[grid.order[0]];
     finish(dir, header, &format, grid, data, info)
 }
@@ -433,7 +443,7 @@ fn finish(
     header: &FileHeader,
     format: &ImageFormat,
     grid: Stack,
-    data: Vec<f32>,
+    data: Samples,
     mut info: FileInfo,
 ) -> Result<Loaded, IoError> {
     info.stored_type = format!(
@@ -522,19 +532,19 @@ fn check_pixel_data(header: &FileHeader, format: &ImageFormat) -> Result<(), IoE
     }
 }
 
-/// The output buffer for `slices` slices of `format`, refused if it would
-/// take more than `max_memory`.
-fn allocate(
+/// The output buffer for `slices` slices of `format` as `T`, refused if it
+/// would take more than `max_memory`.
+fn allocate<T: Sample>(
     path: &Path,
     format: &ImageFormat,
     slices: usize,
     max_memory: u64,
-) -> Result<Vec<f32>, IoError> {
+) -> Result<Vec<T>, IoError> {
     let n = check_volume_size(
         path,
         "Columns x Rows x slices",
         &[format.columns as u64, format.rows as u64, slices as u64],
-        F32_BYTES,
+        T::TYPE.bytes() as u64,
         max_memory,
     )?;
     let mut data = Vec::new();

@@ -1,7 +1,9 @@
 //! Decoding a DICOM file's pixel data (through `dicom-pixeldata`) and
-//! turning each frame into `f32` values: bits outside BitsStored masked
-//! off, sign extended for PixelRepresentation 1, then the modality
-//! rescale `value = slope·stored + intercept` (PS3.3 C.11.1.1.2).
+//! turning each frame into values: bits outside BitsStored masked off,
+//! sign extended for PixelRepresentation 1, then the modality rescale
+//! `value = slope·stored + intercept` (PS3.3 C.11.1.1.2), kept in the
+//! integer type [`kept_type`] finds when every value fits it exactly (a CT
+//! series in `i16`), as `f32` otherwise.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
@@ -10,8 +12,12 @@ use dicom_dictionary_std::tags;
 use dicom_object::DefaultDicomObject;
 use dicom_pixeldata::PixelDecoder;
 
+use volray_core::SampleType;
+
 use super::header::{ImageFormat, Plane};
+use crate::dtype::Stored;
 use crate::error::IoError;
+use crate::shared::rescale::{integer_type, rescaled_range};
 
 /// The decoded frames of one file.
 pub(super) enum Frames {
@@ -111,18 +117,45 @@ fn short(path: &Path, have: usize, want: usize, format: &ImageFormat, frames: us
     )
 }
 
+/// The type the volume keeps: the narrowest integer type that holds every
+/// value BitsStored and PixelRepresentation allow, rescaled by any of
+/// `planes`, where slopes and intercepts are integers; `f32` otherwise
+/// (and for float pixel data).
+pub(super) fn kept_type(format: &ImageFormat, planes: &[Plane]) -> SampleType {
+    if format.float.is_some() || format.bits_stored == 0 || format.bits_stored > 32 {
+        return SampleType::F32;
+    }
+    let bits = i32::from(format.bits_stored);
+    let (lo, hi) = if format.signed {
+        (-(2f64.powi(bits - 1)), 2f64.powi(bits - 1) - 1.0)
+    } else {
+        (0.0, 2f64.powi(bits) - 1.0)
+    };
+    let mut range: Option<(f64, f64)> = None;
+    for plane in planes {
+        let Some((a, b)) = rescaled_range(lo, hi, plane.slope, plane.intercept) else {
+            return SampleType::F32;
+        };
+        range = Some(range.map_or((a, b), |(l, h)| (l.min(a), h.max(b))));
+    }
+    range
+        .and_then(|(l, h)| integer_type(l, h))
+        .unwrap_or(SampleType::F32)
+}
+
 /// Writes frame `frame` of `frames`, rescaled by `plane`, into `out`
-/// (`rows·columns` values).
-pub(super) fn frame_values(
+/// (`rows·columns` values), as `T`: [`kept_type`]'s type for these planes.
+pub(super) fn frame_values<T: Stored>(
     frames: &Frames,
     frame: usize,
     format: &ImageFormat,
     plane: &Plane,
-    out: &mut Vec<f32>,
+    out: &mut Vec<T>,
 ) {
     let n = format.rows * format.columns;
     let (slope, intercept) = (plane.slope, plane.intercept);
-    let rescale = |v: f64| (slope * v + intercept) as f32;
+    // Exact in an integer T (kept_type checked the range); one rounding to f32.
+    let rescale = |v: f64| T::from_f64(slope * v + intercept);
     match frames {
         Frames::Float32(v) => out.extend(
             v[frame * n..(frame + 1) * n]
@@ -229,6 +262,37 @@ mod tests {
     }
 
     #[test]
+    fn ct_values_are_kept_in_the_narrowest_integer_type() {
+        let plane = |slope: f64, intercept: f64| Plane {
+            position: None,
+            orientation: None,
+            pixel_spacing: None,
+            slope,
+            intercept,
+        };
+        let ct = format(16, 12, 11, false);
+        assert_eq!(kept_type(&ct, &[plane(1.0, -1024.0)]), SampleType::I16);
+        assert_eq!(kept_type(&ct, &[plane(1.0, 0.0)]), SampleType::U16);
+        assert_eq!(
+            kept_type(&ct, &[plane(1.0, 0.0), plane(1.0, -1024.0)]),
+            SampleType::I16
+        );
+        assert_eq!(kept_type(&ct, &[plane(0.5, -1024.0)]), SampleType::F32);
+        assert_eq!(
+            kept_type(&format(8, 8, 7, false), &[plane(1.0, 0.0)]),
+            SampleType::U8
+        );
+        assert_eq!(
+            kept_type(&format(16, 16, 15, false), &[plane(1.0, -1.0)]),
+            SampleType::F32
+        );
+        assert_eq!(
+            kept_type(&format(32, 32, 31, true), &[plane(1.0, 0.0)]),
+            SampleType::F32
+        );
+    }
+
+    #[test]
     fn frames_are_rescaled() {
         let f = format(16, 16, 15, true);
         let raw: Vec<u8> = [-3i16, 5, 7, -1]
@@ -242,9 +306,14 @@ mod tests {
             slope: 2.0,
             intercept: -1024.0,
         };
-        let mut out = Vec::new();
-        frame_values(&Frames::Int(raw), 1, &f, &plane, &mut out);
+        let mut out: Vec<f32> = Vec::new();
+        frame_values(&Frames::Int(raw.clone()), 1, &f, &plane, &mut out);
         assert_eq!(out, [2.0 * 7.0 - 1024.0, -2.0 - 1024.0]);
+        // 16 bits signed, times 2, minus 1024, need more than 16 bits.
+        assert_eq!(kept_type(&f, std::slice::from_ref(&plane)), SampleType::F32);
+        let mut ints: Vec<i16> = Vec::new();
+        frame_values(&Frames::Int(raw), 1, &f, &plane, &mut ints);
+        assert_eq!(ints, [2 * 7 - 1024, -2 - 1024]);
         assert_eq!(
             transfer_syntax_name("1.2.840.10008.1.2.4.90"),
             "JPEG 2000 Lossless, 1.2.840.10008.1.2.4.90"

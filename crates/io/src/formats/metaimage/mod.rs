@@ -27,7 +27,7 @@ use crate::dtype::{DType, Endian};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
-use crate::shared::limits::{F32_BYTES, check_frame_dims};
+use crate::shared::limits::check_frame_dims;
 use crate::shared::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
 use crate::shared::text_header::Field;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -243,7 +243,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         "MetaImage field DimSize =",
         &dims,
         frames,
-        F32_BYTES,
+        layout.stored().bytes() as u64,
         opts.max_memory,
     )?;
     let data = payload::read_regions(&regions, per_file, &layout, select)?;

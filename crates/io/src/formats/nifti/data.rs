@@ -201,10 +201,11 @@ pub(super) fn too_big(path: &Path, header: &Header) -> IoError {
     )
 }
 
-/// Applies `scl_slope`/`scl_inter` (nifti1.h: `y = scl_slope · x + scl_inter`
-/// unless `scl_slope` is 0; nibabel also treats a NaN or infinite slope as
-/// "no scaling").
-pub(super) fn apply_scaling(header: &Header, data: &mut [f32], info: &mut FileInfo) {
+/// The `scl_slope`/`scl_inter` to apply (nifti1.h: `y = scl_slope · x +
+/// scl_inter` unless `scl_slope` is 0; nibabel also treats a NaN or
+/// infinite slope as "no scaling"), `None` for none, with notes on what
+/// was ignored or applied.
+pub(super) fn scaling(header: &Header, info: &mut FileInfo) -> Option<(f64, f64)> {
     let (slope, inter) = (header.scl_slope, header.scl_inter);
     if slope == 0.0 || !slope.is_finite() {
         if slope != 0.0 || (inter != 0.0 && !inter.is_nan()) {
@@ -212,7 +213,7 @@ pub(super) fn apply_scaling(header: &Header, data: &mut [f32], info: &mut FileIn
                 "scl_slope {slope} means no scaling; scl_inter {inter} ignored"
             ));
         }
-        return;
+        return None;
     }
     let inter = if inter.is_finite() {
         inter
@@ -222,14 +223,12 @@ pub(super) fn apply_scaling(header: &Header, data: &mut [f32], info: &mut FileIn
         0.0
     };
     if slope == 1.0 && inter == 0.0 {
-        return;
-    }
-    for v in data.iter_mut() {
-        *v = (f64::from(*v) * slope + inter) as f32;
+        return None;
     }
     info.notes.push(format!(
         "values scaled: value = {slope} * stored + {inter} (scl_slope, scl_inter)"
     ));
+    Some((slope, inter))
 }
 
 #[cfg(test)]

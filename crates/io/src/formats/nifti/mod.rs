@@ -29,15 +29,16 @@ mod source;
 
 use std::path::Path;
 
-use self::data::{Layout, apply_scaling, dim_text, too_big};
+use self::data::{Layout, dim_text, scaling, too_big};
 use self::geometry::{geometry, length_unit};
 use self::header::{detect_version, parse_header};
 use self::source::{Source, image_path};
-use crate::dtype::extend_f32;
+use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::compress::MAX_DEFLATE_RATIO;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::limits::{F32_BYTES, check_frame_dims};
+use crate::shared::rescale::rescale;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// Samples decoded per read: bounds the scratch buffer beside the output.
@@ -181,32 +182,43 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     if layout.frames > 1 {
         dims.push(layout.frames);
     }
+    // Kept in the file's type; scaled values are built beside them (as f32
+    // at most), unless the scaling keeps an integer type.
+    let scale = scaling(&header, &mut info);
+    let stored = layout.dtype.stored();
+    let held = stored.bytes() as u64 + if scale.is_some() { F32_BYTES } else { 0 };
     check_frame_dims(
         path,
         "NIfTI field \"dim\"",
         &dims,
         layout.frames,
-        F32_BYTES,
+        held,
         opts.max_memory,
     )?;
     let count = layout.count;
     let size = layout.dtype.size();
-    let mut data = Vec::with_capacity(if data_source.is_gzip() {
-        count.min(CHUNK_SAMPLES)
-    } else {
-        count
-    });
-    let mut chunk = vec![0u8; count.min(CHUNK_SAMPLES) * size];
-    let mut done = 0;
-    while done < count {
-        let n = (count - done).min(CHUNK_SAMPLES);
-        let at = frame_start + (done * size) as u64;
-        data_source.fill(&data_path, &mut chunk[..n * size], at, needed)?;
-        extend_f32(&mut data, &chunk[..n * size], layout.dtype, endian);
-        done += n;
-    }
-
-    apply_scaling(&header, &mut data, &mut info);
+    let data = read_as_stored!(stored, |T| {
+        let mut data: Vec<T> = Vec::with_capacity(if data_source.is_gzip() {
+            count.min(CHUNK_SAMPLES)
+        } else {
+            count
+        });
+        let mut chunk = vec![0u8; count.min(CHUNK_SAMPLES) * size];
+        let mut done = 0;
+        let mut result = Ok(());
+        while done < count && result.is_ok() {
+            let n = (count - done).min(CHUNK_SAMPLES);
+            let at = frame_start + (done * size) as u64;
+            result = data_source.fill(&data_path, &mut chunk[..n * size], at, needed);
+            T::extend(&mut data, &chunk[..n * size], layout.dtype, endian);
+            done += n;
+        }
+        result.map(|()| data)
+    })?;
+    let data = match scale {
+        Some((slope, inter)) => rescale(data, slope, inter),
+        None => data,
+    };
     let (steps, origin) = geometry(path, &header, &mut info)?;
     let volume = grid_to_volume(path, layout.dims, data, steps, origin, &mut info)?;
     Ok(Loaded {

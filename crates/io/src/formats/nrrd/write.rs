@@ -56,11 +56,11 @@ pub fn write_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
     write_atomically(path, |w| {
         w.write_all(header.as_bytes())?;
         let mut bytes = Vec::with_capacity(CHUNK * 4);
-        for chunk in volume.values().chunks(CHUNK) {
+        volume.samples().try_for_each_f32_chunk(CHUNK, |chunk| {
             bytes.clear();
             bytes.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
-            w.write_all(&bytes)?;
-        }
+            w.write_all(&bytes)
+        })?;
         Ok(())
     })
 }
