@@ -2,7 +2,7 @@
 """Write a CT-like head phantom as raw 16-bit samples, for the large-volume
 benchmarks (docs/performance.md). Never committed: 1024^3 is 2 GiB.
 
-    python3 scripts/make_ct_phantom.py SIZE OUT.raw [--dtype i16|u16] [--nz NZ]
+    python3 scripts/make_ct_phantom.py SIZE OUT.raw [--dtype i16|u16] [--nz NZ] [--sidecar]
 
 Values are Hounsfield units (air -1000, soft tissue 20-60, bone 700-1500),
 stored as little-endian int16 (`--dtype i16`, the default) or as uint16
@@ -14,6 +14,11 @@ denser outer table, the brain (grey and white matter), the ventricles, a
 few lesions, the eyes and a jaw bone, plus noise of 8 HU, so that most
 8^3 bricks inside the head hold tissue a CT preset shows.
 
+With --sidecar it also writes OUT.json (dims, dtype, min, max) beside
+OUT.raw, in the peer benchmark's format, so that `volray bench --peers
+DIR --cases NAME:W` and `scripts/vtk_typed_bench.py DIR NAME:W` time
+the same workload on it.
+
 Render it with, for example:
 
     volray render OUT.raw --dims SIZE,SIZE,NZ --dtype i16 --preset ct-bone -o head.png
@@ -22,6 +27,7 @@ Needs numpy. Writes slab by slab (a few hundred MiB of memory at 1024^3).
 """
 
 import argparse
+import json
 import sys
 
 import numpy as np
@@ -69,10 +75,12 @@ def main():
     p.add_argument("--dtype", choices=["i16", "u16"], default="i16")
     p.add_argument("--nz", type=int, default=None)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--sidecar", action="store_true", help="also write OUT.json")
     args = p.parse_args()
     n, nz = args.size, args.nz or args.size
     rng = np.random.default_rng(args.seed)
     step = max(1, (256 << 20) // (n * n * 4 * 8))
+    lo, hi = np.inf, -np.inf
     with open(args.out, "wb") as f:
         for z0 in range(0, nz, step):
             z1 = min(nz, z0 + step)
@@ -82,8 +90,22 @@ def main():
             else:
                 out = np.clip(hu, -32768, 32767).astype("<i2")
             f.write(out.tobytes())
+            lo, hi = min(lo, float(out.min())), max(hi, float(out.max()))
             print(f"\r{z1}/{nz} planes", end="", file=sys.stderr, flush=True)
     print(file=sys.stderr)
+    if args.sidecar:
+        side = {
+            "dims": [n, n, nz],
+            "dtype": "uint16" if args.dtype == "u16" else "int16",
+            "byte_order": "little",
+            "min": lo,
+            "max": hi,
+            "spacing": [1.0, 1.0, 1.0],
+            "origin": [0.0, 0.0, 0.0],
+            "generator": f"scripts/make_ct_phantom.py {n} --nz {nz} --dtype {args.dtype} --seed {args.seed}",
+        }
+        with open(args.out.rsplit(".", 1)[0] + ".json", "w") as f:
+            json.dump(side, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,10 @@
 //! The workload, from the peers' README:
 //! - volumes: `DIR/<name>.raw`, float32 little-endian, x fastest, with a
 //!   JSON sidecar `DIR/<name>.json` giving `dims`, `min`, `max` (and
-//!   `spacing`, `origin`);
+//!   `spacing`, `origin`); volray also reads a `dtype` of `int16`,
+//!   `uint16`, `int8` or `uint8` there, kept in that type (the large-volume
+//!   benchmark's CT phantom, `scripts/make_ct_phantom.py --sidecar`, timed
+//!   against VTK by `scripts/vtk_typed_bench.py`);
 //! - view: orthographic along +x through the volume's centre, +z up (so
 //!   screen right is −y), the window fitting the y-z extent exactly;
 //! - sampling: 0.5 voxel, trilinear, front-to-back compositing;
@@ -53,6 +56,7 @@ const COLOR: [(f32, [f32; 3]); 3] = [
 /// What a sidecar says about its volume.
 struct Sidecar {
     dims: [usize; 3],
+    dtype: DType,
     min: f64,
     max: f64,
     spacing: [f64; 3],
@@ -70,7 +74,7 @@ fn load(dir: &Path, name: &str) -> Result<(Volume, Sidecar), CliError> {
     })?;
     let side =
         parse_sidecar(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-    let mut raw = RawOptions::new(side.dims, DType::F32);
+    let mut raw = RawOptions::new(side.dims, side.dtype);
     raw.endian = Endian::Little;
     raw.spacing = DVec3::from(side.spacing);
     let raw_path = dir.join(format!("{name}.raw"));
@@ -103,13 +107,25 @@ fn parse_sidecar(text: &str) -> Result<Sidecar, String> {
                 .ok_or(format!("\"{key}\" is not three numbers")),
         }
     };
-    for (key, want) in [("dtype", "float32"), ("byte_order", "little")] {
-        if let Some(v) = json.get(key)
-            && v.as_str() != Some(want)
-        {
-            return Err(format!("\"{key}\" is {v}, expected \"{want}\""));
-        }
+    if let Some(v) = json.get("byte_order")
+        && v.as_str() != Some("little")
+    {
+        return Err(format!("\"byte_order\" is {v}, expected \"little\""));
     }
+    // NumPy's names.
+    let dtype = match json.get("dtype").map(|v| v.as_str()) {
+        None | Some(Some("float32")) => DType::F32,
+        Some(Some("int16")) => DType::I16,
+        Some(Some("uint16")) => DType::U16,
+        Some(Some("int8")) => DType::I8,
+        Some(Some("uint8")) => DType::U8,
+        Some(_) => {
+            return Err(format!(
+                "\"dtype\" is {}, expected \"float32\", \"int16\", \"uint16\", \"int8\" or \"uint8\"",
+                json["dtype"]
+            ));
+        }
+    };
     let dims = triple("dims", [0.0; 3])?;
     if dims
         .iter()
@@ -125,6 +141,7 @@ fn parse_sidecar(text: &str) -> Result<Sidecar, String> {
     }
     Ok(Sidecar {
         dims: dims.map(|d| d as usize),
+        dtype,
         min,
         max,
         spacing: triple("spacing", [1.0; 3])?,
@@ -344,7 +361,11 @@ mod tests {
         )
         .unwrap();
         assert_eq!(ok.dims, [50, 50, 50]);
+        assert_eq!(ok.dtype, DType::F32);
         assert_eq!((ok.min, ok.max), (0.5, 2.0));
+        let ct =
+            parse_sidecar(r#"{"dims": [8, 8, 8], "dtype": "int16", "min": -1000, "max": 1500}"#);
+        assert_eq!(ct.unwrap().dtype, DType::I16);
         assert_eq!(ok.spacing, [1.0, 1.0, 2.0]);
         assert_eq!(ok.origin, [0.0; 3]);
         for (text, want) in [
@@ -353,8 +374,12 @@ mod tests {
             (r#"{"dims": [5, 5, 5], "min": 1, "max": 1}"#, "below"),
             (r#"{"dims": [5, 5, 5], "max": 1}"#, "no \"min\""),
             (
-                r#"{"dims": [5, 5, 5], "min": 0, "max": 1, "dtype": "uint8"}"#,
+                r#"{"dims": [5, 5, 5], "min": 0, "max": 1, "dtype": "float64"}"#,
                 "float32",
+            ),
+            (
+                r#"{"dims": [5, 5, 5], "min": 0, "max": 1, "byte_order": "big"}"#,
+                "little",
             ),
             ("[1,", "not JSON"),
         ] {
