@@ -39,6 +39,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             "format": format,
             "dims": [nx, ny, nz],
             "sample_type": v.sample_type().name(),
+            "mapped": v.samples().is_external(),
             "spacing": [s.x, s.y, s.z],
             "origin": [o.x, o.y, o.z],
             "length_unit": unit,
@@ -63,7 +64,12 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     outln!("dims:      {nx} x {ny} x {nz} ({} points)", v.len());
     let kept = v.sample_type();
     outln!(
-        "in memory: {} ({} a voxel, {})",
+        "in memory: {}{} ({} a voxel, {})",
+        if v.samples().is_external() {
+            "mapped from the file, "
+        } else {
+            ""
+        },
         kept.name(),
         match kept.bytes() {
             1 => "1 byte".to_string(),

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use volray_core::glam::DVec3;
 use volray_core::{NonFinite, Volume};
 use volray_io::{
-    DType, Endian, FileInfo, FlatImage, IoError, RawOptions, ReadOptions, VolumeFormat,
+    DType, Endian, FileInfo, FlatImage, IoError, MapPolicy, RawOptions, ReadOptions, VolumeFormat,
 };
 
 /// What `volray render` shows when given no input.
@@ -113,6 +113,9 @@ pub fn describe(args: &InputArgs) -> Result<Described, CliError> {
             frame: args.frame,
             array: args.array.clone(),
             max_memory,
+            // A volume over --max-memory is mapped from its file where its
+            // format allows (volray-io's MapPolicy), refused otherwise.
+            map: MapPolicy::IfLarger,
         };
         let loaded = match volray_io::read(&path, &opts) {
             Ok(loaded) => loaded,

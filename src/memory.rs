@@ -6,7 +6,9 @@
 //! occupied: a sparse one needs less), the caches of classified and lit
 //! bricks up to their budget, the frame, and a cleaned copy with
 //! `--nonfinite transparent`. Beside it the CLI counts what it adds: a
-//! 16-bit PNG's quantised pixels.
+//! 16-bit PNG's quantised pixels. A volume mapped from its file (one over
+//! the limit, see volray-io's `MapPolicy`) does not count: its pages are
+//! the file's, read and dropped by the operating system.
 
 use crate::error::CliError;
 use crate::flags::ViewArgs;
@@ -45,7 +47,14 @@ pub fn cache_budget(
     let limit = u128::from(input.max_memory);
     let grid = (volume.dims(), volume.spacing(), volume.sample_type());
     let mode = input.non_finite(view.sampling.nonfinite.into());
-    let need = render_bytes(grid, settings, mode, 0);
+    // A volume mapped from its file is the page cache's, not ours: only
+    // what the renderer adds counts.
+    let mapped = if volume.samples().is_external() {
+        (volume.len() * volume.sample_type().bytes()) as u128
+    } else {
+        0
+    };
+    let need = render_bytes(grid, settings, mode, 0) - mapped;
     if need > limit {
         let [nx, ny, nz] = volume.dims();
         let what = format!(
@@ -57,7 +66,7 @@ pub fn cache_budget(
             method: Method::Fast,
             ..settings.clone()
         };
-        let fast_need = render_bytes(grid, &fast, mode, 0);
+        let fast_need = render_bytes(grid, &fast, mode, 0) - mapped;
         if settings.method == Method::Reference && fast_need <= limit {
             return Err(CliError::input(format!(
                 "{what} on the reference path (--reference) may take up to {}, more than --max-memory {}; the default path takes at most {}: leave out --reference",

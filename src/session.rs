@@ -64,6 +64,10 @@ pub fn renderer_for<'v>(
 /// A failure to render `name` as one line, naming the flag whose value
 /// caused it: the core's errors say which setting, by variant.
 pub fn render_failure(view: &ViewArgs, name: &str, e: RenderError) -> CliError {
+    if let RenderError::SamplesChanged(_) = e {
+        // The file, not the flags: an I/O failure.
+        return CliError::io(format!("{name}: {e}"));
+    }
     match flag_of(view, &e) {
         Some(flag) => CliError::input(format!("{name}: {flag}: {e}")),
         None => CliError::input(format!("{name}: {e}")),
@@ -75,6 +79,7 @@ fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<&'static str> {
     use volray_core::{CameraPoint, Orbit, Reflection, SettingError as S};
     let flag = match e {
         RenderError::NonFinite { .. } => "--nonfinite",
+        RenderError::SamplesChanged(_) => return None,
         RenderError::Camera(c) => match c {
             CameraError::NoDirection(_) if view.camera.view.is_some() => "--view",
             CameraError::NoDirection(_) => "--look-at",

@@ -22,6 +22,10 @@ pub enum RenderError {
     /// The camera cannot frame a picture.
     #[error(transparent)]
     Camera(#[from] CameraError),
+    /// The volume's samples, in bytes owned elsewhere (a mapped file),
+    /// changed while they were read: the frame is not the file's.
+    #[error("the volume changed while it was rendered: {0}")]
+    SamplesChanged(String),
 }
 
 /// A render setting out of its range: which one, its value and the bound.

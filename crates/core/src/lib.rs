@@ -112,4 +112,7 @@ pub use settings::{
 };
 pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;
-pub use volume::{Sample, SampleType, Samples, Volume, VolumeError, checked_point_count};
+pub use volume::{
+    External, ExternalBytes, ExternalError, Sample, SampleType, Samples, Store, Volume,
+    VolumeError, checked_point_count,
+};

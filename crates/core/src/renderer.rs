@@ -77,6 +77,16 @@ pub struct Renderer<'v> {
     cache_budget: usize,
 }
 
+/// Whether `volume`'s samples were what they are meant to be while they
+/// were read: a mapped file truncated or rewritten meanwhile is an error,
+/// not a picture of whatever the pages held.
+fn verify(volume: &Volume) -> Result<(), RenderError> {
+    volume
+        .samples()
+        .verify()
+        .map_err(RenderError::SamplesChanged)
+}
+
 /// The default budget of the bricked fast path's caches of classified and
 /// lit bricks: 1 GiB, which holds every brick of the peers' volumes (257³:
 /// 100 MiB) and keeps a 1024³ CT's frames within a few GiB.
@@ -143,12 +153,15 @@ impl<'v> Renderer<'v> {
                 total: volume.len(),
             });
         }
+        let source = volume;
         let (volume, non_finite) = match NonFiniteMask::clean(volume) {
             None => (Cow::Borrowed(volume), None),
             Some((mask, cleaned)) => (Cow::Owned(cleaned), Some(mask)),
         };
         // Finite values only; none at all: an empty window at the fill value.
         let value_range = volume.value_range().unwrap_or((0.0, 0.0));
+        // Every sample was read above: were they the file's, if mapped?
+        verify(source)?;
         Ok(Renderer {
             volume,
             non_finite,
@@ -222,14 +235,16 @@ impl<'v> Renderer<'v> {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<PartialImage, RenderError> {
         let frame = self.prepare(settings)?;
-        Ok(match settings.method {
+        let partial = match settings.method {
             Method::Fast => {
                 let mut partial = self.blank(settings, Vec::new());
                 self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
                 partial
             }
             Method::Reference => self.render_reference(settings, &frame, progress),
-        })
+        };
+        verify(&self.volume)?;
+        Ok(partial)
     }
 
     /// The finished frame of `partial` (rendered with `settings`): over the
@@ -256,6 +271,18 @@ impl<'v> Renderer<'v> {
     /// its last step ([`Finish::Over`]), with no second pass over the
     /// pixels; the others are finished from their partial image.
     fn render_frame(
+        &self,
+        settings: &RenderSettings,
+        image: &mut Image,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<FrameTimes, RenderError> {
+        let times = self.render_frame_unverified(settings, image, progress)?;
+        verify(&self.volume)?;
+        Ok(times)
+    }
+
+    /// [`Self::render_frame`] before the samples it read are verified.
+    fn render_frame_unverified(
         &self,
         settings: &RenderSettings,
         image: &mut Image,

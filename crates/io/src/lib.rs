@@ -124,3 +124,4 @@ pub use shared::limits::{
     FALLBACK_MAX_MEMORY, check_memory, check_volume_size, count_values, default_max_memory,
     format_bytes, parse_size,
 };
+pub use shared::mapped::{MapPolicy, MappedFile};

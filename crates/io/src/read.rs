@@ -12,7 +12,7 @@ use volray_core::Volume;
 use crate::formats::VolumeFormat;
 use crate::shared::input::open_input;
 use crate::shared::limits::default_max_memory;
-use crate::{IoError, RawOptions};
+use crate::{IoError, MapPolicy, RawOptions};
 
 /// How to read a file: everything a reader may need beyond the path.
 #[derive(Debug, Clone)]
@@ -38,6 +38,11 @@ pub struct ReadOptions {
     /// [`check_volume_size`](crate::check_volume_size)).
     /// Default: [`default_max_memory`], half the physical memory.
     pub max_memory: u64,
+    /// When a volume is mapped from its file rather than read into memory:
+    /// by default, when it exceeds `max_memory` and its format stores it
+    /// uncompressed, contiguous and in a type and byte order it keeps (see
+    /// [`MapPolicy`]).
+    pub map: MapPolicy,
 }
 
 impl Default for ReadOptions {
@@ -48,6 +53,7 @@ impl Default for ReadOptions {
             frame: None,
             array: None,
             max_memory: default_max_memory(),
+            map: MapPolicy::IfLarger,
         }
     }
 }

@@ -9,8 +9,10 @@
 //! decades on a log scale.
 
 mod samples;
+mod store;
 
 pub use samples::{Sample, SampleType, Samples};
+pub use store::{External, ExternalBytes, ExternalError, Store};
 
 use glam::DVec3;
 use std::borrow::Cow;
@@ -57,7 +59,7 @@ impl Volume {
     /// `data` holds `nx·ny·nz` values, x fastest. Every axis needs at least
     /// two points: a volume with no extent along an axis cannot be ray cast.
     pub fn new(dims: [usize; 3], data: Vec<f32>) -> Result<Self, VolumeError> {
-        Self::from_samples(dims, Samples::F32(data))
+        Self::from_samples(dims, data)
     }
 
     /// [`Volume::new`] with samples of any [`SampleType`], kept in it.
@@ -163,7 +165,7 @@ impl Volume {
 
     /// The same volume with its samples converted to `f32`.
     pub fn to_f32(&self) -> Volume {
-        self.with_samples(Samples::F32(self.values().into_owned()))
+        self.with_samples(Samples::from(self.values().into_owned()))
     }
 
     /// Number of voxels.
@@ -261,8 +263,8 @@ impl Volume {
         let data = values
             .iter()
             .map(|&v| if v <= 0.0 { floor } else { log(v) })
-            .collect();
-        Ok(self.with_samples(Samples::F32(data)))
+            .collect::<Vec<f32>>();
+        Ok(self.with_samples(Samples::from(data)))
     }
 
     /// This volume's grid with other samples (as many, x fastest).

@@ -42,6 +42,8 @@ impl SampleType {
     }
 }
 
+use super::store::Store;
+
 mod sealed {
     pub trait Sealed {}
     impl Sealed for u8 {}
@@ -53,7 +55,9 @@ mod sealed {
 
 /// A sample type a volume can hold: read as the `f32` it converts to
 /// exactly.
-pub trait Sample: Copy + Send + Sync + PartialOrd + Default + 'static + sealed::Sealed {
+pub trait Sample:
+    bytemuck::Pod + Send + Sync + PartialOrd + Default + 'static + sealed::Sealed
+{
     const TYPE: SampleType;
 
     /// The sample's value (exact for every type here).
@@ -110,14 +114,15 @@ impl Sample for f32 {
     }
 }
 
-/// A volume's samples, x fastest, in their stored type.
+/// A volume's samples, x fastest, in their stored type, in memory or in
+/// bytes owned elsewhere ([`Store`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Samples {
-    U8(Vec<u8>),
-    I8(Vec<i8>),
-    U16(Vec<u16>),
-    I16(Vec<i16>),
-    F32(Vec<f32>),
+    U8(Store<u8>),
+    I8(Store<i8>),
+    U16(Store<u16>),
+    I16(Store<i16>),
+    F32(Store<f32>),
 }
 
 /// Runs `$body` with `$data` bound to the samples of `$samples` (a
@@ -128,23 +133,23 @@ macro_rules! with_samples {
     ($samples:expr, |$data:ident| $body:expr) => {
         match $samples {
             $crate::Samples::U8(v) => {
-                let $data: &[u8] = v;
+                let $data: &[u8] = &**v;
                 $body
             }
             $crate::Samples::I8(v) => {
-                let $data: &[i8] = v;
+                let $data: &[i8] = &**v;
                 $body
             }
             $crate::Samples::U16(v) => {
-                let $data: &[u16] = v;
+                let $data: &[u16] = &**v;
                 $body
             }
             $crate::Samples::I16(v) => {
-                let $data: &[i16] = v;
+                let $data: &[i16] = &**v;
                 $body
             }
             $crate::Samples::F32(v) => {
-                let $data: &[f32] = v;
+                let $data: &[f32] = &**v;
                 $body
             }
         }
@@ -178,6 +183,38 @@ impl Samples {
         with_samples!(self, |data| data[i].to_f32())
     }
 
+    /// `Ok` for samples in memory; for samples in outside bytes (a mapped
+    /// file), whether those are still what they were
+    /// ([`ExternalBytes::verify`](super::ExternalBytes::verify)).
+    pub fn verify(&self) -> Result<(), String> {
+        fn of<T: Sample>(store: &Store<T>) -> Result<(), String> {
+            match store {
+                Store::Owned(_) => Ok(()),
+                Store::External(e) => e.verify(),
+            }
+        }
+        match self {
+            Samples::U8(s) => of(s),
+            Samples::I8(s) => of(s),
+            Samples::U16(s) => of(s),
+            Samples::I16(s) => of(s),
+            Samples::F32(s) => of(s),
+        }
+    }
+
+    /// Whether the samples are in outside bytes (a mapped file) rather
+    /// than in memory the volume owns.
+    pub fn is_external(&self) -> bool {
+        matches!(
+            self,
+            Samples::U8(Store::External(_))
+                | Samples::I8(Store::External(_))
+                | Samples::U16(Store::External(_))
+                | Samples::I16(Store::External(_))
+                | Samples::F32(Store::External(_))
+        )
+    }
+
     /// Every sample as `f32`, in a new vector.
     pub fn to_f32_vec(&self) -> Vec<f32> {
         with_samples!(self, |data| data.iter().map(|v| v.to_f32()).collect())
@@ -208,31 +245,31 @@ impl Samples {
 
 impl From<Vec<f32>> for Samples {
     fn from(v: Vec<f32>) -> Self {
-        Samples::F32(v)
+        Samples::F32(Store::Owned(v))
     }
 }
 
 impl From<Vec<u8>> for Samples {
     fn from(v: Vec<u8>) -> Self {
-        Samples::U8(v)
+        Samples::U8(Store::Owned(v))
     }
 }
 
 impl From<Vec<i8>> for Samples {
     fn from(v: Vec<i8>) -> Self {
-        Samples::I8(v)
+        Samples::I8(Store::Owned(v))
     }
 }
 
 impl From<Vec<u16>> for Samples {
     fn from(v: Vec<u16>) -> Self {
-        Samples::U16(v)
+        Samples::U16(Store::Owned(v))
     }
 }
 
 impl From<Vec<i16>> for Samples {
     fn from(v: Vec<i16>) -> Self {
-        Samples::I16(v)
+        Samples::I16(Store::Owned(v))
     }
 }
 

@@ -15,6 +15,7 @@ use crate::dtype::{DType, Endian, Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_samples};
 use crate::shared::limits::{check_dims, default_max_memory};
+use crate::shared::mapped::{self, MapPolicy, Plan, mapped_note};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// The layout of a raw file.
@@ -58,7 +59,7 @@ impl RawOptions {
 /// need, before anything is allocated; the read never goes past that
 /// length. The volume has `opts.spacing` and its origin at zero.
 pub fn read_raw(path: &Path, opts: &RawOptions) -> Result<Volume, IoError> {
-    read_raw_limited(path, opts, default_max_memory())
+    read_raw_limited(path, opts, default_max_memory(), MapPolicy::IfLarger).map(|(v, _)| v)
 }
 
 /// Reads the raw file at `path` with the layout `opts.raw` gives; a file
@@ -69,8 +70,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             path: path.to_path_buf(),
         });
     };
-    let volume = read_raw_limited(path, raw, opts.max_memory)?;
-    let info = FileInfo::new(format!("{} ({}-endian)", raw.dtype, raw.endian));
+    let (volume, plan) = read_raw_limited(path, raw, opts.max_memory, opts.map)?;
+    let mut info = FileInfo::new(format!("{} ({}-endian)", raw.dtype, raw.endian));
+    if plan == Plan::Map {
+        info.notes.push(mapped_note(&volume));
+    }
     Ok(Loaded {
         volume,
         format: VolumeFormat::Raw,
@@ -78,9 +82,15 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     })
 }
 
-/// [`read_raw`], refusing a layout whose volume (in the type it keeps)
-/// would take more than `max_memory` bytes (`--max-memory`).
-fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<Volume, IoError> {
+/// [`read_raw`] within `max_memory` bytes (`--max-memory`): a layout whose
+/// volume (in the type it keeps) would take more is mapped from the file
+/// where `policy` and the layout allow, refused otherwise.
+fn read_raw_limited(
+    path: &Path,
+    opts: &RawOptions,
+    max_memory: u64,
+    policy: MapPolicy,
+) -> Result<(Volume, Plan), IoError> {
     let [nx, ny, nz] = opts.dims;
     if nx < 2 || ny < 2 || nz < 2 {
         return Err(IoError::volume(path, VolumeError::TooThin(nx, ny, nz)));
@@ -112,9 +122,19 @@ fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<V
     }
     let stored = opts.dtype.stored();
     let kept = stored.bytes() as u64;
-    check_dims(path, "raw layout dims", &opts.dims, kept, max_memory)?;
-
     let (dtype, endian) = (opts.dtype, opts.endian);
+    let plan = mapped::plan(
+        policy,
+        mapped::mappable(dtype, endian),
+        check_dims(path, "raw layout dims", &opts.dims, kept, max_memory),
+    )?;
+    if plan == Plan::Map {
+        let samples = mapped::map_samples(path, 0, dtype, count)?;
+        let volume = Volume::from_samples(opts.dims, samples)
+            .and_then(|v| v.with_spacing(opts.spacing))
+            .map_err(|e| IoError::volume(path, e))?;
+        return Ok((volume, plan));
+    }
     let samples = read_as_stored!(stored, |T| {
         let mut data: Vec<T> = Vec::with_capacity(count);
         read_samples(
@@ -131,6 +151,7 @@ fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<V
 
     Volume::from_samples(opts.dims, samples)
         .and_then(|v| v.with_spacing(opts.spacing))
+        .map(|v| (v, plan))
         .map_err(|e| IoError::volume(path, e))
 }
 

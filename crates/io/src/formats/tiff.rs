@@ -755,8 +755,8 @@ mod tests {
         assert_eq!(scale, Some((-32768.0, 1.0)));
         assert!(note.unwrap().contains("-32768 + 1 x stored (HU)"));
         // A 16-bit stack calibrated to -32768..32767 stays 16-bit.
-        let data = rescale(Samples::U16(vec![0, 32768, 65535]), 1.0, -32768.0);
-        assert_eq!(data, Samples::I16(vec![-32768, 0, 32767]));
+        let data = rescale(Samples::from(vec![0u16, 32768, 65535]), 1.0, -32768.0);
+        assert_eq!(data, Samples::from(vec![-32768i16, 0, 32767]));
 
         let ij = ImageJ::parse("ImageJ=1.53\ncf=1\nc0=3\nc1=2\n");
         let (scale, note) = calibration(&ij);

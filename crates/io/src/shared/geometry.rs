@@ -178,6 +178,12 @@ pub fn grid_to_volume(
             new_origin += steps[a] * (dims[a].saturating_sub(1)) as f64;
         }
     }
+    if !identity && data.is_external() {
+        return Err(IoError::invalid(
+            path,
+            "the file's axes are not x, y, z in that order and sense, so its samples would have to be reordered, which a volume mapped from the file (larger than the memory limit) cannot be: store it with x fastest and the axes along +x, +y, +z",
+        ));
+    }
     let data = if identity {
         data
     } else {

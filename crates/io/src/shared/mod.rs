@@ -6,6 +6,8 @@
 //! |---|---|---|
 //! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM; its ratio bound: HDF5 |
 //! | `input.rs` | opening input files, reading samples in bounded chunks | every reader |
+//! | `mapped.rs` | volumes over the memory limit mapped from their file (when and why not) | raw, NRRD, MetaImage, NIfTI, npy, MRC, legacy VTK |
+//! | `sigbus.rs` | a mapped file truncated under the renderer: an error, not a crash | `mapped.rs` |
 //! | `limits.rs` | the memory limit and the size checks before allocating | every reader |
 //! | `hdf5.rs` | HDF5 files opened, attributes read, numeric datasets read in slabs (pure Rust) | HDF5, MINC2 |
 //! | `geometry.rs` | a file's grid (origin, step vectors) → the axis-aligned volume | every reader with geometry |
@@ -21,9 +23,11 @@ pub(crate) mod geometry;
 pub(crate) mod hdf5;
 pub(crate) mod input;
 pub(crate) mod limits;
+pub(crate) mod mapped;
 pub(crate) mod payload;
 pub(crate) mod periodic_cell;
 pub(crate) mod rescale;
+pub(crate) mod sigbus;
 pub(crate) mod text_header;
 pub(crate) mod text_reader;
 pub(crate) mod vtk_arrays;

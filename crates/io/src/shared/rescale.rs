@@ -115,12 +115,12 @@ mod tests {
     fn rescaled_values_are_the_f32_arithmetic_in_the_narrowest_type() {
         let ct: Vec<u16> = vec![0, 1, 1024, 2000, 4095];
         let cases: [(Samples, f64, f64, SampleType); 6] = [
-            (Samples::U16(ct.clone()), 1.0, -1024.0, SampleType::I16),
-            (Samples::U16(ct.clone()), 1.0, 0.0, SampleType::U16),
-            (Samples::U16(ct.clone()), 2.0, 0.0, SampleType::U16),
-            (Samples::U16(ct.clone()), 0.5, -1024.0, SampleType::F32),
-            (Samples::I8(vec![-3, 0, 7]), -1.0, 100.0, SampleType::U8),
-            (Samples::U16(vec![0, 65535]), 1.0, -1.0, SampleType::F32),
+            (Samples::from(ct.clone()), 1.0, -1024.0, SampleType::I16),
+            (Samples::from(ct.clone()), 1.0, 0.0, SampleType::U16),
+            (Samples::from(ct.clone()), 2.0, 0.0, SampleType::U16),
+            (Samples::from(ct.clone()), 0.5, -1024.0, SampleType::F32),
+            (Samples::from(vec![-3i8, 0, 7]), -1.0, 100.0, SampleType::U8),
+            (Samples::from(vec![0u16, 65535]), 1.0, -1.0, SampleType::F32),
         ];
         for (samples, slope, intercept, want) in cases {
             let expect: Vec<f32> = (samples.to_f32_vec().iter())
@@ -131,7 +131,7 @@ mod tests {
             let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&got.to_f32_vec()), bits(&expect));
         }
-        let floats = Samples::F32(vec![1.5, f32::NAN]);
+        let floats = Samples::from(vec![1.5, f32::NAN]);
         let got = rescale(floats, 2.0, 1.0).to_f32_vec();
         assert_eq!(got[0], 4.0);
         assert!(got[1].is_nan());
