@@ -63,7 +63,7 @@ async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_fram
     if !browser::available() {
         return;
     }
-    let viewer = Viewer::start(&["blobs:48", "--size", "200", "--colormap", "viridis"]);
+    let viewer = Viewer::start(&["blobs:48", "--size", "240", "--colormap", "viridis"]);
     let b = Browser::start().await;
     let dir = tempfile::tempdir().unwrap();
 
@@ -78,10 +78,10 @@ async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_fram
     b.wait_still().await;
     assert!(b.frames().await >= 1);
     let first = picture(&b.frame_bytes().await, dir.path(), "first.png");
-    assert_eq!((first.width, first.height), (200, 200));
+    assert_eq!((first.width, first.height), (240, 240));
     let command = b.text("command").await;
     assert!(
-        command.starts_with("volray render blobs:48 --size 200x200"),
+        command.starts_with("volray render blobs:48 --size 240x240"),
         "{command}"
     );
     assert_eq!(azimuth(&command), 0.0);

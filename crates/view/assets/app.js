@@ -102,6 +102,7 @@ function onFrame(buffer) {
     frame.src = url;
     if (old.startsWith("blob:")) URL.revokeObjectURL(old);
     basis = header.basis;
+    lastHeader = header;
     framesShown += 1;
     body.dataset.frames = String(framesShown);
     showCommand(header);
@@ -114,6 +115,7 @@ function onFrame(buffer) {
 }
 let lastShownSeq = 0;
 let basis = null;
+let lastHeader = null;
 
 function download(blob) {
   const a = document.createElement("a");
@@ -137,8 +139,27 @@ function hideError() {
   $("error").hidden = true;
 }
 
+// The command, each flag kept on one line with its value.
 function showCommand(header) {
-  $("command").textContent = header.command;
+  const box = $("command");
+  const words = header.command.split(" ");
+  const groups = [];
+  const isFlag = (w) => /^--?[a-z]/i.test(w);
+  for (const word of words) {
+    const last = groups[groups.length - 1];
+    if (last && !isFlag(word) && isFlag(last) && !last.includes(" ")) {
+      groups[groups.length - 1] += " " + word;
+    } else {
+      groups.push(word);
+    }
+  }
+  box.replaceChildren();
+  groups.forEach((group, i) => {
+    if (i) box.append(" ");
+    const span = document.createElement("span");
+    span.textContent = group;
+    box.append(span);
+  });
   const tf = header.tf_file;
   $("tf-file").hidden = !tf;
   if (tf) {
@@ -169,6 +190,7 @@ function start(message) {
     (message.log ? " (log10)" : "");
   frame.width = state.width;
   frame.height = state.height;
+  $("left").style.width = `${Math.max(360, state.width + 2)}px`;
   const select = $("colormap");
   select.replaceChildren(...message.colormaps.map(([name]) => {
     const option = document.createElement("option");
@@ -532,6 +554,7 @@ function fromHex(hex) { return [1, 3, 5].map((i) => round(parseInt(hex.slice(i, 
 window.volrayView = {
   send: (text) => socket.send(text),
   state: () => structuredClone(state),
+  header: () => lastHeader,
   setState: (patch, quality = "full") => {
     Object.assign(state, patch);
     showControls();
