@@ -161,6 +161,47 @@ async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_fram
             == serde_json::json!(true)
     );
 
+    // The wheel zooms, a shift-drag pans, a double click resets.
+    b.wheel("#frame", -300).await;
+    b.wait_for("document.getElementById('command').textContent.includes('--zoom')")
+        .await;
+    b.wait_still().await;
+    b.drag_holding("#frame", (0.0, 0.0), (30.0, -20.0), 4, true)
+        .await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(command.contains("--look-at"), "{command}");
+    assert_eq!(
+        azimuth(&command),
+        45.0,
+        "a shift-drag does not orbit: {command}"
+    );
+    b.double_click("#frame").await;
+    b.wait_for("!document.getElementById('command').textContent.includes('--zoom')")
+        .await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert_eq!(azimuth(&command), 0.0, "{command}");
+    assert!(!command.contains("--look-at"), "{command}");
+
+    // "Save PNG" at another size.
+    b.eval(
+        "document.getElementById('save-width').value = 64; \
+         document.getElementById('save-height').value = 48; \
+         document.getElementById('save').click(); return true;",
+    )
+    .await;
+    b.wait_for("window.volrayView.saved()").await;
+    let saved = b.eval("return window.volrayView.saved();").await;
+    assert_eq!(
+        (saved["width"].as_u64(), saved["height"].as_u64()),
+        (Some(64), Some(48))
+    );
+    assert!(
+        saved["command"].as_str().unwrap().contains("--size 64x48"),
+        "{saved}"
+    );
+
     // A screenshot of the page, for the docs.
     if let Ok(path) = std::env::var("VOLRAY_VIEW_SCREENSHOT") {
         std::fs::write(path, b.client.screenshot().await.unwrap()).unwrap();

@@ -6,7 +6,10 @@
 //! except under `CI=true`, where they fail: CI installs both.
 #![allow(dead_code)] // each test binary uses part of this
 
-use fantoccini::actions::{InputSource, MOUSE_BUTTON_LEFT, MouseActions, PointerAction};
+use fantoccini::actions::{
+    Actions, InputSource, KeyAction, KeyActions, MOUSE_BUTTON_LEFT, MouseActions, PointerAction,
+    WheelAction, WheelActions,
+};
 use fantoccini::{Client, ClientBuilder, Locator};
 use serde_json::{Value, json};
 use std::net::TcpListener;
@@ -175,9 +178,21 @@ impl Browser {
         v.as_str().unwrap().to_string()
     }
 
-    /// Drags the mouse over the element `selector` from its centre by
-    /// (`dx`, `dy`) pixels, in `steps` moves, holding shift when `shift`.
+    /// Drags the mouse over the element `selector` from `from` (relative
+    /// to its centre) by `by` pixels, in `steps` moves.
     pub async fn drag(&self, selector: &str, from: (f64, f64), by: (f64, f64), steps: u32) {
+        self.drag_holding(selector, from, by, steps, false).await;
+    }
+
+    /// [`Self::drag`], holding shift when `shift`.
+    pub async fn drag_holding(
+        &self,
+        selector: &str,
+        from: (f64, f64),
+        by: (f64, f64),
+        steps: u32,
+        shift: bool,
+    ) {
         let element = self.client.find(Locator::Css(selector)).await.unwrap();
         let mut mouse = MouseActions::new("mouse".to_string())
             .then(PointerAction::MoveToElement {
@@ -199,6 +214,58 @@ impl Browser {
         mouse = mouse.then(PointerAction::Up {
             button: MOUSE_BUTTON_LEFT,
         });
+        let mut actions = Actions::from(mouse);
+        if shift {
+            // One key action a tick: shift is down before the button is.
+            let shift_key = '\u{e008}';
+            let mut keys =
+                KeyActions::new("keys".to_string()).then(KeyAction::Down { value: shift_key });
+            for _ in 0..steps + 2 {
+                keys = keys.then(KeyAction::Pause {
+                    duration: Duration::ZERO,
+                });
+            }
+            actions = actions.and(keys.then(KeyAction::Up { value: shift_key }));
+        }
+        self.client.perform_actions(actions).await.unwrap();
+        self.client.release_actions().await.unwrap();
+    }
+
+    /// Turns the wheel by `delta_y` pixels over the centre of `selector`.
+    pub async fn wheel(&self, selector: &str, delta_y: i64) {
+        let centre = self
+            .eval(&format!(
+                "const r = document.querySelector('{selector}').getBoundingClientRect(); return [r.x + r.width / 2, r.y + r.height / 2];"
+            ))
+            .await;
+        let wheel = WheelActions::new("wheel".to_string()).then(WheelAction::Scroll {
+            duration: None,
+            x: centre[0].as_f64().unwrap() as i64,
+            y: centre[1].as_f64().unwrap() as i64,
+            delta_x: 0,
+            delta_y,
+        });
+        self.client.perform_actions(wheel).await.unwrap();
+    }
+
+    /// A double click at the centre of `selector`.
+    pub async fn double_click(&self, selector: &str) {
+        let element = self.client.find(Locator::Css(selector)).await.unwrap();
+        let mut mouse = MouseActions::new("mouse".to_string()).then(PointerAction::MoveToElement {
+            element,
+            duration: None,
+            x: 0.0,
+            y: 0.0,
+        });
+        for _ in 0..2 {
+            mouse = mouse
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                })
+                .then(PointerAction::Up {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+        }
         self.client.perform_actions(mouse).await.unwrap();
         self.client.release_actions().await.unwrap();
     }

@@ -88,6 +88,7 @@ function onFrame(buffer) {
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, n)));
   const blob = new Blob([new Uint8Array(buffer, 4 + n)], { type: header.mime });
   if (header.quality === "save") {
+    lastSave = { width: header.width, height: header.height, command: header.command };
     download(blob);
     return;
   }
@@ -116,6 +117,7 @@ function onFrame(buffer) {
 let lastShownSeq = 0;
 let basis = null;
 let lastHeader = null;
+let lastSave = null;
 
 function download(blob) {
   const a = document.createElement("a");
@@ -555,6 +557,7 @@ window.volrayView = {
   send: (text) => socket.send(text),
   state: () => structuredClone(state),
   header: () => lastHeader,
+  saved: () => lastSave,
   setState: (patch, quality = "full") => {
     Object.assign(state, patch);
     showControls();
