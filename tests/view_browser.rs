@@ -31,6 +31,15 @@ fn azimuth(command: &str) -> f64 {
         .map_or(0.0, |i| words[i + 1].parse().unwrap())
 }
 
+/// A viewer of `args` and a browser showing its first full frame.
+async fn open(args: &[&str]) -> (Viewer, Browser) {
+    let viewer = Viewer::start(args);
+    let b = Browser::start().await;
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    (viewer, b)
+}
+
 /// Decodes PNG bytes.
 fn picture(bytes: &[u8], dir: &std::path::Path, name: &str) -> Picture {
     let path = dir.join(name);
@@ -214,10 +223,7 @@ async fn two_tabs_are_independent_and_a_closed_tab_frees_its_renderer() {
     if !browser::available() {
         return;
     }
-    let viewer = Viewer::start(&["fractal:65", "--size", "160"]);
-    let b = Browser::start().await;
-    b.client.goto(&viewer.url).await.unwrap();
-    b.wait_still().await;
+    let (viewer, b) = open(&["fractal:65", "--size", "160"]).await;
     let first = b.client.window().await.unwrap();
     let second = b.client.new_window(true).await.unwrap().handle;
     b.client.switch_to_window(second.clone()).await.unwrap();
@@ -253,10 +259,7 @@ async fn a_burst_of_a_thousand_requests_renders_the_latest_not_a_queue() {
     if !browser::available() {
         return;
     }
-    let viewer = Viewer::start(&["fractal:65", "--size", "160"]);
-    let b = Browser::start().await;
-    b.client.goto(&viewer.url).await.unwrap();
-    b.wait_still().await;
+    let (viewer, b) = open(&["fractal:65", "--size", "160"]).await;
     let before = viewer.status()["frames"].as_u64().unwrap();
     // 1,000 drafts in one go, then the full frame of the last state.
     let script = r#"

@@ -249,14 +249,24 @@ impl Browser {
 
     /// A double click at the centre of `selector`.
     pub async fn double_click(&self, selector: &str) {
+        self.clicks(selector, (0.0, 0.0), 2).await;
+    }
+
+    /// A click at (`x`, `y`) from the centre of the element `selector`.
+    pub async fn click_at(&self, selector: &str, x: f64, y: f64) {
+        self.clicks(selector, (x, y), 1).await;
+    }
+
+    /// `n` clicks at `at` from the centre of the element `selector`.
+    async fn clicks(&self, selector: &str, at: (f64, f64), n: usize) {
         let element = self.client.find(Locator::Css(selector)).await.unwrap();
         let mut mouse = MouseActions::new("mouse".to_string()).then(PointerAction::MoveToElement {
             element,
             duration: None,
-            x: 0.0,
-            y: 0.0,
+            x: at.0,
+            y: at.1,
         });
-        for _ in 0..2 {
+        for _ in 0..n {
             mouse = mouse
                 .then(PointerAction::Down {
                     button: MOUSE_BUTTON_LEFT,
@@ -265,26 +275,6 @@ impl Browser {
                     button: MOUSE_BUTTON_LEFT,
                 });
         }
-        self.client.perform_actions(mouse).await.unwrap();
-        self.client.release_actions().await.unwrap();
-    }
-
-    /// A click at (`x`, `y`) from the centre of the element `selector`.
-    pub async fn click_at(&self, selector: &str, x: f64, y: f64) {
-        let element = self.client.find(Locator::Css(selector)).await.unwrap();
-        let mouse = MouseActions::new("mouse".to_string())
-            .then(PointerAction::MoveToElement {
-                element,
-                duration: None,
-                x,
-                y,
-            })
-            .then(PointerAction::Down {
-                button: MOUSE_BUTTON_LEFT,
-            })
-            .then(PointerAction::Up {
-                button: MOUSE_BUTTON_LEFT,
-            });
         self.client.perform_actions(mouse).await.unwrap();
         self.client.release_actions().await.unwrap();
     }
