@@ -124,6 +124,11 @@ async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_fram
         "the CLI's image differs from the page's still frame"
     );
 
+    // A screenshot of the page, for the docs (docs/viewer.png).
+    if let Ok(path) = std::env::var("VOLRAY_VIEW_SCREENSHOT") {
+        std::fs::write(path, b.client.screenshot().await.unwrap()).unwrap();
+    }
+
     // Bad messages: an error in the page, and the server goes on.
     let mut state = b.eval("return window.volrayView.state();").await;
     for (message, expect) in [
@@ -211,10 +216,6 @@ async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_fram
         "{saved}"
     );
 
-    // A screenshot of the page, for the docs.
-    if let Ok(path) = std::env::var("VOLRAY_VIEW_SCREENSHOT") {
-        std::fs::write(path, b.client.screenshot().await.unwrap()).unwrap();
-    }
     b.close().await;
 }
 
