@@ -31,13 +31,17 @@ fn azimuth(command: &str) -> f64 {
         .map_or(0.0, |i| words[i + 1].parse().unwrap())
 }
 
-/// A viewer of `args` and a browser showing its first full frame.
-async fn open(args: &[&str]) -> (Viewer, Browser) {
+/// A viewer of `args` and a browser showing its first full frame; `None`
+/// where the browser tests skip (see `browser::available`).
+async fn open(args: &[&str]) -> Option<(Viewer, Browser)> {
+    if !browser::available() {
+        return None;
+    }
     let viewer = Viewer::start(args);
     let b = Browser::start().await;
     b.client.goto(&viewer.url).await.unwrap();
     b.wait_still().await;
-    (viewer, b)
+    Some((viewer, b))
 }
 
 /// Decodes PNG bytes.
@@ -221,10 +225,9 @@ async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_fram
 
 #[tokio::test(flavor = "current_thread")]
 async fn two_tabs_are_independent_and_a_closed_tab_frees_its_renderer() {
-    if !browser::available() {
+    let Some((viewer, b)) = open(&["fractal:65", "--size", "160"]).await else {
         return;
-    }
-    let (viewer, b) = open(&["fractal:65", "--size", "160"]).await;
+    };
     let first = b.client.window().await.unwrap();
     let second = b.client.new_window(true).await.unwrap().handle;
     b.client.switch_to_window(second.clone()).await.unwrap();
@@ -260,10 +263,9 @@ async fn two_tabs_are_independent_and_a_closed_tab_frees_its_renderer() {
 
 #[tokio::test(flavor = "current_thread")]
 async fn a_burst_of_a_thousand_requests_renders_the_latest_not_a_queue() {
-    if !browser::available() {
+    let Some((viewer, b)) = open(&["fractal:65", "--size", "160"]).await else {
         return;
-    }
-    let (viewer, b) = open(&["fractal:65", "--size", "160"]).await;
+    };
     let before = viewer.status()["frames"].as_u64().unwrap();
     // 1,000 drafts in one go, then the full frame of the last state.
     let script = r#"
