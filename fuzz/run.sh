@@ -3,8 +3,8 @@
 # docs/robustness.md gives, and prints a summary line per target
 # (executions, coverage, corpus size, findings).
 # Usage: fuzz/run.sh SECONDS target...   (build first: cargo +nightly fuzz build)
-# The hdf5 target needs its own build: cargo +nightly fuzz build --features hdf5 hdf5.
-# EXTRA adds libFuzzer flags, e.g. EXTRA=-detect_leaks=0 for hdf5 (libhdf5 leaks on bad files).
+# The hdf5 target reads through hdf5-pure (pure Rust) like the others.
+# EXTRA adds libFuzzer flags, e.g. EXTRA=-detect_leaks=0.
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 cd "$here"

@@ -27,7 +27,7 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
@@ -81,6 +81,10 @@ for t in $targets; do
         # The control byte's high nibble picks the dataset (fuzz_targets/hdf5.rs).
         add hdf5 00 "$fix"/hdf5/one.h5
         for c in 10 20 30 40 50 60 70 72 80 90; do add hdf5 $c "$fix"/hdf5/many.h5; done
+        ;;
+    minc)
+        add minc 00 "$fix"/minc/*.mnc
+        add minc 02 "$fix"/minc/series_u8.mnc
         ;;
     *) echo "seed.sh: unknown target $t" >&2; exit 1 ;;
     esac

@@ -107,6 +107,7 @@ fn naming_flags(e: &IoError) -> String {
         | IoError::Volume { .. }
         | IoError::Npy { .. }
         | IoError::Invalid { .. }
+        | IoError::FlatImage { .. }
         | IoError::ImageSize { .. } => e.to_string(),
     }
 }

@@ -2,12 +2,19 @@
 
 use crate::error::CliError;
 use crate::flags::InfoArgs;
-use crate::input;
-use serde_json::json;
+use crate::input::{self, Described};
+use serde_json::{Value, json};
 use volray_core::Histogram;
+use volray_io::{FileInfo, FlatImage};
 
 pub fn run(args: &InfoArgs) -> Result<(), CliError> {
-    let input = input::load(&args.input)?;
+    let input = match input::describe(&args.input)? {
+        Described::Volume(input) => input,
+        Described::Image { name, image } => {
+            describe_image(&name, &image, args.json);
+            return Ok(());
+        }
+    };
     let v = &input.volume;
     let hist = Histogram::of(v, usize::from(args.bins));
     let (format, info) = match &input.file {
@@ -37,18 +44,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             "values": histogram,
         });
         if let Some(i) = info {
-            out["stored_type"] = json!(i.stored_type);
-            out["frames"] = json!(i.frames);
-            out["frame"] = json!(i.frame);
-            out["arrays"] = json!(i.arrays);
-            out["array"] = json!(i.array);
-            out["header"] = json!(
-                i.header
-                    .iter()
-                    .map(|(k, v)| json!({"key": k, "value": v}))
-                    .collect::<Vec<_>>()
-            );
-            out["notes"] = json!(i.notes);
+            add_file_json(&mut out, i);
         }
         outln!(
             "{}",
@@ -61,21 +57,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     outln!("input:     {}", input.name);
     outln!("format:    {format}");
     if let Some(i) = info {
-        outln!("stored as: {}", i.stored_type);
-        if i.frames > 1 {
-            outln!(
-                "frame:     {} of {} (--frame picks another)",
-                i.frame,
-                i.frames
-            );
-        }
-        if !i.arrays.is_empty() {
-            outln!(
-                "arrays:    {} (read: {}; --array picks another)",
-                i.arrays.join(", "),
-                i.array.as_deref().unwrap_or("-")
-            );
-        }
+        print_stored(i);
     }
     outln!("dims:      {nx} x {ny} x {nz} ({} points)", v.len());
     outln!("spacing:   {}, {}, {}{unit_suffix}", s.x, s.y, s.z);
@@ -91,7 +73,12 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
                 h.max,
                 h.mean
             );
-            if h.non_finite > 0 {
+            if h.non_finite > 0 && info.is_some_and(|i| i.nan_is_empty) {
+                outln!(
+                    "           {} NaN: space the file does not cover, rendered as empty",
+                    h.non_finite
+                );
+            } else if h.non_finite > 0 {
                 outln!("           {} non-finite (NaN or infinite)", h.non_finite);
             }
             outln!("histogram: ({} bins)", h.counts.len());
@@ -109,18 +96,112 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         }
     }
     if let Some(i) = info {
-        if !i.header.is_empty() {
-            outln!("header (as written):");
-            for (k, val) in &i.header {
-                outln!("  {k}: {val}");
-            }
-        }
-        if !i.notes.is_empty() {
-            outln!("how it was read:");
-            for n in &i.notes {
-                outln!("  - {n}");
-            }
-        }
+        print_header_and_notes(i);
     }
     Ok(())
+}
+
+/// What a file holding one image, not a volume, holds, and why `render`
+/// needs more.
+fn describe_image(name: &str, image: &FlatImage, as_json: bool) {
+    let i = &image.info;
+    let [nx, ny, nz] = image.dims;
+    let (s, o) = (image.spacing, image.origin);
+    let (range, non_finite) = image.value_range();
+    if as_json {
+        let mut out = json!({
+            "input": name,
+            "format": image.format.description(),
+            "volume": false,
+            "render": image.reason,
+            "dims": [nx, ny, nz],
+            "spacing": [s.x, s.y, s.z],
+            "origin": [o.x, o.y, o.z],
+            "length_unit": i.length_unit,
+            "values": range.map(|(min, max, mean)| json!({
+                "min": min, "max": max, "mean": mean, "non_finite": non_finite,
+            })),
+        });
+        add_file_json(&mut out, i);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("JSON of plain values")
+        );
+        return;
+    }
+    let unit = i
+        .length_unit
+        .as_deref()
+        .map(|u| format!(" {u}"))
+        .unwrap_or_default();
+    outln!("input:     {name}");
+    outln!("format:    {}", image.format.description());
+    print_stored(i);
+    outln!(
+        "dims:      {nx} x {ny} x {nz} ({} points: an image, not a volume)",
+        image.values.len()
+    );
+    outln!("spacing:   {}, {}, {}{unit}", s.x, s.y, s.z);
+    outln!("origin:    {}, {}, {}{unit}", o.x, o.y, o.z);
+    match range {
+        None => outln!("values:    no finite values"),
+        Some((min, max, mean)) => outln!("values:    min {min}, max {max}, mean {mean:.6e}"),
+    }
+    if non_finite > 0 {
+        outln!("           {non_finite} non-finite (NaN or infinite)");
+    }
+    outln!("render:    refused: {}", image.reason);
+    print_header_and_notes(i);
+}
+
+/// The stored type, and the frames and arrays a file holds.
+fn print_stored(i: &FileInfo) {
+    outln!("stored as: {}", i.stored_type);
+    if i.frames > 1 {
+        outln!(
+            "frame:     {} of {} (--frame picks another)",
+            i.frame,
+            i.frames
+        );
+    }
+    if !i.arrays.is_empty() {
+        outln!(
+            "arrays:    {} (read: {}; --array picks another)",
+            i.arrays.join(", "),
+            i.array.as_deref().unwrap_or("-")
+        );
+    }
+}
+
+/// The header as written and the notes of how the file was read.
+fn print_header_and_notes(i: &FileInfo) {
+    if !i.header.is_empty() {
+        outln!("header (as written):");
+        for (k, val) in &i.header {
+            outln!("  {k}: {val}");
+        }
+    }
+    if !i.notes.is_empty() {
+        outln!("how it was read:");
+        for n in &i.notes {
+            outln!("  - {n}");
+        }
+    }
+}
+
+/// The file's own fields in `volray info --json`.
+fn add_file_json(out: &mut Value, i: &FileInfo) {
+    out["stored_type"] = json!(i.stored_type);
+    out["frames"] = json!(i.frames);
+    out["frame"] = json!(i.frame);
+    out["arrays"] = json!(i.arrays);
+    out["array"] = json!(i.array);
+    out["header"] = json!(
+        i.header
+            .iter()
+            .map(|(k, v)| json!({"key": k, "value": v}))
+            .collect::<Vec<_>>()
+    );
+    out["notes"] = json!(i.notes);
+    out["nan_is_empty"] = json!(i.nan_is_empty);
 }

@@ -3,9 +3,11 @@
 use crate::error::CliError;
 use crate::flags::InputArgs;
 use std::path::{Path, PathBuf};
-use volray_core::Volume;
 use volray_core::glam::DVec3;
-use volray_io::{DType, Endian, FileInfo, RawOptions, ReadOptions, VolumeFormat};
+use volray_core::{NonFinite, Volume};
+use volray_io::{
+    DType, Endian, FileInfo, FlatImage, IoError, RawOptions, ReadOptions, VolumeFormat,
+};
 
 /// What `volray render` shows when given no input.
 pub const DEMO: &str = "blobs:64";
@@ -21,7 +23,44 @@ pub struct Input {
     pub max_memory: u64,
 }
 
+impl Input {
+    /// How rendering treats NaN and infinite values: as `--nonfinite`
+    /// says, except that NaN values the file marks as space it does not
+    /// cover (the box of a skewed crystallographic map, resampled) are
+    /// always empty space.
+    pub fn non_finite(&self, requested: NonFinite) -> NonFinite {
+        match &self.file {
+            Some((_, info)) if info.nan_is_empty => NonFinite::Transparent,
+            _ => requested,
+        }
+    }
+}
+
+/// What `volray info` describes: a volume, or a file holding one image
+/// (a single slice, a 2-D image) that `render` refuses.
+pub enum Described {
+    Volume(Box<Input>),
+    Image {
+        /// The file's path, for messages.
+        name: String,
+        image: Box<FlatImage>,
+    },
+}
+
+/// Loads the input for rendering: a file holding an image, not a volume,
+/// is refused with the reason (exit 1).
 pub fn load(args: &InputArgs) -> Result<Input, CliError> {
+    match describe(args)? {
+        Described::Volume(input) => Ok(*input),
+        Described::Image { name, image } => Err(CliError::from(IoError::FlatImage {
+            path: name.into(),
+            image,
+        })),
+    }
+}
+
+/// Loads the input for `volray info`: a volume, or the image a file holds.
+pub fn describe(args: &InputArgs) -> Result<Described, CliError> {
     let spec = args.input.as_deref().unwrap_or(DEMO);
     let max_memory = args
         .max_memory
@@ -75,7 +114,19 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
             array: args.array.clone(),
             max_memory,
         };
-        let loaded = volray_io::read(&path, &opts)?;
+        let loaded = match volray_io::read(&path, &opts) {
+            Ok(loaded) => loaded,
+            Err(IoError::FlatImage { mut image, .. }) => {
+                if let Some(s) = args.spacing {
+                    image.spacing = DVec3::from(s);
+                }
+                return Ok(Described::Image {
+                    name: spec.to_string(),
+                    image,
+                });
+            }
+            Err(e) => return Err(e.into()),
+        };
         (loaded.volume, Some((loaded.format, loaded.info)))
     };
     let volume = match args.spacing {
@@ -84,12 +135,12 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
             .map_err(|e| CliError::input(format!("--spacing: {e}")))?,
         None => volume,
     };
-    Ok(Input {
+    Ok(Described::Volume(Box::new(Input {
         volume,
         name: spec.to_string(),
         file,
         max_memory,
-    })
+    })))
 }
 
 /// Points per side of the cube grid the built-in source `spec` samples,

@@ -10,7 +10,7 @@ use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use volray_core::camera::CameraError;
-use volray_core::{NonFinite, RenderError, RenderSettings, Renderer};
+use volray_core::{RenderError, RenderSettings, Renderer};
 
 /// Reads the volume `args` name and, with `--log`, takes its log10.
 pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
@@ -49,15 +49,16 @@ pub fn renderer_for<'v>(
     settings: &RenderSettings,
     input: &'v Input,
 ) -> Result<Renderer<'v>, CliError> {
-    crate::memory::check_render(view, settings, input)?;
+    let budget = crate::memory::cache_budget(view, settings, input)?;
     let (name, volume) = (&input.name, &input.volume);
-    let mode = NonFinite::from(view.sampling.nonfinite);
-    Renderer::with_non_finite(volume, mode).map_err(|e| match e {
+    let mode = input.non_finite(view.sampling.nonfinite.into());
+    let renderer = Renderer::with_non_finite(volume, mode).map_err(|e| match e {
         RenderError::NonFinite { .. } => CliError::input(format!(
             "{name}: {e}; use --nonfinite transparent to render them as empty space"
         )),
         e => render_failure(view, name, e),
-    })
+    })?;
+    Ok(renderer.with_cache_budget(budget))
 }
 
 /// A failure to render `name` as one line, naming the flag whose value

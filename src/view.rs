@@ -36,6 +36,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         .prepare(&settings)
         .map_err(|e| crate::session::render_failure(&args.view, &input.name, e))?;
     drop(renderer);
+    let cache_budget = crate::memory::cache_budget(&args.view, &settings, &input)?;
+    let non_finite = input.non_finite(args.view.sampling.nonfinite.into());
 
     let state = start_state(args, &settings);
     state.check().map_err(|e| {
@@ -44,18 +46,13 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         ))
     })?;
     let volume = &input.volume;
-    let reproduce = CliReproduce::new(
-        args,
-        named,
-        volume.dims(),
-        volume.spacing(),
-        input.max_memory,
-    );
+    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
+    let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory);
     reproduce
         .reproduce(&state)
         .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
-    let per_tab =
-        crate::memory::render_bytes(volume.dims(), volume.spacing(), &settings, &args.view).max(1);
+    // Each tab's renderer: the frame and its own brick caches.
+    let per_tab = crate::memory::render_bytes(grid, &settings, non_finite, cache_budget).max(1);
     let max_sessions = (u128::from(input.max_memory) / per_tab).clamp(1, MAX_TABS) as usize;
     let hello = Start {
         name: &input.name,
@@ -68,7 +65,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let pool = thread_pool(args.view.threads)?;
     let viewer = Viewer {
         volume: Arc::new(input.volume),
-        non_finite: args.view.sampling.nonfinite.into(),
+        non_finite,
+        cache_budget,
         hello,
         reproduce: Arc::new(reproduce),
         pool: Arc::new(pool),

@@ -351,3 +351,79 @@ fn every_reader_feeds_the_renderer() {
         assert!(fs::metadata(&png).unwrap().len() > 0);
     }
 }
+
+#[test]
+fn info_describes_a_2d_image_that_render_refuses() {
+    // A 5 x 4 float image x + 10y + 0.5, spacing 0.5, 0.25, from (1, 2)
+    // (crates/io/tests/fixtures/make_flat_fixtures.py, written by pynrrd).
+    let image = "crates/io/tests/fixtures/flat/image.nrrd";
+    let out = volray(&["info", image]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    for expect in [
+        "format:    NRRD",
+        "dims:      5 x 4 x 1 (20 points: an image, not a volume)",
+        "spacing:   0.5, 0.25, 1",
+        "origin:    1, 2, 0",
+        "values:    min 0.5, max 34.5, mean 1.750000e1",
+        "render:    refused: a 2-D image (5 x 4 samples), not a volume",
+        "space directions: (0.5,0) (0,0.25)",
+    ] {
+        assert!(text.contains(expect), "missing {expect:?} in\n{text}");
+    }
+    let out = volray(&["info", image, "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["volume"], false);
+    assert_eq!(v["dims"], serde_json::json!([5, 4, 1]));
+    assert_eq!(v["values"]["max"], 34.5);
+
+    // render refuses with the reason, exit 1, one line.
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("out.png");
+    let out = volray(&["render", image, "-o", png.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains(&format!(
+            "{image}: a 2-D image (5 x 4 samples), not a volume: volray renders volumes of at least 2 points along each axis"
+        )),
+        "{err}"
+    );
+    assert!(!png.exists());
+
+    // A single DICOM slice names the directory to pass instead.
+    let slice = "crates/io/tests/fixtures/dicom/single.dcm";
+    let text = stdout(&volray(&["info", slice]));
+    assert!(
+        text.contains("render:    refused: a single DICOM slice (4 x 3), not a volume: pass the directory of the series (crates/io/tests/fixtures/dicom)"),
+        "{text}"
+    );
+    let out = volray(&["render", slice, "-o", png.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("pass the directory of the series"));
+}
+
+#[test]
+fn a_skewed_map_of_part_of_a_cell_renders_with_empty_space_around_its_box() {
+    // A monoclinic (beta 110) map of 4 x 3 x 5 points of an 8 x 9 x 10 cell
+    // (crates/io/tests/fixtures/make_crystal_map_fixtures.py): resampled,
+    // NaN outside the map's box, which renders as empty space without
+    // --nonfinite.
+    let map = "crates/io/tests/fixtures/mrc/part_monoclinic.ccp4";
+    let out = volray(&["info", map]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    for expect in [
+        "NaN: space the file does not cover, rendered as empty",
+        "not periodic, so only its own box is resampled",
+    ] {
+        assert!(text.contains(expect), "missing {expect:?} in\n{text}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("map.png");
+    let out = volray(&["render", map, "--size", "32", "-o", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(fs::metadata(&png).unwrap().len() > 0);
+}

@@ -1186,6 +1186,38 @@ fn mrc_cases() -> Cases {
         );
     }
     c.flips(f, &bytes, 1024, 4, 8);
+    // A skewed map of part of a cell, its box resampled: cells that make
+    // the box huge, flat or degenerate.
+    let f = "part_triclinic.ccp4";
+    let bytes = fixture(&format!("mrc/{f}"));
+    c.truncations(f, &bytes, 1024, Expect::Bad, Expect::Bad);
+    for (what, offset, value, expect) in [
+        ("angle beta 179.9", 56, f32le(179.9), Expect::Either),
+        (
+            "angles 1 1 1 (a flat cell)",
+            52,
+            [f32le(1.0), f32le(1.0), f32le(1.0)].concat(),
+            Expect::Either,
+        ),
+        (
+            "angles 60 60 179 (no cell)",
+            52,
+            [f32le(60.0), f32le(60.0), f32le(179.0)].concat(),
+            Expect::Either,
+        ),
+        ("cell a 1e30", 40, f32le(1e30), Expect::Either),
+        ("cell c 1e-30", 48, f32le(1e-30), Expect::Either),
+        ("mx 1", 28, i32le(1), Expect::Either),
+        ("nz 1 (one section)", 8, i32le(1), Expect::Either),
+    ] {
+        c.one(
+            &format!("{f}: {what}"),
+            f,
+            put(&bytes, offset, &value),
+            expect,
+        );
+    }
+    c.flips(f, &bytes, 1024, 4, 8);
     c
 }
 
@@ -1243,7 +1275,6 @@ fn chgcar_cases() -> Cases {
 
 // ---------------------------------------------------------------- HDF5
 
-#[cfg(feature = "hdf5")]
 fn hdf5_cases() -> Cases {
     let mut c = Cases::new("hdf5");
     let f = "one.h5";
@@ -1267,6 +1298,114 @@ fn hdf5_cases() -> Cases {
         &format!("{f}: wrong magic"),
         vec![(f.into(), put(&bytes, 1, b"XDF"))],
         &input,
+        Expect::Bad,
+    );
+    // Bit flips through the metadata (superblock, object headers, heaps,
+    // B-trees) of the pure-Rust reader: read or refused, never a crash.
+    c.flips(f, &bytes, n / 2, 24, 5);
+    c
+}
+
+// ------------------------------------------------------------ 2-D images
+
+/// Images, not volumes: `info` describes them (exit 0), `render` refuses
+/// them (exit 1); damaged ones are refused by both.
+fn flat_cases() -> Cases {
+    let mut c = Cases::new("2-D");
+    let f = "image.nrrd";
+    let bytes = fixture(&format!("flat/{f}"));
+    let end = after(&bytes, "\n\n");
+    c.truncations(f, &bytes, end, Expect::Bad, Expect::Bad);
+    c.edits(
+        f,
+        &bytes,
+        &[
+            ("sizes: 5 4", "sizes: 5 400000000", Expect::Bad),
+            ("sizes: 5 4", "sizes: 5 0", Expect::Bad),
+            ("(0.5,0) (0,0.25)", "(nan,0) (0,0.25)", Expect::Either),
+            ("space dimension: 2", "space dimension: 7", Expect::Bad),
+        ],
+    );
+    let f = "image.mha";
+    let bytes = fixture(&format!("flat/{f}"));
+    let end = after(&bytes, "ElementDataFile = LOCAL\n");
+    c.truncations(f, &bytes, end, Expect::Bad, Expect::Bad);
+    c.edits(
+        f,
+        &bytes,
+        &[
+            ("DimSize = 5 4", "DimSize = 5 4000000000", Expect::Bad),
+            (
+                "TransformMatrix = 1 0 0 1",
+                "TransformMatrix = 1 0 0",
+                Expect::Bad,
+            ),
+        ],
+    );
+    let f = "image.nii";
+    let bytes = fixture(&format!("flat/{f}"));
+    c.truncations(f, &bytes, 348, Expect::Bad, Expect::Bad);
+    c
+}
+
+// ---------------------------------------------------------------- MINC2
+
+fn minc_cases() -> Cases {
+    let mut c = Cases::new("minc");
+    for f in ["ramp_i16.mnc", "series_u8.mnc"] {
+        let bytes = fixture(&format!("minc/{f}"));
+        let n = bytes.len();
+        for (what, at) in [
+            ("empty", 0),
+            ("cut at 100 bytes", 100),
+            ("cut in the middle", n / 2),
+            ("one byte short", n - 1),
+        ] {
+            c.one(
+                &format!("{f}: {what}"),
+                f,
+                bytes[..at].to_vec(),
+                Expect::Bad,
+            );
+        }
+        c.one(
+            &format!("{f}: wrong magic"),
+            f,
+            put(&bytes, 1, b"XDF"),
+            Expect::Bad,
+        );
+        // Names the reader looks up, made unknown: a dimension nobody
+        // declared, the image's dataset gone.
+        c.one(
+            &format!("{f}: an unknown dimension"),
+            f,
+            replace(&bytes, "yspace,xspace", "yspace,qspace"),
+            Expect::Bad,
+        );
+        c.one(
+            &format!("{f}: no image-max"),
+            f,
+            replace(&bytes, "image-max", "image-mox"),
+            Expect::Either,
+        );
+        // Bytes flipped through the metadata: read or refused, never a crash.
+        for k in 0..6 {
+            let at = 96 + k * (n / 2 - 96) / 6;
+            let mut flipped = bytes.clone();
+            flipped[at] ^= 0xa5;
+            flipped[at + 1] = 0xff;
+            c.one(
+                &format!("{f}: bytes {at}-{} flipped", at + 1),
+                f,
+                flipped,
+                Expect::Either,
+            );
+        }
+    }
+    c.one(
+        "old.mnc: MINC1 (netCDF)",
+        "old.mnc",
+        b"CDF\x01\0\0\0\0".to_vec(),
         Expect::Bad,
     );
     c
@@ -1380,8 +1519,9 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         cube_cases(),
         mrc_cases(),
         chgcar_cases(),
-        #[cfg(feature = "hdf5")]
         hdf5_cases(),
+        minc_cases(),
+        flat_cases(),
     ];
     for g in groups {
         all.extend(g.list);

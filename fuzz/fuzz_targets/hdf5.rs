@@ -1,4 +1,4 @@
-//! Fuzzes the HDF5 reader (through libhdf5; cargo feature `hdf5`).
+//! Fuzzes the HDF5 reader (pure Rust, hdf5-pure).
 //! The first byte chooses `--frame` (bits 0-2) and the dataset (bits 4-7,
 //! one of the names the seed files hold, or none that exists).
 #![no_main]

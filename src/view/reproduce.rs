@@ -19,7 +19,7 @@ use crate::input;
 use crate::settings::settings_with_tf_text;
 use clap::Parser;
 use volray_core::glam::DVec3;
-use volray_core::{Phong, TransferFunction};
+use volray_core::{NonFinite, Phong, SampleType, TransferFunction};
 use volray_view::{BlendMode, Refusal, Reproduce, Reproduction, START_COLOURS, ViewState, WHITE};
 
 /// The file the command writes and the transfer-function file it names.
@@ -52,21 +52,23 @@ pub struct CliReproduce {
     /// units.
     start: TransferFunction,
     log: bool,
-    /// The volume's grid and the memory limit, for the memory check.
-    dims: [usize; 3],
-    spacing: DVec3,
+    /// The volume's grid and sample type, how its non-finite values are
+    /// rendered, and the memory limit, for the memory check.
+    grid: ([usize; 3], DVec3, SampleType),
+    non_finite: NonFinite,
     max_memory: u64,
 }
 
 impl CliReproduce {
     /// The command lines of a `volray view` started with `args`, whose
     /// transfer function (`--tf`, `--preset`, `--colormap`, `--range`) is
-    /// `start`, for a volume of `dims` voxels `spacing` apart.
+    /// `start`, for a volume of `grid` (dims, spacing, sample type) whose
+    /// non-finite values are rendered as `non_finite` says.
     pub fn new(
         args: &ViewerArgs,
         start: TransferFunction,
-        dims: [usize; 3],
-        spacing: DVec3,
+        grid: ([usize; 3], DVec3, SampleType),
+        non_finite: NonFinite,
         max_memory: u64,
     ) -> Self {
         let inp = &args.input;
@@ -151,8 +153,8 @@ impl CliReproduce {
             ramp: look.opacity,
             start,
             log: look.log,
-            dims,
-            spacing,
+            grid,
+            non_finite,
             max_memory,
         }
     }
@@ -289,7 +291,8 @@ impl Reproduce for CliReproduce {
         };
         let refuse = |e: CliError| Refusal(e.message);
         let settings = settings_with_tf_text(&args.view, json.as_deref()).map_err(refuse)?;
-        let need = crate::memory::render_bytes(self.dims, self.spacing, &settings, &args.view);
+        // The frame must fit with no brick cache (as `render` checks).
+        let need = crate::memory::render_bytes(self.grid, &settings, self.non_finite, 0);
         if need > u128::from(self.max_memory) {
             return Err(Refusal(format!(
                 "a {}x{} frame may take up to {}, more than --max-memory {}",
@@ -401,7 +404,8 @@ mod tests {
         let settings = settings(&args.view).unwrap();
         let state = super::super::start_state(&args, &settings);
         let max_memory = args.input.max_memory.unwrap_or(1 << 30);
-        let r = CliReproduce::new(&args, start, [16; 3], DVec3::ONE, max_memory);
+        let grid = ([16; 3], DVec3::ONE, SampleType::F32);
+        let r = CliReproduce::new(&args, start, grid, NonFinite::Refuse, max_memory);
         (r, state)
     }
 

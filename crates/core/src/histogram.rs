@@ -29,7 +29,7 @@ impl Histogram {
         let mut sum = 0.0f64;
         let mut non_finite = 0u64;
         let width = (f64::from(max) - f64::from(min)) / bins as f64;
-        for &v in volume.data() {
+        for v in volume.values().iter().copied() {
             if !v.is_finite() {
                 non_finite += 1;
                 continue;

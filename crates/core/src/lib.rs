@@ -104,7 +104,7 @@ pub use kernels::phong::{LightGeometry, Phong};
 pub use memory::MemoryBound;
 pub use non_finite::{NonFinite, NonFiniteMask};
 pub use partial::{PartialImage, PartialPixels};
-pub use renderer::{FrameTimes, Renderer};
+pub use renderer::{DEFAULT_CACHE_BUDGET, FrameTimes, Renderer};
 pub use sampling::clipping::ClipPlane;
 pub use settings::{
     Blend, Classification, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_SAMPLES_PER_RAY, Method,
@@ -112,4 +112,4 @@ pub use settings::{
 };
 pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;
-pub use volume::{Volume, VolumeError, checked_point_count};
+pub use volume::{Sample, SampleType, Samples, Volume, VolumeError, checked_point_count};

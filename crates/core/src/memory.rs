@@ -28,7 +28,9 @@ use crate::kernels::gradient;
 use crate::kernels::projection::Projected;
 use crate::non_finite::{self, NonFinite};
 use crate::reference::{self, stage1};
+use crate::renderer::split_budget;
 use crate::settings::{Blend, Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
+use crate::volume::{SampleType, Volume};
 use crate::{bricks, image::Image};
 use glam::DVec3;
 
@@ -52,21 +54,30 @@ impl MemoryBound {
     /// `spacing` apart takes with `settings`, the volume included;
     /// `non_finite` is how its non-finite values are treated
     /// ([`NonFinite::Transparent`] counts the cleaned copy, as if the
-    /// volume had some).
+    /// volume had some); `cache_budget` is the renderer's
+    /// ([`Renderer::with_cache_budget`](crate::Renderer::with_cache_budget)).
+    /// The volume's samples count in their own type.
     pub fn new(
         dims: [usize; 3],
         spacing: DVec3,
+        sample: SampleType,
         settings: &RenderSettings,
         non_finite: NonFinite,
+        cache_budget: usize,
     ) -> Self {
         let voxels: u128 = dims.iter().map(|&n| n as u128).product();
         let grid = BrickGrid::new(dims.map(|n| n.max(2)));
         let bricks = grid.len() as u128;
         let macrocells = bricks * bricks::macrocells::BYTES_PER_BRICK as u128;
         let gradients = voxels * gradient::BYTES_PER_VOXEL as u128;
+        // The reference path reads a dense `f32` copy of other sample types.
+        let reference_values = match sample {
+            SampleType::F32 => 0,
+            _ => voxels * size_of::<f32>() as u128,
+        };
         let path = match (settings.method, settings.blend, settings.classification) {
             (Method::Fast, Blend::Composite, Classification::Pre) => {
-                macrocells + bricked_path(grid, settings)
+                macrocells + bricked_path(grid, settings, cache_budget)
             }
             (Method::Fast, Blend::Composite, Classification::Post) => {
                 macrocells
@@ -76,14 +87,15 @@ impl MemoryBound {
             }
             (Method::Fast, _, _) => macrocells,
             (Method::Reference, Blend::Composite, Classification::Pre) => {
-                gradients
+                reference_values
+                    + gradients
                     + voxels * stage1::BYTES_PER_VOXEL as u128
                     + ray_samples(dims, spacing, settings)
             }
             (Method::Reference, Blend::Composite, Classification::Post) => {
-                gradients + ray_samples(dims, spacing, settings)
+                reference_values + gradients + ray_samples(dims, spacing, settings)
             }
-            (Method::Reference, _, _) => 0,
+            (Method::Reference, _, _) => reference_values,
         };
         let pixels = settings.width as u128 * settings.height as u128;
         let image = size_of::<[f32; 4]>() as u128;
@@ -91,16 +103,34 @@ impl MemoryBound {
             Blend::Composite => pixels * image,
             _ => pixels * (image + size_of::<Projected>() as u128),
         } + size_of::<Image>() as u128;
+        // Only `f32` samples can be non-finite.
         let cleaned = match non_finite {
-            NonFinite::Refuse => 0,
-            NonFinite::Transparent => non_finite::bytes(dims),
+            NonFinite::Transparent if sample == SampleType::F32 => non_finite::bytes(dims),
+            _ => 0,
         };
         MemoryBound {
-            volume: voxels * size_of::<f32>() as u128,
+            volume: voxels * sample.bytes() as u128,
             cleaned,
             path,
             frame,
         }
+    }
+
+    /// [`Self::new`] for `volume`.
+    pub fn for_volume(
+        volume: &Volume,
+        settings: &RenderSettings,
+        non_finite: NonFinite,
+        cache_budget: usize,
+    ) -> Self {
+        Self::new(
+            volume.dims(),
+            volume.spacing(),
+            volume.sample_type(),
+            settings,
+            non_finite,
+            cache_budget,
+        )
     }
 
     /// The whole bound.
@@ -126,25 +156,31 @@ fn ray_samples(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u
 
 /// The bricked fast path with every brick occupied and lit: the classified
 /// and lit bricks, and what a frame allocates for them.
-fn bricked_path(grid: BrickGrid, settings: &RenderSettings) -> u128 {
+fn bricked_path(grid: BrickGrid, settings: &RenderSettings, cache_budget: usize) -> u128 {
     let bricks = grid.len() as u128;
     let per_occupied = bricks::occupied::BYTES_PER_OCCUPIED_BRICK
         + lit_bricks::BYTES_PER_OCCUPIED_BRICK
-        + bricked::FRAME_BYTES_PER_OCCUPIED_BRICK
         + tiles::BYTES_PER_OCCUPIED_BRICK;
+    // The slots, classified and lit, as far as the budget's shares go.
+    let (slot_budget, lit_budget) = split_budget(cache_budget);
+    let slots = (bricks * bricks::occupied::SLOT_BYTES_PER_OCCUPIED_BRICK as u128)
+        .min(slot_budget as u128)
+        + (bricks * lit_bricks::SLOT_BYTES_PER_OCCUPIED_BRICK as u128).min(lit_budget as u128);
     let tiles_x = settings.width.div_ceil(tiles::TILE) as u128;
     let tiles_y = settings.height.div_ceil(tiles::TILE) as u128;
     let tile_count = tiles_x * tiles_y;
     // Each brick is listed in the tiles its projection touches: a brick
     // of the volume framed to fill the window spans about
-    // `window / bricks across` pixels (zoomed), so this many tiles, plus
-    // one on either side; never more than all of them.
+    // `window / bricks across` pixels (zoomed), √3 times that along its
+    // diagonal, and a box of `e` pixels touches at most `⌈e/16⌉ + 1`
+    // tiles along an axis; never more than all of them.
     let across = grid.bricks.iter().copied().min().unwrap_or(1).max(1) as f64;
     let window = settings.width.max(settings.height) as f64;
     let zoom = settings.camera.zoom.max(1.0);
-    let span = (window * zoom * 3f64.sqrt() / across / tiles::TILE as f64).ceil() + 2.0;
+    let span = (window * zoom * 3f64.sqrt() / across / tiles::TILE as f64).ceil() + 1.0;
     let per_brick = (span * span).min(tile_count as f64) as u128;
-    bricks * (per_occupied as u128 + bricks::occupied::BYTES_PER_BRICK as u128)
+    slots
+        + bricks * (per_occupied as u128 + bricks::occupied::BYTES_PER_BRICK as u128)
         + bricks * per_brick * tiles::BYTES_PER_ENTRY as u128
         + tile_count * (tiles::BYTES_PER_TILE + bricked::FRAME_BYTES_PER_TILE) as u128
 }

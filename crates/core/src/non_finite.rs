@@ -105,7 +105,8 @@ impl NonFiniteMask {
             return None;
         }
         let fill = volume.value_range().map_or(0.0, |(lo, _)| lo);
-        let data = volume.data();
+        // Only `f32` samples can be non-finite (the count is 0 otherwise).
+        let data = volume.values();
         let bits: Vec<u64> = data
             .par_chunks(64)
             .map(|chunk| {
@@ -232,14 +233,14 @@ mod tests {
         for i in 0..v.len() {
             let masked = [5, 64, 700].contains(&i);
             assert_eq!(mask.contains(i), masked, "{i}");
-            let want = if masked { 2.0 } else { v.data()[i] };
-            assert_eq!(clean.data()[i], want, "{i}");
+            let want = if masked { 2.0 } else { v.values()[i] };
+            assert_eq!(clean.values()[i], want, "{i}");
         }
         // All non-finite: the fill is 0.
         let all = Volume::new([2, 2, 2], vec![f32::NAN; 8]).unwrap();
         let (mask, clean) = NonFiniteMask::clean(&all).unwrap();
         assert_eq!((mask.count(), mask.fill()), (8, 0.0));
-        assert_eq!(clean.data(), &[0.0; 8]);
+        assert_eq!(*clean.values(), [0.0; 8]);
     }
 
     #[test]

@@ -23,7 +23,7 @@
 //! copy and a mask (see [`NonFinite`](crate::NonFinite) for the exact rules).
 
 use crate::bricks::macrocells::Macrocells;
-use crate::bricks::occupied::ClassifiedBricks;
+use crate::bricks::occupied::{ClassifiedBricks, Source};
 use crate::camera::View;
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::projection as intensity;
@@ -72,6 +72,22 @@ pub struct Renderer<'v> {
     /// (16 bytes per voxel).
     packed_voxels: OnceLock<Vec<wide::f32x4>>,
     fast: Mutex<Option<FastState>>,
+    /// The most bytes the bricked fast path keeps of classified and lit
+    /// bricks ([`Renderer::with_cache_budget`]).
+    cache_budget: usize,
+}
+
+/// The default budget of the bricked fast path's caches of classified and
+/// lit bricks: 1 GiB, which holds every brick of the peers' volumes (257³:
+/// 100 MiB) and keeps a 1024³ CT's frames within a few GiB.
+pub const DEFAULT_CACHE_BUDGET: usize = 1 << 30;
+
+/// The bricked fast path's budget split between classified slots (8 bytes
+/// a slot) and lit ones (16): a third and two thirds, the same number of
+/// bricks each.
+pub(crate) fn split_budget(budget: usize) -> (usize, usize) {
+    let slots = budget / 3;
+    (slots, budget - slots)
 }
 
 /// The fast path's state kept between frames.
@@ -94,8 +110,11 @@ pub struct FrameTimes {
     /// Stage 1 per frame, lighting the occupied bricks' voxels (done as the
     /// rays first reach each brick), and stage 2, casting the rays.
     pub cast: Duration,
-    /// Occupied bricks, and the voxel slots they hold.
+    /// Occupied bricks.
     pub bricks: usize,
+    /// Bytes of classified and lit bricks the caches hold after the frame
+    /// (at most the [cache budget](Renderer::with_cache_budget)).
+    pub cached_bytes: usize,
 }
 
 impl FrameTimes {
@@ -138,7 +157,24 @@ impl<'v> Renderer<'v> {
             max_gradient: OnceLock::new(),
             packed_voxels: OnceLock::new(),
             fast: Mutex::new(None),
+            cache_budget: DEFAULT_CACHE_BUDGET,
         })
+    }
+
+    /// The same renderer keeping at most `bytes` of classified and lit
+    /// bricks on the bricked fast path ([`DEFAULT_CACHE_BUDGET`] unless
+    /// set): beyond it, bricks are classified and lit again when a frame
+    /// needs them, so frames of a volume whose occupied bricks do not fit
+    /// take longer but the memory stays bounded. The images do not depend
+    /// on it.
+    pub fn with_cache_budget(mut self, bytes: usize) -> Self {
+        self.cache_budget = bytes;
+        self
+    }
+
+    /// The budget of the bricked fast path's caches, in bytes.
+    pub fn cache_budget(&self) -> usize {
+        self.cache_budget
     }
 
     /// The volume as rendered: the one given, or, where its non-finite
@@ -455,14 +491,19 @@ impl<'v> Renderer<'v> {
         let classifier = self.classifier(settings);
         let mut guard = self.fast.lock().unwrap_or_else(|e| e.into_inner());
         let t0 = Instant::now();
+        let mask = self.non_finite.as_ref();
+        let masked = |v: usize| mask.is_some_and(|m| m.contains(v));
+        let (slot_budget, lit_budget) = split_budget(self.cache_budget);
         if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
             // Drop the old bricks before building the new ones.
-            let lit = guard.take().map(|s| s.lit).unwrap_or_default();
-            let macrocells = self.macrocells();
-            let mask = self.non_finite.as_ref();
-            let bricks = ClassifiedBricks::new(&self.volume, macrocells, &classifier, |v| {
-                mask.is_some_and(|m| m.contains(v))
-            });
+            *guard = None;
+            let source = Source {
+                volume: &self.volume,
+                classifier: &classifier,
+                masked: &masked,
+            };
+            let bricks = ClassifiedBricks::new(&source, self.macrocells(), slot_budget);
+            let lit = LitBricks::new(bricks.len(), lit_budget);
             *guard = Some(FastState {
                 classifier,
                 bricks,
@@ -474,13 +515,18 @@ impl<'v> Renderer<'v> {
         let bins = TileBins::new(&state.bricks, &frame.sampling, &frame.view);
         let t2 = Instant::now();
         let light = Self::light(settings, &frame.view);
+        let number = state.lit.next_frame();
+        let source = Source {
+            volume: &self.volume,
+            classifier: &state.classifier,
+            masked: &masked,
+        };
         let lighting = Lighting::new(
-            &self.volume,
+            source,
             &state.bricks,
-            &state.classifier,
+            number,
             settings.shading.then_some((&settings.phong, &light)),
         );
-        state.lit.next_frame(state.bricks.len());
         bricked::render(
             &state.bricks,
             &state.lit,
@@ -497,6 +543,7 @@ impl<'v> Renderer<'v> {
         times.bin = t2 - t1;
         times.cast = t3 - t2;
         times.bricks = state.bricks.len();
+        times.cached_bytes = state.bricks.slot_bytes() + state.lit.bytes();
         times
     }
 }

@@ -28,7 +28,7 @@ fn blobs(dims: [usize; 3]) -> Volume {
 /// `volume` with the voxels `hole(i, j, k)` names set to its value.
 fn with_holes(volume: &Volume, hole: impl Fn(usize, usize, usize) -> Option<f32>) -> Volume {
     let [nx, ny, nz] = volume.dims();
-    let mut data = volume.data().to_vec();
+    let mut data = volume.values().to_vec();
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
@@ -74,7 +74,7 @@ fn non_finite_values_are_refused_by_default_with_their_count() {
     let renderer = transparent(&volume);
     assert_eq!(renderer.value_range(), volume.value_range().unwrap());
     assert_eq!(renderer.non_finite().unwrap().count(), 4);
-    assert!(renderer.volume().data().iter().all(|v| v.is_finite()));
+    assert!(renderer.volume().values().iter().all(|v| v.is_finite()));
     // A finite volume is rendered as it is, whatever the mode.
     let finite = blobs([9, 8, 7]);
     let renderer = transparent(&finite);

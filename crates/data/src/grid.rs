@@ -131,7 +131,7 @@ mod tests {
         let v = cube_volume("t", 3, 2.5, |p| p.x).unwrap();
         assert_eq!(v.origin(), DVec3::splat(-2.5));
         assert_eq!(v.spacing(), DVec3::splat(2.5));
-        assert_eq!(v.data()[..3], [-2.5, 0.0, 2.5]);
+        assert_eq!(v.values()[..3], [-2.5, 0.0, 2.5]);
     }
 
     #[test]

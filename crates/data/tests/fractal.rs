@@ -17,7 +17,7 @@ fn raw(size: usize, dimension: f64, seed: u64, random_additions: bool) -> Vec<f3
         raw_field: true,
         ..FractalParams::default()
     };
-    generate(&params).unwrap().data().to_vec()
+    generate(&params).unwrap().values().to_vec()
 }
 
 // ---------------------------------------------------------------------------
@@ -280,7 +280,7 @@ fn matches_the_reference_bit_for_bit() {
                     };
                     let got = generate(&p).unwrap();
                     let want = reference_field(size, &p);
-                    assert!(got.data() == want.as_slice(), "{p}");
+                    assert!(got.values() == want.as_slice(), "{p}");
                 }
             }
         }
@@ -398,7 +398,7 @@ fn same_bytes_for_1_2_and_3_threads() {
                     .num_threads(threads)
                     .build()
                     .unwrap();
-                pool.install(|| generate(&p).unwrap().data().to_vec())
+                pool.install(|| generate(&p).unwrap().values().to_vec())
             })
             .collect();
         let bytes = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
@@ -504,7 +504,7 @@ fn default_clouds_are_about_10_to_20_percent_non_empty() {
                 ..FractalParams::default()
             })
             .unwrap();
-            v.data().iter().filter(|&&x| x > 0.0).count() as f64 / v.len() as f64
+            v.values().iter().filter(|&&x| x > 0.0).count() as f64 / v.len() as f64
         })
         .collect();
     eprintln!("non-empty fractions {fractions:.3?}");
@@ -578,7 +578,7 @@ fn measure_statistics() {
                     ..FractalParams::default()
                 })
                 .unwrap();
-                v.data().iter().filter(|&&x| x > 0.0).count() as f64 / v.len() as f64
+                v.values().iter().filter(|&&x| x > 0.0).count() as f64 / v.len() as f64
             })
             .collect();
         let mean = fractions.iter().sum::<f64>() / fractions.len() as f64;

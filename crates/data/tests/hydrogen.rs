@@ -483,7 +483,7 @@ fn nodal_cones_show_in_the_grid() {
 
 fn grid_sum(v: &Volume) -> f64 {
     let dv = v.spacing().x.powi(3);
-    v.data().iter().map(|&d| f64::from(d)).sum::<f64>() * dv
+    v.values().iter().map(|&d| f64::from(d)).sum::<f64>() * dv
 }
 
 #[test]
@@ -727,7 +727,7 @@ fn huge_extents_give_zeros_not_nans() {
     })
     .unwrap();
     assert_eq!(v.count_non_finite(), 0);
-    assert!(v.data().iter().all(|&d| d == 0.0));
+    assert!(v.values().iter().all(|&d| d == 0.0));
 }
 
 #[test]

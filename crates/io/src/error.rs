@@ -171,6 +171,15 @@ pub enum IoError {
         limit: u64,
     },
 
+    /// A file that holds one image, not a volume (a single slice, a 2-D
+    /// image): what was read, for a caller that describes files rather
+    /// than rendering them; `reason` says why a volume needs more.
+    #[error("{}: {}", path.display(), image.reason)]
+    FlatImage {
+        path: PathBuf,
+        image: Box<crate::FlatImage>,
+    },
+
     /// An image that PNG cannot hold (a side of 0 or more than 2^31 − 1 pixels).
     #[error(
         "{}: cannot write a {width}x{height} image as PNG: each side must be 1 to 2147483647 pixels",
@@ -213,6 +222,7 @@ impl IoError {
             | IoError::NoSuchArray { .. }
             | IoError::ArrayNotScalar { .. }
             | IoError::OverMemoryLimit { .. }
+            | IoError::FlatImage { .. }
             | IoError::ImageSize { .. } => false,
         }
     }
@@ -239,6 +249,7 @@ impl IoError {
             | IoError::NoSuchArray { path, .. }
             | IoError::ArrayNotScalar { path, .. }
             | IoError::OverMemoryLimit { path, .. }
+            | IoError::FlatImage { path, .. }
             | IoError::ImageSize { path, .. } => path,
         }
     }

@@ -21,8 +21,9 @@
 //! every header against the file's length before allocating.
 //!
 //! The format comes from [`ReadOptions::format`], else the file name
-//! ([`VolumeFormat::from_path`]), else its magic number
-//! ([`VolumeFormat::sniff`]). One module per format, under `formats/`:
+//! ([`VolumeFormat::from_path`]), else its content ([`VolumeFormat::sniff`]:
+//! a magic number, or the structure of a cube or VASP text header). One
+//! module per format, under `formats/`:
 //!
 //! | format | module | notes |
 //! |---|---|---|
@@ -35,10 +36,16 @@
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib; Direction; pieces |
 //! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose |
 //! | TIFF stacks `.tif` | `formats/tiff.rs` | pages are z; ImageJ spacing; hyperstack frames |
-//! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | cargo feature `hdf5`; `a[x, y, z]`, `a[t, x, y, z]` |
-//! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled |
-//! | CCP4/MRC `.map`, `.mrc` | `formats/mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin |
-//! | VASP CHGCAR/CHG | `formats/chgcar/` | divided by the cell volume; periodic plane added; spin blocks as frames |
+//! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`); `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
+//! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled; known by content too |
+//! | CCP4/MRC `.map`, `.mrc` | `formats/mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin; skewed: a whole cell resampled periodically, a part (or more) over its box, NaN outside ([`FileInfo::nan_is_empty`]) |
+//! | VASP CHGCAR/CHG | `formats/chgcar/` | divided by the cell volume; periodic plane added; spin blocks as frames; known by content too |
+//! | MINC2 `.mnc` | `formats/minc.rs` | on the HDF5 layer; dimorder, steps, starts, direction cosines; image-min/max scaling as nibabel |
+//!
+//! A file that holds one image rather than a volume (a single DICOM
+//! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is
+//! read and refused as a volume with [`IoError::FlatImage`], which
+//! carries what was read ([`FlatImage`]) for a caller that describes it.
 //!
 //! What the readers share is under `shared/` (its module docs list each
 //! piece and who uses it): [`grid_to_volume`] (`shared/geometry.rs`) maps
@@ -51,7 +58,9 @@
 //! [`check_volume_size`] (`shared/limits.rs`) checks a header's dimensions
 //! for overflow and against [`ReadOptions::max_memory`];
 //! `shared/text_reader.rs` streams numbers out of text formats and text
-//! data; `shared/periodic_cell.rs` resamples skewed periodic cells;
+//! data; `shared/periodic_cell.rs` resamples skewed periodic cells (and
+//! the boxes of skewed maps that are not one cell); `shared/hdf5.rs` opens
+//! HDF5 files and reads their attributes and datasets (HDF5, MINC2);
 //! `shared/vtk_arrays.rs` chooses the array of a VTK file.
 //!
 //! Sample types and byte orders ([`DType`], [`Endian`]) are in `dtype.rs`.
@@ -106,7 +115,7 @@ pub use formats::raw::{RawOptions, read_raw, write_raw};
 pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
-pub use read::{FileInfo, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
+pub use read::{FileInfo, FlatImage, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
 pub use shared::compress::{Compression, inflate_exact};
 pub use shared::geometry::grid_to_volume;
 pub use shared::limits::{

@@ -60,6 +60,46 @@ pub struct Loaded {
     pub info: FileInfo,
 }
 
+/// A file volray parsed that holds one image, not a volume (a single
+/// DICOM slice, a 2-D NRRD, NIfTI, MetaImage or TIFF image): what was
+/// read, so that `volray info` can describe it, carried by
+/// [`IoError::FlatImage`], whose message says why a volume needs more.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlatImage {
+    /// The file's format (set by [`read`]).
+    pub format: VolumeFormat,
+    /// Samples along the file's index axes, x fastest; at least one is 1.
+    pub dims: [usize; 3],
+    /// The distance between samples along each index axis (1 where the
+    /// file gives none, as along the axis of a single slice).
+    pub spacing: volray_core::glam::DVec3,
+    /// The world position of the first sample.
+    pub origin: volray_core::glam::DVec3,
+    /// The samples, index axis 0 fastest, as a volume would hold them.
+    pub values: Vec<f32>,
+    pub info: FileInfo,
+    /// Why this is not a volume and what to pass instead, e.g. `a single
+    /// DICOM slice (512 x 512): pass the directory of the series (ct)`.
+    pub reason: String,
+}
+
+impl FlatImage {
+    /// The least and greatest finite value, their mean, and how many
+    /// values are NaN or infinite; `None` for the range if no value is
+    /// finite.
+    pub fn value_range(&self) -> (Option<(f32, f32, f64)>, usize) {
+        let (mut lo, mut hi, mut sum, mut n) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f64, 0usize);
+        for &v in self.values.iter().filter(|v| v.is_finite()) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            sum += f64::from(v);
+            n += 1;
+        }
+        let range = (n > 0).then(|| (lo, hi, sum / n as f64));
+        (range, self.values.len() - n)
+    }
+}
+
 /// What a file's header said and how the reader used it, for `volray info`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FileInfo {
@@ -83,6 +123,10 @@ pub struct FileInfo {
     /// The named arrays the file holds (VTK), if any, and the one read.
     pub arrays: Vec<String>,
     pub array: Option<String>,
+    /// The volume's NaN values are space the file does not cover (the
+    /// box of a skewed CCP4 map resampled onto an axis-aligned grid):
+    /// to be rendered as empty space, not refused.
+    pub nan_is_empty: bool,
 }
 
 impl FileInfo {
@@ -133,7 +177,13 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             format: spec.description,
         });
     }
-    (spec.read)(path, opts)
+    (spec.read)(path, opts).map_err(|e| match e {
+        IoError::FlatImage { path, mut image } => {
+            image.format = format;
+            IoError::FlatImage { path, image }
+        }
+        other => other,
+    })
 }
 
 /// Splits `file.h5:/group/dataset` into the file and the dataset path,

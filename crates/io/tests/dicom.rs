@@ -230,7 +230,9 @@ fn undecodable_transfer_syntax_is_named() {
 fn single_slice_file_points_to_its_directory() {
     let msg = error("single.dcm", &ReadOptions::default());
     assert!(
-        msg.contains("holds a single slice: pass the directory that holds the whole series"),
+        msg.contains(
+            "a single DICOM slice (4 x 3), not a volume: pass the directory of the series"
+        ),
         "{msg}"
     );
 }

@@ -303,8 +303,8 @@ fn bad_fields_name_field_and_value() {
     refuse(
         d,
         "ndims.mha",
-        &mha("NDims = 2\nDimSize = 4 3", &data),
-        "MetaImage field NDims = 2: volray reads 3-D volumes",
+        &mha("NDims = 5\nDimSize = 4 3 1 1 1", &data),
+        "MetaImage field NDims = 5: volray reads 3-D volumes",
     );
     refuse(
         d,

@@ -205,7 +205,7 @@ fn oblique_affine_keeps_index_axes_and_says_so() {
     assert_eq!(l.volume.dims(), SHAPE);
     assert!((l.volume.spacing() - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-6);
     assert!((l.volume.origin() - DVec3::new(5.0, 6.0, 7.0)).length() < 1e-6);
-    for (n, &value) in l.volume.data().iter().enumerate() {
+    for (n, &value) in l.volume.values().iter().enumerate() {
         let (i, j, k) = (n % 4, (n / 4) % 3, n / 12);
         assert_eq!(value, typed("f32", ramp(i, j, k)));
     }
@@ -396,10 +396,18 @@ fn bad_header_fields() {
         "{msg}"
     );
 
+    // dim[0] 2: the first slice, a 2-D image (tests/flat.rs), described
+    // but not a volume; dim[0] 1 is no image at all.
     let mut b = f32_nii();
     put_i16(&mut b, 40, 2);
     let msg = error_for("e.nii", &b);
-    assert!(msg.contains("\"dim[0]\" is 2"), "{msg}");
+    assert!(
+        msg.contains("a 2-D image (4 x 3 samples), not a volume"),
+        "{msg}"
+    );
+    put_i16(&mut b, 40, 1);
+    let msg = error_for("e.nii", &b);
+    assert!(msg.contains("\"dim[0]\" is 1"), "{msg}");
 
     let mut b = f32_nii();
     put_i16(&mut b, 40, 9);
@@ -414,7 +422,7 @@ fn bad_header_fields() {
     let mut b = f32_nii();
     put_i16(&mut b, 46, 1);
     let msg = error_for("h.nii", &b);
-    assert!(msg.contains("4x3x1 voxels"), "{msg}");
+    assert!(msg.contains("a 2-D image (4 x 3 samples)"), "{msg}");
 
     let mut b = f32_nii();
     put_i16(&mut b, 70, 128);

@@ -103,7 +103,7 @@ fn write_npy_round_trips_a_numpy_file() {
         .chunks_exact(4)
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect();
-    assert_eq!(data, original.data());
+    assert_eq!(data, *original.values());
 }
 
 #[test]
@@ -128,6 +128,6 @@ fn write_npy_round_trips_odd_values() {
     let back = read_npy(&p).unwrap();
     // .npy stores no spacing: it comes back as 1.
     assert_eq!(back.spacing(), DVec3::ONE);
-    let bits = |v: &Volume| v.data().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let bits = |v: &Volume| v.values().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&back), bits(&v));
 }

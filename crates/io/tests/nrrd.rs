@@ -368,7 +368,13 @@ fn bad_header_fields_name_field_and_value() {
         d,
         "dim2.nrrd",
         &with_data("type: uchar\ndimension: 2\nsizes: 4 3\nencoding: raw\n"),
-        "NRRD field \"dimension\": 2: volray reads 3-D volumes",
+        "a 2-D image (4 x 3 samples), not a volume",
+    );
+    refuse(
+        d,
+        "dim1.nrrd",
+        &with_data("type: uchar\ndimension: 1\nsizes: 12\nencoding: raw\n"),
+        "NRRD field \"dimension\": 1: volray reads 3-D volumes",
     );
     refuse(
         d,

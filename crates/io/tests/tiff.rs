@@ -204,8 +204,12 @@ fn unsupported_stacks_are_refused_clearly() {
         msg.contains("TIFF page 2 is 4x2 pixels but page 0 is 4x3"),
         "{msg}"
     );
+    // One page is an image (tests/flat.rs): read, not a volume.
     let msg = error("single_page.tif", &none);
-    assert!(msg.contains("1 slice(s)"), "{msg}");
+    assert!(
+        msg.contains("a 2-D image (4 x 3 samples), not a volume"),
+        "{msg}"
+    );
 }
 
 #[test]

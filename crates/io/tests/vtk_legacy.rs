@@ -203,7 +203,7 @@ fn hand_written_ascii_file_reads() {
     let p = dir.path().join("small.vtk");
     std::fs::write(&p, &text).unwrap();
     let l = read(&p, &ReadOptions::default()).unwrap();
-    assert_eq!(l.volume.data(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
+    assert_eq!(*l.volume.values(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
     assert_eq!(l.volume.spacing(), DVec3::ONE);
     assert_eq!(l.volume.origin(), DVec3::ZERO);
     assert_eq!(l.info.arrays, ["a b"]);
@@ -215,7 +215,7 @@ fn hand_written_ascii_file_reads() {
     std::fs::write(&p, &text).unwrap();
     let l = read(&p, &ReadOptions::default()).unwrap();
     assert_eq!(l.volume.origin(), DVec3::new(-2.0, 0.0, 0.0));
-    assert_eq!(l.volume.data(), [2.0, 1.0, 4.0, 3.0, 6.0, 5.0, 8.0, 7.0]);
+    assert_eq!(*l.volume.values(), [2.0, 1.0, 4.0, 3.0, 6.0, 5.0, 8.0, 7.0]);
 }
 
 #[test]

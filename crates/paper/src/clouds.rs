@@ -143,7 +143,7 @@ pub fn cloud(size: usize, seed: u64, style: &CloudStyle) -> Result<Cloud, PaperE
     let field = generate(&base)?;
     // The ramped field lies in [0, 1]; a threshold of 1 or more would empty
     // it, which `volray-data` refuses, and no share > 0 asks for it.
-    let threshold = threshold_for(field.data(), style.filled).min(0.999);
+    let threshold = threshold_for(&field.values(), style.filled).min(0.999);
     drop(field);
     let params = FractalParams { threshold, ..base };
     Ok(Cloud {
@@ -222,11 +222,11 @@ mod tests {
         let c = cloud(33, 1, &style).unwrap();
         let inside = generate(&unthresholded(33, 1, &style))
             .unwrap()
-            .data()
+            .values()
             .iter()
             .filter(|&&v| v > 0.0)
             .count();
-        let filled = c.volume.data().iter().filter(|&&v| v > 0.0).count();
+        let filled = c.volume.values().iter().filter(|&&v| v > 0.0).count();
         let share = filled as f64 / inside as f64;
         assert!((share - style.filled).abs() < 0.01, "{share}");
         let again = volray_data::generate(&c.spec()).unwrap();

@@ -154,7 +154,7 @@ pub fn density(l: u32, m: u32, grid: usize) -> Result<Volume, PaperError> {
 /// they are (the densities are non-negative); a volume whose sum is not
 /// positive gives its maximum.
 pub fn density_level(volume: &Volume, share: f64) -> f32 {
-    let mut values: Vec<f32> = volume.data().to_vec();
+    let mut values: Vec<f32> = volume.values().to_vec();
     values.sort_unstable_by(|a, b| b.total_cmp(a));
     let total: f64 = values.iter().map(|&v| f64::from(v)).sum();
     if total <= 0.0 {

@@ -67,6 +67,9 @@ pub struct Viewer {
     /// so by [`Start::log`]).
     pub volume: Arc<Volume>,
     pub non_finite: NonFinite,
+    /// The bytes each tab's renderer may keep in brick caches
+    /// (`Renderer::with_cache_budget`).
+    pub cache_budget: usize,
     /// The page's first message ([`Start::hello`]).
     pub hello: Hello,
     pub reproduce: Arc<dyn Reproduce>,
@@ -93,6 +96,7 @@ impl Viewer {
         let shared = session::Shared {
             volume: self.volume,
             non_finite: self.non_finite,
+            cache_budget: self.cache_budget,
             reproduce: self.reproduce,
             pool: self.pool,
             stats: Arc::new(stats::Stats::default()),

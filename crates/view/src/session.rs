@@ -33,6 +33,8 @@ pub enum Outgoing {
 pub struct Shared {
     pub volume: Arc<Volume>,
     pub non_finite: NonFinite,
+    /// The bytes each tab's renderer may keep in brick caches.
+    pub cache_budget: usize,
     pub reproduce: Arc<dyn Reproduce>,
     pub pool: Arc<rayon::ThreadPool>,
     pub stats: Arc<Stats>,
@@ -75,12 +77,13 @@ pub fn spawn(
     let pool = Arc::clone(&shared.pool);
     let stats = Arc::clone(&shared.stats);
     let non_finite = shared.non_finite;
+    let cache_budget = shared.cache_budget;
     std::thread::Builder::new()
         .name("view-render".into())
         .spawn(move || {
             let _open = open;
             let renderer = match Renderer::with_non_finite(&volume, non_finite) {
-                Ok(r) => r,
+                Ok(r) => r.with_cache_budget(cache_budget),
                 Err(e) => {
                     let message = ServerMessage::Error {
                         seq: None,
@@ -239,6 +242,7 @@ mod tests {
         Shared {
             volume: Arc::new(volume),
             non_finite: NonFinite::Refuse,
+            cache_budget: volray_core::DEFAULT_CACHE_BUDGET,
             reproduce: Arc::new(Plain),
             pool: Arc::new(
                 rayon::ThreadPoolBuilder::new()

@@ -7,7 +7,7 @@
 //! out most empty bricks without classifying their voxels one by one.
 
 use crate::bricks::{BrickGrid, SIDE, slot_coords};
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
 use rayon::prelude::*;
 
 /// Bytes each brick takes in [`Macrocells`].
@@ -23,25 +23,30 @@ pub struct Macrocells {
 impl Macrocells {
     pub fn new(volume: &Volume) -> Self {
         let grid = BrickGrid::new(volume.dims());
-        let data = volume.data();
-        let ranges = (0..grid.len())
-            .into_par_iter()
-            .map(|i| {
-                let b = grid.coords(i);
-                let mut range = (f32::INFINITY, f32::NEG_INFINITY);
-                // Whole rows of slots at a time: x varies fastest in both.
-                for s in slot_coords().step_by(SIDE) {
-                    let start = grid.voxel_of_slot(b, s);
-                    let end = grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
-                    for &v in &data[start..=end] {
-                        range = (range.0.min(v), range.1.max(v));
-                    }
-                }
-                range
-            })
-            .collect();
+        let ranges = crate::with_samples!(volume.samples(), |data| ranges(data, grid));
         Macrocells { grid, ranges }
     }
+}
+
+/// Every brick's `(min, max)` over `data`'s values as `f32`.
+fn ranges<T: Sample>(data: &[T], grid: BrickGrid) -> Vec<(f32, f32)> {
+    (0..grid.len())
+        .into_par_iter()
+        .map(|i| {
+            let b = grid.coords(i);
+            let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+            // Whole rows of slots at a time: x varies fastest in both.
+            for s in slot_coords().step_by(SIDE) {
+                let start = grid.voxel_of_slot(b, s);
+                let end = grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
+                for v in &data[start..=end] {
+                    let v = v.to_f32();
+                    range = (range.0.min(v), range.1.max(v));
+                }
+            }
+            range
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 //! beyond the volume repeat the last voxel, which no clamped sample can tell
 //! apart from the voxel itself.
 
+pub mod cache;
 pub mod macrocells;
 pub mod occupied;
 
@@ -75,6 +76,13 @@ impl BrickGrid {
     /// Whether the brick has a face on the volume's boundary.
     pub fn touches_boundary(&self, b: [usize; 3]) -> bool {
         (0..3).any(|a| b[a] == 0 || b[a] + 1 == self.bricks[a])
+    }
+
+    /// Coordinates of the voxel of linear index `v` (into the volume).
+    #[inline]
+    pub fn voxel_coords(&self, v: usize) -> [usize; 3] {
+        let [nx, ny, _] = self.dims;
+        [v % nx, (v / nx) % ny, v / (nx * ny)]
     }
 
     /// Linear index (into the volume) of the voxel in slot `s` of brick `b`:

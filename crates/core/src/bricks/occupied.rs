@@ -1,6 +1,6 @@
 //! The fast path's view-independent stage 1: the occupied bricks of a
-//! volume under one transfer function, with every voxel's normal, material
-//! colour and opacity, kept compact and kept across frames.
+//! volume under one transfer function, and every voxel's normal and
+//! opacity, kept compact and kept across frames, under a memory budget.
 //!
 //! A brick (see [`crate::bricks`]) is *occupied* when any of its voxels has
 //! a non-zero opacity; the others hold no sample that could add to a ray
@@ -8,9 +8,12 @@
 //! they are neither stored nor visited. The min/max macro-cell grid rules
 //! out most of them at once (see [`crate::bricks::macrocells`]); the rest are
 //! classified voxel by voxel, with the voxel's gradient where the opacity
-//! depends on it (an iso-surface, gradient-magnitude opacity). Inside an occupied brick a mask marks the
-//! occupied *cells* (any of the eight corners with non-zero opacity), so
-//! that the ray caster skips empty cells with one bit test.
+//! depends on it (an iso-surface, gradient-magnitude opacity). Inside an
+//! occupied brick a mask marks the occupied *cells* (any of the eight
+//! corners with non-zero opacity), so that the ray caster skips empty cells
+//! with one bit test, and the box of the occupied cells bounds each ray's
+//! samples in it. These are kept for every occupied brick (about 100 bytes
+//! a brick).
 //!
 //! Storage per voxel slot of an occupied brick (8 bytes, [`Voxel`]): the
 //! unit normal (gradient direction, errata 1) as three `i16` in units of
@@ -21,35 +24,44 @@
 //! would cost up to 1/510 per sample). The material colour is not stored:
 //! each frame recomputes it exactly from the voxel's value.
 //!
+//! **Budget.** The slots of the occupied bricks are kept in a
+//! [`BrickCache`] of at most the budget's bytes (5.8 KiB a brick). When
+//! they all fit they are all classified at once and kept, as if there were
+//! no budget. When they do not (a dense 1024³ CT has two million occupied
+//! bricks, 11 GiB of slots), a brick is classified when a frame first
+//! needs it, and kept while the budget has room or while recent frames use
+//! it; the others are classified again when needed (see the cache's
+//! policy). Classifying a brick gives the same slots whenever it is done,
+//! so the images do not depend on the budget.
+//!
 //! All of this depends on the volume and the classifier only: the light,
 //! which follows the camera, is applied per frame by [`crate::cpu::lit_bricks`].
 
+use crate::bricks::cache::{BrickCache, CacheRef};
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot, slot_coords};
-use crate::kernels::gradient::gradient_at;
+use crate::kernels::gradient::Differences;
 use crate::transfer::classifier::Classifier;
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
 use rayon::prelude::*;
 
-/// Bytes one occupied brick takes, for the memory bound
-/// ([`crate::memory`]): its [`SLOTS`] voxels and its entries in every
-/// per-brick list of [`ClassifiedBricks`] (and the flag each brick gets
-/// while they are found).
-pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize = SLOTS * size_of::<Voxel>()
-    + size_of::<[usize; 3]>()
+/// Bytes one occupied brick takes beside its slots, for the memory bound
+/// ([`crate::memory`]): its entries in every per-brick list of
+/// [`ClassifiedBricks`] and in the cache of its slots.
+pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize = size_of::<u32>()
     + size_of::<[u64; CELLS / 64]>()
     + size_of::<([u8; 3], [u8; 3])>()
-    + size_of::<[u64; SLOTS.div_ceil(64)]>();
-/// Bytes every brick, occupied or not, takes in [`ClassifiedBricks`]
-/// (`slot_of`, and the occupancy flag while classifying).
-pub(crate) const BYTES_PER_BRICK: usize = size_of::<u32>() + size_of::<bool>();
+    + BrickCache::<Classified>::BYTES_PER_ENTRY;
+/// Bytes of one occupied brick's classified slots, in the cache.
+pub(crate) const SLOT_BYTES_PER_OCCUPIED_BRICK: usize = size_of::<Classified>();
+/// Bytes every brick, occupied or not, takes while the occupied ones are
+/// found (a flag).
+pub(crate) const BYTES_PER_BRICK: usize = size_of::<bool>();
 
 /// Units of a `u16` colour or opacity: 65535 is 1.
 pub const UNIT: f32 = 65535.0;
 /// Units of an `i16` normal component: 32767 is 1.
 pub const NORMAL_UNIT: f32 = 32767.0;
-/// `slot_of` entry of a brick that is not occupied.
-pub const EMPTY: u32 = u32::MAX;
 
 /// `x` in [0, 1] to the nearest `u16` step.
 #[inline]
@@ -81,55 +93,88 @@ pub struct Voxel {
     pub alpha: u16,
 }
 
-/// The occupied bricks of a volume under one classifier.
-#[derive(Debug, Clone, PartialEq)]
+/// What classifying a brick reads: the volume, the classifier, and which
+/// voxels are masked (non-finite in the original, for a cleaned volume;
+/// see [`NonFinite`](crate::NonFinite)), which get zero opacity.
+#[derive(Clone, Copy)]
+pub struct Source<'a> {
+    pub volume: &'a Volume,
+    pub classifier: &'a Classifier,
+    pub masked: &'a (dyn Fn(usize) -> bool + Sync),
+}
+
+/// The occupied bricks of a volume under one classifier, and the cache of
+/// their classified slots.
 pub struct ClassifiedBricks {
     pub grid: BrickGrid,
-    /// Per brick (see [`BrickGrid::index`]): its number among the occupied
-    /// bricks, or [`EMPTY`].
-    pub slot_of: Vec<u32>,
-    /// Per occupied brick: its coordinates.
-    pub occupied: Vec<[usize; 3]>,
+    /// Per occupied brick: its index in the grid ([`BrickGrid::index`]).
+    occupied: Vec<u32>,
     /// Per occupied brick: bit [`cell`] set where the cell has a corner of
     /// non-zero opacity.
     pub cells: Vec<[u64; CELLS / 64]>,
     /// Per occupied brick: the first and the last occupied cell along x, y
     /// and z. Samples outside this box are in empty cells.
     pub occupied_cells: Vec<([u8; 3], [u8; 3])>,
-    /// Per occupied brick: bit `s` set where slot `s` is a corner of an
-    /// occupied cell. The other slots are never sampled.
-    pub needed: Vec<[u64; SLOTS.div_ceil(64)]>,
-    /// Per occupied brick, [`SLOTS`] each, in slot order.
-    pub voxels: Vec<Voxel>,
+    /// Per occupied brick, its classified slots, while the budget holds
+    /// them.
+    voxels: BrickCache<Classified>,
+}
+
+/// An occupied brick's classified slots: its [`SLOTS`] voxels in slot
+/// order, and which of them are the corners of occupied cells (the others
+/// are never sampled).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Classified {
+    pub voxels: [Voxel; SLOTS],
+    pub needed: [u64; SLOTS.div_ceil(64)],
+}
+
+impl Classified {
+    /// All zero, to be filled.
+    fn blank() -> Box<Self> {
+        Box::new(Classified {
+            voxels: [Voxel::default(); SLOTS],
+            needed: [0; SLOTS.div_ceil(64)],
+        })
+    }
 }
 
 impl ClassifiedBricks {
-    /// Classifies `volume` brick by brick; `macrocells` are its value
-    /// ranges. For a cleaned volume, the voxels `masked` says (non-finite in the
-    /// original, see [`NonFinite`](crate::NonFinite)) get zero opacity.
-    pub fn new(
-        volume: &Volume,
+    /// Finds the occupied bricks of `source`'s volume (`macrocells` are its
+    /// value ranges) and classifies them, keeping at most `budget` bytes of
+    /// classified slots (see the module docs).
+    pub fn new(source: &Source, macrocells: &Macrocells, budget: usize) -> Self {
+        crate::with_samples!(source.volume.samples(), |data| Self::classify(
+            source, data, macrocells, budget
+        ))
+    }
+
+    /// [`Self::new`] on samples `data` of type `T`.
+    fn classify<T: Sample>(
+        source: &Source,
+        data: &[T],
         macrocells: &Macrocells,
-        classifier: &Classifier,
-        masked: impl Fn(usize) -> bool + Sync,
+        budget: usize,
     ) -> Self {
+        let Source {
+            volume,
+            classifier,
+            masked,
+        } = *source;
         let grid = macrocells.grid;
-        let data = volume.data();
-        let [nx, ny, _] = grid.dims;
-        let coords = |v: usize| (v % nx, (v / nx) % ny, v / (nx * ny));
-        // The gradient is computed here only where the opacity needs it;
-        // the occupied bricks' voxels below need it for their normals anyway.
-        let opacity = |v: usize| {
+        let differences = Differences::new(data, volume);
+        // The opacity of voxel `v` (at `(x, y, z)`) in the stored units;
+        // the gradient is computed only where the opacity needs it.
+        let opacity = |v: usize, [x, y, z]: [usize; 3]| {
             if masked(v) {
                 return 0;
             }
             let gradient = if classifier.uses_gradient() {
-                let (x, y, z) = coords(v);
-                gradient_at(volume, x, y, z)
+                differences.at(x, y, z)
             } else {
                 [0.0; 3]
             };
-            quantise(classifier.opacity_at(data[v], gradient))
+            quantise(classifier.opacity_at(data[v].to_f32(), gradient))
         };
         let is_occupied: Vec<bool> = (0..grid.len())
             .into_par_iter()
@@ -137,62 +182,94 @@ impl ClassifiedBricks {
                 let (lo, hi) = macrocells.ranges[i];
                 let b = grid.coords(i);
                 !classifier.is_transparent_between(lo, hi)
-                    && slot_coords().any(|s| opacity(grid.voxel_of_slot(b, s)) > 0)
+                    && slot_coords().any(|s| {
+                        let v = grid.voxel_of_slot(b, s);
+                        opacity(v, grid.voxel_coords(v)) > 0
+                    })
             })
             .collect();
 
-        let mut slot_of = vec![EMPTY; grid.len()];
-        let mut occupied = Vec::new();
-        for (i, _) in is_occupied.iter().enumerate().filter(|(_, o)| **o) {
-            slot_of[i] = occupied.len() as u32;
-            occupied.push(grid.coords(i));
-        }
+        let occupied: Vec<u32> = (is_occupied.iter().enumerate())
+            .filter(|(_, o)| **o)
+            .map(|(i, _)| i as u32)
+            .collect();
+        drop(is_occupied);
 
-        let mut voxels = vec![Voxel::default(); occupied.len() * SLOTS];
-        let mut cells = vec![[0u64; CELLS / 64]; occupied.len()];
-        let mut occupied_cells = vec![([0u8; 3], [0u8; 3]); occupied.len()];
-        let mut needed = vec![[0u64; SLOTS.div_ceil(64)]; occupied.len()];
-        voxels
-            .par_chunks_mut(SLOTS)
-            .zip(cells.par_iter_mut())
-            .zip(occupied_cells.par_iter_mut())
-            .zip(needed.par_iter_mut())
-            .zip(occupied.par_iter())
-            .for_each(|((((voxels, cells), bounds), needed), &b)| {
-                for (s, [i, j, k]) in slot_coords().enumerate() {
-                    let v = grid.voxel_of_slot(b, [i, j, k]);
-                    let (x, y, z) = coords(v);
-                    let gradient = gradient_at(volume, x, y, z);
-                    let alpha = if masked(v) {
-                        0.0
-                    } else {
-                        classifier.opacity_at(data[v], gradient)
-                    };
-                    voxels[s] = Voxel {
-                        normal: quantise_normal(gradient),
-                        alpha: quantise(alpha),
-                    };
-                }
-                *cells = cell_mask(voxels);
-                *bounds = cell_bounds(cells);
-                *needed = needed_slots(cells);
-            });
+        // Every occupied brick's cells, from its slots' opacities; and, if
+        // the budget holds them all, its slots, classified now and kept.
+        let voxels = BrickCache::new(occupied.len(), budget, |_, _| true, |f, now| f + 1 < now);
+        let eager = occupied.len() * size_of::<Classified>() <= budget;
+        let (cells, occupied_cells): (Vec<_>, Vec<_>) = (0..occupied.len())
+            .into_par_iter()
+            .map(|n| {
+                let b = grid.coords(occupied[n] as usize);
+                let cells = if eager {
+                    let mut slots = Classified::blank();
+                    classify_brick(source, &differences, data, grid, b, &mut slots.voxels);
+                    let cells = cell_mask(|s| slots.voxels[s].alpha);
+                    slots.needed = needed_slots(&cells);
+                    assert!(voxels.put(n, slots), "the budget holds every brick");
+                    cells
+                } else {
+                    let mut alpha = [0u16; SLOTS];
+                    for (s, local) in slot_coords().enumerate() {
+                        let v = grid.voxel_of_slot(b, local);
+                        alpha[s] = opacity(v, grid.voxel_coords(v));
+                    }
+                    cell_mask(|s| alpha[s])
+                };
+                (cells, cell_bounds(&cells))
+            })
+            .unzip();
 
         ClassifiedBricks {
             grid,
-            slot_of,
             occupied,
             cells,
             occupied_cells,
-            needed,
             voxels,
         }
+    }
+
+    /// Occupied brick `n`'s classified slots in frame `frame`: from the
+    /// cache, or classified now from `source` (the one the bricks were made
+    /// from) into the cache or, when it has no room, into `scratch` (see
+    /// [`BrickCache::get`]).
+    pub fn classified<'a>(
+        &'a self,
+        n: usize,
+        frame: u64,
+        source: &Source,
+        scratch: &'a mut Option<Box<Classified>>,
+    ) -> CacheRef<'a, Classified> {
+        self.voxels.get(
+            n,
+            frame,
+            Classified::blank,
+            |slots| {
+                crate::with_samples!(source.volume.samples(), |data| classify_brick(
+                    source,
+                    &Differences::new(data, source.volume),
+                    data,
+                    self.grid,
+                    self.brick(n),
+                    &mut slots.voxels
+                ));
+                slots.needed = needed_slots(&self.cells[n]);
+            },
+            scratch,
+        )
+    }
+
+    /// Bytes of classified slots held now.
+    pub fn slot_bytes(&self) -> usize {
+        self.voxels.bytes()
     }
 
     /// The index-space box of occupied brick `n`'s occupied cells, clipped
     /// to the volume.
     pub fn occupied_box(&self, n: usize) -> ([usize; 3], [usize; 3]) {
-        let origin = self.grid.origin(self.occupied[n]);
+        let origin = self.grid.origin(self.brick(n));
         let (first, last) = self.occupied_cells[n];
         let lo = std::array::from_fn(|a| origin[a] + first[a] as usize);
         let hi =
@@ -204,10 +281,48 @@ impl ClassifiedBricks {
     pub fn len(&self) -> usize {
         self.occupied.len()
     }
+
+    /// The coordinates of occupied brick `n`.
+    #[inline]
+    pub fn brick(&self, n: usize) -> [usize; 3] {
+        self.grid.coords(self.occupied[n] as usize)
+    }
+
+    /// The coordinates of every occupied brick, in order.
+    pub fn bricks(&self) -> impl ExactSizeIterator<Item = [usize; 3]> + '_ {
+        (0..self.len()).map(|n| self.brick(n))
+    }
 }
 
-/// The occupied cells of one brick from its slots' opacities.
-fn cell_mask(voxels: &[Voxel]) -> [u64; CELLS / 64] {
+/// Classifies the slots of brick `b` (samples `data`, their `differences`)
+/// into `slots`: each voxel's normal and opacity.
+fn classify_brick<T: Sample>(
+    source: &Source,
+    differences: &Differences<T>,
+    data: &[T],
+    grid: BrickGrid,
+    b: [usize; 3],
+    slots: &mut [Voxel; SLOTS],
+) {
+    for (s, local) in slot_coords().enumerate() {
+        let v = grid.voxel_of_slot(b, local);
+        let [x, y, z] = grid.voxel_coords(v);
+        let gradient = differences.at(x, y, z);
+        let alpha = if (source.masked)(v) {
+            0.0
+        } else {
+            source.classifier.opacity_at(data[v].to_f32(), gradient)
+        };
+        slots[s] = Voxel {
+            normal: quantise_normal(gradient),
+            alpha: quantise(alpha),
+        };
+    }
+}
+
+/// The occupied cells of one brick from its slots' opacities (`alpha` of
+/// slot `s`, in the stored units).
+fn cell_mask(alpha: impl Fn(usize) -> u16) -> [u64; CELLS / 64] {
     let mut mask = [0u64; CELLS / 64];
     let side = SIDE - 1;
     for k in 0..side {
@@ -215,7 +330,7 @@ fn cell_mask(voxels: &[Voxel]) -> [u64; CELLS / 64] {
             for i in 0..side {
                 let any = (0..8).any(|c| {
                     let s = slot(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
-                    voxels[s].alpha > 0
+                    alpha(s) > 0
                 });
                 if any {
                     let n = cell(i, j, k);
@@ -227,19 +342,31 @@ fn cell_mask(voxels: &[Voxel]) -> [u64; CELLS / 64] {
     mask
 }
 
-/// The slots at the corners of a brick's occupied cells.
-fn needed_slots(cells: &[u64; CELLS / 64]) -> [u64; SLOTS.div_ceil(64)] {
+/// The slots at the corners of a brick's occupied cells: a slot is needed
+/// where any of the (up to) eight cells around it is occupied. Row by row:
+/// the cells along x of row `(j, k)` are one byte of the mask, and a row of
+/// slots `(j, k)` takes the cells of rows `j − 1..=j` and `k − 1..=k`,
+/// widened by one along x.
+pub fn needed_slots(cells: &[u64; CELLS / 64]) -> [u64; SLOTS.div_ceil(64)] {
+    // Cell (i, j, k) is bit i + 8j of word k (`cell`).
+    const _: () = assert!(BRICK == 8 && CELLS / 64 == BRICK);
+    let row = |j: usize, k: usize| (cells[k] >> (8 * j)) as u16 & 0xFF;
     let mut needed = [0u64; SLOTS.div_ceil(64)];
-    for k in 0..BRICK {
-        for j in 0..BRICK {
-            for i in 0..BRICK {
-                let n = cell(i, j, k);
-                if cells[n / 64] >> (n % 64) & 1 == 1 {
-                    for c in 0..8 {
-                        let s = slot(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
-                        needed[s / 64] |= 1 << (s % 64);
-                    }
+    for k in 0..SIDE {
+        for j in 0..SIDE {
+            let mut m = 0u16;
+            for dk in k.saturating_sub(1)..=k.min(BRICK - 1) {
+                for dj in j.saturating_sub(1)..=j.min(BRICK - 1) {
+                    m |= row(dj, dk);
                 }
+            }
+            // Slots i and i + 1 are the corners of cell i; the row's nine
+            // bits may straddle two words.
+            let first = slot(0, j, k);
+            let bits = u128::from(m | (m << 1)) << (first % 64);
+            needed[first / 64] |= bits as u64;
+            if let Some(next) = needed.get_mut(first / 64 + 1) {
+                *next |= (bits >> 64) as u64;
             }
         }
     }
@@ -269,11 +396,31 @@ fn cell_bounds(cells: &[u64; CELLS / 64]) -> ([u8; 3], [u8; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels::gradient::max_magnitude;
+    use crate::kernels::gradient::{gradient_at, max_magnitude};
     use crate::transfer::classifier::OpacityMap;
     use crate::transfer::function::PiecewiseLinear;
     use crate::transfer::iso::IsoSurface;
     use glam::DVec3;
+
+    /// The bricks of `v` under `c`, keeping `budget` bytes of slots.
+    fn classify(v: &Volume, c: &Classifier, budget: usize) -> ClassifiedBricks {
+        let source = Source {
+            volume: v,
+            classifier: c,
+            masked: &|_| false,
+        };
+        ClassifiedBricks::new(&source, &Macrocells::new(v), budget)
+    }
+
+    /// Occupied brick `n`'s slots.
+    fn slots(b: &ClassifiedBricks, n: usize, v: &Volume, c: &Classifier) -> Vec<Voxel> {
+        let source = Source {
+            volume: v,
+            classifier: c,
+            masked: &|_| false,
+        };
+        b.classified(n, 1, &source, &mut None).voxels.to_vec()
+    }
 
     /// Opacity zero below t = 0.5, a ramp above it.
     fn threshold() -> Classifier {
@@ -289,10 +436,8 @@ mod tests {
         data[12 + 30 * (3 + 10 * 20)] = 1.0;
         let v = Volume::new([30, 10, 25], data).unwrap();
         let c = threshold();
-        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, |_| false);
-        assert_eq!(b.occupied, vec![[1, 0, 2]]);
-        assert_eq!(b.slot_of[b.grid.index([1, 0, 2])], 0);
-        assert_eq!(b.slot_of.iter().filter(|&&s| s != EMPTY).count(), 1);
+        let b = classify(&v, &c, usize::MAX);
+        assert_eq!(b.bricks().collect::<Vec<_>>(), vec![[1, 0, 2]]);
         // The voxel is local (4, 3, 4): the eight cells around it are occupied.
         let occupied: Vec<usize> = (0..CELLS)
             .filter(|n| b.cells[0][n / 64] >> (n % 64) & 1 == 1)
@@ -304,19 +449,50 @@ mod tests {
         assert_eq!(occupied, want);
         assert_eq!(b.occupied_cells, vec![([3, 2, 3], [4, 3, 4])]);
         // The corners of those cells: the 3 × 3 × 3 slots around the voxel.
+        let needed_bits = needed_slots(&b.cells[0]);
         let needed: Vec<usize> = (0..SLOTS)
-            .filter(|s| b.needed[0][s / 64] >> (s % 64) & 1 == 1)
+            .filter(|s| needed_bits[s / 64] >> (s % 64) & 1 == 1)
             .collect();
         let mut want: Vec<usize> = (0..27)
             .map(|c| slot(3 + c % 3, 2 + (c / 3) % 3, 3 + c / 9))
             .collect();
         want.sort();
         assert_eq!(needed, want);
-        assert_eq!(
-            b.voxels[slot(4, 3, 4)].alpha,
-            quantise(c.sample_opacity(1.0))
-        );
-        assert_eq!(b.voxels[slot(5, 3, 4)].alpha, 0);
+        let voxels = slots(&b, 0, &v, &c);
+        assert_eq!(voxels[slot(4, 3, 4)].alpha, quantise(c.sample_opacity(1.0)));
+        assert_eq!(voxels[slot(5, 3, 4)].alpha, 0);
+    }
+
+    #[test]
+    fn the_needed_slots_are_the_corners_of_the_occupied_cells() {
+        // Cell masks of every density, from a hash: the row-wise dilation
+        // against the definition, cell by cell, corner by corner.
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        for density in [1u64, 5, 20, 64] {
+            let cells: [u64; CELLS / 64] = std::array::from_fn(|_| {
+                (0..64).fold(0, |word, bit| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    word | (u64::from(seed % 64 < density) << bit)
+                })
+            });
+            let mut want = [0u64; SLOTS.div_ceil(64)];
+            for k in 0..BRICK {
+                for j in 0..BRICK {
+                    for i in 0..BRICK {
+                        let n = cell(i, j, k);
+                        if cells[n / 64] >> (n % 64) & 1 == 1 {
+                            for c in 0..8 {
+                                let s = slot(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+                                want[s / 64] |= 1 << (s % 64);
+                            }
+                        }
+                    }
+                }
+            }
+            assert_eq!(needed_slots(&cells), want, "density {density}");
+        }
     }
 
     #[test]
@@ -324,8 +500,8 @@ mod tests {
         let mut data = vec![0.0f32; 20 * 5 * 5];
         data[8 + 20 * (2 + 5 * 2)] = 1.0;
         let v = Volume::new([20, 5, 5], data).unwrap();
-        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &threshold(), |_| false);
-        assert_eq!(b.occupied, vec![[0, 0, 0], [1, 0, 0]]);
+        let b = classify(&v, &threshold(), usize::MAX);
+        assert_eq!(b.bricks().collect::<Vec<_>>(), vec![[0, 0, 0], [1, 0, 0]]);
     }
 
     #[test]
@@ -336,10 +512,12 @@ mod tests {
             (0.6 + 0.03 * (1.5 * p.x + 4.0 * p.y)) as f32
         })
         .unwrap();
-        let b = ClassifiedBricks::new(&v, &Macrocells::new(&v), &threshold(), |_| false);
+        let c = threshold();
+        let b = classify(&v, &c, usize::MAX);
         assert!(b.len() > 0);
         let want = DVec3::new(1.5, 4.0, 0.0).normalize() * NORMAL_UNIT as f64;
-        for v in &b.voxels {
+        let all: Vec<Voxel> = (0..b.len()).flat_map(|n| slots(&b, n, &v, &c)).collect();
+        for v in &all {
             for a in 0..3 {
                 let n = v.normal;
                 assert!((n[a] as f64 - want[a]).abs() <= 1.0, "{n:?} vs {want}");
@@ -368,7 +546,14 @@ mod tests {
             thickness: 2.0,
         };
         let c = base.with_iso(iso, 1.0, max_magnitude(&v));
-        let b = ClassifiedBricks::new(&v, &m, &c, |_| false);
+        // Every brick's slots kept, and none kept: the same bricks, cells
+        // and slots.
+        let b = classify(&v, &c, usize::MAX);
+        let lazy = classify(&v, &c, 0);
+        assert_eq!(
+            (&b.occupied, &b.cells, &b.occupied_cells),
+            (&lazy.occupied, &lazy.cells, &lazy.occupied_cells)
+        );
         let mut skipped_by_range = 0;
         for i in 0..m.grid.len() {
             let brick = m.grid.coords(i);
@@ -376,23 +561,21 @@ mod tests {
                 .map(|s| {
                     let n = m.grid.voxel_of_slot(brick, s);
                     let (x, y, z) = (n % 40, (n / 40) % 40, n / 1600);
-                    quantise(c.opacity_at(v.data()[n], gradient_at(&v, x, y, z)))
+                    quantise(c.opacity_at(v.samples().get(n), gradient_at(&v, x, y, z)))
                 })
                 .collect();
             let visible = alphas.iter().any(|a| *a > 0);
-            assert_eq!(b.slot_of[i] != EMPTY, visible, "brick {brick:?}");
+            let number = b.bricks().position(|o| o == brick);
+            assert_eq!(number.is_some(), visible, "brick {brick:?}");
             let (lo, hi) = m.ranges[i];
             if c.is_transparent_between(lo, hi) {
                 assert!(!visible, "brick {brick:?} called transparent");
                 skipped_by_range += 1;
             }
-            if visible {
-                let n = b.slot_of[i] as usize;
-                let stored: Vec<u16> = b.voxels[n * SLOTS..][..SLOTS]
-                    .iter()
-                    .map(|v| v.alpha)
-                    .collect();
+            if let Some(n) = number {
+                let stored: Vec<u16> = slots(&b, n, &v, &c).iter().map(|v| v.alpha).collect();
                 assert_eq!(stored, alphas);
+                assert_eq!(slots(&lazy, n, &v, &c), slots(&b, n, &v, &c));
             }
         }
         // 5³ bricks; the 98 that touch the grid's faces hold no value

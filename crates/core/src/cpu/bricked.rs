@@ -54,8 +54,6 @@ use glam::{DVec3, Vec4};
 use rayon::prelude::*;
 use wide::f32x4;
 
-/// Bytes one occupied brick takes while a frame is cast (its cell box).
-pub(crate) const FRAME_BYTES_PER_OCCUPIED_BRICK: usize = size_of::<CellBox>();
 /// Bytes one tile takes while a frame is cast (its rows of pixels).
 pub(crate) const FRAME_BYTES_PER_TILE: usize =
     size_of::<Vec<&mut [PartialPixel]>>() + TILE * size_of::<&mut [PartialPixel]>();
@@ -202,8 +200,7 @@ impl Steppings for [Stepping] {
 
 /// Everything a ray reads.
 struct Scene<'a> {
-    boxes: Vec<CellBox>,
-    cells: &'a [[u64; 8]],
+    bricks: &'a ClassifiedBricks,
     lit: &'a LitBricks,
     lighting: &'a Lighting<'a>,
 }
@@ -229,8 +226,7 @@ pub fn render(
     let width = view.width();
     assert_eq!(pixels.len(), width * view.height());
     let scene = Scene {
-        boxes: (0..bricks.len()).map(|n| cell_box(bricks, n)).collect(),
-        cells: &bricks.cells,
+        bricks,
         lit,
         lighting,
     };
@@ -262,7 +258,7 @@ fn to_lanes(v: DVec3) -> f32x4 {
 }
 
 fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
-    let b = bricks.occupied[n];
+    let b = bricks.brick(n);
     let origin = lanes(bricks.grid.origin(b));
     let (lo, hi) = bricks.occupied_box(n);
     CellBox {
@@ -412,48 +408,69 @@ impl<'a> Rays<'a> {
         states: &mut [RayState],
         steppings: &S,
     ) {
+        // Where a brick the lit-brick cache has no room for is lit.
+        let mut scratch = None;
         for &n in list {
-            let b = &scene.boxes[n as usize];
-            let lit = scene.lit.get(n as usize, scene.lighting);
-            let cells = &scene.cells[n as usize];
-            for (i, state) in states.iter_mut().enumerate() {
-                if state.done {
-                    continue;
-                }
-                let stepping = steppings.of(i);
-                let local = state.origin - b.origin;
-                let Some((first, mut last)) = stepping.samples_in(b, local) else {
-                    continue;
-                };
-                let mut first = first.max(state.next);
-                if b.boundary || self.clipped {
-                    let range = *state.exact.get_or_insert_with(|| {
-                        let (col, row) = pixel(i);
-                        let base = stepping.base;
-                        (self.sampling.pixel(self.view, col, row))
-                            .map(|r| (relative(r.first, base), relative(r.last, base)))
-                    });
-                    let Some((f, l)) = range else {
-                        // The ray misses the volume: it has no samples.
-                        state.done = true;
-                        continue;
-                    };
-                    (first, last) = (first.max(f), last.min(l));
-                }
-                if first > last {
-                    continue;
-                }
-                state.next = last + 1;
-                let segment = Segment {
-                    origin: local,
-                    delta: stepping.delta,
-                    lo: b.lo,
-                    hi: b.hi,
-                    first,
-                    last,
-                };
-                state.done = march(&mut state.acc, lit.voxels(), cells, &segment);
+            // The brick's box, computed per tile rather than kept per
+            // frame (64 bytes an occupied brick): a few operations for the
+            // tile's 256 rays.
+            let b = &cell_box(scene.bricks, n as usize);
+            let cells = &scene.bricks.cells[n as usize];
+            let lit = scene.lit.get(n as usize, scene.lighting, &mut scratch);
+            self.cross(b, &lit, cells, pixel, states, steppings);
+        }
+    }
+
+    /// Takes the samples of every ray of a tile (`states`, as in
+    /// [`Self::cast`]) in one brick: its box `b`, its `lit` voxels and its
+    /// occupied `cells`.
+    #[inline(always)]
+    fn cross<S: Steppings + ?Sized>(
+        &self,
+        b: &CellBox,
+        lit: &[[f32; 4]; SLOTS],
+        cells: &[u64; 8],
+        pixel: &impl Fn(usize) -> (usize, usize),
+        states: &mut [RayState],
+        steppings: &S,
+    ) {
+        for (i, state) in states.iter_mut().enumerate() {
+            if state.done {
+                continue;
             }
+            let stepping = steppings.of(i);
+            let local = state.origin - b.origin;
+            let Some((first, mut last)) = stepping.samples_in(b, local) else {
+                continue;
+            };
+            let mut first = first.max(state.next);
+            if b.boundary || self.clipped {
+                let range = *state.exact.get_or_insert_with(|| {
+                    let (col, row) = pixel(i);
+                    let base = stepping.base;
+                    (self.sampling.pixel(self.view, col, row))
+                        .map(|r| (relative(r.first, base), relative(r.last, base)))
+                });
+                let Some((f, l)) = range else {
+                    // The ray misses the volume: it has no samples.
+                    state.done = true;
+                    continue;
+                };
+                (first, last) = (first.max(f), last.min(l));
+            }
+            if first > last {
+                continue;
+            }
+            state.next = last + 1;
+            let segment = Segment {
+                origin: local,
+                delta: stepping.delta,
+                lo: b.lo,
+                hi: b.hi,
+                first,
+                last,
+            };
+            state.done = march(&mut state.acc, lit, cells, &segment);
         }
     }
 }
@@ -474,7 +491,10 @@ struct Segment {
 
 /// Composites the samples of `segment` into `acc` from the brick's `lit`
 /// voxels and occupied `cells`. Returns whether the ray has terminated.
-#[inline]
+// Out of line: a function of its own, the sample loop compiles the same
+// whatever its callers become (inlined, the compiler's choices around it
+// moved its cost by several per cent from one change to the next).
+#[inline(never)]
 fn march(
     acc: &mut FrontToBack,
     lit: &[[f32; 4]; SLOTS],

@@ -16,104 +16,105 @@
 //! the result is `f32` RGBA per slot, ready for the ray caster to load
 //! without conversion.
 
-use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, UNIT, Voxel};
-use crate::bricks::{SIDE, SLOTS, slot_coords};
+use crate::bricks::cache::{BrickCache, CacheRef};
+use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, Source, UNIT, Voxel};
+use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
 use crate::transfer::classifier::Classifier;
-use crate::volume::Volume;
-use std::sync::{RwLock, RwLockReadGuard};
+use crate::volume::Sample;
 use wide::bytemuck::cast;
 use wide::{f32x4, i16x8, i32x4, i32x8};
 
-/// Bytes one occupied brick takes in [`LitBricks`] once lit: its lock and
-/// its lit voxels.
-pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize =
-    size_of::<RwLock<LitBrick>>() + size_of::<[[f32; 4]; SLOTS]>();
+/// Bytes one occupied brick's entry takes in [`LitBricks`], beside its
+/// lit voxels.
+pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize = BrickCache::<[[f32; 4]; SLOTS]>::BYTES_PER_ENTRY;
+/// Bytes of one occupied brick's lit voxels.
+pub(crate) const SLOT_BYTES_PER_OCCUPIED_BRICK: usize = size_of::<[[f32; 4]; SLOTS]>();
 
-/// The frame's lit bricks, each lit the first time a ray needs it.
+/// The frame's lit bricks, each lit the first time a ray needs it, under a
+/// budget of bytes (see [`BrickCache`]).
 ///
 /// Lighting a brick just before its rays cross it keeps its voxels in the
 /// cache for them, lets the lighting's memory traffic overlap the ray
 /// casting's arithmetic, and skips the bricks no tile lists (off screen),
 /// which then need no buffer either. The buffers are kept from frame to
 /// frame; a brick lit in an earlier frame is lit again, because the light
-/// moves with the camera.
-#[derive(Debug, Default)]
+/// moves with the camera. When the budget does not hold every brick a
+/// frame lights, a brick beyond it is lit into a temporary buffer each
+/// time a tile needs it.
 pub struct LitBricks {
-    bricks: Vec<RwLock<LitBrick>>,
+    cache: BrickCache<[[f32; 4]; SLOTS]>,
     /// The frame being rendered: bricks lit for another are stale.
     frame: u64,
 }
 
-/// One brick's lit voxels, `f32` RGBA in slot order, once it has been lit.
-#[derive(Debug, Default)]
-pub struct LitBrick {
-    frame: u64,
-    voxels: Option<Box<[[f32; 4]; SLOTS]>>,
-}
-
-impl LitBrick {
-    /// The lit voxels (only for a brick [`LitBricks::get`] returned).
-    pub fn voxels(&self) -> &[[f32; 4]; SLOTS] {
-        self.voxels
-            .as_ref()
-            .expect("a brick is lit before it is read")
-    }
-}
-
 impl LitBricks {
-    /// Starts a new frame of `bricks` occupied bricks: every brick is stale.
-    pub fn next_frame(&mut self, bricks: usize) {
-        self.frame += 1;
-        self.bricks.resize_with(bricks, Default::default);
+    /// The lit bricks of `bricks` occupied bricks, at most `budget` bytes
+    /// of lit voxels.
+    pub fn new(bricks: usize, budget: usize) -> Self {
+        LitBricks {
+            cache: BrickCache::new(bricks, budget, |f, now| f == now, |f, now| f < now),
+            frame: 0,
+        }
     }
 
-    /// Occupied brick `n`, lit by `lighting` if it is not yet lit for this
-    /// frame.
-    pub fn get(&self, n: usize, lighting: &Lighting) -> RwLockReadGuard<'_, LitBrick> {
-        let lock = &self.bricks[n];
-        let read = lock.read().unwrap_or_else(|e| e.into_inner());
-        if read.frame == self.frame {
-            return read;
-        }
-        drop(read);
-        {
-            let mut write = lock.write().unwrap_or_else(|e| e.into_inner());
-            // Another thread may have lit it meanwhile.
-            if write.frame != self.frame {
-                let voxels = write
-                    .voxels
-                    .get_or_insert_with(|| Box::new([[0.0; 4]; SLOTS]));
-                lighting.shade(n, voxels);
-                write.frame = self.frame;
-            }
-        }
-        lock.read().unwrap_or_else(|e| e.into_inner())
+    /// Starts a new frame: every brick is stale. Returns its number
+    /// (from 1).
+    pub fn next_frame(&mut self) -> u64 {
+        self.frame += 1;
+        self.frame
+    }
+
+    /// Occupied brick `n` lit by `lighting` for this frame (lit now,
+    /// unless it already is): the cache's buffer, or, when it has no room,
+    /// the one in `scratch` (see [`BrickCache::get`]).
+    #[inline]
+    pub fn get<'a>(
+        &'a self,
+        n: usize,
+        lighting: &Lighting,
+        scratch: &'a mut Option<Box<[[f32; 4]; SLOTS]>>,
+    ) -> CacheRef<'a, [[f32; 4]; SLOTS]> {
+        self.cache.get(
+            n,
+            self.frame,
+            || Box::new([[0.0; 4]; SLOTS]),
+            |out| lighting.shade(n, out),
+            scratch,
+        )
+    }
+
+    /// Bytes of lit voxels held now.
+    pub fn bytes(&self) -> usize {
+        self.cache.bytes()
     }
 }
 
 /// Everything needed to light one brick of one frame.
 pub struct Lighting<'a> {
-    volume: &'a Volume,
+    source: Source<'a>,
     bricks: &'a ClassifiedBricks,
+    /// The frame, for the cache of classified bricks.
+    frame: u64,
     material: Material,
     /// `None`: unlit, the colour is the material colour.
     light: Option<FrameLight>,
 }
 
 impl<'a> Lighting<'a> {
-    /// The lighting of `bricks` (classified from `volume` by `classifier`)
-    /// under `lighting` (`None` for unlit rendering).
+    /// The lighting of `bricks` (classified from `source`) under
+    /// `lighting` (`None` for unlit rendering) in frame `frame`.
     pub fn new(
-        volume: &'a Volume,
+        source: Source<'a>,
         bricks: &'a ClassifiedBricks,
-        classifier: &Classifier,
+        frame: u64,
         lighting: Option<(&Phong, &LightGeometry)>,
     ) -> Self {
         Lighting {
-            volume,
+            source,
             bricks,
-            material: Material::new(classifier),
+            frame,
+            material: Material::new(source.classifier),
             light: lighting.map(|(phong, light)| FrameLight::new(phong, light)),
         }
     }
@@ -121,21 +122,14 @@ impl<'a> Lighting<'a> {
     /// Lights occupied brick `n` into `out`: `lit × material`, clamped, and
     /// the stored opacity.
     pub fn shade(&self, n: usize, out: &mut [[f32; 4]; SLOTS]) {
-        let (bricks, b) = (self.bricks, self.bricks.occupied[n]);
-        let voxels = &bricks.voxels[n * SLOTS..][..SLOTS];
-        let data = self.volume.data();
-        // The slots' values: rows of slots along x are rows of the volume,
-        // the last voxel repeated past its end.
+        let mut scratch = None;
+        let classified = (self.bricks).classified(n, self.frame, &self.source, &mut scratch);
+        let (bricks, b) = (self.bricks, self.bricks.brick(n));
+        let voxels = &classified.voxels;
         let mut values = [0.0f32; SLOTS];
-        for s in slot_coords().step_by(SIDE) {
-            let start = bricks.grid.voxel_of_slot(b, s);
-            let end = bricks.grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
-            let row = &data[start..=end];
-            let first = SIDE * (s[1] + SIDE * s[2]);
-            for (i, v) in values[first..first + SIDE].iter_mut().enumerate() {
-                *v = row[i.min(row.len() - 1)];
-            }
-        }
+        crate::with_samples!(self.source.volume.samples(), |data| {
+            slot_values(data, &bricks.grid, b, &mut values)
+        });
         // Four slots at a time, one per SIMD lane.
         let mut group = |slots: [usize; 4], lanes: usize| {
             let colours = shade4(
@@ -150,7 +144,7 @@ impl<'a> Lighting<'a> {
         };
         // Slots that are no occupied cell's corner are never sampled (64 is
         // a multiple of 4, so a group's bits are in one word).
-        let needed = &bricks.needed[n];
+        let needed = &classified.needed;
         for s in (0..SLOTS - 3).step_by(4) {
             if needed[s / 64] >> (s % 64) & 0xF != 0 {
                 group([s, s + 1, s + 2, s + 3], 4);
@@ -158,6 +152,21 @@ impl<'a> Lighting<'a> {
         }
         // The last slot (SLOTS = 4·182 + 1), in every lane.
         group([SLOTS - 1; 4], 1);
+    }
+}
+
+/// The values of brick `b`'s slots, from the volume's samples `data`: rows
+/// of slots along x are rows of the volume, the last voxel repeated past
+/// its end.
+fn slot_values<T: Sample>(data: &[T], grid: &BrickGrid, b: [usize; 3], values: &mut [f32; SLOTS]) {
+    for s in slot_coords().step_by(SIDE) {
+        let start = grid.voxel_of_slot(b, s);
+        let end = grid.voxel_of_slot(b, [SIDE - 1, s[1], s[2]]);
+        let row = &data[start..=end];
+        let first = SIDE * (s[1] + SIDE * s[2]);
+        for (i, v) in values[first..first + SIDE].iter_mut().enumerate() {
+            *v = row[i.min(row.len() - 1)].to_f32();
+        }
     }
 }
 

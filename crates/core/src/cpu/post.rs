@@ -84,7 +84,7 @@ use crate::non_finite::NonFiniteMask;
 use crate::sampling::grid::clamp_to_grid;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::transfer::classifier::Classifier;
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -122,9 +122,11 @@ pub struct Scene<'a> {
 /// `(gx, gy, gz, f)`, x fastest: what [`render`] reads.
 pub fn packed_voxels(volume: &Volume, gradients: &[[f32; 3]]) -> Vec<f32x4> {
     assert_eq!(gradients.len(), volume.len());
-    (gradients.par_iter().zip(volume.data()))
-        .map(|(&[x, y, z], &f)| f32x4::new([x, y, z, f]))
-        .collect()
+    crate::with_samples!(volume.samples(), |data| {
+        (gradients.par_iter().zip(data))
+            .map(|(&[x, y, z], f)| f32x4::new([x, y, z, f.to_f32()]))
+            .collect()
+    })
 }
 
 /// What a frame's rays did: a measure of the work skipping saved.
@@ -498,7 +500,7 @@ mod tests {
             let [x, y, z, f] =
                 interpolate(corners(|i| voxels[i], base, sy, sz), offsets).to_array();
             // The value lane is the scalar lerps' value to the last bit.
-            let scalar = sample_scalar(volume.data(), dims, p);
+            let scalar = sample_scalar(&volume.values(), dims, p);
             assert_eq!(f.to_bits(), scalar.to_bits(), "{p}");
             let want = reference([p.x, p.y, p.z].map(f64::from), dims, DVec3::ZERO, |i| {
                 Vec3::from(grads[i]).as_dvec3()

@@ -34,7 +34,7 @@ use crate::kernels::trilinear::sample_scalar;
 use crate::non_finite::NonFiniteMask;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::settings::Blend;
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -42,9 +42,10 @@ use rayon::prelude::*;
 /// past it: rounding cannot carry a sample counted in the brick out of it.
 const EXIT_SLACK: f64 = 1e-4;
 
-/// What the rays read.
-struct Scene<'a> {
-    volume: &'a Volume,
+/// What the rays read: the samples, of type `T`.
+struct Scene<'a, T> {
+    data: &'a [T],
+    dims: [usize; 3],
     /// The samples not to count, if the volume had non-finite values.
     mask: Option<&'a NonFiniteMask>,
     macrocells: &'a Macrocells,
@@ -73,14 +74,28 @@ pub fn render(
     progress: &(dyn Fn(usize) + Sync),
 ) {
     assert_eq!(pixels.len(), view.width() * view.height());
-    let scene = Scene {
-        volume,
-        mask,
-        macrocells,
-        blend,
-        range,
-    };
-    let width = view.width();
+    crate::with_samples!(volume.samples(), |data| {
+        let scene = Scene {
+            data,
+            dims: volume.dims(),
+            mask,
+            macrocells,
+            blend,
+            range,
+        };
+        cast(&scene, view, sampling, pixels, progress)
+    })
+}
+
+/// Casts every ray of `view` through `scene` into `pixels`.
+fn cast<T: Sample>(
+    scene: &Scene<T>,
+    view: &View,
+    sampling: &Sampling,
+    pixels: &mut [Projected],
+    progress: &(dyn Fn(usize) + Sync),
+) {
+    let (width, blend) = (view.width(), scene.blend);
     pixels
         .par_chunks_mut(width)
         .enumerate()
@@ -95,12 +110,11 @@ pub fn render(
         });
 }
 
-impl Scene<'_> {
+impl<T: Sample> Scene<'_, T> {
     /// The projection of one ray's samples (it has at least one; the mask
     /// may skip them all).
     fn project(&self, ray: &PixelSamples) -> Projected {
-        let dims = self.volume.dims();
-        let data = self.volume.data();
+        let (dims, data) = (self.dims, self.data);
         let top = Vec3::new(
             (dims[0] - 1) as f32,
             (dims[1] - 1) as f32,

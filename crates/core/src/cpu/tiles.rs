@@ -55,7 +55,7 @@ use glam::DVec3;
 /// entries in the tiles' lists ([`BYTES_PER_ENTRY`] each): its depth and
 /// its tile rectangle.
 pub(crate) const BYTES_PER_OCCUPIED_BRICK: usize =
-    size_of::<(f64, u32)>() + size_of::<Option<[usize; 4]>>();
+    size_of::<(f64, u32)>() + size_of::<Option<[u16; 4]>>();
 /// Bytes of one brick's entry in one tile's list.
 pub(crate) const BYTES_PER_ENTRY: usize = size_of::<u32>();
 /// Bytes per tile: its list's start, and its count while binning.
@@ -63,6 +63,9 @@ pub(crate) const BYTES_PER_TILE: usize = 2 * size_of::<u32>();
 
 /// Tile edge in pixels.
 pub const TILE: usize = 16;
+
+// Tile numbers are kept as `u16`.
+const _: () = assert!(crate::settings::MAX_IMAGE_SIDE / TILE <= u16::MAX as usize);
 
 /// Slack, in pixels, around each brick's projected box: pixel centres on
 /// its edge are listed whatever the rounding.
@@ -94,12 +97,12 @@ impl TileBins {
         let mut order: Vec<(f64, u32)> = match view {
             View::Orthographic(v) => {
                 let direction = v.direction / grid.spacing;
-                (bricks.occupied.iter().enumerate())
-                    .map(|(n, &b)| (site(b).dot(direction), n as u32))
+                (bricks.bricks().enumerate())
+                    .map(|(n, b)| (site(b).dot(direction), n as u32))
                     .collect()
             }
-            View::Perspective(v) => (bricks.occupied.iter().enumerate())
-                .map(|(n, &b)| {
+            View::Perspective(v) => (bricks.bricks().enumerate())
+                .map(|(n, b)| {
                     let world = grid.origin + site(b) * grid.spacing;
                     (world.distance_squared(v.eye), n as u32)
                 })
@@ -119,7 +122,7 @@ impl TileBins {
             clipping.may_keep_box((world(lo) - margin, world(hi) + margin))
         };
         let margin = DVec3::splat(STEP_SLACK * sampling.step + 1e-3 * grid.spacing.max_element());
-        let rects: Vec<Option<[usize; 4]>> = order
+        let rects: Vec<Option<[u16; 4]>> = order
             .iter()
             .map(|&(_, n)| {
                 let cells = bricks.occupied_box(n as usize);
@@ -137,6 +140,7 @@ impl TileBins {
             .collect();
         let mut count = vec![0u32; tiles_x * tiles_y + 1];
         for &[x0, x1, y0, y1] in rects.iter().flatten() {
+            let [x0, x1, y0, y1] = [x0, x1, y0, y1].map(usize::from);
             for ty in y0..=y1 {
                 for tx in x0..=x1 {
                     count[ty * tiles_x + tx + 1] += 1;
@@ -149,7 +153,8 @@ impl TileBins {
         let start = count.clone();
         let mut entries = vec![0u32; *count.last().unwrap_or(&0) as usize];
         for (&(_, n), rect) in order.iter().zip(&rects) {
-            if let Some([x0, x1, y0, y1]) = *rect {
+            if let Some(rect) = *rect {
+                let [x0, x1, y0, y1] = rect.map(usize::from);
                 for ty in y0..=y1 {
                     for tx in x0..=x1 {
                         let t = ty * tiles_x + tx;
@@ -274,28 +279,22 @@ fn extend(bounds: &mut [f64; 4], col: f64, row: f64) {
 
 /// The tiles `[x0, x1] × [y0, y1]` holding a pixel centre inside the
 /// image-coordinate bounds `[c0, c1, r0, r1]` of a `width × height` image,
-/// or `None` if none does.
-fn tile_rect([c0, c1, r0, r1]: [f64; 4], width: usize, height: usize) -> Option<[usize; 4]> {
+/// or `None` if none does. (Tile numbers fit `u16`: an image side is at
+/// most [`MAX_IMAGE_SIDE`](crate::MAX_IMAGE_SIDE) pixels.)
+fn tile_rect([c0, c1, r0, r1]: [f64; 4], width: usize, height: usize) -> Option<[u16; 4]> {
     // Pixel (c, r) has its centre at (c + 0.5, r + 0.5).
     let first = |x: f64| (x - 0.5 - SLACK).ceil().max(0.0);
     let last = |x: f64, n: usize| (x - 0.5 + SLACK).floor().min(n as f64 - 1.0);
     let (x0, x1) = (first(c0), last(c1, width));
     let (y0, y1) = (first(r0), last(r1, height));
-    (x0 <= x1 && y0 <= y1).then_some({
-        [
-            x0 as usize / TILE,
-            x1 as usize / TILE,
-            y0 as usize / TILE,
-            y1 as usize / TILE,
-        ]
-    })
+    (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1].map(|p| (p as usize / TILE) as u16))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::bricks::macrocells::Macrocells;
-    use crate::bricks::occupied::ClassifiedBricks;
+    use crate::bricks::occupied::{ClassifiedBricks, Source};
     use crate::camera::Camera;
     use crate::sampling::clipping::Clipping;
     use crate::transfer::classifier::{Classifier, OpacityMap};
@@ -308,7 +307,12 @@ mod tests {
         // tile; the four bricks along x share it, nearest (largest x) first.
         let v = Volume::new([33, 33, 33], vec![1.0; 33 * 33 * 33]).unwrap();
         let c = Classifier::new((0.0, 1.0), OpacityMap::Ramp { p: 0.1, q: 0.5 }, None, 1.0);
-        let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, |_| false);
+        let source = Source {
+            volume: &v,
+            classifier: &c,
+            masked: &|_| false,
+        };
+        let bricks = ClassifiedBricks::new(&source, &Macrocells::new(&v), usize::MAX);
         assert_eq!(bricks.len(), 64);
         let sampling = Sampling {
             grid: GridFrame {
@@ -332,7 +336,7 @@ mod tests {
         let xs: Vec<usize> = bins
             .list(1, 0)
             .iter()
-            .map(|&n| bricks.occupied[n as usize])
+            .map(|&n| bricks.brick(n as usize))
             .inspect(|b| assert_eq!((b[1], b[2]), (1, 3)))
             .map(|b| b[0])
             .collect();
@@ -350,7 +354,7 @@ mod tests {
         let bins = TileBins::new(&bricks, &cropped, &view);
         assert_eq!(bins.len(), 32);
         let xs: Vec<usize> = (bins.list(2, 3).iter())
-            .map(|&n| bricks.occupied[n as usize][0])
+            .map(|&n| bricks.brick(n as usize)[0])
             .collect();
         assert_eq!(xs, vec![1, 0]);
     }
@@ -401,7 +405,12 @@ mod tests {
             .with_origin(DVec3::new(-3.0, 2.0, 1.0))
             .unwrap();
         let c = Classifier::new((0.0, 1.0), OpacityMap::Ramp { p: 0.0, q: 0.5 }, None, 1.0);
-        let bricks = ClassifiedBricks::new(&v, &Macrocells::new(&v), &c, |_| false);
+        let source = Source {
+            volume: &v,
+            classifier: &c,
+            masked: &|_| false,
+        };
+        let bricks = ClassifiedBricks::new(&source, &Macrocells::new(&v), usize::MAX);
         let all = bricks.grid.len();
         assert!(
             bricks.len() > all / 4 && bricks.len() < all,
@@ -463,7 +472,7 @@ mod tests {
                             assert!(
                                 enter >= last_entry - 1e-9,
                                 "{camera:?} ({col}, {row}): brick {:?} entered at {enter} after one at {last_entry}",
-                                bricks.occupied[n as usize]
+                                bricks.brick(n as usize)
                             );
                             last_entry = enter;
                             listed += 1;

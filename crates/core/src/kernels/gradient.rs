@@ -11,7 +11,8 @@
 //! Their largest magnitude, [`max_magnitude`], scales gradient-magnitude
 //! opacity and bounds Levoy's iso-surfaces (see [`crate::transfer::classifier`]).
 
-use crate::volume::Volume;
+use crate::volume::{Sample, Volume};
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// Bytes per voxel of [`gradients`].
@@ -21,44 +22,74 @@ pub const BYTES_PER_VOXEL: usize = size_of::<[f32; 3]>();
 pub fn gradients(volume: &Volume) -> Vec<[f32; 3]> {
     let [nx, ny, _] = volume.dims();
     let mut out = vec![[0.0f32; 3]; volume.len()];
-    out.par_chunks_mut(nx * ny)
-        .enumerate()
-        .for_each(|(k, slice)| {
-            for j in 0..ny {
-                for i in 0..nx {
-                    slice[i + nx * j] = gradient_at(volume, i, j, k);
+    crate::with_samples!(volume.samples(), |data| {
+        let d = Differences::new(data, volume);
+        out.par_chunks_mut(nx * ny)
+            .enumerate()
+            .for_each(|(k, slice)| {
+                for j in 0..ny {
+                    for i in 0..nx {
+                        slice[i + nx * j] = d.at(i, j, k);
+                    }
                 }
-            }
-        });
+            });
+    });
     out
 }
 
 /// World-space gradient of `volume` at voxel (`i`, `j`, `k`): central
-/// differences inside, one-sided ones on the faces.
+/// differences inside, one-sided ones on the faces. (Loops over many
+/// voxels take a [`Differences`] of the samples' own type.)
 #[inline]
 pub fn gradient_at(volume: &Volume, i: usize, j: usize, k: usize) -> [f32; 3] {
-    let [nx, ny, nz] = volume.dims();
-    let spacing = volume.spacing();
-    let data = volume.data();
-    let at = |i: usize, j: usize, k: usize| data[i + nx * (j + ny * k)];
-    // One axis: the neighbours below and above, clamped to the grid, and
-    // how many voxel steps they span (2, or 1 at a face).
-    let axis = |c: usize, n: usize| {
-        let lo = c.saturating_sub(1);
-        let hi = (c + 1).min(n - 1);
-        (lo, hi, hi - lo)
-    };
-    let d = |lo: f32, hi: f32, span: usize, spacing: f64| {
-        (hi - lo) * (1.0 / spacing) as f32 / span as f32
-    };
-    let (i0, i1, si) = axis(i, nx);
-    let (j0, j1, sj) = axis(j, ny);
-    let (k0, k1, sk) = axis(k, nz);
-    [
-        d(at(i0, j, k), at(i1, j, k), si, spacing.x),
-        d(at(i, j0, k), at(i, j1, k), sj, spacing.y),
-        d(at(i, j, k0), at(i, j, k1), sk, spacing.z),
-    ]
+    crate::with_samples!(volume.samples(), |data| Differences::new(data, volume)
+        .at(i, j, k))
+}
+
+/// A volume's samples of type `T` with what central differences need.
+#[derive(Debug, Clone, Copy)]
+pub struct Differences<'a, T> {
+    data: &'a [T],
+    dims: [usize; 3],
+    spacing: DVec3,
+}
+
+impl<'a, T: Sample> Differences<'a, T> {
+    /// The differences of `volume`, whose samples are `data`.
+    pub fn new(data: &'a [T], volume: &Volume) -> Self {
+        debug_assert_eq!(data.len(), volume.len());
+        Differences {
+            data,
+            dims: volume.dims(),
+            spacing: volume.spacing(),
+        }
+    }
+
+    /// The world-space gradient at voxel (`i`, `j`, `k`).
+    #[inline]
+    pub fn at(&self, i: usize, j: usize, k: usize) -> [f32; 3] {
+        let [nx, ny, nz] = self.dims;
+        let spacing = self.spacing;
+        let at = |i: usize, j: usize, k: usize| self.data[i + nx * (j + ny * k)].to_f32();
+        // One axis: the neighbours below and above, clamped to the grid, and
+        // how many voxel steps they span (2, or 1 at a face).
+        let axis = |c: usize, n: usize| {
+            let lo = c.saturating_sub(1);
+            let hi = (c + 1).min(n - 1);
+            (lo, hi, hi - lo)
+        };
+        let d = |lo: f32, hi: f32, span: usize, spacing: f64| {
+            (hi - lo) * (1.0 / spacing) as f32 / span as f32
+        };
+        let (i0, i1, si) = axis(i, nx);
+        let (j0, j1, sj) = axis(j, ny);
+        let (k0, k1, sk) = axis(k, nz);
+        [
+            d(at(i0, j, k), at(i1, j, k), si, spacing.x),
+            d(at(i, j0, k), at(i, j1, k), sj, spacing.y),
+            d(at(i, j, k0), at(i, j, k1), sk, spacing.z),
+        ]
+    }
 }
 
 /// `|g|`, in `f32` as every path computes it: the classifier's opacity
@@ -73,18 +104,21 @@ pub fn magnitude(g: [f32; 3]) -> f32 {
 /// `volume` (0 for a constant volume), without storing the gradients.
 pub fn max_magnitude(volume: &Volume) -> f32 {
     let [nx, ny, nz] = volume.dims();
-    (0..nz)
-        .into_par_iter()
-        .map(|k| {
-            let mut max = 0.0f32;
-            for j in 0..ny {
-                for i in 0..nx {
-                    max = max.max(magnitude(gradient_at(volume, i, j, k)));
+    crate::with_samples!(volume.samples(), |data| {
+        let d = Differences::new(data, volume);
+        (0..nz)
+            .into_par_iter()
+            .map(|k| {
+                let mut max = 0.0f32;
+                for j in 0..ny {
+                    for i in 0..nx {
+                        max = max.max(magnitude(d.at(i, j, k)));
+                    }
                 }
-            }
-            max
-        })
-        .reduce(|| 0.0, f32::max)
+                max
+            })
+            .reduce(|| 0.0, f32::max)
+    })
 }
 
 #[cfg(test)]

@@ -18,6 +18,7 @@
 //! gxz + hxyz` (up to rounding).
 
 use crate::kernels::lanes::Lanes;
+use crate::volume::Sample;
 use glam::Vec3;
 use std::ops::{Add, Mul};
 
@@ -69,13 +70,13 @@ pub fn cell_of(p: Vec3, last: [usize; 3]) -> ([usize; 3], [f32; 3]) {
 }
 
 /// The fast trilinear interpolation of the scalars `values` (x fastest,
-/// `dims` voxels) at index-space point `p`, which must lie in `[0, n−1]³`.
+/// `dims` voxels, any sample type, read as `f32`) at index-space point `p`, which must lie in `[0, n−1]³`.
 #[inline]
-pub fn sample_scalar(values: &[f32], dims: [usize; 3], p: Vec3) -> f32 {
+pub fn sample_scalar<T: Sample>(values: &[T], dims: [usize; 3], p: Vec3) -> f32 {
     let [nx, ny, nz] = dims;
     let (c, f) = cell_of(p, [nx - 2, ny - 2, nz - 2]);
     let base = c[0] + nx * (c[1] + ny * c[2]);
-    interpolate(corners(|i| values[i], base, nx, nx * ny), f)
+    interpolate(corners(|i| values[i].to_f32(), base, nx, nx * ny), f)
 }
 
 /// The eight voxels of the cell around index-space point `p` (indices

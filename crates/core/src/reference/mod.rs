@@ -128,13 +128,16 @@ pub fn render(
             let PartialPixels::Projection { pixels, .. } = image.pixels_mut() else {
                 unreachable!("a projection image")
             };
+            // The reference path reads every value as f32, from a dense copy
+            // where the samples are of another type.
+            let values = volume.values();
             rows(pixels, width, progress, |col, row| {
                 let mut projection = Projected::empty(blend);
                 for p in positions(col, row) {
                     if mask.is_some_and(|m| m.skips(p.into())) {
                         continue;
                     }
-                    let f = trilinear::reference(p, dims, 0.0, |i| volume.data()[i] as f64);
+                    let f = trilinear::reference(p, dims, 0.0, |i| values[i] as f64);
                     projection.add(blend, f);
                 }
                 projection

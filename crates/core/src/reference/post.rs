@@ -26,10 +26,13 @@ use crate::non_finite::NonFiniteMask;
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{DVec3, DVec4, Vec3};
+use std::borrow::Cow;
 
 /// Classifies and shades samples of one volume for one frame.
 pub struct PostClassifier<'a> {
     volume: &'a Volume,
+    /// The volume's values as `f32` (the reference path is dense).
+    values: Cow<'a, [f32]>,
     gradients: Vec<[f32; 3]>,
     classifier: &'a Classifier,
     lighting: Option<(&'a Phong, LightGeometry)>,
@@ -47,6 +50,7 @@ impl<'a> PostClassifier<'a> {
     ) -> Self {
         PostClassifier {
             volume,
+            values: volume.values(),
             gradients: gradients(volume),
             classifier,
             lighting,
@@ -67,8 +71,7 @@ impl<'a> PostClassifier<'a> {
             return DVec4::ZERO;
         }
         let dims = self.volume.dims();
-        let data = self.volume.data();
-        let f = trilinear::reference(p, dims, 0.0, |i| data[i] as f64) as f32;
+        let f = trilinear::reference(p, dims, 0.0, |i| self.values[i] as f64) as f32;
         let g = trilinear::reference(p, dims, DVec3::ZERO, |i| {
             Vec3::from(self.gradients[i]).as_dvec3()
         })

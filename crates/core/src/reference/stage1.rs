@@ -39,7 +39,7 @@ pub fn shade_and_classify(
     let slice = volume.dims()[0] * volume.dims()[1];
     voxels
         .par_chunks_mut(slice)
-        .zip(volume.data().par_chunks(slice))
+        .zip(volume.values().par_chunks(slice))
         .zip(gradients.par_chunks(slice))
         .for_each(|((out, values), grads)| {
             for ((o, &f), g) in out.iter_mut().zip(values).zip(grads) {

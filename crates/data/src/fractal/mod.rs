@@ -29,7 +29,7 @@
 //! assert_eq!(cloud.dims(), [17, 17, 17]);
 //! assert_eq!(cloud.get(0, 8, 8), 0.0); // empty at the boundary
 //! let raw = generate(&FractalParams { raw_field: true, ..params })?;
-//! assert!(raw.data().iter().any(|&v| v < 0.0)); // mean 0 before post-processing
+//! assert!(raw.values().iter().any(|&v| v < 0.0)); // mean 0 before post-processing
 //! # Ok::<(), volray_data::DataError>(())
 //! ```
 

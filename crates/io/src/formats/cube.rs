@@ -35,11 +35,40 @@ use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
 use crate::shared::limits::{F32_BYTES, check_dims};
 use crate::shared::periodic_cell;
-use crate::shared::text_reader::{TextReader, integer, number};
+use crate::shared::text_reader::{TextReader, all_numbers, integer, number, whole_lines};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// Atom lines listed one by one in [`FileInfo::header`]; the rest are counted.
 const LISTED_ATOMS: usize = 32;
+
+/// Whether a file's first bytes (`text`) open as a cube file: two comment
+/// lines, the atom count (an integer) and the origin (three numbers,
+/// maybe NVal), three axis lines of a non-zero point count and a non-zero
+/// step vector; then, as far as the window reaches, one line per atom of
+/// five numbers. The lines up to the third axis must be within the window.
+pub(crate) fn sniff_text(text: &str) -> bool {
+    let mut lines = whole_lines(text).skip(2);
+    // Every token of a header line a number, the first an integer.
+    let mut header = |len: std::ops::RangeInclusive<usize>| {
+        let line = lines.next()?;
+        let values = all_numbers(line).filter(|v| len.contains(&v.len()))?;
+        let first = line.split_whitespace().next()?.parse::<i64>().ok()?;
+        Some((first, values))
+    };
+    let Some((atoms, _)) = header(4..=5) else {
+        return false;
+    };
+    for _ in 0..3 {
+        match header(4..=4) {
+            Some((n, v)) if n != 0 && v[1..].iter().any(|&x| x != 0.0) => {}
+            _ => return false,
+        }
+    }
+    // From here on the window may end.
+    lines
+        .take(atoms.unsigned_abs().min(1 << 20) as usize)
+        .all(|l| all_numbers(l).is_some_and(|v| v.len() == 5))
+}
 
 /// Reads the cube file at `path` (see the module docs).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {

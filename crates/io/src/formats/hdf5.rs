@@ -1,11 +1,13 @@
-//! HDF5 datasets (`file.h5:/group/dataset`), read with the system HDF5
-//! library through `hdf5-metno` (cargo feature `hdf5`).
+//! HDF5 datasets (`file.h5:/group/dataset`), read in pure Rust through
+//! `hdf5-pure` (`shared/hdf5.rs`): no system library, in every build.
 //!
 //! Axis convention, the same as volray's `.npy` reader: a 3-D dataset of
 //! shape `(n0, n1, n2)` (C order, the last index varying fastest in the
 //! file) is indexed `a[x, y, z]`, so the volume has dims `[n0, n1, n2]`
 //! and is transposed on reading. A 4-D dataset is a series `a[t, x, y, z]`
 //! and `--frame t` picks one volume (0 by default); only that volume is read.
+//! A 2-D dataset `a[x, y]` is an image: read, and refused as a volume with
+//! what it holds ([`IoError::FlatImage`]).
 //!
 //! Geometry from the dataset's attributes, each one value per dataset
 //! axis in dataset order (so axis 0 is x), or a single value for all
@@ -18,30 +20,18 @@
 //! dataset is read; otherwise the datasets are listed in the error. The
 //! dataset's shape and storage are checked against the file's length
 //! before anything is read, and samples are read in slabs of the first
-//! axis, so the scratch memory beside the volume stays small.
+//! axis, so the scratch memory beside the volume stays small. A file
+//! holding MINC2's layout (`/minc-2.0`) is MINC2's (`formats/minc.rs`).
 
 use std::path::{Path, PathBuf};
 
-use hdf5::types::{FixedAscii, TypeDescriptor, VarLenAscii, VarLenUnicode};
-use hdf5::{Dataset, File, Group};
-use hdf5_metno as hdf5;
-use ndarray::Ix3;
+use hdf5_pure::{AttrValue, Dataset, Group};
 use volray_core::glam::DVec3;
 
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::input::open_input;
-use crate::shared::limits::{check_held, count_values, format_bytes};
+use crate::shared::hdf5::{self as h5, Slabs, numbers, numeric_type, sorted_attrs, text};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
-
-/// A dataset may decode to at most this many times the file's length
-/// (compressed chunks; deflate inflates at most about 1032:1), or to
-/// [`SMALL_FILE_ALLOWANCE`] bytes whatever the file's length.
-const MAX_INFLATION: u64 = crate::shared::compress::MAX_DEFLATE_RATIO;
-const SMALL_FILE_ALLOWANCE: u64 = 64 << 20;
-
-/// Samples read per slab.
-const SLAB_SAMPLES: usize = 1 << 20;
 
 /// The search for datasets stops after this many objects or this depth
 /// (hard links can make a group its own descendant).
@@ -58,24 +48,38 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         Some((file, dataset)) => (file, Some(dataset)),
         None => (path.to_path_buf(), None),
     };
-    let (_, file_len) = open_input(&file_path)?;
+    let h5 = h5::open(&file_path)?;
     let fail = |reason: String| IoError::invalid(&file_path, reason);
-    let file = File::open(&file_path).map_err(|e| fail(format!("HDF5: cannot open: {e}")))?;
+    let root = h5.file.root();
+    if dataset_path.is_none() && h5.file.group("minc-2.0").is_ok() {
+        return super::minc::read(&file_path, opts);
+    }
 
-    let dataset = match &dataset_path {
-        Some(name) => file.dataset(name).map_err(|_| {
-            let found = volumes_in(&file);
-            fail(format!(
-                "HDF5 file has no dataset \"{name}\"; its 3-D/4-D numeric datasets: {}",
-                listing(&found)
-            ))
-        })?,
+    let (name, dataset) = match &dataset_path {
+        Some(name) => {
+            let dataset = h5.file.dataset(name).map_err(|_| {
+                let found = volumes_in(&root);
+                fail(format!(
+                    "HDF5 file has no dataset \"{name}\"; its 3-D/4-D numeric datasets: {}",
+                    listing(&found)
+                ))
+            })?;
+            let absolute = if name.starts_with('/') {
+                name.clone()
+            } else {
+                format!("/{name}")
+            };
+            (absolute, dataset)
+        }
         None => {
-            let found = volumes_in(&file);
+            let found = volumes_in(&root);
             match found.as_slice() {
-                [(only, _)] => file
-                    .dataset(only)
-                    .map_err(|e| fail(format!("HDF5 dataset \"{only}\": {e}")))?,
+                [(only, _)] => (
+                    only.clone(),
+                    h5.file
+                        .dataset(only)
+                        .map_err(|e| fail(format!("HDF5 dataset \"{only}\": {e}")))?,
+                ),
                 _ => {
                     return Err(fail(format!(
                         "HDF5 file holds {} 3-D/4-D numeric datasets: name one as FILE:/path ({})",
@@ -86,24 +90,13 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             }
         }
     };
-    let name = dataset.name();
     let what = |reason: String| fail(format!("HDF5 dataset \"{name}\": {reason}"));
 
-    let descriptor = dataset
-        .dtype()
-        .and_then(|t| t.to_descriptor())
-        .map_err(|e| what(format!("unreadable type: {e}")))?;
-    let sample_size = match &descriptor {
-        TypeDescriptor::Integer(s) | TypeDescriptor::Unsigned(s) => *s as usize,
-        TypeDescriptor::Float(s) => *s as usize,
-        other => {
-            return Err(what(format!(
-                "type {other} is not numeric: volray reads integer and float datasets"
-            )));
-        }
-    };
-    let shape = dataset.shape();
+    let sample = numeric_type(&dataset).map_err(what)?;
+    let shape = h5::shape(&dataset).map_err(what)?;
     let (frames, dims) = match shape.as_slice() {
+        // A 2-D image a[x, y]: read, and described rather than rendered.
+        &[n0, n1] => (1, [n0, n1, 1]),
         &[n0, n1, n2] => (1, [n0, n1, n2]),
         &[t, n0, n1, n2] => (t, [n0, n1, n2]),
         other => {
@@ -123,58 +116,37 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             ),
         ));
     }
-    if dims.iter().any(|&n| n < 2) {
-        return Err(what(format!(
-            "volume of {}x{}x{} samples: every axis needs at least 2",
-            dims[0], dims[1], dims[2]
-        )));
-    }
-    let voxels = dims[0]
-        .checked_mul(dims[1])
-        .and_then(|n| n.checked_mul(dims[2]))
-        .filter(|n| n.checked_mul(sample_size.max(4)).is_some())
-        .ok_or_else(|| what(format!("shape {shape:?} is too large to address")))?;
-    let budget = file_len
-        .saturating_mul(MAX_INFLATION)
-        .max(SMALL_FILE_ALLOWANCE);
-    let bytes = (voxels as u64).saturating_mul(sample_size as u64);
-    if bytes > budget {
-        return Err(what(format!(
-            "shape {shape:?} of {descriptor} is {bytes} bytes per volume, more than a {file_len}-byte file can hold even compressed"
-        )));
-    }
-
-    // The f32 volume, and one slab of f64 values (at most a plane's worth
-    // beyond SLAB_SAMPLES) while reading.
-    let shape_dims: Vec<u64> = shape.iter().map(|&n| n as u64).collect();
-    count_values(&file_path, "shape", &shape_dims)?;
-    let slab_values = dims[1] * dims[2] * slab_planes(dims[1] * dims[2], 1).min(dims[0]);
-    let peak = voxels as u128 * 4 + slab_values as u128 * 8;
-    check_held(
+    let series = frames > 1 || shape.len() == 4;
+    let slabs = Slabs::new(
+        &dataset,
+        &shape,
+        frames,
+        series.then_some(frame),
+        sample.size,
+    );
+    let voxels = slabs.check(
         &file_path,
         &format!("dataset shape {shape:?}"),
-        voxels as u128,
-        peak,
-        &format!("{} as f32 and an f64 slab", format_bytes(peak)),
+        h5.len,
         opts.max_memory,
     )?;
 
-    let mut info = FileInfo::new(stored_type(&dataset, &descriptor));
+    let attrs = sorted_attrs(dataset.attrs());
+    let mut info = FileInfo::new(sample.name.clone());
     info.frames = frames;
     info.frame = frame;
-    info.header = header_fields(&dataset, &shape, &descriptor);
+    info.header = header_fields(&dataset, &name, &shape, &sample.name, &attrs);
     info.notes.push(format!(
         "C-order dataset of shape {shape:?} read as a[{}x, y, z] (the first axis is x; the file's fastest axis is z), transposed to x fastest",
-        if frames > 1 { "t, " } else { "" }
+        if series { "t, " } else { "" }
     ));
     if frames > 1 {
         info.notes
             .push(format!("volume {frame} of {frames} read (first axis: t)"));
     }
-    let (spacing, origin) = geometry(&dataset, frames > 1, &mut info).map_err(what)?;
+    let (spacing, origin) = geometry(&attrs, series, &mut info).map_err(what)?;
 
-    let data = read_volume(&dataset, dims, frames > 1, frame, voxels)
-        .map_err(|e| what(format!("cannot read: {e}")))?;
+    let data = read_volume(&slabs, dims, voxels).map_err(what)?;
     let steps = [
         DVec3::X * spacing.x,
         DVec3::Y * spacing.y,
@@ -188,73 +160,43 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     })
 }
 
-/// Reads volume `frame` of `dataset` (3-D, or 4-D when `series`) into an
-/// x-fastest buffer, one slab of the first axis at a time.
-fn read_volume(
-    dataset: &Dataset,
-    dims: [usize; 3],
-    series: bool,
-    frame: usize,
-    voxels: usize,
-) -> hdf5::Result<Vec<f32>> {
+/// Reads one volume into an x-fastest buffer: the dataset's first axis
+/// is x, its last (fastest in the file) z.
+fn read_volume(slabs: &Slabs, dims: [usize; 3], voxels: usize) -> Result<Vec<f32>, String> {
     let [n0, n1, n2] = dims;
-    let plane = n1 * n2;
-    // Slabs follow the chunking along the first axis, so each chunk is
-    // decompressed once.
-    let chunk0 = dataset
-        .chunk()
-        .and_then(|c| c.get(usize::from(series)).copied())
-        .unwrap_or(1)
-        .max(1);
-    let slab = slab_planes(plane, chunk0);
     let mut data = vec![0.0f32; voxels];
-    let mut x0 = 0;
-    while x0 < n0 {
-        let x1 = (x0 + slab).min(n0);
-        let part = if series {
-            dataset.read_slice::<f64, _, Ix3>((frame, x0..x1, .., ..))?
-        } else {
-            dataset.read_slice::<f64, _, Ix3>((x0..x1, .., ..))?
-        };
-        // part[x - x0, y, z] goes to x + n0·(y + n1·z).
-        for ((dx, y, z), &v) in part.indexed_iter() {
-            data[x0 + dx + n0 * (y + n1 * z)] = v as f32;
+    // Sample (x, y, z) at C-order index x·n1·n2 + y·n2 + z goes to
+    // x + n0·(y + n1·z).
+    slabs.read(|first, part| {
+        for (i, &v) in part.iter().enumerate() {
+            let at = first + i;
+            let (x, yz) = (at / (n1 * n2), at % (n1 * n2));
+            let (y, z) = (yz / n2, yz % n2);
+            data[x + n0 * (y + n1 * z)] = v as f32;
         }
-        x0 = x1;
-    }
+    })?;
     Ok(data)
-}
-
-/// Planes of the first axis read at once: whole chunks adding up to about
-/// [`SLAB_SAMPLES`], or, where one chunk is larger than that, as many
-/// planes as fit [`SLAB_SAMPLES`] (at least one), so that a header's chunk
-/// size cannot make the scratch buffer large.
-fn slab_planes(plane: usize, chunk0: usize) -> usize {
-    if plane.saturating_mul(chunk0) <= SLAB_SAMPLES {
-        (SLAB_SAMPLES / plane / chunk0).max(1) * chunk0
-    } else {
-        (SLAB_SAMPLES / plane).max(1)
-    }
 }
 
 /// Spacing and origin from the dataset's attributes (see the module docs).
 fn geometry(
-    dataset: &Dataset,
+    attrs: &[(String, AttrValue)],
     series: bool,
     info: &mut FileInfo,
 ) -> Result<(DVec3, DVec3), String> {
+    let attr = |name: &str| attrs.iter().find(|(n, _)| n == name).map(|(_, v)| v);
     let unit = ["unit", "units"]
         .iter()
-        .find_map(|name| string_attr(dataset, name));
+        .find_map(|name| attr(name).and_then(text));
     let mut spacing = DVec3::ONE;
     let mut origin = DVec3::ZERO;
     let mut sources = Vec::new();
-    if let Some(s) = vector_attr(dataset, "element_size_um", series)? {
+    if let Some(s) = vector_attr(attr("element_size_um"), "element_size_um", series)? {
         spacing = s;
         sources.push("element_size_um");
         info.length_unit = Some("um".into());
     }
-    if let Some(s) = vector_attr(dataset, "spacing", series)? {
+    if let Some(s) = vector_attr(attr("spacing"), "spacing", series)? {
         spacing = s;
         sources.push("spacing");
         info.length_unit = unit.clone();
@@ -265,7 +207,7 @@ fn geometry(
             spacing.x, spacing.y, spacing.z
         ));
     }
-    if let Some(o) = vector_attr(dataset, "origin", series)? {
+    if let Some(o) = vector_attr(attr("origin"), "origin", series)? {
         origin = o;
         sources.push("origin");
         if info.length_unit.is_none() {
@@ -297,13 +239,15 @@ fn geometry(
 
 /// A numeric attribute of one value per axis (or one for all axes; a
 /// series may give a leading time value, dropped), if present.
-fn vector_attr(dataset: &Dataset, name: &str, series: bool) -> Result<Option<DVec3>, String> {
-    let Ok(attr) = dataset.attr(name) else {
+fn vector_attr(
+    value: Option<&AttrValue>,
+    name: &str,
+    series: bool,
+) -> Result<Option<DVec3>, String> {
+    let Some(value) = value else {
         return Ok(None);
     };
-    let values = attr
-        .read_raw::<f64>()
-        .map_err(|_| format!("attribute \"{name}\" is not numeric"))?;
+    let values = numbers(value).ok_or_else(|| format!("attribute \"{name}\" is not numeric"))?;
     let v: &[f64] = match values.len() {
         1 => return finite(name, DVec3::splat(values[0])).map(Some),
         3 => &values,
@@ -329,70 +273,56 @@ fn finite(name: &str, v: DVec3) -> Result<DVec3, String> {
     }
 }
 
-fn string_attr(dataset: &Dataset, name: &str) -> Option<String> {
-    let attr = dataset.attr(name).ok()?;
-    let s = attr
-        .read_scalar::<VarLenUnicode>()
-        .map(|s| s.as_str().to_string())
-        .or_else(|_| {
-            attr.read_scalar::<VarLenAscii>()
-                .map(|s| s.as_str().to_string())
-        })
-        .or_else(|_| {
-            attr.read_scalar::<FixedAscii<256>>()
-                .map(|s| s.as_str().to_string())
-        })
-        .ok()?;
-    let s = s.trim().to_string();
-    (!s.is_empty()).then_some(s)
-}
-
-fn stored_type(dataset: &Dataset, descriptor: &TypeDescriptor) -> String {
-    let order = match dataset.dtype().map(|t| t.byte_order()) {
-        Ok(hdf5::datatype::ByteOrder::BigEndian) => " (big-endian)",
-        Ok(hdf5::datatype::ByteOrder::LittleEndian) => " (little-endian)",
-        _ => "",
-    };
-    format!("{descriptor}{order}")
-}
-
 /// The dataset's description and attributes, for `volray info`.
 fn header_fields(
     dataset: &Dataset,
+    name: &str,
     shape: &[usize],
-    descriptor: &TypeDescriptor,
+    type_name: &str,
+    attrs: &[(String, AttrValue)],
 ) -> Vec<(String, String)> {
     let mut fields = vec![
-        ("dataset".to_string(), dataset.name()),
+        ("dataset".to_string(), name.to_string()),
         ("shape".to_string(), format!("{shape:?}")),
-        ("type".to_string(), descriptor.to_string()),
+        ("type".to_string(), type_name.to_string()),
     ];
-    if let Some(chunk) = dataset.chunk() {
+    if let Ok(Some(chunk)) = dataset.chunk_shape() {
         fields.push(("chunks".to_string(), format!("{chunk:?}")));
     }
-    let filters = dataset.filters();
+    let filters: Vec<&str> = dataset
+        .filters()
+        .iter()
+        .map(|&id| filter_name(id))
+        .collect();
     if !filters.is_empty() {
-        fields.push(("filters".to_string(), format!("{filters:?}")));
+        fields.push(("filters".to_string(), filters.join(", ")));
     }
-    for name in dataset.attr_names().unwrap_or_default() {
-        let value = string_attr(dataset, &name)
-            .or_else(|| {
-                let v = dataset.attr(&name).ok()?.read_raw::<f64>().ok()?;
-                let shown: Vec<String> = v.iter().take(16).map(|x| x.to_string()).collect();
-                Some(format!("[{}]", shown.join(", ")))
-            })
-            .unwrap_or_else(|| "(not shown)".into());
-        fields.push((format!("@{name}"), value));
+    for (name, value) in attrs {
+        fields.push((format!("@{name}"), h5::shown(value)));
     }
     fields
 }
 
-/// The 3-D and 4-D numeric datasets of `file`, with their shapes, in
+/// The registered name of an HDF5 filter.
+fn filter_name(id: u16) -> &'static str {
+    match id {
+        1 => "deflate",
+        2 => "shuffle",
+        3 => "fletcher32",
+        4 => "szip",
+        5 => "nbit",
+        6 => "scaleoffset",
+        32000 => "lzf",
+        _ => "other",
+    }
+}
+
+/// The 3-D and 4-D numeric datasets under `root`, with their shapes, in
 /// name order (at most [`MAX_OBJECTS`] objects visited).
-fn volumes_in(file: &File) -> Vec<(String, Vec<usize>)> {
+fn volumes_in(root: &Group) -> Vec<(String, Vec<usize>)> {
     let mut found = Vec::new();
     let mut visited = 0;
-    visit(file, "", 0, &mut visited, &mut found);
+    visit(root, "", 0, &mut visited, &mut found);
     found
 }
 
@@ -406,31 +336,35 @@ fn visit(
     if depth > MAX_DEPTH {
         return;
     }
-    let mut names = group.member_names().unwrap_or_default();
-    names.sort();
-    for name in names {
+    let mut datasets = group.datasets().unwrap_or_default();
+    datasets.sort();
+    for name in datasets {
         *visited += 1;
         if *visited > MAX_OBJECTS {
             return;
         }
-        let path = format!("{prefix}/{name}");
-        if let Ok(ds) = group.dataset(&name) {
-            let numeric = ds.dtype().and_then(|t| t.to_descriptor()).is_ok_and(|d| {
-                matches!(
-                    d,
-                    TypeDescriptor::Integer(_)
-                        | TypeDescriptor::Unsigned(_)
-                        | TypeDescriptor::Float(_)
-                )
-            });
-            let shape = ds.shape();
-            if numeric && matches!(shape.len(), 3 | 4) {
-                found.push((path, shape));
-            }
-        } else if let Ok(sub) = group.group(&name) {
-            visit(&sub, &path, depth + 1, visited, found);
+        let Ok(ds) = group.dataset(&name) else {
+            continue;
+        };
+        if let Ok(shape) = h5::shape(&ds)
+            && matches!(shape.len(), 3 | 4)
+            && h5::is_numeric(&ds)
+        {
+            found.push((format!("{prefix}/{name}"), shape));
         }
     }
+    let mut groups = group.groups().unwrap_or_default();
+    groups.sort();
+    for name in groups {
+        *visited += 1;
+        if *visited > MAX_OBJECTS {
+            return;
+        }
+        if let Ok(sub) = group.group(&name) {
+            visit(&sub, &format!("{prefix}/{name}"), depth + 1, visited, found);
+        }
+    }
+    found.sort();
 }
 
 fn listing(found: &[(String, Vec<usize>)]) -> String {

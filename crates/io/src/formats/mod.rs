@@ -17,9 +17,9 @@
 pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
-#[cfg(feature = "hdf5")]
 pub(crate) mod hdf5;
 pub(crate) mod metaimage;
+pub(crate) mod minc;
 pub(crate) mod mrc;
 pub(crate) mod nifti;
 pub(crate) mod npy;
@@ -28,22 +28,6 @@ pub(crate) mod raw;
 pub(crate) mod tiff;
 pub(crate) mod vti;
 pub(crate) mod vtk_legacy;
-
-/// Without the `hdf5` feature, HDF5 files are still recognised, and
-/// refused with a message saying how to build volray to read them.
-#[cfg(not(feature = "hdf5"))]
-pub(crate) mod hdf5 {
-    use std::path::Path;
-
-    use crate::{IoError, Loaded, ReadOptions};
-
-    pub(crate) fn read(path: &Path, _opts: &ReadOptions) -> Result<Loaded, IoError> {
-        Err(IoError::invalid(
-            path,
-            "this volray was built without HDF5 support: rebuild with `cargo build --release --features hdf5` (needs Debian's libhdf5-dev)",
-        ))
-    }
-}
 
 use std::fmt;
 use std::path::Path;
@@ -76,14 +60,16 @@ pub enum VolumeFormat {
     Dicom,
     /// Multi-page TIFF stacks (`.tif`, `.tiff`).
     Tiff,
-    /// An HDF5 dataset, `file.h5:/path/to/dataset` (cargo feature `hdf5`).
+    /// An HDF5 dataset, `file.h5:/path/to/dataset`.
     Hdf5,
     /// Gaussian cube (`.cube`, `.cub`).
     Cube,
     /// CCP4 / MRC maps (`.map`, `.mrc`, `.ccp4`).
     Mrc,
-    /// VASP CHGCAR / CHG (by file name).
+    /// VASP CHGCAR / CHG and their kin (by file name or content).
     Chgcar,
+    /// MINC2 (`.mnc`): HDF5 in libminc's layout.
+    Minc,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -302,7 +288,10 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         extensions: &["cube", "cub"],
         name_stems: &[],
         known_as: ".cube",
-        magic: Magic::NONE,
+        magic: Magic {
+            text: Some(cube::sniff_text),
+            ..Magic::NONE
+        },
         frames: true,
         arrays: false,
         read: cube::read,
@@ -328,10 +317,27 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
             "chgcar", "chg", "aeccar0", "aeccar1", "aeccar2", "parchg", "elfcar", "locpot",
         ],
         known_as: "CHGCAR/CHG",
-        magic: Magic::NONE,
+        magic: Magic {
+            text: Some(chgcar::sniff_text),
+            ..Magic::NONE
+        },
         frames: true,
         arrays: false,
         read: chgcar::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Minc,
+        name: "minc",
+        description: "MINC2",
+        extensions: &["mnc"],
+        name_stems: &[],
+        known_as: ".mnc",
+        // HDF5's magic is the HDF5 row's; a MINC2 file under another name
+        // is handed over by the HDF5 reader.
+        magic: Magic::NONE,
+        frames: true,
+        arrays: false,
+        read: minc::read,
     },
 ];
 
@@ -581,14 +587,14 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 13);
-        assert_eq!(VolumeFormat::ALL[12], VolumeFormat::Chgcar);
+        assert_eq!(VolumeFormat::ALL.len(), 14);
+        assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
     #[test]

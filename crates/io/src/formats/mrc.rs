@@ -22,7 +22,11 @@
 //!   CCP4 convention); the note says which was used.
 //! - Cell angles other than 90°: a map covering exactly one unit cell is
 //!   periodic and is resampled onto an orthogonal grid (see
-//!   [`crate::shared::periodic_cell`]); a part of a skewed cell is refused.
+//!   [`crate::shared::periodic_cell`]); a map of a part of a skewed cell,
+//!   or of more than one cell, is not: its own box (a parallelepiped) is
+//!   resampled onto an axis-aligned grid at its finest spacing, and the
+//!   samples outside the box are NaN, marked as empty space
+//!   ([`FileInfo::nan_is_empty`]).
 
 use std::io::{Seek, SeekFrom};
 use std::path::Path;
@@ -446,24 +450,22 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let mut info = FileInfo::new(format!("{type_name} (MODE {mode}, {endian}-endian)"));
     info.header = header;
     info.length_unit = Some("angstrom".into());
-    let volume = if skewed {
+    // A skewed grid one point thick is an image: grid_to_volume says so.
+    let volume = if skewed && dims.iter().all(|&n| n >= 2) {
         let whole_cell = (0..3).all(|d| m[axis_of[d]] as i64 == dims[d] as i64);
-        if !whole_cell {
-            return Err(invalid(format!(
-                "CELLB {} {} {}: a skewed unit cell, and the map's {} x {} x {} points are not the whole cell's MX MY MZ {} {} {} (in column, row, section order), so it cannot be resampled as a periodic cell",
-                deg[0],
-                deg[1],
-                deg[2],
-                dims[0],
-                dims[1],
-                dims[2],
-                m[axis_of[0]],
-                m[axis_of[1]],
-                m[axis_of[2]]
-            )));
-        }
+        let resample = if whole_cell {
+            periodic_cell::resample
+        } else {
+            // A part of the cell, or more than one: the map's own box.
+            info.nan_is_empty = true;
+            notes.push(format!(
+                "the map's {} x {} x {} points are not the whole cell's MX MY MZ {} {} {} (in column, row, section order): not periodic, so only its own box is resampled",
+                dims[0], dims[1], dims[2], m[axis_of[0]], m[axis_of[1]], m[axis_of[2]]
+            ));
+            periodic_cell::resample_box
+        };
         let axis_names = axis_of.map(|a| names[a]);
-        let (volume, note) = periodic_cell::resample(
+        let (volume, note) = resample(
             dims,
             &data,
             steps,

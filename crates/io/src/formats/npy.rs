@@ -156,7 +156,7 @@ pub fn write_npy(path: &Path, volume: &Volume) -> Result<(), IoError> {
         w.write_all(&len.to_le_bytes())?;
         w.write_all(header.as_bytes())?;
         let mut buf = Vec::with_capacity(4 * 8192);
-        for chunk in volume.data().chunks(8192) {
+        for chunk in volume.values().chunks(8192) {
             buf.clear();
             buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
             w.write_all(&buf)?;
@@ -709,7 +709,7 @@ mod tests {
             &f32_data(24),
         );
         let v = read_npy(&write(dir.path(), "f.npy", &f)).unwrap();
-        assert_eq!(v.data(), (0..24).map(|i| i as f32).collect::<Vec<_>>());
+        assert_eq!(v.values(), (0..24).map(|i| i as f32).collect::<Vec<_>>());
     }
 
     #[test]
@@ -766,7 +766,7 @@ mod tests {
             let p = write(dir.path(), "t.npy", &npy_bytes(1, &header, &data));
             let v = read_npy(&p).unwrap_or_else(|e| panic!("{descr}: {e}"));
             let want: Vec<f32> = values.iter().map(|&v| v as f32).collect();
-            assert_eq!(v.data(), want, "{descr}");
+            assert_eq!(v.values(), want, "{descr}");
         }
     }
 
@@ -780,7 +780,7 @@ mod tests {
             &npy_bytes(1, h, &[0, 1, 2, 0, 255, 0, 0, 1]),
         );
         assert_eq!(
-            read_npy(&p).unwrap().data(),
+            *read_npy(&p).unwrap().values(),
             [0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0]
         );
 
@@ -801,8 +801,8 @@ mod tests {
             f32::INFINITY,
             -0.0,
         ];
-        assert_eq!(v.data(), want);
-        assert!(v.data()[7].is_sign_negative());
+        assert_eq!(*v.values(), want);
+        assert!(v.values()[7].is_sign_negative());
         assert!(f16_to_f32(0x7e00).is_nan());
     }
 

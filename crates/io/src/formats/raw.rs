@@ -134,7 +134,7 @@ fn read_raw_limited(path: &Path, opts: &RawOptions, max_memory: u64) -> Result<V
 pub fn write_raw(path: &Path, volume: &Volume) -> Result<(), IoError> {
     write_atomically(path, |w| {
         let mut buf = Vec::with_capacity(4 * 4096);
-        for chunk in volume.data().chunks(4096) {
+        for chunk in volume.values().chunks(4096) {
             buf.clear();
             buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
             w.write_all(&buf)?;
@@ -305,6 +305,6 @@ mod tests {
         let bytes: Vec<u8> = (0..n).flat_map(|i| (i as f32).to_le_bytes()).collect();
         let p = write(dir.path(), "big.raw", &bytes);
         let v = read_raw(&p, &RawOptions::new(dims, DType::F32)).unwrap();
-        assert!(v.data().iter().enumerate().all(|(i, &x)| x == i as f32));
+        assert!(v.values().iter().enumerate().all(|(i, &x)| x == i as f32));
     }
 }

@@ -208,15 +208,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             info.frames
         ));
     }
-    if shape.slices < 2 {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "TIFF stack has {} slice(s) per volume: a volume needs at least 2 pages",
-                shape.slices
-            ),
-        ));
-    }
+    // One page per volume is a 2-D image: read, and described rather
+    // than rendered (`grid_to_volume`).
 
     let (w, h) = (first.width as usize, first.height as usize);
     let dims = [w, h, shape.slices];

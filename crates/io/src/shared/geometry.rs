@@ -13,7 +13,9 @@
 //!   its own index axes with spacing |step| (what VTK before 9.0 and many
 //!   viewers do), and a note says the rotation was not applied;
 //! - non-orthogonal (skewed) steps: refused; a reader that can resample
-//!   (Gaussian cube, CHGCAR) does so before calling this.
+//!   (Gaussian cube, CHGCAR) does so before calling this;
+//! - a grid one sample thick along an axis (a slice, a 2-D image): no
+//!   volume, but an [`IoError::FlatImage`] carrying what was read.
 
 use std::path::Path;
 
@@ -22,6 +24,57 @@ use volray_core::glam::DVec3;
 
 use crate::FileInfo;
 use crate::error::IoError;
+
+/// What a grid one sample thick holds, as an [`IoError::FlatImage`]: the
+/// samples in the file's index order, the spacing |step| along each axis
+/// (1 where the step is not a length, as along a single slice).
+fn flat_image(
+    path: &Path,
+    dims: [usize; 3],
+    data: Vec<f32>,
+    steps: [DVec3; 3],
+    origin: DVec3,
+    info: &FileInfo,
+) -> IoError {
+    let spacing = steps.map(|s| {
+        let len = s.length();
+        if len.is_finite() && len > 0.0 {
+            len
+        } else {
+            1.0
+        }
+    });
+    let shown: Vec<String> = dims
+        .iter()
+        .filter(|&&n| n > 1)
+        .map(|n| n.to_string())
+        .collect();
+    let reason = format!(
+        "a {}-D image ({} samples), not a volume: volray renders volumes of at least 2 points along each axis",
+        shown.len(),
+        if shown.is_empty() {
+            "1".to_string()
+        } else {
+            shown.join(" x ")
+        }
+    );
+    IoError::FlatImage {
+        path: path.to_path_buf(),
+        image: Box::new(crate::FlatImage {
+            format: crate::VolumeFormat::Raw,
+            dims,
+            spacing: DVec3::from(spacing),
+            origin: if origin.is_finite() {
+                origin
+            } else {
+                DVec3::ZERO
+            },
+            values: data,
+            info: info.clone(),
+            reason,
+        }),
+    }
+}
 
 /// Cosine tolerance for "parallel" and "orthogonal": headers written with
 /// single precision carry direction cosines good to about 1e-7.
@@ -39,6 +92,9 @@ pub fn grid_to_volume(
     origin: DVec3,
     info: &mut FileInfo,
 ) -> Result<Volume, IoError> {
+    if dims.contains(&1) && !dims.contains(&0) {
+        return Err(flat_image(path, dims, data, steps, origin, info));
+    }
     if !origin.is_finite() {
         return Err(IoError::invalid(
             path,
@@ -184,7 +240,7 @@ mod tests {
         let v =
             grid_to_volume(Path::new("f"), dims, data.clone(), steps, origin, &mut info).unwrap();
         let [nx, ny, _] = v.dims();
-        for (n, &value) in v.data().iter().enumerate() {
+        for (n, &value) in v.values().iter().enumerate() {
             let (i, j, k) = (n % nx, (n / nx) % ny, n / (nx * ny));
             let old = value as usize;
             let (a, b, c) = (

@@ -4,9 +4,10 @@
 //!
 //! | module | what | used by |
 //! |---|---|---|
-//! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM, HDF5 |
+//! | `compress.rs` | gzip and zlib inflated to a declared size | NRRD, MetaImage, NIfTI, VTI, TIFF, DICOM; its ratio bound: HDF5 |
 //! | `input.rs` | opening input files, reading samples in bounded chunks | every reader |
 //! | `limits.rs` | the memory limit and the size checks before allocating | every reader |
+//! | `hdf5.rs` | HDF5 files opened, attributes read, numeric datasets read in slabs (pure Rust) | HDF5, MINC2 |
 //! | `geometry.rs` | a file's grid (origin, step vectors) → the axis-aligned volume | every reader with geometry |
 //! | `text_header.rs` | header lines and field values | NRRD, MetaImage |
 //! | `payload.rs` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
@@ -16,6 +17,7 @@
 
 pub(crate) mod compress;
 pub(crate) mod geometry;
+pub(crate) mod hdf5;
 pub(crate) mod input;
 pub(crate) mod limits;
 pub(crate) mod payload;

@@ -11,6 +11,11 @@
 //! cell's bounding box. Samples of the box outside the cell are periodic
 //! images, exactly what the crystal holds there.
 //!
+//! A grid that is not one whole cell (a CCP4 map of part of a cell, or of
+//! more than one) is not periodic: [`resample_box`] resamples its own box
+//! (the parallelepiped from its first point to its last) the same way,
+//! without wrapping, and marks the samples outside the box NaN.
+//!
 //! [`grid_to_volume`]: crate::grid_to_volume
 
 use std::path::Path;
@@ -96,80 +101,242 @@ pub(crate) fn resample(
     unit: &str,
     max_memory: u64,
 ) -> Result<(Volume, String), ResampleError> {
-    let cell = DMat3::from_cols(
-        steps[0] * dims[0] as f64,
-        steps[1] * dims[1] as f64,
-        steps[2] * dims[2] as f64,
+    let grid = Grid::new(dims, data, steps, origin);
+    let (volume, described) = grid.resample(Extent::Periodic, max_memory)?;
+    let [a, b, c] = names;
+    let note = format!(
+        "{}: the grid was treated as one periodic cell of {} x {} x {} points ({a} x {b} x {c}) and resampled trilinearly onto {} covering the cell's bounding box; samples outside the cell are its periodic images",
+        not_orthogonal(steps, names),
+        dims[0],
+        dims[1],
+        dims[2],
+        described.in_unit(unit),
     );
-    let volume = cell.determinant().abs();
-    let to_grid = DMat3::from_cols(steps[0], steps[1], steps[2]);
-    if !(volume.is_finite() && volume > 0.0) || to_grid.determinant() == 0.0 {
-        return Err(ResampleError::Cell(
-            "the cell vectors are linearly dependent (the cell has no volume)".into(),
-        ));
-    }
-    let to_grid = to_grid.inverse();
+    Ok((volume, note))
+}
 
-    // The bounding box of the cell: each world axis spans the sum of the
-    // negative and of the positive components of the cell vectors.
-    let mut lo = origin;
-    let mut extent = DVec3::ZERO;
-    for a in 0..3 {
-        let v = cell.col(a);
-        lo += v.min(DVec3::ZERO);
-        extent += v.abs();
-    }
-    // Isotropic spacing: the file's finest step, so no detail is lost,
-    // grown if the box would hold more than MAX_GROWTH times the file's
-    // points.
-    let points = (dims[0] * dims[1] * dims[2]) as f64;
-    let mut h = steps[0]
-        .length()
-        .min(steps[1].length())
-        .min(steps[2].length());
-    let box_points = extent.x * extent.y * extent.z / (h * h * h);
-    if box_points > MAX_GROWTH * points {
-        h *= (box_points / (MAX_GROWTH * points)).cbrt();
-    }
-    if !(extent.is_finite() && h.is_finite() && h > 0.0) {
+/// Resamples a skewed grid that is not one periodic cell (a part of a
+/// crystal's cell, or more than one) as [`resample`] does, but over the
+/// grid's own box only, the parallelepiped from its first point to its
+/// last: samples of the bounding box outside it are NaN, space the file
+/// does not cover (to be rendered as empty).
+pub(crate) fn resample_box(
+    dims: [usize; 3],
+    data: &[f32],
+    steps: [DVec3; 3],
+    origin: DVec3,
+    names: [&str; 3],
+    unit: &str,
+    max_memory: u64,
+) -> Result<(Volume, String), ResampleError> {
+    if dims.iter().any(|&n| n < 2) {
         return Err(ResampleError::Cell(format!(
-            "the cell's bounding box ({}, {}, {}) cannot be sampled",
-            extent.x, extent.y, extent.z
+            "{} x {} x {} points span no box: every axis needs at least 2",
+            dims[0], dims[1], dims[2]
         )));
     }
-    let mut out_dims = [0usize; 3];
-    let mut spacing = DVec3::ZERO;
-    for w in 0..3 {
-        // Each axis holds at most the capped total (plus rounding).
-        let steps = (extent[w] / h)
-            .round()
-            .clamp(1.0, 2.0 * MAX_GROWTH * points);
-        let n = steps as usize + 1;
-        out_dims[w] = n;
-        spacing[w] = extent[w] / (n - 1) as f64;
+    let grid = Grid::new(dims, data, steps, origin);
+    let (volume, described) = grid.resample(Extent::Box, max_memory)?;
+    let [a, b, c] = names;
+    let note = format!(
+        "{} and the grid is not one whole periodic cell: its box of {} x {} x {} points ({a} x {b} x {c}), a parallelepiped, was resampled trilinearly onto {} covering the box; the {} samples outside the box are NaN (empty space, no data)",
+        not_orthogonal(steps, names),
+        dims[0],
+        dims[1],
+        dims[2],
+        described.in_unit(unit),
+        volume.len() - described.inside,
+    );
+    Ok((volume, note))
+}
+
+/// "the grid axes are not orthogonal (angle(b, c) ..., ... degrees)", the
+/// axes named `names`.
+fn not_orthogonal(steps: [DVec3; 3], names: [&str; 3]) -> String {
+    let [alpha, beta, gamma] = angles(steps);
+    let [a, b, c] = names;
+    format!(
+        "the grid axes are not orthogonal (angle({b}, {c}) {alpha:.3}, angle({a}, {c}) {beta:.3}, angle({a}, {b}) {gamma:.3} degrees)"
+    )
+}
+
+/// A file's grid: `dims` points, index axis 0 fastest, axis `a` stepping
+/// by `steps[a]` from `origin`.
+struct Grid<'d> {
+    dims: [usize; 3],
+    data: &'d [f32],
+    steps: [DVec3; 3],
+    origin: DVec3,
+}
+
+/// What part of space a grid's values cover.
+#[derive(Clone, Copy, PartialEq)]
+enum Extent {
+    /// All of it: the grid is one period of a crystal, `dims[a]` steps long.
+    Periodic,
+    /// Its own box only, `dims[a] - 1` steps long.
+    Box,
+}
+
+/// The axis-aligned grid a cell was resampled onto, for notes.
+struct Described {
+    dims: [usize; 3],
+    spacing: DVec3,
+    lo: DVec3,
+    /// Samples inside the cell or box (the others are periodic images or NaN).
+    inside: usize,
+}
+
+impl Described {
+    fn in_unit(&self, unit: &str) -> String {
+        let ([nx, ny, nz], s, lo) = (self.dims, self.spacing, self.lo);
+        format!(
+            "an orthogonal {nx}x{ny}x{nz} grid with spacing {:.6}, {:.6}, {:.6} {unit} from ({:.6}, {:.6}, {:.6})",
+            s.x, s.y, s.z, lo.x, lo.y, lo.z
+        )
     }
-    let [nx, ny, nz] = out_dims;
-    // After the cap, rounding each axis up by at most 1.5 samples can
-    // multiply the count by at most 2.5^3 < 16: a safety net only.
-    let total = nx as f64 * ny as f64 * nz as f64;
-    if total > 16.0 * MAX_GROWTH * points + 4096.0 {
-        return Err(ResampleError::Cell(format!(
-            "the cell's bounding box would need {nx}x{ny}x{nz} samples, far more than the file's {points} points"
-        )));
+}
+
+impl<'d> Grid<'d> {
+    fn new(dims: [usize; 3], data: &'d [f32], steps: [DVec3; 3], origin: DVec3) -> Self {
+        Grid {
+            dims,
+            data,
+            steps,
+            origin,
+        }
     }
-    let held = (total + data.len() as f64) * 4.0;
-    if held > max_memory as f64 {
-        return Err(ResampleError::Memory {
-            need: format!(
-                "resampling onto {nx}x{ny}x{nz} points beside the file's {points} takes {} as f32, more than",
-                format_bytes(held as u128)
-            ),
-            limit: max_memory,
+
+    fn resample(
+        &self,
+        extent_kind: Extent,
+        max_memory: u64,
+    ) -> Result<(Volume, Described), ResampleError> {
+        let Grid {
+            dims,
+            data,
+            steps,
+            origin,
+        } = *self;
+        // The steps each cell vector spans.
+        let spans = dims.map(|n| match extent_kind {
+            Extent::Periodic => n as f64,
+            Extent::Box => (n - 1) as f64,
         });
+        let cell = DMat3::from_cols(
+            steps[0] * spans[0],
+            steps[1] * spans[1],
+            steps[2] * spans[2],
+        );
+        let volume = cell.determinant().abs();
+        let to_grid = DMat3::from_cols(steps[0], steps[1], steps[2]);
+        if !(volume.is_finite() && volume > 0.0) || to_grid.determinant() == 0.0 {
+            return Err(ResampleError::Cell(
+                "the cell vectors are linearly dependent (the cell has no volume)".into(),
+            ));
+        }
+        let to_grid = to_grid.inverse();
+
+        // The bounding box of the cell: each world axis spans the sum of the
+        // negative and of the positive components of the cell vectors.
+        let mut lo = origin;
+        let mut extent = DVec3::ZERO;
+        for a in 0..3 {
+            let v = cell.col(a);
+            lo += v.min(DVec3::ZERO);
+            extent += v.abs();
+        }
+        // Isotropic spacing: the file's finest step, so no detail is lost,
+        // grown if the box would hold more than MAX_GROWTH times the file's
+        // points.
+        let points = (dims[0] * dims[1] * dims[2]) as f64;
+        let mut h = steps[0]
+            .length()
+            .min(steps[1].length())
+            .min(steps[2].length());
+        let box_points = extent.x * extent.y * extent.z / (h * h * h);
+        if box_points > MAX_GROWTH * points {
+            h *= (box_points / (MAX_GROWTH * points)).cbrt();
+        }
+        if !(extent.is_finite() && h.is_finite() && h > 0.0) {
+            return Err(ResampleError::Cell(format!(
+                "the cell's bounding box ({}, {}, {}) cannot be sampled",
+                extent.x, extent.y, extent.z
+            )));
+        }
+        let mut out_dims = [0usize; 3];
+        let mut spacing = DVec3::ZERO;
+        for w in 0..3 {
+            // Each axis holds at most the capped total (plus rounding).
+            let steps = (extent[w] / h)
+                .round()
+                .clamp(1.0, 2.0 * MAX_GROWTH * points);
+            let n = steps as usize + 1;
+            out_dims[w] = n;
+            spacing[w] = extent[w] / (n - 1) as f64;
+        }
+        let [nx, ny, nz] = out_dims;
+        // After the cap, rounding each axis up by at most 1.5 samples can
+        // multiply the count by at most 2.5^3 < 16: a safety net only.
+        let total = nx as f64 * ny as f64 * nz as f64;
+        if total > 16.0 * MAX_GROWTH * points + 4096.0 {
+            return Err(ResampleError::Cell(format!(
+                "the cell's bounding box would need {nx}x{ny}x{nz} samples, far more than the file's {points} points"
+            )));
+        }
+        let held = (total + data.len() as f64) * 4.0;
+        if held > max_memory as f64 {
+            return Err(ResampleError::Memory {
+                need: format!(
+                    "resampling onto {nx}x{ny}x{nz} points beside the file's {points} takes {} as f32, more than",
+                    format_bytes(held as u128)
+                ),
+                limit: max_memory,
+            });
+        }
+        let mut out = Vec::with_capacity(nx * ny * nz);
+        let mut inside = 0;
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let p = lo + DVec3::new(i as f64, j as f64, k as f64) * spacing;
+                    let g = to_grid * (p - origin);
+                    let value = match extent_kind {
+                        Extent::Periodic => {
+                            if (0..3).all(|a| g[a] >= 0.0 && g[a] < spans[a]) {
+                                inside += 1;
+                            }
+                            self.periodic(g)
+                        }
+                        Extent::Box => match self.bounded(g) {
+                            Some(v) => {
+                                inside += 1;
+                                v
+                            }
+                            None => f32::NAN,
+                        },
+                    };
+                    out.push(value);
+                }
+            }
+        }
+        let volume = Volume::new(out_dims, out)
+            .and_then(|v| v.with_spacing(spacing))
+            .and_then(|v| v.with_origin(lo))
+            .map_err(|e| ResampleError::Cell(e.to_string()))?;
+        let described = Described {
+            dims: out_dims,
+            spacing,
+            lo,
+            inside,
+        };
+        Ok((volume, described))
     }
-    let mut out = Vec::with_capacity(nx * ny * nz);
-    let sample = |p: DVec3| -> f32 {
-        let g = to_grid * (p - origin);
+
+    /// The value at grid coordinates `g`, each index wrapped into the
+    /// period.
+    fn periodic(&self, g: DVec3) -> f32 {
+        let dims = self.dims;
         let mut base = [0usize; 3];
         let mut next = [0usize; 3];
         let mut t = [0.0f64; 3];
@@ -182,7 +349,36 @@ pub(crate) fn resample(
             base[a] = i;
             next[a] = (i + 1) % dims[a];
         }
-        let at = |i: usize, j: usize, k: usize| f64::from(data[i + dims[0] * (j + dims[1] * k)]);
+        self.trilinear(base, next, t)
+    }
+
+    /// The value at grid coordinates `g` within the box (each coordinate
+    /// 0 to `dims[a] - 1`, up to rounding), or `None` outside it.
+    fn bounded(&self, g: DVec3) -> Option<f32> {
+        let dims = self.dims;
+        let mut base = [0usize; 3];
+        let mut next = [0usize; 3];
+        let mut t = [0.0f64; 3];
+        for a in 0..3 {
+            let last = (dims[a] - 1) as f64;
+            let tol = 1e-9 * last.max(1.0);
+            if !(g[a] >= -tol && g[a] <= last + tol) {
+                return None;
+            }
+            let x = g[a].clamp(0.0, last);
+            let i = (x.floor() as usize).min(dims[a] - 2);
+            base[a] = i;
+            next[a] = i + 1;
+            t[a] = x - i as f64;
+        }
+        Some(self.trilinear(base, next, t))
+    }
+
+    /// Trilinear interpolation between the corners `base` and `next`.
+    fn trilinear(&self, base: [usize; 3], next: [usize; 3], t: [f64; 3]) -> f32 {
+        let dims = self.dims;
+        let at =
+            |i: usize, j: usize, k: usize| f64::from(self.data[i + dims[0] * (j + dims[1] * k)]);
         let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
         let c00 = lerp(
             at(base[0], base[1], base[2]),
@@ -207,26 +403,7 @@ pub(crate) fn resample(
         let c0 = lerp(c00, c10, t[1]);
         let c1 = lerp(c01, c11, t[1]);
         lerp(c0, c1, t[2]) as f32
-    };
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                let p = lo + DVec3::new(i as f64, j as f64, k as f64) * spacing;
-                out.push(sample(p));
-            }
-        }
     }
-    let [alpha, beta, gamma] = angles(steps);
-    let [a, b, c] = names;
-    let note = format!(
-        "the grid axes are not orthogonal (angle({b}, {c}) {alpha:.3}, angle({a}, {c}) {beta:.3}, angle({a}, {b}) {gamma:.3} degrees): the grid was treated as one periodic cell of {} x {} x {} points ({a} x {b} x {c}) and resampled trilinearly onto an orthogonal {nx}x{ny}x{nz} grid with spacing {:.6}, {:.6}, {:.6} {unit} covering the cell's bounding box from ({:.6}, {:.6}, {:.6}); samples outside the cell are its periodic images",
-        dims[0], dims[1], dims[2], spacing.x, spacing.y, spacing.z, lo.x, lo.y, lo.z,
-    );
-    let volume = Volume::new(out_dims, out)
-        .and_then(|v| v.with_spacing(spacing))
-        .and_then(|v| v.with_origin(lo))
-        .map_err(|e| ResampleError::Cell(e.to_string()))?;
-    Ok((volume, note))
 }
 
 #[cfg(test)]

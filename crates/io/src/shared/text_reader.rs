@@ -255,6 +255,21 @@ pub(crate) fn number(token: &str, what: &str) -> Result<f64, String> {
 }
 
 /// Parses an integer token for the field called `what`.
+/// The whole lines of a file's first bytes, as the format sniffers get
+/// them: a last line without its newline may have been cut by the window
+/// and is left out.
+pub(crate) fn whole_lines(text: &str) -> impl Iterator<Item = &str> {
+    let whole = text.rfind('\n').map_or("", |end| &text[..end]);
+    whole.lines()
+}
+
+/// The finite numbers of `line`, if every whitespace-separated token is one.
+pub(crate) fn all_numbers(line: &str) -> Option<Vec<f64>> {
+    line.split_whitespace()
+        .map(|t| parse_number(t).filter(|v| v.is_finite()))
+        .collect()
+}
+
 pub(crate) fn integer(token: &str, what: &str) -> Result<i64, String> {
     token
         .parse::<i64>()

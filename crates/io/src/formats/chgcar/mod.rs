@@ -32,6 +32,8 @@
 
 mod poscar;
 
+pub(crate) use poscar::sniff_text;
+
 use std::io::BufReader;
 use std::path::Path;
 
@@ -55,18 +57,32 @@ enum Content {
 }
 
 fn content_of(path: &Path) -> Content {
+    // Any word of the name: `LOCPOT`, `Li_LOCPOT`, `run3-ELFCAR.gz`.
+    let words = name_words(path);
+    if words.iter().any(|w| w == "locpot") {
+        Content::Unscaled("LOCPOT holds the local potential in eV")
+    } else if words.iter().any(|w| w == "elfcar") {
+        Content::Unscaled("ELFCAR holds the dimensionless electron localisation function")
+    } else {
+        Content::ChargeTimesVolume
+    }
+}
+
+/// Whether `path`'s name says which VASP file it is (a word of it is
+/// one of the names the format table lists).
+fn named(path: &Path) -> bool {
+    let stems = VolumeFormat::Chgcar.spec().name_stems;
+    name_words(path).iter().any(|w| stems.contains(&w.as_str()))
+}
+
+/// The words of `path`'s file name, lower case, split at `.`, `_`, `-`.
+fn name_words(path: &Path) -> Vec<String> {
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    match name.split(['.', '_', '-']).next().unwrap_or("") {
-        "locpot" => Content::Unscaled("LOCPOT holds the local potential in eV"),
-        "elfcar" => {
-            Content::Unscaled("ELFCAR holds the dimensionless electron localisation function")
-        }
-        _ => Content::ChargeTimesVolume,
-    }
+    name.split(['.', '_', '-']).map(str::to_string).collect()
 }
 
 /// The block of the file that was read, once found.
@@ -203,6 +219,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     } else {
         format!("frame {wanted} of {frames} is {label}")
     });
+    if !named(path) {
+        info.notes.push(
+            "known as VASP by its content: the name says not which file it is, so it is read as a charge file (CHGCAR, CHG, AECCAR, PARCHG); a LOCPOT or ELFCAR, whose values are not divided by the cell volume, is known by a name holding LOCPOT or ELFCAR".into(),
+        );
+    }
     match content {
         Content::ChargeTimesVolume => info.notes.push(format!(
             "values divided by the cell volume {:.6} cubic angstrom (the file stores density times volume, as the VASP wiki documents for CHGCAR): electrons per cubic angstrom",

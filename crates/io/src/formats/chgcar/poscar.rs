@@ -20,7 +20,7 @@ use std::io::BufRead;
 use volray_core::glam::{DMat3, DVec3};
 
 use crate::error::IoError;
-use crate::shared::text_reader::{TextReader, integer, parse_number};
+use crate::shared::text_reader::{TextReader, all_numbers, integer, parse_number, whole_lines};
 
 /// Atom positions listed one by one in the header; the rest are counted.
 const LISTED_ATOMS: usize = 32;
@@ -181,6 +181,91 @@ pub(super) fn read<R: BufRead>(
         volume,
         header,
     })
+}
+
+/// Whether a file's first bytes (`text`) open with a POSCAR block: a
+/// comment, the scale (one number, or three positive ones), three lattice
+/// vectors of three numbers, species names (VASP 5) and their counts, an
+/// optional `Selective dynamics`, `Direct` or `Cartesian`; then, as far
+/// as the window reaches, one position per atom and the grid line of
+/// three positive integers. Every line up to the coordinate kind must be
+/// within the window.
+pub(crate) fn sniff_text(text: &str) -> bool {
+    let mut lines = whole_lines(text);
+    let mut next = || lines.next();
+    let (Some(_comment), Some(scale)) = (next(), next().and_then(all_numbers)) else {
+        return false;
+    };
+    let scale_ok = match scale[..] {
+        [s] => s != 0.0,
+        [x, y, z] => x > 0.0 && y > 0.0 && z > 0.0,
+        _ => false,
+    };
+    if !scale_ok || !(0..3).all(|_| next().and_then(all_numbers).is_some_and(|v| v.len() == 3)) {
+        return false;
+    }
+    let Some(mut line) = next() else {
+        return false;
+    };
+    let species: Vec<&str> = line.split_whitespace().collect();
+    let named = species
+        .first()
+        .is_some_and(|w| w.starts_with(|c: char| c.is_ascii_alphabetic()));
+    if named {
+        let name = |w: &&str| {
+            w.starts_with(|c: char| c.is_ascii_alphabetic())
+                && w.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "_/.-".contains(c))
+        };
+        match next() {
+            Some(counts) if species.iter().all(name) => line = counts,
+            _ => return false,
+        }
+    }
+    let counts: Option<Vec<u64>> = line.split_whitespace().map(|t| t.parse().ok()).collect();
+    let Some(counts) = counts.filter(|c| !c.is_empty() && (!named || c.len() == species.len()))
+    else {
+        return false;
+    };
+    let Some(mut line) = next() else {
+        return false;
+    };
+    if line.trim_start().starts_with(['s', 'S']) {
+        match next() {
+            Some(kind) => line = kind,
+            None => return false,
+        }
+    }
+    if !line
+        .trim_start()
+        .starts_with(['d', 'D', 'c', 'C', 'k', 'K'])
+    {
+        return false;
+    }
+    // From here on the window may end.
+    let atoms: u64 = counts.iter().sum();
+    for _ in 0..atoms {
+        match lines.next() {
+            None => return true,
+            Some(l) => {
+                let coords: Vec<&str> = l.split_whitespace().take(3).collect();
+                if coords.len() < 3
+                    || !coords
+                        .iter()
+                        .all(|t| parse_number(t).is_some_and(f64::is_finite))
+                {
+                    return false;
+                }
+            }
+        }
+    }
+    match lines.find(|l| !l.trim().is_empty()) {
+        None => true,
+        Some(grid) => {
+            let n: Vec<&str> = grid.split_whitespace().collect();
+            n.len() == 3 && n.iter().all(|t| t.parse::<u64>().is_ok_and(|v| v > 0))
+        }
+    }
 }
 
 /// Reads the grid line `NGX NGY NGZ` after the atoms (blank lines before

@@ -106,17 +106,7 @@ fn read_multiframe(
         .map_err(|r| IoError::invalid(path, format!("DICOM: {r}")))?;
     check_pixel_data(&header, &format)?;
     if header.frames == 1 {
-        let dir = path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .map(|p| p.display().to_string())
-            .unwrap_or_else(|| ".".into());
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "this DICOM file holds a single slice: pass the directory that holds the whole series ({dir}) to read a volume"
-            ),
-        ));
+        return read_single_slice(path, header, format, max_memory, info);
     }
     let groups = volumes(&header.planes).map_err(|r| IoError::invalid(path, r))?;
     info.frames = groups.len();
@@ -164,6 +154,51 @@ fn read_multiframe(
         frame_values(&decoded, frames[k], &format, &planes[k], &mut data);
     }
     finish(path, &header, &format, grid, data, info)
+}
+
+/// A file of one slice: read, and refused as a volume with what it holds
+/// ([`IoError::FlatImage`]), naming the directory to pass instead.
+fn read_single_slice(
+    path: &Path,
+    header: FileHeader,
+    format: ImageFormat,
+    max_memory: u64,
+    info: FileInfo,
+) -> Result<Loaded, IoError> {
+    let plane = header.planes[0].clone();
+    let [row_step, column_step] = plane.pixel_spacing.unwrap_or([1.0, 1.0]);
+    let [along_row, along_column] = plane.orientation.unwrap_or([DVec3::X, DVec3::Y]);
+    let grid = Stack {
+        order: vec![0],
+        steps: [
+            along_row * column_step,
+            along_column * row_step,
+            along_row.cross(along_column),
+        ],
+        origin: plane.position.unwrap_or(DVec3::ZERO),
+        notes: Vec::new(),
+    };
+    let mut data = allocate(path, &format, 1, max_memory)?;
+    let bytes = read_all(path)?;
+    let obj = parse_whole(path, &bytes)?;
+    drop(bytes);
+    let decoded = decode(path, &obj, &format, 1)?;
+    frame_values(&decoded, 0, &format, &plane, &mut data);
+    match finish(path, &header, &format, grid, data, info) {
+        Err(IoError::FlatImage { path, mut image }) => {
+            let dir = path
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .map(|p| p.display().to_string())
+                .unwrap_or_else(|| ".".into());
+            image.reason = format!(
+                "a single DICOM slice ({} x {}), not a volume: pass the directory of the series ({dir}) to read a volume",
+                format.columns, format.rows
+            );
+            Err(IoError::FlatImage { path, image })
+        }
+        other => other,
+    }
 }
 
 /// Reads the series in directory `dir` (see the module documentation).

@@ -101,11 +101,12 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
     let field = |name| Field::metaimage(path, name);
     let ndims = field("NDims").uint(required(path, &header, "NDims")?)?;
-    if !(3..=4).contains(&ndims) {
+    // NDims 2 is an image: read, and described rather than rendered.
+    if !(2..=4).contains(&ndims) {
         return Err(IoError::invalid(
             path,
             format!(
-                "MetaImage field NDims = {ndims}: volray reads 3-D volumes and 4-D series of volumes"
+                "MetaImage field NDims = {ndims}: volray reads 3-D volumes and 4-D series of volumes (and describes 2-D images)"
             ),
         ));
     }
@@ -250,7 +251,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.length_unit = geometry.unit.clone();
     let volume = grid_to_volume(
         path,
-        [dims[0], dims[1], dims[2]],
+        [dims[0], dims[1], dims.get(2).copied().unwrap_or(1)],
         data,
         geometry.steps,
         geometry.origin,
@@ -462,10 +463,11 @@ impl Geometry {
                 matrix = m;
             }
         }
-        let mut steps = [DVec3::ZERO; 3];
-        for (a, step) in steps.iter_mut().enumerate() {
-            let row = &matrix[a * ndims..a * ndims + 3];
-            *step = DVec3::new(row[0], row[1], row[2]) * spacing[a];
+        // A 2-D image's third axis is a unit step along z.
+        let mut steps = [DVec3::Z; 3];
+        for (a, step) in steps.iter_mut().enumerate().take(ndims) {
+            let row = &matrix[a * ndims..a * ndims + ndims.min(3)];
+            *step = DVec3::new(row[0], row[1], row.get(2).copied().unwrap_or(0.0)) * spacing[a];
         }
         if ndims == 4 {
             if (0..3).any(|a| matrix[a * 4 + 3] != 0.0) {
@@ -515,7 +517,7 @@ impl Geometry {
             .map(str::to_string);
         Ok(Geometry {
             steps,
-            origin: DVec3::new(origin[0], origin[1], origin[2]),
+            origin: DVec3::new(origin[0], origin[1], origin.get(2).copied().unwrap_or(0.0)),
             unit,
         })
     }

@@ -76,11 +76,13 @@ impl Layout {
             ));
         }
         let ndim = ndim as usize;
-        if ndim < 3 {
+        // A 2-D image is read (its third axis one sample) and described
+        // rather than rendered.
+        if ndim < 2 {
             return Err(IoError::invalid(
                 path,
                 format!(
-                    "NIfTI field \"dim[0]\" is {ndim}: volray renders 3-D volumes, not {ndim}-D images"
+                    "NIfTI field \"dim[0]\" is {ndim}: volray renders 3-D volumes, not {ndim}-D data"
                 ),
             ));
         }
@@ -104,12 +106,20 @@ impl Layout {
             ));
         }
         let to_usize = |a: usize| usize::try_from(dim[a]).ok();
-        let dims = [1, 2, 3].map(|a| to_usize(a).unwrap_or(usize::MAX));
-        if dims.iter().any(|&n| n < 2) {
+        let dims = [1, 2, 3].map(|a| {
+            if a > ndim {
+                1
+            } else {
+                to_usize(a).unwrap_or(usize::MAX)
+            }
+        });
+        // An axis of 1 (a 2-D image) is read, and described rather than
+        // rendered (`grid_to_volume`); an axis of 0 holds nothing.
+        if dims.contains(&0) {
             return Err(IoError::invalid(
                 path,
                 format!(
-                    "NIfTI field \"dim\" gives {}x{}x{} voxels: every axis needs at least 2",
+                    "NIfTI field \"dim\" gives {}x{}x{} voxels: an axis of 0 holds no image",
                     dim[1], dim[2], dim[3]
                 ),
             ));

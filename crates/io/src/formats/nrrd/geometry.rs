@@ -152,6 +152,56 @@ pub(super) struct Geometry {
 }
 
 impl Geometry {
+    /// The geometry of a 2-D image (`dimension: 2`): `space directions`
+    /// (of a 2-D or 3-D space) or `spacings`, and `space origin`; the
+    /// third axis is a unit step along z.
+    pub(super) fn image(path: &Path, header: &Header) -> Result<Geometry, IoError> {
+        let space_dim = match (header.get("space dimension"), header.get("space")) {
+            (Some(v), _) => Some(Field::nrrd(path, "space dimension").uint(v)?),
+            (None, Some(s)) => Some(parse_space(path, s)?.dim),
+            (None, None) => None,
+        };
+        let sd = space_dim.unwrap_or(3);
+        if !(2..=3).contains(&sd) {
+            return Err(Field::nrrd(path, "space dimension")
+                .error(format!("{sd}: a 2-D image lies in a 2-D or 3-D space")));
+        }
+        let point = |c: &[f64]| DVec3::new(c[0], c[1], c.get(2).copied().unwrap_or(0.0));
+        let mut steps = [DVec3::X, DVec3::Y, DVec3::Z];
+        if let Some(v) = header.get("space directions") {
+            for (a, d) in vectors(path, "space directions", v, 2, sd)?
+                .iter()
+                .enumerate()
+            {
+                if let Some(c) = d {
+                    steps[a] = point(c);
+                }
+            }
+        } else if let Some(v) = header.get("spacings") {
+            let spacings = Field::nrrd(path, "spacings").numbers(v, 2)?;
+            for a in 0..2 {
+                if spacings[a].is_finite() && spacings[a] != 0.0 {
+                    steps[a] *= spacings[a];
+                }
+            }
+        }
+        let origin = match header.get("space origin") {
+            Some(v) => match &vectors(path, "space origin", v, 1, sd)?[0] {
+                Some(c) => point(c),
+                None => DVec3::ZERO,
+            },
+            None => DVec3::ZERO,
+        };
+        Ok(Geometry {
+            frame_axis: None,
+            axes: [0, 1, 2],
+            steps,
+            origin,
+            unit: None,
+            kinds: None,
+        })
+    }
+
     pub(super) fn parse(
         path: &Path,
         header: &Header,

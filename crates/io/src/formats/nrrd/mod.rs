@@ -52,12 +52,12 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 
     let field = |name| Field::nrrd(path, name);
     let dim = field("dimension").uint(required(path, &header, "dimension")?)?;
-    if !(3..=4).contains(&dim) {
+    if !(2..=4).contains(&dim) {
         return Err(field("dimension").error(format!(
-            "{dim}: volray reads 3-D volumes and 4-D files of volumes"
+            "{dim}: volray reads 3-D volumes and 4-D files of volumes (and describes 2-D images)"
         )));
     }
-    let sizes = field("sizes").sizes(required(path, &header, "sizes")?, dim)?;
+    let mut sizes = field("sizes").sizes(required(path, &header, "sizes")?, dim)?;
     let type_name = required(path, &header, "type")?;
     let dtype = parse_type(path, type_name)?;
     let encoding = parse_encoding(path, required(path, &header, "encoding")?)?;
@@ -89,8 +89,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     // Every product of sizes below fits in memory once the total does.
     let total = field("sizes").sample_count(&sizes, dtype.size())?;
 
-    // Which axis, if any, holds several volumes, and the geometry.
-    let geometry = Geometry::parse(path, &header, &sizes, notes)?;
+    // Which axis, if any, holds several volumes, and the geometry. A 2-D
+    // image is read as one slice, described rather than rendered.
+    let geometry = if dim == 2 {
+        sizes.push(1);
+        Geometry::image(path, &header)?
+    } else {
+        Geometry::parse(path, &header, &sizes, notes)?
+    };
     let frames = geometry.frame_axis.map_or(1, |f| sizes[f]);
     let frame = payload::chosen_frame(path, opts.frame, frames)?;
     let select = match geometry.frame_axis {

@@ -56,7 +56,7 @@ pub fn write_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
     write_atomically(path, |w| {
         w.write_all(header.as_bytes())?;
         let mut bytes = Vec::with_capacity(CHUNK * 4);
-        for chunk in volume.data().chunks(CHUNK) {
+        for chunk in volume.values().chunks(CHUNK) {
             bytes.clear();
             bytes.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
             w.write_all(&bytes)?;

@@ -3,11 +3,17 @@
 //! Voxels are grid *points* (the paper's `g_ijk`, VTK's point data): voxel
 //! `(i, j, k)` sits at `origin + (i·dx, j·dy, k·dz)`, so the volume spans
 //! `(n − 1)·spacing` along each axis and a cell is bounded by eight voxels.
-//! Values are stored as `f32` with x varying fastest:
-//! `index = x + nx·(y + ny·z)`. [`Volume::to_log10`] puts values that span
+//! Values are stored with x varying fastest, `index = x + nx·(y + ny·z)`,
+//! in the type they came in ([`Samples`]: `u8`, `i8`, `u16`, `i16` or
+//! `f32`), and read as `f32`. [`Volume::to_log10`] puts values that span
 //! decades on a log scale.
 
+mod samples;
+
+pub use samples::{Sample, SampleType, Samples};
+
 use glam::DVec3;
+use std::borrow::Cow;
 use thiserror::Error;
 
 /// Why a grid could not be made into a [`Volume`].
@@ -31,13 +37,13 @@ pub enum VolumeError {
     NoPositiveValue(f32),
 }
 
-/// A regular grid of `f32` scalars with per-axis spacing and an origin.
+/// A regular grid of scalars with per-axis spacing and an origin.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Volume {
     dims: [usize; 3],
     spacing: DVec3,
     origin: DVec3,
-    data: Vec<f32>,
+    samples: Samples,
 }
 
 /// Number of points of a grid of `dims`, or `None` if it overflows `usize`.
@@ -51,23 +57,32 @@ impl Volume {
     /// `data` holds `nx·ny·nz` values, x fastest. Every axis needs at least
     /// two points: a volume with no extent along an axis cannot be ray cast.
     pub fn new(dims: [usize; 3], data: Vec<f32>) -> Result<Self, VolumeError> {
+        Self::from_samples(dims, Samples::F32(data))
+    }
+
+    /// [`Volume::new`] with samples of any [`SampleType`], kept in it.
+    pub fn from_samples(
+        dims: [usize; 3],
+        samples: impl Into<Samples>,
+    ) -> Result<Self, VolumeError> {
+        let samples = samples.into();
         let [nx, ny, nz] = dims;
         if nx < 2 || ny < 2 || nz < 2 {
             return Err(VolumeError::TooThin(nx, ny, nz));
         }
         let expected = checked_point_count(dims).ok_or(VolumeError::DimsOverflow(nx, ny, nz))?;
-        if data.len() != expected {
+        if samples.len() != expected {
             return Err(VolumeError::LengthMismatch {
                 dims,
                 expected,
-                actual: data.len(),
+                actual: samples.len(),
             });
         }
         Ok(Volume {
             dims,
             spacing: DVec3::ONE,
             origin: DVec3::ZERO,
-            data,
+            samples,
         })
     }
 
@@ -127,19 +142,38 @@ impl Volume {
         self.origin
     }
 
-    /// The values, x fastest.
-    pub fn data(&self) -> &[f32] {
-        &self.data
+    /// The samples, x fastest, in their stored type.
+    pub fn samples(&self) -> &Samples {
+        &self.samples
+    }
+
+    /// The type the samples are kept in.
+    pub fn sample_type(&self) -> SampleType {
+        self.samples.sample_type()
+    }
+
+    /// The values as `f32`, x fastest: the samples themselves for an `f32`
+    /// volume, a converted copy for another type.
+    pub fn values(&self) -> Cow<'_, [f32]> {
+        match &self.samples {
+            Samples::F32(data) => Cow::Borrowed(data),
+            other => Cow::Owned(other.to_f32_vec()),
+        }
+    }
+
+    /// The same volume with its samples converted to `f32`.
+    pub fn to_f32(&self) -> Volume {
+        self.with_samples(Samples::F32(self.values().into_owned()))
     }
 
     /// Number of voxels.
     pub fn len(&self) -> usize {
-        self.data.len()
+        self.samples.len()
     }
 
     /// Always false: a volume has at least 2×2×2 voxels.
     pub fn is_empty(&self) -> bool {
-        self.data.is_empty()
+        self.samples.is_empty()
     }
 
     /// Linear index of voxel (i, j, k): `i + nx·(j + ny·k)`.
@@ -151,7 +185,7 @@ impl Volume {
     /// Value at voxel (i, j, k).
     #[inline]
     pub fn get(&self, i: usize, j: usize, k: usize) -> f32 {
-        self.data[self.index(i, j, k)]
+        self.samples.get(self.index(i, j, k))
     }
 
     /// World position of voxel (i, j, k).
@@ -181,19 +215,26 @@ impl Volume {
 
     /// Number of NaN or infinite values.
     pub fn count_non_finite(&self) -> usize {
-        self.data.iter().filter(|v| !v.is_finite()).count()
+        match &self.samples {
+            Samples::F32(data) => data.iter().filter(|v| !v.is_finite()).count(),
+            _ => 0,
+        }
     }
 
     /// `(fmin, fmax)` over the finite values, or `None` if there are none.
     pub fn value_range(&self) -> Option<(f32, f32)> {
-        let mut range: Option<(f32, f32)> = None;
-        for &v in self.data.iter().filter(|v| v.is_finite()) {
-            range = Some(match range {
-                None => (v, v),
-                Some((lo, hi)) => (lo.min(v), hi.max(v)),
-            });
+        fn range<T: Sample>(data: &[T]) -> Option<(f32, f32)> {
+            let mut range: Option<(f32, f32)> = None;
+            for v in data.iter().filter(|v| v.is_finite()) {
+                let v = v.to_f32();
+                range = Some(match range {
+                    None => (v, v),
+                    Some((lo, hi)) => (lo.min(v), hi.max(v)),
+                });
+            }
+            range
         }
-        range
+        crate::with_samples!(&self.samples, |data| range(data))
     }
 
     /// The same grid with every value `f` replaced by `log10 f`, for data
@@ -204,30 +245,35 @@ impl Volume {
     /// them). NaN stays NaN and `+∞` stays `+∞` (the renderer refuses
     /// both, or renders them as empty space: [`NonFinite`](crate::NonFinite)). A volume with no positive finite value is refused.
     pub fn to_log10(&self) -> Result<Volume, VolumeError> {
-        let smallest = self
-            .data
+        let values = self.values();
+        let smallest = values
             .iter()
             .copied()
             .filter(|v| *v > 0.0 && v.is_finite())
             .fold(f32::INFINITY, f32::min);
         if smallest == f32::INFINITY {
-            let largest = self.data.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            let largest = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
             return Err(VolumeError::NoPositiveValue(largest));
         }
         // In f64, so that exact powers of ten give exact exponents.
         let log = |v: f32| (v as f64).log10() as f32;
         let floor = log(smallest);
-        let data = self
-            .data
+        let data = values
             .iter()
             .map(|&v| if v <= 0.0 { floor } else { log(v) })
             .collect();
-        Ok(Volume {
+        Ok(self.with_samples(Samples::F32(data)))
+    }
+
+    /// This volume's grid with other samples (as many, x fastest).
+    fn with_samples(&self, samples: Samples) -> Volume {
+        debug_assert_eq!(samples.len(), self.len());
+        Volume {
             dims: self.dims,
             spacing: self.spacing,
             origin: self.origin,
-            data,
-        })
+            samples,
+        }
     }
 }
 
@@ -309,19 +355,19 @@ mod tests {
         assert_eq!(log.dims(), v.dims());
         assert_eq!(log.bounds(), v.bounds());
         for (i, k) in (-6..=9).enumerate() {
-            let got = log.data()[i];
+            let got = log.values()[i];
             assert!((got - k as f32).abs() <= 1e-6, "10^{k}: {got}");
         }
         // Exact powers of ten that f32 holds exactly give exact exponents.
         for (i, k) in (0..=9).enumerate() {
-            assert_eq!(log.data()[6 + i], k as f32);
+            assert_eq!(log.values()[6 + i], k as f32);
         }
         // 0 and −3 sit at the bottom of the scale, log10(1e−6).
-        assert_eq!(log.data()[16], log.data()[0]);
-        assert_eq!(log.data()[17], log.data()[0]);
-        assert!(log.data()[18].is_nan());
-        assert_eq!(log.data()[19], f32::INFINITY);
-        assert_eq!(log.data()[20], 0.0);
+        assert_eq!(log.values()[16], log.values()[0]);
+        assert_eq!(log.values()[17], log.values()[0]);
+        assert!(log.values()[18].is_nan());
+        assert_eq!(log.values()[19], f32::INFINITY);
+        assert_eq!(log.values()[20], 0.0);
     }
 
     #[test]

@@ -1,0 +1,245 @@
+//! A volume's samples in the type they were stored in: 8- and 16-bit
+//! integers stay 1 and 2 bytes a voxel in memory (a 1024³ 16-bit CT is
+//! 2 GiB, not the 4 GiB of an `f32` copy).
+//!
+//! Every path reads a sample as the `f32` it converts to exactly
+//! ([`Sample::to_f32`]: every `u8`, `i8`, `u16` and `i16` is an `f32`), at
+//! the moment it reads it, and computes from there in `f32` as before; so
+//! a volume of any of these types renders exactly as its `f32` conversion
+//! would, bit for bit. The loops that read samples are written once,
+//! generic over [`Sample`], and [`with_samples!`](crate::with_samples)
+//! picks the instance for a volume's type once per call, outside the loop.
+
+/// The types a volume keeps its samples in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SampleType {
+    U8,
+    I8,
+    U16,
+    I16,
+    F32,
+}
+
+impl SampleType {
+    /// Bytes a sample takes.
+    pub fn bytes(self) -> usize {
+        match self {
+            SampleType::U8 | SampleType::I8 => 1,
+            SampleType::U16 | SampleType::I16 => 2,
+            SampleType::F32 => 4,
+        }
+    }
+
+    /// The usual name: `u8`, `i8`, `u16`, `i16`, `f32`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SampleType::U8 => "u8",
+            SampleType::I8 => "i8",
+            SampleType::U16 => "u16",
+            SampleType::I16 => "i16",
+            SampleType::F32 => "f32",
+        }
+    }
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for u8 {}
+    impl Sealed for i8 {}
+    impl Sealed for u16 {}
+    impl Sealed for i16 {}
+    impl Sealed for f32 {}
+}
+
+/// A sample type a volume can hold: read as the `f32` it converts to
+/// exactly.
+pub trait Sample: Copy + Send + Sync + PartialOrd + Default + 'static + sealed::Sealed {
+    const TYPE: SampleType;
+
+    /// The sample's value (exact for every type here).
+    fn to_f32(self) -> f32;
+
+    /// Whether it is a finite number (integers always are).
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        true
+    }
+}
+
+impl Sample for u8 {
+    const TYPE: SampleType = SampleType::U8;
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        f32::from(self)
+    }
+}
+
+impl Sample for i8 {
+    const TYPE: SampleType = SampleType::I8;
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        f32::from(self)
+    }
+}
+
+impl Sample for u16 {
+    const TYPE: SampleType = SampleType::U16;
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        f32::from(self)
+    }
+}
+
+impl Sample for i16 {
+    const TYPE: SampleType = SampleType::I16;
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        f32::from(self)
+    }
+}
+
+impl Sample for f32 {
+    const TYPE: SampleType = SampleType::F32;
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+}
+
+/// A volume's samples, x fastest, in their stored type.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Samples {
+    U8(Vec<u8>),
+    I8(Vec<i8>),
+    U16(Vec<u16>),
+    I16(Vec<i16>),
+    F32(Vec<f32>),
+}
+
+/// Runs `$body` with `$data` bound to the samples of `$samples` (a
+/// [`Samples`]) as a slice of their own type: the body is compiled once
+/// per sample type, so that a loop inside it reads its type directly.
+#[macro_export]
+macro_rules! with_samples {
+    ($samples:expr, |$data:ident| $body:expr) => {
+        match $samples {
+            $crate::Samples::U8(v) => {
+                let $data: &[u8] = v;
+                $body
+            }
+            $crate::Samples::I8(v) => {
+                let $data: &[i8] = v;
+                $body
+            }
+            $crate::Samples::U16(v) => {
+                let $data: &[u16] = v;
+                $body
+            }
+            $crate::Samples::I16(v) => {
+                let $data: &[i16] = v;
+                $body
+            }
+            $crate::Samples::F32(v) => {
+                let $data: &[f32] = v;
+                $body
+            }
+        }
+    };
+}
+
+impl Samples {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        with_samples!(self, |data| data.len())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Their type.
+    pub fn sample_type(&self) -> SampleType {
+        match self {
+            Samples::U8(_) => SampleType::U8,
+            Samples::I8(_) => SampleType::I8,
+            Samples::U16(_) => SampleType::U16,
+            Samples::I16(_) => SampleType::I16,
+            Samples::F32(_) => SampleType::F32,
+        }
+    }
+
+    /// Sample `i` as `f32`.
+    #[inline]
+    pub fn get(&self, i: usize) -> f32 {
+        with_samples!(self, |data| data[i].to_f32())
+    }
+
+    /// Every sample as `f32`, in a new vector.
+    pub fn to_f32_vec(&self) -> Vec<f32> {
+        with_samples!(self, |data| data.iter().map(|v| v.to_f32()).collect())
+    }
+}
+
+impl From<Vec<f32>> for Samples {
+    fn from(v: Vec<f32>) -> Self {
+        Samples::F32(v)
+    }
+}
+
+impl From<Vec<u8>> for Samples {
+    fn from(v: Vec<u8>) -> Self {
+        Samples::U8(v)
+    }
+}
+
+impl From<Vec<i8>> for Samples {
+    fn from(v: Vec<i8>) -> Self {
+        Samples::I8(v)
+    }
+}
+
+impl From<Vec<u16>> for Samples {
+    fn from(v: Vec<u16>) -> Self {
+        Samples::U16(v)
+    }
+}
+
+impl From<Vec<i16>> for Samples {
+    fn from(v: Vec<i16>) -> Self {
+        Samples::I16(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_integer_sample_converts_to_f32_exactly() {
+        for v in [i16::MIN, -1, 0, 1, i16::MAX] {
+            assert_eq!(v.to_f32() as i16, v);
+        }
+        for v in [0, 1, 32768, u16::MAX] {
+            assert_eq!(v.to_f32() as u16, v);
+        }
+        // u16 needs 16 bits of mantissa; f32 has 24.
+        assert_eq!(65535u16.to_f32(), 65535.0);
+        assert_eq!((-128i8).to_f32(), -128.0);
+        assert_eq!(255u8.to_f32(), 255.0);
+        assert!(!f32::NAN.is_finite() && Sample::is_finite(7u8));
+    }
+
+    #[test]
+    fn samples_report_their_type_and_values() {
+        let s = Samples::from(vec![3u16, 65535, 0]);
+        assert_eq!((s.sample_type(), s.len()), (SampleType::U16, 3));
+        assert_eq!(s.get(1), 65535.0);
+        assert_eq!(s.to_f32_vec(), vec![3.0, 65535.0, 0.0]);
+        assert_eq!(SampleType::U16.bytes(), 2);
+        assert_eq!(SampleType::I8.name(), "i8");
+    }
+}

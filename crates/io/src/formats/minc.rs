@@ -1,0 +1,369 @@
+//! MINC2 (`.mnc`): HDF5 files in the layout libminc writes, read in pure
+//! Rust (`shared/hdf5.rs`), matching nibabel's `Minc2Image`.
+//!
+//! - The image is `/minc-2.0/image/0/image`; its `dimorder` attribute
+//!   names its axes, slowest first (`zspace,yspace,xspace`, or any order
+//!   of the three, after an optional leading `time`, whose volumes are
+//!   frames).
+//! - Each dimension, `/minc-2.0/dimensions/<name>`, gives `step`, `start`
+//!   and `direction_cosines` (default: the name's own axis). The world
+//!   position of file index `i` is `Σ cosines_a · (start_a + step_a ·
+//!   i_a)` over the three spatial axes, nibabel's affine: a negative step
+//!   flips the axis (exactly, by [`grid_to_volume`]); cosines away from
+//!   the world axes are noted and the grid kept in its own axes, as other
+//!   readers do with rotations.
+//! - Integer images hold normalised values: the real value is the stored
+//!   one clipped to `valid_range` (default: the type's range), mapped
+//!   linearly from that range onto `[image-min, image-max]`, datasets
+//!   over the first one or two axes (one value per slice) or scalars.
+//!   Float images are real values already.
+//!
+//! The file's fastest axis is volray's x, so the samples need no
+//! transposing. MINC1 files (netCDF) are refused with a hint.
+
+use std::path::Path;
+
+use hdf5_pure::{AttrValue, Dataset, Group};
+use volray_core::glam::DVec3;
+
+use crate::error::IoError;
+use crate::shared::geometry::grid_to_volume;
+use crate::shared::hdf5::{
+    self as h5, Slabs, numbers, numeric_type, read_small, shown, sorted_attrs, text,
+};
+use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+
+const IMAGE: &str = "minc-2.0/image/0";
+
+/// Reads the MINC2 file at `path`.
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let fail = |reason: String| IoError::invalid(path, format!("MINC2: {reason}"));
+    if let Ok(mut f) = std::fs::File::open(path) {
+        use std::io::Read;
+        let mut magic = [0u8; 3];
+        if f.read_exact(&mut magic).is_ok() && &magic == b"CDF" {
+            return Err(fail(
+                "this is a MINC1 (netCDF) file: volray reads MINC2; convert it with `mincconvert -2`"
+                    .into(),
+            ));
+        }
+    }
+    let h5 = h5::open(path)?;
+    let group = h5
+        .file
+        .group(IMAGE)
+        .map_err(|_| fail(format!("no group /{IMAGE}: not a MINC2 file")))?;
+    let image = group
+        .dataset("image")
+        .map_err(|_| fail(format!("no dataset /{IMAGE}/image")))?;
+    let what = |reason: String| fail(format!("/{IMAGE}/image: {reason}"));
+    let sample = numeric_type(&image).map_err(what)?;
+    let shape = h5::shape(&image).map_err(what)?;
+    let attrs = sorted_attrs(image.attrs());
+    let attr = |name: &str| attrs.iter().find(|(n, _)| n == name).map(|(_, v)| v);
+    let order = dimorder(attr("dimorder"), shape.len()).map_err(what)?;
+
+    // The spatial axes: the last three; a fourth, leading, is frames.
+    let (frames, spatial) = match (shape.as_slice(), order.as_slice()) {
+        ([_, _, _], [_, _, _]) => (1, 0),
+        ([t, _, _, _], [first, ..]) if !first.ends_with("space") => (*t, 1),
+        _ => {
+            return Err(what(format!(
+                "dimorder \"{}\" over shape {shape:?}: volray reads three spatial dimensions (xspace, yspace, zspace), after an optional leading one such as time",
+                order.join(",")
+            )));
+        }
+    };
+    let names = &order[spatial..];
+    if let Some(bad) = names.iter().find(|n| !n.ends_with("space")) {
+        return Err(what(format!(
+            "dimension \"{bad}\" is not spatial: volray reads xspace, yspace and zspace (after an optional leading time)"
+        )));
+    }
+    let frame = opts.frame.unwrap_or(0);
+    if frame >= frames {
+        return Err(IoError::frame_out_of_range(
+            path,
+            frame,
+            format!(
+                "the MINC2 image holds {frames} volume(s) along \"{}\", numbered from 0",
+                order[0]
+            ),
+        ));
+    }
+    let n = [shape[spatial], shape[spatial + 1], shape[spatial + 2]];
+    let slabs = Slabs::new(
+        &image,
+        &shape,
+        frames,
+        (spatial == 1).then_some(frame),
+        sample.size,
+    );
+    let voxels = slabs.check(
+        path,
+        &format!("image shape {shape:?}"),
+        h5.len,
+        opts.max_memory,
+    )?;
+
+    let mut info = FileInfo::new(sample.name.clone());
+    info.frames = frames;
+    info.frame = frame;
+    info.header = vec![
+        ("image".into(), format!("/{IMAGE}/image")),
+        ("shape".into(), format!("{shape:?}")),
+        ("type".into(), sample.name.clone()),
+    ];
+    info.header
+        .extend(attrs.iter().map(|(k, v)| (format!("@{k}"), shown(v))));
+
+    let (steps, origin) = geometry(&h5.file.root(), names, &mut info).map_err(fail)?;
+    let scaling = if sample.name.starts_with("float") {
+        info.notes
+            .push("float image: real values as stored (no image-min/image-max scaling)".into());
+        None
+    } else {
+        Scaling::read(
+            &group,
+            &image,
+            &order,
+            &shape,
+            attr("valid_range"),
+            &mut info,
+        )
+        .map_err(what)?
+    };
+    if frames > 1 {
+        info.notes.push(format!(
+            "volume {frame} of {frames} read (first axis: {})",
+            order[0]
+        ));
+    }
+
+    // C order, fastest axis last: index axis 0 of the volume is the
+    // file's last axis, so the samples keep their order.
+    let mut data = vec![0.0f32; voxels];
+    let base = frame * voxels;
+    slabs
+        .read(|at, part| {
+            for (i, &v) in part.iter().enumerate() {
+                let value = match &scaling {
+                    Some(s) => s.real(base + at + i, v),
+                    None => v,
+                };
+                data[at + i] = value as f32;
+            }
+        })
+        .map_err(what)?;
+    let dims = [n[2], n[1], n[0]];
+    let steps = [steps[2], steps[1], steps[0]];
+    let volume = grid_to_volume(path, dims, data, steps, origin, &mut info)?;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Minc,
+        info,
+    })
+}
+
+/// The axis names of `dimorder` (`"zspace,yspace,xspace"`), one per axis
+/// of a `rank`-axis dataset.
+fn dimorder(value: Option<&AttrValue>, rank: usize) -> Result<Vec<String>, String> {
+    let value = value.ok_or("no \"dimorder\" attribute naming its dimensions")?;
+    let text = text(value).ok_or("attribute \"dimorder\" is not a string")?;
+    let names: Vec<String> = text.split(',').map(|s| s.trim().to_string()).collect();
+    if names.len() < rank || names.iter().any(String::is_empty) {
+        return Err(format!(
+            "dimorder \"{text}\" does not name its {rank} dimensions"
+        ));
+    }
+    Ok(names[..rank].to_vec())
+}
+
+/// The step vector of each spatial axis (in file order, slowest first)
+/// and the world position of index 0, from the dimension datasets.
+fn geometry(
+    root: &Group,
+    names: &[String],
+    info: &mut FileInfo,
+) -> Result<([DVec3; 3], DVec3), String> {
+    let mut steps = [DVec3::ZERO; 3];
+    let mut origin = DVec3::ZERO;
+    let mut described = Vec::new();
+    for (a, name) in names.iter().enumerate() {
+        let default = match name.as_str() {
+            "xspace" => DVec3::X,
+            "yspace" => DVec3::Y,
+            "zspace" => DVec3::Z,
+            other => {
+                return Err(format!(
+                    "dimension \"{other}\": volray knows xspace, yspace and zspace"
+                ));
+            }
+        };
+        let attrs = root
+            .dataset(&format!("minc-2.0/dimensions/{name}"))
+            .map(|d| sorted_attrs(d.attrs()))
+            .unwrap_or_default();
+        let attr = |key: &str| attrs.iter().find(|(n, _)| n == key).map(|(_, v)| v);
+        let number = |key: &str, default: f64| -> Result<f64, String> {
+            match attr(key).map(numbers) {
+                None => Ok(default),
+                Some(Some(v)) if v.len() == 1 && v[0].is_finite() => Ok(v[0]),
+                Some(_) => Err(format!(
+                    "dimension {name}: attribute \"{key}\" is not one finite number"
+                )),
+            }
+        };
+        let step = number("step", 1.0)?;
+        let start = number("start", 0.0)?;
+        let cosines = match attr("direction_cosines").map(numbers) {
+            None => default,
+            Some(Some(v)) if v.len() == 3 && v.iter().all(|c| c.is_finite()) => {
+                DVec3::new(v[0], v[1], v[2])
+            }
+            Some(_) => {
+                return Err(format!(
+                    "dimension {name}: attribute \"direction_cosines\" is not three finite numbers"
+                ));
+            }
+        };
+        if let Some(spacing) = attr("spacing").and_then(text)
+            && spacing.starts_with("irregular")
+        {
+            return Err(format!(
+                "dimension {name} is irregularly spaced: volray reads regular grids"
+            ));
+        }
+        if a == 0 {
+            info.length_unit = attr("units").and_then(text);
+        }
+        steps[a] = cosines * step;
+        origin += cosines * start;
+        described.push(format!(
+            "{name} step {step} start {start} cosines ({}, {}, {})",
+            cosines.x, cosines.y, cosines.z
+        ));
+    }
+    info.notes.push(format!(
+        "geometry from /minc-2.0/dimensions: {}; world = Σ cosines · (start + step · index), nibabel's affine",
+        described.join("; ")
+    ));
+    Ok((steps, origin))
+}
+
+/// The map from stored to real values of an integer image.
+struct Scaling {
+    /// Stored values are clipped to `[lo, hi]`, the valid range.
+    lo: f64,
+    hi: f64,
+    /// image-min and image-max, one per slice of the first axes.
+    min: Vec<f64>,
+    max: Vec<f64>,
+    /// Samples per value of `min` and `max`.
+    per: usize,
+}
+
+impl Scaling {
+    /// The scaling of `image`, from `valid_range` (else the type's range)
+    /// and the image-min and image-max datasets beside it; none where
+    /// they are missing (noted).
+    fn read(
+        group: &Group,
+        image: &Dataset,
+        order: &[String],
+        shape: &[usize],
+        valid_range: Option<&AttrValue>,
+        info: &mut FileInfo,
+    ) -> Result<Option<Scaling>, String> {
+        let (Ok(min_ds), Ok(max_ds)) = (group.dataset("image-min"), group.dataset("image-max"))
+        else {
+            info.notes.push(
+                "no image-min/image-max datasets: the stored values are read as they are".into(),
+            );
+            return Ok(None);
+        };
+        let (type_lo, type_hi) = type_range(image)?;
+        let (lo, hi) = match valid_range.map(numbers) {
+            None => (type_lo, type_hi),
+            Some(Some(v)) if v.len() == 2 && v[0] < v[1] => (v[0], v[1]),
+            Some(_) => return Err("attribute \"valid_range\" is not two increasing numbers".into()),
+        };
+        if lo < type_lo || hi > type_hi {
+            return Err(format!(
+                "valid_range [{lo}, {hi}] is outside the stored type's range [{type_lo}, {type_hi}]"
+            ));
+        }
+        let scale_order = |ds: &Dataset| -> Result<Vec<String>, String> {
+            let rank = h5::shape(ds)?.len();
+            match sorted_attrs(ds.attrs())
+                .iter()
+                .find(|(n, _)| n == "dimorder")
+            {
+                Some((_, v)) if rank > 0 => dimorder(Some(v), rank),
+                _ => Ok(order[..rank].to_vec()),
+            }
+        };
+        let (min_order, max_order) = (scale_order(&min_ds)?, scale_order(&max_ds)?);
+        if min_order != max_order {
+            return Err("image-min and image-max have different dimensions".into());
+        }
+        let k = min_order.len();
+        if k > 2 || min_order != order[..k.min(order.len())] {
+            return Err(format!(
+                "image-min/image-max over \"{}\": volray reads scaling over the image's first one or two dimensions",
+                min_order.join(",")
+            ));
+        }
+        let slices: usize = shape[..k].iter().product();
+        let min = read_small(&min_ds, slices).map_err(|e| format!("image-min {e}"))?;
+        let max = read_small(&max_ds, slices).map_err(|e| format!("image-max {e}"))?;
+        if min.len() != slices || max.len() != slices {
+            return Err(format!(
+                "image-min/image-max hold {} and {} values for {slices} slices",
+                min.len(),
+                max.len()
+            ));
+        }
+        let per = shape[k..].iter().product();
+        info.notes.push(format!(
+            "real values: stored values clipped to [{lo}, {hi}] ({}) mapped onto [image-min, image-max] {}",
+            if valid_range.is_some() { "valid_range" } else { "the type's range" },
+            if k == 0 {
+                format!("[{}, {}]", min[0], max[0])
+            } else {
+                format!("per slice of {}", min_order.join(","))
+            }
+        ));
+        Ok(Some(Scaling {
+            lo,
+            hi,
+            min,
+            max,
+            per,
+        }))
+    }
+
+    /// The real value of stored value `v` at C-order index `at`.
+    fn real(&self, at: usize, v: f64) -> f64 {
+        let s = at / self.per;
+        let (min, max) = (self.min[s], self.max[s]);
+        let slope = (max - min) / (self.hi - self.lo);
+        v.clamp(self.lo, self.hi) * slope + (min - self.lo * slope)
+    }
+}
+
+/// The range of the image's integer type.
+fn type_range(image: &Dataset) -> Result<(f64, f64), String> {
+    use hdf5_pure::DType as T;
+    Ok(match image.dtype().map_err(|e| e.to_string())? {
+        T::I8 => (i8::MIN.into(), i8::MAX.into()),
+        T::U8 => (0.0, u8::MAX.into()),
+        T::I16 => (i16::MIN.into(), i16::MAX.into()),
+        T::U16 => (0.0, u16::MAX.into()),
+        T::I32 => (i32::MIN.into(), i32::MAX.into()),
+        T::U32 => (0.0, u32::MAX.into()),
+        T::I64 => (i64::MIN as f64, i64::MAX as f64),
+        T::U64 => (0.0, u64::MAX as f64),
+        other => return Err(format!("type {other} has no integer range")),
+    })
+}

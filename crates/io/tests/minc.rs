@@ -1,0 +1,142 @@
+//! MINC2 files written by h5py in libminc's layout and checked with
+//! nibabel's `Minc2Image` (`fixtures/make_minc_fixtures.py`): the values
+//! and world positions volray reads are nibabel's.
+//!
+//! Stored values at file index (i0, i1, i2), slowest first: `i2 + 10·i1 +
+//! 100·i0` (series: `i2 + 2·i1 + 6·i0 + 50·t`), mapped to real values by
+//! the per-slice image-min and image-max.
+
+mod common;
+
+use common::{Grid, assert_frame_out_of_range, assert_note, check_voxels, check_world, frame};
+use volray_core::glam::DVec3;
+use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
+
+fn load(name: &str, opts: &ReadOptions) -> Loaded {
+    let l = read(&common::fixture("minc", name), opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(l.format, VolumeFormat::Minc);
+    l
+}
+
+fn close(got: f32, want: f64) -> bool {
+    (f64::from(got) - want).abs() <= 1e-5 * want.abs().max(1.0)
+}
+
+#[test]
+fn per_slice_scaling_and_a_flipped_axis_match_nibabel() {
+    let l = load("ramp_i16.mnc", &ReadOptions::default());
+    // nibabel's affine, array axes (z, y, x): x step 1.5 from -3, y step
+    // -2 from 10, z step 2.5 from 4.
+    let affine = [
+        [0.0, 0.0, 1.5, -3.0],
+        [0.0, -2.0, 0.0, 10.0],
+        [2.5, 0.0, 0.0, 4.0],
+    ];
+    let grid = Grid::from_affine([3, 4, 5], &affine);
+    let real = |z: usize, y: usize, x: usize| {
+        let raw = (x + 10 * y + 100 * z) as f64;
+        let (lo, hi) = (-1.0 - z as f64, 100.0 + 10.0 * z as f64);
+        raw * (hi - lo) / 1000.0 + lo
+    };
+    // Exact f32 of the real value (the reader computes in f64).
+    check_world("ramp_i16", &l.volume, &grid, 1e-9, |z, y, x| {
+        real(z, y, x) as f32
+    });
+    assert_eq!(l.volume.dims(), [5, 4, 3]);
+    assert_eq!(l.volume.spacing(), DVec3::new(1.5, 2.0, 2.5));
+    // y flipped: the lowest y is 10 - 2·3 = 4.
+    assert_eq!(l.volume.origin(), DVec3::new(-3.0, 4.0, 4.0));
+    assert_eq!(l.info.stored_type, "int16 (little-endian)");
+    assert_eq!(l.info.length_unit.as_deref(), Some("mm"));
+    assert_note(&l, "valid_range");
+    assert_note(&l, "per slice of zspace");
+    assert_note(&l, "index axis 1 -> -y");
+    assert!(
+        l.info
+            .header
+            .contains(&("@dimorder".into(), "zspace,yspace,xspace".into())),
+        "{:?}",
+        l.info.header
+    );
+}
+
+#[test]
+fn direction_cosines_and_another_dimorder() {
+    let l = load("oblique_f32.mnc", &ReadOptions::default());
+    // dimorder yspace, zspace, xspace: index axis 0 is x (step 1), 1 is z
+    // (step 3), 2 is y (step 2); float values unscaled.
+    check_voxels("oblique_f32", &l.volume, [5, 3, 4], |x, z, y| {
+        (x + 10 * z + 100 * y) as f32 + 0.5
+    });
+    assert_eq!(l.volume.spacing(), DVec3::new(1.0, 3.0, 2.0));
+    // nibabel's affine, last column: R · starts.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let want = DVec3::new(c - 2.0 * s, s + 2.0 * c, 3.0);
+    assert!(
+        (l.volume.origin() - want).length() < 1e-12,
+        "{}",
+        l.volume.origin()
+    );
+    assert_note(&l, "rotated away from world x, y, z");
+    assert_note(&l, "float image");
+}
+
+#[test]
+fn a_time_series_scaled_per_time_and_slice() {
+    for t in 0..2 {
+        let l = load("series_u8.mnc", &frame(t));
+        assert_eq!((l.info.frames, l.info.frame), (2, t));
+        assert_eq!(l.volume.dims(), [5, 4, 3]);
+        for (z, y, x) in
+            (0..3).flat_map(|z| (0..4).flat_map(move |y| (0..5).map(move |x| (z, y, x))))
+        {
+            let raw = (x + 2 * y + 6 * z + 50 * t) as f64;
+            let (lo, hi) = (-(t as f64) - z as f64, 10.0 + (t + z) as f64);
+            let want = raw * (hi - lo) / 255.0 + lo;
+            let got = l.volume.get(x, y, z);
+            assert!(
+                close(got, want),
+                "frame {t} ({x}, {y}, {z}): {got} vs {want}"
+            );
+        }
+        assert_eq!(l.volume.spacing(), DVec3::ONE);
+        assert_note(&l, "the type's range");
+        assert_note(&l, "per slice of time,zspace");
+    }
+    let path = common::fixture("minc", "series_u8.mnc");
+    let err = common::error_about(&path, &frame(2), &path);
+    assert_frame_out_of_range(&err, 2, "the MINC2 image holds 2 volume(s) along \"time\"");
+}
+
+#[test]
+fn a_minc2_file_under_an_hdf5_name_is_read_as_minc2() {
+    let dir = tempfile::tempdir().unwrap();
+    let renamed = dir.path().join("scan.h5");
+    std::fs::copy(common::fixture("minc", "ramp_i16.mnc"), &renamed).unwrap();
+    let l = read(&renamed, &ReadOptions::default()).unwrap();
+    assert_eq!(l.format, VolumeFormat::Minc);
+    assert_eq!(
+        l.volume,
+        load("ramp_i16.mnc", &ReadOptions::default()).volume
+    );
+}
+
+#[test]
+fn not_minc2_is_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    // An HDF5 file without the MINC2 layout.
+    let plain = dir.path().join("plain.mnc");
+    std::fs::copy(common::fixture("hdf5", "one.h5"), &plain).unwrap();
+    let msg = common::refused(&plain, &ReadOptions::default());
+    assert!(msg.contains("MINC2: no group /minc-2.0/image/0"), "{msg}");
+    // MINC1 is netCDF.
+    let msg = common::refused_at(
+        dir.path(),
+        "old.mnc",
+        b"CDF\x01\0\0\0\0",
+        &ReadOptions::default(),
+    );
+    assert!(msg.contains("MINC1 (netCDF)"), "{msg}");
+    let msg = common::refused_at(dir.path(), "junk.mnc", b"not hdf5", &ReadOptions::default());
+    assert!(msg.contains("HDF5: cannot open"), "{msg}");
+}
