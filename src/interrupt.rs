@@ -7,6 +7,29 @@
 //! The signals are caught by `signal-hook`, which turns them into messages
 //! to a thread of ours: the deleting happens there, outside the signal
 //! handler, where taking a lock and calling the file system are allowed.
+//!
+//! A command that serves until it is stopped (`volray view`) registers a
+//! stop with [`stop_instead`]: the first signal then runs it, and the
+//! command ends as it finishes, with exit 0; a second signal exits as
+//! above, in case stopping hangs.
+
+use std::sync::Mutex;
+
+/// What the next signal does instead of exiting.
+type Stop = Box<dyn FnOnce() + Send>;
+static STOP: Mutex<Option<Stop>> = Mutex::new(None);
+
+/// Makes the next signal call `stop` instead of ending the process.
+#[cfg_attr(not(unix), allow(dead_code))]
+pub fn stop_instead(stop: impl FnOnce() + Send + 'static) {
+    *STOP.lock().unwrap_or_else(|e| e.into_inner()) = Some(Box::new(stop));
+}
+
+/// The registered stop, taken (it runs once).
+#[cfg_attr(not(unix), allow(dead_code))]
+fn take_stop() -> Option<Stop> {
+    STOP.lock().unwrap_or_else(|e| e.into_inner()).take()
+}
 
 /// Starts the thread that answers the signals. If it cannot be started the
 /// signals keep their default action (the process dies at once, possibly
@@ -26,7 +49,11 @@ pub fn install() {
     let spawned = std::thread::Builder::new()
         .name("signals".into())
         .spawn(move || {
-            if let Some(signal) = signals.forever().next() {
+            for signal in signals.forever() {
+                if let Some(stop) = take_stop() {
+                    stop();
+                    continue;
+                }
                 // Holds the registry's lock until the exit, so no other
                 // thread publishes or starts a file in between.
                 volray_io::remove_unfinished_files();

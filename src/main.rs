@@ -10,7 +10,8 @@
 //! - one module per subcommand: `render.rs` (one still image, and the
 //!   checks before any work) with `animate.rs` (turntables and series),
 //!   `bench.rs` (with `bench/peers.rs` and `bench/vtk.rs`), `info.rs`,
-//!   `generate.rs`, `paper.rs`;
+//!   `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
+//!   `view/reproduce.rs`: the page's state as a `volray render` command);
 //! - what they share: `input.rs` (reading INPUT), `settings.rs` (the flags
 //!   as volray-core's `RenderSettings`), `session.rs` (loading, the
 //!   renderer, threads, progress, which flag a render error is about),
@@ -41,6 +42,7 @@ mod paper;
 mod render;
 mod session;
 mod settings;
+mod view;
 
 use flags::Command;
 use std::process::ExitCode;
@@ -57,6 +59,7 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Paper(args) => paper::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

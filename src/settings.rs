@@ -14,15 +14,27 @@ use volray_core::{
     RenderSettings, TransferFunction,
 };
 
-/// The render settings the view arguments describe.
+/// The render settings the view arguments describe (reading `--tf`).
 pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
+    let tf_text = view.look.tf.as_deref().map(read_tf_file).transpose()?;
+    settings_with_tf_text(view, tf_text.as_deref())
+}
+
+/// The render settings the view arguments describe, with the text of the
+/// `--tf` file given rather than read: [`settings`] reads it, `volray
+/// view` writes the file its Command box names. `tf_text` is used only
+/// when `--tf` is given.
+pub fn settings_with_tf_text(
+    view: &ViewArgs,
+    tf_text: Option<&str>,
+) -> Result<RenderSettings, CliError> {
     let ViewArgs {
         camera: cam,
         look,
         sampling,
         threads: _,
     } = view;
-    let transfer_function = transfer_function(look)?;
+    let transfer_function = in_log_units(look, named_transfer_function(look, tf_text)?)?;
     let settings = RenderSettings {
         width: cam.size.0,
         height: cam.size.1,
@@ -75,24 +87,26 @@ pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
     Ok(settings)
 }
 
-/// The transfer function of `--tf` or `--preset` (else the default), with
-/// `--colormap`'s colours and `--range`'s window, each refused where it
-/// would replace what `--tf` or a CT preset fixes; with `--log` the window
-/// is converted from the data's units.
-fn transfer_function(look: &LookArgs) -> Result<TransferFunction, CliError> {
-    let transfer_function = match &look.tf {
-        Some(path) => {
-            let text = read_tf_file(path)?;
-            TransferFunction::from_json(&text)
-                .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?
+/// The transfer function of `--tf` (its file's text `tf_text`) or
+/// `--preset` (else the default), with `--colormap`'s colours and
+/// `--range`'s window, each refused where it would replace what `--tf` or
+/// a CT preset fixes; the window in the data's units, as the flags give it.
+pub fn named_transfer_function(
+    look: &LookArgs,
+    tf_text: Option<&str>,
+) -> Result<TransferFunction, CliError> {
+    let transfer_function = match (&look.tf, tf_text) {
+        (Some(path), Some(text)) => TransferFunction::from_json(text)
+            .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?,
+        (Some(path), None) => {
+            return Err(CliError::io(format!(
+                "--tf {}: the file was not read",
+                path.display()
+            )));
         }
-        None => TransferFunction::default(),
+        (None, _) => TransferFunction::default(),
     };
-    let from = if look.tf.is_some() {
-        "--tf"
-    } else {
-        "--preset"
-    };
+    let from = tf_source(look);
     let mut transfer_function = match &look.preset {
         Some(_) if look.tf.is_some() => {
             return Err(CliError::input(
@@ -133,6 +147,25 @@ fn transfer_function(look: &LookArgs) -> Result<TransferFunction, CliError> {
         }
         transfer_function.domain = Some(range);
     }
+    Ok(transfer_function)
+}
+
+/// The flag a transfer function came from, for messages.
+fn tf_source(look: &LookArgs) -> &'static str {
+    if look.tf.is_some() {
+        "--tf"
+    } else {
+        "--preset"
+    }
+}
+
+/// With `--log`, the window of `transfer_function` converted from the
+/// data's units to the log10 the renderer sees.
+fn in_log_units(
+    look: &LookArgs,
+    mut transfer_function: TransferFunction,
+) -> Result<TransferFunction, CliError> {
+    let from = tf_source(look);
     if look.log
         && let Some((lo, hi)) = transfer_function.domain
     {
@@ -157,7 +190,7 @@ fn transfer_function(look: &LookArgs) -> Result<TransferFunction, CliError> {
 const TF_MAX_BYTES: u64 = 16 << 20;
 
 /// Reads a `--tf` file: a regular file of at most [`TF_MAX_BYTES`].
-fn read_tf_file(path: &Path) -> Result<String, CliError> {
+pub fn read_tf_file(path: &Path) -> Result<String, CliError> {
     use std::io::Read;
     let name = path.display();
     let meta = std::fs::metadata(path)

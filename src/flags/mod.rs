@@ -10,9 +10,9 @@
 //!   (the step, jitter, the path, non-finite values), and `--threads`;
 //! - `output.rs` and `animation.rs`: render's output file, and its
 //!   turntables and series;
-//! - `render.rs`, `bench.rs`, `info.rs`, `generate.rs`, `paper.rs`: each
-//!   subcommand's arguments (`bench.rs` also says which groups `--peers`
-//!   refuses);
+//! - `render.rs`, `bench.rs`, `info.rs`, `generate.rs`, `paper.rs`,
+//!   `viewer.rs` (`volray view`): each subcommand's arguments (`bench.rs`
+//!   also says which groups `--peers` refuses);
 //! - `parse.rs`: the value parsers, and clap's errors on one line.
 
 mod animation;
@@ -28,6 +28,7 @@ mod parse;
 mod render;
 mod sampling;
 mod view;
+mod viewer;
 
 pub use bench::BenchArgs;
 pub use camera::CameraArgs;
@@ -36,8 +37,10 @@ pub use info::InfoArgs;
 pub use input::InputArgs;
 pub use look::{BlendMode, LookArgs};
 pub use paper::{PaperArgs, PaperItem};
+pub use parse::one_line_error;
 pub use render::RenderArgs;
 pub use view::ViewArgs;
+pub use viewer::ViewerArgs;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
@@ -73,6 +76,12 @@ pub enum Command {
     /// Reproduce the paper's Figures 1a, 1b, 1c, 2a, 2b and Table 1 into a
     /// directory (figure1a.png ... figure2b.png, table1.md).
     Paper(PaperArgs),
+    /// Explore a volume in a web browser: serves a page that orbits,
+    /// zooms and pans, edits the transfer function and shows the `volray
+    /// render` command of the current view; frames are rendered here.
+    /// Prints the page's URL (with its access token) and serves until
+    /// Ctrl-C.
+    View(ViewerArgs),
 }
 
 /// The command line, parsed; or, when it asks for help or the version or

@@ -1,0 +1,112 @@
+//! What the page is told first about the volume and the starting view:
+//! the [`Hello`] message, with the value histogram the window and the
+//! opacity editor are drawn over, and the colours of every colour choice.
+
+use crate::protocol::Hello;
+use crate::state::{START_COLOURS, ViewState, WHITE};
+use volray_core::transfer::colormap;
+use volray_core::{Histogram, RenderSettings, Volume};
+
+/// Bins of the histogram drawn under the transfer-function editor.
+pub const HISTOGRAM_BINS: usize = 128;
+
+/// Colours per colour choice, evenly spaced over `t` in [0, 1].
+pub const COLOUR_SAMPLES: usize = 64;
+
+/// The volume and the starting view as the page's first message.
+pub struct Start<'a> {
+    /// The input's name, as given.
+    pub name: &'a str,
+    /// The volume as rendered (log10 of the data's when `log`).
+    pub volume: &'a Volume,
+    pub log: bool,
+    /// The starting state, and the settings it renders with.
+    pub state: &'a ViewState,
+    pub settings: &'a RenderSettings,
+}
+
+impl Start<'_> {
+    /// The first message.
+    pub fn hello(&self) -> Hello {
+        let histogram = Histogram::of(self.volume, HISTOGRAM_BINS);
+        let range = histogram.as_ref().map_or([0.0, 0.0], |h| [h.min, h.max]);
+        let tf = &self.settings.transfer_function;
+        let start_window = tf
+            .domain
+            .map_or([f64::from(range[0]), f64::from(range[1])], |(lo, hi)| {
+                [lo, hi]
+            });
+        let sample = |eval: &dyn Fn(f32) -> [f32; 3]| -> Vec<[f32; 3]> {
+            (0..COLOUR_SAMPLES)
+                .map(|i| eval(i as f32 / (COLOUR_SAMPLES - 1) as f32))
+                .collect()
+        };
+        let mut colormaps = Vec::new();
+        if let Some(colour) = &tf.color {
+            colormaps.push((START_COLOURS.to_string(), sample(&|t| colour.eval(t))));
+        }
+        colormaps.push((WHITE.to_string(), sample(&|_| [1.0; 3])));
+        for name in colormap::NAMES {
+            let map = colormap::colormap(name).expect("a listed colour map");
+            colormaps.push((name.to_string(), sample(&|t| map.eval(t))));
+        }
+        let (p, q) = self.settings.opacity_ramp;
+        Hello {
+            name: self.name.to_string(),
+            dims: self.volume.dims(),
+            spacing: self.volume.spacing().to_array(),
+            range,
+            log: self.log,
+            histogram: histogram.map_or_else(Vec::new, |h| h.counts),
+            start: self.state.clone(),
+            opacity_ramp: [p, q],
+            start_opacity: tf
+                .opacity
+                .as_ref()
+                .map(|f| f.points().iter().map(|(t, [a])| [*t, *a]).collect()),
+            start_window,
+            colormaps,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::state::tests::sample;
+    use volray_core::TransferFunction;
+
+    #[test]
+    fn hello_describes_the_volume_and_the_start() {
+        let volume = Volume::new([2, 2, 2], (0..8).map(|i| i as f32).collect()).unwrap();
+        let settings = RenderSettings {
+            transfer_function: TransferFunction::from_json(
+                r#"{"domain": [1, 5], "opacity": [[0, 0], [1, 0.5]], "color": [[0, 1, 0, 0], [1, 0, 0, 1]]}"#,
+            )
+            .unwrap(),
+            ..RenderSettings::default()
+        };
+        let state = sample();
+        let hello = Start {
+            name: "cube",
+            volume: &volume,
+            log: false,
+            state: &state,
+            settings: &settings,
+        }
+        .hello();
+        assert_eq!(hello.range, [0.0, 7.0]);
+        assert_eq!(hello.histogram.len(), HISTOGRAM_BINS);
+        assert_eq!(hello.histogram.iter().sum::<u64>(), 8);
+        assert_eq!(hello.start_window, [1.0, 5.0]);
+        assert_eq!(hello.start_opacity, Some(vec![[0.0, 0.0], [1.0, 0.5]]));
+        let names: Vec<&str> = hello.colormaps.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(&names[..3], ["start", "white", "viridis"]);
+        let start = &hello.colormaps[0].1;
+        assert_eq!(
+            (start[0], start[COLOUR_SAMPLES - 1]),
+            ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+        );
+        assert_eq!(hello.opacity_ramp, [0.0, 0.5]);
+    }
+}

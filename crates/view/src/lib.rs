@@ -1,0 +1,107 @@
+//! # volray-view: explore a volume in the browser, rendered where it lives
+//!
+//! `volray view` serves one volume to a browser: the page orbits, zooms
+//! and pans the camera, edits the transfer function over the volume's
+//! histogram and switches blend modes, and the server renders each view
+//! on its CPU cores and streams the frames back. Nothing is installed on
+//! the viewing side but a browser, which may sit at the other end of an
+//! SSH tunnel.
+//!
+//! ```text
+//!  page (assets/) ──WebSocket: the whole ViewState, JSON──► server.rs ─► mailbox.rs (one slot:
+//!    ▲  drag: "draft"; mouse-up: "full"                                  │  the latest request)
+//!    │                                                                  ▼
+//!    └──── binary: FrameHeader + JPEG (draft) or PNG (full) ◄── session.rs: the tab's thread,
+//!          (protocol.rs)                               encode.rs     its own Renderer;
+//!                                                                  Reproduce: state → settings
+//!                                                                  and the `volray render` line
+//! ```
+//!
+//! | file | what |
+//! |---|---|
+//! | `server.rs` | the routes (page, assets, `/ws`, `/api/status`), the token guard, a tab's socket loop |
+//! | `token.rs` | the 128-bit access token and its constant-time check |
+//! | `state.rs` | [`ViewState`]: what the page's controls set, and its bounds |
+//! | `protocol.rs` | the messages both ways, parsed and checked |
+//! | `mailbox.rs` | the single-slot mailbox: stale requests dropped, never queued |
+//! | `session.rs` | a tab's renderer thread: render, encode, send |
+//! | `reproduce.rs` | [`Reproduce`]: the caller turns a state into settings and a command |
+//! | `hello.rs` | the page's first message: histogram, colours, the start |
+//! | `encode.rs` | JPEG and PNG, quantised as `volray render` writes PNGs |
+//! | `stats.rs` | counters for `/api/status` |
+//! | `page.rs`, `assets/` | the page, embedded |
+//!
+//! The crate knows nothing of command-line flags: the caller's
+//! [`Reproduce`] writes the state as a command and builds the settings
+//! from that command, so that the still frame and the command agree.
+
+mod encode;
+mod hello;
+mod mailbox;
+mod page;
+mod protocol;
+mod reproduce;
+mod server;
+mod session;
+mod state;
+mod stats;
+mod token;
+
+pub use hello::Start;
+pub use protocol::{Basis, FrameHeader, Hello, Quality, ServerMessage};
+pub use reproduce::{Refusal, Reproduce, Reproduction};
+pub use server::{ServeError, Server, Stopper};
+pub use state::{
+    BlendMode, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState, WHITE, ZOOM_RANGE,
+};
+pub use stats::Snapshot;
+pub use token::{NoRandomness, Token};
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+use volray_core::{NonFinite, Volume};
+
+/// Everything a viewer serves.
+pub struct Viewer {
+    /// The volume as rendered (log10 of the data's when the page is told
+    /// so by [`Start::log`]).
+    pub volume: Arc<Volume>,
+    pub non_finite: NonFinite,
+    /// The bytes each tab's renderer may keep in brick caches
+    /// (`Renderer::with_cache_budget`).
+    pub cache_budget: usize,
+    /// The page's first message ([`Start::hello`]).
+    pub hello: Hello,
+    pub reproduce: Arc<dyn Reproduce>,
+    /// The workers every tab's frames are rendered on.
+    pub pool: Arc<rayon::ThreadPool>,
+    /// The most tabs rendering at once.
+    pub max_sessions: usize,
+}
+
+/// A viewer that could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewError {
+    #[error("{0}")]
+    Token(#[from] NoRandomness),
+    #[error("{0}")]
+    Serve(#[from] ServeError),
+}
+
+impl Viewer {
+    /// Binds `addr` with a new access token; [`Server::run`] serves.
+    pub fn bind(self, addr: SocketAddr) -> Result<Server, ViewError> {
+        let token = Token::generate()?;
+        let hello = ServerMessage::Hello(Box::new(self.hello)).to_json();
+        let shared = session::Shared {
+            volume: self.volume,
+            non_finite: self.non_finite,
+            cache_budget: self.cache_budget,
+            reproduce: self.reproduce,
+            pool: self.pool,
+            stats: Arc::new(stats::Stats::default()),
+            max_sessions: self.max_sessions,
+        };
+        Ok(Server::bind(addr, token, hello, shared)?)
+    }
+}

@@ -1,0 +1,310 @@
+//! The messages between the page and the server, over one WebSocket per
+//! tab.
+//!
+//! The page sends text messages, each a JSON object:
+//!
+//! - `{"type": "view", "seq": N, "quality": "draft"|"full", "state": {...}}`:
+//!   render this [`ViewState`]; `draft` while the user drags (half size,
+//!   JPEG), `full` once the interaction stops (full size, PNG). Only the
+//!   latest waiting request is rendered.
+//! - `{"type": "save", "seq": N, "state": {...}}`: render the state at
+//!   its size, as a PNG to download.
+//!
+//! The server answers with text messages (the [`Hello`] first, then
+//! [`ServerMessage::Error`] for a message it refused or a frame it could
+//! not render, naming the message's `seq`) and binary messages, one per
+//! frame: a 4-byte little-endian length, a JSON [`FrameHeader`] of that
+//! length, then the image file.
+
+use crate::state::{StateError, ViewState};
+use serde::{Deserialize, Serialize};
+
+/// The largest message a page may send: a state with the most opacity
+/// points is a few kilobytes.
+pub const MAX_MESSAGE_BYTES: usize = 64 << 10;
+
+/// How good a frame must be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Quality {
+    /// Half size, JPEG: while the view moves.
+    Draft,
+    /// Full size, PNG: the still view.
+    Full,
+    /// The size asked for, PNG, to download.
+    Save,
+}
+
+/// A request from the page.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub enum ClientMessage {
+    View {
+        seq: u64,
+        quality: Quality,
+        state: ViewState,
+    },
+    Save {
+        seq: u64,
+        state: ViewState,
+    },
+}
+
+/// A request the server can render: its sequence number, quality and
+/// checked state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    pub seq: u64,
+    pub quality: Quality,
+    pub state: ViewState,
+}
+
+/// A message refused: not JSON of a known shape, or out of bounds.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MessageError {
+    #[error("message of {0} bytes is too long (at most {MAX_MESSAGE_BYTES})")]
+    TooLong(usize),
+    #[error("malformed message: {0}")]
+    Malformed(String),
+    #[error("\"quality\": \"save\" is asked for with a save message")]
+    SaveQuality,
+    #[error("{0}")]
+    State(#[from] StateError),
+}
+
+impl MessageError {
+    /// The `seq` of the refused message, when it could be read.
+    pub fn seq_of(text: &str) -> Option<u64> {
+        serde_json::from_str::<serde_json::Value>(text)
+            .ok()?
+            .get("seq")?
+            .as_u64()
+    }
+}
+
+/// Parses and checks a message from the page.
+pub fn parse(text: &str) -> Result<Request, MessageError> {
+    if text.len() > MAX_MESSAGE_BYTES {
+        return Err(MessageError::TooLong(text.len()));
+    }
+    let message: ClientMessage =
+        serde_json::from_str(text).map_err(|e| MessageError::Malformed(e.to_string()))?;
+    let request = match message {
+        ClientMessage::View {
+            quality: Quality::Save,
+            ..
+        } => return Err(MessageError::SaveQuality),
+        ClientMessage::View {
+            seq,
+            quality,
+            state,
+        } => Request {
+            seq,
+            quality,
+            state,
+        },
+        ClientMessage::Save { seq, state } => Request {
+            seq,
+            quality: Quality::Save,
+            state,
+        },
+    };
+    request.state.check()?;
+    Ok(request)
+}
+
+/// The screen axes of a rendered view, for panning: the page moves the
+/// reference by `−dx·right + dy·up` world units per `pixels_per_unit`
+/// pixels dragged (at full size).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Basis {
+    /// The view reference, the image centre.
+    pub reference: [f64; 3],
+    pub right: [f64; 3],
+    pub up: [f64; 3],
+    /// Full-size pixels per world unit at the reference.
+    pub pixels_per_unit: f64,
+}
+
+/// What comes before a frame's image in its binary message.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrameHeader {
+    /// The request's sequence number.
+    pub seq: u64,
+    pub quality: Quality,
+    /// `image/jpeg` or `image/png`.
+    pub mime: &'static str,
+    pub width: usize,
+    pub height: usize,
+    /// Milliseconds spent rendering and encoding.
+    pub render_ms: f64,
+    pub encode_ms: f64,
+    /// The command that renders the full-quality frame of this state.
+    pub command: String,
+    /// The transfer-function file it names: name and JSON.
+    pub tf_file: Option<(String, String)>,
+    pub basis: Basis,
+}
+
+/// `header` and `image` as one binary message.
+pub fn frame_message(header: &FrameHeader, image: &[u8]) -> Vec<u8> {
+    let json = serde_json::to_vec(header).expect("a frame header serialises");
+    let mut out = Vec::with_capacity(4 + json.len() + image.len());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(&json);
+    out.extend_from_slice(image);
+    out
+}
+
+/// The volume as the page is told it first.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Hello {
+    /// The input's name (its spec or path, as given).
+    pub name: String,
+    pub dims: [usize; 3],
+    pub spacing: [f64; 3],
+    /// `[min, max]` of the values rendered.
+    pub range: [f32; 2],
+    /// Whether the values rendered are log10 of the data's.
+    pub log: bool,
+    /// Counts of the values in equal bins over `range`.
+    pub histogram: Vec<u64>,
+    /// The starting view, and where a double click returns.
+    pub start: ViewState,
+    /// The starting opacity ramp `[p, q]` (used while the state's
+    /// opacity is `None`).
+    pub opacity_ramp: [f32; 2],
+    /// The starting transfer function's opacity points, if it has some.
+    pub start_opacity: Option<Vec<[f32; 2]>>,
+    /// The starting window (the transfer function's domain, else the
+    /// value range).
+    pub start_window: [f64; 2],
+    /// Each colour choice and its colours at evenly spaced `t`, to draw.
+    pub colormaps: Vec<(String, Vec<[f32; 3]>)>,
+}
+
+/// A message from the server as text.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum ServerMessage {
+    Hello(Box<Hello>),
+    /// A refused message or a frame that could not be rendered.
+    Error {
+        seq: Option<u64>,
+        message: String,
+    },
+}
+
+impl ServerMessage {
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).expect("server messages serialise")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::state::tests::sample;
+
+    fn view(quality: &str) -> String {
+        serde_json::json!({
+            "type": "view", "seq": 5, "quality": quality, "state": sample()
+        })
+        .to_string()
+    }
+
+    #[test]
+    fn views_and_saves_parse() {
+        let r = parse(&view("draft")).unwrap();
+        assert_eq!((r.seq, r.quality, r.state), (5, Quality::Draft, sample()));
+        assert_eq!(parse(&view("full")).unwrap().quality, Quality::Full);
+        let save = serde_json::json!({"type": "save", "seq": 9, "state": sample()});
+        let r = parse(&save.to_string()).unwrap();
+        assert_eq!((r.seq, r.quality), (9, Quality::Save));
+    }
+
+    #[test]
+    fn bad_messages_are_errors_not_panics() {
+        let mut nan = serde_json::to_value(sample()).unwrap();
+        nan["zoom"] = serde_json::Value::Null;
+        let mut far = sample();
+        far.zoom = 1e9;
+        let cases = [
+            ("{", "malformed"),
+            ("", "malformed"),
+            ("[1,2]", "malformed"),
+            ("null", "malformed"),
+            (r#"{"type": "view"}"#, "malformed"),
+            (r#"{"type": "explode", "seq": 1}"#, "malformed"),
+            (
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": nan})
+                    .to_string(),
+                "malformed",
+            ),
+            (
+                r#"{"type": "view", "seq": 1, "quality": "full", "state": {"zoom": NaN}}"#,
+                "malformed",
+            ),
+            (&view("save"), "save message"),
+            (&view("best"), "malformed"),
+            (
+                &serde_json::json!({"type": "view", "seq": -1, "quality": "full", "state": sample()})
+                    .to_string(),
+                "malformed",
+            ),
+            (
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": far})
+                    .to_string(),
+                "zoom 1000000000 is outside",
+            ),
+            (
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": sample(), "x": 1})
+                    .to_string(),
+                "malformed",
+            ),
+            (&"x".repeat(MAX_MESSAGE_BYTES + 1), "too long"),
+        ];
+        for (text, expect) in cases {
+            let err = parse(text).unwrap_err().to_string();
+            assert!(err.contains(expect), "{text:.80}: {err}");
+        }
+        assert_eq!(MessageError::seq_of(&view("best")), Some(5));
+        assert_eq!(MessageError::seq_of("{"), None);
+    }
+
+    #[test]
+    fn a_frame_message_is_length_header_image() {
+        let header = FrameHeader {
+            seq: 3,
+            quality: Quality::Full,
+            mime: "image/png",
+            width: 2,
+            height: 1,
+            render_ms: 1.5,
+            encode_ms: 0.5,
+            command: "volray render".into(),
+            tf_file: None,
+            basis: Basis {
+                reference: [0.0; 3],
+                right: [0.0, 1.0, 0.0],
+                up: [0.0, 0.0, 1.0],
+                pixels_per_unit: 2.0,
+            },
+        };
+        let message = frame_message(&header, b"IMAGE");
+        let n = u32::from_le_bytes(message[..4].try_into().unwrap()) as usize;
+        let json: serde_json::Value = serde_json::from_slice(&message[4..4 + n]).unwrap();
+        assert_eq!(json["seq"], 3);
+        assert_eq!(json["quality"], "full");
+        assert_eq!(json["basis"]["pixels_per_unit"], 2.0);
+        assert_eq!(&message[4 + n..], b"IMAGE");
+        let error = ServerMessage::Error {
+            seq: Some(4),
+            message: "no".into(),
+        };
+        assert_eq!(
+            error.to_json(),
+            r#"{"type":"error","seq":4,"message":"no"}"#
+        );
+    }
+}

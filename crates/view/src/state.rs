@@ -1,0 +1,305 @@
+//! The view a page asks for: everything the page's controls set (the
+//! orbit, zoom and pan; the projection; the blend mode and isovalue; the
+//! step, shading and background; the value window, the opacity points and
+//! the colours), as one JSON object the page sends whole with every
+//! change. Sending the whole state rather than changes makes every message
+//! stand alone, so that the server may drop all but the latest.
+//!
+//! [`ViewState::check`] bounds every field before anything is rendered:
+//! a message from a page is untrusted input.
+
+use serde::{Deserialize, Serialize};
+use volray_core::transfer::colormap;
+
+/// The largest side of a frame a page may ask for (the full-quality view
+/// and "Save PNG"): 4096² pixels of RGBA `f32` take 256 MiB.
+pub const MAX_SIDE: usize = 4096;
+
+/// The smallest and largest step along the rays, in voxels.
+pub const STEP_RANGE: (f64, f64) = (1e-3, 64.0);
+
+/// The smallest and largest zoom.
+pub const ZOOM_RANGE: (f64, f64) = (1e-3, 1e3);
+
+/// The largest orbit angle, in degrees (as `--azimuth` takes).
+pub const MAX_ANGLE: f64 = 1e6;
+
+/// The most points of the opacity function.
+pub const MAX_OPACITY_POINTS: usize = 256;
+
+/// The colours that are not a named colour map: the starting transfer
+/// function's own, and none (white material).
+pub const START_COLOURS: &str = "start";
+pub const WHITE: &str = "white";
+
+/// How the samples along a ray make its pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BlendMode {
+    /// The paper's compositing of classified, shaded samples.
+    Composite,
+    /// Maximum intensity projection.
+    Mip,
+    /// Minimum intensity projection.
+    Minip,
+    /// The mean value along the ray.
+    Average,
+    /// Compositing of Levoy's isovalue contour ([`ViewState::iso`]).
+    Iso,
+}
+
+impl BlendMode {
+    /// Whether the mode projects the interpolated value (no opacity, no
+    /// lighting).
+    pub fn is_projection(self) -> bool {
+        matches!(self, BlendMode::Mip | BlendMode::Minip | BlendMode::Average)
+    }
+}
+
+/// Everything the page's controls set. Values are in the units the
+/// renderer sees (log10 of the data's when the volume is rendered as its
+/// logarithm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewState {
+    /// The full-quality frame's size in pixels.
+    pub width: usize,
+    pub height: usize,
+    /// Degrees the eye orbits about the up vector, then rises.
+    pub azimuth: f64,
+    pub elevation: f64,
+    pub zoom: f64,
+    /// The view reference (`None`: the volume's centre); panning moves it.
+    pub look_at: Option<[f64; 3]>,
+    /// The view point before the orbits (`None`: on the +x side of the
+    /// reference); panning moves it with the reference.
+    pub view_point: Option<[f64; 3]>,
+    /// The vertical field of view in degrees; `None`: orthographic.
+    pub perspective: Option<f64>,
+    pub blend: BlendMode,
+    /// Levoy's isovalue, needed by [`BlendMode::Iso`].
+    pub iso: Option<f32>,
+    /// Sample spacing along the rays, in voxels.
+    pub step: f64,
+    pub shading: bool,
+    /// The opaque background, components in [0, 1].
+    pub background: [f32; 3],
+    /// The value window `[lo, hi]` the transfer function spans; `None`:
+    /// as at the start (the starting function's domain, else the
+    /// volume's range).
+    pub window: Option<[f64; 2]>,
+    /// Opacity points `[t, alpha]`, sorted by `t`; `None`: as at the start.
+    pub opacity: Option<Vec<[f32; 2]>>,
+    /// A colour map's name, [`START_COLOURS`] or [`WHITE`].
+    pub colormap: String,
+}
+
+/// A state that cannot be rendered: which field, and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StateError {
+    #[error("{field} {value} is outside {lo} to {hi}")]
+    OutOfRange {
+        field: &'static str,
+        value: f64,
+        lo: f64,
+        hi: f64,
+    },
+    #[error("{field} must be finite numbers")]
+    NotFinite { field: &'static str },
+    #[error("blend iso needs an isovalue")]
+    NoIsovalue,
+    #[error("the value window [{lo}, {hi}] must have lo < hi")]
+    EmptyWindow { lo: f64, hi: f64 },
+    #[error("opacity point {index}: {problem}")]
+    OpacityPoint { index: usize, problem: &'static str },
+    #[error("the opacity function needs 1 to {max} points, not {count}")]
+    OpacityPoints { count: usize, max: usize },
+    #[error("unknown colour map \"{0}\"")]
+    Colormap(String),
+}
+
+impl ViewState {
+    /// Checks every field against its bounds, naming the first that is
+    /// out of them.
+    pub fn check(&self) -> Result<(), StateError> {
+        let side = |field, value: usize| within(field, value as f64, (1.0, MAX_SIDE as f64));
+        side("width", self.width)?;
+        side("height", self.height)?;
+        within("azimuth", self.azimuth, (-MAX_ANGLE, MAX_ANGLE))?;
+        within("elevation", self.elevation, (-MAX_ANGLE, MAX_ANGLE))?;
+        within("zoom", self.zoom, ZOOM_RANGE)?;
+        for (field, point) in [("look_at", self.look_at), ("view_point", self.view_point)] {
+            if point.is_some_and(|p| !p.iter().all(|x| x.is_finite())) {
+                return Err(StateError::NotFinite { field });
+            }
+        }
+        if let Some(fov) = self.perspective {
+            within("perspective", fov, (0.0, 180.0))?;
+            if fov == 0.0 || fov == 180.0 {
+                return Err(StateError::OutOfRange {
+                    field: "perspective",
+                    value: fov,
+                    lo: 0.0,
+                    hi: 180.0,
+                });
+            }
+        }
+        match self.iso {
+            Some(v) => within(
+                "iso",
+                f64::from(v),
+                (-f64::from(f32::MAX), f64::from(f32::MAX)),
+            )?,
+            None if self.blend == BlendMode::Iso => return Err(StateError::NoIsovalue),
+            None => {}
+        }
+        within("step", self.step, STEP_RANGE)?;
+        for c in self.background {
+            within("background", f64::from(c), (0.0, 1.0))?;
+        }
+        if let Some([lo, hi]) = self.window {
+            let bound = f64::from(f32::MAX);
+            within("window", lo, (-bound, bound))?;
+            within("window", hi, (-bound, bound))?;
+            if lo >= hi {
+                return Err(StateError::EmptyWindow { lo, hi });
+            }
+        }
+        if let Some(points) = &self.opacity {
+            check_opacity(points)?;
+        }
+        let known = [START_COLOURS, WHITE].contains(&self.colormap.as_str())
+            || colormap::NAMES.contains(&self.colormap.as_str());
+        if !known {
+            return Err(StateError::Colormap(self.colormap.clone()));
+        }
+        Ok(())
+    }
+}
+
+/// `value` finite and in `[lo, hi]`.
+fn within(field: &'static str, value: f64, (lo, hi): (f64, f64)) -> Result<(), StateError> {
+    if !value.is_finite() {
+        return Err(StateError::NotFinite { field });
+    }
+    if !(lo..=hi).contains(&value) {
+        return Err(StateError::OutOfRange {
+            field,
+            value,
+            lo,
+            hi,
+        });
+    }
+    Ok(())
+}
+
+/// Opacity points: 1 to [`MAX_OPACITY_POINTS`], `t` and alpha in [0, 1],
+/// sorted by `t`.
+fn check_opacity(points: &[[f32; 2]]) -> Result<(), StateError> {
+    if points.is_empty() || points.len() > MAX_OPACITY_POINTS {
+        return Err(StateError::OpacityPoints {
+            count: points.len(),
+            max: MAX_OPACITY_POINTS,
+        });
+    }
+    for (index, [t, a]) in points.iter().enumerate() {
+        let problem = if !(0.0..=1.0).contains(t) {
+            "t must lie in [0, 1]"
+        } else if !(0.0..=1.0).contains(a) {
+            "opacity must lie in [0, 1]"
+        } else if index > 0 && *t < points[index - 1][0] {
+            "points must be sorted by t"
+        } else {
+            continue;
+        };
+        return Err(StateError::OpacityPoint { index, problem });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A valid state: the default view of a 480² frame.
+    pub fn sample() -> ViewState {
+        ViewState {
+            width: 480,
+            height: 480,
+            azimuth: 0.0,
+            elevation: 0.0,
+            zoom: 1.0,
+            look_at: None,
+            view_point: None,
+            perspective: None,
+            blend: BlendMode::Composite,
+            iso: None,
+            step: 1.0,
+            shading: true,
+            background: [0.0; 3],
+            window: None,
+            opacity: None,
+            colormap: WHITE.into(),
+        }
+    }
+
+    #[test]
+    fn a_valid_state_passes_and_round_trips_through_json() {
+        let mut s = sample();
+        s.opacity = Some(vec![[0.0, 0.0], [0.5, 0.25], [0.5, 0.75], [1.0, 1.0]]);
+        s.window = Some([-1.5, 2.0]);
+        s.colormap = "viridis".into();
+        s.perspective = Some(30.0);
+        s.blend = BlendMode::Iso;
+        s.iso = Some(0.25);
+        assert_eq!(s.check(), Ok(()));
+        let json = serde_json::to_string(&s).unwrap();
+        assert_eq!(serde_json::from_str::<ViewState>(&json).unwrap(), s);
+    }
+
+    #[test]
+    fn every_bound_is_checked() {
+        type Spoil = fn(&mut ViewState);
+        let bad: Vec<(Spoil, &str)> = vec![
+            (|s| s.width = 0, "width 0 is outside 1 to 4096"),
+            (|s| s.height = 5000, "height"),
+            (|s| s.azimuth = f64::NAN, "azimuth must be finite"),
+            (|s| s.elevation = 2e6, "elevation"),
+            (|s| s.zoom = 0.0, "zoom"),
+            (|s| s.look_at = Some([0.0, f64::INFINITY, 0.0]), "look_at"),
+            (|s| s.perspective = Some(180.0), "perspective"),
+            (|s| s.perspective = Some(0.0), "perspective"),
+            (|s| s.blend = BlendMode::Iso, "isovalue"),
+            (|s| s.iso = Some(f32::NAN), "iso must be finite"),
+            (|s| s.step = 0.0, "step"),
+            (|s| s.background = [0.0, 1.5, 0.0], "background"),
+            (|s| s.window = Some([2.0, 2.0]), "lo < hi"),
+            (|s| s.window = Some([0.0, 1e300]), "window"),
+            (|s| s.opacity = Some(vec![]), "1 to 256 points"),
+            (|s| s.opacity = Some(vec![[0.0, 2.0]]), "opacity must lie"),
+            (|s| s.opacity = Some(vec![[-0.1, 0.0]]), "t must lie"),
+            (
+                |s| s.opacity = Some(vec![[0.5, 0.0], [0.25, 0.0]]),
+                "sorted",
+            ),
+            (|s| s.colormap = "jet".into(), "unknown colour map \"jet\""),
+        ];
+        for (spoil, expect) in bad {
+            let mut s = sample();
+            spoil(&mut s);
+            let err = s.check().unwrap_err().to_string();
+            assert!(err.contains(expect), "{err} (expected {expect})");
+        }
+    }
+
+    #[test]
+    fn unknown_fields_and_nulls_are_refused() {
+        let mut json = serde_json::to_value(sample()).unwrap();
+        json["colour"] = "red".into();
+        assert!(serde_json::from_value::<ViewState>(json).is_err());
+        let mut json = serde_json::to_value(sample()).unwrap();
+        // JSON.stringify(NaN) is null.
+        json["azimuth"] = serde_json::Value::Null;
+        assert!(serde_json::from_value::<ViewState>(json).is_err());
+    }
+}

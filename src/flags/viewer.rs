@@ -1,0 +1,39 @@
+//! `volray view`'s flags: the input and every rendering option (the view
+//! it starts from, as `render` takes them), and where to serve: `--port`,
+//! `--bind`, `--no-browser`. (`view.rs` beside this file is the group of
+//! flags that render a frame, which `render` and `bench` share too.)
+
+use super::input::InputArgs;
+use super::view::ViewArgs;
+use clap::Args;
+use std::net::IpAddr;
+
+/// `volray view`.
+#[derive(Debug, Args)]
+pub struct ViewerArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+
+    #[command(flatten)]
+    pub view: ViewArgs,
+
+    /// The port to serve on; 0 picks a free one.
+    #[arg(long, value_name = "N", default_value_t = 0, help_heading = "Serving")]
+    pub port: u16,
+
+    /// The address to listen on. Anything but a loopback address lets
+    /// other machines reach the viewer (with the token): use an SSH
+    /// tunnel instead where you can.
+    #[arg(
+        long,
+        value_name = "ADDR",
+        default_value = "127.0.0.1",
+        help_heading = "Serving"
+    )]
+    pub bind: IpAddr,
+
+    /// Do not open a browser (by default one is opened when a display is
+    /// present).
+    #[arg(long, help_heading = "Serving")]
+    pub no_browser: bool,
+}

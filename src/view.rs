@@ -1,0 +1,134 @@
+//! `volray view`: serve a volume to a web browser (`volray-view`). Reads
+//! INPUT and the starting `--tf` file once (the page cannot name files),
+//! checks the starting view as `render` would, prints the page's URL with
+//! its access token as the first line on standard output, opens a browser
+//! where there is a display, and serves until Ctrl-C or SIGTERM, then
+//! exits 0.
+//!
+//! `view/reproduce.rs` turns the page's states into `volray render`
+//! commands and their settings; `view/browser.rs` opens the browser.
+
+mod browser;
+mod reproduce;
+
+use crate::error::CliError;
+use crate::flags::{BlendMode as BlendFlag, ViewerArgs};
+use crate::session::{load, renderer_for, thread_pool};
+use crate::settings::{named_transfer_function, read_tf_file, settings_with_tf_text};
+use reproduce::CliReproduce;
+use std::net::SocketAddr;
+use std::sync::Arc;
+use volray_core::{Projection, RenderSettings};
+use volray_view::{BlendMode, Reproduce, START_COLOURS, Start, ViewState, Viewer, WHITE};
+
+/// The most tabs rendering at once, whatever the memory allows.
+const MAX_TABS: u128 = 8;
+
+pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
+    let look = &args.view.look;
+    let tf_text = look.tf.as_deref().map(read_tf_file).transpose()?;
+    let settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
+    let named = named_transfer_function(look, tf_text.as_deref())?;
+    let input = load(&args.input, look.log)?;
+    // The checks `render` makes: memory, non-finite values, the view.
+    let renderer = renderer_for(&args.view, &settings, &input)?;
+    renderer
+        .prepare(&settings)
+        .map_err(|e| crate::session::render_failure(&args.view, &input.name, e))?;
+    drop(renderer);
+    let cache_budget = crate::memory::cache_budget(&args.view, &settings, &input)?;
+    let non_finite = input.non_finite(args.view.sampling.nonfinite.into());
+
+    let state = start_state(args, &settings);
+    state.check().map_err(|e| {
+        CliError::input(format!(
+            "the starting view is beyond the viewer's bounds: {e}"
+        ))
+    })?;
+    let volume = &input.volume;
+    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
+    let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory);
+    reproduce
+        .reproduce(&state)
+        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
+    // Each tab's renderer: the frame and its own brick caches.
+    let per_tab = crate::memory::render_bytes(grid, &settings, non_finite, cache_budget).max(1);
+    let max_sessions = (u128::from(input.max_memory) / per_tab).clamp(1, MAX_TABS) as usize;
+    let hello = Start {
+        name: &input.name,
+        volume,
+        log: look.log,
+        state: &state,
+        settings: &settings,
+    }
+    .hello();
+    let pool = thread_pool(args.view.threads)?;
+    let viewer = Viewer {
+        volume: Arc::new(input.volume),
+        non_finite,
+        cache_budget,
+        hello,
+        reproduce: Arc::new(reproduce),
+        pool: Arc::new(pool),
+        max_sessions,
+    };
+
+    let addr = SocketAddr::new(args.bind, args.port);
+    let server = viewer.bind(addr).map_err(|e| CliError::io(e.to_string()))?;
+    let url = server
+        .url()
+        .map_err(|e| CliError::io(format!("cannot read the bound address: {e}")))?;
+    outln!("{url}");
+    if !args.bind.is_loopback() {
+        eprintln!(
+            "volray: warning: listening on {}, reachable from other machines by anyone with the URL; prefer the default 127.0.0.1 with an SSH tunnel (ssh -L)",
+            args.bind
+        );
+    }
+    if !args.no_browser {
+        browser::open(&url);
+    }
+    let stopper = server.stopper();
+    crate::interrupt::stop_instead(move || stopper.stop());
+    server.run().map_err(|e| CliError::io(e.to_string()))
+}
+
+/// The page's starting state: the view the flags describe.
+pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
+    let look = &args.view.look;
+    let camera = &settings.camera;
+    let colormap = match &look.colormap {
+        Some(name) if name == "gray" => "grey".to_string(),
+        Some(name) => name.clone(),
+        None if settings.transfer_function.color.is_some() => START_COLOURS.to_string(),
+        None => WHITE.to_string(),
+    };
+    ViewState {
+        width: settings.width,
+        height: settings.height,
+        azimuth: camera.azimuth,
+        elevation: camera.elevation,
+        zoom: camera.zoom,
+        look_at: camera.look_at.map(|p| p.to_array()),
+        view_point: camera.view_point.map(|p| p.to_array()),
+        perspective: match camera.projection {
+            Projection::Perspective { fov_degrees } => Some(fov_degrees),
+            Projection::Orthographic => None,
+        },
+        blend: match look.blend {
+            BlendFlag::Mip => BlendMode::Mip,
+            BlendFlag::Minip => BlendMode::Minip,
+            BlendFlag::Average => BlendMode::Average,
+            BlendFlag::Iso => BlendMode::Iso,
+            BlendFlag::Composite if settings.iso.is_some() => BlendMode::Iso,
+            BlendFlag::Composite => BlendMode::Composite,
+        },
+        iso: settings.iso.map(|iso| iso.value),
+        step: settings.step,
+        shading: settings.shading,
+        background: settings.background,
+        window: None,
+        opacity: None,
+        colormap,
+    }
+}

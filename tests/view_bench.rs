@@ -1,0 +1,212 @@
+//! The viewer's goals, measured in a real browser (ignored by `cargo
+//! test`; timings are not assertions). Run on a quiet machine:
+//!
+//! ```sh
+//! cargo test --release --test view_bench -- --ignored --nocapture
+//! ```
+//!
+//! `volray view fractal:129 --threads 2` (480² frames) in headless
+//! Chromium driven over WebDriver with real pointer events. The page's
+//! hooks are timestamped inside the page (a MutationObserver on
+//! `data-frames` and `data-state`, listeners on the pointer events), so
+//! the WebDriver round trips are not counted:
+//!
+//! - frames/s during a continuous drag: frames shown between the drag's
+//!   pointerdown and pointerup, over that time (3 s, a move every 16 ms);
+//! - mouse-up to full-quality frame: from a drag's pointerup to
+//!   `data-state = "still"`, over 15 drags (median);
+//! - TF edit to new frame: from the pointerdown of a click that adds an
+//!   opacity point to the next frame shown, over 15 clicks (median);
+//! - a burst of 1,000 requests to the full frame of the last, and the
+//!   server's resident memory before and after.
+
+#[path = "view_support/browser.rs"]
+mod browser;
+#[path = "view_support/viewer.rs"]
+mod viewer;
+
+use browser::Browser;
+use serde_json::Value;
+use std::time::Duration;
+use viewer::Viewer;
+
+/// Timestamps the page's hooks and pointer events, in milliseconds.
+const INSTRUMENT: &str = r#"
+    window.bench = [];
+    const log = (what) => window.bench.push([what, performance.now()]);
+    new MutationObserver((changes) => {
+        for (const c of changes) {
+            if (c.attributeName === "data-frames") {
+                log("frame");
+                const h = window.volrayView.header();
+                if (h.quality === "draft") window.bench.push(["draft_ms", h.render_ms, h.encode_ms]);
+            }
+            if (c.attributeName === "data-state" && document.body.dataset.state === "still") log("still");
+        }
+    }).observe(document.body, { attributes: true });
+    for (const id of ["viewport", "tf"]) {
+        for (const kind of ["pointerdown", "pointerup"]) {
+            document.getElementById(id).addEventListener(kind, () => log(id + ":" + kind), { capture: true });
+        }
+    }
+    return true;
+"#;
+
+/// The events logged since the last call.
+async fn events(b: &Browser) -> Vec<(String, f64)> {
+    let v = b
+        .eval("const e = window.bench; window.bench = []; return e;")
+        .await;
+    let Value::Array(list) = v else { panic!("{v}") };
+    list.iter()
+        .map(|e| (e[0].as_str().unwrap().to_string(), e[1].as_f64().unwrap()))
+        .collect()
+}
+
+/// The time of the first event named `what` at or after `from`.
+fn first(events: &[(String, f64)], what: &str, from: f64) -> Option<f64> {
+    events
+        .iter()
+        .find(|(name, t)| name == what && *t >= from)
+        .map(|e| e.1)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
+
+fn summary(name: &str, v: &[f64]) {
+    let mut sorted = v.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    println!(
+        "{name}: median {:.1} ms (min {:.1}, max {:.1}, n = {})",
+        median(v.to_vec()),
+        sorted[0],
+        sorted[sorted.len() - 1],
+        v.len()
+    );
+}
+
+/// Resident memory of `pid`, in MiB.
+fn rss_mib(pid: u32) -> f64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let kb: f64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap();
+    kb / 1024.0
+}
+
+#[tokio::test(flavor = "current_thread")]
+#[ignore = "a benchmark: run on a quiet machine with --ignored --nocapture"]
+async fn viewer_goals_for_fractal_129_at_480() {
+    if !browser::available() {
+        return;
+    }
+    let volume = std::env::var("VOLRAY_VIEW_BENCH_VOLUME").unwrap_or("fractal:129".into());
+    let viewer = Viewer::start(&[&volume, "--threads", "2", "--colormap", "magma"]);
+    let b = Browser::start().await;
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    b.eval(INSTRUMENT).await;
+    // Warm up: a drag and a TF edit.
+    b.drag("#frame", (0.0, 0.0), (40.0, 10.0), 10).await;
+    b.wait_still().await;
+    b.click_at("#tf", 0.0, -40.0).await;
+    b.wait_still().await;
+    events(&b).await;
+
+    // A continuous drag of 3 s.
+    b.drag("#frame", (-150.0, 0.0), (300.0, 60.0), 188).await;
+    b.wait_still().await;
+    let e = events(&b).await;
+    let down = first(&e, "viewport:pointerdown", 0.0).unwrap();
+    let up = first(&e, "viewport:pointerup", down).unwrap();
+    let shown = e
+        .iter()
+        .filter(|(n, t)| n == "frame" && *t > down && *t <= up)
+        .count();
+    let draft = b.eval("return window.volrayView.header();").await;
+    let fps = shown as f64 / ((up - down) / 1000.0);
+    let drafts: Vec<f64> = e
+        .iter()
+        .filter(|(n, _)| n == "draft_ms")
+        .map(|(_, t)| *t)
+        .collect();
+    summary("  a draft frame's rendering (240², on the server)", &drafts);
+    println!(
+        "drag: {shown} frames in {:.0} ms: {fps:.1} frames/s (a full frame renders in {} ms)",
+        up - down,
+        draft["render_ms"]
+    );
+
+    // Mouse-up to the full-quality frame.
+    let mut still = Vec::new();
+    let (mut render, mut encode) = (Vec::new(), Vec::new());
+    for i in 0..15 {
+        let dx = if i % 2 == 0 { 60.0 } else { -60.0 };
+        b.drag("#frame", (0.0, 0.0), (dx, 20.0), 10).await;
+        b.wait_still().await;
+        let e = events(&b).await;
+        let up = first(&e, "viewport:pointerup", 0.0).unwrap();
+        still.push(first(&e, "still", up).unwrap() - up);
+        let header = b.eval("return window.volrayView.header();").await;
+        render.push(header["render_ms"].as_f64().unwrap());
+        encode.push(header["encode_ms"].as_f64().unwrap());
+    }
+    summary("mouse-up to full-quality frame", &still);
+    summary("  of which rendering the full frame", &render);
+    summary("  of which encoding its PNG", &encode);
+
+    // TF edit to the next frame shown (and to the still frame).
+    let mut edit = Vec::new();
+    let mut edit_still = Vec::new();
+    for i in 0..15 {
+        let x = -140.0 + 20.0 * i as f64;
+        let y = if i % 2 == 0 { -50.0 } else { 10.0 };
+        b.click_at("#tf", x, y).await;
+        b.wait_still().await;
+        let e = events(&b).await;
+        let down = first(&e, "tf:pointerdown", 0.0).unwrap();
+        edit.push(first(&e, "frame", down).unwrap() - down);
+        edit_still.push(first(&e, "still", down).unwrap() - down);
+        let header = b.eval("return window.volrayView.header();").await;
+        render.push(header["render_ms"].as_f64().unwrap());
+    }
+    summary("TF edit to new frame", &edit);
+    summary("TF edit to full-quality frame", &edit_still);
+    summary(
+        "  of which rendering (classification included)",
+        &render[15..],
+    );
+
+    // A burst of 1,000 requests, then the full frame of the last.
+    let rss_before = rss_mib(viewer.pid());
+    let frames_before = viewer.status()["frames"].as_u64().unwrap();
+    let t = b
+        .eval(
+            r#"const v = window.volrayView; const t = performance.now();
+               for (let i = 0; i < 1000; i++) v.sendState({azimuth: i / 10}, "draft");
+               v.sendState({azimuth: 123.4}, "full"); return t;"#,
+        )
+        .await
+        .as_f64()
+        .unwrap();
+    b.wait_still().await;
+    let e = events(&b).await;
+    let burst = first(&e, "still", t).unwrap() - t;
+    let rendered = viewer.status()["frames"].as_u64().unwrap() - frames_before;
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    println!(
+        "burst of 1,000 + 1: full frame after {burst:.0} ms, {rendered} frames rendered; server RSS {rss_before:.0} MiB before, {:.0} MiB after",
+        rss_mib(viewer.pid())
+    );
+    b.close().await;
+}

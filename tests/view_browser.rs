@@ -1,0 +1,375 @@
+//! `volray view` end to end, in a real headless Chromium driven over
+//! WebDriver: the first frame appears; a drag changes the image and the
+//! azimuth in the Command box; a transfer-function edit changes the
+//! image; the Command line, run through the CLI, writes the page's still
+//! frame pixel for pixel; bad messages are answered in the page and the
+//! server goes on; two tabs are independent and a closed tab frees its
+//! renderer; a burst of 1,000 requests is not queued. Without a browser
+//! these skip with a note, except under `CI=true`, where they fail.
+//!
+//! The token and the signals need no browser: a bare HTTP client and
+//! `kill` check them.
+
+#[path = "view_support/browser.rs"]
+mod browser;
+mod common;
+#[path = "view_support/viewer.rs"]
+mod viewer;
+
+use browser::Browser;
+use common::Picture;
+use std::process::Command;
+use std::time::Duration;
+use viewer::{Viewer, http_get};
+
+/// Reads the azimuth from a command line (0 when it gives none).
+fn azimuth(command: &str) -> f64 {
+    let words: Vec<&str> = command.split_whitespace().collect();
+    words
+        .iter()
+        .position(|w| *w == "--azimuth")
+        .map_or(0.0, |i| words[i + 1].parse().unwrap())
+}
+
+/// A viewer of `args` and a browser showing its first full frame; `None`
+/// where the browser tests skip (see `browser::available`).
+async fn open(args: &[&str]) -> Option<(Viewer, Browser)> {
+    if !browser::available() {
+        return None;
+    }
+    let viewer = Viewer::start(args);
+    let b = Browser::start().await;
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    Some((viewer, b))
+}
+
+/// Decodes PNG bytes.
+fn picture(bytes: &[u8], dir: &std::path::Path, name: &str) -> Picture {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    Picture::read(&path)
+}
+
+/// Runs the page's Command line (and writes its transfer-function file)
+/// in `dir` with this build's `volray`; the image it writes.
+fn run_command(command: &str, tf_file: Option<(&str, &str)>, dir: &std::path::Path) -> Picture {
+    if let Some((name, json)) = tf_file {
+        std::fs::write(dir.join(name), json).unwrap();
+    }
+    let line = command
+        .strip_prefix("volray ")
+        .expect("the command starts with volray");
+    let status = Command::new("sh")
+        .arg("-c")
+        .arg(format!("\"$VOLRAY\" {line}"))
+        .env("VOLRAY", env!("CARGO_BIN_EXE_volray"))
+        .current_dir(dir)
+        .status()
+        .unwrap();
+    assert!(status.success(), "{command}");
+    Picture::read(&dir.join("view.png"))
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_frame() {
+    if !browser::available() {
+        return;
+    }
+    let viewer = Viewer::start(&["blobs:48", "--size", "240", "--colormap", "viridis"]);
+    let b = Browser::start().await;
+    let dir = tempfile::tempdir().unwrap();
+
+    // A wrong token gets 403, in the browser too.
+    let base = viewer.url.split("?token=").next().unwrap().to_string();
+    b.client.goto(&format!("{base}?token=0123")).await.unwrap();
+    let body = b.eval("return document.body.textContent;").await;
+    assert!(body.as_str().unwrap().contains("403"), "{body}");
+
+    // The first frame.
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    assert!(b.frames().await >= 1);
+    let first = picture(&b.frame_bytes().await, dir.path(), "first.png");
+    assert_eq!((first.width, first.height), (240, 240));
+    let command = b.text("command").await;
+    assert!(
+        command.starts_with("volray render blobs:48 --size 240x240"),
+        "{command}"
+    );
+    assert_eq!(azimuth(&command), 0.0);
+
+    // A drag orbits: another image, another azimuth.
+    let shown = b.frames().await;
+    b.drag("#frame", (0.0, 0.0), (80.0, 0.0), 8).await;
+    b.wait_still().await;
+    assert!(b.frames().await > shown);
+    let orbited = picture(&b.frame_bytes().await, dir.path(), "orbited.png");
+    assert_ne!(orbited, first, "the drag did not change the image");
+    let command = b.text("command").await;
+    assert!(azimuth(&command) < -10.0, "{command}");
+
+    // A transfer-function edit: a click on the editor adds an opaque point.
+    b.click_at("#tf", -40.0, -60.0).await;
+    b.wait_still().await;
+    let edited = picture(&b.frame_bytes().await, dir.path(), "edited.png");
+    assert_ne!(edited, orbited, "the edit did not change the image");
+    let command = b.text("command").await;
+    assert!(command.contains("--tf view-tf.json"), "{command}");
+    let tf_name = b.text("tf-name").await;
+    let tf_json = b.text("tf-json").await;
+    assert_eq!(tf_name, "view-tf.json");
+    assert!(tf_json.contains("\"opacity\""), "{tf_json}");
+
+    // The command line, run through the CLI, gives the still frame.
+    let cli = run_command(&command, Some((&tf_name, &tf_json)), dir.path());
+    assert_eq!(
+        cli, edited,
+        "the CLI's image differs from the page's still frame"
+    );
+
+    // A screenshot of the page, for the docs (docs/viewer.png).
+    if let Ok(path) = std::env::var("VOLRAY_VIEW_SCREENSHOT") {
+        std::fs::write(path, b.client.screenshot().await.unwrap()).unwrap();
+    }
+
+    // Bad messages: an error in the page, and the server goes on.
+    let mut state = b.eval("return window.volrayView.state();").await;
+    for (message, expect) in [
+        ("{".to_string(), "malformed"),
+        (
+            serde_json::json!({"type": "view", "seq": 1_000_000, "quality": "full",
+                "state": {"azimuth": 1}})
+            .to_string(),
+            "malformed",
+        ),
+        (
+            {
+                state["zoom"] = serde_json::Value::Null; // JSON.stringify(NaN)
+                serde_json::json!({"type": "view", "seq": 1_000_001, "quality": "full", "state": state}).to_string()
+            },
+            "malformed",
+        ),
+        (
+            {
+                state["zoom"] = 1e9.into();
+                serde_json::json!({"type": "view", "seq": 1_000_002, "quality": "full", "state": state}).to_string()
+            },
+            "zoom 1000000000 is outside",
+        ),
+    ] {
+        let script = format!(
+            "window.volrayView.send({}); return true;",
+            serde_json::to_string(&message).unwrap()
+        );
+        b.eval(&script).await;
+        b.wait_for(&format!(
+            "!document.getElementById('error').hidden && document.getElementById('error').textContent.includes({})",
+            serde_json::to_string(expect).unwrap()
+        ))
+        .await;
+    }
+    b.eval("window.volrayView.setState({azimuth: 45}); return true;")
+        .await;
+    b.wait_still().await;
+    assert_eq!(azimuth(&b.text("command").await), 45.0);
+    assert!(
+        b.eval("return document.getElementById('error').hidden;")
+            .await
+            == serde_json::json!(true)
+    );
+
+    // The wheel zooms, a shift-drag pans, a double click resets.
+    b.wheel("#frame", -300).await;
+    b.wait_for("document.getElementById('command').textContent.includes('--zoom')")
+        .await;
+    b.wait_still().await;
+    b.drag_holding("#frame", (0.0, 0.0), (30.0, -20.0), 4, true)
+        .await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(command.contains("--look-at"), "{command}");
+    assert_eq!(
+        azimuth(&command),
+        45.0,
+        "a shift-drag does not orbit: {command}"
+    );
+    b.double_click("#frame").await;
+    b.wait_for("!document.getElementById('command').textContent.includes('--zoom')")
+        .await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert_eq!(azimuth(&command), 0.0, "{command}");
+    assert!(!command.contains("--look-at"), "{command}");
+
+    // "Save PNG" at another size.
+    b.eval(
+        "document.getElementById('save-width').value = 64; \
+         document.getElementById('save-height').value = 48; \
+         document.getElementById('save').click(); return true;",
+    )
+    .await;
+    b.wait_for("window.volrayView.saved()").await;
+    let saved = b.eval("return window.volrayView.saved();").await;
+    assert_eq!(
+        (saved["width"].as_u64(), saved["height"].as_u64()),
+        (Some(64), Some(48))
+    );
+    assert!(
+        saved["command"].as_str().unwrap().contains("--size 64x48"),
+        "{saved}"
+    );
+
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn two_tabs_are_independent_and_a_closed_tab_frees_its_renderer() {
+    let Some((viewer, b)) = open(&["fractal:65", "--size", "160"]).await else {
+        return;
+    };
+    let first = b.client.window().await.unwrap();
+    let second = b.client.new_window(true).await.unwrap().handle;
+    b.client.switch_to_window(second.clone()).await.unwrap();
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    viewer.wait_status(browser::PATIENCE, |s| s["sessions"] == 2);
+
+    // The second tab orbits; the first keeps its view.
+    b.eval("window.volrayView.setState({azimuth: 90, colormap: 'magma'}); return true;")
+        .await;
+    b.wait_still().await;
+    assert_eq!(azimuth(&b.text("command").await), 90.0);
+    b.client.switch_to_window(first).await.unwrap();
+    let command = b.text("command").await;
+    assert_eq!(azimuth(&command), 0.0, "{command}");
+    assert!(!command.contains("magma"), "{command}");
+    b.eval("window.volrayView.setState({elevation: 30}); return true;")
+        .await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(command.contains("--azimuth 0 --elevation 30"), "{command}");
+
+    // Closing the second tab frees its renderer.
+    b.client.switch_to_window(second).await.unwrap();
+    b.client.close_window().await.unwrap();
+    viewer.wait_status(browser::PATIENCE, |s| s["sessions"] == 1);
+
+    // SIGTERM with a tab still open: the server stops, exit 0.
+    let status = viewer.stop("TERM", browser::PATIENCE);
+    assert_eq!(status.code(), Some(0));
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn a_burst_of_a_thousand_requests_renders_the_latest_not_a_queue() {
+    let Some((viewer, b)) = open(&["fractal:65", "--size", "160"]).await else {
+        return;
+    };
+    let before = viewer.status()["frames"].as_u64().unwrap();
+    // 1,000 drafts in one go, then the full frame of the last state.
+    let script = r#"
+        const v = window.volrayView;
+        for (let i = 0; i < 1000; i++) v.sendState({azimuth: i / 10}, "draft");
+        v.sendState({azimuth: 99.9}, "full");
+        return true;
+    "#;
+    b.eval(script).await;
+    b.wait_still().await;
+    assert_eq!(azimuth(&b.text("command").await), 99.9);
+    let rendered = viewer.status()["frames"].as_u64().unwrap() - before;
+    // Each frame takes milliseconds, the burst microseconds: a queue would
+    // have rendered all 1,001.
+    assert!(
+        rendered < 1001,
+        "{rendered} frames rendered: the requests were queued"
+    );
+    eprintln!("burst: {rendered} of 1001 requests rendered");
+    b.close().await;
+}
+
+#[test]
+fn every_request_without_the_token_is_refused() {
+    let viewer = Viewer::start(&["blobs:16", "--size", "32"]);
+    let token = viewer.token.clone();
+    let ws = [
+        "Upgrade: websocket",
+        "Connection: Upgrade",
+        "Sec-WebSocket-Version: 13",
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+    ];
+    for path in [
+        "/",
+        "/app.js",
+        "/style.css",
+        "/api/status",
+        "/ws",
+        "/nothing",
+    ] {
+        for query in [
+            String::new(),
+            "?token=".into(),
+            format!("?token={}", &token[1..]),
+        ] {
+            let (code, _) = http_get(&viewer.host, &format!("{path}{query}"), &ws[..]);
+            assert_eq!(code, 403, "{path}{query}");
+        }
+    }
+    let with = |path: &str| format!("{path}?token={token}");
+    assert_eq!(viewer.get(&with("/")).0, 200);
+    assert_eq!(viewer.get(&with("/app.js")).0, 200);
+    assert_eq!(viewer.get(&with("/nothing")).0, 404);
+    assert_eq!(http_get(&viewer.host, &with("/ws"), &ws).0, 101);
+    // Another site's page cannot open the socket, token or not.
+    let foreign = [&ws[..], &["Origin: http://example.org"]].concat();
+    assert_eq!(http_get(&viewer.host, &with("/ws"), &foreign).0, 403);
+}
+
+#[test]
+fn sigterm_and_ctrl_c_stop_the_server_with_exit_0() {
+    for signal in ["TERM", "INT"] {
+        let viewer = Viewer::start(&["blobs:16", "--size", "32"]);
+        assert_eq!(viewer.status()["sessions"], 0);
+        let status = viewer.stop(signal, Duration::from_secs(30));
+        assert_eq!(status.code(), Some(0), "SIG{signal}");
+    }
+}
+
+#[test]
+fn a_bind_beyond_loopback_warns_and_a_bad_start_is_refused() {
+    use std::io::{BufRead, BufReader};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_volray"))
+        .args([
+            "view", "blobs:16", "--size", "32", "--bind", "0.0.0.0", "--port", "0",
+        ])
+        .arg("--no-browser")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut url = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut url)
+        .unwrap();
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    let mut warning = String::new();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut warning)
+        .unwrap();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        warning.contains("warning: listening on 0.0.0.0"),
+        "{warning}"
+    );
+
+    let out = common::volray(&["view", "blobs:16", "--zoom", "0.0001", "--no-browser"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        common::stderr(&out).contains("zoom"),
+        "{}",
+        common::stderr(&out)
+    );
+    let out = common::volray(&["view", "blobs:16", "--blend", "mip", "--opacity", "0,1"]);
+    assert_eq!(out.status.code(), Some(1));
+}
