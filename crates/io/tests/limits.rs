@@ -3,7 +3,9 @@
 //!
 //! For each format a valid fixture is read with the limit at exactly the
 //! bytes the reader holds (accepted) and one byte less (refused, naming the
-//! header field and the limit). What a reader holds is its documented
+//! header field and the limit), reading into memory only
+//! ([`MapPolicy::Never`]: by default a volume over the limit that its file
+//! stores plainly is mapped instead, which `tests/mapped.rs` covers). What a reader holds is its documented
 //! rule: the volume in the type it keeps (1, 2 or 4 bytes a voxel) for the
 //! streaming readers, plus the whole-payload buffers of those that keep one
 //! (DICOM multi-frame, VTK XML, CHGCAR, HDF5) and the `f32` values a
@@ -18,7 +20,7 @@ use std::fs;
 use std::path::Path;
 
 use common::{fixture, refused_error};
-use volray_io::{IoError, Loaded, ReadOptions, read};
+use volray_io::{IoError, Loaded, MapPolicy, ReadOptions, read};
 
 /// Reads `path` with `base`'s options: with the limit at `need(&loaded)`
 /// bytes it reads, with one byte less it is refused
@@ -34,6 +36,7 @@ fn limit_is_exact(
     let need = need(&loaded);
     let at = |max_memory| ReadOptions {
         max_memory,
+        map: MapPolicy::Never,
         ..base.clone()
     };
     let again = read(path, &at(need)).unwrap_or_else(|e| panic!("limit {need}: {e}"));
@@ -179,6 +182,23 @@ fn vtk_legacy_and_xml() {
         volume_bytes,
         "array \"",
     );
+    // Legacy VTK is never mapped: the refusal says why and what to do.
+    for (name, why) in [
+        ("legacy_f32.vtk", "big-endian"),
+        ("legacy_i16_ascii.vtk", "ASCII text"),
+    ] {
+        let over = ReadOptions {
+            max_memory: 8,
+            ..ReadOptions::default()
+        };
+        let msg = refused_error(&vtk(name), &over).to_string();
+        assert!(
+            msg.contains("cannot be mapped from the file instead")
+                && msg.contains(why)
+                && msg.contains("save the volume as raw NRRD"),
+            "{msg}"
+        );
+    }
 
     // VTK XML is read whole: for these tiny grids the file is what binds
     // (each value takes its stored bytes and an f32, 8 + 4 at most).
