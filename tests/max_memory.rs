@@ -140,3 +140,65 @@ fn built_in_sources_and_rendering_obey_the_limit() {
         &["rendering 33x33x33 voxels"],
     );
 }
+
+/// A raw volume larger than `--max-memory` is mapped from its file rather
+/// than refused, and renders exactly as it does read into memory; `info`
+/// says it is mapped. A compressed one cannot be mapped, and its refusal
+/// says so and what to do.
+#[test]
+fn a_volume_over_the_limit_is_mapped_and_renders_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("ct.raw");
+    let n = 64usize;
+    let bytes: Vec<u8> = (0..n * n * n)
+        .flat_map(|i| {
+            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
+            let r = ((x * x + y * y + z * z) as f64).sqrt();
+            let hu: i16 = if r < 40.0 {
+                40 + (x % 7) as i16 * 100
+            } else {
+                -1000
+            };
+            hu.to_le_bytes()
+        })
+        .collect();
+    std::fs::write(&raw, bytes).unwrap();
+    let raw = raw.to_str().unwrap();
+    let layout = ["--dims", "64,64,64", "--dtype", "i16"];
+    let (mapped, read_in) = (dir.path().join("mapped.png"), dir.path().join("read.png"));
+    for (limit, out) in [("400K", &mapped), ("1G", &read_in)] {
+        let args = [
+            &["render", raw][..],
+            &layout,
+            &["--preset", "ct-bone", "--size", "48", "--max-memory", limit],
+            &["-o", out.to_str().unwrap()],
+        ]
+        .concat();
+        let run = volray(&args);
+        assert!(run.status.success(), "{limit}: {}", stderr(&run));
+    }
+    assert_eq!(
+        std::fs::read(&mapped).unwrap(),
+        std::fs::read(&read_in).unwrap()
+    );
+    let info = volray(&[&["info", raw, "--max-memory", "400K"][..], &layout].concat());
+    let text = String::from_utf8_lossy(&info.stdout).to_string();
+    assert!(
+        text.contains("in memory: mapped from the file, i16 (2 bytes a voxel, 512 KiB)"),
+        "{text}"
+    );
+
+    refused(
+        &[
+            "info",
+            "--max-memory",
+            "10",
+            "crates/io/tests/fixtures/nrrd/u8_gzip.nrrd",
+        ],
+        &[
+            "cannot be mapped from the file instead (gzip-compressed data: store it uncompressed (raw encoding))",
+            "(60 values, 60 bytes at 1 byte a value), which",
+            "exceed --max-memory 10 bytes",
+        ],
+    );
+}

@@ -38,6 +38,7 @@ use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::{open_input, read_exact_at, read_samples};
 use crate::shared::limits::check_dims;
+use crate::shared::mapped::{self, Plan};
 use crate::shared::periodic_cell;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
@@ -304,7 +305,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     // The file holds the data, so these sizes fit in u64 and usize.
     let end = end as u64;
     let kept = dtype.stored().bytes() as u64;
-    check_dims(path, "NX NY NZ", &dims, kept, opts.max_memory)?;
+    // Over the limit, the map may still be mapped (decided below).
+    let within_limit = match check_dims(path, "NX NY NZ", &dims, kept, opts.max_memory) {
+        Err(e) if !matches!(e, IoError::OverMemoryLimit { .. }) => return Err(e),
+        other => other,
+    };
     let count = count as usize;
     if file_len > end {
         notes.push(format!("{} bytes after the data ignored", file_len - end));
@@ -437,19 +442,29 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     file.seek(SeekFrom::Start(offset))
         .map_err(|e| IoError::os(path, "seek in", e))?;
     let endian = h.endian;
-    let data = read_as_stored!(dtype.stored(), |T| {
-        let mut data: Vec<T> = Vec::with_capacity(count);
-        read_samples(
-            path,
-            &mut file,
-            count,
-            dtype.size(),
-            offset,
-            |bytes, out| T::extend(out, bytes, dtype, endian),
-            |values| data.extend_from_slice(values),
-        )
-        .map(|()| data)
-    })?;
+    let mappable = if skewed {
+        Err("a skewed cell is resampled as it is read".to_string())
+    } else {
+        mapped::mappable(dtype, endian, offset)
+    };
+    let plan = mapped::plan(opts.map, mappable, within_limit)?;
+    let data = if plan == Plan::Map {
+        mapped::map_samples(path, offset, dtype, count)?
+    } else {
+        read_as_stored!(dtype.stored(), |T| {
+            let mut data: Vec<T> = Vec::with_capacity(count);
+            read_samples(
+                path,
+                &mut file,
+                count,
+                dtype.size(),
+                offset,
+                |bytes, out| T::extend(out, bytes, dtype, endian),
+                |values| data.extend_from_slice(values),
+            )
+            .map(|()| data)
+        })?
+    };
 
     let mut info = FileInfo::new(format!("{type_name} (MODE {mode}, {endian}-endian)"));
     info.header = header;
@@ -484,6 +499,9 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     } else {
         grid_to_volume(path, dims, data, steps, origin, &mut info)?
     };
+    if plan == Plan::Map {
+        notes.push(mapped::mapped_note(&volume));
+    }
     // Notes in the order the header was read, then geometry's own.
     let geometry_notes = std::mem::take(&mut info.notes);
     info.notes = notes;

@@ -26,6 +26,7 @@ use crate::dtype::{DType, Endian, Stored, f16_to_f32, read_as_stored};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_exact_at, read_samples};
 use crate::shared::limits::check_dims;
+use crate::shared::mapped::{self, MapPolicy, Plan};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 const MAGIC: &[u8; 6] = b"\x93NUMPY";
@@ -48,13 +49,13 @@ const ALIGN: usize = 64;
 /// The header is checked against the file's length before anything is
 /// allocated, and the file must end exactly where the data does.
 pub fn read_npy(path: &Path) -> Result<Volume, IoError> {
-    read_npy_with_info(path, crate::default_max_memory()).map(|(v, _)| v)
+    read_npy_with_info(path, crate::default_max_memory(), MapPolicy::IfLarger).map(|(v, _)| v)
 }
 
 /// Reads the `.npy` file at `path` (see [`read_npy`]) within
 /// `opts.max_memory`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let (volume, info) = read_npy_with_info(path, opts.max_memory)?;
+    let (volume, info) = read_npy_with_info(path, opts.max_memory, opts.map)?;
     Ok(Loaded {
         volume,
         format: VolumeFormat::Npy,
@@ -62,9 +63,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     })
 }
 
-/// [`read_npy`], with the header's fields for `volray info`, refusing a
-/// shape whose `f32` volume would take more than `max_memory` bytes.
-fn read_npy_with_info(path: &Path, max_memory: u64) -> Result<(Volume, FileInfo), IoError> {
+/// [`read_npy`], with the header's fields for `volray info`, within
+/// `max_memory` bytes: a larger array is mapped from the file where
+/// `policy` and its layout allow, refused otherwise.
+fn read_npy_with_info(
+    path: &Path,
+    max_memory: u64,
+    policy: MapPolicy,
+) -> Result<(Volume, FileInfo), IoError> {
     let (mut file, file_len) = open_input(path)?;
     let header = read_header(path, &mut file, file_len)?;
     let [nx, ny, nz] = header.shape;
@@ -73,14 +79,29 @@ fn read_npy_with_info(path: &Path, max_memory: u64) -> Result<(Volume, FileInfo)
     }
     // read_header checked count · size against the file, so no overflow.
     let stored = header.elem.stored();
-    let count = check_dims(
-        path,
-        "shape",
-        &header.shape,
-        stored.bytes() as u64,
-        max_memory,
+    let count = nx * ny * nz;
+    let mappable = match header.elem {
+        _ if !header.fortran_order => Err(
+            "C order: a[x, y, z] has z fastest and is transposed as it is read; save it with np.asfortranarray".to_string(),
+        ),
+        Elem::Plain(d, e) => mapped::mappable(d, e, header.data_offset),
+        _ => Err(format!("{} elements are converted as they are read", descr_name(header.elem))),
+    };
+    let plan = mapped::plan(
+        policy,
+        mappable,
+        check_dims(
+            path,
+            "shape",
+            &header.shape,
+            stored.bytes() as u64,
+            max_memory,
+        ),
     )?;
-    let data = read_as_stored!(stored, |T| read_data::<T>(path, &mut file, &header, count))?;
+    let data = match (plan, header.elem) {
+        (Plan::Map, Elem::Plain(d, _)) => mapped::map_samples(path, header.data_offset, d, count)?,
+        _ => read_as_stored!(stored, |T| read_data::<T>(path, &mut file, &header, count))?,
+    };
     let elem = header.elem;
     let mut info = FileInfo::new(descr_name(elem));
     info.header = vec![
@@ -101,6 +122,9 @@ fn read_npy_with_info(path: &Path, max_memory: u64) -> Result<(Volume, FileInfo)
             .push("C order: the array a[x, y, z] was transposed to x fastest".into());
     }
     let volume = Volume::from_samples(header.shape, data).map_err(|e| IoError::volume(path, e))?;
+    if plan == Plan::Map {
+        info.notes.push(mapped::mapped_note(&volume));
+    }
     Ok((volume, info))
 }
 

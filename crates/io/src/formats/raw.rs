@@ -125,7 +125,7 @@ fn read_raw_limited(
     let (dtype, endian) = (opts.dtype, opts.endian);
     let plan = mapped::plan(
         policy,
-        mapped::mappable(dtype, endian),
+        mapped::mappable(dtype, endian, 0),
         check_dims(path, "raw layout dims", &opts.dims, kept, max_memory),
     )?;
     if plan == Plan::Map {

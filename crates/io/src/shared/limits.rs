@@ -197,8 +197,9 @@ pub fn check_memory(
         format!("{} as f32", format_bytes(bytes))
     } else {
         format!(
-            "{} at {bytes_per_value} bytes a value while reading",
-            format_bytes(bytes)
+            "{} at {bytes_per_value} byte{} a value",
+            format_bytes(bytes),
+            if bytes_per_value == 1 { "" } else { "s" }
         )
     };
     check_held(path, what, values, bytes, &held, max_memory)

@@ -93,9 +93,12 @@ pub(crate) fn mapped_note(volume: &volray_core::Volume) -> String {
     )
 }
 
-/// Whether samples of `dtype` stored in `endian` order can be used as they
-/// are in the file, or why not.
-pub(crate) fn mappable(dtype: DType, endian: Endian) -> Result<(), String> {
+/// Whether samples of `dtype` stored in `endian` order from byte `offset`
+/// of a file can be used as they are in the file, or why not. A mapping
+/// starts at a page boundary, so samples of 2 or 4 bytes must start at a
+/// multiple of their size to be read in place; a header of another length
+/// before them (an attached NRRD or MetaImage header) prevents it.
+pub(crate) fn mappable(dtype: DType, endian: Endian, offset: u64) -> Result<(), String> {
     if !matches!(
         dtype,
         DType::U8 | DType::I8 | DType::U16 | DType::I16 | DType::F32
@@ -109,6 +112,12 @@ pub(crate) fn mappable(dtype: DType, endian: Endian) -> Result<(), String> {
             "{endian}-endian samples on a {}-endian machine: store them {}-endian",
             Endian::NATIVE,
             Endian::NATIVE
+        ));
+    }
+    let size = dtype.size() as u64;
+    if !offset.is_multiple_of(size) {
+        return Err(format!(
+            "the samples start at byte {offset}, not a multiple of their {size} bytes: store them in a file of their own (a detached header)"
         ));
     }
     Ok(())
@@ -263,15 +272,20 @@ mod tests {
 
     #[test]
     fn only_native_types_in_native_order_map() {
-        assert!(mappable(DType::U16, Endian::NATIVE).is_ok());
-        assert!(mappable(DType::U8, Endian::Big).is_ok());
-        let err = mappable(DType::F64, Endian::NATIVE).unwrap_err();
+        assert!(mappable(DType::U16, Endian::NATIVE, 352).is_ok());
+        assert!(mappable(DType::U8, Endian::Big, 3).is_ok());
+        let err = mappable(DType::F32, Endian::NATIVE, 366).unwrap_err();
+        assert!(
+            err.contains("start at byte 366, not a multiple of their 4 bytes"),
+            "{err}"
+        );
+        let err = mappable(DType::F64, Endian::NATIVE, 0).unwrap_err();
         assert!(err.contains("converted to f32"), "{err}");
         let other = match Endian::NATIVE {
             Endian::Little => Endian::Big,
             Endian::Big => Endian::Little,
         };
-        let err = mappable(DType::I16, other).unwrap_err();
+        let err = mappable(DType::I16, other, 0).unwrap_err();
         assert!(err.contains("-endian machine"), "{err}");
     }
 

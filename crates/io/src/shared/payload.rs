@@ -21,6 +21,7 @@ use flate2::read::{MultiGzDecoder, ZlibDecoder};
 use crate::dtype::{DType, Endian, Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_samples};
+use crate::shared::mapped;
 use crate::shared::text_reader::TextReader;
 use volray_core::{SampleType, Samples};
 
@@ -368,6 +369,47 @@ pub(crate) fn read_regions(
     read_as_stored!(layout.stored(), |T| read_regions_as::<T>(
         regions, per_region, layout, frame
     ))
+}
+
+/// Where the samples `frame` selects lie in the one file they can be
+/// mapped from: a single region, raw encoding, the kept volume contiguous
+/// (the frame axis of a 4-D file is its slowest), the samples stored as a
+/// volume keeps them ([`mapped::mappable`]); otherwise why not.
+pub(crate) fn mappable(
+    regions: &[Region],
+    per_region: usize,
+    layout: &Layout,
+    frame: FrameSelect,
+) -> Result<(PathBuf, u64), String> {
+    let [region] = regions else {
+        return Err(format!(
+            "the data is split over {} files: store it in one",
+            regions.len()
+        ));
+    };
+    let encoding = match layout.encoding {
+        Encoding::Raw => None,
+        Encoding::Gzip => Some("gzip-compressed"),
+        Encoding::Zlib => Some("zlib-compressed"),
+        Encoding::Text => Some("text"),
+        Encoding::Hex => Some("hex"),
+    };
+    if let Some(e) = encoding {
+        return Err(format!("{e} data: store it uncompressed (raw encoding)"));
+    }
+    let size = layout.dtype.size() as u64;
+    let offset = if frame.count <= 1 {
+        region.start
+    } else if frame.stride.checked_mul(frame.count) == Some(per_region) {
+        region.start + (frame.index * frame.stride) as u64 * size
+    } else {
+        return Err(
+            "the volumes of the 4-D file are interleaved (its frame axis is not the slowest)"
+                .into(),
+        );
+    };
+    mapped::mappable(layout.dtype, layout.endian, offset)?;
+    Ok((region.path.clone(), offset))
 }
 
 /// [`read_regions`] as `T`.

@@ -28,6 +28,7 @@ use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
 use crate::shared::limits::check_frame_dims;
+use crate::shared::mapped::{self, Plan};
 use crate::shared::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
 use crate::shared::text_header::Field;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -238,15 +239,25 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         payload::check_region(&region, per_file, &layout, notes)?;
         regions.push(region);
     }
-    check_frame_dims(
-        path,
-        "MetaImage field DimSize =",
-        &dims,
-        frames,
-        layout.stored().bytes() as u64,
-        opts.max_memory,
+    let mappable = payload::mappable(&regions, per_file, &layout, select);
+    let plan = mapped::plan(
+        opts.map,
+        mappable.as_ref().map(|_| ()).map_err(Clone::clone),
+        check_frame_dims(
+            path,
+            "MetaImage field DimSize =",
+            &dims,
+            frames,
+            layout.stored().bytes() as u64,
+            opts.max_memory,
+        ),
     )?;
-    let data = payload::read_regions(&regions, per_file, &layout, select)?;
+    let data = match (plan, mappable) {
+        (Plan::Map, Ok((file, offset))) => {
+            mapped::map_samples(&file, offset, dtype, total / frames)?
+        }
+        _ => payload::read_regions(&regions, per_file, &layout, select)?,
+    };
 
     info.length_unit = geometry.unit.clone();
     let volume = grid_to_volume(
@@ -257,6 +268,9 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         geometry.origin,
         &mut info,
     )?;
+    if plan == Plan::Map {
+        info.notes.push(mapped::mapped_note(&volume));
+    }
     Ok(Loaded {
         volume,
         format: VolumeFormat::MetaImage,

@@ -38,6 +38,7 @@ use crate::error::IoError;
 use crate::shared::compress::MAX_DEFLATE_RATIO;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::limits::{F32_BYTES, check_frame_dims};
+use crate::shared::mapped::{self, Plan};
 use crate::shared::rescale::rescale;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
@@ -187,40 +188,58 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let scale = scaling(&header, &mut info);
     let stored = layout.dtype.stored();
     let held = stored.bytes() as u64 + if scale.is_some() { F32_BYTES } else { 0 };
-    check_frame_dims(
-        path,
-        "NIfTI field \"dim\"",
-        &dims,
-        layout.frames,
-        held,
-        opts.max_memory,
+    let mappable = if data_source.is_gzip() {
+        Err("gzip-compressed data: store it as .nii".to_string())
+    } else if scale.is_some() {
+        Err("scl_slope scales the values as they are read".to_string())
+    } else {
+        mapped::mappable(layout.dtype, endian, frame_start)
+    };
+    let plan = mapped::plan(
+        opts.map,
+        mappable,
+        check_frame_dims(
+            path,
+            "NIfTI field \"dim\"",
+            &dims,
+            layout.frames,
+            held,
+            opts.max_memory,
+        ),
     )?;
     let count = layout.count;
     let size = layout.dtype.size();
-    let data = read_as_stored!(stored, |T| {
-        let mut data: Vec<T> = Vec::with_capacity(if data_source.is_gzip() {
-            count.min(CHUNK_SAMPLES)
-        } else {
-            count
-        });
-        let mut chunk = vec![0u8; count.min(CHUNK_SAMPLES) * size];
-        let mut done = 0;
-        let mut result = Ok(());
-        while done < count && result.is_ok() {
-            let n = (count - done).min(CHUNK_SAMPLES);
-            let at = frame_start + (done * size) as u64;
-            result = data_source.fill(&data_path, &mut chunk[..n * size], at, needed);
-            T::extend(&mut data, &chunk[..n * size], layout.dtype, endian);
-            done += n;
-        }
-        result.map(|()| data)
-    })?;
+    let data = if plan == Plan::Map {
+        mapped::map_samples(&data_path, frame_start, layout.dtype, count)?
+    } else {
+        read_as_stored!(stored, |T| {
+            let mut data: Vec<T> = Vec::with_capacity(if data_source.is_gzip() {
+                count.min(CHUNK_SAMPLES)
+            } else {
+                count
+            });
+            let mut chunk = vec![0u8; count.min(CHUNK_SAMPLES) * size];
+            let mut done = 0;
+            let mut result = Ok(());
+            while done < count && result.is_ok() {
+                let n = (count - done).min(CHUNK_SAMPLES);
+                let at = frame_start + (done * size) as u64;
+                result = data_source.fill(&data_path, &mut chunk[..n * size], at, needed);
+                T::extend(&mut data, &chunk[..n * size], layout.dtype, endian);
+                done += n;
+            }
+            result.map(|()| data)
+        })?
+    };
     let data = match scale {
         Some((slope, inter)) => rescale(data, slope, inter),
         None => data,
     };
     let (steps, origin) = geometry(path, &header, &mut info)?;
     let volume = grid_to_volume(path, layout.dims, data, steps, origin, &mut info)?;
+    if plan == Plan::Map {
+        info.notes.push(mapped::mapped_note(&volume));
+    }
     Ok(Loaded {
         volume,
         format: VolumeFormat::Nifti,

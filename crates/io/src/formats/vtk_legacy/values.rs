@@ -10,6 +10,7 @@ use super::lexer::Lexer;
 use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::shared::limits::{F32_BYTES, check_memory};
+use crate::shared::mapped::{self, MapPolicy};
 
 /// Samples decoded per read of BINARY data.
 const CHUNK_SAMPLES: usize = 1 << 16;
@@ -114,12 +115,15 @@ pub(super) fn array_values<R: std::io::BufRead + std::io::Seek>(
                 ));
             }
             if let Some(max_memory) = decode {
-                check_memory(
-                    lx.path(),
-                    &format!("array \"{name}\""),
-                    count as u128,
-                    F32_BYTES,
-                    max_memory,
+                within(
+                    check_memory(
+                        lx.path(),
+                        &format!("array \"{name}\""),
+                        count as u128,
+                        F32_BYTES,
+                        max_memory,
+                    ),
+                    "legacy VTK stores BINARY values big-endian, and volray reads its arrays into f32",
                 )?;
                 Some(binary_values(lx, spec.sample, count)?)
             } else {
@@ -139,12 +143,15 @@ pub(super) fn array_values<R: std::io::BufRead + std::io::Seek>(
                 ));
             }
             if let Some(max_memory) = decode {
-                check_memory(
-                    lx.path(),
-                    &format!("array \"{name}\""),
-                    count as u128,
-                    F32_BYTES,
-                    max_memory,
+                within(
+                    check_memory(
+                        lx.path(),
+                        &format!("array \"{name}\""),
+                        count as u128,
+                        F32_BYTES,
+                        max_memory,
+                    ),
+                    "its values are ASCII text, parsed into f32",
                 )?;
             }
             let mut out = decode.map(|_| Vec::with_capacity(count));
@@ -176,6 +183,19 @@ pub(super) fn array_values<R: std::io::BufRead + std::io::Seek>(
 
 /// One ASCII value, converted as VTK's stream reads it into the array type
 /// (integers wrap into narrower types as a C cast does).
+/// A legacy VTK array is never mapped: over the memory limit, `check` is
+/// refused with `why` and what to do instead.
+fn within(check: Result<(), IoError>, why: &str) -> Result<(), IoError> {
+    mapped::plan(
+        MapPolicy::IfLarger,
+        Err(format!(
+            "{why}: save the volume as raw NRRD with a detached header, or .npy, in little-endian u8, i8, u16, i16 or f32"
+        )),
+        check.map(|()| 0),
+    )
+    .map(drop)
+}
+
 fn ascii_value(t: &str, sample: SampleType) -> Option<f32> {
     let int = || t.parse::<i64>().ok();
     Some(match sample {
