@@ -200,6 +200,8 @@ struct Row {
     parts: [f64; 2],
     classify_ms: f64,
     bricks: usize,
+    /// The median number of bricks a timed frame lit.
+    lit: f64,
     vtk: Option<super::vtk::VtkRun>,
 }
 
@@ -261,6 +263,7 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
                 .first()
                 .and_then(|t| t.parts.map(|p| p.bricks))
                 .unwrap_or(0),
+            lit: part(|p| p.lit as f64),
             vtk: match (&harness, vtk) {
                 (Some(h), Some(run)) => Some(h.compare(run, &warm, dataset, window)?),
                 _ => None,
@@ -295,12 +298,13 @@ fn nominal(row: &Row) -> f64 {
 fn print_row(row: &Row, threads: usize) {
     let [bin, cast] = row.parts;
     let head = format!(
-        "  {:<13} {:>5}² t={threads}: median {:.4} s, {:.3e} samples/s (bin {bin:.2} + shade and cast {cast:.2} ms; {} bricks, classified once in {:.1} ms)",
+        "  {:<13} {:>5}² t={threads}: median {:.4} s, {:.3e} samples/s (bin {bin:.2} + shade and cast {cast:.2} ms; {} bricks, {} lit a frame, classified once in {:.1} ms)",
         row.dataset,
         row.window,
         row.median_s,
         nominal(row) / row.median_s,
         row.bricks,
+        row.lit,
         row.classify_ms,
     );
     match &row.vtk {

@@ -122,6 +122,9 @@ pub struct FrameTimes {
     pub cast: Duration,
     /// Occupied bricks.
     pub bricks: usize,
+    /// Bricks lit for the frame: those a ray sampled before it
+    /// terminated (hidden and off-screen bricks are not lit).
+    pub lit: usize,
     /// Bytes of classified and lit bricks the caches hold after the frame
     /// (at most the [cache budget](Renderer::with_cache_budget)).
     pub cached_bytes: usize,
@@ -570,6 +573,7 @@ impl<'v> Renderer<'v> {
         times.bin = t2 - t1;
         times.cast = t3 - t2;
         times.bricks = state.bricks.len();
+        times.lit = lighting.count();
         times.cached_bytes = state.bricks.slot_bytes() + state.lit.bytes();
         times
     }

@@ -12,7 +12,7 @@ use common::{
 };
 use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
-use volray_core::{RenderSettings, Renderer, TransferFunction, Volume};
+use volray_core::{Image, RenderSettings, Renderer, TransferFunction, Volume};
 
 /// The fewest pixels of opacity above 0.2 the reference must show for a
 /// comparison to count: one.
@@ -159,6 +159,46 @@ fn early_termination_stays_within_a_level_in_an_opaque_volume() {
     // Opaque: the white background does not show through.
     let centre = reference.get(25, 22);
     assert!(centre[3] > 0.999, "{centre:?}");
+}
+
+#[test]
+fn bricks_hidden_behind_an_opaque_surface_are_not_lit() {
+    // An opaque slab, 80 voxels deep along the view (ten bricks): rays
+    // terminate in its first brick, so the nine behind it are never lit,
+    // and the image is still the reference's.
+    let volume = Volume::from_fn([81, 24, 24], DVec3::ONE, DVec3::ZERO, |p| {
+        (0.9 + 0.1 * (p.y * 0.4).sin() * (p.z * 0.3).cos()) as f32
+    })
+    .unwrap();
+    let renderer = Renderer::new(&volume).unwrap();
+    let settings = RenderSettings {
+        width: 40,
+        height: 40,
+        step: 0.5,
+        camera: Camera {
+            view_point: Some(DVec3::new(-200.0, 12.0, 12.0)),
+            ..Camera::default()
+        },
+        transfer_function: tf(r#"{"opacity": [[0, 0.9], [1, 0.99]],
+            "color": [[0, 0.2, 0.6, 0.9], [1, 0.9, 0.5, 0.2]]}"#),
+        ..RenderSettings::default()
+    };
+    let mut image = Image::new(0, 0, [0.0; 4]);
+    let times = renderer.render_into(&settings, &mut image).unwrap();
+    // 10 × 3 × 3 bricks, all occupied; the front layer's 9 are lit (a
+    // ray on a brick face may also reach the second layer).
+    assert_eq!(times.bricks, 90);
+    assert!(times.lit >= 9 && times.lit <= 18, "{} lit", times.lit);
+    let (fast, reference) = both_paths(&renderer, &settings);
+    assert!(fast.max_abs_diff(&reference).unwrap() <= 1.0 / 255.0);
+    // Nearly transparent instead, light crosses the slab: every brick is lit.
+    let faint = RenderSettings {
+        transfer_function: tf(r#"{"opacity": [[0, 0.001], [1, 0.002]],
+            "color": [[0, 0.2, 0.6, 0.9], [1, 0.9, 0.5, 0.2]]}"#),
+        ..settings
+    };
+    let times = renderer.render_into(&faint, &mut image).unwrap();
+    assert_eq!(times.lit, 90);
 }
 
 #[test]

@@ -41,6 +41,7 @@
 //! SIMD: positions and colours are `f32x4` (x, y, z or r, g, b, α in the
 //! lanes); the eight corners of a cell are eight 16-byte loads.
 
+use crate::bricks::cache::CacheRef;
 use crate::bricks::occupied::ClassifiedBricks;
 use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
 use crate::camera::View;
@@ -410,30 +411,50 @@ impl<'a> Rays<'a> {
     ) {
         // Where a brick the lit-brick cache has no room for is lit.
         let mut scratch = None;
+        let mut live = states.iter().filter(|s| !s.done).count();
         for &n in list {
+            // Once every ray of the tile has terminated, the bricks behind
+            // are hidden: neither lit nor classified. (A dense CT seen at
+            // 1024² hides most of its bricks behind the skin: lighting
+            // every brick of the list took 2.8 s of a 512³ frame.)
+            if live == 0 {
+                break;
+            }
             // The brick's box, computed per tile rather than kept per
             // frame (64 bytes an occupied brick): a few operations for the
             // tile's 256 rays.
             let b = &cell_box(scene.bricks, n as usize);
             let cells = &scene.bricks.cells[n as usize];
-            let lit = scene.lit.get(n as usize, scene.lighting, &mut scratch);
-            self.cross(b, &lit, cells, pixel, states, steppings);
+            let scratch = &mut scratch;
+            live -= self.cross(
+                b,
+                move || scene.lit.get(n as usize, scene.lighting, scratch),
+                cells,
+                pixel,
+                states,
+                steppings,
+            );
         }
     }
 
     /// Takes the samples of every ray of a tile (`states`, as in
-    /// [`Self::cast`]) in one brick: its box `b`, its `lit` voxels and its
-    /// occupied `cells`.
+    /// [`Self::cast`]) in one brick: its box `b`, its occupied `cells` and
+    /// its voxels, which `light` lights when the first ray has samples in
+    /// the brick (a brick that no live ray samples is never lit). Returns
+    /// how many rays ended here.
     #[inline(always)]
-    fn cross<S: Steppings + ?Sized>(
+    fn cross<'l, S: Steppings + ?Sized>(
         &self,
         b: &CellBox,
-        lit: &[[f32; 4]; SLOTS],
+        light: impl FnOnce() -> CacheRef<'l, [[f32; 4]; SLOTS]>,
         cells: &[u64; 8],
         pixel: &impl Fn(usize) -> (usize, usize),
         states: &mut [RayState],
         steppings: &S,
-    ) {
+    ) -> usize {
+        let mut light = Some(light);
+        let mut lit = None;
+        let mut ended = 0;
         for (i, state) in states.iter_mut().enumerate() {
             if state.done {
                 continue;
@@ -454,6 +475,7 @@ impl<'a> Rays<'a> {
                 let Some((f, l)) = range else {
                     // The ray misses the volume: it has no samples.
                     state.done = true;
+                    ended += 1;
                     continue;
                 };
                 (first, last) = (first.max(f), last.min(l));
@@ -470,8 +492,12 @@ impl<'a> Rays<'a> {
                 first,
                 last,
             };
+            let lit: &[[f32; 4]; SLOTS] =
+                lit.get_or_insert_with(|| light.take().expect("lit once")());
             state.done = march(&mut state.acc, lit, cells, &segment);
+            ended += usize::from(state.done);
         }
+        ended
     }
 }
 

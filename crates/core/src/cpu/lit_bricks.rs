@@ -22,6 +22,7 @@ use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Sample;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use wide::bytemuck::cast;
 use wide::{f32x4, i16x8, i32x4, i32x8};
 
@@ -99,6 +100,8 @@ pub struct Lighting<'a> {
     material: Material,
     /// `None`: unlit, the colour is the material colour.
     light: Option<FrameLight>,
+    /// Bricks lit ([`Self::count`]).
+    lit: AtomicUsize,
 }
 
 impl<'a> Lighting<'a> {
@@ -116,12 +119,20 @@ impl<'a> Lighting<'a> {
             frame,
             material: Material::new(source.classifier),
             light: lighting.map(|(phong, light)| FrameLight::new(phong, light)),
+            lit: AtomicUsize::new(0),
         }
+    }
+
+    /// How many bricks were lit so far (a brick lit twice, into the
+    /// cache's buffer and then into a scratch one, counts twice).
+    pub fn count(&self) -> usize {
+        self.lit.load(Ordering::Relaxed)
     }
 
     /// Lights occupied brick `n` into `out`: `lit × material`, clamped, and
     /// the stored opacity.
     pub fn shade(&self, n: usize, out: &mut [[f32; 4]; SLOTS]) {
+        self.lit.fetch_add(1, Ordering::Relaxed);
         let mut scratch = None;
         let classified = (self.bricks).classified(n, self.frame, &self.source, &mut scratch);
         let (bricks, b) = (self.bricks, self.bricks.brick(n));
