@@ -7,9 +7,11 @@
 //! | [`function`] | piecewise-linear functions and the transfer-function JSON |
 //! | [`colormap`] | named colour maps (viridis, magma, ..., cool-to-warm) |
 //! | [`presets`] | transfer functions for CT, MR and electron densities |
+//! | [`auto`] | a transfer function chosen from a volume's histogram (`--tf auto`) |
 //! | [`iso`] | Levoy's isovalue contours (1988, eq. 3) |
 //! | [`gradient_opacity`] | opacity scaled by a ramp of the gradient magnitude |
 
+pub mod auto;
 pub mod classifier;
 pub mod colormap;
 pub mod function;
