@@ -36,6 +36,7 @@ pub fn turntable(
     frames: usize,
 ) -> Result<(), CliError> {
     let input = load(&args.input, args.view.look.log)?;
+    let base = &crate::render::with_auto(args, base, &input.volume);
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
@@ -65,10 +66,16 @@ pub fn series(
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
-    // Pass 1: the value range and bounds of all the volumes together.
+    // Pass 1: the value range and bounds of all the volumes together, and
+    // the first volume's histogram, should the transfer function be chosen
+    // from it.
     let mut extent = Extent::default();
+    let mut first = None;
     for spec in specs {
         let input = load_one(args, spec)?;
+        if first.is_none() && args.view.look.auto_tf() {
+            first = volray_core::Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
+        }
         let renderer = renderer_for(&args.view, base, &input)?;
         extent.add(renderer.value_range(), input.volume.bounds());
         if base.gradient_opacity.is_some() {
@@ -76,7 +83,18 @@ pub fn series(
             extent.max_gradient = extent.max_gradient.max(max);
         }
     }
-    let settings = extent.fix(base);
+    let mut settings = extent.fix(base);
+    if let Some(histogram) = &first {
+        // Chosen from the first volume, over the window of them all.
+        let tf = &mut settings.transfer_function;
+        let chosen = volray_core::transfer::auto::transfer_function(histogram, tf.domain);
+        if args.view.look.opacity.is_none() {
+            tf.opacity = chosen.opacity;
+        }
+        if tf.color.is_none() {
+            tf.color = chosen.color;
+        }
+    }
 
     // Pass 2: render each.
     let mut writer = Writer::new(args, &settings, specs.len())?;

@@ -34,7 +34,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         None => {
             if let Some(json) = &args.json {
                 let input = args.input.input.as_deref().unwrap_or(crate::input::DEMO);
-                let tf: Vec<&Path> = args.view.look.tf.iter().map(|p| p.as_path()).collect();
+                let tf: Vec<&Path> = args.view.look.tf_file().into_iter().collect();
                 crate::overwrite::refuse_overwriting_inputs(
                     std::slice::from_ref(json),
                     &[input.to_string()],
@@ -177,7 +177,8 @@ pub fn write_json(path: &Path, rows: &[JsonRow]) -> Result<(), CliError> {
 /// `volray bench INPUT`: the frames of one volume.
 fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
     let input = load(&args.input, args.view.look.log)?;
-    let base = settings(&args.view)?;
+    let mut base = settings(&args.view)?;
+    crate::settings::choose_auto(&args.view.look, &mut base.transfer_function, &input.volume);
     let pool = thread_pool(args.view.threads)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
 

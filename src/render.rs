@@ -25,13 +25,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     crate::overwrite::refuse_overwriting_inputs(
         &output_files(args, kind, specs.len()),
         &specs,
-        &args
-            .view
-            .look
-            .tf
-            .iter()
-            .map(|p| p.as_path())
-            .collect::<Vec<_>>(),
+        &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
     )?;
     let pool = thread_pool(args.view.threads)?;
     match (kind, args.animation.turntable) {
@@ -43,6 +37,18 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
 }
 
+/// `settings` with the transfer function chosen from `volume` where
+/// no flag names one (`--tf auto`, see [`crate::settings::choose_auto`]).
+pub fn with_auto(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    volume: &volray_core::Volume,
+) -> RenderSettings {
+    let mut settings = settings.clone();
+    crate::settings::choose_auto(&args.view.look, &mut settings.transfer_function, volume);
+    settings
+}
+
 /// One frame of one volume, to an image file.
 fn still(
     args: &RenderArgs,
@@ -51,6 +57,7 @@ fn still(
     kind: OutputKind,
 ) -> Result<(), CliError> {
     let input = load(&args.input, args.view.look.log)?;
+    let settings = &with_auto(args, settings, &input.volume);
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let image = pool

@@ -8,15 +8,15 @@ use crate::error::CliError;
 use crate::flags::{BlendMode, CameraArgs, LookArgs, ViewArgs};
 use std::path::Path;
 use volray_core::glam::DVec3;
-use volray_core::transfer::{colormap, presets};
+use volray_core::transfer::{auto, colormap, presets};
 use volray_core::{
-    Blend, Camera, Classification, ClipPlane, IsoSurface, Method, Phong, Projection,
-    RenderSettings, TransferFunction,
+    Blend, Camera, Classification, ClipPlane, Histogram, IsoSurface, Method, Phong, Projection,
+    RenderSettings, TransferFunction, Volume,
 };
 
 /// The render settings the view arguments describe (reading `--tf`).
 pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
-    let tf_text = view.look.tf.as_deref().map(read_tf_file).transpose()?;
+    let tf_text = view.look.tf_file().map(read_tf_file).transpose()?;
     settings_with_tf_text(view, tf_text.as_deref())
 }
 
@@ -95,7 +95,7 @@ pub fn named_transfer_function(
     look: &LookArgs,
     tf_text: Option<&str>,
 ) -> Result<TransferFunction, CliError> {
-    let transfer_function = match (&look.tf, tf_text) {
+    let transfer_function = match (look.tf_file(), tf_text) {
         (Some(path), Some(text)) => TransferFunction::from_json(text)
             .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?,
         (Some(path), None) => {
@@ -127,7 +127,7 @@ pub fn named_transfer_function(
         )));
     }
     if let Some(name) = &look.colormap {
-        if look.tf.is_some() && transfer_function.color.is_some() {
+        if look.tf_file().is_some() && transfer_function.color.is_some() {
             return Err(CliError::input(
                 "--colormap conflicts with the colour function in --tf: give one of them",
             ));
@@ -148,6 +148,29 @@ pub fn named_transfer_function(
         transfer_function.domain = Some(range);
     }
     Ok(transfer_function)
+}
+
+/// Where [`LookArgs::auto_tf`] says so, the transfer function chosen from
+/// `volume`'s histogram (volray-core's [`auto`]) over `transfer_function`'s
+/// window: its opacity unless `--opacity` gives the paper's ramp, its
+/// colours unless `--colormap` names them. `volume` is what the renderer
+/// sees (with `--log`, the log10 of the data), and the window is in its
+/// units, as [`settings`] leaves it.
+pub fn choose_auto(look: &LookArgs, transfer_function: &mut TransferFunction, volume: &Volume) {
+    if !look.auto_tf() {
+        return;
+    }
+    // A volume with no finite value is refused later, by the renderer.
+    let Some(histogram) = Histogram::of(volume, auto::BINS) else {
+        return;
+    };
+    let chosen = auto::transfer_function(&histogram, transfer_function.domain);
+    if look.opacity.is_none() {
+        transfer_function.opacity = chosen.opacity;
+    }
+    if transfer_function.color.is_none() {
+        transfer_function.color = chosen.color;
+    }
 }
 
 /// The flag a transfer function came from, for messages.

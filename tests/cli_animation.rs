@@ -212,7 +212,10 @@ fn a_series_is_one_frame_per_file_under_one_transfer_function() {
     let files: Vec<(String, f32)> = (1..=3)
         .map(|s| scaled_ball(dir.path(), &format!("ball{s}.raw"), s as f32))
         .collect();
-    let raw = ["--dims", "9,9,9", "--size", "24"];
+    // A named transfer function (the ramp in grey): one chosen from the
+    // data (`--tf auto`, the default) would depend on the volume it is
+    // chosen from, and a frame would not be its file rendered alone.
+    let raw = ["--dims", "9,9,9", "--size", "24", "--colormap", "grey"];
     let out = path(dir.path(), "series.png");
     let mut args = vec!["render"];
     args.extend(files.iter().map(|(f, _)| f.as_str()));

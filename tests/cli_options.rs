@@ -231,7 +231,9 @@ fn gradient_opacity_hides_uniform_regions() {
         (j as f32 / 4.0).min(1.0)
     });
     let mut args = strs(&vol);
-    args.extend(["--size", "16"]);
+    // The paper's ramp: opacity wherever the value is above 0 (the colours
+    // chosen from the data, the same in both renders).
+    args.extend(["--size", "16", "--opacity", "0,0.5"]);
     let plain = render(dir.path(), &args);
     args.extend(["--gradient-opacity", "0.5,1"]);
     let graded = render(dir.path(), &args);
@@ -449,4 +451,76 @@ fn bad_values_are_refused_in_one_line_naming_the_flag() {
     assert_eq!(run.status.code(), Some(1));
     assert!(stderr(&run).contains("--log") && stderr(&run).contains("neg.raw"));
     assert!(!out.exists());
+}
+
+/// A ball of 1 (radius 6) in a haze of 0.1 with a little noise (falling
+/// counts: 0.1, 0.104, 0.108, 0.112 in 8:4:2:1), and one voxel of 0 in a
+/// corner: a CT-like histogram, one tall peak low in the range 0..1.
+fn ball_in_haze(dir: &Path) -> Vec<String> {
+    raw_volume(dir, "haze.raw", [21, 21, 21], |i, j, k| {
+        let d = |n: usize| n as f32 - 10.0;
+        let level = match (i * 7 + j * 13 + k * 31) % 15 {
+            0..=7 => 0.0,
+            8..=11 => 1.0,
+            12..=13 => 2.0,
+            _ => 3.0,
+        };
+        if (i, j, k) == (0, 0, 0) {
+            0.0
+        } else if (d(i) * d(i) + d(j) * d(j) + d(k) * d(k)).sqrt() <= 6.0 {
+            1.0
+        } else {
+            0.1 + 0.004 * level
+        }
+    })
+}
+
+#[test]
+fn with_no_transfer_function_the_background_peak_is_transparent_and_the_rest_in_viridis() {
+    let dir = tempfile::tempdir().unwrap();
+    let vol = ball_in_haze(dir.path());
+    let mut args = strs(&vol);
+    args.extend(["--size", "40"]);
+    let chosen = render(dir.path(), &args);
+    // The default is `--tf auto`.
+    let explicit = render(dir.path(), &[&args[..], &["--tf", "auto"]].concat());
+    assert_eq!(chosen.at(0, 0), explicit.at(0, 0));
+    assert!((0..40).all(|r| (0..40).all(|c| chosen.at(c, r) == explicit.at(c, r))));
+    // The haze around the ball is cut: the corners are the background.
+    for (c, r) in [(0, 0), (39, 0), (0, 39), (39, 39), (20, 1)] {
+        assert_eq!(chosen.at(c, r), [0, 0, 0], "({c}, {r})");
+    }
+    // The ball, at the top of the range, in viridis' yellow: red and
+    // green above blue.
+    let [r, g, b] = chosen.at(20, 20);
+    assert!(r > b && g > b && g > 40, "{r} {g} {b}");
+
+    // --opacity keeps the paper's ramp: the haze (t ≈ 0.1) gets opacity
+    // 0.05 per voxel and shows around the ball.
+    let ramp = render(dir.path(), &[&args[..], &["--opacity", "0,0.5"]].concat());
+    assert!(ramp.lit(20, 1), "{:?}", ramp.at(20, 1));
+    // So does a named colour map alone (no transfer function is chosen).
+    let magma = render(dir.path(), &[&args[..], &["--colormap", "magma"]].concat());
+    assert_ne!(magma.at(20, 1), [0, 0, 0]);
+    // A projection keeps its grey (no transfer function is chosen).
+    let mip = render(dir.path(), &[&args[..], &["--blend", "mip"]].concat());
+    let [r, g, b] = mip.at(20, 20);
+    assert!(r == g && g == b && r > 200, "{r} {g} {b}");
+}
+
+#[test]
+fn tf_auto_conflicts_with_a_preset() {
+    let run = volray(&[
+        "render",
+        "blobs:16",
+        "--tf",
+        "auto",
+        "--preset",
+        "mr",
+        "-o",
+        "/tmp/x.png",
+    ]);
+    assert_eq!(run.status.code(), Some(1));
+    let err = stderr(&run);
+    assert!(err.contains("--preset conflicts with --tf"), "{err}");
 }

@@ -72,6 +72,40 @@ fn run_command(command: &str, tf_file: Option<(&str, &str)>, dir: &std::path::Pa
 }
 
 #[tokio::test(flavor = "current_thread")]
+async fn a_page_started_with_no_transfer_function_shows_the_one_chosen_and_names_it() {
+    // No --tf, --preset or --colormap: `render` would choose one from the
+    // data (`--tf auto`); the page starts from it, and its command gives
+    // the still frame with that choice written out.
+    let Some((_viewer, b)) = open(&["blobs:32", "--size", "96"]).await else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let still = picture(&b.frame_bytes().await, dir.path(), "still.png");
+    let command = b.text("command").await;
+    assert!(command.contains("--tf view-tf.json"), "{command}");
+    let tf_json = b.text("tf-json").await;
+    assert!(
+        tf_json.contains("\"opacity\"") && tf_json.contains("\"color\""),
+        "{tf_json}"
+    );
+    let cli = run_command(&command, Some(("view-tf.json", &tf_json)), dir.path());
+    assert_eq!(cli, still, "the CLI's image differs from the page's");
+    // And it is what `render` draws with no options.
+    let plain = dir.path().join("plain.png");
+    let out = common::volray(&[
+        "render",
+        "blobs:32",
+        "--size",
+        "96",
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert_eq!(Picture::read(&plain), still);
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
 async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_frame() {
     if !browser::available() {
         return;

@@ -10,7 +10,7 @@ use super::parse::{
     parse_range, parse_rgb, parse_shininess, parse_thickness,
 };
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Classification, shading and compositing.
 #[derive(Debug, Args)]
@@ -21,8 +21,12 @@ pub struct LookArgs {
     pub opacity: Option<(f32, f32)>,
 
     /// Transfer function JSON: {"domain": [lo, hi], "opacity": [[t, a], ...],
-    /// "color": [[t, r, g, b], ...]}, all keys optional.
-    #[arg(long, value_name = "FILE.json")]
+    /// "color": [[t, r, g, b], ...]}, all keys optional; or `auto`: chosen
+    /// from the volume's histogram (the background peak transparent, a
+    /// ramp above it, viridis over the range), which is also what
+    /// compositing uses when no --tf, --preset, --colormap or --iso is
+    /// given (a file named auto: ./auto).
+    #[arg(long, value_name = "FILE.json|auto")]
     pub tf: Option<PathBuf>,
 
     /// A transfer-function preset: ct-bone and ct-soft-tissue (Hounsfield
@@ -32,7 +36,8 @@ pub struct LookArgs {
     pub preset: Option<String>,
 
     /// A named colour map for the colour transfer function, replacing a
-    /// preset's colours. Conflicts with a colour in --tf [default: white].
+    /// preset's colours. Conflicts with a colour in --tf [default: chosen
+    /// from the data (--tf auto) when nothing else is named, else white].
     #[arg(
         long,
         value_name = "viridis|magma|inferno|plasma|cividis|turbo|coolwarm|grey"
@@ -124,6 +129,28 @@ pub struct LookArgs {
     /// colours: sharper, slower.
     #[arg(long, help_heading = "Rendering options")]
     pub post_classification: bool,
+}
+
+/// `--tf auto`.
+pub const AUTO: &str = "auto";
+
+impl LookArgs {
+    /// The `--tf` file, unless `--tf auto`.
+    pub fn tf_file(&self) -> Option<&Path> {
+        self.tf.as_deref().filter(|p| *p != Path::new(AUTO))
+    }
+
+    /// Whether the transfer function is chosen from the volume's histogram
+    /// (volray-core's `transfer::auto`): `--tf auto`, or compositing with
+    /// no `--tf`, `--preset`, `--colormap` or `--iso`.
+    pub fn auto_tf(&self) -> bool {
+        self.tf.as_deref() == Some(Path::new(AUTO))
+            || (self.tf.is_none()
+                && self.preset.is_none()
+                && self.colormap.is_none()
+                && self.iso.is_none()
+                && self.blend == BlendMode::Composite)
+    }
 }
 
 /// `--blend`: how a ray's samples make its pixel.

@@ -248,7 +248,12 @@ impl CliReproduce {
                 "the starting transfer function has no colours: pick a colour map".into(),
             ));
         }
-        let json = (opacity.is_some() || colours.is_some())
+        // With no transfer function, colour map or isosurface, `render`
+        // would choose its own from the volume (`--tf auto`): an empty one
+        // keeps the page's ramp and white.
+        let named_map = !matches!(state.colormap.as_str(), START_COLOURS | WHITE);
+        let bare = !projection && state.blend != BlendMode::Iso && !named_map;
+        let json = (opacity.is_some() || colours.is_some() || bare)
             .then(|| tf_json(opacity.as_deref(), colours.as_deref()));
         if json.is_some() {
             w.opt("--tf", Some(TF_FILE.to_string()));
@@ -457,6 +462,30 @@ mod tests {
             unreachable!()
         };
         assert_eq!(out.settings, settings(&args.view).unwrap());
+    }
+
+    #[test]
+    fn a_white_ramp_is_named_so_that_render_does_not_choose_its_own() {
+        let (r, mut state) = reproduce(&["--opacity", "0.05,0.6"]);
+        state.colormap = WHITE.to_string();
+        state.opacity = None;
+        let out = r.reproduce(&state).unwrap();
+        assert!(
+            out.command.contains("--opacity 0.05,0.6") && out.command.contains("--tf"),
+            "{}",
+            out.command
+        );
+        let (words, json) = r.words(&state).unwrap();
+        let argv = std::iter::once("volray").chain(words.iter().map(String::as_str));
+        let Command::Render(args) = Cli::try_parse_from(argv).unwrap().command else {
+            unreachable!()
+        };
+        assert!(!args.view.look.auto_tf());
+        let s = render_settings(&words, json.as_deref());
+        assert_eq!(s.transfer_function.opacity, None);
+        assert_eq!(s.transfer_function.color, None);
+        assert_eq!(s.opacity_ramp, (0.05, 0.6));
+        assert_eq!(out.settings, s);
     }
 
     #[test]
