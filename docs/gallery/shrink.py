@@ -1,6 +1,10 @@
 """Shrinks `volray paper all` outputs for the README gallery.
 
     python docs/gallery/shrink.py OUT_DIR docs/gallery
+    python docs/gallery/shrink.py --strip docs/gallery/first.png A.png B.png ...
+
+The second form puts same-height PNGs side by side into one (the README's
+first picture: what `volray render` draws with no options).
 
 Each figure is reduced to an indexed-colour PNG of at most 128 colours
 (k-means in RGB, scipy), the 480x480 clouds first halved by 2x2 box
@@ -77,22 +81,31 @@ def write_indexed(path, indices, palette):
     )
 
 
+def shrink(rgb, path):
+    """Writes `rgb` to `path` as an indexed PNG of at most COLOURS colours."""
+    pixels = rgb.reshape(-1, 3)
+    # Black (the background) is kept exact; the rest is clustered.
+    rng = np.random.default_rng(1)
+    centres, _ = kmeans2(pixels[pixels.sum(axis=1) > 0], COLOURS - 1, minit="++", seed=rng)
+    palette = np.vstack([[0.0, 0.0, 0.0], centres]).clip(0, 255).round()
+    d = ((pixels[:, None, :] - palette[None, :, :]) ** 2).sum(axis=2)
+    indices = d.argmin(axis=1).reshape(rgb.shape[:2])
+    write_indexed(path, indices, palette)
+    print(path, Path(path).stat().st_size, "bytes")
+
+
 def main(src, dst):
     for name in ["figure1a", "figure1b", "figure1c", "figure2a", "figure2b"]:
         rgb = read_rgb(Path(src) / f"{name}.png").astype(np.float64)
         if name.startswith("figure2"):
             h, w, _ = rgb.shape
             rgb = rgb.reshape(h // 2, 2, w // 2, 2, 3).mean(axis=(1, 3))
-        pixels = rgb.reshape(-1, 3)
-        # Black (the background) is kept exact; the rest is clustered.
-        rng = np.random.default_rng(1)
-        centres, _ = kmeans2(pixels[pixels.sum(axis=1) > 0], COLOURS - 1, minit="++", seed=rng)
-        palette = np.vstack([[0.0, 0.0, 0.0], centres]).clip(0, 255).round()
-        d = ((pixels[:, None, :] - palette[None, :, :]) ** 2).sum(axis=2)
-        indices = d.argmin(axis=1).reshape(rgb.shape[:2])
-        write_indexed(Path(dst) / f"{name}.png", indices, palette)
-        print(name, (Path(dst) / f"{name}.png").stat().st_size, "bytes")
+        shrink(rgb, Path(dst) / f"{name}.png")
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:])
+    if sys.argv[1] == "--strip":
+        panels = [read_rgb(p).astype(np.float64) for p in sys.argv[3:]]
+        shrink(np.concatenate(panels, axis=1), sys.argv[2])
+    else:
+        main(*sys.argv[1:])
