@@ -8,6 +8,7 @@
 //! | [`colormap`] | named colour maps (viridis, magma, ..., cool-to-warm) |
 //! | [`presets`] | transfer functions for CT, MR and electron densities |
 //! | [`auto`] | a transfer function chosen from a volume's histogram (`--tf auto`) |
+//! | [`labels`] | label volumes (segmentations): a colour and an opacity per label |
 //! | [`iso`] | Levoy's isovalue contours (1988, eq. 3) |
 //! | [`gradient_opacity`] | opacity scaled by a ramp of the gradient magnitude |
 
@@ -17,4 +18,5 @@ pub mod colormap;
 pub mod function;
 pub mod gradient_opacity;
 pub mod iso;
+pub mod labels;
 pub mod presets;

@@ -46,6 +46,8 @@ pub struct Volume {
     spacing: DVec3,
     origin: DVec3,
     samples: Samples,
+    /// Whether the values are labels ([`Volume::as_labels`]).
+    labels: bool,
 }
 
 /// Number of points of a grid of `dims`, or `None` if it overflows `usize`.
@@ -85,6 +87,7 @@ impl Volume {
             spacing: DVec3::ONE,
             origin: DVec3::ZERO,
             samples,
+            labels: false,
         })
     }
 
@@ -127,6 +130,24 @@ impl Volume {
         }
         self.origin = origin;
         Ok(self)
+    }
+
+    /// The same grid read as labels (a segmentation): each value names a
+    /// region rather than measuring something. Every path then shades with
+    /// the gradient of the smoothed indicator of each voxel's own label
+    /// ([`crate::kernels::gradient`]) instead of the values' gradient,
+    /// which between labels 1 and 5 would point at the larger number; a
+    /// transfer function that is constant over each label
+    /// ([`crate::transfer::labels`]) classifies by label, pre-classified, so
+    /// that no two labels' values are ever blended.
+    pub fn as_labels(mut self) -> Self {
+        self.labels = true;
+        self
+    }
+
+    /// Whether the values are labels ([`Self::as_labels`]).
+    pub fn is_labels(&self) -> bool {
+        self.labels
     }
 
     /// Points along x, y and z.
@@ -275,6 +296,7 @@ impl Volume {
             spacing: self.spacing,
             origin: self.origin,
             samples,
+            labels: self.labels,
         }
     }
 }
