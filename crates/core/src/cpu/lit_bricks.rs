@@ -21,6 +21,7 @@ use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, Source, UNIT, Voxel
 use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
 use crate::transfer::classifier::Classifier;
+use crate::transfer::labels::colour_value;
 use crate::volume::Sample;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use wide::bytemuck::cast;
@@ -138,8 +139,23 @@ impl<'a> Lighting<'a> {
         let (bricks, b) = (self.bricks, self.bricks.brick(n));
         let voxels = &classified.voxels;
         let mut values = [0.0f32; SLOTS];
-        crate::with_samples!(self.source.volume.samples(), |data| {
-            slot_values(data, &bricks.grid, b, &mut values)
+        let volume = self.source.volume;
+        crate::with_samples!(volume.samples(), |data| {
+            slot_values(data, &bricks.grid, b, &mut values);
+            if volume.is_labels() {
+                // The colour of a hidden label's voxel: its shown
+                // neighbour's (see `colour_value`), as the reference's.
+                let classifier = self.source.classifier;
+                let shown = |f: f32| classifier.unit_opacity(f) > 0.0;
+                let [nx, ny, _] = volume.dims();
+                for (n, s) in slot_coords().enumerate() {
+                    if !shown(values[n]) {
+                        let at = bricks.grid.voxel_of_slot(b, s);
+                        let voxel = [at % nx, (at / nx) % ny, at / (nx * ny)];
+                        values[n] = colour_value(data, volume.dims(), voxel, shown);
+                    }
+                }
+            }
         });
         // Four slots at a time, one per SIMD lane.
         let mut group = |slots: [usize; 4], lanes: usize| {

@@ -12,6 +12,7 @@
 
 use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
 use crate::transfer::classifier::Classifier;
+use crate::transfer::labels::colour_value;
 use crate::volume::Volume;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -36,14 +37,27 @@ pub fn shade_and_classify(
     lighting: Option<(&Phong, &LightGeometry)>,
 ) -> ShadedVolume {
     let mut voxels = vec![Vec4::ZERO; volume.len()];
-    let slice = volume.dims()[0] * volume.dims()[1];
+    let dims = volume.dims();
+    let slice = dims[0] * dims[1];
+    let values = volume.values();
+    // A label volume's hidden voxels take a shown neighbour's colour.
+    let shown = |f: f32| classifier.unit_opacity(f) > 0.0;
+    let colour_of = |f: f32, at: usize| {
+        if volume.is_labels() && !shown(f) {
+            let voxel = [at % dims[0], (at / dims[0]) % dims[1], at / slice];
+            classifier.material(colour_value(&values, dims, voxel, shown))
+        } else {
+            classifier.material(f)
+        }
+    };
     voxels
         .par_chunks_mut(slice)
-        .zip(volume.values().par_chunks(slice))
+        .zip(values.par_chunks(slice))
         .zip(gradients.par_chunks(slice))
-        .for_each(|((out, values), grads)| {
-            for ((o, &f), g) in out.iter_mut().zip(values).zip(grads) {
-                let color = lit_colour(lighting, Vec3::from(*g), classifier.material(f));
+        .enumerate()
+        .for_each(|(k, ((out, values), grads))| {
+            for (n, ((o, &f), g)) in out.iter_mut().zip(values).zip(grads).enumerate() {
+                let color = lit_colour(lighting, Vec3::from(*g), colour_of(f, k * slice + n));
                 *o = Vec3::from(color).extend(classifier.opacity_at(f, *g));
             }
         });

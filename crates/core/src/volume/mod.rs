@@ -145,6 +145,11 @@ impl Volume {
         self
     }
 
+    /// Marks the values as labels, or not ([`Self::as_labels`], in place).
+    pub fn set_labels(&mut self, labels: bool) {
+        self.labels = labels;
+    }
+
     /// Whether the values are labels ([`Self::as_labels`]).
     pub fn is_labels(&self) -> bool {
         self.labels
