@@ -35,8 +35,8 @@ pub fn turntable(
     pool: &ThreadPool,
     frames: usize,
 ) -> Result<(), CliError> {
-    let input = load(&args.input, args.view.look.log)?;
-    let base = &crate::render::with_auto(args, base, &input.volume);
+    let mut input = load(&args.input, args.view.look.log)?;
+    let base = &crate::render::from_volume(args, base, &mut input)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
@@ -69,12 +69,17 @@ pub fn series(
     // Pass 1: the value range and bounds of all the volumes together, and
     // the first volume's histogram, should the transfer function be chosen
     // from it.
+    let look = &args.view.look;
     let mut extent = Extent::default();
     let mut first = None;
+    let mut labels = std::collections::BTreeSet::new();
     for spec in specs {
         let input = load_one(args, spec)?;
-        if first.is_none() && args.view.look.auto_tf() {
+        if first.is_none() && look.auto_tf() {
             first = volray_core::Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
+        }
+        if look.labels {
+            labels.extend(crate::settings::volume_labels(&input.volume, &input.name)?);
         }
         let renderer = renderer_for(&args.view, base, &input)?;
         extent.add(renderer.value_range(), input.volume.bounds());
@@ -84,6 +89,17 @@ pub fn series(
         }
     }
     let mut settings = extent.fix(base);
+    if look.labels {
+        // The labels of every volume, so that a label has one colour.
+        let found: Vec<i64> = labels.into_iter().collect();
+        let names = format!("{} volumes", specs.len());
+        crate::settings::label_transfer_function(
+            look,
+            &mut settings.transfer_function,
+            &found,
+            &names,
+        )?;
+    }
     if let Some(histogram) = &first {
         // Chosen from the first volume, over the window of them all.
         let tf = &mut settings.transfer_function;
@@ -99,7 +115,8 @@ pub fn series(
     // Pass 2: render each.
     let mut writer = Writer::new(args, &settings, specs.len())?;
     for spec in specs {
-        let input = load_one(args, spec)?;
+        let mut input = load_one(args, spec)?;
+        input.volume.set_labels(look.labels);
         let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
         let renderer = renderer_for(&args.view, &settings, &input)?;
         let image = writer.render(pool, &renderer, &settings);

@@ -176,9 +176,14 @@ pub fn write_json(path: &Path, rows: &[JsonRow]) -> Result<(), CliError> {
 
 /// `volray bench INPUT`: the frames of one volume.
 fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
-    let input = load(&args.input, args.view.look.log)?;
+    let mut input = load(&args.input, args.view.look.log)?;
     let mut base = settings(&args.view)?;
-    crate::settings::choose_auto(&args.view.look, &mut base.transfer_function, &input.volume);
+    crate::settings::from_volume(
+        &args.view.look,
+        &mut base.transfer_function,
+        &mut input.volume,
+        &input.name,
+    )?;
     let pool = thread_pool(args.view.threads)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
 

@@ -5,6 +5,7 @@ use crate::flags::InfoArgs;
 use crate::input::{self, Described};
 use serde_json::{Value, json};
 use volray_core::Histogram;
+use volray_core::transfer::labels;
 use volray_io::{FileInfo, FlatImage};
 
 pub fn run(args: &InfoArgs) -> Result<(), CliError> {
@@ -17,6 +18,10 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     };
     let v = &input.volume;
     let hist = Histogram::of(v, usize::from(args.bins));
+    // An integer volume with few distinct values, each on many voxels, is
+    // likely a segmentation.
+    let labels = (labels::labels_of(v, SUGGEST_LABELS).ok().flatten())
+        .filter(|found| found.len() * 16 <= v.len());
     let (format, info) = match &input.file {
         Some((format, info)) => (format.description().to_string(), Some(info)),
         None => ("built-in source".to_string(), None),
@@ -44,6 +49,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             "origin": [o.x, o.y, o.z],
             "length_unit": unit,
             "values": histogram,
+            "labels": labels,
         });
         if let Some(i) = info {
             add_file_json(&mut out, i);
@@ -112,11 +118,24 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             }
         }
     }
+    if let Some(found) = &labels {
+        let shown: Vec<String> = found.iter().take(16).map(i64::to_string).collect();
+        outln!(
+            "labels:    {} distinct integer values ({}{}): a segmentation? render it with --labels",
+            found.len(),
+            shown.join(", "),
+            if found.len() > 16 { ", ..." } else { "" }
+        );
+    }
     if let Some(i) = info {
         print_header_and_notes(i);
     }
     Ok(())
 }
+
+/// `info` suggests `--labels` for integer volumes with at most this many
+/// distinct values.
+const SUGGEST_LABELS: usize = 256;
 
 /// What a file holding one image, not a volume, holds, and why `render`
 /// needs more.

@@ -37,16 +37,22 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
 }
 
-/// `settings` with the transfer function chosen from `volume` where
-/// no flag names one (`--tf auto`, see [`crate::settings::choose_auto`]).
-pub fn with_auto(
+/// `settings` with what the flags leave to `input`'s volume: `--labels`
+/// or the transfer function chosen from it (`--tf auto`; see
+/// [`crate::settings::from_volume`]), the volume marked as labels.
+pub fn from_volume(
     args: &RenderArgs,
     settings: &RenderSettings,
-    volume: &volray_core::Volume,
-) -> RenderSettings {
+    input: &mut crate::input::Input,
+) -> Result<RenderSettings, CliError> {
     let mut settings = settings.clone();
-    crate::settings::choose_auto(&args.view.look, &mut settings.transfer_function, volume);
-    settings
+    crate::settings::from_volume(
+        &args.view.look,
+        &mut settings.transfer_function,
+        &mut input.volume,
+        &input.name,
+    )?;
+    Ok(settings)
 }
 
 /// One frame of one volume, to an image file.
@@ -56,8 +62,8 @@ fn still(
     pool: &rayon::ThreadPool,
     kind: OutputKind,
 ) -> Result<(), CliError> {
-    let input = load(&args.input, args.view.look.log)?;
-    let settings = &with_auto(args, settings, &input.volume);
+    let mut input = load(&args.input, args.view.look.log)?;
+    let settings = &from_volume(args, settings, &mut input)?;
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let image = pool

@@ -8,7 +8,7 @@ use crate::error::CliError;
 use crate::flags::{BlendMode, CameraArgs, LookArgs, ViewArgs};
 use std::path::Path;
 use volray_core::glam::DVec3;
-use volray_core::transfer::{auto, colormap, presets};
+use volray_core::transfer::{auto, colormap, labels, presets};
 use volray_core::{
     Blend, Camera, Classification, ClipPlane, Histogram, IsoSurface, Method, Phong, Projection,
     RenderSettings, TransferFunction, Volume,
@@ -148,6 +148,76 @@ pub fn named_transfer_function(
         transfer_function.domain = Some(range);
     }
     Ok(transfer_function)
+}
+
+/// What the flags leave to the volume `name`: with `--labels`, the volume
+/// marked as labels (volray-core's [`labels`]) and, unless `--tf` names a
+/// file, the labels' transfer function; else, where
+/// [`LookArgs::auto_tf`] says so, the transfer function chosen from its
+/// histogram ([`choose_auto`]).
+pub fn from_volume(
+    look: &LookArgs,
+    transfer_function: &mut TransferFunction,
+    volume: &mut Volume,
+    name: &str,
+) -> Result<(), CliError> {
+    if !look.labels {
+        choose_auto(look, transfer_function, volume);
+        return Ok(());
+    }
+    let found = volume_labels(volume, name)?;
+    volume.set_labels(true);
+    label_transfer_function(look, transfer_function, &found, name)
+}
+
+/// The labels of `volume` (`name`), refused as `--labels` would be.
+pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, CliError> {
+    labels::labels_of(volume, labels::MAX_LABELS)
+        .map_err(|e| CliError::input(format!("{name}: --labels: {e}")))?
+        .ok_or_else(|| {
+            CliError::input(format!(
+                "{name}: --labels: more than {} distinct values: not a label volume",
+                labels::MAX_LABELS
+            ))
+        })
+}
+
+/// With `--labels`, the transfer function of `found` (the labels of the
+/// volume or volumes `name`) as `--label-opacity` and `--show-labels` say,
+/// unless `--tf` names a file, which then gives it.
+pub fn label_transfer_function(
+    look: &LookArgs,
+    transfer_function: &mut TransferFunction,
+    found: &[i64],
+    name: &str,
+) -> Result<(), CliError> {
+    let styled = look.label_opacity.is_some() || look.show_labels.is_some();
+    match look.tf.as_deref() {
+        Some(_) if look.tf_file().is_none() => Err(CliError::input(
+            "--tf auto conflicts with --labels, which gives each label its colour: give one of them",
+        )),
+        Some(_) if styled => Err(CliError::input(
+            "--label-opacity and --show-labels shape the colours --labels gives; --tf replaces them: give one of them",
+        )),
+        Some(_) => Ok(()),
+        None if look.range.is_some() => Err(CliError::input(
+            "--range conflicts with --labels, whose window spans the labels: give one of them",
+        )),
+        None => {
+            let style = labels::LabelStyle {
+                opacity: look.label_opacity.clone().map(|l| l.0).unwrap_or_default(),
+                shown: look.show_labels.clone().map(|l| l.0),
+            };
+            *transfer_function = labels::transfer_function(found, &style).map_err(|e| {
+                let flag = match e {
+                    labels::LabelError::Absent(..) => "--label-opacity / --show-labels",
+                    _ => "--labels",
+                };
+                CliError::input(format!("{name}: {flag}: {e}"))
+            })?;
+            Ok(())
+        }
+    }
 }
 
 /// Where [`LookArgs::auto_tf`] says so, the transfer function chosen from

@@ -14,7 +14,7 @@ mod reproduce;
 use crate::error::CliError;
 use crate::flags::{BlendMode as BlendFlag, ViewerArgs};
 use crate::session::{load, renderer_for, thread_pool};
-use crate::settings::{choose_auto, named_transfer_function, read_tf_file, settings_with_tf_text};
+use crate::settings::{from_volume, named_transfer_function, read_tf_file, settings_with_tf_text};
 use reproduce::CliReproduce;
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -29,11 +29,18 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let tf_text = look.tf_file().map(read_tf_file).transpose()?;
     let mut settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
     let mut named = named_transfer_function(look, tf_text.as_deref())?;
-    let input = load(&args.input, look.log)?;
-    // A transfer function chosen from the volume (`--tf auto`) is the
-    // page's starting one, and its commands name it in full.
-    choose_auto(look, &mut settings.transfer_function, &input.volume);
-    if look.auto_tf() {
+    let mut input = load(&args.input, look.log)?;
+    // A transfer function chosen from the volume (`--tf auto`, `--labels`)
+    // is the page's starting one, and its commands name it in full.
+    from_volume(
+        look,
+        &mut settings.transfer_function,
+        &mut input.volume,
+        &input.name,
+    )?;
+    if look.labels && look.tf_file().is_none() {
+        named = settings.transfer_function.clone();
+    } else if look.auto_tf() {
         // The same points: `t` is relative to the window, whatever its units.
         named.opacity = settings.transfer_function.opacity.clone();
         named.color = settings.transfer_function.color.clone();

@@ -106,6 +106,28 @@ async fn a_page_started_with_no_transfer_function_shows_the_one_chosen_and_names
 }
 
 #[tokio::test(flavor = "current_thread")]
+async fn a_label_volumes_page_names_its_labels_and_reproduces_its_frame() {
+    let seg = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/io/tests/fixtures/labels/seg.nii.gz"
+    );
+    let Some((_viewer, b)) = open(&[seg, "--labels", "--size", "64"]).await else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let still = picture(&b.frame_bytes().await, dir.path(), "still.png");
+    let command = b.text("command").await;
+    assert!(
+        command.contains("--labels") && command.contains("--tf view-tf.json"),
+        "{command}"
+    );
+    let tf_json = b.text("tf-json").await;
+    let cli = run_command(&command, Some(("view-tf.json", &tf_json)), dir.path());
+    assert_eq!(cli, still, "the CLI's image differs from the page's");
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
 async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_frame() {
     if !browser::available() {
         return;

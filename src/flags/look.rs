@@ -6,8 +6,9 @@
 //! `--background`). `settings.rs` turns them into volray-core's settings.
 
 use super::parse::{
-    parse_background, parse_direction, parse_gradient_opacity, parse_iso_value, parse_opacity,
-    parse_range, parse_rgb, parse_shininess, parse_thickness,
+    LabelList, LabelOpacities, parse_background, parse_direction, parse_gradient_opacity,
+    parse_iso_value, parse_label_list, parse_label_opacity, parse_opacity, parse_range, parse_rgb,
+    parse_shininess, parse_thickness,
 };
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -43,6 +44,24 @@ pub struct LookArgs {
         value_name = "viridis|magma|inferno|plasma|cividis|turbo|coolwarm|grey"
     )]
     pub colormap: Option<String>,
+
+    /// Render a label volume (a segmentation: integer labels): each label in
+    /// its own colour (a categorical table by label value, label 0
+    /// transparent), classified by label so that two labels' values are
+    /// never blended, and shaded by the gradient of each label's smoothed
+    /// indicator rather than of the values. `volray info` suggests it for
+    /// integer volumes with at most 256 distinct values.
+    #[arg(long, conflicts_with_all = ["preset", "colormap", "opacity", "log", "iso", "post_classification"])]
+    pub labels: bool,
+
+    /// With --labels: the opacity of each label named, L:A,... (A per unit
+    /// voxel distance, in [0, 1]) [default: 1 for every label but 0].
+    #[arg(long, value_name = "L:A,...", requires = "labels", value_parser = parse_label_opacity, allow_hyphen_values = true)]
+    pub label_opacity: Option<LabelOpacities>,
+
+    /// With --labels: show only these labels, L,... (0 too, if named).
+    #[arg(long, value_name = "L,...", requires = "labels", value_parser = parse_label_list, allow_hyphen_values = true)]
+    pub show_labels: Option<LabelList>,
 
     /// The value window LO,HI that t = 0..1 spans (values outside are
     /// clamped) [default: the volume's min and max]. Conflicts with a
@@ -146,6 +165,7 @@ impl LookArgs {
     pub fn auto_tf(&self) -> bool {
         self.tf.as_deref() == Some(Path::new(AUTO))
             || (self.tf.is_none()
+                && !self.labels
                 && self.preset.is_none()
                 && self.colormap.is_none()
                 && self.iso.is_none()

@@ -417,3 +417,42 @@ mod tests {
         assert!(parse_fps("0").is_err() && parse_fps("101").is_err());
     }
 }
+
+/// `--label-opacity L:A,...`: labels (integers) and opacities in [0, 1].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LabelOpacities(pub Vec<(i64, f32)>);
+
+pub fn parse_label_opacity(s: &str) -> Result<LabelOpacities, String> {
+    let pairs = s.split(',').map(|pair| {
+        let (l, a) = pair
+            .split_once(':')
+            .ok_or_else(|| format!("'{pair}' is not L:A (a label and its opacity)"))?;
+        let label = parse_label(l)?;
+        let a = parse_number(a.trim())?;
+        if !(0.0..=1.0).contains(&a) {
+            return Err(format!("opacity {a} of label {label} must be in [0, 1]"));
+        }
+        Ok((label, a as f32))
+    });
+    pairs
+        .collect::<Result<Vec<_>, String>>()
+        .map(LabelOpacities)
+}
+
+/// `--show-labels L,...`: labels (integers).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LabelList(pub Vec<i64>);
+
+pub fn parse_label_list(s: &str) -> Result<LabelList, String> {
+    s.split(',')
+        .map(parse_label)
+        .collect::<Result<Vec<_>, String>>()
+        .map(LabelList)
+}
+
+/// One label: an integer.
+fn parse_label(s: &str) -> Result<i64, String> {
+    s.trim()
+        .parse::<i64>()
+        .map_err(|_| format!("label '{}' is not an integer", s.trim()))
+}

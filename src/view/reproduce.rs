@@ -108,6 +108,8 @@ impl CliReproduce {
                 .then(|| "transparent".to_string()),
         );
         always.flag("--log", look.log);
+        // Label normals; the colours and opacities go in the --tf file.
+        always.flag("--labels", look.labels);
 
         let mut shaping = Words::default();
         shaping.opt(
