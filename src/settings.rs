@@ -34,6 +34,16 @@ pub fn settings_with_tf_text(
         sampling,
         threads: _,
     } = view;
+    for (given, flag) in [
+        (look.label_opacity.is_some(), "--label-opacity"),
+        (look.show_labels.is_some(), "--show-labels"),
+    ] {
+        if given && !look.labels {
+            return Err(CliError::input(format!(
+                "{flag} applies to label volumes: give --labels"
+            )));
+        }
+    }
     let transfer_function = in_log_units(look, named_transfer_function(look, tf_text)?)?;
     let settings = RenderSettings {
         width: cam.size.0,

@@ -104,7 +104,7 @@ mod tests {
         }
         let defaults = (arg.get_default_values().iter()).map(|v| v.to_string_lossy().into_owned());
         let value = defaults
-            .chain(["1", "0,1", "2,2,2", "0,1,0,1,0,1"].map(String::from))
+            .chain(["1", "0,1", "2,2,2", "0,1,0,1,0,1", "1:0.5"].map(String::from))
             .find(|v| bench(&[&flag, v]).is_ok())
             .unwrap_or_else(|| panic!("no sample value fits {flag}: add one here"));
         vec![flag, value]
@@ -118,9 +118,10 @@ mod tests {
         let flags: Vec<&clap::Arg> = (cli.find_subcommand("bench").unwrap().get_arguments())
             .filter(|arg| ignored.contains(arg.get_id()))
             .collect();
-        // The 41 flags of the list this replaced: all but INPUT of the
-        // input options, and all but --threads of the view options.
-        assert_eq!(flags.len(), 41);
+        // The 41 flags of the list this replaced (all but INPUT of the
+        // input options, and all but --threads of the view options), and
+        // --labels, --label-opacity and --show-labels since.
+        assert_eq!(flags.len(), 44);
         for arg in flags {
             let given = given(arg);
             let given: Vec<&str> = given.iter().map(String::as_str).collect();

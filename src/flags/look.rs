@@ -56,11 +56,11 @@ pub struct LookArgs {
 
     /// With --labels: the opacity of each label named, L:A,... (A per unit
     /// voxel distance, in [0, 1]) [default: 1 for every label but 0].
-    #[arg(long, value_name = "L:A,...", requires = "labels", value_parser = parse_label_opacity, allow_hyphen_values = true)]
+    #[arg(long, value_name = "L:A,...", value_parser = parse_label_opacity, allow_hyphen_values = true)]
     pub label_opacity: Option<LabelOpacities>,
 
     /// With --labels: show only these labels, L,... (0 too, if named).
-    #[arg(long, value_name = "L,...", requires = "labels", value_parser = parse_label_list, allow_hyphen_values = true)]
+    #[arg(long, value_name = "L,...", value_parser = parse_label_list, allow_hyphen_values = true)]
     pub show_labels: Option<LabelList>,
 
     /// The value window LO,HI that t = 0..1 spans (values outside are
