@@ -149,8 +149,10 @@ impl<'a> Lighting<'a> {
                 let classifier = self.source.classifier;
                 let shown = |f: f32| classifier.unit_opacity(f) > 0.0;
                 let [nx, ny, _] = volume.dims();
+                let needed = &classified.needed;
                 for (n, s) in slot_coords().enumerate() {
-                    if !shown(values[n]) {
+                    // Slots no occupied cell uses are never sampled.
+                    if needed[n / 64] >> (n % 64) & 1 != 0 && !shown(values[n]) {
                         let at = bricks.grid.voxel_of_slot(b, s);
                         let voxel = [at % nx, (at / nx) % ny, at / (nx * ny)];
                         values[n] = colour_value(data, volume.dims(), voxel, shown);
