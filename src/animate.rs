@@ -102,14 +102,7 @@ pub fn series(
     }
     if let Some(histogram) = &first {
         // Chosen from the first volume, over the window of them all.
-        let tf = &mut settings.transfer_function;
-        let chosen = volray_core::transfer::auto::transfer_function(histogram, tf.domain);
-        if args.view.look.opacity.is_none() {
-            tf.opacity = chosen.opacity;
-        }
-        if tf.color.is_none() {
-            tf.color = chosen.color;
-        }
+        crate::settings::apply_auto(look, &mut settings.transfer_function, histogram);
     }
 
     // Pass 2: render each.

@@ -241,10 +241,20 @@ pub fn choose_auto(look: &LookArgs, transfer_function: &mut TransferFunction, vo
         return;
     }
     // A volume with no finite value is refused later, by the renderer.
-    let Some(histogram) = Histogram::of(volume, auto::BINS) else {
-        return;
-    };
-    let chosen = auto::transfer_function(&histogram, transfer_function.domain);
+    if let Some(histogram) = Histogram::of(volume, auto::BINS) {
+        apply_auto(look, transfer_function, &histogram);
+    }
+}
+
+/// The transfer function chosen from values whose statistics are
+/// `histogram`, put into `transfer_function` as [`choose_auto`] says (a
+/// series chooses from its first volume's histogram).
+pub fn apply_auto(
+    look: &LookArgs,
+    transfer_function: &mut TransferFunction,
+    histogram: &Histogram,
+) {
+    let chosen = auto::transfer_function(histogram, transfer_function.domain);
     if look.opacity.is_none() {
         transfer_function.opacity = chosen.opacity;
     }
