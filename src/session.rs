@@ -9,7 +9,6 @@ use crate::flags::{InputArgs, ViewArgs};
 use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use volray_core::camera::CameraError;
 use volray_core::{RenderError, RenderSettings, Renderer};
 
 /// Reads the volume `args` name and, with `--log`, takes its log10.
@@ -75,56 +74,10 @@ pub fn render_failure(view: &ViewArgs, name: &str, e: RenderError) -> CliError {
 }
 
 /// The flag whose value a core error is about, if one is.
-fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<&'static str> {
-    use volray_core::{CameraPoint, Orbit, Reflection, SettingError as S};
-    let flag = match e {
-        RenderError::NonFinite { .. } => "--nonfinite",
-        RenderError::SamplesChanged(_) => return None,
-        RenderError::Camera(c) => match c {
-            CameraError::NoDirection(_) if view.camera.view.is_some() => "--view",
-            CameraError::NoDirection(_) => "--look-at",
-            CameraError::UpParallel { .. } => "--up",
-            CameraError::NotFinite(CameraPoint::ViewPoint, _) if view.camera.view.is_some() => {
-                "--view"
-            }
-            CameraError::NotFinite(CameraPoint::ViewReference, _)
-                if view.camera.look_at.is_some() =>
-            {
-                "--look-at"
-            }
-            CameraError::NotFinite(CameraPoint::Up, _) => "--up",
-            // A default point beyond f64: the volume's bounds are to blame.
-            CameraError::NotFinite(..) => return None,
-            CameraError::FieldOfView(_) => "--perspective",
-            CameraError::Zoom(_) => "--zoom",
-            CameraError::Angle(Orbit::Azimuth, _) => "--azimuth",
-            CameraError::Angle(Orbit::Elevation, _) => "--elevation",
-            CameraError::EmptyImage { .. } => "--size",
-            CameraError::Bounds { .. } | CameraError::WrongProjection { .. } => return None,
-        },
-        RenderError::Setting(s) => match s {
-            S::ImageSide { .. } | S::ImagePixels { .. } => "--size",
-            S::Step(_) | S::StepTooSmall { .. } => "--step",
-            S::OpacityRamp { .. } => "--opacity",
-            S::Reflection { term, .. } => match term {
-                Reflection::Ambient => "--ambient",
-                Reflection::Diffuse => "--diffuse",
-                Reflection::Specular => "--specular",
-                Reflection::LightColor => "--light-color",
-            },
-            S::Shininess(_) => "--shininess",
-            S::Background(_) => "--background",
-            S::LightDirection(_) => "--light",
-            S::Crop { .. } => "--crop",
-            S::ClipPoint(_) | S::ClipNormal(_) => "--clip",
-            S::IsoValue(_) => "--iso",
-            S::IsoThickness(_) => "--iso-thickness",
-            S::GradientOpacity { .. } => "--gradient-opacity",
-            // Set by a series from its volumes, not by a flag.
-            S::GradientOpacityMax(_) => return None,
-        },
-    };
-    Some(flag)
+fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<String> {
+    let camera = crate::settings::camera(&view.camera);
+    volray_options::option_of(e, &camera)
+        .map(|opt| volray_options::Naming::option(&crate::settings::Flags, opt))
 }
 
 /// A pool of `threads` workers (default: one per core).

@@ -1,18 +1,32 @@
-//! The render settings the flags describe: the transfer function put
-//! together from `--tf`, `--preset`, `--colormap`, `--range` and `--log`,
-//! the camera, `--blend` checked against the options only compositing
-//! uses, Levoy's `--iso` contour, and the rest as they are; then checked
-//! by volray-core, so that a bad combination is refused before any work.
+//! The render settings the flags describe: the flags read into
+//! volray-options' [`Options`] (the `--tf` file's text with them), which
+//! checks them together and builds volray-core's settings, as it does for
+//! Python and the viewer; its errors worded with the flags ([`Flags`]).
 
 use crate::error::CliError;
-use crate::flags::{BlendMode, CameraArgs, LookArgs, ViewArgs};
+use crate::flags::{BlendMode, CameraArgs, LookArgs, SamplingArgs, ViewArgs};
 use std::path::Path;
-use volray_core::glam::DVec3;
-use volray_core::transfer::{auto, colormap, labels, presets};
-use volray_core::{
-    Blend, Camera, Classification, ClipPlane, Histogram, IsoSurface, Method, Phong, Projection,
-    RenderSettings, TransferFunction, Volume,
-};
+use volray_core::{Histogram, RenderSettings, TransferFunction, Volume};
+use volray_options::{CameraOptions, LookOptions, Naming, Opt, OptionError, Options, Tf};
+
+/// How the command line writes an option: `--look-at`, `--no-shading`,
+/// `--blend mip`.
+pub struct Flags;
+
+impl Naming for Flags {
+    fn option(&self, opt: Opt) -> String {
+        format!("--{}", opt.name())
+    }
+
+    fn with_value(&self, opt: Opt, value: &str) -> String {
+        format!("--{} {value}", opt.name())
+    }
+}
+
+/// An option error as one line naming the flags: bad input, exit 1.
+pub fn refused(e: OptionError) -> CliError {
+    CliError::input(e.message(&Flags))
+}
 
 /// The render settings the view arguments describe (reading `--tf`).
 pub fn settings(view: &ViewArgs) -> Result<RenderSettings, CliError> {
@@ -28,274 +42,142 @@ pub fn settings_with_tf_text(
     view: &ViewArgs,
     tf_text: Option<&str>,
 ) -> Result<RenderSettings, CliError> {
-    let ViewArgs {
-        camera: cam,
-        look,
-        sampling,
-        threads: _,
-    } = view;
-    for (given, flag) in [
-        (look.label_opacity.is_some(), "--label-opacity"),
-        (look.show_labels.is_some(), "--show-labels"),
-    ] {
-        if given && !look.labels {
-            return Err(CliError::input(format!(
-                "{flag} applies to label volumes: give --labels"
-            )));
-        }
+    volray_options::settings(&options(view, tf_text)?).map_err(refused)
+}
+
+/// The options the view arguments give, in volray-options' terms, with
+/// the text of the `--tf` file.
+pub fn options(view: &ViewArgs, tf_text: Option<&str>) -> Result<Options, CliError> {
+    let mut look = look(&view.look);
+    if let (Some(path), Some(Tf::Json { text, .. })) = (view.look.tf_file(), &mut look.tf) {
+        *text = tf_text
+            .ok_or_else(|| CliError::io(format!("--tf {}: the file was not read", path.display())))?
+            .to_string();
     }
-    let transfer_function = in_log_units(look, named_transfer_function(look, tf_text)?)?;
-    let settings = RenderSettings {
-        width: cam.size.0,
-        height: cam.size.1,
-        camera: camera(cam),
+    Ok(Options {
+        camera: camera(&view.camera),
+        look,
+        sampling: sampling(&view.sampling),
+    })
+}
+
+/// The camera flags as options.
+pub fn camera(cam: &CameraArgs) -> CameraOptions {
+    CameraOptions {
+        size: cam.size,
+        view: cam.view,
+        look_at: cam.look_at,
+        up: cam.up,
+        perspective: cam.perspective,
+        zoom: cam.zoom,
+        azimuth: cam.azimuth,
+        elevation: cam.elevation,
+        clip: cam.clip.clone(),
+        crop: cam.crop,
+    }
+}
+
+fn sampling(sampling: &SamplingArgs) -> volray_options::SamplingOptions {
+    volray_options::SamplingOptions {
         step: sampling.step,
-        opacity_ramp: look
-            .opacity
-            .unwrap_or(RenderSettings::default().opacity_ramp),
-        transfer_function,
-        phong: Phong {
-            ambient: look.ambient,
-            diffuse: look.diffuse,
-            specular: look.specular,
-            shininess: look.shininess,
-            light_color: look.light_color,
-        },
-        shading: !look.no_shading,
-        light_direction: look.light.map(DVec3::from),
-        background: look.background,
-        method: if sampling.reference {
-            Method::Reference
-        } else {
-            Method::Fast
-        },
-        blend: blend(look)?,
-        classification: if look.post_classification {
-            Classification::Post
-        } else {
-            Classification::Pre
-        },
+        reference: sampling.reference,
         jitter: sampling.jitter,
-        clip_planes: (cam.clip.iter())
-            .map(|&(point, normal)| ClipPlane {
-                point: DVec3::from(point),
-                normal: DVec3::from(normal),
-            })
-            .collect(),
-        crop: (cam.crop).map(|(lo, hi)| (DVec3::from(lo), DVec3::from(hi))),
-        iso: iso(look)?,
+        nonfinite: sampling.nonfinite.into(),
+    }
+}
+
+/// The look flags as options. A `--tf` file's text is left empty here:
+/// only [`options`] reads it into the settings; what follows the volume
+/// ([`from_volume`]) asks only whether one is given.
+fn look(look: &LookArgs) -> LookOptions {
+    LookOptions {
+        opacity: look.opacity,
+        tf: look.tf.as_ref().map(|path| match look.tf_file() {
+            None => Tf::Auto,
+            Some(_) => Tf::Json {
+                source: path.display().to_string(),
+                text: String::new(),
+            },
+        }),
+        preset: look.preset.clone(),
+        colormap: look.colormap.clone(),
+        labels: look.labels,
+        label_opacity: look.label_opacity.clone().map(|l| l.0),
+        show_labels: look.show_labels.clone().map(|l| l.0),
+        range: look.range,
+        ambient: look.ambient,
+        diffuse: look.diffuse,
+        specular: look.specular,
+        shininess: look.shininess,
+        light: look.light,
+        light_color: look.light_color,
+        shading: !look.no_shading,
+        background: look.background,
+        blend: match look.blend {
+            BlendMode::Composite => volray_options::BlendMode::Composite,
+            BlendMode::Mip => volray_options::BlendMode::Mip,
+            BlendMode::Minip => volray_options::BlendMode::Minip,
+            BlendMode::Average => volray_options::BlendMode::Average,
+            BlendMode::Iso => volray_options::BlendMode::Iso,
+        },
+        iso: look.iso,
+        iso_thickness: look.iso_thickness,
+        log: look.log,
         gradient_opacity: look.gradient_opacity,
-        gradient_opacity_max: None,
-    };
-    settings
-        .validate()
-        .map_err(|e| CliError::input(e.to_string()))?;
-    settings
-        .camera
-        .validate()
-        .map_err(|e| CliError::input(e.to_string()))?;
-    Ok(settings)
+        post_classification: look.post_classification,
+    }
 }
 
 /// The transfer function of `--tf` (its file's text `tf_text`) or
 /// `--preset` (else the default), with `--colormap`'s colours and
-/// `--range`'s window, each refused where it would replace what `--tf` or
-/// a CT preset fixes; the window in the data's units, as the flags give it.
+/// `--range`'s window (volray-options' `named_transfer_function`).
 pub fn named_transfer_function(
-    look: &LookArgs,
+    look_args: &LookArgs,
     tf_text: Option<&str>,
 ) -> Result<TransferFunction, CliError> {
-    let transfer_function = match (look.tf_file(), tf_text) {
-        (Some(path), Some(text)) => TransferFunction::from_json(text)
-            .map_err(|e| CliError::input(format!("--tf {}: {e}", path.display())))?,
-        (Some(path), None) => {
-            return Err(CliError::io(format!(
-                "--tf {}: the file was not read",
-                path.display()
-            )));
-        }
-        (None, _) => TransferFunction::default(),
-    };
-    let from = tf_source(look);
-    let mut transfer_function = match &look.preset {
-        Some(_) if look.tf.is_some() => {
-            return Err(CliError::input(
-                "--preset conflicts with --tf: give one of them",
-            ));
-        }
-        Some(name) => presets::preset(name).ok_or_else(|| {
-            CliError::input(format!(
-                "--preset: unknown preset '{name}': expected one of {}",
-                presets::NAMES.join(", ")
-            ))
-        })?,
-        None => transfer_function,
-    };
-    if look.opacity.is_some() && transfer_function.opacity.is_some() {
-        return Err(CliError::input(format!(
-            "--opacity conflicts with the opacity function in {from}: give one of them"
-        )));
+    let mut look = look(look_args);
+    if let Some(Tf::Json { text, .. }) = &mut look.tf {
+        *text = tf_text.unwrap_or_default().to_string();
     }
-    if let Some(name) = &look.colormap {
-        if look.tf_file().is_some() && transfer_function.color.is_some() {
-            return Err(CliError::input(
-                "--colormap conflicts with the colour function in --tf: give one of them",
-            ));
-        }
-        transfer_function.color = Some(colormap::colormap(name).ok_or_else(|| {
-            CliError::input(format!(
-                "--colormap: unknown colour map '{name}': expected one of {}",
-                colormap::NAMES.join(", ")
-            ))
-        })?);
-    }
-    if let Some(range) = look.range {
-        if transfer_function.domain.is_some() {
-            return Err(CliError::input(format!(
-                "--range conflicts with the value domain fixed by {from}: give one of them"
-            )));
-        }
-        transfer_function.domain = Some(range);
-    }
-    Ok(transfer_function)
+    volray_options::named_transfer_function(&look).map_err(refused)
 }
 
-/// What the flags leave to the volume `name`: with `--labels`, the volume
-/// marked as labels (volray-core's [`labels`]) and, unless `--tf` names a
-/// file, the labels' transfer function; else, where
-/// [`LookArgs::auto_tf`] says so, the transfer function chosen from its
-/// histogram ([`choose_auto`]).
+/// What the flags leave to the volume `name`: `--labels`, or the transfer
+/// function chosen from its histogram (volray-options' `from_volume`).
 pub fn from_volume(
-    look: &LookArgs,
+    look_args: &LookArgs,
     transfer_function: &mut TransferFunction,
     volume: &mut Volume,
     name: &str,
 ) -> Result<(), CliError> {
-    if !look.labels {
-        choose_auto(look, transfer_function, volume);
-        return Ok(());
-    }
-    let found = volume_labels(volume, name)?;
-    volume.set_labels(true);
-    label_transfer_function(look, transfer_function, &found, name)
+    volray_options::from_volume(&look(look_args), transfer_function, volume, name).map_err(refused)
 }
 
 /// The labels of `volume` (`name`), refused as `--labels` would be.
 pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, CliError> {
-    labels::labels_of(volume, labels::MAX_LABELS)
-        .map_err(|e| CliError::input(format!("{name}: --labels: {e}")))?
-        .ok_or_else(|| {
-            CliError::input(format!(
-                "{name}: --labels: more than {} distinct values: not a label volume",
-                labels::MAX_LABELS
-            ))
-        })
+    volray_options::volume_labels(volume, name).map_err(refused)
 }
 
 /// With `--labels`, the transfer function of `found` (the labels of the
-/// volume or volumes `name`) as `--label-opacity` and `--show-labels` say,
-/// unless `--tf` names a file, which then gives it.
+/// volumes `name`), as `--label-opacity` and `--show-labels` say.
 pub fn label_transfer_function(
-    look: &LookArgs,
+    look_args: &LookArgs,
     transfer_function: &mut TransferFunction,
     found: &[i64],
     name: &str,
 ) -> Result<(), CliError> {
-    let styled = look.label_opacity.is_some() || look.show_labels.is_some();
-    match look.tf.as_deref() {
-        Some(_) if look.tf_file().is_none() => Err(CliError::input(
-            "--tf auto conflicts with --labels, which gives each label its colour: give one of them",
-        )),
-        Some(_) if styled => Err(CliError::input(
-            "--label-opacity and --show-labels shape the colours --labels gives; --tf replaces them: give one of them",
-        )),
-        Some(_) => Ok(()),
-        None if look.range.is_some() => Err(CliError::input(
-            "--range conflicts with --labels, whose window spans the labels: give one of them",
-        )),
-        None => {
-            let style = labels::LabelStyle {
-                opacity: look.label_opacity.clone().map(|l| l.0).unwrap_or_default(),
-                shown: look.show_labels.clone().map(|l| l.0),
-            };
-            *transfer_function = labels::transfer_function(found, &style).map_err(|e| {
-                let flag = match e {
-                    labels::LabelError::Absent(..) => "--label-opacity / --show-labels",
-                    _ => "--labels",
-                };
-                CliError::input(format!("{name}: {flag}: {e}"))
-            })?;
-            Ok(())
-        }
-    }
-}
-
-/// Where [`LookArgs::auto_tf`] says so, the transfer function chosen from
-/// `volume`'s histogram (volray-core's [`auto`]) over `transfer_function`'s
-/// window: its opacity unless `--opacity` gives the paper's ramp, its
-/// colours unless `--colormap` names them. `volume` is what the renderer
-/// sees (with `--log`, the log10 of the data), and the window is in its
-/// units, as [`settings`] leaves it.
-pub fn choose_auto(look: &LookArgs, transfer_function: &mut TransferFunction, volume: &Volume) {
-    if !look.auto_tf() {
-        return;
-    }
-    // A volume with no finite value is refused later, by the renderer.
-    if let Some(histogram) = Histogram::of(volume, auto::BINS) {
-        apply_auto(look, transfer_function, &histogram);
-    }
+    volray_options::label_transfer_function(&look(look_args), transfer_function, found, name)
+        .map_err(refused)
 }
 
 /// The transfer function chosen from values whose statistics are
-/// `histogram`, put into `transfer_function` as [`choose_auto`] says (a
-/// series chooses from its first volume's histogram).
+/// `histogram` (a series chooses from its first volume's).
 pub fn apply_auto(
-    look: &LookArgs,
+    look_args: &LookArgs,
     transfer_function: &mut TransferFunction,
     histogram: &Histogram,
 ) {
-    let chosen = auto::transfer_function(histogram, transfer_function.domain);
-    if look.opacity.is_none() {
-        transfer_function.opacity = chosen.opacity;
-    }
-    if transfer_function.color.is_none() {
-        transfer_function.color = chosen.color;
-    }
-}
-
-/// The flag a transfer function came from, for messages.
-fn tf_source(look: &LookArgs) -> &'static str {
-    if look.tf.is_some() {
-        "--tf"
-    } else {
-        "--preset"
-    }
-}
-
-/// With `--log`, the window of `transfer_function` converted from the
-/// data's units to the log10 the renderer sees.
-fn in_log_units(
-    look: &LookArgs,
-    mut transfer_function: TransferFunction,
-) -> Result<TransferFunction, CliError> {
-    let from = tf_source(look);
-    if look.log
-        && let Some((lo, hi)) = transfer_function.domain
-    {
-        // The window is given in the data's units; the renderer sees log10.
-        let from = if look.range.is_some() {
-            "--range"
-        } else {
-            from
-        };
-        if lo <= 0.0 {
-            return Err(CliError::input(format!(
-                "{from}: with --log the value window is in the data's own units and must be positive, but LO is {lo}"
-            )));
-        }
-        transfer_function.domain = Some((lo.log10(), hi.log10()));
-    }
-    Ok(transfer_function)
+    volray_options::apply_auto(&look(look_args), transfer_function, histogram)
 }
 
 /// The largest `--tf` file read: a transfer function is a few hundred
@@ -329,116 +211,13 @@ pub fn read_tf_file(path: &Path) -> Result<String, CliError> {
     Ok(text)
 }
 
-/// The camera of the camera options (their image size aside).
-fn camera(cam: &CameraArgs) -> Camera {
-    Camera {
-        view_point: cam.view.map(DVec3::from),
-        look_at: cam.look_at.map(DVec3::from),
-        up: DVec3::from(cam.up),
-        projection: match cam.perspective {
-            Some(fov_degrees) => Projection::Perspective { fov_degrees },
-            None => Projection::Orthographic,
-        },
-        zoom: cam.zoom,
-        azimuth: cam.azimuth,
-        elevation: cam.elevation,
-        ..Camera::default()
-    }
-}
-
-/// `--blend`, checked against the options that only compositing uses:
-/// a projection shows the interpolated scalar, with no opacity to shape
-/// and no lighting.
-fn blend(look: &LookArgs) -> Result<Blend, CliError> {
-    let (blend, name) = match look.blend {
-        BlendMode::Composite => (Blend::Composite, "composite"),
-        BlendMode::Iso if look.iso.is_none() => {
-            return Err(CliError::input(
-                "--blend iso needs the isovalue: give --iso VALUE",
-            ));
-        }
-        BlendMode::Iso => (Blend::Composite, "iso"),
-        BlendMode::Mip => (Blend::Maximum, "mip"),
-        BlendMode::Minip => (Blend::Minimum, "minip"),
-        BlendMode::Average => (Blend::Average, "average"),
-    };
-    if blend.is_projection() {
-        for (given, flag) in [
-            (look.iso.is_some(), "--iso"),
-            (look.gradient_opacity.is_some(), "--gradient-opacity"),
-            (look.post_classification, "--post-classification"),
-            (look.opacity.is_some(), "--opacity"),
-        ] {
-            if given {
-                return Err(CliError::input(format!(
-                    "{flag} shapes the opacity of --blend composite; --blend {name} projects the interpolated value and has none"
-                )));
-            }
-        }
-    }
-    let unlit = if blend.is_projection() {
-        Some(format!("--blend {name} is unshaded"))
-    } else if look.no_shading {
-        Some("--no-shading turns the lighting off".to_string())
-    } else {
-        None
-    };
-    if let (Some(why), Some(flag)) = (unlit, lighting_flag(look)) {
-        return Err(CliError::input(format!(
-            "{flag} sets the lighting, but {why}: leave {flag} out"
-        )));
-    }
-    Ok(blend)
-}
-
-/// The first lighting option given a value other than its default (the
-/// library's, which `--help` shows), if any.
-fn lighting_flag(look: &LookArgs) -> Option<&'static str> {
-    let lit = Phong::default();
-    [
-        (look.ambient != lit.ambient, "--ambient"),
-        (look.diffuse != lit.diffuse, "--diffuse"),
-        (look.specular != lit.specular, "--specular"),
-        (look.shininess != lit.shininess, "--shininess"),
-        (look.light_color != lit.light_color, "--light-color"),
-        (look.light.is_some(), "--light"),
-    ]
-    .into_iter()
-    .find_map(|(given, flag)| given.then_some(flag))
-}
-
-/// `--iso VALUE --iso-thickness R`; with `--log` the value is in the data's
-/// units, like `--range`.
-fn iso(look: &LookArgs) -> Result<Option<IsoSurface>, CliError> {
-    let Some(value) = look.iso else {
-        return match look.iso_thickness {
-            Some(_) => Err(CliError::input(
-                "--iso-thickness is the half-width of the --iso shell: give --iso VALUE too",
-            )),
-            None => Ok(None),
-        };
-    };
-    let value = if look.log {
-        if value <= 0.0 {
-            return Err(CliError::input(format!(
-                "--iso: with --log the isovalue is in the data's own units and must be positive, but it is {value}"
-            )));
-        }
-        (value as f64).log10() as f32
-    } else {
-        value
-    };
-    Ok(Some(IsoSurface {
-        value,
-        thickness: look.iso_thickness.unwrap_or(1.0),
-    }))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::flags::{Cli, Command, RenderArgs};
     use clap::Parser;
+    use volray_core::glam::DVec3;
+    use volray_core::{Blend, ClipPlane, IsoSurface, Projection};
 
     #[test]
     fn command_line_defaults_are_the_library_defaults() {

@@ -39,6 +39,7 @@ pub use look::{BlendMode, LookArgs};
 pub use paper::{PaperArgs, PaperItem};
 pub use parse::one_line_error;
 pub use render::RenderArgs;
+pub use sampling::SamplingArgs;
 pub use view::ViewArgs;
 pub use viewer::ViewerArgs;
 

@@ -149,6 +149,18 @@ impl<'v> Renderer<'v> {
     /// volume and a bit per voxel (see [`NonFinite`](crate::NonFinite)); a volume
     /// without them is used as it is, whatever `mode`.
     pub fn with_non_finite(volume: &'v Volume, mode: NonFinite) -> Result<Self, RenderError> {
+        Self::prepare_volume(Cow::Borrowed(volume), mode)
+    }
+
+    /// [`Renderer::with_non_finite`] for a volume the renderer keeps: a
+    /// renderer that outlives its caller's scope (one held by a Python
+    /// object across frames, say). A volume whose samples are outside
+    /// bytes (a mapped file, a numpy array) is cheap to move here.
+    pub fn owning(volume: Volume, mode: NonFinite) -> Result<Renderer<'static>, RenderError> {
+        Renderer::prepare_volume(Cow::Owned(volume), mode)
+    }
+
+    fn prepare_volume(volume: Cow<'v, Volume>, mode: NonFinite) -> Result<Self, RenderError> {
         let count = volume.count_non_finite();
         if count > 0 && mode == NonFinite::Refuse {
             return Err(RenderError::NonFinite {
@@ -156,15 +168,17 @@ impl<'v> Renderer<'v> {
                 total: volume.len(),
             });
         }
-        let source = volume;
-        let (volume, non_finite) = match NonFiniteMask::clean(volume) {
-            None => (Cow::Borrowed(volume), None),
-            Some((mask, cleaned)) => (Cow::Owned(cleaned), Some(mask)),
+        let (volume, non_finite) = match NonFiniteMask::clean(&volume) {
+            None => (volume, None),
+            Some((mask, cleaned)) => {
+                // Every sample was read: were they the file's, if mapped?
+                verify(&volume)?;
+                (Cow::Owned(cleaned), Some(mask))
+            }
         };
         // Finite values only; none at all: an empty window at the fill value.
         let value_range = volume.value_range().unwrap_or((0.0, 0.0));
-        // Every sample was read above: were they the file's, if mapped?
-        verify(source)?;
+        verify(&volume)?;
         Ok(Renderer {
             volume,
             non_finite,

@@ -1,0 +1,115 @@
+//! What the options leave to the volume itself: with labels, the volume
+//! marked as a label volume and the labels' transfer function; otherwise,
+//! where [`LookOptions::auto_tf`] says so, the transfer function chosen
+//! from the volume's histogram. Called once the volume is read (and, with
+//! the log option, turned into its log10).
+
+use crate::error::OptionError;
+use crate::option::Opt;
+use crate::options::{LookOptions, Tf};
+use volray_core::transfer::{auto, labels};
+use volray_core::{Histogram, TransferFunction, Volume};
+
+/// Puts into `transfer_function` (and `volume`) what `look` leaves to the
+/// volume `name` (for messages): labels or the automatic choice.
+pub fn from_volume(
+    look: &LookOptions,
+    transfer_function: &mut TransferFunction,
+    volume: &mut Volume,
+    name: &str,
+) -> Result<(), OptionError> {
+    if !look.labels {
+        choose_auto(look, transfer_function, volume);
+        return Ok(());
+    }
+    let found = volume_labels(volume, name)?;
+    volume.set_labels(true);
+    label_transfer_function(look, transfer_function, &found, name)
+}
+
+/// The labels of `volume` (`name`), refused where it is not a label
+/// volume.
+pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, OptionError> {
+    let refused = |error: String| OptionError::Labels {
+        volume: name.to_string(),
+        opts: &[Opt::Labels],
+        error,
+    };
+    labels::labels_of(volume, labels::MAX_LABELS)
+        .map_err(|e| refused(e.to_string()))?
+        .ok_or_else(|| {
+            refused(format!(
+                "more than {} distinct values: not a label volume",
+                labels::MAX_LABELS
+            ))
+        })
+}
+
+/// With labels, the transfer function of `found` (the labels of the
+/// volume or volumes `name`) with the label opacities and the shown
+/// subset, unless a transfer function is given, which then gives it.
+pub fn label_transfer_function(
+    look: &LookOptions,
+    transfer_function: &mut TransferFunction,
+    found: &[i64],
+    name: &str,
+) -> Result<(), OptionError> {
+    let styled = look.label_opacity.is_some() || look.show_labels.is_some();
+    match &look.tf {
+        Some(Tf::Auto) => Err(OptionError::AutoWithLabels),
+        Some(_) if styled => Err(OptionError::LabelStyleWithTf),
+        Some(_) => Ok(()),
+        None if look.range.is_some() => Err(OptionError::RangeWithLabels),
+        None => {
+            let style = labels::LabelStyle {
+                opacity: look.label_opacity.clone().unwrap_or_default(),
+                shown: look.show_labels.clone(),
+            };
+            *transfer_function = labels::transfer_function(found, &style).map_err(|e| {
+                let opts: &'static [Opt] = match e {
+                    labels::LabelError::Absent(..) => &[Opt::LabelOpacity, Opt::ShowLabels],
+                    _ => &[Opt::Labels],
+                };
+                OptionError::Labels {
+                    volume: name.to_string(),
+                    opts,
+                    error: e.to_string(),
+                }
+            })?;
+            Ok(())
+        }
+    }
+}
+
+/// Where [`LookOptions::auto_tf`] says so, the transfer function chosen
+/// from `volume`'s histogram (volray-core's [`auto`]) over
+/// `transfer_function`'s window: its opacity unless the opacity ramp is
+/// given, its colours unless a colour map is. `volume` is what the
+/// renderer sees (with the log option, the log10 of the data), and the
+/// window is in its units, as [`crate::settings()`] leaves it.
+pub fn choose_auto(look: &LookOptions, transfer_function: &mut TransferFunction, volume: &Volume) {
+    if !look.auto_tf() {
+        return;
+    }
+    // A volume with no finite value is refused later, by the renderer.
+    if let Some(histogram) = Histogram::of(volume, auto::BINS) {
+        apply_auto(look, transfer_function, &histogram);
+    }
+}
+
+/// The transfer function chosen from values whose statistics are
+/// `histogram`, put into `transfer_function` as [`choose_auto`] says (a
+/// series chooses from its first volume's histogram).
+pub fn apply_auto(
+    look: &LookOptions,
+    transfer_function: &mut TransferFunction,
+    histogram: &Histogram,
+) {
+    let chosen = auto::transfer_function(histogram, transfer_function.domain);
+    if look.opacity.is_none() {
+        transfer_function.opacity = chosen.opacity;
+    }
+    if transfer_function.color.is_none() {
+        transfer_function.color = chosen.color;
+    }
+}
