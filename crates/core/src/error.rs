@@ -26,6 +26,10 @@ pub enum RenderError {
     /// changed while they were read: the frame is not the file's.
     #[error("the volume changed while it was rendered: {0}")]
     SamplesChanged(String),
+    /// The frame was stopped by its caller
+    /// ([`Renderer::render_stoppable`](crate::Renderer::render_stoppable)).
+    #[error("the frame was stopped before it was finished")]
+    Stopped,
 }
 
 /// A render setting out of its range: which one, its value and the bound.

@@ -85,6 +85,7 @@ pub mod kernels;
 mod memory;
 mod non_finite;
 mod partial;
+mod progress;
 mod reference;
 mod renderer;
 pub mod sampling;
@@ -104,6 +105,7 @@ pub use kernels::phong::{LightGeometry, Phong};
 pub use memory::MemoryBound;
 pub use non_finite::{NonFinite, NonFiniteMask};
 pub use partial::{PartialImage, PartialPixels};
+pub use progress::Progress;
 pub use renderer::{DEFAULT_CACHE_BUDGET, FrameTimes, Renderer};
 pub use sampling::clipping::ClipPlane;
 pub use settings::{

@@ -37,6 +37,7 @@ use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
 use crate::non_finite::{NonFinite, NonFiniteMask};
 use crate::partial::{PartialImage, PartialPixels};
+use crate::progress::Progress;
 use crate::reference;
 use crate::reference::Shader;
 use crate::reference::post::PostClassifier;
@@ -45,6 +46,7 @@ use crate::settings::{Blend, Classification, Method, RenderSettings};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use std::borrow::Cow;
+use std::sync::atomic::AtomicBool;
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
@@ -237,7 +239,25 @@ impl<'v> Renderer<'v> {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<Image, RenderError> {
         let mut image = Image::new(0, 0, [0.0; 4]);
-        self.render_frame(settings, &mut image, progress)?;
+        self.render_frame(settings, &mut image, &Progress::new(progress))?;
+        Ok(image)
+    }
+
+    /// [`Self::render_with_progress`], stopped when `stop` is set (by
+    /// another thread): the work left is skipped, within about one tile's
+    /// time, and the answer is [`RenderError::Stopped`].
+    pub fn render_stoppable(
+        &self,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(usize) + Sync),
+        stop: &AtomicBool,
+    ) -> Result<Image, RenderError> {
+        let mut image = Image::new(0, 0, [0.0; 4]);
+        let progress = Progress::new(progress).stopping(stop);
+        self.render_frame(settings, &mut image, &progress)?;
+        if progress.stopped() {
+            return Err(RenderError::Stopped);
+        }
         Ok(image)
     }
 
@@ -251,6 +271,7 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<PartialImage, RenderError> {
+        let progress = &Progress::new(progress);
         let frame = self.prepare(settings)?;
         let partial = match settings.method {
             Method::Fast => {
@@ -280,7 +301,7 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         image: &mut Image,
     ) -> Result<FrameTimes, RenderError> {
-        self.render_frame(settings, image, &|_| {})
+        self.render_frame(settings, image, &Progress::new(&|_| {}))
     }
 
     /// A whole frame into `image`'s buffer. A composited frame on a fast
@@ -291,7 +312,7 @@ impl<'v> Renderer<'v> {
         &self,
         settings: &RenderSettings,
         image: &mut Image,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> Result<FrameTimes, RenderError> {
         let times = self.render_frame_unverified(settings, image, progress)?;
         verify(&self.volume)?;
@@ -303,7 +324,7 @@ impl<'v> Renderer<'v> {
         &self,
         settings: &RenderSettings,
         image: &mut Image,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> Result<FrameTimes, RenderError> {
         let frame = self.prepare(settings)?;
         let start = Instant::now();
@@ -425,7 +446,7 @@ impl<'v> Renderer<'v> {
         &self,
         settings: &RenderSettings,
         frame: &Frame,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> PartialImage {
         let render =
             |shader: &Shader| reference::render(shader, &frame.view, &frame.sampling, progress);
@@ -459,7 +480,7 @@ impl<'v> Renderer<'v> {
         frame: &Frame,
         partial: &mut PartialImage,
         finish: Finish,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> FrameTimes {
         let pixels = match partial.pixels_mut() {
             PartialPixels::Composite(pixels) => pixels,
@@ -499,7 +520,7 @@ impl<'v> Renderer<'v> {
         frame: &Frame,
         pixels: &mut [PartialPixel],
         finish: Finish,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> FrameTimes {
         let start = Instant::now();
         let classifier = self.classifier(settings);
@@ -529,7 +550,7 @@ impl<'v> Renderer<'v> {
         frame: &Frame,
         pixels: &mut [PartialPixel],
         finish: Finish,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> FrameTimes {
         let mut times = FrameTimes::default();
         let classifier = self.classifier(settings);

@@ -49,6 +49,7 @@ use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::{TILE, TileBins};
 use crate::kernels::composite::{Finish, FrontToBack, PartialPixel};
 use crate::kernels::trilinear::{corners, interpolate};
+use crate::progress::Progress;
 use crate::sampling::Sampling;
 use crate::sampling::jitter;
 use glam::{DVec3, Vec4};
@@ -222,7 +223,7 @@ pub fn render(
     view: &View,
     pixels: &mut [PartialPixel],
     finish: Finish,
-    progress: &(dyn Fn(usize) + Sync),
+    progress: &Progress,
 ) {
     let width = view.width();
     assert_eq!(pixels.len(), width * view.height());
@@ -243,9 +244,12 @@ pub fn render(
         }
     }
     tiles.into_par_iter().enumerate().for_each(|(t, mut rows)| {
+        if progress.stopped() {
+            return;
+        }
         let (tx, ty) = (t % bins.tiles_x, t / bins.tiles_x);
         rays.tile(&scene, bins.list(tx, ty), (tx, ty), finish, &mut rows);
-        progress(rows.iter().map(|r| r.len()).sum());
+        progress.done(rows.iter().map(|r| r.len()).sum());
     });
 }
 

@@ -81,6 +81,7 @@ use crate::kernels::composite::{EMPTY, Finish, FrontToBack, PartialPixel};
 use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
 use crate::kernels::trilinear::{cell_of, corners, interpolate};
 use crate::non_finite::NonFiniteMask;
+use crate::progress::Progress;
 use crate::sampling::grid::clamp_to_grid;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::transfer::classifier::Classifier;
@@ -256,7 +257,7 @@ pub fn render(
     sampling: &Sampling,
     pixels: &mut [PartialPixel],
     finish: Finish,
-    progress: &(dyn Fn(usize) + Sync),
+    progress: &Progress,
 ) -> PostWork {
     let dims = scene.macrocells.grid.dims;
     assert_eq!(scene.voxels.len(), dims.iter().product::<usize>());
@@ -273,13 +274,16 @@ pub fn render(
         .enumerate()
         .map(|(row, pixels)| {
             let mut work = PostWork::default();
+            if progress.stopped() {
+                return work;
+            }
             for (col, pixel) in pixels.iter_mut().enumerate() {
                 *pixel = finish.apply(match sampling.pixel(view, col, row) {
                     Some(ray) => rays.cast(&ray, &mut work).partial(),
                     None => EMPTY,
                 });
             }
-            progress(pixels.len());
+            progress.done(pixels.len());
             work
         })
         .reduce(PostWork::default, |mut a, b| {

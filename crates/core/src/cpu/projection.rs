@@ -32,6 +32,7 @@ use crate::camera::View;
 use crate::kernels::projection::Projected;
 use crate::kernels::trilinear::sample_scalar;
 use crate::non_finite::NonFiniteMask;
+use crate::progress::Progress;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::settings::Blend;
 use crate::volume::{Sample, Volume};
@@ -71,7 +72,7 @@ pub fn render(
     sampling: &Sampling,
     blend: Blend,
     pixels: &mut [Projected],
-    progress: &(dyn Fn(usize) + Sync),
+    progress: &Progress,
 ) {
     assert_eq!(pixels.len(), view.width() * view.height());
     crate::with_samples!(volume.samples(), |data| {
@@ -93,20 +94,23 @@ fn cast<T: Sample>(
     view: &View,
     sampling: &Sampling,
     pixels: &mut [Projected],
-    progress: &(dyn Fn(usize) + Sync),
+    progress: &Progress,
 ) {
     let (width, blend) = (view.width(), scene.blend);
     pixels
         .par_chunks_mut(width)
         .enumerate()
         .for_each(|(row, pixels)| {
+            if progress.stopped() {
+                return;
+            }
             for (col, pixel) in pixels.iter_mut().enumerate() {
                 *pixel = match sampling.pixel(view, col, row) {
                     Some(ray) => scene.project(&ray),
                     None => Projected::empty(blend),
                 };
             }
-            progress(pixels.len());
+            progress.done(pixels.len());
         });
 }
 

@@ -35,6 +35,7 @@ use crate::kernels::projection::Projected;
 use crate::kernels::trilinear;
 use crate::non_finite::NonFiniteMask;
 use crate::partial::{PartialImage, PartialPixels};
+use crate::progress::Progress;
 use crate::reference::post::PostClassifier;
 use crate::reference::stage1::ShadedVolume;
 use crate::sampling::Sampling;
@@ -71,7 +72,7 @@ pub fn render(
     shader: &Shader,
     view: &View,
     sampling: &Sampling,
-    progress: &(dyn Fn(usize) + Sync),
+    progress: &Progress,
 ) -> PartialImage {
     let (width, height) = (view.width(), view.height());
     let dims = sampling.grid.dims;
@@ -84,17 +85,20 @@ pub fn render(
     fn rows<P: Send>(
         pixels: &mut [P],
         width: usize,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
         pixel: impl Fn(usize, usize) -> P + Sync,
     ) {
         pixels
             .par_chunks_mut(width)
             .enumerate()
             .for_each(|(row, out)| {
+                if progress.stopped() {
+                    return;
+                }
                 for (col, p) in out.iter_mut().enumerate() {
                     *p = pixel(col, row);
                 }
-                progress(out.len());
+                progress.done(out.len());
             });
     }
     match shader {

@@ -1,0 +1,91 @@
+//! Stopping a frame: a stop flag set before or during a frame makes the
+//! renderer answer `Stopped` on every path, and the renderer's next frame
+//! is the frame it would have drawn anyway.
+
+mod common;
+
+use common::{blobs, on_the_reference};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use volray_core::glam::DVec3;
+use volray_core::{Blend, Classification, RenderError, RenderSettings, Renderer};
+
+fn settings_on_every_path() -> Vec<(&'static str, RenderSettings)> {
+    let base = RenderSettings {
+        width: 64,
+        height: 64,
+        ..RenderSettings::default()
+    };
+    vec![
+        ("bricked", base.clone()),
+        (
+            "post-classified",
+            RenderSettings {
+                classification: Classification::Post,
+                ..base.clone()
+            },
+        ),
+        (
+            "maximum projection",
+            RenderSettings {
+                blend: Blend::Maximum,
+                ..base.clone()
+            },
+        ),
+        ("reference", on_the_reference(&base)),
+    ]
+}
+
+#[test]
+fn a_frame_stopped_before_it_starts_is_stopped_on_every_path() {
+    let volume = blobs([24, 20, 16], DVec3::ONE, DVec3::ZERO);
+    let renderer = Renderer::new(&volume).unwrap();
+    let stop = AtomicBool::new(true);
+    for (path, settings) in settings_on_every_path() {
+        let pixels = AtomicUsize::new(0);
+        let answer = renderer.render_stoppable(
+            &settings,
+            &|n| {
+                pixels.fetch_add(n, Ordering::Relaxed);
+            },
+            &stop,
+        );
+        assert!(
+            matches!(answer, Err(RenderError::Stopped)),
+            "{path}: {answer:?}"
+        );
+        assert_eq!(pixels.load(Ordering::Relaxed), 0, "{path}: work was done");
+    }
+}
+
+#[test]
+fn a_frame_stopped_half_way_leaves_the_next_frame_unchanged() {
+    let volume = blobs([24, 20, 16], DVec3::ONE, DVec3::ZERO);
+    for (path, settings) in settings_on_every_path() {
+        let expected = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+        let renderer = Renderer::new(&volume).unwrap();
+        let stop = AtomicBool::new(false);
+        // Stopped from the progress report, once some pixels are done.
+        let answer =
+            renderer.render_stoppable(&settings, &|_| stop.store(true, Ordering::Relaxed), &stop);
+        assert!(
+            matches!(answer, Err(RenderError::Stopped)),
+            "{path}: {answer:?}"
+        );
+        let again = renderer.render(&settings).unwrap();
+        assert_eq!(again, expected, "{path}: the frame after a stopped one");
+    }
+}
+
+#[test]
+fn a_frame_never_stopped_is_the_plain_frame() {
+    let volume = blobs([24, 20, 16], DVec3::ONE, DVec3::ZERO);
+    let renderer = Renderer::new(&volume).unwrap();
+    let stop = AtomicBool::new(false);
+    for (path, settings) in settings_on_every_path() {
+        let plain = renderer.render(&settings).unwrap();
+        let stoppable = renderer
+            .render_stoppable(&settings, &|_| {}, &stop)
+            .unwrap();
+        assert_eq!(stoppable, plain, "{path}");
+    }
+}
