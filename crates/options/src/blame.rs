@@ -13,7 +13,7 @@ use volray_core::{CameraPoint, Orbit, Reflection, RenderError, SettingError as S
 pub fn option_of(e: &RenderError, camera: &CameraOptions) -> Option<Opt> {
     let opt = match e {
         RenderError::NonFinite { .. } => Opt::NonFinite,
-        RenderError::SamplesChanged(_) => return None,
+        RenderError::SamplesChanged(_) | RenderError::Stopped => return None,
         RenderError::Camera(c) => match c {
             CameraError::NoDirection(_) if camera.view.is_some() => Opt::View,
             CameraError::NoDirection(_) => Opt::LookAt,

@@ -654,7 +654,7 @@ mod tests {
             &frame.sampling,
             pixels,
             Finish::Partial,
-            &|_| {},
+            &Progress::new(&|_| {}),
         );
         let image = renderer.finish(settings, partial);
         (image, work, frame.nominal_samples())
