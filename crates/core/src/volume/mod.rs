@@ -175,6 +175,12 @@ impl Volume {
         &self.samples
     }
 
+    /// The samples, the volume given up (to hand them to another owner,
+    /// such as a numpy array, without a copy).
+    pub fn into_samples(self) -> Samples {
+        self.samples
+    }
+
     /// The type the samples are kept in.
     pub fn sample_type(&self) -> SampleType {
         self.samples.sample_type()

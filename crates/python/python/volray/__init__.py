@@ -1,0 +1,53 @@
+"""volray: volume rendering by ray casting, numpy in, image out.
+
+    >>> import numpy as np, volray
+    >>> x, y, z = np.mgrid[-1:1:64j, -1:1:64j, -1:1:64j]
+    >>> ball = np.exp(-4 * (x * x + y * y + z * z)).astype(np.float32)
+    >>> frame = volray.render(ball, azimuth=30, size=256)
+    >>> frame.save("ball.png")        # or np.asarray(frame), or show it in Jupyter
+
+Axes: an array is ``a[x, y, z]``, as in volray's own ``.npy`` files,
+nibabel, pyvista and yt; give ``order="zyx"`` for ``a[z, y, x]`` (numpy
+images, SimpleITK, napari). ``spacing``, ``origin`` and every world
+coordinate (``view``, ``look_at``, ``crop``, ``clip``) are ``(x, y, z)``.
+An array whose memory has x fastest (Fortran order, or C order with
+``order="zyx"``) of uint8, int8, uint16, int16 or float32 is rendered
+without a copy; other types become float32. Arrays volray returns
+(``Volume.data``, ``hydrogen``, ``fractal``) are ``a[x, y, z]``.
+
+Every keyword of :func:`render` is the ``volray render`` flag of the same
+name (``look_at`` is ``--look-at``; ``shading=False`` is ``--no-shading``)
+with the same default and the same pixels. Bad input raises ``ValueError``
+(``TypeError`` for a wrong type, ``OSError`` when a file cannot be read or
+written) with the command line's one-line message; Ctrl-C stops a render.
+"""
+
+from ._volray import (
+    COLORMAPS,
+    PRESETS,
+    Camera,
+    Frame,
+    Renderer,
+    TransferFunction,
+    Volume,
+    __version__,
+    fractal,
+    hydrogen,
+    read,
+    render,
+)
+
+__all__ = [
+    "COLORMAPS",
+    "PRESETS",
+    "Camera",
+    "Frame",
+    "Renderer",
+    "TransferFunction",
+    "Volume",
+    "__version__",
+    "fractal",
+    "hydrogen",
+    "read",
+    "render",
+]

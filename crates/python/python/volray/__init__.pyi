@@ -1,0 +1,227 @@
+"""Type stubs for volray (see the package's docstring for the conventions)."""
+
+from os import PathLike
+from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+PRESETS: List[str]
+COLORMAPS: List[str]
+
+Vec3 = Tuple[float, float, float]
+Rgb = Union[float, Tuple[float, float, float]]
+Pair = Tuple[float, float]
+Plane = Union[Tuple[float, float, float, float, float, float], Tuple[Vec3, Vec3]]
+ArrayLike = Union[npt.NDArray[Any], Sequence[Any]]
+Path = Union[str, PathLike]
+Blend = Literal["composite", "mip", "maximum", "minip", "minimum", "average", "iso"]
+
+class TransferFunction:
+    def __init__(
+        self,
+        opacity: Optional[Sequence[Tuple[float, float]]] = None,
+        color: Optional[Sequence[Tuple[float, float, float, float]]] = None,
+        domain: Optional[Pair] = None,
+    ) -> None: ...
+    @staticmethod
+    def from_json(text_or_path: Union[str, PathLike]) -> "TransferFunction": ...
+    @staticmethod
+    def preset(name: str) -> "TransferFunction": ...
+    def with_colormap(self, name: str) -> "TransferFunction": ...
+    @property
+    def opacity(self) -> Optional[List[Tuple[float, float]]]: ...
+    @property
+    def color(self) -> Optional[List[Tuple[float, float, float, float]]]: ...
+    @property
+    def domain(self) -> Optional[Pair]: ...
+    def __call__(self, t: float) -> Tuple[float, float, float, float]: ...
+
+class Camera:
+    def __init__(
+        self,
+        *,
+        size: Union[int, Tuple[int, int]] = 480,
+        view: Optional[Vec3] = None,
+        look_at: Optional[Vec3] = None,
+        up: Vec3 = (0, 0, 1),
+        perspective: Optional[float] = None,
+        azimuth: float = 0,
+        elevation: float = 0,
+        zoom: float = 1,
+        clip: Optional[Union[Plane, Sequence[Plane]]] = None,
+        crop: Optional[Tuple[float, float, float, float, float, float]] = None,
+    ) -> None: ...
+    size: Tuple[int, int]
+    view: Optional[Vec3]
+    look_at: Optional[Vec3]
+    azimuth: float
+    elevation: float
+    zoom: float
+    perspective: Optional[float]
+
+class Volume:
+    def __init__(
+        self,
+        data: ArrayLike,
+        *,
+        spacing: Optional[Vec3] = None,
+        origin: Optional[Vec3] = None,
+        order: Literal["xyz", "zyx"] = "xyz",
+        labels: bool = False,
+    ) -> None: ...
+    @property
+    def data(self) -> npt.NDArray[Any]: ...
+    @property
+    def dims(self) -> Tuple[int, int, int]: ...
+    @property
+    def spacing(self) -> Vec3: ...
+    @property
+    def origin(self) -> Vec3: ...
+    @property
+    def labels(self) -> bool: ...
+    @property
+    def sample_type(self) -> str: ...
+    @property
+    def info(self) -> Dict[str, Any]: ...
+
+class Frame:
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    def to_numpy(self, dtype: Any = None) -> npt.NDArray[Any]: ...
+    def __array__(self, dtype: Any = None, copy: Optional[bool] = None) -> npt.NDArray[Any]: ...
+    def save(self, path: Path, *, bit_depth: Literal[8, 16] = 8) -> None: ...
+    def _repr_png_(self) -> bytes: ...
+
+class Renderer:
+    def __init__(
+        self,
+        volume: Union[Volume, ArrayLike],
+        *,
+        spacing: Optional[Vec3] = None,
+        origin: Optional[Vec3] = None,
+        order: Literal["xyz", "zyx"] = "xyz",
+        labels: Optional[bool] = None,
+        log: bool = False,
+        nonfinite: Literal["refuse", "transparent"] = "refuse",
+        max_memory: Optional[int] = None,
+    ) -> None: ...
+    def render(
+        self,
+        *,
+        size: Union[int, Tuple[int, int]] = 480,
+        view: Optional[Vec3] = None,
+        look_at: Optional[Vec3] = None,
+        up: Vec3 = (0, 0, 1),
+        perspective: Optional[float] = None,
+        azimuth: float = 0,
+        elevation: float = 0,
+        zoom: float = 1,
+        clip: Optional[Union[Plane, Sequence[Plane]]] = None,
+        crop: Optional[Tuple[float, float, float, float, float, float]] = None,
+        camera: Optional[Camera] = None,
+        step: float = 1,
+        jitter: bool = False,
+        reference: bool = False,
+        opacity: Optional[Pair] = None,
+        tf: Union[None, Literal["auto"], TransferFunction, Mapping[str, Any], Path] = None,
+        preset: Optional[str] = None,
+        colormap: Optional[str] = None,
+        range: Optional[Pair] = None,
+        blend: Blend = "composite",
+        iso: Optional[float] = None,
+        iso_thickness: Optional[float] = None,
+        gradient_opacity: Optional[Pair] = None,
+        post_classification: bool = False,
+        shading: bool = True,
+        ambient: Rgb = 0.1,
+        diffuse: Rgb = 0.7,
+        specular: Rgb = 0.2,
+        shininess: float = 10,
+        light: Optional[Vec3] = None,
+        light_color: Rgb = 1,
+        background: Rgb = 0,
+        label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
+        show_labels: Optional[Sequence[int]] = None,
+        threads: Optional[int] = None,
+    ) -> Frame: ...
+    @property
+    def value_range(self) -> Pair: ...
+
+def render(
+    volume: Union[Volume, ArrayLike],
+    *,
+    spacing: Optional[Vec3] = None,
+    origin: Optional[Vec3] = None,
+    order: Literal["xyz", "zyx"] = "xyz",
+    labels: Optional[bool] = None,
+    log: bool = False,
+    nonfinite: Literal["refuse", "transparent"] = "refuse",
+    max_memory: Optional[int] = None,
+    size: Union[int, Tuple[int, int]] = 480,
+    view: Optional[Vec3] = None,
+    look_at: Optional[Vec3] = None,
+    up: Vec3 = (0, 0, 1),
+    perspective: Optional[float] = None,
+    azimuth: float = 0,
+    elevation: float = 0,
+    zoom: float = 1,
+    clip: Optional[Union[Plane, Sequence[Plane]]] = None,
+    crop: Optional[Tuple[float, float, float, float, float, float]] = None,
+    camera: Optional[Camera] = None,
+    step: float = 1,
+    jitter: bool = False,
+    reference: bool = False,
+    opacity: Optional[Pair] = None,
+    tf: Union[None, Literal["auto"], TransferFunction, Mapping[str, Any], Path] = None,
+    preset: Optional[str] = None,
+    colormap: Optional[str] = None,
+    range: Optional[Pair] = None,
+    blend: Blend = "composite",
+    iso: Optional[float] = None,
+    iso_thickness: Optional[float] = None,
+    gradient_opacity: Optional[Pair] = None,
+    post_classification: bool = False,
+    shading: bool = True,
+    ambient: Rgb = 0.1,
+    diffuse: Rgb = 0.7,
+    specular: Rgb = 0.2,
+    shininess: float = 10,
+    light: Optional[Vec3] = None,
+    light_color: Rgb = 1,
+    background: Rgb = 0,
+    label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
+    show_labels: Optional[Sequence[int]] = None,
+    threads: Optional[int] = None,
+) -> Frame: ...
+
+def read(
+    path: Path,
+    *,
+    format: Optional[str] = None,
+    frame: Optional[int] = None,
+    array: Optional[str] = None,
+    dims: Optional[Tuple[int, int, int]] = None,
+    dtype: Optional[str] = None,
+    endian: Optional[Literal["little", "big"]] = None,
+    spacing: Optional[Vec3] = None,
+    max_memory: Optional[int] = None,
+) -> Volume: ...
+
+def hydrogen(
+    n: int, l: int, m: int, grid: int = 50, extent: Optional[float] = None, real: bool = False
+) -> npt.NDArray[np.float32]: ...
+
+def fractal(
+    size: int,
+    dimension: float = 3.7,
+    sigma: float = 1.0,
+    seed: int = 1,
+    ramp: float = 0.3,
+    threshold: float = 0.45,
+    raw_field: bool = False,
+    random_additions: bool = False,
+) -> npt.NDArray[np.float32]: ...

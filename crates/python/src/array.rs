@@ -1,0 +1,239 @@
+//! numpy arrays as volumes, without a copy where the array can be used as
+//! it is.
+//!
+//! The axis convention: `order="xyz"` (the default) reads `a[x, y, z]`,
+//! as volray's own `.npy` files, nibabel, pyvista and yt hold volumes: a
+//! Fortran-ordered array (x fastest in memory, volray-core's [`Volume`]
+//! layout) is used as it is. `order="zyx"` reads `a[z, y, x]` (numpy
+//! images, SimpleITK, napari, scikit-image): a C-ordered array is used as
+//! it is. Either way the samples are kept as a C-contiguous `(nz, ny,
+//! nx)` array of the type the volume keeps, made by
+//! `numpy.ascontiguousarray`, which returns the array itself (or a view)
+//! where nothing needs to change; only other strides, another byte order
+//! or a type the volume does not keep (`u32`, `i32`, `f64`, ... become
+//! `f32`) cost a copy. Arrays handed back (`Volume.data`, `hydrogen`,
+//! `fractal`) are `a[x, y, z]` views of those samples. Spacing, origin
+//! and every world coordinate are `(x, y, z)` whatever the order.
+
+use crate::errors::value_error;
+use numpy::{PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use std::sync::Arc;
+use volray_core::glam::DVec3;
+use volray_core::{External, ExternalBytes, Sample, SampleType, Samples, Store, Volume};
+
+/// Which index of the array is x.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Order {
+    /// `a[x, y, z]`.
+    Xyz,
+    /// `a[z, y, x]`.
+    Zyx,
+}
+
+impl Order {
+    pub fn parse(name: &str) -> PyResult<Self> {
+        match name {
+            "zyx" | "C" => Ok(Order::Zyx),
+            "xyz" | "F" => Ok(Order::Xyz),
+            _ => Err(value_error(format!(
+                "order: '{name}' is not an axis order: expected 'xyz' (a[x, y, z], the default) or 'zyx' (a[z, y, x])"
+            ))),
+        }
+    }
+}
+
+/// The sample type a volume keeps for a numpy dtype of `kind` and
+/// `itemsize`, if it is a type volray takes.
+fn sample_type(kind: u8, itemsize: usize) -> Option<SampleType> {
+    Some(match (kind, itemsize) {
+        (b'u', 1) | (b'b', 1) => SampleType::U8,
+        (b'i', 1) => SampleType::I8,
+        (b'u', 2) => SampleType::U16,
+        (b'i', 2) => SampleType::I16,
+        (b'f', 4) => SampleType::F32,
+        // Kept as f32, as volray-io keeps these types read from files.
+        (b'u' | b'i', 4 | 8) | (b'f', 2 | 8) => SampleType::F32,
+        _ => return None,
+    })
+}
+
+fn numpy_name(sample: SampleType) -> &'static str {
+    match sample {
+        SampleType::U8 => "uint8",
+        SampleType::I8 => "int8",
+        SampleType::U16 => "uint16",
+        SampleType::I16 => "int16",
+        SampleType::F32 => "float32",
+    }
+}
+
+/// `data` (a numpy array, or anything `numpy.asarray` takes) as the
+/// C-contiguous `(nz, ny, nx)` array of a type a volume keeps, read in
+/// `order`; `what` names it in messages.
+pub fn normalise<'py>(
+    data: &Bound<'py, PyAny>,
+    order: Order,
+    what: &str,
+) -> PyResult<(Bound<'py, PyUntypedArray>, SampleType)> {
+    let py = data.py();
+    let np = py.import("numpy")?;
+    let array = match data.cast::<PyUntypedArray>() {
+        Ok(a) => a.clone(),
+        Err(_) => np
+            .call_method1("asarray", (data,))
+            .and_then(|a| Ok(a.cast_into::<PyUntypedArray>()?))
+            .map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "{what}: expected a 3-D numpy array, got {}",
+                    type_name(data)
+                ))
+            })?,
+    };
+    if array.ndim() != 3 {
+        return Err(value_error(format!(
+            "{what}: a volume is a 3-D array, but this one has shape {:?}",
+            array.shape()
+        )));
+    }
+    let dtype = array.dtype();
+    let sample = sample_type(dtype.kind(), dtype.itemsize()).ok_or_else(|| {
+        PyTypeError::new_err(format!(
+            "{what}: numpy dtype {} is not a volume's: expected uint8, int8, uint16, int16, uint32, int32, float32 or float64",
+            dtype.str().map(|s| s.to_string()).unwrap_or_default()
+        ))
+    })?;
+    let oriented = match order {
+        Order::Zyx => array.into_any(),
+        Order::Xyz => array.getattr("T")?,
+    };
+    let kept = np.call_method1("ascontiguousarray", (oriented, numpy_name(sample)))?;
+    Ok((kept.cast_into::<PyUntypedArray>()?, sample))
+}
+
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "an object".into())
+}
+
+/// The bytes of a C-contiguous numpy array, owned by the array: a
+/// volume's samples without a copy.
+struct ArrayBytes {
+    /// Keeps the array, and so its buffer, alive.
+    _array: Py<PyAny>,
+    ptr: *const u8,
+    len: usize,
+}
+
+// SAFETY: `ptr` is only read (through `bytes`), and the buffer it points
+// into is kept alive by `_array`, a strong reference: a `Py` may be sent
+// and shared between threads (its reference count is only touched with
+// the interpreter attached). The bytes are shared with Python, which may
+// write them while the GIL is released for a render: that is the same
+// contract as any extension that reads a numpy array without the GIL
+// (numpy's own ufuncs do), stated in `Volume`'s documentation: do not
+// change an array while it renders.
+unsafe impl Send for ArrayBytes {}
+unsafe impl Sync for ArrayBytes {}
+
+impl std::fmt::Debug for ArrayBytes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "numpy array of {} bytes", self.len)
+    }
+}
+
+impl ExternalBytes for ArrayBytes {
+    fn bytes(&self) -> &[u8] {
+        // SAFETY: `ptr` is the data pointer of a C-contiguous array of
+        // `len` bytes (`nbytes`, checked non-zero with every side ≥ 2
+        // before this is made), aligned for its dtype (numpy allocates
+        // aligned buffers and `ascontiguousarray` returns an aligned
+        // array), alive as long as `_array` (see the `Send` note).
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+
+    fn verify(&self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+fn store<T: Sample + numpy::Element>(array: &Bound<'_, PyUntypedArray>) -> PyResult<Store<T>> {
+    let typed = array.cast::<PyArray3<T>>()?;
+    let len = typed.len();
+    let bytes = ArrayBytes {
+        _array: typed.clone().into_any().unbind(),
+        ptr: typed.data() as *const u8,
+        len: len * size_of::<T>(),
+    };
+    let external =
+        External::new(Arc::new(bytes), 0, len).map_err(|e| value_error(e.to_string()))?;
+    Ok(Store::External(external))
+}
+
+/// A volume over the samples of `array` (from [`normalise`]), without a
+/// copy.
+pub fn volume(
+    array: &Bound<'_, PyUntypedArray>,
+    sample: SampleType,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    what: &str,
+) -> PyResult<Volume> {
+    let shape = array.shape();
+    let dims = [shape[2], shape[1], shape[0]];
+    if dims.iter().any(|&n| n < 2) {
+        return Err(value_error(format!(
+            "{what}: every axis needs at least two points to be ray cast, but the array has shape {shape:?}"
+        )));
+    }
+    let samples = match sample {
+        SampleType::U8 => Samples::U8(store::<u8>(array)?),
+        SampleType::I8 => Samples::I8(store::<i8>(array)?),
+        SampleType::U16 => Samples::U16(store::<u16>(array)?),
+        SampleType::I16 => Samples::I16(store::<i16>(array)?),
+        SampleType::F32 => Samples::F32(store::<f32>(array)?),
+    };
+    let bad = |e: volray_core::VolumeError| value_error(format!("{what}: {e}"));
+    Volume::from_samples(dims, samples)
+        .map_err(bad)?
+        .with_spacing(DVec3::from(spacing))
+        .map_err(|e| value_error(format!("spacing: {e}")))?
+        .with_origin(DVec3::from(origin))
+        .map_err(|e| value_error(format!("origin: {e}")))
+}
+
+/// A volume's samples as a C-contiguous numpy array `(nz, ny, nx)`,
+/// moved into it without a copy where the volume owns them.
+pub fn to_numpy<'py>(py: Python<'py>, volume: Volume) -> PyResult<Bound<'py, PyUntypedArray>> {
+    let [nx, ny, nz] = volume.dims();
+    fn array<'py, T: Sample + numpy::Element>(
+        py: Python<'py>,
+        store: Store<T>,
+        shape: [usize; 3],
+    ) -> PyResult<Bound<'py, PyUntypedArray>> {
+        let vec = match store {
+            Store::Owned(v) => v,
+            Store::External(e) => Store::External(e).to_vec(),
+        };
+        Ok(numpy::PyArray1::from_vec(py, vec)
+            .reshape(shape)?
+            .into_any()
+            .cast_into::<PyUntypedArray>()?)
+    }
+    let shape = [nz, ny, nx];
+    match volume.into_samples() {
+        Samples::U8(s) => array(py, s, shape),
+        Samples::I8(s) => array(py, s, shape),
+        Samples::U16(s) => array(py, s, shape),
+        Samples::I16(s) => array(py, s, shape),
+        Samples::F32(s) => array(py, s, shape),
+    }
+}
+
+/// The `a[x, y, z]` view of samples kept `(nz, ny, nx)`: what Python sees.
+pub fn xyz<'py>(stored: &Bound<'py, PyUntypedArray>) -> PyResult<Bound<'py, PyAny>> {
+    stored.getattr("T")
+}

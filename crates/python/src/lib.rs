@@ -1,0 +1,51 @@
+//! volray for Python: `import volray`, numpy arrays in, images out.
+//!
+//! The module wraps the libraries, not the command line: volray-io reads
+//! files, volray-data generates the paper's volumes, volray-options turns
+//! keyword arguments into render settings exactly as it turns `volray
+//! render`'s flags into them (so the same options give the same pixels),
+//! and volray-core renders with the GIL released. The Python half
+//! (`python/volray/__init__.py`) re-exports this module's names with
+//! their documentation; `python/volray/__init__.pyi` types them.
+//!
+//! ```python
+//! import numpy as np, volray
+//! x, y, z = np.mgrid[-1:1:64j, -1:1:64j, -1:1:64j]
+//! frame = volray.render(np.exp(-4 * (x*x + y*y + z*z)).astype(np.float32), azimuth=30)
+//! frame.save("ball.png")            # or show it in Jupyter, or np.asarray(frame)
+//! ```
+//!
+//! Where things are: [`array`] (numpy arrays as volumes, without a copy),
+//! [`volume`] (`Volume`, `read`), [`keywords`] (keyword arguments to
+//! options, and their names in messages), [`renderer`] (`Renderer`,
+//! `render`, Ctrl-C), [`frame`] (`Frame`), [`transfer`]
+//! (`TransferFunction`, `Camera`), [`generate`] (`hydrogen`, `fractal`),
+//! [`errors`] (library errors to Python exceptions).
+
+use pyo3::prelude::*;
+
+mod array;
+mod errors;
+mod frame;
+mod generate;
+mod keywords;
+mod renderer;
+mod transfer;
+mod volume;
+
+#[pymodule]
+fn _volray(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<volume::Volume>()?;
+    m.add_class::<renderer::Renderer>()?;
+    m.add_class::<frame::Frame>()?;
+    m.add_class::<transfer::TransferFunction>()?;
+    m.add_class::<transfer::Camera>()?;
+    m.add_function(wrap_pyfunction!(renderer::render, m)?)?;
+    m.add_function(wrap_pyfunction!(volume::read, m)?)?;
+    m.add_function(wrap_pyfunction!(generate::hydrogen, m)?)?;
+    m.add_function(wrap_pyfunction!(generate::fractal, m)?)?;
+    m.add("PRESETS", volray_core::transfer::presets::NAMES.to_vec())?;
+    m.add("COLORMAPS", volray_core::transfer::colormap::NAMES.to_vec())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,249 @@
+//! `TransferFunction` (volray-core's, from points, JSON or a preset) and
+//! `Camera` (the camera keywords kept together, for `camera=`).
+
+use crate::errors::value_error;
+use crate::keywords::{Keywords, camera_from};
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::Path;
+use volray_core::transfer::{colormap, presets};
+use volray_core::{PiecewiseLinear, TransferFunction as CoreTf};
+use volray_options::CameraOptions;
+
+/// The largest JSON file read as a transfer function: a few hundred
+/// points; this bounds what a wrong path (a device, a huge file) costs.
+const JSON_MAX_BYTES: u64 = 16 << 20;
+
+/// The text of the transfer-function file `path`.
+pub fn read_json(path: &Path) -> PyResult<String> {
+    let name = path.display();
+    let meta = std::fs::metadata(path)
+        .map_err(|e| PyOSError::new_err(format!("tf {name}: cannot read: {e}")))?;
+    if !meta.is_file() {
+        return Err(value_error(format!("tf {name}: not a regular file")));
+    }
+    if meta.len() > JSON_MAX_BYTES {
+        return Err(value_error(format!(
+            "tf {name}: {} bytes is too large for a transfer function (at most {JSON_MAX_BYTES})",
+            meta.len()
+        )));
+    }
+    std::fs::read_to_string(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::InvalidData => value_error(format!(
+            "tf {name}: not UTF-8 text (a JSON file is expected)"
+        )),
+        _ => PyOSError::new_err(format!("tf {name}: cannot read: {e}")),
+    })
+}
+
+/// A transfer function: opacity and colour as piecewise-linear functions
+/// of the value, over `domain` (the volume's value range if `None`), the
+/// `t` of each point in [0, 1] of the domain.
+#[pyclass(frozen, module = "volray")]
+pub struct TransferFunction {
+    pub function: CoreTf,
+}
+
+#[pymethods]
+impl TransferFunction {
+    /// `TransferFunction(opacity=[(t, a), ...], color=[(t, r, g, b), ...],
+    /// domain=None)`: points sorted by `t`, values in [0, 1].
+    #[new]
+    #[pyo3(signature = (opacity=None, color=None, domain=None))]
+    fn new(
+        opacity: Option<Vec<(f32, f32)>>,
+        color: Option<Vec<(f32, f32, f32, f32)>>,
+        domain: Option<(f64, f64)>,
+    ) -> PyResult<Self> {
+        let bad =
+            |e: volray_core::transfer::function::TransferFunctionError| value_error(e.to_string());
+        let opacity = opacity
+            .map(|p| {
+                PiecewiseLinear::new("opacity", p.into_iter().map(|(t, a)| (t, [a])).collect())
+            })
+            .transpose()
+            .map_err(bad)?;
+        let color = color
+            .map(|p| {
+                PiecewiseLinear::new(
+                    "color",
+                    p.into_iter().map(|(t, r, g, b)| (t, [r, g, b])).collect(),
+                )
+            })
+            .transpose()
+            .map_err(bad)?;
+        if let Some((lo, hi)) = domain
+            && !(lo.is_finite() && hi.is_finite() && lo < hi)
+        {
+            return Err(value_error(format!(
+                "domain ({lo}, {hi}) must be two finite numbers with lo < hi"
+            )));
+        }
+        Ok(TransferFunction {
+            function: CoreTf {
+                domain,
+                opacity,
+                color,
+            },
+        })
+    }
+
+    /// The transfer function of a JSON text or file (the form `volray
+    /// render --tf` reads).
+    #[staticmethod]
+    fn from_json(text_or_path: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let text: String = match text_or_path.extract::<String>() {
+            Ok(s) if s.trim_start().starts_with('{') => s,
+            _ => {
+                let path: std::path::PathBuf = text_or_path.extract()?;
+                read_json(&path)?
+            }
+        };
+        CoreTf::from_json(&text)
+            .map(|function| TransferFunction { function })
+            .map_err(|e| value_error(e.to_string()))
+    }
+
+    /// A named transfer function: one of `volray.PRESETS`.
+    #[staticmethod]
+    fn preset(name: &str) -> PyResult<Self> {
+        presets::preset(name)
+            .map(|function| TransferFunction { function })
+            .ok_or_else(|| {
+                value_error(format!(
+                    "preset: unknown preset '{name}': expected one of {}",
+                    presets::NAMES.join(", ")
+                ))
+            })
+    }
+
+    /// This transfer function with the colours of a named colour map (one
+    /// of `volray.COLORMAPS`).
+    fn with_colormap(&self, name: &str) -> PyResult<Self> {
+        let color = colormap::colormap(name).ok_or_else(|| {
+            value_error(format!(
+                "colormap: unknown colour map '{name}': expected one of {}",
+                colormap::NAMES.join(", ")
+            ))
+        })?;
+        Ok(TransferFunction {
+            function: CoreTf {
+                color: Some(color),
+                ..self.function.clone()
+            },
+        })
+    }
+
+    #[getter]
+    fn opacity(&self) -> Option<Vec<(f32, f32)>> {
+        (self.function.opacity.as_ref())
+            .map(|f| f.points().iter().map(|(t, [a])| (*t, *a)).collect())
+    }
+
+    #[getter]
+    fn color(&self) -> Option<Vec<(f32, f32, f32, f32)>> {
+        (self.function.color.as_ref()).map(|f| {
+            f.points()
+                .iter()
+                .map(|(t, [r, g, b])| (*t, *r, *g, *b))
+                .collect()
+        })
+    }
+
+    #[getter]
+    fn domain(&self) -> Option<(f64, f64)> {
+        self.function.domain
+    }
+
+    /// The value's opacity and colour `(a, r, g, b)` at `t` in [0, 1] of
+    /// the domain (1 and white where a function is not given).
+    fn __call__(&self, t: f32) -> (f32, f32, f32, f32) {
+        let [a] = (self.function.opacity.as_ref()).map_or([1.0], |f| f.eval(t));
+        let [r, g, b] = (self.function.color.as_ref()).map_or([1.0; 3], |f| f.eval(t));
+        (a, r, g, b)
+    }
+
+    fn __repr__(&self) -> String {
+        let count = |n: Option<usize>| n.map_or("none".to_string(), |n| format!("{n} points"));
+        format!(
+            "TransferFunction(opacity: {}, color: {}, domain: {:?})",
+            count(self.function.opacity.as_ref().map(|f| f.points().len())),
+            count(self.function.color.as_ref().map(|f| f.points().len())),
+            self.function.domain
+        )
+    }
+}
+
+/// A camera: the camera keywords of `render` kept together
+/// (`render(volume, camera=cam)`), with the same defaults.
+#[pyclass(frozen, module = "volray")]
+pub struct Camera {
+    pub options: CameraOptions,
+}
+
+#[pymethods]
+impl Camera {
+    /// `Camera(size=480, view=None, look_at=None, up=(0, 0, 1),
+    /// perspective=None, azimuth=0, elevation=0, zoom=1, clip=None,
+    /// crop=None)`.
+    #[new]
+    #[pyo3(signature = (**kwargs))]
+    fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        const CAMERA: &[&str] = &[
+            "size",
+            "view",
+            "look_at",
+            "up",
+            "perspective",
+            "azimuth",
+            "elevation",
+            "zoom",
+            "clip",
+            "crop",
+        ];
+        let k = Keywords::new(kwargs, &[CAMERA], "Camera")?;
+        Ok(Camera {
+            options: camera_from(&k)?,
+        })
+    }
+
+    #[getter]
+    fn size(&self) -> (usize, usize) {
+        self.options.size
+    }
+
+    #[getter]
+    fn view(&self) -> Option<[f64; 3]> {
+        self.options.view
+    }
+
+    #[getter]
+    fn look_at(&self) -> Option<[f64; 3]> {
+        self.options.look_at
+    }
+
+    #[getter]
+    fn azimuth(&self) -> f64 {
+        self.options.azimuth
+    }
+
+    #[getter]
+    fn elevation(&self) -> f64 {
+        self.options.elevation
+    }
+
+    #[getter]
+    fn zoom(&self) -> f64 {
+        self.options.zoom
+    }
+
+    #[getter]
+    fn perspective(&self) -> Option<f64> {
+        self.options.perspective
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Camera({:?})", self.options)
+    }
+}

@@ -1,0 +1,275 @@
+//! `Volume` (a numpy array with its spacing, origin and what its file
+//! said) and `read` (any file volray reads, or a built-in source).
+
+use crate::array::{self, Order};
+use crate::errors::{io_error, value_error};
+use numpy::{PyUntypedArray, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
+use volray_core::{Histogram, SampleType, Volume as CoreVolume};
+use volray_io::{DType, Endian, FileInfo, MapPolicy, RawOptions, ReadOptions, VolumeFormat};
+
+/// A volume: `data`, a numpy array `a[x, y, z]` (x fastest in memory),
+/// and where its voxels lie, `spacing` and `origin` in `(x, y, z)`.
+///
+/// An array is used without a copy where its memory already has x
+/// fastest (Fortran order with `order="xyz"`, C order with
+/// `order="zyx"`) in a type a volume keeps (uint8, int8, uint16, int16,
+/// float32); do not change it while a frame of it renders (the GIL is
+/// released meanwhile).
+#[pyclass(frozen, module = "volray")]
+pub struct Volume {
+    /// The samples, C-contiguous `(nz, ny, nx)`.
+    pub data: Py<PyUntypedArray>,
+    pub sample: SampleType,
+    pub spacing: [f64; 3],
+    pub origin: [f64; 3],
+    pub labels: bool,
+    /// The file's path or the source's spec, for messages.
+    pub name: String,
+    pub file: Option<(VolumeFormat, FileInfo)>,
+}
+
+impl Volume {
+    /// A volume of `data` (an array, or anything numpy takes) read in
+    /// `order`.
+    pub fn from_array(
+        data: &Bound<'_, PyAny>,
+        spacing: Option<[f64; 3]>,
+        origin: Option<[f64; 3]>,
+        order: Order,
+        labels: bool,
+    ) -> PyResult<Self> {
+        let (array, sample) = array::normalise(data, order, "volume")?;
+        let volume = Volume {
+            data: array.unbind(),
+            sample,
+            spacing: spacing.unwrap_or([1.0; 3]),
+            origin: origin.unwrap_or([0.0; 3]),
+            labels,
+            name: "volume".into(),
+            file: None,
+        };
+        // Sides, spacing and origin checked now, not at the first frame.
+        volume.core(data.py())?;
+        Ok(volume)
+    }
+
+    /// The volume as volray-core's, over the same samples (no copy).
+    pub fn core(&self, py: Python<'_>) -> PyResult<CoreVolume> {
+        let volume = array::volume(
+            self.data.bind(py),
+            self.sample,
+            self.spacing,
+            self.origin,
+            &self.name,
+        )?;
+        Ok(if self.labels {
+            volume.as_labels()
+        } else {
+            volume
+        })
+    }
+
+    /// Whether the file marks its NaN values as space it does not cover
+    /// (always rendered as empty space).
+    pub fn nan_is_empty(&self) -> bool {
+        self.file
+            .as_ref()
+            .is_some_and(|(_, info)| info.nan_is_empty)
+    }
+}
+
+#[pymethods]
+impl Volume {
+    /// `Volume(data, *, spacing=(1, 1, 1), origin=(0, 0, 0), order="xyz",
+    /// labels=False)`: `order="xyz"` reads `data[x, y, z]` (volray's
+    /// `.npy` files, nibabel, pyvista, yt), `"zyx"` reads `data[z, y, x]`
+    /// (numpy images, SimpleITK, napari); `labels=True` marks a
+    /// segmentation.
+    #[new]
+    #[pyo3(signature = (data, *, spacing=None, origin=None, order="xyz", labels=false))]
+    fn new(
+        data: &Bound<'_, PyAny>,
+        spacing: Option<[f64; 3]>,
+        origin: Option<[f64; 3]>,
+        order: &str,
+        labels: bool,
+    ) -> PyResult<Self> {
+        Volume::from_array(data, spacing, origin, Order::parse(order)?, labels)
+    }
+
+    /// The samples, `a[x, y, z]`: a view of them, not a copy.
+    #[getter]
+    fn data<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array::xyz(self.data.bind(py))
+    }
+
+    /// Points along x, y and z.
+    #[getter]
+    fn dims(&self, py: Python<'_>) -> (usize, usize, usize) {
+        let shape = self.data.bind(py).shape().to_vec();
+        (shape[2], shape[1], shape[0])
+    }
+
+    #[getter]
+    fn spacing(&self) -> (f64, f64, f64) {
+        self.spacing.into()
+    }
+
+    #[getter]
+    fn origin(&self) -> (f64, f64, f64) {
+        self.origin.into()
+    }
+
+    #[getter]
+    fn labels(&self) -> bool {
+        self.labels
+    }
+
+    /// The type the samples are kept in: `"u8"`, `"i16"`, `"f32"`, ...
+    #[getter]
+    fn sample_type(&self) -> &'static str {
+        self.sample.name()
+    }
+
+    /// What `volray info` says of the volume: its format, dims, sample
+    /// type, spacing, origin, value statistics, and for a file the type
+    /// stored, frames, arrays, header fields and the notes on how it was
+    /// read.
+    #[getter]
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let format = match &self.file {
+            Some((format, _)) => format.description(),
+            None => "numpy array",
+        };
+        d.set_item("input", &self.name)?;
+        d.set_item("format", format)?;
+        d.set_item("dims", self.dims(py))?;
+        d.set_item("sample_type", self.sample.name())?;
+        d.set_item("spacing", self.spacing)?;
+        d.set_item("origin", self.origin)?;
+        let volume = self.core(py)?;
+        let histogram = py.detach(|| Histogram::of(&volume, 256));
+        let values = PyDict::new(py);
+        if let Some(h) = histogram {
+            values.set_item("min", h.min)?;
+            values.set_item("max", h.max)?;
+            values.set_item("mean", h.mean)?;
+            values.set_item("non_finite", h.non_finite)?;
+        }
+        d.set_item("values", values)?;
+        if let Some((_, i)) = &self.file {
+            d.set_item("length_unit", &i.length_unit)?;
+            d.set_item("stored_type", &i.stored_type)?;
+            d.set_item("frames", i.frames)?;
+            d.set_item("frame", i.frame)?;
+            d.set_item("arrays", PyList::new(py, &i.arrays)?)?;
+            d.set_item("array", &i.array)?;
+            let header = PyDict::new(py);
+            for (k, v) in &i.header {
+                header.set_item(k, v)?;
+            }
+            d.set_item("header", header)?;
+            d.set_item("notes", PyList::new(py, &i.notes)?)?;
+            d.set_item("nan_is_empty", i.nan_is_empty)?;
+        }
+        Ok(d)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let (x, y, z) = self.dims(py);
+        format!(
+            "Volume({}: {x}x{y}x{z} {}, spacing {:?}, origin {:?}{})",
+            self.name,
+            self.sample.name(),
+            self.spacing,
+            self.origin,
+            if self.labels { ", labels" } else { "" }
+        )
+    }
+}
+
+/// `read(path, *, format=None, frame=None, array=None, dims=None,
+/// dtype=None, endian=None, spacing=None, max_memory=None)`: the volume
+/// in a file of any format volray reads (or a built-in source such as
+/// `"hydrogen:4,2,1"`), its samples moved into a numpy array without a
+/// copy. `dims`, `dtype` and `endian` describe a raw file.
+#[pyfunction]
+#[pyo3(signature = (path, *, format=None, frame=None, array=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn read(
+    py: Python<'_>,
+    path: PathBuf,
+    format: Option<&str>,
+    frame: Option<usize>,
+    array: Option<String>,
+    dims: Option<[usize; 3]>,
+    dtype: Option<&str>,
+    endian: Option<&str>,
+    spacing: Option<[f64; 3]>,
+    max_memory: Option<u64>,
+) -> PyResult<Volume> {
+    let spec = path.to_string_lossy().to_string();
+    let max_memory = max_memory.unwrap_or_else(volray_io::default_max_memory);
+    let (volume, file) = if volray_data::is_source_spec(&spec) {
+        let volume = py
+            .detach(|| volray_data::generate(&spec))
+            .map_err(|e| value_error(e.to_string()))?;
+        (volume, None)
+    } else {
+        let format = (format.map(str::parse::<VolumeFormat>))
+            .transpose()
+            .map_err(|e| value_error(format!("format: {e}")))?;
+        let raw = match dims {
+            Some(dims) => {
+                let dtype = (dtype.map(str::parse::<DType>))
+                    .transpose()
+                    .map_err(|e| value_error(format!("dtype: {e}")))?
+                    .unwrap_or(DType::F32);
+                let mut raw = RawOptions::new(dims, dtype);
+                raw.endian = (endian.map(str::parse::<Endian>))
+                    .transpose()
+                    .map_err(|e| value_error(format!("endian: {e}")))?
+                    .unwrap_or(Endian::Little);
+                raw.spacing = spacing.unwrap_or([1.0; 3]).into();
+                Some(raw)
+            }
+            None if dtype.is_some() || endian.is_some() => {
+                return Err(value_error(format!(
+                    "{spec}: dtype and endian describe a raw file: give dims too"
+                )));
+            }
+            None => None,
+        };
+        let opts = ReadOptions {
+            format,
+            raw,
+            frame,
+            array,
+            max_memory,
+            // The samples move into a numpy array, which owns its memory.
+            map: MapPolicy::Never,
+        };
+        let loaded = py
+            .detach(|| volray_io::read(&path, &opts))
+            .map_err(io_error)?;
+        (loaded.volume, Some((loaded.format, loaded.info)))
+    };
+    let spacing = spacing.unwrap_or(volume.spacing().to_array());
+    let origin = volume.origin().to_array();
+    let labels = volume.is_labels();
+    let sample = volume.sample_type();
+    let data = array::to_numpy(py, volume)?;
+    Ok(Volume {
+        data: data.unbind(),
+        sample,
+        spacing,
+        origin,
+        labels,
+        name: spec,
+        file,
+    })
+}
