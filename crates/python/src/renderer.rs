@@ -1,8 +1,9 @@
 //! `Renderer` (a volume prepared once, rendered frame after frame at
 //! `volray bench` speed) and `render` (one frame), with the GIL released
 //! while rendering and Ctrl-C honoured: the frame renders on a worker
-//! thread while the calling thread asks Python for pending signals every
-//! 20 ms; on KeyboardInterrupt it stops the frame (volray-core's
+//! thread while the calling thread waits for it, asking Python for
+//! pending signals every 20 ms of the wait (a finished frame returns at
+//! once); on KeyboardInterrupt it stops the frame (volray-core's
 //! `render_stoppable`: the work left is skipped) and raises.
 
 use crate::array::Order;
@@ -13,6 +14,7 @@ use crate::volume::Volume;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 use volray_core::transfer::auto;
 use volray_core::{
@@ -160,25 +162,41 @@ impl Renderer {
             _ => {}
         }
         self.check_memory(&settings)?;
-        let pool = pool(threads)?;
+        let pool = threads.map(pool).transpose()?;
         let stop = AtomicBool::new(false);
         let inner = &self.inner;
         let settings = &settings;
         let mut interrupt = None;
         let rendered = py.detach(|| {
             std::thread::scope(|s| {
-                let worker =
-                    s.spawn(|| pool.install(|| inner.render_stoppable(settings, &|_| {}, &stop)));
-                while !worker.is_finished() {
-                    std::thread::sleep(SIGNAL_POLL);
-                    if interrupt.is_none()
-                        && let Err(e) = Python::attach(|py| py.check_signals())
-                    {
-                        interrupt = Some(e);
-                        stop.store(true, Ordering::Relaxed);
+                let (done, finished) = mpsc::channel();
+                let (pool, stop) = (&pool, &stop);
+                s.spawn(move || {
+                    let frame = || inner.render_stoppable(settings, &|_| {}, stop);
+                    // The global pool (one worker per core) unless threads= is given.
+                    let image = match pool {
+                        Some(pool) => pool.install(frame),
+                        None => frame(),
+                    };
+                    // The receiver waits for this; it cannot be gone.
+                    let _ = done.send(image);
+                });
+                loop {
+                    match finished.recv_timeout(SIGNAL_POLL) {
+                        Ok(image) => break image,
+                        Err(RecvTimeoutError::Timeout) => {
+                            if interrupt.is_none()
+                                && let Err(e) = Python::attach(|py| py.check_signals())
+                            {
+                                interrupt = Some(e);
+                                stop.store(true, Ordering::Relaxed);
+                            }
+                        }
+                        Err(RecvTimeoutError::Disconnected) => {
+                            panic!("the render thread ended without a frame")
+                        }
                     }
                 }
-                worker.join().expect("the render thread does not panic")
             })
         });
         if let Some(e) = interrupt {
@@ -234,12 +252,9 @@ fn cache_budget(renderer: &CoreRenderer<'_>, mode: NonFinite, max_memory: u64) -
     (u128::from(max_memory).saturating_sub(need)).min(DEFAULT_CACHE_BUDGET as u128) as usize
 }
 
-/// A pool of `threads` workers, or the global one (one per core).
-fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n);
-    }
+/// A pool of `threads` workers.
+fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
+    let builder = rayon::ThreadPoolBuilder::new().num_threads(threads);
     builder.build().map_err(|e| {
         pyo3::exceptions::PyOSError::new_err(format!("cannot start worker threads: {e}"))
     })
