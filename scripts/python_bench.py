@@ -12,7 +12,10 @@ command line and Python alternate ROUNDS times in one run, and the ratio
 of their medians is the overhead of the module (argument parsing, the
 GIL released and taken back, the frame handed to numpy). pyvista, when
 its import works (it needs VTK and an off-screen OpenGL context), renders
-the same array with add_volume(mapper="fixed_point") off screen.
+the same array with add_volume(mapper="fixed_point") off screen, with
+the same work: a linear opacity ramp over the value range (volray's
+`opacity=(0, 1)`), viridis, shading on, one sample per voxel along each
+ray and one ray per pixel (automatic sample distances off).
 """
 
 import argparse
@@ -36,7 +39,8 @@ def cli_median(binary, spec, size, frames):
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.json"
         subprocess.run(
-            [binary, "bench", spec, "--size", str(size), "--frames", str(frames), "--json", str(out)],
+            [binary, "bench", spec, "--size", str(size), "--frames", str(frames), "--json", str(out)]
+            + ["--opacity", "0,1", "--colormap", "viridis"],
             check=True,
             capture_output=True,
         )
@@ -44,11 +48,12 @@ def cli_median(binary, spec, size, frames):
 
 
 def python_median(renderer, size, frames):
-    renderer.render(size=size, azimuth=0.0)  # warm-up
+    look = dict(opacity=(0, 1), colormap="viridis")
+    renderer.render(size=size, azimuth=0.0, **look)  # warm-up
     times = []
     for i in range(1, frames + 1):
         start = time.perf_counter()
-        frame = renderer.render(size=size, azimuth=0.5 * i)
+        frame = renderer.render(size=size, azimuth=0.5 * i, **look)
         np.asarray(frame)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
@@ -62,7 +67,14 @@ def pyvista_median(array, spacing, size, frames):
     grid = pv.ImageData(dimensions=array.shape, spacing=spacing)
     grid.point_data["values"] = array.ravel(order="F")
     plotter = pv.Plotter(off_screen=True, window_size=(size, size))
-    plotter.add_volume(grid, scalars="values", mapper="fixed_point", cmap="viridis")
+    actor = plotter.add_volume(
+        grid, scalars="values", mapper="fixed_point", cmap="viridis", opacity="linear", shade=True
+    )
+    # The same work as volray's: one sample per voxel along each ray, one
+    # ray per pixel, whatever the frame rate.
+    actor.mapper.SetAutoAdjustSampleDistances(False)
+    actor.mapper.SetSampleDistance(min(spacing))
+    actor.mapper.SetImageSampleDistance(1.0)
     plotter.show(auto_close=False)  # warm-up
     times = []
     for _ in range(frames):

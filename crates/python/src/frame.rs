@@ -3,9 +3,10 @@
 //! OpenEXR.
 
 use crate::errors::{io_error, value_error};
-use numpy::{PyArray1, PyArrayMethods, PyUntypedArray};
+use numpy::{PyArray1, PyArray3, PyArrayMethods, PyUntypedArray};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
+use rayon::prelude::*;
 use std::path::PathBuf;
 use volray_core::Image;
 use volray_io::{BitDepth, quantize_8};
@@ -18,10 +19,24 @@ pub struct Frame {
 }
 
 impl Frame {
-    fn rgba8(&self) -> Vec<u8> {
-        (self.image.pixels().iter())
-            .flat_map(|p| p.map(quantize_8))
-            .collect()
+    /// The pixels quantised as a PNG holds them, into a new numpy array
+    /// `(height, width, 4)`, rows in parallel (a 480² frame: 3.3 ms on one
+    /// thread, measured, against a 38 ms frame).
+    fn rgba8<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let (w, h) = (self.image.width(), self.image.height());
+        let array = PyArray3::<u8>::zeros(py, [h, w, 4], false);
+        {
+            let mut out = array.readwrite();
+            let out = out.as_slice_mut()?;
+            (out.par_chunks_mut(4 * w.max(1)))
+                .zip(self.image.pixels().par_chunks(w.max(1)))
+                .for_each(|(out, row)| {
+                    for (o, p) in out.chunks_exact_mut(4).zip(row) {
+                        o.copy_from_slice(&p.map(quantize_8));
+                    }
+                });
+        }
+        Ok(array.into_any())
     }
 
     /// The frame as an 8-bit RGB PNG, the bytes `volray render` writes.
@@ -87,9 +102,7 @@ impl Frame {
             let values: Vec<f32> = self.image.pixels().iter().flatten().copied().collect();
             PyArray1::from_vec(py, values).reshape(shape)?.into_any()
         } else {
-            PyArray1::from_vec(py, self.rgba8())
-                .reshape(shape)?
-                .into_any()
+            self.rgba8(py)?
         };
         let array = match dtype {
             // float64 asked: numpy converts.
