@@ -47,16 +47,19 @@ def cli_median(binary, spec, size, frames):
         return json.loads(out.read_text())[0]["median_s"]
 
 
-def python_median(renderer, size, frames):
+def python_medians(renderer, size, frames):
+    """Medians of the frame alone and of the frame made a numpy array."""
     look = dict(opacity=(0, 1), colormap="viridis")
     renderer.render(size=size, azimuth=0.0, **look)  # warm-up
-    times = []
+    alone, with_numpy = [], []
     for i in range(1, frames + 1):
         start = time.perf_counter()
         frame = renderer.render(size=size, azimuth=0.5 * i, **look)
+        rendered = time.perf_counter()
         np.asarray(frame)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
+        alone.append(rendered - start)
+        with_numpy.append(time.perf_counter() - start)
+    return statistics.median(alone), statistics.median(with_numpy)
 
 
 def pyvista_median(array, spacing, size, frames):
@@ -97,18 +100,28 @@ def main():
     args = parser.parse_args()
     if not os.path.exists(args.binary):
         sys.exit(f"{args.binary}: build it first (cargo build --release)")
-    print(f"{'workload':28} {'cli ms':>8} {'python ms':>10} {'python/cli':>11} {'pyvista ms':>11}")
+    print(
+        f"{'workload':26} {'cli ms':>8} {'python ms':>10} {'ratio':>6} "
+        f"{'+numpy ms':>10} {'ratio':>6} {'pyvista ms':>11}"
+    )
     for spec in args.workloads:
         volume = volray.read(spec)
         renderer = volray.Renderer(volume)
-        cli, py = [], []
+        cli, alone, with_numpy = [], [], []
         for _ in range(args.rounds):
             cli.append(cli_median(args.binary, spec, args.size, args.frames))
-            py.append(python_median(renderer, args.size, args.frames))
-        c, p = statistics.median(cli), statistics.median(py)
+            a, n = python_medians(renderer, args.size, args.frames)
+            alone.append(a)
+            with_numpy.append(n)
+        c = statistics.median(cli)
+        a, n = statistics.median(alone), statistics.median(with_numpy)
         pv = pyvista_median(volume.data, volume.spacing, args.size, args.frames)
         pv_text = f"{pv * 1e3:11.1f}" if pv is not None else f"{'n/a':>11}"
-        print(f"{spec:28} {c * 1e3:8.1f} {p * 1e3:10.1f} {p / c:11.3f} {pv_text}", flush=True)
+        print(
+            f"{spec:26} {c * 1e3:8.1f} {a * 1e3:10.1f} {a / c:6.3f} "
+            f"{n * 1e3:10.1f} {n / c:6.3f} {pv_text}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":
