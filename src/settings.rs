@@ -89,7 +89,7 @@ fn sampling(sampling: &SamplingArgs) -> volray_options::SamplingOptions {
 /// The look flags as options. A `--tf` file's text is left empty here:
 /// only [`options`] reads it into the settings; what follows the volume
 /// ([`from_volume`]) asks only whether one is given.
-fn look(look: &LookArgs) -> LookOptions {
+pub fn look(look: &LookArgs) -> LookOptions {
     LookOptions {
         opacity: look.opacity,
         tf: look.tf.as_ref().map(|path| match look.tf_file() {

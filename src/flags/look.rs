@@ -161,15 +161,10 @@ impl LookArgs {
 
     /// Whether the transfer function is chosen from the volume's histogram
     /// (volray-core's `transfer::auto`): `--tf auto`, or compositing with
-    /// no `--tf`, `--preset`, `--colormap` or `--iso`.
+    /// no `--tf`, `--preset`, `--colormap` or `--iso` (volray-options'
+    /// `LookOptions::auto_tf` decides).
     pub fn auto_tf(&self) -> bool {
-        self.tf.as_deref() == Some(Path::new(AUTO))
-            || (self.tf.is_none()
-                && !self.labels
-                && self.preset.is_none()
-                && self.colormap.is_none()
-                && self.iso.is_none()
-                && self.blend == BlendMode::Composite)
+        crate::settings::look(self).auto_tf()
     }
 }
 

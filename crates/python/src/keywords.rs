@@ -14,8 +14,9 @@ use std::collections::HashSet;
 use volray_core::NonFinite;
 use volray_options::{BlendMode, CameraOptions, LookOptions, Options, Tf};
 
-/// The keywords of one frame, for `Renderer.render` and `render`.
-pub const FRAME: &[&str] = &[
+/// The camera's keywords, for `Camera(...)`, `Renderer.render` and
+/// `render`.
+pub const CAMERA: &[&str] = &[
     "size",
     "view",
     "look_at",
@@ -26,6 +27,11 @@ pub const FRAME: &[&str] = &[
     "zoom",
     "clip",
     "crop",
+];
+
+/// The keywords of one frame besides the camera's, for `Renderer.render`
+/// and `render`.
+pub const FRAME: &[&str] = &[
     "camera",
     "step",
     "jitter",
@@ -148,18 +154,6 @@ fn rgb<'py>(k: &Keywords<'py>, key: &str) -> PyResult<Option<[f32; 3]>> {
 
 /// The camera keywords (or a `Camera`'s, given as `camera=`).
 pub fn camera_options(k: &Keywords<'_>) -> PyResult<CameraOptions> {
-    const CAMERA: &[&str] = &[
-        "size",
-        "view",
-        "look_at",
-        "up",
-        "perspective",
-        "azimuth",
-        "elevation",
-        "zoom",
-        "clip",
-        "crop",
-    ];
     if let Some(camera) = k.get("camera") {
         let camera = camera
             .cast::<Camera>()

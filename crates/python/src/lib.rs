@@ -15,12 +15,12 @@
 //! frame.save("ball.png")            # or show it in Jupyter, or np.asarray(frame)
 //! ```
 //!
-//! Where things are: [`array`] (numpy arrays as volumes, without a copy),
-//! [`volume`] (`Volume`, `read`), [`keywords`] (keyword arguments to
-//! options, and their names in messages), [`renderer`] (`Renderer`,
-//! `render`, Ctrl-C), [`frame`] (`Frame`), [`transfer`]
-//! (`TransferFunction`, `Camera`), [`generate`] (`hydrogen`, `fractal`),
-//! [`errors`] (library errors to Python exceptions).
+//! Where things are: `array.rs` (numpy arrays as volumes, without a copy),
+//! `volume.rs` (`Volume`, `read`), `keywords.rs` (keyword arguments to
+//! options), `renderer.rs` (`Renderer`, `render`, Ctrl-C), `frame.rs`
+//! (`Frame`), `transfer.rs` (`TransferFunction`, `Camera`), `generate.rs`
+//! (`hydrogen`, `fractal`), `errors.rs` (library errors as Python
+//! exceptions, options named as Python spells them).
 
 use pyo3::prelude::*;
 

@@ -9,7 +9,7 @@
 use crate::array::Order;
 use crate::errors::{option_error, render_error, settings_error, value_error};
 use crate::frame::Frame;
-use crate::keywords::{self, FRAME, Keywords, VOLUME};
+use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
 use crate::volume::Volume;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -278,7 +278,7 @@ impl Renderer {
     /// One frame: the keywords of `render` but the volume's own.
     #[pyo3(signature = (**kwargs))]
     fn render(&self, py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Frame> {
-        let k = Keywords::new(kwargs, &[FRAME], "render")?;
+        let k = Keywords::new(kwargs, &[CAMERA, FRAME], "render")?;
         self.frame(py, &k)
     }
 
@@ -304,6 +304,6 @@ pub fn render(
     volume: &Bound<'_, PyAny>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Frame> {
-    let k = Keywords::new(kwargs, &[VOLUME, FRAME], "render")?;
+    let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME], "render")?;
     Renderer::build(py, volume, &k)?.frame(py, &k)
 }

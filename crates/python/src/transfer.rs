@@ -2,7 +2,7 @@
 //! `Camera` (the camera keywords kept together, for `camera=`).
 
 use crate::errors::value_error;
-use crate::keywords::{Keywords, camera_from};
+use crate::keywords::{CAMERA, Keywords, camera_from};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -190,18 +190,6 @@ impl Camera {
     #[new]
     #[pyo3(signature = (**kwargs))]
     fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        const CAMERA: &[&str] = &[
-            "size",
-            "view",
-            "look_at",
-            "up",
-            "perspective",
-            "azimuth",
-            "elevation",
-            "zoom",
-            "clip",
-            "crop",
-        ];
         let k = Keywords::new(kwargs, &[CAMERA], "Camera")?;
         Ok(Camera {
             options: camera_from(&k)?,
