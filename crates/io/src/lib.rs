@@ -28,7 +28,7 @@
 //! | format | module | notes |
 //! |---|---|---|
 //! | raw | `formats/raw.rs` | layout from [`RawOptions`] |
-//! | NumPy `.npy` | `formats/npy.rs` | `a[x, y, z]`; C order transposed |
+//! | NumPy `.npy` | `formats/npy/` | `a[x, y, z]`; C order transposed |
 //! | NRRD `.nrrd`, `.nhdr` | `formats/nrrd/` | raw, gzip, ascii, hex; detached and multi-file data; space directions; 4-D frames |
 //! | MetaImage `.mha`, `.mhd` | `formats/metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
 //! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
