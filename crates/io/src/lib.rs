@@ -52,7 +52,7 @@
 //! a file's grid (origin and one step vector per index axis) onto the
 //! axis-aligned volume, reordering and flipping axes exactly;
 //! `shared/text_header.rs` reads the lines and field values of NRRD and
-//! MetaImage headers, and `shared/payload.rs` their data (skips,
+//! MetaImage headers, and `shared/payload/` their data (skips,
 //! encodings, multi-file lists) within the file's bounds;
 //! [`inflate_exact`] (`shared/compress.rs`) inflates to a declared size;
 //! [`check_volume_size`] (`shared/limits.rs`) checks a header's dimensions

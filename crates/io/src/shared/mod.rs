@@ -12,7 +12,7 @@
 //! | `hdf5.rs` | HDF5 files opened, attributes read, numeric datasets read in slabs (pure Rust) | HDF5, MINC2 |
 //! | `geometry.rs` | a file's grid (origin, step vectors) → the axis-aligned volume | every reader with geometry |
 //! | `text_header.rs` | header lines and field values | NRRD, MetaImage |
-//! | `payload.rs` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
+//! | `payload/` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
 //! | `text_reader.rs` | numbers streamed out of text | cube, CHGCAR, text data of NRRD and MetaImage |
 //! | `rescale.rs` | stored values rescaled (slope, intercept), kept in an integer type where exact | NIfTI, DICOM |
 //! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |

@@ -175,10 +175,12 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             files.len()
         ));
     }
-    let mappable = payload::mappable(&regions, per_file, &layout, select);
-    let plan = mapped::plan(
+    let (data, plan) = payload::plan_frame(
+        &regions,
+        per_file,
+        &layout,
+        select,
         opts.map,
-        mappable.as_ref().map(|_| ()).map_err(Clone::clone),
         check_frame_dims(
             path,
             "NRRD field \"sizes\"",
@@ -188,12 +190,6 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             opts.max_memory,
         ),
     )?;
-    let data = match (plan, mappable) {
-        (Plan::Map, Ok((file, offset))) => {
-            mapped::map_samples(&file, offset, dtype, total / frames)?
-        }
-        _ => payload::read_regions(&regions, per_file, &layout, select)?,
-    };
 
     let volume_dims = [
         sizes[geometry.axes[0]],
