@@ -24,16 +24,20 @@
 //! Without ImageJ metadata the spacing is 1 (the resolution tags of a
 //! plain TIFF describe print size, not voxel size) and the origin is 0.
 
-use std::fs::File;
-use std::io::{BufReader, ErrorKind};
+mod imagej;
+mod page;
+
+use std::io::BufReader;
 use std::path::Path;
 
 use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
-use tiff::{ColorType, TiffError};
-use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
+use self::imagej::{ImageJ, calibration, imagej_geometry, stack_shape};
+use self::page::{
+    Sample, compression_name, find_ascii, find_f64, header_fields, page_info, tiff_error,
+};
 use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
@@ -51,60 +55,6 @@ const MAX_INFLATION: u64 = crate::shared::compress::MAX_DEFLATE_RATIO;
 /// Small files may decode to this many bytes whatever their length, so
 /// that a tiny but highly compressible stack is still read.
 const SMALL_FILE_ALLOWANCE: u64 = 64 << 20;
-
-/// Header values longer than this are shortened in [`FileInfo::header`].
-const MAX_HEADER_VALUE: usize = 200;
-
-/// What one page (IFD) declares.
-#[derive(Debug, Clone, PartialEq)]
-struct Page {
-    /// Position of the IFD in the file's chain, counted from 0.
-    ifd: usize,
-    width: u32,
-    height: u32,
-    sample: Result<Sample, String>,
-    /// `NewSubfileType`: bit 0 reduced resolution, bit 2 mask.
-    subfile: u32,
-    compression: u16,
-    /// `PhotometricInterpretation`: 0 WhiteIsZero, 1 BlackIsZero, ...
-    photometric: Option<u32>,
-}
-
-/// A greyscale sample type.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Sample {
-    Uint(u8),
-    Int(u8),
-    Float(u8),
-}
-
-impl Sample {
-    fn name(self) -> String {
-        match self {
-            Sample::Uint(b) => format!("uint{b}"),
-            Sample::Int(b) => format!("int{b}"),
-            Sample::Float(b) => format!("float{b}"),
-        }
-    }
-
-    fn bytes(self) -> u64 {
-        let (Sample::Uint(b) | Sample::Int(b) | Sample::Float(b)) = self;
-        u64::from(b) / 8
-    }
-
-    /// The type the volume keeps: 8- and 16-bit integers as they are,
-    /// the rest as `f32`.
-    fn stored(self) -> SampleType {
-        match self {
-            Sample::Uint(8) => SampleType::U8,
-            Sample::Uint(16) => SampleType::U16,
-            Sample::Int(8) => SampleType::I8,
-            Sample::Int(16) => SampleType::I16,
-            _ => SampleType::F32,
-        }
-    }
-}
-
 /// Reads the TIFF stack at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (file, file_len) = open_input(path)?;
@@ -316,7 +266,6 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         info,
     })
 }
-
 /// Refuses a stack whose `voxels` samples would decode to more bytes than
 /// a `file_len`-byte file can plausibly hold (see [`MAX_INFLATION`]).
 fn check_budget(
@@ -344,253 +293,6 @@ fn check_budget(
     }
     Ok(())
 }
-
-/// The hyperstack layout: how many channels, slices and time points the
-/// pages hold.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct Shape {
-    channels: usize,
-    slices: usize,
-    times: usize,
-}
-
-/// The stack's shape from ImageJ's counts, checked against the pages.
-fn stack_shape(path: &Path, imagej: Option<&ImageJ>, pages: usize) -> Result<Shape, IoError> {
-    let Some(ij) = imagej else {
-        return Ok(Shape {
-            channels: 1,
-            slices: pages,
-            times: 1,
-        });
-    };
-    let count = |key: &str| -> Result<Option<usize>, IoError> {
-        match ij.get(key) {
-            None => Ok(None),
-            Some(v) => match v.parse::<usize>() {
-                Ok(n) if n >= 1 => Ok(Some(n)),
-                _ => Err(IoError::invalid(
-                    path,
-                    format!("ImageJ description field \"{key}\": \"{v}\" is not a positive count"),
-                )),
-            },
-        }
-    };
-    let channels = count("channels")?.unwrap_or(1);
-    let times = count("frames")?.unwrap_or(1);
-    let images = count("images")?;
-    let slices = match count("slices")? {
-        Some(s) => s,
-        None => {
-            let n = images.unwrap_or(pages);
-            n / (channels * times).max(1)
-        }
-    };
-    let declared = channels
-        .checked_mul(slices)
-        .and_then(|n| n.checked_mul(times));
-    if declared != Some(pages) {
-        let hint = if pages == 1 {
-            " (ImageJ's contiguous layout for stacks over 4 GB, with one page, is not supported)"
-        } else {
-            ""
-        };
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "ImageJ description says channels={channels} slices={slices} frames={times} but the file has {pages} full-resolution page(s){hint}"
-            ),
-        ));
-    }
-    Ok(Shape {
-        channels,
-        slices,
-        times,
-    })
-}
-
-/// The `key=value` lines of an ImageJ `ImageDescription`, in order.
-#[derive(Debug, Clone, Default, PartialEq)]
-struct ImageJ {
-    fields: Vec<(String, String)>,
-}
-
-impl ImageJ {
-    fn parse(description: &str) -> Self {
-        let fields = description
-            .lines()
-            .filter_map(|line| {
-                let (k, v) = line.split_once('=')?;
-                Some((k.trim().to_string(), v.trim().to_string()))
-            })
-            .collect();
-        ImageJ { fields }
-    }
-
-    fn get(&self, key: &str) -> Option<&str> {
-        self.fields
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
-    }
-
-    /// A finite number under `key`, if present and readable.
-    fn number(&self, key: &str) -> Option<f64> {
-        self.get(key)?.parse::<f64>().ok().filter(|v| v.is_finite())
-    }
-
-    /// The length unit, with ImageJ's `\u00B5` escape decoded.
-    fn unit(&self) -> Option<String> {
-        let raw = self.get("unit")?;
-        Some(
-            raw.replace("\\u00B5", "\u{b5}")
-                .replace("\\u00b5", "\u{b5}"),
-        )
-    }
-}
-
-/// ImageJ's linear calibration `value = c0 + c1·stored` (`cf=0`, ImageJ's
-/// `Calibration.STRAIGHT_LINE`) as `(c0, c1)` when there is one to apply,
-/// and the note to give about it.
-fn calibration(ij: &ImageJ) -> (Option<(f64, f64)>, Option<String>) {
-    let Some(cf) = ij.get("cf") else {
-        return (None, None);
-    };
-    if cf != "0" {
-        let note = format!(
-            "ImageJ calibration function cf={cf} (not a straight line) ignored: stored values kept"
-        );
-        return (None, Some(note));
-    }
-    let (c0, c1) = (
-        ij.number("c0").unwrap_or(0.0),
-        ij.number("c1").unwrap_or(1.0),
-    );
-    if c0 == 0.0 && c1 == 1.0 {
-        return (None, None);
-    }
-    let unit = ij
-        .get("vunit")
-        .map(|u| format!(" ({u})"))
-        .unwrap_or_default();
-    let note = format!("ImageJ calibration applied: value = {c0} + {c1} x stored{unit}");
-    (Some((c0, c1)), Some(note))
-}
-
-/// Spacing and origin from ImageJ's calibration: see the module docs.
-fn imagej_geometry(
-    ij: &ImageJ,
-    resolution: [Option<f64>; 2],
-    spacing: &mut DVec3,
-    origin: &mut DVec3,
-    info: &mut FileInfo,
-) {
-    let unit = ij.unit().filter(|u| u != "pixel" && !u.is_empty());
-    let Some(unit) = unit else {
-        info.notes
-            .push("ImageJ stack without a length unit: spacing 1, 1, 1 (pixels)".into());
-        return;
-    };
-    for (a, res) in resolution.into_iter().enumerate() {
-        match res {
-            Some(r) if r.is_finite() && r > 0.0 => spacing[a] = 1.0 / r,
-            Some(r) => info.notes.push(format!(
-                "{} {r} is not a positive number of pixels per {unit}: spacing 1 used",
-                ["XResolution", "YResolution"][a]
-            )),
-            None => {}
-        }
-    }
-    match ij.number("spacing") {
-        Some(s) if s > 0.0 => spacing.z = s,
-        Some(s) => info.notes.push(format!(
-            "ImageJ spacing={s} is not positive: z spacing 1 used"
-        )),
-        None => {}
-    }
-    for (a, key) in ["xorigin", "yorigin", "zorigin"].into_iter().enumerate() {
-        if let Some(o) = ij.number(key) {
-            origin[a] = -o * spacing[a];
-        }
-    }
-    info.notes.push(format!(
-        "spacing {}, {}, {} {unit} from ImageJ metadata (x, y: 1/XResolution, 1/YResolution; z: spacing=){}",
-        spacing.x,
-        spacing.y,
-        spacing.z,
-        if *origin != DVec3::ZERO {
-            format!(
-                "; origin {}, {}, {} from xorigin/yorigin/zorigin (pixels)",
-                origin.x, origin.y, origin.z
-            )
-        } else {
-            String::new()
-        }
-    ));
-    info.length_unit = Some(unit);
-}
-
-/// What the current page declares.
-fn page_info(
-    path: &Path,
-    decoder: &mut Decoder<BufReader<File>>,
-    ifd: usize,
-) -> Result<Page, IoError> {
-    let (width, height) = decoder
-        .dimensions()
-        .map_err(|e| tiff_error(path, &format!("page {ifd}"), e))?;
-    let subfile = find_u32(decoder, Tag::NewSubfileType).unwrap_or(0);
-    let compression = find_u32(decoder, Tag::Compression).unwrap_or(1) as u16;
-    let format = find_u32(decoder, Tag::SampleFormat).unwrap_or(1);
-    let photometric = find_u32(decoder, Tag::PhotometricInterpretation);
-    let sample = match decoder.colortype() {
-        Ok(ColorType::Gray(bits)) => greyscale(bits, format, photometric),
-        Ok(ColorType::RGB(_) | ColorType::YCbCr(_)) => Err(
-            "RGB pixels (3 samples each): volray reads greyscale stacks only; convert to greyscale first"
-                .to_string(),
-        ),
-        Ok(ColorType::Palette(_)) => Err(
-            "palette-colour pixels: volray reads greyscale stacks only".to_string(),
-        ),
-        Ok(other) => Err(format!(
-            "{other:?} pixels: volray reads greyscale stacks (one sample per pixel) only"
-        )),
-        Err(e) => Err(format!("unsupported pixel layout: {e}")),
-    };
-    Ok(Page {
-        ifd,
-        width,
-        height,
-        sample,
-        subfile,
-        compression,
-        photometric,
-    })
-}
-
-/// The sample type of a greyscale page of `bits` per sample and TIFF
-/// `SampleFormat` `format` (1 unsigned, 2 signed, 3 IEEE float).
-fn greyscale(bits: u8, format: u32, photometric: Option<u32>) -> Result<Sample, String> {
-    if photometric == Some(4) {
-        return Err("transparency-mask pixels (PhotometricInterpretation 4)".into());
-    }
-    let sample = match (format, bits) {
-        (1, 8 | 16 | 32 | 64) => Sample::Uint(bits),
-        (2, 8 | 16 | 32 | 64) => Sample::Int(bits),
-        (3, 16 | 32 | 64) => Sample::Float(bits),
-        (1..=3, _) => {
-            return Err(format!(
-                "{bits}-bit samples are not supported (8, 16, 32 or 64 bits)"
-            ));
-        }
-        _ => {
-            return Err(format!(
-                "SampleFormat {format} is not supported (1 unsigned, 2 signed, 3 float)"
-            ));
-        }
-    };
-    Ok(sample)
-}
-
 /// Appends a decoded page to `out`, as `T`: the page's own type where
 /// [`Sample::stored`] keeps it, `f32` (rounded once, as `as f32` does)
 /// otherwise.
@@ -612,67 +314,6 @@ fn extend_page<T: Stored>(out: &mut Vec<T>, image: DecodingResult) {
         DecodingResult::F64(v) => keep(out, v.into_iter().map(|x| x as f32)),
     }
 }
-
-/// The first page's tags as written, in file order, values shortened.
-fn header_fields(decoder: &mut Decoder<BufReader<File>>) -> Vec<(String, String)> {
-    let tags: Vec<_> = decoder.tag_iter().filter_map(Result::ok).collect();
-    tags.into_iter()
-        .map(|(tag, value)| {
-            let name = match tag {
-                Tag::Unknown(n) => format!("tag {n}"),
-                t => format!("{t:?}"),
-            };
-            let text = match value.clone().into_string() {
-                Ok(s) => s.trim_end_matches('\0').replace('\n', "; "),
-                Err(_) => format!("{value:?}"),
-            };
-            (name, shorten(&text))
-        })
-        .collect()
-}
-
-fn shorten(text: &str) -> String {
-    if text.chars().count() <= MAX_HEADER_VALUE {
-        return text.to_string();
-    }
-    let head: String = text.chars().take(MAX_HEADER_VALUE).collect();
-    format!("{head}... ({} characters)", text.chars().count())
-}
-
-fn find_u32(decoder: &mut Decoder<BufReader<File>>, tag: Tag) -> Option<u32> {
-    decoder.find_tag_unsigned::<u32>(tag).ok().flatten()
-}
-
-/// A numeric tag (RATIONAL, as resolutions are written, or any number).
-fn find_f64(decoder: &mut Decoder<BufReader<File>>, tag: Tag) -> Option<f64> {
-    use tiff::decoder::ifd::Value;
-    match decoder.find_tag(tag).ok().flatten()? {
-        Value::Rational(n, d) => Some(f64::from(n) / f64::from(d)),
-        Value::SRational(n, d) => Some(f64::from(n) / f64::from(d)),
-        Value::Double(v) => Some(v),
-        Value::Float(v) => Some(f64::from(v)),
-        Value::Short(v) => Some(f64::from(v)),
-        Value::Unsigned(v) => Some(f64::from(v)),
-        _ => None,
-    }
-}
-
-fn find_ascii(decoder: &mut Decoder<BufReader<File>>, tag: Tag) -> Option<String> {
-    decoder.find_tag(tag).ok().flatten()?.into_string().ok()
-}
-
-fn compression_name(code: u16) -> String {
-    match code {
-        1 => "uncompressed".into(),
-        5 => "LZW".into(),
-        6 | 7 => "JPEG".into(),
-        8 | 0x80b2 => "deflate".into(),
-        0x8005 => "PackBits".into(),
-        0xc350 => "zstd".into(),
-        n => format!("compression {n}"),
-    }
-}
-
 /// "0, 2, 5" for up to 10 indices, then "and N more".
 fn list_indices(indices: &[usize]) -> String {
     let shown: Vec<String> = indices.iter().take(10).map(|i| i.to_string()).collect();
@@ -683,35 +324,10 @@ fn list_indices(indices: &[usize]) -> String {
         format!("pages {}", shown.join(", "))
     }
 }
-
-/// A `tiff` crate error while reading `what`: an operating-system failure
-/// stays one; a short or corrupt file is bad input.
-fn tiff_error(path: &Path, what: &str, error: TiffError) -> IoError {
-    match error {
-        // An offset from the file that cannot be sought to (2^63 or more)
-        // fails in the operating system, but the file is what is wrong.
-        TiffError::IoError(e) if e.kind() == ErrorKind::InvalidInput => IoError::invalid(
-            path,
-            format!("TIFF {what}: an offset in the file lies beyond any file's end ({e})"),
-        ),
-        TiffError::IoError(e) if e.kind() != ErrorKind::UnexpectedEof => {
-            IoError::os(path, "read", e)
-        }
-        TiffError::IoError(_) => {
-            IoError::invalid(path, format!("TIFF {what}: file ends early (truncated?)"))
-        }
-        TiffError::LimitsExceeded => IoError::invalid(
-            path,
-            format!(
-                "TIFF {what}: a page or tag is larger than the decoder's limits (256 MiB per page, 1 MiB per tag)"
-            ),
-        ),
-        e => IoError::invalid(path, format!("TIFF {what}: {e}")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::imagej::Shape;
+    use super::page::greyscale;
     use super::*;
     use volray_core::Samples;
 
