@@ -21,6 +21,13 @@ fn with(map: MapPolicy, frame: Option<usize>) -> ReadOptions {
     }
 }
 
+/// A raw file `v.raw` in `dir` holding `values`' bytes in order.
+fn raw_file<const N: usize>(dir: &Path, values: impl IntoIterator<Item = [u8; N]>) -> PathBuf {
+    let p = dir.join("v.raw");
+    fs::write(&p, values.into_iter().flatten().collect::<Vec<u8>>()).unwrap();
+    p
+}
+
 /// Every fixture of the formats that map, read both ways: mapped where
 /// the layout allows (same samples, same everything else), read where it
 /// does not; returns the fixtures mapped.
@@ -118,18 +125,10 @@ fn mapped_samples_are_the_samples_read() {
 #[test]
 fn a_volume_over_the_limit_is_mapped_or_refused_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("v.raw");
     let values: Vec<i16> = (0..16 * 16 * 16)
         .map(|i| (i % 3000) as i16 - 1000)
         .collect();
-    fs::write(
-        &p,
-        values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    )
-    .unwrap();
+    let p = raw_file(dir.path(), values.iter().map(|v| v.to_le_bytes()));
     let raw = |dtype, endian| {
         let mut r = RawOptions::new([16, 16, 16], dtype);
         r.endian = endian;
@@ -186,19 +185,11 @@ fn a_volume_over_the_limit_is_mapped_or_refused_with_the_reason() {
 #[test]
 fn a_mapped_file_truncated_before_a_frame_fails_the_frame() {
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("v.raw");
     let n = 48usize;
     let values: Vec<u16> = (0..n * n * n)
         .map(|i| ((i * 7919) % 60000) as u16)
         .collect();
-    fs::write(
-        &p,
-        values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    )
-    .unwrap();
+    let p = raw_file(dir.path(), values.iter().map(|v| v.to_le_bytes()));
     let opts = ReadOptions {
         raw: Some(RawOptions::new([n, n, n], volray_io::DType::U16)),
         map: MapPolicy::Always,
@@ -239,5 +230,4 @@ fn a_mapped_file_truncated_before_a_frame_fails_the_frame() {
         }
         other => panic!("{other:?}"),
     }
-    let _ = Path::new("");
 }
