@@ -29,7 +29,7 @@
 //! ```
 //!
 //! The other paths share every step they can: post-classified frames
-//! (`cpu/post.rs`: interpolate the scalar and the gradient, then classify
+//! (`cpu/post/`: interpolate the scalar and the gradient, then classify
 //! and shade each sample, walking the bricks each ray crosses) and the
 //! projections (`cpu/projection.rs`: maximum, minimum, average of the
 //! scalar, skipping bricks that cannot change the result) take the same

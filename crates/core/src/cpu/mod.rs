@@ -7,7 +7,7 @@
 //! | `tiles.rs` | per frame, the occupied bricks each 16² image tile's rays may cross, front to back |
 //! | `lit_bricks.rs` | per frame, each occupied brick's voxels lit (Phong × material), as the rays first reach it |
 //! | `bricked.rs` | the pre-classified caster (the paper's method, the default): rays through their tile's bricks |
-//! | `post.rs` | the post-classified caster: rays walk the bricks they cross, skipping transparent ones |
+//! | `post/` | the post-classified caster: rays walk the bricks they cross, skipping transparent ones |
 //! | `projection.rs` | maximum, minimum and average projections of the scalar |
 
 pub mod bricked;
