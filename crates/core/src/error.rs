@@ -66,6 +66,8 @@ pub enum SettingError {
     LightDirection(DVec3),
     #[error("crop box {lo} .. {hi} must be finite with low < high on every axis")]
     Crop { lo: DVec3, hi: DVec3 },
+    #[error("{0}")]
+    Piece(Box<crate::piece::Misfit>),
     #[error("clip plane point {0} must be finite")]
     ClipPoint(DVec3),
     #[error("clip plane normal {0} must be a finite, non-zero vector")]

@@ -3,6 +3,7 @@
 
 use crate::camera::View;
 use crate::error::{RenderError, SettingError};
+use crate::piece::Piece;
 use crate::sampling::clipping::{ClipPlane, Clipping};
 use crate::sampling::grid::GridFrame;
 use crate::sampling::{PixelSamples, Sampling};
@@ -22,14 +23,27 @@ impl Frame {
     /// Checks `settings` and frames their camera and samples on `volume`.
     pub fn new(settings: &RenderSettings, volume: &Volume) -> Result<Self, RenderError> {
         settings.validate()?;
+        let grid = GridFrame {
+            dims: volume.dims(),
+            origin: volume.origin(),
+            spacing: volume.spacing(),
+        };
+        // A piece is framed, and sampled, as the whole volume it is part of.
+        let whole = match &settings.piece {
+            Some(piece) => {
+                piece.validate(volume.dims(), volume.spacing())?;
+                piece.whole
+            }
+            None => grid,
+        };
         let view = View::frame(
             &settings.camera,
-            volume.bounds(),
+            whole.bounds(),
             settings.width,
             settings.height,
         )?;
         let step = settings.step * volume.spacing().min_element();
-        let samples = volume.extent().length() / step;
+        let samples = whole.extent().length() / step;
         if samples > MAX_SAMPLES_PER_RAY {
             return Err(SettingError::StepTooSmall {
                 step: settings.step,
@@ -38,11 +52,6 @@ impl Frame {
             }
             .into());
         }
-        let grid = GridFrame {
-            dims: volume.dims(),
-            origin: volume.origin(),
-            spacing: volume.spacing(),
-        };
         let clipping = Clipping {
             crop: settings.crop,
             // Unit normals: the planes' arithmetic stays in range.
@@ -59,6 +68,7 @@ impl Frame {
             clipping,
             jitter: settings.jitter,
             from_eye: matches!(view, View::Perspective(_)),
+            ownership: settings.piece.as_ref().map(Piece::ownership),
         };
         Ok(Frame { view, sampling })
     }

@@ -374,18 +374,18 @@ impl<'v> Renderer<'v> {
     pub(crate) fn classifier(&self, settings: &RenderSettings) -> Classifier {
         let mut classifier = Classifier::from_transfer_function(
             &settings.transfer_function,
-            self.value_range,
+            self.value_range_of(settings),
             settings.opacity_ramp,
             settings.step as f32,
         );
         if let Some(iso) = settings.iso {
             let voxel_size = self.volume.spacing().min_element() as f32;
-            classifier = classifier.with_iso(iso, voxel_size, self.max_gradient());
+            classifier = classifier.with_iso(iso, voxel_size, self.max_gradient_of(settings));
         }
         if let Some(range) = settings.gradient_opacity {
             let max = settings
                 .gradient_opacity_max
-                .unwrap_or_else(|| self.max_gradient());
+                .unwrap_or_else(|| self.max_gradient_of(settings));
             classifier = classifier.with_gradient_opacity(range, max);
         }
         classifier
@@ -395,6 +395,24 @@ impl<'v> Renderer<'v> {
     fn macrocells(&self) -> &Macrocells {
         self.macrocells
             .get_or_init(|| Macrocells::new(&self.volume))
+    }
+
+    /// The value range a frame of `settings` classifies by: the whole
+    /// volume's, for a piece of one.
+    fn value_range_of(&self, settings: &RenderSettings) -> (f32, f32) {
+        settings
+            .piece
+            .as_ref()
+            .map_or(self.value_range, |p| p.value_range)
+    }
+
+    /// The largest gradient magnitude a frame of `settings` scales by: the
+    /// whole volume's, for a piece of one.
+    fn max_gradient_of(&self, settings: &RenderSettings) -> f32 {
+        match &settings.piece {
+            Some(piece) => piece.max_gradient,
+            None => self.max_gradient(),
+        }
     }
 
     /// The volume's largest gradient magnitude (world units), found once.
@@ -491,7 +509,7 @@ impl<'v> Renderer<'v> {
                     &self.volume,
                     self.non_finite.as_ref(),
                     macrocells,
-                    self.value_range,
+                    self.value_range_of(settings),
                     &frame.view,
                     &frame.sampling,
                     *blend,

@@ -7,6 +7,7 @@ use crate::camera::Camera;
 use crate::error::{ImageSide, Reflection, SettingError};
 pub use crate::kernels::blend::Blend;
 use crate::kernels::phong::Phong;
+use crate::piece::Piece;
 use crate::sampling::clipping::ClipPlane;
 use crate::transfer::function::TransferFunction;
 use crate::transfer::gradient_opacity::GradientOpacity;
@@ -85,6 +86,10 @@ pub struct RenderSettings {
     /// series of volumes shares the largest of them all, as it shares one
     /// value window.
     pub gradient_opacity_max: Option<f32>,
+    /// Render only this piece of a larger volume, as one rank of a
+    /// distributed render does (see [`crate::piece`]); `None` renders the
+    /// renderer's volume as the whole.
+    pub piece: Option<Piece>,
 }
 
 impl Default for RenderSettings {
@@ -109,6 +114,7 @@ impl Default for RenderSettings {
             iso: None,
             gradient_opacity: None,
             gradient_opacity_max: None,
+            piece: None,
         }
     }
 }

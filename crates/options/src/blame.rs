@@ -52,6 +52,8 @@ pub fn option_of(e: &RenderError, camera: &CameraOptions) -> Option<Opt> {
             S::GradientOpacity { .. } => Opt::GradientOpacity,
             // Set by a series from its volumes, not by an option.
             S::GradientOpacityMax(_) => return None,
+            // Set by a distributed render for each rank, not by an option.
+            S::Piece(_) => return None,
         },
     };
     Some(opt)

@@ -73,6 +73,7 @@ pub fn settings(options: &Options) -> Result<RenderSettings, OptionError> {
         iso: iso(look)?,
         gradient_opacity: look.gradient_opacity,
         gradient_opacity_max: None,
+        piece: None,
     };
     (settings.validate()).map_err(|e| OptionError::Invalid(e.into()))?;
     (settings.camera.validate()).map_err(|e| OptionError::Invalid(e.into()))?;

@@ -310,7 +310,9 @@ impl<'a> Rays<'a> {
         Rays {
             sampling,
             view,
-            clipped: sampling.clipping.is_active(),
+            // A piece's rays are cut to what it owns: every brick takes
+            // each ray's exact range.
+            clipped: sampling.clipping.is_active() || sampling.ownership.is_some(),
             geometry,
         }
     }

@@ -324,6 +324,7 @@ mod tests {
             clipping: Clipping::default(),
             jitter: false,
             from_eye: false,
+            ownership: None,
         };
         let view = View::frame(&Camera::default(), v.bounds(), 64, 64).unwrap();
         let bins = TileBins::new(&bricks, &sampling, &view);
@@ -452,6 +453,7 @@ mod tests {
                 clipping: Clipping::default(),
                 jitter: false,
                 from_eye: matches!(view, View::Perspective(_)),
+                ownership: None,
             };
             let bins = TileBins::new(&bricks, &sampling, &view);
             let t_min = if sampling.from_eye {

@@ -31,6 +31,17 @@ pub struct GridFrame {
 }
 
 impl GridFrame {
+    /// The world size of the grid's box, `(n − 1)·spacing` on each axis.
+    pub fn extent(&self) -> DVec3 {
+        let n = |a: usize| (self.dims[a] - 1) as f64;
+        DVec3::new(n(0), n(1), n(2)) * self.spacing
+    }
+
+    /// The grid's box in the world: its first and last voxels' positions.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        (self.origin, self.origin + self.extent())
+    }
+
     /// Where a world ray `origin + t·dir` (`dir` a unit vector) is inside
     /// the grid's box: `(t_enter, t_exit)` in world units of `t`, the same
     /// `t` as the ray's. `None` if the line misses the box. The

@@ -22,6 +22,7 @@ pub mod grid;
 pub mod jitter;
 
 use crate::camera::View;
+use crate::piece::Ownership;
 use crate::sampling::clipping::Clipping;
 use crate::sampling::grid::{GridFrame, clamp_to_grid};
 use glam::DVec3;
@@ -37,6 +38,9 @@ pub struct Sampling {
     pub jitter: bool,
     /// Rays start at the eye (perspective): only `t ≥ 0` is sampled.
     pub from_eye: bool,
+    /// A piece of a larger volume ([`crate::piece`]): rays are bounded by
+    /// the whole grid, and take only the samples the piece owns.
+    pub ownership: Option<Ownership>,
 }
 
 /// The samples of one pixel's ray: `k` from `first` to `last` (inclusive).
@@ -90,7 +94,8 @@ impl Sampling {
         origin: DVec3,
         direction: DVec3,
     ) -> Option<PixelSamples> {
-        let (mut t0, t1) = self.grid.span(origin, direction)?;
+        let bounds = self.ownership.as_ref().map_or(&self.grid, |o| &o.whole);
+        let (mut t0, t1) = bounds.span(origin, direction)?;
         if self.from_eye {
             t0 = t0.max(0.0);
         }
@@ -108,13 +113,21 @@ impl Sampling {
         let tolerance = 1e-6 * step;
         let first = ((t0 - tolerance) / step - offset).ceil();
         let last = ((t1 + tolerance) / step - offset).floor();
-        (first <= last).then_some(PixelSamples {
+        if first > last {
+            return None;
+        }
+        let (first, last) = (first as i64, last as i64);
+        let (first, last) = match &self.ownership {
+            Some(owned) => owned.restrict(origin, direction, step, offset, (first, last))?,
+            None => (first, last),
+        };
+        Some(PixelSamples {
             origin: (origin - self.grid.origin) / self.grid.spacing,
             direction: direction / self.grid.spacing,
             step,
             offset,
-            first: first as i64,
-            last: last as i64,
+            first,
+            last,
         })
     }
 }
@@ -139,6 +152,7 @@ mod tests {
             clipping,
             jitter,
             from_eye,
+            ownership: None,
         }
     }
 
@@ -180,6 +194,7 @@ mod tests {
             clipping: Clipping::default(),
             jitter: false,
             from_eye: false,
+            ownership: None,
         };
         let samples = s.pixel(&view, col, row);
         (view, samples)

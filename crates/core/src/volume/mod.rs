@@ -222,6 +222,41 @@ impl Volume {
         self.samples.get(self.index(i, j, k))
     }
 
+    /// The voxels `lo[a] ≤ i < hi[a]` as a volume of their own: the same
+    /// sample type, spacing and labels, placed where they are in the world
+    /// (its origin is voxel `lo`'s position). Reads only those voxels, so
+    /// a box of a mapped volume touches only its own pages.
+    ///
+    /// # Panics
+    /// If the box is not inside the grid or is thinner than two voxels on
+    /// an axis (callers make it from the grid's dimensions).
+    pub fn sub_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Volume {
+        assert!(
+            (0..3).all(|a| lo[a] + 2 <= hi[a] && hi[a] <= self.dims[a]),
+            "box {lo:?}..{hi:?} of a {:?} grid",
+            self.dims
+        );
+        let [nx, ny, _] = self.dims;
+        let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+        let samples: Samples = crate::with_samples!(&self.samples, |data| {
+            let mut out = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+            for z in lo[2]..hi[2] {
+                for y in lo[1]..hi[1] {
+                    let row = (z * ny + y) * nx;
+                    out.extend_from_slice(&data[row + lo[0]..row + hi[0]]);
+                }
+            }
+            Samples::from(out)
+        });
+        Volume {
+            dims,
+            spacing: self.spacing,
+            origin: self.world_position(lo[0], lo[1], lo[2]),
+            samples,
+            labels: self.labels,
+        }
+    }
+
     /// World position of voxel (i, j, k).
     pub fn world_position(&self, i: usize, j: usize, k: usize) -> DVec3 {
         self.origin + DVec3::new(i as f64, j as f64, k as f64) * self.spacing
