@@ -271,18 +271,38 @@ impl<'v> Renderer<'v> {
         settings: &RenderSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<PartialImage, RenderError> {
+        self.render_partial_timed(settings, progress)
+            .map(|(partial, _)| partial)
+    }
+
+    /// [`Self::render_partial`], saying where the time went (as
+    /// [`Self::render_into`] does).
+    pub fn render_partial_timed(
+        &self,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<(PartialImage, FrameTimes), RenderError> {
         let progress = &Progress::new(progress);
         let frame = self.prepare(settings)?;
-        let partial = match settings.method {
+        let start = Instant::now();
+        let (partial, times) = match settings.method {
             Method::Fast => {
                 let mut partial = self.blank(settings, Vec::new());
-                self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
-                partial
+                let times =
+                    self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
+                (partial, times)
             }
-            Method::Reference => self.render_reference(settings, &frame, progress),
+            Method::Reference => {
+                let partial = self.render_reference(settings, &frame, progress);
+                let times = FrameTimes {
+                    cast: start.elapsed(),
+                    ..FrameTimes::default()
+                };
+                (partial, times)
+            }
         };
         verify(&self.volume)?;
-        Ok(partial)
+        Ok((partial, times))
     }
 
     /// The finished frame of `partial` (rendered with `settings`): over the

@@ -1,0 +1,412 @@
+//! One distributed frame, as every rank runs it: split, read the piece,
+//! agree on the whole volume's statistics, render the piece, composite.
+//!
+//! Every step that can fail on one rank (reading, rendering) ends with
+//! every rank learning every rank's outcome ([`Transport::all_gather`]),
+//! so that a failure on one rank stops them all with the same error,
+//! and none waits forever on a rank that has given up.
+
+use crate::compose::{ComposeError, ComposeStats, composite};
+use crate::kd::{Decomposition, Viewpoint};
+use crate::schedule::Plan;
+use crate::transport::{Transport, TransportError};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+use volray_core::camera::View;
+use volray_core::kernels::gradient::{Differences, magnitude};
+use volray_core::sampling::grid::GridFrame;
+use volray_core::{
+    Image, NonFinite, PartialImage, Piece, RenderError, RenderSettings, Renderer, Volume,
+    with_samples,
+};
+
+/// Where a rank's piece comes from.
+pub trait Source {
+    /// The whole volume's grid.
+    fn grid(&self) -> GridFrame;
+    /// The voxels `lo..hi` (half-open) of the whole grid as a volume: a
+    /// one-line error naming the file and the problem if they cannot be
+    /// read, or do not fit this rank's memory.
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String>;
+}
+
+/// A volume in memory is a source of its boxes.
+impl Source for Volume {
+    fn grid(&self) -> GridFrame {
+        GridFrame {
+            dims: self.dims(),
+            origin: self.origin(),
+            spacing: self.spacing(),
+        }
+    }
+
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        Ok(self.sub_box(lo, hi))
+    }
+}
+
+/// Why a distributed frame failed: the same on every rank.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum FrameError {
+    /// A rank failed (the lowest-numbered rank that did), with its message.
+    #[error("rank {rank}: {message}")]
+    Rank { rank: usize, message: String },
+    /// Rendering refused the settings (every rank refuses alike).
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    #[error(transparent)]
+    Compose(#[from] ComposeError),
+}
+
+/// Where one rank's time went, and what it held.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RankTimes {
+    pub read: Duration,
+    /// Agreeing on the value range (and largest gradient).
+    pub agree: Duration,
+    pub classify: Duration,
+    pub cast: Duration,
+    pub compose: ComposeStats,
+    /// Voxels this rank owns and holds (its box with its ghost layers).
+    pub owned_voxels: usize,
+    pub held_voxels: usize,
+}
+
+impl RankTimes {
+    const FIELDS: usize = 10;
+
+    fn to_bytes(self) -> Vec<u8> {
+        let c = self.compose;
+        [
+            self.read.as_secs_f64(),
+            self.agree.as_secs_f64(),
+            self.classify.as_secs_f64(),
+            self.cast.as_secs_f64(),
+            c.composite.as_secs_f64(),
+            c.gather.as_secs_f64(),
+            c.bytes_sent as f64,
+            c.rounds as f64,
+            self.owned_voxels as f64,
+            self.held_voxels as f64,
+        ]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect()
+    }
+
+    fn from_bytes(b: &[u8]) -> Option<RankTimes> {
+        if b.len() != 8 * Self::FIELDS {
+            return None;
+        }
+        let v = |i: usize| f64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap());
+        let d = |i: usize| Duration::from_secs_f64(v(i).max(0.0));
+        Some(RankTimes {
+            read: d(0),
+            agree: d(1),
+            classify: d(2),
+            cast: d(3),
+            compose: ComposeStats {
+                composite: d(4),
+                gather: d(5),
+                bytes_sent: v(6) as usize,
+                messages: 0,
+                rounds: v(7) as usize,
+            },
+            owned_voxels: v(8) as usize,
+            held_voxels: v(9) as usize,
+        })
+    }
+}
+
+/// A rank's piece, read: what it renders with.
+pub struct Held {
+    pub renderer: Option<Renderer<'static>>,
+    pub piece_owned: ([usize; 3], [usize; 3]),
+    pub offset: [usize; 3],
+    /// Value range and largest gradient over what this rank holds.
+    value_range: Option<(f32, f32)>,
+    max_gradient: f32,
+    pub times: RankTimes,
+}
+
+/// One rank's part of distributed rendering of one volume: reads its piece
+/// once, then renders frames.
+pub struct Distributed<'t, T: Transport + ?Sized> {
+    transport: &'t T,
+    grid: GridFrame,
+    decomposition: Decomposition,
+    plan: Plan,
+    held: Held,
+    /// The whole volume's value range and largest gradient, agreed.
+    value_range: (f32, f32),
+    max_gradient: Option<f32>,
+}
+
+/// Every rank's outcome of a step, or the first failure, on every rank.
+fn agree<T: Transport + ?Sized>(
+    transport: &T,
+    outcome: Result<Vec<u8>, String>,
+) -> Result<Vec<Vec<u8>>, FrameError> {
+    let message = match &outcome {
+        Ok(bytes) => [&[0u8][..], bytes].concat(),
+        Err(e) => [&[1u8][..], e.as_bytes()].concat(),
+    };
+    let all = transport.all_gather(&message)?;
+    let mut out = Vec::with_capacity(all.len());
+    for (rank, m) in all.into_iter().enumerate() {
+        match m.split_first() {
+            Some((0, body)) => out.push(body.to_vec()),
+            Some((_, body)) => {
+                return Err(FrameError::Rank {
+                    rank,
+                    message: String::from_utf8_lossy(body).into_owned(),
+                });
+            }
+            None => {
+                return Err(FrameError::Rank {
+                    rank,
+                    message: "sent an empty status".into(),
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
+    /// Splits `source`'s grid among the ranks, reads this rank's piece
+    /// (with its ghost layers), and agrees on the value range. Fails on
+    /// every rank if any rank's read fails.
+    pub fn read(
+        transport: &'t T,
+        source: &dyn Source,
+        non_finite: NonFinite,
+    ) -> Result<Self, FrameError> {
+        let grid = source.grid();
+        let decomposition = Decomposition::new(grid.dims, transport.size());
+        let rank = transport.rank();
+        let plan = Plan::new(&decomposition, rank);
+        let owned_box = decomposition.boxes[rank];
+        let owned = (owned_box.lo, owned_box.hi);
+        let (lo, hi) = Piece::held(owned, grid.dims);
+        let start = Instant::now();
+        let read = if owned_box.is_empty() {
+            Ok(None)
+        } else {
+            (source.read(lo, hi))
+                .and_then(|v| {
+                    Renderer::owning(v, non_finite).map_err(|e| format!("its piece: {e}"))
+                })
+                .map(Some)
+        };
+        let read_time = start.elapsed();
+        let start = Instant::now();
+        let local = read.as_ref().map(|r| {
+            let range = r.as_ref().and_then(|r| r.volume().value_range());
+            match range {
+                Some((a, b)) => [1.0, a as f64, b as f64],
+                None => [0.0, 0.0, 0.0],
+            }
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect::<Vec<u8>>()
+        });
+        let all = agree(transport, local.map_err(|e| e.clone()))?;
+        let renderer = read.expect("agreed: every read succeeded");
+        let mut range: Option<(f32, f32)> = None;
+        for m in &all {
+            let v = |i: usize| f64::from_le_bytes(m[8 * i..8 * i + 8].try_into().unwrap());
+            if m.len() == 24 && v(0) == 1.0 {
+                let (a, b) = (v(1) as f32, v(2) as f32);
+                range = Some(range.map_or((a, b), |(x, y)| (x.min(a), y.max(b))));
+            }
+        }
+        let times = RankTimes {
+            read: read_time,
+            agree: start.elapsed(),
+            owned_voxels: owned_box.voxels(),
+            held_voxels: renderer.as_ref().map_or(0, |r| r.volume().len()),
+            ..RankTimes::default()
+        };
+        Ok(Distributed {
+            transport,
+            grid,
+            decomposition,
+            plan,
+            held: Held {
+                value_range: range,
+                renderer,
+                piece_owned: owned,
+                offset: lo,
+                max_gradient: 0.0,
+                times,
+            },
+            value_range: range.unwrap_or((0.0, 0.0)),
+            max_gradient: None,
+        })
+    }
+
+    /// The whole volume's grid.
+    pub fn grid(&self) -> GridFrame {
+        self.grid
+    }
+
+    /// This rank's renderer (none if its box is empty).
+    pub fn renderer(&self) -> Option<&Renderer<'static>> {
+        self.held.renderer.as_ref()
+    }
+
+    /// The whole volume's value range, agreed by the ranks.
+    pub fn value_range(&self) -> (f32, f32) {
+        self.value_range
+    }
+
+    /// The whole volume's largest gradient magnitude: the largest over
+    /// every rank's owned voxels (not its ghosts, whose outermost layer
+    /// has one-sided differences), found the first time a frame needs it.
+    fn max_gradient(&mut self) -> Result<f32, FrameError> {
+        if let Some(g) = self.max_gradient {
+            return Ok(g);
+        }
+        let local = self.held.renderer.as_ref().map_or(0.0, |r| {
+            owned_max_gradient(r.volume(), self.held.offset, self.held.piece_owned)
+        });
+        self.held.max_gradient = local;
+        let all = agree(self.transport, Ok(local.to_le_bytes().to_vec()))?;
+        let g = (all.iter())
+            .filter_map(|m| m.as_slice().try_into().ok().map(f32::from_le_bytes))
+            .fold(0.0f32, f32::max);
+        self.max_gradient = Some(g);
+        Ok(g)
+    }
+
+    /// The settings this rank renders its piece with.
+    pub fn piece_settings(&mut self, settings: &RenderSettings) -> Result<RenderSettings, FrameError> {
+        let needs_gradient = settings.iso.is_some() || settings.gradient_opacity.is_some();
+        let max_gradient = if needs_gradient {
+            self.max_gradient()?
+        } else {
+            0.0
+        };
+        Ok(RenderSettings {
+            piece: Some(Piece {
+                whole: self.grid,
+                offset: self.held.offset,
+                owned: self.held.piece_owned,
+                value_range: self.value_range,
+                max_gradient,
+            }),
+            ..settings.clone()
+        })
+    }
+
+    /// Renders one frame of `settings` across the ranks: the finished
+    /// frame on rank 0, `None` on the others; and this rank's times.
+    pub fn render(
+        &mut self,
+        settings: &RenderSettings,
+    ) -> Result<(Option<Image>, RankTimes), FrameError> {
+        let settings = self.piece_settings(settings)?;
+        let view = View::frame(
+            &settings.camera,
+            self.grid.bounds(),
+            settings.width,
+            settings.height,
+        )
+        .map_err(RenderError::from)?;
+        let viewpoint = match &view {
+            View::Orthographic(v) => Viewpoint::Direction(v.direction),
+            View::Perspective(v) => Viewpoint::Eye(v.eye),
+        };
+        let rendered = match &self.held.renderer {
+            Some(r) => r.render_partial_timed(&settings, &|_| {}).map(Some),
+            None => settings.validate().map(|_| None).map_err(RenderError::from),
+        };
+        // Every rank refuses the same settings alike; anything else (one
+        // rank out of memory, say) must not leave the others waiting.
+        let status = rendered.as_ref().map(|_| Vec::new()).map_err(|e| e.to_string());
+        if let Err(FrameError::Rank { rank, message }) = agree(self.transport, status) {
+            return Err(match rendered {
+                Err(e) => FrameError::Render(e),
+                Ok(_) => FrameError::Rank { rank, message },
+            });
+        }
+        let mut times = self.held.times;
+        let partial = match rendered.expect("agreed") {
+            Some((partial, t)) => {
+                times.classify = t.classify;
+                times.cast = t.cast + t.bin;
+                partial
+            }
+            None => blank(&settings),
+        };
+        let (image, stats) =
+            composite(self.transport, &self.plan, &viewpoint, &self.grid, partial)?;
+        times.compose = stats;
+        let image = image.map(|partial| self.finish(&settings, partial));
+        Ok((image, times))
+    }
+
+    /// Every rank's times, on every rank.
+    pub fn gather_times(&self, times: RankTimes) -> Result<Vec<RankTimes>, FrameError> {
+        let all = self.transport.all_gather(&times.to_bytes())?;
+        Ok(all
+            .iter()
+            .map(|b| RankTimes::from_bytes(b).unwrap_or_default())
+            .collect())
+    }
+
+    /// The frame of the whole volume's `partial` image.
+    fn finish(&self, settings: &RenderSettings, partial: PartialImage) -> Image {
+        match &self.held.renderer {
+            Some(r) => r.finish(settings, partial),
+            // Rank 0 always owns voxels; a frame of nothing otherwise.
+            None => partial.finish(settings.background, |_| settings.background),
+        }
+    }
+
+    /// The decomposition of the grid among the ranks.
+    pub fn decomposition(&self) -> &Decomposition {
+        &self.decomposition
+    }
+
+    /// Whether this rank holds a piece's value range (not an empty box).
+    pub fn holds_values(&self) -> bool {
+        self.held.value_range.is_some()
+    }
+}
+
+/// A partial image with nothing in it, for a rank with an empty box.
+fn blank(settings: &RenderSettings) -> PartialImage {
+    let (w, h) = (settings.width, settings.height);
+    if settings.blend.is_projection() {
+        PartialImage::projection(w, h, settings.blend)
+    } else {
+        PartialImage::composite(w, h)
+    }
+}
+
+/// The largest gradient magnitude at the owned voxels of a piece held
+/// from whole-grid voxel `offset`.
+fn owned_max_gradient(
+    volume: &Volume,
+    offset: [usize; 3],
+    (lo, hi): ([usize; 3], [usize; 3]),
+) -> f32 {
+    let local = |a: usize, i: usize| i - offset[a];
+    with_samples!(volume.samples(), |data| {
+        let d = Differences::new(data, volume);
+        let mut max = 0.0f32;
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                for i in lo[0]..hi[0] {
+                    let g = d.at(local(0, i), local(1, j), local(2, k));
+                    max = max.max(magnitude(g));
+                }
+            }
+        }
+        max
+    })
+}

@@ -1,0 +1,225 @@
+//! Distributed frames with ranks as threads (the MPI runs are the CLI's
+//! tests): for 1 to 8 ranks, the frame composited on rank 0 is the frame
+//! one process renders, within 1/255 per channel, orthographic and
+//! perspective (the eye outside and inside the volume), with shading,
+//! crop and clip planes, every blend mode and post-classification; and
+//! the same from run to run.
+
+use volray_core::camera::{Camera, Projection};
+use volray_core::glam::DVec3;
+use volray_core::{
+    Blend, Classification, ClipPlane, Image, IsoSurface, RenderSettings, Renderer,
+    TransferFunction, Volume,
+};
+use volray_distributed::frame::{Distributed, FrameError};
+use volray_distributed::transport::Local;
+
+/// Three Gaussian blobs on an anisotropic, offset grid.
+fn volume() -> Volume {
+    let centres = [
+        (DVec3::new(8.0, 10.0, 7.0), 4.0),
+        (DVec3::new(20.0, 14.0, 12.0), 5.0),
+        (DVec3::new(14.0, 22.0, 16.0), 3.5),
+    ];
+    Volume::from_fn(
+        [29, 27, 23],
+        DVec3::new(1.0, 1.1, 0.9),
+        DVec3::new(-2.0, 1.0, 0.5),
+        |p| {
+            (centres.iter())
+                .map(|(c, r)| (-(p - *c).length_squared() / (2.0 * r * r)).exp() as f32)
+                .sum()
+        },
+    )
+    .unwrap()
+}
+
+fn colorful() -> TransferFunction {
+    TransferFunction::from_json(
+        r#"{"opacity": [[0, 0], [0.1, 0], [0.6, 0.4], [1, 0.9]],
+            "color": [[0, 0.23, 0.299, 0.754], [0.5, 0.865, 0.865, 0.865], [1, 0.706, 0.016, 0.15]]}"#,
+    )
+    .unwrap()
+}
+
+/// The frame of `settings` rendered by `ranks` threads, on rank 0.
+fn distributed(volume: &Volume, settings: &RenderSettings, ranks: usize) -> Image {
+    let mut frames: Vec<Option<Image>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (Local::group(ranks).into_iter())
+            .map(|t| {
+                s.spawn(move || {
+                    let mut d = Distributed::read(&t, volume, Default::default()).unwrap();
+                    d.render(settings).unwrap().0
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert!(frames[1..].iter().all(Option::is_none));
+    frames.swap_remove(0).expect("rank 0's frame")
+}
+
+fn cases() -> Vec<(String, RenderSettings)> {
+    let base = RenderSettings {
+        width: 64,
+        height: 56,
+        transfer_function: colorful(),
+        background: [0.1, 0.1, 0.2],
+        ..RenderSettings::default()
+    };
+    let cameras = [
+        (
+            "orthographic",
+            Camera {
+                azimuth: 30.0,
+                elevation: 25.0,
+                ..Camera::default()
+            },
+        ),
+        (
+            "perspective",
+            Camera {
+                projection: Projection::Perspective { fov_degrees: 40.0 },
+                azimuth: -50.0,
+                elevation: -15.0,
+                ..Camera::default()
+            },
+        ),
+        (
+            "perspective from inside",
+            Camera {
+                projection: Projection::Perspective { fov_degrees: 75.0 },
+                view_point: Some(DVec3::new(12.5, 14.0, 10.0)),
+                look_at: Some(DVec3::new(25.0, 20.0, 14.0)),
+                ..Camera::default()
+            },
+        ),
+    ];
+    let mut out = Vec::new();
+    for (name, camera) in cameras {
+        let s = RenderSettings {
+            camera,
+            ..base.clone()
+        };
+        out.push((format!("{name}, composite"), s.clone()));
+        out.push((
+            format!("{name}, post-classified"),
+            RenderSettings {
+                classification: Classification::Post,
+                ..s.clone()
+            },
+        ));
+        for blend in [Blend::Maximum, Blend::Minimum, Blend::Average] {
+            out.push((
+                format!("{name}, {blend:?}"),
+                RenderSettings { blend, ..s.clone() },
+            ));
+        }
+    }
+    let s = RenderSettings {
+        camera: Camera {
+            azimuth: 110.0,
+            elevation: 40.0,
+            ..Camera::default()
+        },
+        ..base.clone()
+    };
+    out.push((
+        "cropped, clipped, unshaded, half steps".into(),
+        RenderSettings {
+            crop: Some((DVec3::new(0.0, 3.0, 2.0), DVec3::new(22.0, 30.0, 18.0))),
+            clip_planes: vec![ClipPlane {
+                point: DVec3::new(12.0, 14.0, 10.0),
+                normal: DVec3::new(1.0, -0.4, 0.3),
+            }],
+            shading: false,
+            step: 0.5,
+            ..s.clone()
+        },
+    ));
+    out.push((
+        "iso-surface and gradient opacity, jittered".into(),
+        RenderSettings {
+            iso: Some(IsoSurface {
+                value: 0.5,
+                thickness: 1.5,
+            }),
+            gradient_opacity: Some((0.0, 0.5)),
+            jitter: true,
+            ..s
+        },
+    ));
+    out
+}
+
+#[test]
+fn one_to_eight_ranks_give_the_single_process_frame_within_a_level() {
+    let volume = volume();
+    let renderer = Renderer::new(&volume).unwrap();
+    let mut worst: f32 = 0.0;
+    for (name, settings) in cases() {
+        let single = renderer.render(&settings).unwrap();
+        assert!(
+            single.pixels().iter().any(|p| p[3] > 0.3),
+            "{name}: nearly empty"
+        );
+        for ranks in 1..=8 {
+            let frame = distributed(&volume, &settings, ranks);
+            let diff = frame.max_abs_diff(&single).unwrap();
+            worst = worst.max(diff);
+            assert!(diff <= 1.0 / 255.0, "{name}, {ranks} ranks: {diff}");
+        }
+    }
+    println!("largest difference from one process: {worst:e}");
+}
+
+#[test]
+fn the_same_rank_count_gives_the_same_frame_bit_for_bit() {
+    let volume = volume();
+    for (name, settings) in cases().into_iter().step_by(3) {
+        let a = distributed(&volume, &settings, 5);
+        let b = distributed(&volume, &settings, 5);
+        assert!(a == b, "{name}");
+    }
+}
+
+/// A source whose read fails on one box.
+struct Failing(Volume);
+
+impl volray_distributed::frame::Source for Failing {
+    fn grid(&self) -> volray_core::sampling::grid::GridFrame {
+        volray_distributed::frame::Source::grid(&self.0)
+    }
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        if lo[0] > 0 {
+            return Err("scan.raw: unexpected end of file at byte 4096".into());
+        }
+        self.0.read(lo, hi)
+    }
+}
+
+#[test]
+fn a_rank_that_cannot_read_its_piece_fails_every_rank_with_its_error() {
+    let source = Failing(volume());
+    let errors: Vec<FrameError> = std::thread::scope(|s| {
+        let handles: Vec<_> = (Local::group(4).into_iter())
+            .map(|t| {
+                let source = &source;
+                s.spawn(move || {
+                    Distributed::read(&t, source, Default::default())
+                        .err()
+                        .unwrap()
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for e in &errors {
+        assert_eq!(e, &errors[0]);
+    }
+    let FrameError::Rank { rank, message } = &errors[0] else {
+        panic!("{:?}", errors[0])
+    };
+    assert_eq!(*rank, 2, "the first rank whose box starts past x = 0");
+    assert!(message.contains("scan.raw"), "{message}");
+}
