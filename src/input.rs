@@ -50,7 +50,13 @@ pub enum Described {
 /// Loads the input for rendering: a file holding an image, not a volume,
 /// is refused with the reason (exit 1).
 pub fn load(args: &InputArgs) -> Result<Input, CliError> {
-    match describe(args)? {
+    load_with(args, MapPolicy::IfLarger)
+}
+
+/// [`load`], mapping the file as `map` says (a distributed render maps
+/// every file it can, and reads each rank's box from the map).
+pub fn load_with(args: &InputArgs, map: MapPolicy) -> Result<Input, CliError> {
+    match describe_with(args, map)? {
         Described::Volume(input) => Ok(*input),
         Described::Image { name, image } => Err(CliError::from(IoError::FlatImage {
             path: name.into(),
@@ -61,6 +67,11 @@ pub fn load(args: &InputArgs) -> Result<Input, CliError> {
 
 /// Loads the input for `volray info`: a volume, or the image a file holds.
 pub fn describe(args: &InputArgs) -> Result<Described, CliError> {
+    describe_with(args, MapPolicy::IfLarger)
+}
+
+/// [`describe`], mapping the file as `map` says.
+fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError> {
     let spec = args.input.as_deref().unwrap_or(DEMO);
     let max_memory = args
         .max_memory
@@ -115,7 +126,7 @@ pub fn describe(args: &InputArgs) -> Result<Described, CliError> {
             max_memory,
             // A volume over --max-memory is mapped from its file where its
             // format allows (volray-io's MapPolicy), refused otherwise.
-            map: MapPolicy::IfLarger,
+            map,
         };
         let loaded = match volray_io::read(&path, &opts) {
             Ok(loaded) => loaded,

@@ -30,6 +30,8 @@ mod output;
 
 mod animate;
 mod bench;
+#[cfg(feature = "mpi")]
+mod distributed;
 mod error;
 mod flags;
 mod generate;
@@ -53,6 +55,17 @@ fn main() -> ExitCode {
         Err(code) => return code,
     };
     interrupt::install();
+    #[cfg(feature = "mpi")]
+    if distributed::launched() {
+        let result = match &cli.command {
+            Command::Render(args) => Some(distributed::render(args)),
+            Command::Bench(args) => Some(distributed::bench(args)),
+            _ => None,
+        };
+        if let Some(result) = result {
+            return exit(result);
+        }
+    }
     let result = match &cli.command {
         Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),
@@ -61,10 +74,18 @@ fn main() -> ExitCode {
         Command::Paper(args) => paper::run(args),
         Command::View(args) => view::run(args),
     };
+    exit(result)
+}
+
+/// The exit code of a command's outcome, its error printed.
+fn exit(result: Result<(), error::CliError>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("volray: error: {e}");
+            // One write, so that the lines of several processes (MPI
+            // ranks) do not interleave.
+            let line = format!("volray: error: {e}\n");
+            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
             ExitCode::from(e.code)
         }
     }

@@ -71,9 +71,19 @@ fn still(
         .map_err(|e| render_failure(&args.view, &input.name, e))?;
     bar.finish_and_clear();
 
+    write_still(args, kind, &image)
+}
+
+/// Writes one frame to OUTPUT, as `kind` says (atomically: a failed write
+/// leaves no file).
+pub fn write_still(
+    args: &RenderArgs,
+    kind: OutputKind,
+    image: &volray_core::Image,
+) -> Result<(), CliError> {
     match kind {
-        OutputKind::Png(depth) => volray_io::write_png(&args.out.output, &image, depth)?,
-        OutputKind::Exr => volray_io::write_exr(&args.out.output, &image)?,
+        OutputKind::Png(depth) => volray_io::write_png(&args.out.output, image, depth)?,
+        OutputKind::Exr => volray_io::write_exr(&args.out.output, image)?,
         OutputKind::Gif => {
             let mut gif = Animation::create(
                 &args.out.output,
@@ -82,7 +92,7 @@ fn still(
                 1,
                 animate::DEFAULT_FPS,
             )?;
-            gif.push(&image)?;
+            gif.push(image)?;
             gif.finish()?;
         }
         OutputKind::Animation => unreachable!("animations are rendered by animate.rs"),
@@ -114,7 +124,7 @@ fn animation_reason(args: &RenderArgs) -> Result<Option<&'static str>, CliError>
 
 /// What an output file name asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum OutputKind {
+pub enum OutputKind {
     Png(BitDepth),
     /// OpenEXR: the f32 frame buffer, unquantised.
     Exr,
@@ -128,7 +138,7 @@ enum OutputKind {
 /// anything else PNG (at `--bit-depth`). An animation (`animation` says
 /// which flag asks for one) is an animated PNG, a GIF or a PNG sequence,
 /// at 8 bits. `--bit-depth 16` is refused where the format cannot hold it.
-fn output_kind(
+pub fn output_kind(
     output: &Path,
     bit_depth: u8,
     animation: Option<&str>,
@@ -175,7 +185,7 @@ fn output_kind(
 
 /// The files the run will write: OUTPUT, or each frame's file of a PNG
 /// sequence.
-fn output_files(args: &RenderArgs, kind: OutputKind, inputs: usize) -> Vec<PathBuf> {
+pub fn output_files(args: &RenderArgs, kind: OutputKind, inputs: usize) -> Vec<PathBuf> {
     let frames = args.animation.turntable.map_or(inputs, |n| n as usize);
     match AnimationKind::from_path(&args.out.output) {
         Some(AnimationKind::PngSequence) if kind == OutputKind::Animation => (0..frames)
@@ -187,7 +197,7 @@ fn output_files(args: &RenderArgs, kind: OutputKind, inputs: usize) -> Vec<PathB
 
 /// Refuses, before any work, an output that cannot be written where it is
 /// asked for (overwriting an input is refused by `overwrite.rs`).
-fn check_output(output: &Path) -> Result<(), CliError> {
+pub fn check_output(output: &Path) -> Result<(), CliError> {
     let dir = match output.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

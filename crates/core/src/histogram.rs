@@ -43,6 +43,57 @@ impl Histogram {
     }
 
     /// The lower edge of bin `b` (`b == bins` gives `max`).
+    /// The histogram of the voxels `lo..hi` (half-open) of `volume` in
+    /// `bins` bins over `(min, max)` (a larger volume's range, of which
+    /// this box is a part): the parts of a volume's voxels, each counted
+    /// so and [`merge`](Self::merge)d, give [`Histogram::of`] the whole.
+    pub fn of_box(
+        volume: &Volume,
+        (lo, hi): ([usize; 3], [usize; 3]),
+        (min, max): (f32, f32),
+        bins: usize,
+    ) -> Self {
+        let bins = bins.max(1);
+        let mut counts = vec![0u64; bins];
+        let width = (f64::from(max) - f64::from(min)) / bins as f64;
+        let [nx, ny, _] = volume.dims();
+        let (mut sum, mut non_finite) = (0.0, 0);
+        with_samples!(volume.samples(), |data| {
+            for z in lo[2]..hi[2] {
+                for y in lo[1]..hi[1] {
+                    let row = (z * ny + y) * nx;
+                    let (s, n) =
+                        accumulate(&data[row + lo[0]..row + hi[0]], min, width, &mut counts);
+                    sum += s;
+                    non_finite += n;
+                }
+            }
+        });
+        let finite: u64 = counts.iter().sum();
+        Histogram {
+            min,
+            max,
+            mean: if finite > 0 { sum / finite as f64 } else { 0.0 },
+            counts,
+            non_finite,
+        }
+    }
+
+    /// The histogram of two parts' voxels together (the same bins).
+    pub fn merge(&mut self, other: &Histogram) {
+        let (a, b) = (
+            self.counts.iter().sum::<u64>(),
+            other.counts.iter().sum::<u64>(),
+        );
+        if a + b > 0 {
+            self.mean = (self.mean * a as f64 + other.mean * b as f64) / (a + b) as f64;
+        }
+        for (x, y) in self.counts.iter_mut().zip(&other.counts) {
+            *x += y;
+        }
+        self.non_finite += other.non_finite;
+    }
+
     pub fn edge(&self, b: usize) -> f64 {
         let bins = self.counts.len();
         if b >= bins {

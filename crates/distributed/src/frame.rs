@@ -16,8 +16,8 @@ use volray_core::camera::View;
 use volray_core::kernels::gradient::{Differences, magnitude};
 use volray_core::sampling::grid::GridFrame;
 use volray_core::{
-    Image, NonFinite, PartialImage, Piece, RenderError, RenderSettings, Renderer, Volume,
-    with_samples,
+    Histogram, Image, NonFinite, PartialImage, Piece, RenderError, RenderSettings, Renderer,
+    Volume, with_samples,
 };
 
 /// Where a rank's piece comes from.
@@ -141,11 +141,14 @@ pub struct Distributed<'t, T: Transport + ?Sized> {
     held: Held,
     /// The whole volume's value range and largest gradient, agreed.
     value_range: (f32, f32),
+    /// Whether any rank found a finite value.
+    values_found: bool,
     max_gradient: Option<f32>,
 }
 
-/// Every rank's outcome of a step, or the first failure, on every rank.
-fn agree<T: Transport + ?Sized>(
+/// Every rank's outcome of a step (its bytes), or the first failure, on
+/// every rank: what each rank does after a step that may fail on one.
+pub fn agree<T: Transport + ?Sized>(
     transport: &T,
     outcome: Result<Vec<u8>, String>,
 ) -> Result<Vec<Vec<u8>>, FrameError> {
@@ -244,6 +247,7 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
                 times,
             },
             value_range: range.unwrap_or((0.0, 0.0)),
+            values_found: range.is_some(),
             max_gradient: None,
         })
     }
@@ -283,7 +287,10 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
     }
 
     /// The settings this rank renders its piece with.
-    pub fn piece_settings(&mut self, settings: &RenderSettings) -> Result<RenderSettings, FrameError> {
+    pub fn piece_settings(
+        &mut self,
+        settings: &RenderSettings,
+    ) -> Result<RenderSettings, FrameError> {
         let needs_gradient = settings.iso.is_some() || settings.gradient_opacity.is_some();
         let max_gradient = if needs_gradient {
             self.max_gradient()?
@@ -326,7 +333,10 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
         };
         // Every rank refuses the same settings alike; anything else (one
         // rank out of memory, say) must not leave the others waiting.
-        let status = rendered.as_ref().map(|_| Vec::new()).map_err(|e| e.to_string());
+        let status = rendered
+            .as_ref()
+            .map(|_| Vec::new())
+            .map_err(|e| e.to_string());
         if let Err(FrameError::Rank { rank, message }) = agree(self.transport, status) {
             return Err(match rendered {
                 Err(e) => FrameError::Render(e),
@@ -365,6 +375,49 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             // Rank 0 always owns voxels; a frame of nothing otherwise.
             None => partial.finish(settings.background, |_| settings.background),
         }
+    }
+
+    /// The whole volume's histogram in `bins` bins over its value range
+    /// (what `--tf auto` chooses from): each rank counts its owned voxels,
+    /// and the counts are summed on every rank. `None` for a volume with
+    /// no finite value.
+    pub fn histogram(&self, bins: usize) -> Result<Option<Histogram>, FrameError> {
+        let local = self.held.renderer.as_ref().map(|r| {
+            let (lo, hi) = self.held.piece_owned;
+            let o = self.held.offset;
+            let owned = (
+                std::array::from_fn(|a| lo[a] - o[a]),
+                std::array::from_fn(|a| hi[a] - o[a]),
+            );
+            Histogram::of_box(r.volume(), owned, self.value_range, bins)
+        });
+        let bytes = local.map_or_else(Vec::new, |h| {
+            let mut out: Vec<u8> = h.mean.to_le_bytes().to_vec();
+            out.extend_from_slice(&h.non_finite.to_le_bytes());
+            for c in &h.counts {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+            out
+        });
+        let all = agree(self.transport, Ok(bytes))?;
+        let mut whole: Option<Histogram> = None;
+        for m in all.iter().filter(|m| m.len() == 16 + 8 * bins.max(1)) {
+            let word = |i: usize| m[8 * i..8 * i + 8].try_into().unwrap();
+            let part = Histogram {
+                min: self.value_range.0,
+                max: self.value_range.1,
+                mean: f64::from_le_bytes(word(0)),
+                non_finite: u64::from_le_bytes(word(1)),
+                counts: (0..bins.max(1))
+                    .map(|b| u64::from_le_bytes(word(2 + b)))
+                    .collect(),
+            };
+            match &mut whole {
+                Some(h) => h.merge(&part),
+                None => whole = Some(part),
+            }
+        }
+        Ok(whole.filter(|_| self.values_found))
     }
 
     /// The decomposition of the grid among the ranks.

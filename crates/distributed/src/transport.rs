@@ -85,22 +85,17 @@ impl Local {
     /// `size` connected ranks: give one to each thread.
     pub fn group(size: usize) -> Vec<Local> {
         // Channel (a, b) carries a's messages to b.
-        let mut senders: Vec<Vec<Option<Sender<Vec<u8>>>>> = vec![vec![]; size];
-        let mut receivers: Vec<Vec<Option<Receiver<Vec<u8>>>>> =
-            (0..size).map(|_| (0..size).map(|_| None).collect()).collect();
-        for (a, row) in senders.iter_mut().enumerate() {
-            for b in 0..size {
+        let mut to: Vec<Vec<Sender<Vec<u8>>>> = (0..size).map(|_| Vec::new()).collect();
+        let mut from: Vec<Vec<Mutex<Receiver<Vec<u8>>>>> = (0..size).map(|_| Vec::new()).collect();
+        for senders in to.iter_mut() {
+            for receivers in from.iter_mut() {
                 let (tx, rx) = channel();
-                row.push(Some(tx));
-                receivers[b][a] = Some(rx);
+                senders.push(tx);
+                receivers.push(Mutex::new(rx));
             }
         }
-        (senders.into_iter().zip(receivers).enumerate())
-            .map(|(rank, (to, from))| Local {
-                rank,
-                to: to.into_iter().map(Option::unwrap).collect(),
-                from: from.into_iter().map(|r| Mutex::new(r.unwrap())).collect(),
-            })
+        (to.into_iter().zip(from).enumerate())
+            .map(|(rank, (to, from))| Local { rank, to, from })
             .collect()
     }
 

@@ -56,7 +56,10 @@ pub fn non_empty(image: &PartialImage, rows: Range<usize>) -> (Range<usize>, Ran
         let Some(first) = (0..width).find(|&c| filled(base + c)) else {
             continue;
         };
-        let last = (first..width).rev().find(|&c| filled(base + c)).unwrap_or(first);
+        let last = (first..width)
+            .rev()
+            .find(|&c| filled(base + c))
+            .unwrap_or(first);
         r0 = r0.min(row);
         r1 = row + 1;
         c0 = c0.min(first);
@@ -238,14 +241,23 @@ mod tests {
         let PartialPixels::Projection { pixels, .. } = b.pixels() else {
             unreachable!()
         };
-        assert_eq!(pixels[1], Projected { value: 6.0, count: 4 });
+        assert_eq!(
+            pixels[1],
+            Projected {
+                value: 6.0,
+                count: 4
+            }
+        );
         assert_eq!(pixels[0].count, 0);
     }
 
     #[test]
     fn malformed_messages_are_refused() {
         let mut a = PartialImage::composite(2, 2);
-        assert_eq!(combine_into(&mut a, &[0; 3], true), Err(WireError::Short(3)));
+        assert_eq!(
+            combine_into(&mut a, &[0; 3], true),
+            Err(WireError::Short(3))
+        );
         let mut bytes = encode(&PartialImage::composite(2, 2), 0..2);
         bytes[0] = 1;
         assert_eq!(combine_into(&mut a, &bytes, true), Err(WireError::Kind(1)));
