@@ -15,7 +15,7 @@
 //!    beyond a power of two folded in first), exchanging only the
 //!    non-empty rectangle of each piece of image ([`wire`]); rank 0
 //!    gathers the parts.
-//! 4. [`transport`]: the messages, over MPI (feature `mpi`, [`mpi`]) or
+//! 4. [`transport`]: the messages, over MPI (feature `mpi`, module `mpi`) or
 //!    between threads of one process ([`transport::Local`]).
 //!
 //! ```

@@ -1,5 +1,5 @@
 //! How ranks talk: the four operations compositing and agreeing need, over
-//! MPI in a real run ([`crate::mpi`], feature `mpi`) or over channels
+//! MPI in a real run (module `mpi`, feature `mpi`) or over channels
 //! between threads of one process ([`Local`], for tests and for trying
 //! the algorithms without a cluster).
 
