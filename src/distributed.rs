@@ -204,7 +204,9 @@ struct CliSource {
     whole: Option<Volume>,
     /// The piece rank 0 read and sent, for a file that cannot be mapped.
     sent: Option<Volume>,
-    log: bool,
+    /// `--log`: the whole volume's smallest positive value, which values
+    /// `<= 0` take on the log scale (agreed by the ranks).
+    log_floor: Option<f32>,
     max_memory: u64,
     settings: RenderSettings,
     non_finite: NonFinite,
@@ -249,7 +251,7 @@ impl CliSource {
             grid,
             whole: None,
             sent: None,
-            log: view.look.log,
+            log_floor: None,
             max_memory,
             settings: settings.clone(),
             non_finite,
@@ -266,6 +268,7 @@ impl CliSource {
                 .map_err(|e| e.to_string());
             agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
             source.whole = Some(input.expect("agreed").volume);
+            source.agree_log_floor(mpi, view)?;
             return Ok(source);
         }
         // Rank 0 sends each rank its piece.
@@ -289,7 +292,46 @@ impl CliSource {
             let bytes = mpi.receive(0).map_err(|e| CliError::io(e.to_string()))?;
             source.sent = decode_piece(&bytes);
         }
+        source.agree_log_floor(mpi, view)?;
         Ok(source)
+    }
+
+    /// For `--log`: the smallest positive value over every rank's piece
+    /// (the pieces cover the volume), as one process takes it over the
+    /// whole volume.
+    fn agree_log_floor(&mut self, mpi: &Mpi, view: &ViewArgs) -> Result<(), CliError> {
+        if !view.look.log {
+            return Ok(());
+        }
+        let b = Decomposition::new(self.grid.dims, mpi.size()).boxes[mpi.rank()];
+        let smallest = if b.is_empty() {
+            Ok(None)
+        } else {
+            let (lo, hi) = volray_core::Piece::held((b.lo, b.hi), self.grid.dims);
+            self.raw_piece(lo, hi).map(|p| p.smallest_positive())
+        };
+        let local = smallest.map(|s| s.unwrap_or(f32::INFINITY).to_le_bytes().to_vec());
+        let all = agree(mpi, local).map_err(|e| failure(view, &self.name, e))?;
+        let floor = (all.iter())
+            .filter_map(|m| m.as_slice().try_into().ok().map(f32::from_le_bytes))
+            .fold(f32::INFINITY, f32::min);
+        if floor == f32::INFINITY {
+            return Err(CliError::input(format!(
+                "--log: {}: a log scale needs a positive value, and the volume has none",
+                self.name
+            )));
+        }
+        self.log_floor = Some(floor);
+        Ok(())
+    }
+
+    /// The voxels `lo..hi` as read or generated, before `--log`.
+    fn raw_piece(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        match (&self.whole, &self.sent) {
+            (Some(whole), _) => Ok(whole.sub_box(lo, hi)),
+            (None, Some(sent)) => Ok(sent.clone()),
+            (None, None) => Err(format!("{}: rank 0 sent no piece", self.name)),
+        }
     }
 }
 
@@ -381,15 +423,10 @@ impl Source for CliSource {
     }
 
     fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
-        let piece = match (&self.whole, &self.sent) {
-            (Some(whole), _) => whole.sub_box(lo, hi),
-            (None, Some(sent)) => sent.clone(),
-            (None, None) => return Err(format!("{}: rank 0 sent no piece", self.name)),
-        };
-        let piece = if self.log {
-            (piece.to_log10()).map_err(|e| format!("--log: {}: {e}", self.name))?
-        } else {
-            piece
+        let piece = self.raw_piece(lo, hi)?;
+        let piece = match self.log_floor {
+            Some(smallest) => piece.to_log10_above(smallest),
+            None => piece,
         };
         let need = crate::memory::render_bytes(
             (piece.dims(), piece.spacing(), piece.sample_type()),

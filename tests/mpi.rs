@@ -121,7 +121,7 @@ fn one_to_four_ranks_render_the_one_process_image_within_a_level() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &[&str]); 6] = [
+    let cases: [(&str, &[&str]); 7] = [
         (
             "orthographic",
             &["fractal:65", "--azimuth", "30", "--elevation", "20"],

@@ -314,24 +314,39 @@ impl Volume {
     /// them). NaN stays NaN and `+∞` stays `+∞` (the renderer refuses
     /// both, or renders them as empty space: [`NonFinite`](crate::NonFinite)). A volume with no positive finite value is refused.
     pub fn to_log10(&self) -> Result<Volume, VolumeError> {
-        let values = self.values();
-        let smallest = values
-            .iter()
-            .copied()
+        match self.smallest_positive() {
+            Some(smallest) => Ok(self.to_log10_above(smallest)),
+            None => {
+                let largest = self
+                    .values()
+                    .iter()
+                    .copied()
+                    .fold(f32::NEG_INFINITY, f32::max);
+                Err(VolumeError::NoPositiveValue(largest))
+            }
+        }
+    }
+
+    /// The smallest positive finite value, if any: the bottom of
+    /// [`Self::to_log10`]'s scale.
+    pub fn smallest_positive(&self) -> Option<f32> {
+        let smallest = (self.values().iter().copied())
             .filter(|v| *v > 0.0 && v.is_finite())
             .fold(f32::INFINITY, f32::min);
-        if smallest == f32::INFINITY {
-            let largest = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-            return Err(VolumeError::NoPositiveValue(largest));
-        }
+        (smallest < f32::INFINITY).then_some(smallest)
+    }
+
+    /// [`Self::to_log10`] with values `<= 0` at `log10 smallest`: a piece
+    /// of a larger volume takes the whole volume's smallest positive value,
+    /// so that its scale is the whole's.
+    pub fn to_log10_above(&self, smallest: f32) -> Volume {
         // In f64, so that exact powers of ten give exact exponents.
         let log = |v: f32| (v as f64).log10() as f32;
         let floor = log(smallest);
-        let data = values
-            .iter()
+        let data = (self.values().iter())
             .map(|&v| if v <= 0.0 { floor } else { log(v) })
             .collect::<Vec<f32>>();
-        Ok(self.with_samples(Samples::from(data)))
+        self.with_samples(Samples::from(data))
     }
 
     /// This volume's grid with other samples (as many, x fastest).
