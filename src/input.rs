@@ -77,14 +77,8 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
         .max_memory
         .unwrap_or_else(volray_io::default_max_memory);
     let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
-    let file_flags = args.format.is_some() || args.frame.is_some() || args.array.is_some();
     let (volume, file) = if volray_data::is_source_spec(spec) {
-        if raw_flags || file_flags {
-            return Err(CliError::input(format!(
-                "{spec}: --dims, --dtype, --endian, --format, --frame and --array apply to files only, not to built-in sources"
-            )));
-        }
-        let n = source_points(spec)? as u64;
+        let n = source_grid(args, spec)? as u64;
         volray_io::check_volume_size(
             Path::new(spec),
             "points per side",
@@ -160,6 +154,19 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
 /// Points per side of the cube grid the built-in source `spec` samples,
 /// parsed as the source itself parses it (every built-in source is an
 /// N³ grid), so that its size is checked before it is generated.
+/// The points per side of built-in source `spec`, after refusing the file
+/// flags given with it.
+pub fn source_grid(args: &InputArgs, spec: &str) -> Result<usize, CliError> {
+    let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
+    let file_flags = args.format.is_some() || args.frame.is_some() || args.array.is_some();
+    if raw_flags || file_flags {
+        return Err(CliError::input(format!(
+            "{spec}: --dims, --dtype, --endian, --format, --frame and --array apply to files only, not to built-in sources"
+        )));
+    }
+    source_points(spec)
+}
+
 fn source_points(spec: &str) -> Result<usize, CliError> {
     use volray_data::{
         SourceSpec, blobs::Blobs, fractal::FractalParams, hydrogen::HydrogenParams,

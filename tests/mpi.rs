@@ -164,6 +164,8 @@ fn one_to_four_ranks_render_the_one_process_image_within_a_level() {
             "average",
             &["blobs:40", "--blend", "average", "--azimuth", "45"],
         ),
+        // Zeros go to the whole volume's smallest positive value, not a piece's.
+        ("log scale", &["fractal:65", "--log", "--azimuth", "60"]),
     ];
     for (name, args) in cases {
         let mut args = args.to_vec();

@@ -62,13 +62,27 @@ pub fn cube_volume(
             message: format!("grid half width must be positive and finite, got {half_width}"),
         });
     }
-    let coords: Vec<f64> = (0..n).map(|i| half_width * coordinate(i, n)).collect();
-    let mut data = vec![0.0f32; n * n * n];
-    data.par_chunks_mut(n * n)
-        .zip(coords.par_iter())
+    // The whole grid, or the box `generate_box` asked for.
+    let (lo, hi) = WINDOW.get().unwrap_or(([0; 3], [n; 3]));
+    if (0..3).any(|a| lo[a] + 2 > hi[a] || hi[a] > n) {
+        return Err(DataError::Invalid {
+            spec: spec.to_string(),
+            message: format!("box {lo:?}..{hi:?} is not inside the {n}³ grid"),
+        });
+    }
+    let coords = |a: usize| -> Vec<f64> {
+        (lo[a]..hi[a])
+            .map(|i| half_width * coordinate(i, n))
+            .collect()
+    };
+    let (xs, ys, zs) = (coords(0), coords(1), coords(2));
+    let (nx, ny) = (xs.len(), ys.len());
+    let mut data = vec![0.0f32; nx * ny * zs.len()];
+    data.par_chunks_mut(nx * ny)
+        .zip(zs.par_iter())
         .for_each(|(slice, &z)| {
-            for (row, &y) in slice.chunks_mut(n).zip(&coords) {
-                for (v, &x) in row.iter_mut().zip(&coords) {
+            for (row, &y) in slice.chunks_mut(nx).zip(&ys) {
+                for (v, &x) in row.iter_mut().zip(&xs) {
                     *v = f(DVec3::new(x, y, z)) as f32;
                 }
             }
@@ -77,10 +91,52 @@ pub fn cube_volume(
         spec: spec.to_string(),
         error,
     };
-    Volume::new([n, n, n], data)
-        .and_then(|v| v.with_spacing(DVec3::splat(2.0 * half_width / (n - 1) as f64)))
-        .and_then(|v| v.with_origin(DVec3::splat(-half_width)))
+    let spacing = DVec3::splat(2.0 * half_width / (n - 1) as f64);
+    // The box's first voxel where `Volume::sub_box` of the whole puts it.
+    let first = DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64);
+    Volume::new([nx, ny, zs.len()], data)
+        .and_then(|v| v.with_spacing(spacing))
+        .and_then(|v| v.with_origin(DVec3::splat(-half_width) + first * spacing))
         .map_err(volume_error)
+}
+
+thread_local! {
+    /// The box of voxels [`cube_volume`] samples on this thread, if not
+    /// the whole grid: set by [`generate_box`] around one generation.
+    static WINDOW: std::cell::Cell<Option<([usize; 3], [usize; 3])>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// The voxels `lo..hi` (half-open) of the volume `spec` generates, as
+/// `generate(spec)?.sub_box(lo, hi)` would give them, bit for bit, with
+/// their world placement. The sources sampled point by point on a cube
+/// grid (all but the fractal) compute only those voxels; the fractal
+/// (midpoint displacement, a whole-grid process) is generated whole and
+/// cut. A rank of a distributed render generates its box so.
+pub fn generate_box(spec: &str, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, DataError> {
+    struct Reset;
+    impl Drop for Reset {
+        fn drop(&mut self) {
+            WINDOW.set(None);
+        }
+    }
+    let volume = {
+        WINDOW.set(Some((lo, hi)));
+        let _reset = Reset;
+        crate::generate(spec)?
+    };
+    let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+    if volume.dims() == dims {
+        return Ok(volume);
+    }
+    let whole = volume.dims();
+    if (0..3).any(|a| lo[a] + 2 > hi[a] || hi[a] > whole[a]) {
+        return Err(DataError::Invalid {
+            spec: spec.to_string(),
+            message: format!("box {lo:?}..{hi:?} is not inside the {whole:?} grid"),
+        });
+    }
+    Ok(volume.sub_box(lo, hi))
 }
 
 #[cfg(test)]
@@ -150,5 +206,25 @@ mod tests {
         assert!(cube_volume("s", 2, f64::NAN, |_| 0.0).is_err());
         assert!(check_points(2).is_ok() && check_points(1025).is_ok());
         assert!(check_points(0).is_err());
+    }
+
+    #[test]
+    fn a_box_of_a_source_is_the_same_box_of_the_whole_volume() {
+        for spec in [
+            "marschner-lobb:17",
+            "blobs:12",
+            "hydrogen:3,2,1,grid=15",
+            "sphere:11",
+            "torus:11",
+            "fractal:17",
+        ] {
+            let whole = crate::generate(spec).unwrap();
+            let (lo, hi) = ([1, 0, 3], [6, 9, 11.min(whole.dims()[2])]);
+            let part = generate_box(spec, lo, hi).unwrap();
+            assert_eq!(part, whole.sub_box(lo, hi), "{spec}");
+        }
+        // The window is gone afterwards: the whole grid again.
+        assert_eq!(crate::generate("blobs:12").unwrap().dims(), [12; 3]);
+        assert!(generate_box("blobs:12", [0; 3], [13, 2, 2]).is_err());
     }
 }

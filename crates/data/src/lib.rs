@@ -77,6 +77,7 @@ pub mod sphere;
 pub mod torus;
 
 pub use error::DataError;
+pub use grid::generate_box;
 pub use sources::{SourceInfo, find, generate, is_source_spec, sources};
 pub use spec::{Args, SourceSpec};
 pub use volray_core::Volume;
