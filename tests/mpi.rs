@@ -324,7 +324,9 @@ fn a_rank_that_cannot_read_ends_every_rank_with_one_error_and_no_file() {
         .lines()
         .filter(|l| l.starts_with("volray: error:"))
         .collect();
-    assert_eq!(errors.len(), 3, "{stderr}");
+    // Every rank fails with this line; mpirun ends the others once the
+    // first exits, so some may be stopped before they print it.
+    assert!(!errors.is_empty() && errors.len() <= 3, "{stderr}");
     assert!(errors.iter().all(|e| *e == errors[0]), "{stderr}");
     assert!(errors[0].contains("short.raw"), "{stderr}");
     assert!(!out.exists());
@@ -347,7 +349,7 @@ fn a_rank_that_cannot_read_ends_every_rank_with_one_error_and_no_file() {
         .lines()
         .filter(|l| l.starts_with("volray: error:"))
         .collect();
-    assert_eq!(errors.len(), 4, "{stderr}");
+    assert!(!errors.is_empty() && errors.len() <= 4, "{stderr}");
     assert!(errors.iter().all(|e| *e == errors[0]), "{stderr}");
     assert!(
         errors[0].contains("rank 0:") && errors[0].contains("run on more ranks"),
