@@ -407,38 +407,16 @@ fn held_piece(volume: &Volume, lo: [usize; 3], hi: [usize; 3], dims: [usize; 3])
 fn describe(input: &Input, local: bool) -> Vec<u8> {
     let v = &input.volume;
     let nan_is_empty = input.non_finite(NonFinite::Refuse) == NonFinite::Transparent;
-    let mut out = Vec::new();
-    for d in v.dims() {
-        out.extend_from_slice(&(d as u64).to_le_bytes());
-    }
-    for x in v
-        .origin()
-        .to_array()
-        .into_iter()
-        .chain(v.spacing().to_array())
-    {
-        out.extend_from_slice(&x.to_le_bytes());
-    }
+    let mut out = grid_bytes(v);
     out.push(local as u8);
     out.push(nan_is_empty as u8);
     out
 }
 
-fn parse_header(b: &[u8]) -> (GridFrame, bool, bool) {
-    let u = |i: usize| u64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap()) as usize;
-    let f = |i: usize| f64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap());
-    let grid = GridFrame {
-        dims: [u(0), u(1), u(2)],
-        origin: DVec3::new(f(3), f(4), f(5)),
-        spacing: DVec3::new(f(6), f(7), f(8)),
-    };
-    (grid, b[72] != 0, b[73] != 0)
-}
-
-/// A piece on the wire: dims (3 × u64), origin and spacing (6 × f64), the
-/// labels flag, then its samples as little-endian `f32`.
-fn encode_piece(v: &Volume) -> Vec<u8> {
-    let mut out = Vec::with_capacity(81 + 4 * v.len());
+/// A volume's grid on the wire: dims (3 × `u64`), origin and spacing
+/// (6 × `f64`), little-endian: 72 bytes.
+fn grid_bytes(v: &Volume) -> Vec<u8> {
+    let mut out = Vec::with_capacity(72);
     for d in v.dims() {
         out.extend_from_slice(&(d as u64).to_le_bytes());
     }
@@ -450,6 +428,29 @@ fn encode_piece(v: &Volume) -> Vec<u8> {
     {
         out.extend_from_slice(&x.to_le_bytes());
     }
+    out
+}
+
+/// The grid of [`grid_bytes`] (`b` at least 72 bytes).
+fn parse_grid(b: &[u8]) -> GridFrame {
+    let u = |i: usize| u64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap()) as usize;
+    let f = |i: usize| f64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap());
+    GridFrame {
+        dims: [u(0), u(1), u(2)],
+        origin: DVec3::new(f(3), f(4), f(5)),
+        spacing: DVec3::new(f(6), f(7), f(8)),
+    }
+}
+
+fn parse_header(b: &[u8]) -> (GridFrame, bool, bool) {
+    (parse_grid(b), b[72] != 0, b[73] != 0)
+}
+
+/// A piece on the wire: dims (3 × u64), origin and spacing (6 × f64), the
+/// labels flag, then its samples as little-endian `f32`.
+fn encode_piece(v: &Volume) -> Vec<u8> {
+    let mut out = grid_bytes(v);
+    out.reserve(1 + 4 * v.len());
     out.push(v.is_labels() as u8);
     for x in v.samples().to_f32_vec() {
         out.extend_from_slice(&x.to_le_bytes());
@@ -461,7 +462,7 @@ fn decode_piece(b: &[u8]) -> Option<Volume> {
     if b.len() < 73 {
         return None;
     }
-    let (grid, labels, _) = parse_header(&[&b[..72], &[b[72], 0]].concat());
+    let (grid, labels) = (parse_grid(b), b[72] != 0);
     let data: Vec<f32> = (b[73..].chunks_exact(4))
         .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
         .collect();
