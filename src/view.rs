@@ -21,8 +21,10 @@ use std::sync::Arc;
 use volray_core::{Projection, RenderSettings};
 use volray_view::{BlendMode, Reproduce, START_COLOURS, Start, ViewState, Viewer, WHITE};
 
-/// The most tabs rendering at once, whatever the memory allows.
-const MAX_TABS: u128 = 8;
+/// The most tabs rendering at once, whatever the memory allows (the
+/// memory itself is held to `--max-memory` by the viewer's ledger:
+/// the volume, each tab's renderer, each frame in flight).
+const MAX_TABS: usize = 8;
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let look = &args.view.look;
@@ -66,9 +68,6 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     reproduce
         .reproduce(&state)
         .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
-    // Each tab's renderer: the frame and its own brick caches.
-    let per_tab = crate::memory::render_bytes(grid, &settings, non_finite, cache_budget).max(1);
-    let max_sessions = (u128::from(input.max_memory) / per_tab).clamp(1, MAX_TABS) as usize;
     let hello = Start {
         name: &input.name,
         volume,
@@ -82,10 +81,11 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         volume: Arc::new(input.volume),
         non_finite,
         cache_budget,
+        max_memory: u128::from(input.max_memory),
         hello,
         reproduce: Arc::new(reproduce),
         pool: Arc::new(pool),
-        max_sessions,
+        max_sessions: MAX_TABS,
     };
 
     let addr = SocketAddr::new(args.bind, args.port);

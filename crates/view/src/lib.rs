@@ -23,8 +23,9 @@
 //! | `token.rs` | the 128-bit access token and its constant-time check |
 //! | `state.rs` | [`ViewState`]: what the page's controls set, and its bounds |
 //! | `protocol.rs` | the messages both ways, parsed and checked |
-//! | `mailbox.rs` | the single-slot mailbox: stale requests dropped, never queued |
-//! | `session.rs` | a tab's renderer thread: render, encode, send |
+//! | `mailbox.rs` | the single-slot mailbox: stale requests dropped, never queued; the stop flag of the frame a newer request supersedes |
+//! | `session.rs` | a tab's renderer thread: reserve, render (stoppable), encode, send |
+//! | `ledger.rs` | the memory limit shared by every tab: the volume, each tab's renderer, each frame in flight |
 //! | `reproduce.rs` | [`Reproduce`]: the caller turns a state into settings and a command |
 //! | `hello.rs` | the page's first message: histogram, colours, the start |
 //! | `encode.rs` | JPEG and PNG, quantised as `volray render` writes PNGs |
@@ -37,6 +38,7 @@
 
 mod encode;
 mod hello;
+mod ledger;
 mod mailbox;
 mod page;
 mod protocol;
@@ -48,6 +50,7 @@ mod stats;
 mod token;
 
 pub use hello::Start;
+pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
 pub use protocol::{Basis, FrameHeader, Hello, Quality, ServerMessage};
 pub use reproduce::{Refusal, Reproduce, Reproduction};
 pub use server::{ServeError, Server, Stopper};
@@ -68,14 +71,19 @@ pub struct Viewer {
     pub volume: Arc<Volume>,
     pub non_finite: NonFinite,
     /// The bytes each tab's renderer may keep in brick caches
-    /// (`Renderer::with_cache_budget`).
+    /// (`Renderer::with_cache_budget`); less where the limit needs it for
+    /// the starting view's frame.
     pub cache_budget: usize,
+    /// The memory limit of the whole server: the volume, every tab's
+    /// renderer and every frame in flight, together.
+    pub max_memory: u128,
     /// The page's first message ([`Start::hello`]).
     pub hello: Hello,
     pub reproduce: Arc<dyn Reproduce>,
     /// The workers every tab's frames are rendered on.
     pub pool: Arc<rayon::ThreadPool>,
-    /// The most tabs rendering at once.
+    /// The most tabs rendering at once (each has a thread), whatever the
+    /// memory allows.
     pub max_sessions: usize,
 }
 
@@ -86,22 +94,38 @@ pub enum ViewError {
     Token(#[from] NoRandomness),
     #[error("{0}")]
     Serve(#[from] ServeError),
+    #[error("the starting view: {0}")]
+    Start(#[from] Refusal),
+    #[error("{0}")]
+    Memory(#[from] Overdrawn),
 }
 
 impl Viewer {
     /// Binds `addr` with a new access token; [`Server::run`] serves.
     pub fn bind(self, addr: SocketAddr) -> Result<Server, ViewError> {
         let token = Token::generate()?;
+        let start = self.reproduce.reproduce(&self.hello.start)?.settings;
+        let (costs, cache_budget) = ledger::Costs::fitting(
+            &self.volume,
+            &start,
+            self.non_finite,
+            self.cache_budget,
+            self.max_memory,
+        );
+        let ledger = ledger::Ledger::new(self.max_memory);
+        let volume = ledger.reserve("the volume", costs.volume)?;
         let hello = ServerMessage::Hello(Box::new(self.hello)).to_json();
         let shared = session::Shared {
             volume: self.volume,
             non_finite: self.non_finite,
-            cache_budget: self.cache_budget,
+            cache_budget,
             reproduce: self.reproduce,
             pool: self.pool,
             stats: Arc::new(stats::Stats::default()),
             max_sessions: self.max_sessions,
+            ledger,
+            costs,
         };
-        Ok(Server::bind(addr, token, hello, shared)?)
+        Ok(Server::bind(addr, token, hello, shared, volume)?)
     }
 }

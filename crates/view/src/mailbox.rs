@@ -5,7 +5,15 @@
 //!
 //! The sender never waits; the receiver waits for a request or for the
 //! mailbox to close (the tab went away, the server is stopping).
+//!
+//! The mailbox also holds the stop flag of the frame being rendered: a
+//! request for the slot whose frame is being rendered sets it (the frame
+//! is superseded: its view is no longer the page's), and so does closing.
+//! A view does not stop a save, nor a save a view: the file asked for is
+//! still wanted while the view moves. The renderer passes the flag to
+//! volray-core, whose casters stop within a tile's work.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard};
 
 /// What a mailbox holds: at most one view request and one save request.
@@ -16,6 +24,8 @@ struct Slots<T> {
     closed: bool,
     /// Requests replaced before they were taken.
     dropped: u64,
+    /// The slot of the request taken last, until [`Mailbox::finished`].
+    rendering: Option<Slot>,
 }
 
 /// A single-slot mailbox of requests `T`.
@@ -23,6 +33,9 @@ struct Slots<T> {
 pub struct Mailbox<T> {
     slots: Mutex<Slots<T>>,
     ready: Condvar,
+    /// Set when the request being rendered is superseded or the mailbox
+    /// closes; cleared when the next request is taken.
+    stop: AtomicBool,
 }
 
 /// Which slot a request goes to.
@@ -42,8 +55,10 @@ impl<T> Default for Mailbox<T> {
                 save: None,
                 closed: false,
                 dropped: 0,
+                rendering: None,
             }),
             ready: Condvar::new(),
+            stop: AtomicBool::new(false),
         }
     }
 }
@@ -54,12 +69,18 @@ impl<T> Mailbox<T> {
         self.slots.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Puts `request` in its slot, replacing (dropping) what waits there.
-    /// A closed mailbox drops it.
+    /// Puts `request` in its slot, replacing (dropping) what waits there,
+    /// and stops the frame of that slot being rendered. A closed mailbox
+    /// drops it.
     pub fn put(&self, slot: Slot, request: T) {
         let mut slots = self.lock();
         if slots.closed {
             return;
+        }
+        if slots.rendering == Some(slot) {
+            // Under the lock, so that `take` cannot clear it for the
+            // request that supersedes the frame.
+            self.stop.store(true, Ordering::Relaxed);
         }
         let place = match slot {
             Slot::Latest => &mut slots.latest,
@@ -72,15 +93,22 @@ impl<T> Mailbox<T> {
         self.ready.notify_one();
     }
 
-    /// Waits for a request (a save first) and takes it; `None` once the
-    /// mailbox is closed.
+    /// Waits for a request (a save first) and takes it, clearing the stop
+    /// flag for its frame; `None` once the mailbox is closed.
     pub fn take(&self) -> Option<T> {
         let mut slots = self.lock();
+        slots.rendering = None;
         loop {
             if slots.closed {
                 return None;
             }
-            if let Some(request) = slots.save.take().or_else(|| slots.latest.take()) {
+            let taken = match slots.save.take() {
+                Some(save) => Some((Slot::Save, save)),
+                None => slots.latest.take().map(|view| (Slot::Latest, view)),
+            };
+            if let Some((slot, request)) = taken {
+                slots.rendering = Some(slot);
+                self.stop.store(false, Ordering::Relaxed);
                 return Some(request);
             }
             slots = self.ready.wait(slots).unwrap_or_else(|e| e.into_inner());
@@ -94,8 +122,26 @@ impl<T> Mailbox<T> {
         slots.closed = true;
         slots.latest = None;
         slots.save = None;
+        self.stop.store(true, Ordering::Relaxed);
         drop(slots);
         self.ready.notify_all();
+    }
+
+    /// The frame being rendered is done: requests put from now on no
+    /// longer stop it (they wait for the next [`Self::take`]).
+    pub fn finished(&self) {
+        self.lock().rendering = None;
+    }
+
+    /// The stop flag of the request taken last, for the renderer.
+    pub fn stop_flag(&self) -> &AtomicBool {
+        &self.stop
+    }
+
+    /// Whether the request taken last was superseded or the mailbox closed.
+    #[cfg(test)]
+    pub fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
     }
 
     /// How many requests were replaced before they were taken.
@@ -151,6 +197,35 @@ mod tests {
         mailbox.put(Slot::Latest, 1);
         assert_eq!(mailbox.waiting(), 0);
         assert_eq!(mailbox.take(), None);
+    }
+
+    #[test]
+    fn a_newer_request_stops_the_frame_of_its_slot_only() {
+        let mailbox = Mailbox::default();
+        mailbox.put(Slot::Latest, "view 1");
+        assert_eq!(mailbox.take(), Some("view 1"));
+        assert!(!mailbox.stopped());
+        // A save does not stop the view being rendered; a newer view does.
+        mailbox.put(Slot::Save, "save");
+        assert!(!mailbox.stopped());
+        mailbox.put(Slot::Latest, "view 2");
+        assert!(mailbox.stopped());
+        // The next request taken starts unstopped; a view does not stop
+        // the save being rendered, a newer save does.
+        assert_eq!(mailbox.take(), Some("save"));
+        assert!(!mailbox.stopped());
+        mailbox.put(Slot::Latest, "view 3");
+        assert!(!mailbox.stopped());
+        mailbox.put(Slot::Save, "save 2");
+        assert!(mailbox.stopped());
+        // Once the frame is finished, requests wait without stopping it.
+        assert_eq!(mailbox.take(), Some("save 2"));
+        mailbox.finished();
+        mailbox.put(Slot::Save, "save 3");
+        assert!(!mailbox.stopped());
+        // Closing stops whatever is rendered.
+        mailbox.close();
+        assert!(mailbox.stopped());
     }
 
     #[test]

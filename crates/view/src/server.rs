@@ -6,6 +6,7 @@
 //! before it runs, so that the caller can print the URL first; it stops
 //! when its [`Stopper`] is called, closing every tab's renderer.
 
+use crate::ledger::Reservation;
 use crate::mailbox::{Mailbox, Slot};
 use crate::page;
 use crate::protocol::{self, MAX_MESSAGE_BYTES, MessageError, Quality, Request, ServerMessage};
@@ -45,6 +46,8 @@ struct App {
     shared: Shared,
     /// Every tab's mailbox, to close them when the server stops.
     mailboxes: Mutex<Vec<Weak<Mailbox<Request>>>>,
+    /// The volume's bytes in the ledger, for as long as the server lives.
+    _volume: Reservation,
 }
 
 /// A bound server, not yet serving.
@@ -72,6 +75,7 @@ impl Server {
         token: Token,
         hello: String,
         shared: Shared,
+        volume: Reservation,
     ) -> Result<Server, ServeError> {
         let bind_error = |source| ServeError::Bind { addr, source };
         let listener = TcpListener::bind(addr).map_err(bind_error)?;
@@ -83,6 +87,7 @@ impl Server {
                 hello,
                 shared,
                 mailboxes: Mutex::new(Vec::new()),
+                _volume: volume,
             }),
             stop: Arc::new(Notify::new()),
         })
@@ -210,7 +215,8 @@ fn asset(body: impl Into<Body>, mime: &'static str) -> Response {
 }
 
 async fn status(State(app): State<Arc<App>>) -> Response {
-    let json = serde_json::to_string(&app.shared.stats.snapshot()).expect("counters serialise");
+    let snapshot = app.shared.stats.snapshot(&app.shared.ledger);
+    let json = serde_json::to_string(&snapshot).expect("counters serialise");
     asset(json, "application/json")
 }
 
@@ -290,9 +296,12 @@ async fn serve_tab(app: Arc<App>, mut socket: WebSocket) {
                     }
                 }
                 outgoing = out_rx.recv() => {
-                    let message = match outgoing {
-                        Some(Outgoing::Frame(bytes)) => Message::Binary(bytes.into()),
-                        Some(Outgoing::Text(text)) => Message::Text(text.into()),
+                    // A frame's bytes stay reserved until it is sent.
+                    let (message, _reserved) = match outgoing {
+                        Some(Outgoing::Frame(bytes, reserved)) => {
+                            (Message::Binary(bytes.into()), Some(reserved))
+                        }
+                        Some(Outgoing::Text(text)) => (Message::Text(text.into()), None),
                         None => break,
                     };
                     if socket.send(message).await.is_err() {
@@ -302,6 +311,7 @@ async fn serve_tab(app: Arc<App>, mut socket: WebSocket) {
             }
         }
     }
+    // Stops the frame being rendered, if any, and ends the tab's thread.
     mailbox.close();
 }
 
