@@ -4,7 +4,9 @@
 //! image; the Command line, run through the CLI, writes the page's still
 //! frame pixel for pixel; bad messages are answered in the page and the
 //! server goes on; two tabs are independent and a closed tab frees its
-//! renderer; a burst of 1,000 requests is not queued. Without a browser
+//! renderer; a burst of 1,000 requests is not queued; a slow frame is
+//! stopped by a newer request and by closing its tab; two tabs' frames
+//! together are held within `--max-memory`. Without a browser
 //! these skip with a note, except under `CI=true`, where they fail.
 //!
 //! The token and the signals need no browser: a bare HTTP client and
@@ -322,7 +324,8 @@ async fn a_burst_of_a_thousand_requests_renders_the_latest_not_a_queue() {
     let Some((viewer, b)) = open(&["fractal:65", "--size", "160"]).await else {
         return;
     };
-    let before = viewer.status()["frames"].as_u64().unwrap();
+    let status = viewer.status();
+    let before = status["frames"].as_u64().unwrap() + status["stopped"].as_u64().unwrap();
     // 1,000 drafts in one go, then the full frame of the last state.
     let script = r#"
         const v = window.volrayView;
@@ -333,14 +336,89 @@ async fn a_burst_of_a_thousand_requests_renders_the_latest_not_a_queue() {
     b.eval(script).await;
     b.wait_still().await;
     assert_eq!(azimuth(&b.text("command").await), 99.9);
-    let rendered = viewer.status()["frames"].as_u64().unwrap() - before;
-    // Each frame takes milliseconds, the burst microseconds: a queue would
-    // have rendered all 1,001.
+    let after = viewer.status();
+    // The frames begun: rendered and sent, or stopped by a newer request.
+    let begun =
+        |s: &serde_json::Value| s["frames"].as_u64().unwrap() + s["stopped"].as_u64().unwrap();
+    let rendered = begun(&after) - before;
+    // The mailbox keeps only the latest request: a handful of frames is
+    // begun, not one per request (a queue would begin all 1,001, each
+    // taken and then stopped by the next).
     assert!(
-        rendered < 1001,
-        "{rendered} frames rendered: the requests were queued"
+        rendered <= 100,
+        "{rendered} of 1001 requests were begun as frames: the requests were queued"
     );
     eprintln!("burst: {rendered} of 1001 requests rendered");
+    b.close().await;
+}
+
+/// A 4096² frame at step 0.001: minutes of work on any machine.
+const SLOW: &str =
+    "window.volrayView.sendState({width: 4096, height: 4096, step: 0.001}); return true;";
+
+/// An ordinary view at `azimuth`.
+fn ordinary(azimuth: u32) -> String {
+    format!(
+        "window.volrayView.sendState({{width: 160, height: 160, step: 1, azimuth: {azimuth}}}); return true;"
+    )
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn a_slow_frame_is_stopped_by_a_newer_request_and_by_closing_its_tab_and_memory_is_shared() {
+    // 800 MiB: one 4096² frame fits (about 460 MiB with its encoding),
+    // two do not.
+    let Some((viewer, b)) = open(&["fractal:65", "--size", "160", "--max-memory", "800M"]).await
+    else {
+        return;
+    };
+    let first = b.client.window().await.unwrap();
+    let second = b.client.new_window(true).await.unwrap().handle;
+    b.client.switch_to_window(second.clone()).await.unwrap();
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+
+    // The first tab asks for the slow frame.
+    b.client.switch_to_window(first.clone()).await.unwrap();
+    b.eval(SLOW).await;
+    viewer.wait_status(browser::PATIENCE, |s| s["rendering"] == 1);
+
+    // The second tab's 4096² frame does not fit beside it: refused, with
+    // the reason in the page, not queued.
+    b.client.switch_to_window(second.clone()).await.unwrap();
+    b.eval("window.volrayView.sendState({width: 4096, height: 4096}); return true;")
+        .await;
+    b.wait_for("document.body.dataset.state === 'error'").await;
+    let error = b.text("error").await;
+    assert!(
+        error.starts_with("a 4096x4096 frame needs up to ")
+            && error.contains("but the open tabs hold")
+            && error.contains("of the memory limit 800 MiB"),
+        "{error}"
+    );
+    assert_eq!(viewer.status()["refused"], 1);
+
+    // An ordinary request in the first tab stops its slow frame; its own
+    // frame comes.
+    b.client.switch_to_window(first).await.unwrap();
+    b.eval(&ordinary(45)).await;
+    b.wait_still().await;
+    assert_eq!(azimuth(&b.text("command").await), 45.0);
+    let status = viewer.status();
+    assert_eq!(
+        (&status["stopped"], &status["rendering"]),
+        (&1.into(), &0.into()),
+        "{status}"
+    );
+
+    // The second tab starts a slow frame and closes: the frame is
+    // stopped, the renderer freed, the server idle.
+    b.client.switch_to_window(second).await.unwrap();
+    b.eval(SLOW).await;
+    viewer.wait_status(browser::PATIENCE, |s| s["rendering"] == 1);
+    b.client.close_window().await.unwrap();
+    viewer.wait_status(browser::PATIENCE, |s| {
+        s["rendering"] == 0 && s["sessions"] == 1 && s["stopped"] == 2
+    });
     b.close().await;
 }
 
