@@ -181,15 +181,26 @@ impl MappedFile {
         if len == 0 {
             return Err(IoError::invalid(path, "the file is empty: nothing to map"));
         }
-        // SAFETY: the map is read-only and private to this process. Another
-        // process may still change the file under it; this crate cannot
-        // prevent that, so it guards against it: reads past a truncated
-        // end are caught (the guard below, registered before any read of
-        // the map) and turn into zeros plus an error from `verify`, and a
-        // change of length or modification time fails `verify` too. The
-        // samples read are plain numbers (every bit pattern is a value),
-        // so bytes changing under a read give wrong values, which
-        // `verify` reports, never undefined values.
+        // SAFETY: `MmapOptions::map` maps the file read-only and *shared*
+        // (memmap2's `MmapInner::map`: `PROT_READ`, `MAP_SHARED`): the
+        // pages are the page cache's, so a write to the file by another
+        // process shows through them at once. A private mapping would not
+        // prevent that either: Linux shows a file's changes through the
+        // pages of a `MAP_PRIVATE` mapping not yet copied, and a read-only
+        // one is never copied (POSIX leaves it unspecified, mmap(2)). So
+        // the `&[u8]` this hands out is sound only under the assumption
+        // every mapped-file reader makes, that nobody writes or truncates
+        // the file while it is mapped; no lock can enforce that (advisory
+        // locks bind only those who take them). What this crate does
+        // instead is keep a breach of it from crashing the process or
+        // passing unnoticed: reads past a truncated end are caught (the
+        // guard below, registered before any read of the map; the zero
+        // page it maps over the faulting page is in place of the shared
+        // one, see `sigbus`) and read zeros, which `verify` reports, as it
+        // does a change of length or modification time. The samples are
+        // plain numbers (every bit pattern is a value of `u8`, `i8`,
+        // `u16`, `i16` or `f32`), so bytes changed under a read give wrong
+        // values, never invalid ones.
         let map =
             unsafe { MmapOptions::new().map(&file) }.map_err(|e| IoError::os(path, "map", e))?;
         let guard = Guard::new(map.as_ptr() as usize, map.len())

@@ -171,11 +171,15 @@ extern "C" fn on_sigbus(
             continue;
         }
         let page = addr & !(installed.page - 1);
-        // SAFETY: `page` lies in a registered read-only file mapping that
-        // is alive (its guard unregisters it before it is unmapped); a
-        // private anonymous page replaces that one page of it in place,
-        // readable and zero, so the faulting read can be retried. Nothing
-        // else maps there: the range is the mapping's own.
+        // SAFETY: `page` lies in a registered mapping (`MappedFile`'s:
+        // read-only and shared, `MAP_SHARED`) that is alive: the read
+        // that faulted borrows it, so it cannot be unmapped during the
+        // read, and its guard unregisters it before it is unmapped. A
+        // private anonymous page replaces that one page of the shared
+        // mapping in place (`MAP_FIXED`), readable and zero, so the
+        // faulting read can be retried; the rest of the mapping stays the
+        // file's, and unmapping the whole range later unmaps this page
+        // too. Nothing else maps there: the range is the mapping's own.
         let mapped = unsafe {
             libc::mmap(
                 page as *mut libc::c_void,
@@ -235,5 +239,194 @@ mod tests {
         let c = Guard::new(0x9000, 0x1000).unwrap();
         assert_eq!(TABLE[c.slot].end.load(Ordering::Acquire), 0xa000);
         assert!(Guard::new(usize::MAX, 2).is_err());
+    }
+
+    // What the handler does with a SIGBUS outside every guarded range can
+    // only be seen in a process it may end, so each case below runs in a
+    // child: the test binary itself, re-run with `CHILD` naming the case
+    // and a filter selecting the same test. The child maps a file of three
+    // pages, cuts the file to nothing, guards page 0 and reads it (zeros,
+    // caught), then reads page 2 (unguarded): a real SIGBUS, with the
+    // faulting address in `si_addr`, that the guard hands on. The parent
+    // judges the child by how it ended.
+
+    /// The environment variable that makes a test its own child.
+    const CHILD: &str = "VOLRAY_SIGBUS_CHILD";
+
+    /// Exit codes of the child: the earlier handler ran, for the read it
+    /// should have seen (`si_addr` on page 2, after the guarded read of
+    /// page 0 succeeded); and every way it can go wrong.
+    const CHAINED: i32 = 42;
+    const WRONG_ADDRESS: i32 = 43;
+    const BEFORE_GUARDED_READ: i32 = 44;
+    const SURVIVED: i32 = 45;
+
+    /// Where page 2 of the child's mapping starts, the page size, and
+    /// whether the guarded read of page 0 is done: read by the earlier
+    /// handlers.
+    static PAGE_2: AtomicUsize = AtomicUsize::new(0);
+    static PAGE: AtomicUsize = AtomicUsize::new(0);
+    static GUARDED_READ_DONE: AtomicBool = AtomicBool::new(false);
+
+    /// An earlier handler installed with `SA_SIGINFO`: ends the process
+    /// with [`CHAINED`] if it is handed the fault it should see.
+    extern "C" fn earlier_siginfo(
+        _signal: libc::c_int,
+        info: *mut libc::siginfo_t,
+        _context: *mut libc::c_void,
+    ) {
+        // SAFETY: called as a SA_SIGINFO handler (by the kernel or by the
+        // guard passing its own arguments on), so `info` is a valid
+        // siginfo_t; `_exit` is async-signal-safe.
+        unsafe {
+            let addr = (*info).si_addr() as usize;
+            let page = PAGE_2.load(Ordering::Acquire);
+            let size = PAGE.load(Ordering::Acquire);
+            libc::_exit(if !GUARDED_READ_DONE.load(Ordering::Acquire) {
+                BEFORE_GUARDED_READ
+            } else if addr >= page && addr < page + size {
+                CHAINED
+            } else {
+                WRONG_ADDRESS
+            });
+        }
+    }
+
+    /// An earlier handler of the one-argument form (no `SA_SIGINFO`).
+    extern "C" fn earlier_plain(_signal: libc::c_int) {
+        // SAFETY: `_exit` is async-signal-safe.
+        unsafe {
+            libc::_exit(if GUARDED_READ_DONE.load(Ordering::Acquire) {
+                CHAINED
+            } else {
+                BEFORE_GUARDED_READ
+            });
+        }
+    }
+
+    /// Sets SIGBUS's disposition before the guard is installed.
+    fn set_earlier(handler: usize, flags: libc::c_int) {
+        // SAFETY: a zeroed sigaction is valid (empty mask, no flags);
+        // `handler` is SIG_DFL, SIG_IGN or one of the functions above,
+        // whose signature matches `flags`; the structure outlives the call.
+        let done = unsafe {
+            let mut action: libc::sigaction = std::mem::zeroed();
+            action.sa_sigaction = handler;
+            action.sa_flags = flags;
+            libc::sigemptyset(&mut action.sa_mask);
+            libc::sigaction(libc::SIGBUS, &action, std::ptr::null_mut())
+        };
+        assert_eq!(done, 0, "sigaction: {}", std::io::Error::last_os_error());
+    }
+
+    /// The child's side: `case` says what SIGBUS's disposition is before
+    /// the guard is installed ("std" leaves the one Rust's runtime
+    /// installs at start-up, for stack overflows).
+    fn child(case: &str) -> ! {
+        // A core dump of the child killed on purpose is noise.
+        let no_core = libc::rlimit {
+            rlim_cur: 0,
+            rlim_max: 0,
+        };
+        // SAFETY: a valid rlimit, read by the call only.
+        unsafe { libc::setrlimit(libc::RLIMIT_CORE, &no_core) };
+        match case {
+            "siginfo" => set_earlier(earlier_siginfo as *const () as usize, libc::SA_SIGINFO),
+            "plain" => set_earlier(earlier_plain as *const () as usize, 0),
+            "default" => set_earlier(libc::SIG_DFL, 0),
+            "ignored" => set_earlier(libc::SIG_IGN, 0),
+            "std" => {}
+            other => panic!("unknown case {other}"),
+        }
+        // SAFETY: sysconf has no preconditions.
+        let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) } as usize;
+        PAGE.store(page, Ordering::Release);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cut.raw");
+        std::fs::write(&path, vec![7u8; 3 * page]).unwrap();
+        let file = std::fs::File::open(&path).unwrap();
+        // SAFETY: nobody else knows of this file; it is cut below on
+        // purpose, and reads past its end are what is tested.
+        let map = unsafe { memmap2::Mmap::map(&file) }.unwrap();
+        let base = map.as_ptr() as usize;
+        PAGE_2.store(base + 2 * page, Ordering::Release);
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .unwrap()
+            .set_len(0)
+            .unwrap();
+        let guard = Guard::new(base, page).unwrap();
+        // SAFETY: inside the live mapping; page 0 is guarded.
+        let first = unsafe { std::ptr::read_volatile(map.as_ptr()) };
+        assert_eq!((first, guard.faulted()), (0, true));
+        GUARDED_READ_DONE.store(true, Ordering::Release);
+        // SAFETY: inside the live mapping, past the file's end and outside
+        // the guarded range: SIGBUS, which is what this child is for.
+        let _ = unsafe { std::ptr::read_volatile(map.as_ptr().add(2 * page)) };
+        std::process::exit(SURVIVED);
+    }
+
+    /// Runs `case` in a child (this test binary, filtered to the test
+    /// `test`), giving how it ended.
+    fn run_child(test: &str, case: &str) -> std::process::Output {
+        let module = module_path!().split_once("::").unwrap().1;
+        let output = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([&format!("{module}::{test}"), "--exact", "--nocapture"])
+            .env(CHILD, case)
+            .output()
+            .unwrap();
+        // The child must have run the case, not filtered it away.
+        assert!(
+            !String::from_utf8_lossy(&output.stdout).contains("running 0 tests"),
+            "{test} not found"
+        );
+        output
+    }
+
+    fn describe(output: &std::process::Output) -> String {
+        format!(
+            "{:?}\n{}{}",
+            output.status,
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        )
+    }
+
+    #[test]
+    fn a_sigbus_outside_every_guard_goes_to_the_handler_installed_before() {
+        if let Ok(case) = std::env::var(CHILD) {
+            child(&case);
+        }
+        let test = "a_sigbus_outside_every_guard_goes_to_the_handler_installed_before";
+        for case in ["siginfo", "plain"] {
+            let output = run_child(test, case);
+            assert_eq!(
+                output.status.code(),
+                Some(CHAINED),
+                "{case}: {}",
+                describe(&output)
+            );
+        }
+    }
+
+    #[test]
+    fn a_sigbus_outside_every_guard_without_a_handler_before_ends_the_process() {
+        use std::os::unix::process::ExitStatusExt;
+        if let Ok(case) = std::env::var(CHILD) {
+            child(&case);
+        }
+        let test = "a_sigbus_outside_every_guard_without_a_handler_before_ends_the_process";
+        // SIG_IGN cannot ignore a fault: the kernel delivers it with the
+        // default action, and so does the guard.
+        for case in ["default", "ignored", "std"] {
+            let output = run_child(test, case);
+            assert_eq!(
+                output.status.signal(),
+                Some(libc::SIGBUS),
+                "{case}: {}",
+                describe(&output)
+            );
+        }
     }
 }
