@@ -23,6 +23,29 @@ const SMALL_FILE_ALLOWANCE: u64 = 64 << 20;
 /// Samples read per slab of rows.
 const SLAB_SAMPLES: usize = 1 << 20;
 
+#[cfg(test)]
+thread_local! {
+    /// The tests' slab size in samples (the fixtures hold 60 samples, a
+    /// sliver of one slab of [`SLAB_SAMPLES`]), and the slabs read since
+    /// it was set: see `tests::in_slabs_of`.
+    static TEST_SLABS: std::cell::Cell<(usize, usize)> =
+        const { std::cell::Cell::new((SLAB_SAMPLES, 0)) };
+}
+
+/// Samples read per slab: [`SLAB_SAMPLES`], or what a test set.
+fn slab_samples() -> usize {
+    #[cfg(test)]
+    return TEST_SLABS.with(|t| t.get().0);
+    #[cfg(not(test))]
+    SLAB_SAMPLES
+}
+
+/// Counts a slab read, for the tests.
+fn slab_read() {
+    #[cfg(test)]
+    TEST_SLABS.with(|t| t.set((t.get().0, t.get().1 + 1)));
+}
+
 /// An open HDF5 file and its length in bytes.
 pub(crate) struct H5File {
     pub file: File,
@@ -122,16 +145,17 @@ pub(crate) fn shape(dataset: &Dataset) -> Result<Vec<usize>, String> {
 }
 
 /// Rows of the first axis read at once for rows of `row` samples: whole
-/// chunks adding up to about [`SLAB_SAMPLES`], or, where one chunk is
-/// larger than that, as many rows as fit [`SLAB_SAMPLES`] (at least one),
-/// so that a header's chunk size cannot make the scratch buffer large.
-fn slab_rows(row: usize, chunk0: usize) -> usize {
+/// chunks adding up to about `slab` samples ([`SLAB_SAMPLES`]), or,
+/// where one chunk is larger than that, as many rows as fit `slab` (at
+/// least one), so that a header's chunk size cannot make the scratch
+/// buffer large.
+fn slab_rows(row: usize, chunk0: usize, slab: usize) -> usize {
     let row = row.max(1);
     let chunk0 = chunk0.max(1);
-    if row.saturating_mul(chunk0) <= SLAB_SAMPLES {
-        (SLAB_SAMPLES / row / chunk0).max(1) * chunk0
+    if row.saturating_mul(chunk0) <= slab {
+        (slab / row / chunk0).max(1) * chunk0
     } else {
-        (SLAB_SAMPLES / row).max(1)
+        (slab / row).max(1)
     }
 }
 
@@ -188,7 +212,7 @@ impl<'d> Slabs<'d> {
             rows,
             row,
             frame,
-            slab: slab_rows(row, chunk_along(dataset, 0)),
+            slab: slab_rows(row, chunk_along(dataset, 0), slab_samples()),
         }
     }
 
@@ -253,6 +277,7 @@ impl<'d> Slabs<'d> {
         let mut first = 0;
         while first < self.rows {
             let end = (first + self.slab).min(self.rows);
+            slab_read();
             take(
                 first * self.row,
                 &self.rows_of(first, end - first, self.row)?,
@@ -374,4 +399,132 @@ pub(crate) fn sorted_attrs(
         attrs.map(|a| a.into_iter().collect()).unwrap_or_default();
     attrs.sort_by(|a, b| a.0.cmp(&b.0));
     attrs
+}
+
+#[cfg(test)]
+mod tests {
+    //! The readers' slabs: the fixtures (shape (4, 3, 5), 60 samples)
+    //! read with the slab shrunk to a row or a few, so that a volume spans
+    //! several slabs, every value checked against the fixture's content
+    //! (the scripts `tests/fixtures/make_hdf5_fixtures.py` and
+    //! `make_minc_fixtures.py`), so that a slab placed at the wrong offset
+    //! fails.
+
+    use super::*;
+    use crate::{ReadOptions, read};
+    use volray_core::Volume;
+
+    /// Reads `file` (under `tests/fixtures/`) with slabs of at most
+    /// `samples` samples (`--frame frame`), giving the volume and the
+    /// slabs read.
+    fn in_slabs_of(samples: usize, file: &str, frame: Option<usize>) -> (Volume, usize) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures")
+            .join(file);
+        let opts = ReadOptions {
+            frame,
+            ..ReadOptions::default()
+        };
+        TEST_SLABS.with(|t| t.set((samples, 0)));
+        let loaded = read(&path, &opts);
+        let slabs = TEST_SLABS.with(|t| t.replace((SLAB_SAMPLES, 0)).1);
+        let loaded = loaded.unwrap_or_else(|e| panic!("{file}: {e}"));
+        (loaded.volume, slabs)
+    }
+
+    /// Every voxel of `volume` (dims `dims`) is `want(x, y, z)` within a
+    /// relative `tolerance`.
+    fn check(
+        what: &str,
+        volume: &Volume,
+        dims: [usize; 3],
+        tolerance: f64,
+        want: impl Fn(usize, usize, usize) -> f64,
+    ) {
+        assert_eq!(volume.dims(), dims, "{what}");
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let (got, want) = (f64::from(volume.get(x, y, z)), want(x, y, z));
+                    assert!(
+                        (got - want).abs() <= tolerance * want.abs().max(1.0),
+                        "{what}: ({x}, {y}, {z}) is {got}, not {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Slab sizes in samples, and the slabs a volume of 4 rows of 15
+    /// samples takes, contiguous and in chunks of 2 rows: one row at a
+    /// time (however small the slab, at least a row; a chunk split), 2
+    /// rows (a whole chunk), 3 rows (the last slab short; a chunk), and
+    /// the default, one slab for all.
+    const SLABS: [(usize, usize, usize); 5] = [
+        (1, 4, 4),
+        (15, 4, 4),
+        (30, 2, 2),
+        (45, 2, 2),
+        (SLAB_SAMPLES, 1, 1),
+    ];
+
+    #[test]
+    fn hdf5_volumes_read_in_several_slabs_hold_every_value_in_its_place() {
+        // v = x + 10y + 100z at a[x, y, z], dims (4, 3, 5).
+        let v = |x: usize, y: usize, z: usize| (x + 10 * y + 100 * z) as f64;
+        for (samples, contiguous, chunked) in SLABS {
+            let (volume, slabs) = in_slabs_of(samples, "hdf5/one.h5", None);
+            check("density", &volume, [4, 3, 5], 0.0, |x, y, z| {
+                v(x, y, z) + 0.5
+            });
+            assert_eq!(slabs, contiguous, "one.h5 in slabs of {samples}");
+            let (volume, slabs) = in_slabs_of(samples, "hdf5/many.h5:/u8", None);
+            check("u8", &volume, [4, 3, 5], 0.0, |x, y, z| {
+                (x + 2 * y + 6 * z) as f64
+            });
+            assert_eq!(slabs, contiguous, "u8 in slabs of {samples}");
+            let (volume, _) = in_slabs_of(samples, "hdf5/many.h5:/i16_be", None);
+            check("i16_be", &volume, [4, 3, 5], 0.0, |x, y, z| -v(x, y, z));
+            let (volume, _) = in_slabs_of(samples, "hdf5/many.h5:/i64", None);
+            check("i64", &volume, [4, 3, 5], 0.0, |x, y, z| {
+                f64::from((v(x, y, z) - 2f64.powi(40)) as f32)
+            });
+            let (volume, slabs) = in_slabs_of(samples, "hdf5/many.h5:/gzip_u16", None);
+            check("gzip_u16", &volume, [4, 3, 5], 0.0, v);
+            assert_eq!(slabs, chunked, "gzip_u16 in slabs of {samples}");
+            // A volume of a series is read whole, whatever the slab.
+            let (volume, slabs) = in_slabs_of(samples, "hdf5/many.h5:/series", Some(2));
+            check("series", &volume, [4, 3, 5], 0.0, |x, y, z| {
+                v(x, y, z) + 2000.0
+            });
+            assert_eq!(slabs, 0, "series");
+        }
+    }
+
+    #[test]
+    fn minc2_volumes_read_in_several_slabs_keep_each_slice_scaling() {
+        // ramp_i16.mnc: file index (z, y, x) of shape (3, 4, 5) holds
+        // x + 10y + 100z, scaled per z slice from [0, 1000] to
+        // [-1 - z, 100 + 10z]; y is flipped (step -2), so volume row y is
+        // file row 3 - y.
+        let real = |x: usize, y: usize, z: usize| {
+            let raw = (x + 10 * (3 - y) + 100 * z) as f64;
+            let (lo, hi) = (-1.0 - z as f64, 100.0 + 10.0 * z as f64);
+            f64::from((raw * (hi - lo) / 1000.0 + lo) as f32)
+        };
+        // oblique_f32.mnc: shape (4, 3, 5), unscaled x + 10z + 100y + 0.5
+        // at file index (y, z, x).
+        let oblique = |x: usize, z: usize, y: usize| (x + 10 * z + 100 * y) as f64 + 0.5;
+        // 3 rows of 20 samples (ramp) and 4 of 15 (oblique).
+        for (samples, ramp_slabs, oblique_slabs) in
+            [(1, 3, 4), (20, 3, 4), (40, 2, 2), (SLAB_SAMPLES, 1, 1)]
+        {
+            let (volume, slabs) = in_slabs_of(samples, "minc/ramp_i16.mnc", None);
+            check("ramp_i16", &volume, [5, 4, 3], 1e-6, real);
+            assert_eq!(slabs, ramp_slabs, "ramp_i16 in slabs of {samples}");
+            let (volume, slabs) = in_slabs_of(samples, "minc/oblique_f32.mnc", None);
+            check("oblique_f32", &volume, [5, 3, 4], 0.0, oblique);
+            assert_eq!(slabs, oblique_slabs, "oblique_f32 in slabs of {samples}");
+        }
+    }
 }
