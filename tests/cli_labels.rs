@@ -78,21 +78,82 @@ fn each_label_shows_in_its_own_colour_and_label_0_is_transparent() {
         PALETTE[2]
     );
     assert_eq!(inner.at(24, 12), [0, 0, 0], "label 1 is hidden");
-    // Label 1 made transparent instead: the same picture but for label 5.
-    let clear = render(
+}
+
+/// The fixture's labels (see the module docs) with label 1 left out: 0
+/// where the big ball is, as an `.npy` file (`f32`, `a[x, y, z]`).
+fn without_label_1(dir: &Path) -> String {
+    const N: usize = 24;
+    let mut data = vec![0f32; N * N * N];
+    for z in 0..N {
+        for y in 0..N {
+            for x in 0..N {
+                let d = |i: usize| i as f64 - 11.5;
+                let r = (d(x).powi(2) + d(y).powi(2) + d(z).powi(2)).sqrt();
+                let label = if r <= 4.5 {
+                    2.0
+                } else if (1..4).contains(&x) && (1..4).contains(&y) && (18..22).contains(&z) {
+                    5.0
+                } else {
+                    0.0
+                };
+                data[x + N * (y + N * z)] = label;
+            }
+        }
+    }
+    let volume = volray_core::Volume::new([N; 3], data).unwrap();
+    let path = dir.join("without_1.npy");
+    volray_io::write_npy(&path, &volume).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn label_opacity_0_makes_a_label_vanish_and_between_lets_the_inside_show_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let seg = fixture("seg.nii.gz");
+    let look = ["--labels", "--no-shading"];
+    let with = |opacity: &'static str| [&look[..], &["--label-opacity", opacity]].concat();
+    let opaque = render(dir.path(), "opaque.png", &seg, &look);
+    let gone = render(dir.path(), "gone.png", &seg, &with("1:0"));
+    let faint = render(dir.path(), "faint.png", &seg, &with("1:0.2"));
+    // Label 1 at opacity 0 is the volume without it: the inner ball and
+    // the box of label 5, nothing of the big ball.
+    let without = render(
         dir.path(),
-        "clear.png",
-        &seg,
-        &[
-            "--labels",
-            "--no-shading",
-            "--label-opacity",
-            "1:0",
-            "--show-labels",
-            "2",
-        ],
+        "without.png",
+        &without_label_1(dir.path()),
+        &look,
     );
-    assert_eq!(clear.max_diff(&inner), 0);
+    assert_eq!(gone.max_diff(&without), 0);
+    let centre = gone.at(24, 24);
+    assert!(
+        close(centre, PALETTE[2], 3),
+        "{centre:?} vs {:?}",
+        PALETTE[2]
+    );
+    assert_eq!(gone.at(24, 12), [0, 0, 0], "label 1 has vanished");
+    // Opaque, label 1 hides the inner ball; faint, the ray crosses about
+    // 4.5 voxels of it first and the inner ball's green shows through:
+    // the centre's red (orange 255, green 44) falls between the two.
+    let centre = opaque.at(24, 24);
+    assert!(
+        close(centre, PALETTE[1], 3),
+        "{centre:?} vs {:?}",
+        PALETTE[1]
+    );
+    let red = |p: &Picture| p.at(24, 24)[0];
+    assert!(
+        red(&gone) < red(&faint) && red(&faint) < red(&opaque),
+        "{} {} {}",
+        red(&gone),
+        red(&faint),
+        red(&opaque)
+    );
+    // Between the balls' outlines the ray meets label 1 alone: orange
+    // opaque, dimmer orange (over the black background) faint.
+    let (solid, dim) = (opaque.at(24, 12), faint.at(24, 12));
+    assert!(close(solid, PALETTE[1], 3), "{solid:?}");
+    assert!(dim[0] > 0 && dim[0] < solid[0], "{dim:?} vs {solid:?}");
 }
 
 #[test]
