@@ -15,10 +15,12 @@
 //! `fractal`) are `a[x, y, z]` views of those samples. Spacing, origin
 //! and every world coordinate are `(x, y, z)` whatever the order.
 
+use crate::digest::digest;
 use crate::errors::value_error;
 use numpy::{PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::types::IntoPyDict;
 use std::sync::Arc;
 use volray_core::glam::DVec3;
 use volray_core::{External, ExternalBytes, Sample, SampleType, Samples, Store, Volume};
@@ -108,7 +110,19 @@ pub fn normalise<'py>(
         Order::Zyx => array.into_any(),
         Order::Xyz => array.getattr("T")?,
     };
-    let kept = np.call_method1("ascontiguousarray", (oriented, numpy_name(sample)))?;
+    let mut kept = np.call_method1("ascontiguousarray", (oriented, numpy_name(sample)))?;
+    // numpy does not promise alignment: a view at an odd byte offset
+    // (`np.frombuffer(buf, np.uint16, offset=1)`) is C-contiguous and kept
+    // as it is by `ascontiguousarray`. Its samples cannot be read in place
+    // as `u16` (`External::new` would refuse them), so they are copied
+    // into a fresh array, which numpy allocates aligned.
+    if !kept
+        .getattr("flags")?
+        .getattr("aligned")?
+        .extract::<bool>()?
+    {
+        kept = np.call_method1("array", (kept,))?;
+    }
     Ok((kept.cast_into::<PyUntypedArray>()?, sample))
 }
 
@@ -121,11 +135,14 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
 
 /// The bytes of a C-contiguous numpy array, owned by the array: a
 /// volume's samples without a copy.
-struct ArrayBytes {
+pub struct ArrayBytes {
     /// Keeps the array, and so its buffer, alive.
     _array: Py<PyAny>,
     ptr: *const u8,
     len: usize,
+    /// The [`digest`] of the bytes when the volume over them was made,
+    /// where a renderer checks that they stay so ([`ExternalBytes::verify`]).
+    expected: Option<u64>,
 }
 
 // SAFETY: `ptr` is only read (through `bytes`), and the buffer it points
@@ -135,9 +152,43 @@ struct ArrayBytes {
 // write them while the GIL is released for a render: that is the same
 // contract as any extension that reads a numpy array without the GIL
 // (numpy's own ufuncs do), stated in `Volume`'s documentation: do not
-// change an array while it renders.
+// change an array while it renders. A renderer digests the bytes before
+// each frame and, through `verify`, after it, so a write between frames
+// is rendered and a write during one is refused, not shown.
 unsafe impl Send for ArrayBytes {}
 unsafe impl Sync for ArrayBytes {}
+
+impl ArrayBytes {
+    /// The bytes of `array`, one contiguous run (C or Fortran order)
+    /// whatever its type, byte order or alignment, expected to keep the
+    /// digest `expected` where one is given.
+    pub fn new(array: &Bound<'_, PyUntypedArray>, expected: Option<u64>) -> PyResult<Self> {
+        if !(array.is_c_contiguous() || array.is_fortran_contiguous()) {
+            return Err(value_error("volume: the samples are not contiguous"));
+        }
+        // SAFETY: `as_array_ptr` is the `PyArrayObject` of `array`, alive
+        // while the `Bound` is held (the GIL attached); its data pointer
+        // is read, nothing is written.
+        let ptr = unsafe { (*array.as_array_ptr()).fields.data } as *const u8;
+        Ok(ArrayBytes {
+            _array: array.clone().into_any().unbind(),
+            ptr,
+            len: array.len() * array.dtype().itemsize(),
+            expected,
+        })
+    }
+
+    /// Whether `self` and `other` are the same bytes of memory.
+    pub fn same_bytes(&self, other: &ArrayBytes) -> bool {
+        self.ptr == other.ptr && self.len == other.len
+    }
+
+    /// The [`digest`] of the bytes as they are now (on the current rayon
+    /// pool; the GIL need not be held).
+    pub fn digest(&self) -> u64 {
+        digest(self.bytes())
+    }
+}
 
 impl std::fmt::Debug for ArrayBytes {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -147,40 +198,65 @@ impl std::fmt::Debug for ArrayBytes {
 
 impl ExternalBytes for ArrayBytes {
     fn bytes(&self) -> &[u8] {
-        // SAFETY: `ptr` is the data pointer of a C-contiguous array of
-        // `len` bytes (`nbytes`, checked non-zero with every side ≥ 2
-        // before this is made), aligned for its dtype (numpy allocates
-        // aligned buffers and `ascontiguousarray` returns an aligned
-        // array), alive as long as `_array` (see the `Send` note).
+        if self.len == 0 {
+            return &[];
+        }
+        // SAFETY: a `&[u8]` needs a non-null pointer aligned for `u8` (any
+        // pointer is) to `len` initialised bytes in one allocation that
+        // live as long as the slice. `ptr` is the data pointer of a
+        // C-contiguous array (checked in `new`), so its `len` =
+        // elements × itemsize bytes are one run in one buffer, non-null as
+        // the array is not empty; its bytes were written by numpy or are
+        // what its allocator handed out (`np.empty`): arbitrary values,
+        // each a valid `u8`, from memory allocated outside Rust. The buffer lives as long as `_array` (the
+        // array, which holds its base), and so as long as `self`. numpy
+        // cannot move or free the buffer under that reference: `resize`
+        // refuses an array referenced elsewhere unless told
+        // `refcheck=False`, which numpy documents as unsafe. Reading the
+        // bytes as samples of their type (`Store`'s `Deref`) needs the
+        // type's alignment, which numpy does not promise: `normalise`
+        // copies a misaligned array, and `External::new` checks the
+        // alignment again (refusing, never reading unaligned). What Rust's
+        // rules also ask, that nothing writes the bytes while the slice
+        // lives, is the documented contract (see the `Send` note), and
+        // `verify` refuses a frame that read bytes changed under it.
         unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
     }
 
     fn verify(&self) -> Result<(), String> {
-        Ok(())
+        match self.expected {
+            Some(expected) if self.digest() != expected => Err(
+                "the array changed while it was rendered: write to it only between frames"
+                    .to_string(),
+            ),
+            _ => Ok(()),
+        }
     }
 }
 
-fn store<T: Sample + numpy::Element>(array: &Bound<'_, PyUntypedArray>) -> PyResult<Store<T>> {
-    let typed = array.cast::<PyArray3<T>>()?;
-    let len = typed.len();
-    let bytes = ArrayBytes {
-        _array: typed.clone().into_any().unbind(),
-        ptr: typed.data() as *const u8,
-        len: len * size_of::<T>(),
-    };
+fn store<T: Sample + numpy::Element>(
+    array: &Bound<'_, PyUntypedArray>,
+    expected: Option<u64>,
+) -> PyResult<Store<T>> {
+    // The dtype checked against the type the bytes are read as.
+    array.cast::<PyArray3<T>>()?;
+    let bytes = ArrayBytes::new(array, expected)?;
+    let len = bytes.len / size_of::<T>();
     let external =
         External::new(Arc::new(bytes), 0, len).map_err(|e| value_error(e.to_string()))?;
     Ok(Store::External(external))
 }
 
 /// A volume over the samples of `array` (from [`normalise`]), without a
-/// copy.
+/// copy; `expected`, where given, is their [`digest`], which the
+/// renderer's [`ExternalBytes::verify`] checks after each frame.
 pub fn volume(
     array: &Bound<'_, PyUntypedArray>,
     sample: SampleType,
     spacing: [f64; 3],
     origin: [f64; 3],
     what: &str,
+    expected: Option<u64>,
 ) -> PyResult<Volume> {
     let shape = array.shape();
     let dims = [shape[2], shape[1], shape[0]];
@@ -190,11 +266,11 @@ pub fn volume(
         )));
     }
     let samples = match sample {
-        SampleType::U8 => Samples::U8(store::<u8>(array)?),
-        SampleType::I8 => Samples::I8(store::<i8>(array)?),
-        SampleType::U16 => Samples::U16(store::<u16>(array)?),
-        SampleType::I16 => Samples::I16(store::<i16>(array)?),
-        SampleType::F32 => Samples::F32(store::<f32>(array)?),
+        SampleType::U8 => Samples::U8(store::<u8>(array, expected)?),
+        SampleType::I8 => Samples::I8(store::<i8>(array, expected)?),
+        SampleType::U16 => Samples::U16(store::<u16>(array, expected)?),
+        SampleType::I16 => Samples::I16(store::<i16>(array, expected)?),
+        SampleType::F32 => Samples::F32(store::<f32>(array, expected)?),
     };
     let bad = |e: volray_core::VolumeError| value_error(format!("{what}: {e}"));
     Volume::from_samples(dims, samples)
@@ -206,31 +282,61 @@ pub fn volume(
 }
 
 /// A volume's samples as a C-contiguous numpy array `(nz, ny, nx)`,
-/// moved into it without a copy where the volume owns them.
-pub fn to_numpy<'py>(py: Python<'py>, volume: Volume) -> PyResult<Bound<'py, PyUntypedArray>> {
+/// moved into it without a copy where the volume owns them; read-only
+/// unless `writeable`: then numpy refuses to make it (or any view of it)
+/// writeable again, as its memory is owned by a Rust object that offers
+/// no writeable buffer, so the samples cannot change.
+pub fn to_numpy<'py>(
+    py: Python<'py>,
+    volume: Volume,
+    writeable: bool,
+) -> PyResult<Bound<'py, PyUntypedArray>> {
     let [nx, ny, nz] = volume.dims();
     fn array<'py, T: Sample + numpy::Element>(
         py: Python<'py>,
         store: Store<T>,
         shape: [usize; 3],
+        writeable: bool,
     ) -> PyResult<Bound<'py, PyUntypedArray>> {
         let vec = match store {
             Store::Owned(v) => v,
             Store::External(e) => Store::External(e).to_vec(),
         };
-        Ok(numpy::PyArray1::from_vec(py, vec)
+        let flat = numpy::PyArray1::from_vec(py, vec);
+        if !writeable {
+            // Before the reshape, so that no array over the memory is
+            // writeable (numpy lets a view become writeable again while
+            // its base is).
+            flat.call_method("setflags", (), Some(&[("write", false)].into_py_dict(py)?))?;
+        }
+        Ok(flat
             .reshape(shape)?
             .into_any()
             .cast_into::<PyUntypedArray>()?)
     }
     let shape = [nz, ny, nx];
     match volume.into_samples() {
-        Samples::U8(s) => array(py, s, shape),
-        Samples::I8(s) => array(py, s, shape),
-        Samples::U16(s) => array(py, s, shape),
-        Samples::I16(s) => array(py, s, shape),
-        Samples::F32(s) => array(py, s, shape),
+        Samples::U8(s) => array(py, s, shape, writeable),
+        Samples::I8(s) => array(py, s, shape, writeable),
+        Samples::U16(s) => array(py, s, shape, writeable),
+        Samples::I16(s) => array(py, s, shape, writeable),
+        Samples::F32(s) => array(py, s, shape, writeable),
     }
+}
+
+/// The bytes whose digest says whether `object` (an array, or anything
+/// numpy takes, handed to a renderer) changed: the array's own memory
+/// where it is one contiguous run, else a C-ordered copy (made each time
+/// this is asked: the price of a strided view, or of a list).
+pub fn watched(object: &Bound<'_, PyAny>) -> PyResult<ArrayBytes> {
+    if let Ok(array) = object.cast::<PyUntypedArray>()
+        && (array.is_c_contiguous() || array.is_fortran_contiguous())
+    {
+        return ArrayBytes::new(array, None);
+    }
+    let np = object.py().import("numpy")?;
+    let copy = np.call_method1("ascontiguousarray", (object,))?;
+    ArrayBytes::new(copy.cast::<PyUntypedArray>()?, None)
 }
 
 /// The `a[x, y, z]` view of samples kept `(nz, ny, nx)`: what Python sees.

@@ -33,7 +33,7 @@ pub fn hydrogen(
     let volume = py
         .detach(|| volray_data::hydrogen::generate(&params))
         .map_err(|e| value_error(e.to_string()))?;
-    crate::array::xyz(&to_numpy(py, volume)?)
+    crate::array::xyz(&to_numpy(py, volume, true)?)
 }
 
 /// `fractal(size, dimension=3.7, sigma=1, seed=0, ramp=..., threshold=...,
@@ -68,5 +68,5 @@ pub fn fractal(
     let volume = py
         .detach(|| volray_data::fractal::generate(&params))
         .map_err(|e| value_error(e.to_string()))?;
-    crate::array::xyz(&to_numpy(py, volume)?)
+    crate::array::xyz(&to_numpy(py, volume, true)?)
 }

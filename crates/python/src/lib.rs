@@ -25,6 +25,7 @@
 use pyo3::prelude::*;
 
 mod array;
+mod digest;
 mod errors;
 mod frame;
 mod generate;
@@ -44,6 +45,10 @@ fn _volray(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(volume::read, m)?)?;
     m.add_function(wrap_pyfunction!(generate::hydrogen, m)?)?;
     m.add_function(wrap_pyfunction!(generate::fractal, m)?)?;
+    // Test hooks, not exported by the package.
+    m.add_function(wrap_pyfunction!(renderer::_interrupt_next_frame, m)?)?;
+    m.add_function(wrap_pyfunction!(renderer::_hooked_frame_pixels, m)?)?;
+    m.add_function(wrap_pyfunction!(renderer::_digest, m)?)?;
     m.add("PRESETS", volray_core::transfer::presets::NAMES.to_vec())?;
     m.add("COLORMAPS", volray_core::transfer::colormap::NAMES.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

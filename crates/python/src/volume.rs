@@ -16,8 +16,10 @@ use volray_io::{DType, Endian, FileInfo, MapPolicy, RawOptions, ReadOptions, Vol
 /// An array is used without a copy where its memory already has x
 /// fastest (Fortran order with `order="xyz"`, C order with
 /// `order="zyx"`) in a type a volume keeps (uint8, int8, uint16, int16,
-/// float32); do not change it while a frame of it renders (the GIL is
-/// released meanwhile).
+/// float32). Change it between frames and a `Renderer` renders what it
+/// holds then (it digests the samples before each frame); do not change
+/// it while a frame of it renders (the GIL is released meanwhile: the
+/// frame is refused with `OSError`). A volume `read` gives is read-only.
 #[pyclass(frozen, module = "volray")]
 pub struct Volume {
     /// The samples, C-contiguous `(nz, ny, nx)`.
@@ -28,6 +30,9 @@ pub struct Volume {
     pub labels: bool,
     /// The file's path or the source's spec, for messages.
     pub name: String,
+    /// Whether the samples are volray's own, read-only (`read`'s): they
+    /// cannot change, so a renderer need not digest them each frame.
+    pub frozen: bool,
     pub file: Option<(VolumeFormat, FileInfo)>,
 }
 
@@ -49,6 +54,7 @@ impl Volume {
             origin: origin.unwrap_or([0.0; 3]),
             labels,
             name: "volume".into(),
+            frozen: false,
             file: None,
         };
         // Sides, spacing and origin checked now, not at the first frame.
@@ -58,12 +64,19 @@ impl Volume {
 
     /// The volume as volray-core's, over the same samples (no copy).
     pub fn core(&self, py: Python<'_>) -> PyResult<CoreVolume> {
+        self.core_expecting(py, None)
+    }
+
+    /// [`Volume::core`], its samples expected to keep the digest
+    /// `expected` (checked after each frame) where one is given.
+    pub fn core_expecting(&self, py: Python<'_>, expected: Option<u64>) -> PyResult<CoreVolume> {
         let volume = array::volume(
             self.data.bind(py),
             self.sample,
             self.spacing,
             self.origin,
             &self.name,
+            expected,
         )?;
         Ok(if self.labels {
             volume.as_labels()
@@ -196,7 +209,8 @@ impl Volume {
 /// dtype=None, endian=None, spacing=None, max_memory=None)`: the volume
 /// in a file of any format volray reads (or a built-in source such as
 /// `"hydrogen:4,2,1"`), its samples moved into a numpy array without a
-/// copy. `dims`, `dtype` and `endian` describe a raw file.
+/// copy, read-only (`volume.data.copy()` is a writeable copy). `dims`,
+/// `dtype` and `endian` describe a raw file.
 #[pyfunction]
 #[pyo3(signature = (path, *, format=None, frame=None, array=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
 #[allow(clippy::too_many_arguments)]
@@ -262,7 +276,9 @@ pub fn read(
     let origin = volume.origin().to_array();
     let labels = volume.is_labels();
     let sample = volume.sample_type();
-    let data = array::to_numpy(py, volume)?;
+    // Read-only: a renderer of the volume need not digest the samples
+    // before each frame (docs/python.md); `.copy()` gives a writeable one.
+    let data = array::to_numpy(py, volume, false)?;
     Ok(Volume {
         data: data.unbind(),
         sample,
@@ -270,6 +286,7 @@ pub fn read(
         origin,
         labels,
         name: spec,
+        frozen: true,
         file,
     })
 }
