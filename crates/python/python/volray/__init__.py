@@ -13,7 +13,10 @@ coordinate (``view``, ``look_at``, ``crop``, ``clip``) are ``(x, y, z)``.
 An array whose memory has x fastest (Fortran order, or C order with
 ``order="zyx"``) of uint8, int8, uint16, int16 or float32 is rendered
 without a copy; other types become float32. Arrays volray returns
-(``Volume.data``, ``hydrogen``, ``fractal``) are ``a[x, y, z]``.
+(``Volume.data``, ``hydrogen``, ``fractal``) are ``a[x, y, z]``; a volume
+:func:`read` from a file is read-only (``.copy()`` it to change it). A
+:class:`Renderer` renders an array as it is at each frame: change it in
+place between frames, not while one renders.
 
 Every keyword of :func:`render` is the ``volray render`` flag of the same
 name (``look_at`` is ``--look-at``; ``shading=False`` is ``--no-shading``)
