@@ -210,3 +210,109 @@ async fn viewer_goals_for_fractal_129_at_480() {
     );
     b.close().await;
 }
+
+/// CPU seconds `pid` has used (user and system).
+fn cpu_seconds(pid: u32) -> f64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+    // The fields after the command's closing parenthesis; utime and stime
+    // are the 14th and 15th of the line, in clock ticks (100 a second).
+    let rest = &stat[stat.rfind(')').unwrap() + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = fields[11].parse::<f64>().unwrap() + fields[12].parse::<f64>().unwrap();
+    ticks / 100.0
+}
+
+/// A 4096² frame at step 0.001, and an ordinary one at `azimuth`.
+const SLOW: &str =
+    "window.volrayView.sendState({width: 4096, height: 4096, step: 0.001}); return true;";
+
+/// Sends the ordinary view at `azimuth`, returning the page's time.
+async fn send_ordinary(b: &Browser, azimuth: u32) -> f64 {
+    b.eval(&format!(
+        "const t = performance.now(); window.volrayView.sendState({{width: 480, height: 480, step: 1, azimuth: {azimuth}}}); return t;"
+    ))
+    .await
+    .as_f64()
+    .unwrap()
+}
+
+#[tokio::test(flavor = "current_thread")]
+#[ignore = "a benchmark: run on a quiet machine with --ignored --nocapture"]
+async fn a_slow_frame_gives_way_to_an_ordinary_one_and_to_its_tab_closing() {
+    if !browser::available() {
+        return;
+    }
+    let volume = std::env::var("VOLRAY_VIEW_BENCH_VOLUME").unwrap_or("fractal:129".into());
+    let viewer = Viewer::start(&[&volume, "--threads", "2", "--colormap", "magma"]);
+    let b = Browser::start().await;
+    let first_tab = b.client.window().await.unwrap();
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    b.eval(INSTRUMENT).await;
+    events(&b).await;
+
+    // A 4096², step 0.001 frame, well under way, then an ordinary 480²
+    // full frame: from the ordinary request to its frame shown.
+    let mut ordinary = Vec::new();
+    let mut render = Vec::new();
+    for i in 0..10 {
+        b.eval(SLOW).await;
+        viewer.wait_status(browser::PATIENCE, |s| s["rendering"] == 1);
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        let t = send_ordinary(&b, 10 * i).await;
+        b.wait_still().await;
+        let e = events(&b).await;
+        ordinary.push(first(&e, "still", t).unwrap() - t);
+        let header = b.eval("return window.volrayView.header();").await;
+        render.push(header["render_ms"].as_f64().unwrap());
+    }
+    summary(
+        "a 4096² step-0.001 frame, then an ordinary one: its frame shown after",
+        &ordinary,
+    );
+    summary("  of which rendering the ordinary frame", &render);
+
+    // A tab closed during a slow frame: from the close to no frame being
+    // rendered (the status polled every 5 ms; the WebDriver round trip of
+    // the close is counted), and the server's CPU time in the second
+    // after.
+    let mut idle = Vec::new();
+    let mut cpu_after = Vec::new();
+    for _ in 0..10 {
+        let tab = b.client.new_window(true).await.unwrap().handle;
+        b.client.switch_to_window(tab).await.unwrap();
+        b.client.goto(&viewer.url).await.unwrap();
+        b.wait_still().await;
+        b.eval(SLOW).await;
+        viewer.wait_status(browser::PATIENCE, |s| s["rendering"] == 1);
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        let start = std::time::Instant::now();
+        b.client.close_window().await.unwrap();
+        loop {
+            if viewer.status()["rendering"] == 0 {
+                break;
+            }
+            assert!(
+                start.elapsed() < browser::PATIENCE,
+                "the frame was not stopped"
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        idle.push(start.elapsed().as_secs_f64() * 1e3);
+        let cpu = cpu_seconds(viewer.pid());
+        tokio::time::sleep(Duration::from_secs(1)).await;
+        cpu_after.push((cpu_seconds(viewer.pid()) - cpu) * 1e3);
+        b.client.switch_to_window(first_tab.clone()).await.unwrap();
+    }
+    summary(
+        "a tab closed during a slow frame: no frame rendering after",
+        &idle,
+    );
+    summary(
+        "  the server's CPU time in the second after (ms)",
+        &cpu_after,
+    );
+    let status = viewer.status();
+    println!("status at the end: {status}");
+    b.close().await;
+}
