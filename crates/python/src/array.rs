@@ -226,7 +226,7 @@ impl ExternalBytes for ArrayBytes {
     fn verify(&self) -> Result<(), String> {
         match self.expected {
             Some(expected) if self.digest() != expected => Err(
-                "the array changed while it was rendered: write to it only between frames"
+                "the numpy array was written during the frame: write to it only between frames"
                     .to_string(),
             ),
             _ => Ok(()),
