@@ -119,7 +119,7 @@ pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
 pub use read::{FileInfo, FlatImage, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
 pub use shared::compress::{Compression, inflate_exact};
-pub use shared::geometry::grid_to_volume;
+pub use shared::geometry::{Reorientation, grid_to_volume};
 pub use shared::limits::{
     FALLBACK_MAX_MEMORY, check_memory, check_volume_size, count_values, default_max_memory,
     format_bytes, parse_size,

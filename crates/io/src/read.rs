@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use volray_core::Volume;
 
 use crate::formats::VolumeFormat;
+use crate::shared::geometry::Reorientation;
 use crate::shared::input::open_input;
 use crate::shared::limits::default_max_memory;
 use crate::{IoError, MapPolicy, RawOptions};
@@ -133,6 +134,11 @@ pub struct FileInfo {
     /// box of a skewed CCP4 map resampled onto an axis-aligned grid):
     /// to be rendered as empty space, not refused.
     pub nan_is_empty: bool,
+    /// The volume was mapped in the file's own axis order, which is not
+    /// x, y, z along world +x, +y, +z (only under
+    /// [`MapPolicy::AlwaysInFileOrder`]): how to take the world-aligned
+    /// volume's boxes from it.
+    pub reorientation: Option<Reorientation>,
 }
 
 impl FileInfo {
@@ -183,13 +189,20 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             format: spec.description,
         });
     }
-    (spec.read)(path, opts).map_err(|e| match e {
+    let loaded = (spec.read)(path, opts).map_err(|e| match e {
         IoError::FlatImage { path, mut image } => {
             image.format = format;
             IoError::FlatImage { path, image }
         }
         other => other,
-    })
+    })?;
+    if loaded.info.reorientation.is_some() && opts.map != MapPolicy::AlwaysInFileOrder {
+        return Err(IoError::invalid(
+            path,
+            "the file's axes are not x, y, z in that order and sense, so its samples would have to be reordered, which a volume mapped from the file (larger than the memory limit) cannot be: store it with x fastest and the axes along +x, +y, +z",
+        ));
+    }
+    Ok(loaded)
 }
 
 /// Splits `file.h5:/group/dataset` into the file and the dataset path,

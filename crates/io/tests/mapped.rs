@@ -120,6 +120,63 @@ fn mapped_samples_are_the_samples_read() {
     }
 }
 
+/// Files whose axes run in another order or sense (NIfTI with a flipped
+/// or permuted qform, a CCP4
+/// map with MAPC/MAPR/MAPS 2,1,3) map in their own axis order under
+/// `AlwaysInFileOrder`, and every box of the world-aligned volume taken
+/// from that mapping, reordered box by box as an MPI rank takes its
+/// piece, equals the same box of the volume read into memory and
+/// reordered whole: samples, spacing, origin.
+#[test]
+fn boxes_of_a_file_mapped_in_its_own_axis_order_are_the_boxes_read() {
+    for name in [
+        ("nifti", "flipped.nii"),
+        ("nifti", "qform_permuted.nii"),
+        ("mrc", "permuted.mrc"),
+    ] {
+        let path = fixture(name.0, name.1);
+        let whole = read(&path, &with(MapPolicy::Never, None)).unwrap().volume;
+        // Mapped as the other policies would, it is refused.
+        let err = read(&path, &with(MapPolicy::Always, None)).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("cannot be: store it with x fastest"),
+            "{err}"
+        );
+        let mapped = read(&path, &with(MapPolicy::AlwaysInFileOrder, None)).unwrap();
+        assert!(mapped.volume.samples().is_external(), "{}", name.1);
+        let r = mapped.info.reorientation.expect("axes to reorder");
+        assert_eq!(r.dims(), whole.dims(), "{}", name.1);
+        assert_eq!(mapped.volume.dims(), r.file_dims, "{}", name.1);
+        let [nx, ny, nz] = whole.dims();
+        let boxes = [
+            ([0, 0, 0], [nx, ny, nz]),
+            ([0, 0, 0], [2, 2, 2]),
+            ([nx - 2, ny - 2, nz - 2], [nx, ny, nz]),
+            ([1, 0, nz / 2 - 1], [nx, ny / 2 + 1, nz]),
+            ([nx / 3, ny / 3, 0], [nx / 3 + 2, ny, nz / 2 + 1]),
+        ];
+        for (lo, hi) in boxes {
+            let from_map = r.sub_box(&mapped.volume, lo, hi).unwrap();
+            let expect = whole.sub_box(lo, hi);
+            assert_eq!(
+                from_map.values(),
+                expect.values(),
+                "{} {lo:?}..{hi:?}",
+                name.1
+            );
+            assert_eq!(from_map.dims(), expect.dims());
+            assert_eq!(from_map.sample_type(), expect.sample_type());
+            assert!((from_map.spacing() - expect.spacing()).length() < 1e-12);
+            assert!(
+                (from_map.origin() - expect.origin()).length() < 1e-9,
+                "{} {lo:?}",
+                name.1
+            );
+        }
+    }
+}
+
 /// A raw file over the limit maps; one that cannot be mapped is refused
 /// with the reason.
 #[test]

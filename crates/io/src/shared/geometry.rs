@@ -179,27 +179,40 @@ pub fn grid_to_volume(
         }
     }
     if !identity && data.is_external() {
-        return Err(IoError::invalid(
-            path,
-            "the file's axes are not x, y, z in that order and sense, so its samples would have to be reordered, which a volume mapped from the file (larger than the memory limit) cannot be: store it with x fastest and the axes along +x, +y, +z",
+        // A mapping cannot be reordered in place: the volume stays in the
+        // file's axes, and whoever reads it by boxes reorders each box
+        // (`read` refuses it unless asked for, by
+        // `MapPolicy::AlwaysInFileOrder`).
+        let reorientation = Reorientation {
+            file_dims: dims,
+            world_axis,
+            flipped,
+            spacing,
+            origin: new_origin,
+        };
+        info.notes.push(format!(
+            "mapped in the file's own axis order; each box read is reordered so that x, y, z run along world +x, +y, +z ({})",
+            reorientation.describe()
         ));
+        info.reorientation = Some(reorientation);
+        return Volume::from_samples(dims, data)
+            .and_then(|v| v.with_spacing(DVec3::from(lengths)))
+            .and_then(|v| v.with_origin(origin))
+            .map_err(|e| IoError::volume(path, e));
     }
     let data = if identity {
         data
     } else {
-        let names = ["x", "y", "z"];
-        let map: Vec<String> = (0..3)
-            .map(|a| {
-                format!(
-                    "index axis {a} -> {}{}",
-                    if flipped[a] { "-" } else { "+" },
-                    names[world_axis[a]]
-                )
-            })
-            .collect();
+        let map = Reorientation {
+            file_dims: dims,
+            world_axis,
+            flipped,
+            spacing,
+            origin: new_origin,
+        }
+        .describe();
         info.notes.push(format!(
-            "samples reordered so that x, y, z run along world +x, +y, +z ({})",
-            map.join(", ")
+            "samples reordered so that x, y, z run along world +x, +y, +z ({map})"
         ));
         with_samples!(&data, |values| Samples::from(reorder(
             values, dims, world_axis, flipped
@@ -209,6 +222,101 @@ pub fn grid_to_volume(
         .and_then(|v| v.with_spacing(spacing))
         .and_then(|v| v.with_origin(new_origin))
         .map_err(|e| IoError::volume(path, e))
+}
+
+/// How a grid stored along other axes, or along them backwards, maps onto
+/// the world-aligned volume, for a volume kept in the file's own axis
+/// order (mapped: see [`MapPolicy::AlwaysInFileOrder`](crate::MapPolicy)).
+/// [`Reorientation::sub_box`] reads a box of the world-aligned volume
+/// from the file's grid: only the file's pages holding that box are read,
+/// and only the box is reordered.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reorientation {
+    /// Samples along each of the file's index axes.
+    pub file_dims: [usize; 3],
+    /// The world axis each file index axis runs along.
+    pub world_axis: [usize; 3],
+    /// Whether it runs along it backwards.
+    pub flipped: [bool; 3],
+    /// The world-aligned volume's spacing and the world position of its
+    /// sample (0, 0, 0).
+    pub spacing: DVec3,
+    pub origin: DVec3,
+}
+
+impl Reorientation {
+    /// The world-aligned volume's samples along x, y, z.
+    pub fn dims(&self) -> [usize; 3] {
+        let mut dims = [0; 3];
+        for a in 0..3 {
+            dims[self.world_axis[a]] = self.file_dims[a];
+        }
+        dims
+    }
+
+    /// The box of the file's grid (in its index axes) holding the box
+    /// `lo..hi` (half-open) of the world-aligned volume.
+    pub fn file_box(&self, lo: [usize; 3], hi: [usize; 3]) -> ([usize; 3], [usize; 3]) {
+        let mut file_lo = [0; 3];
+        let mut file_hi = [0; 3];
+        for a in 0..3 {
+            let w = self.world_axis[a];
+            if self.flipped[a] {
+                // World index i is file index n - 1 - i.
+                file_lo[a] = self.file_dims[a] - hi[w];
+                file_hi[a] = self.file_dims[a] - lo[w];
+            } else {
+                file_lo[a] = lo[w];
+                file_hi[a] = hi[w];
+            }
+        }
+        (file_lo, file_hi)
+    }
+
+    /// The box `lo..hi` (half-open, at least 2 samples along each axis) of
+    /// the world-aligned volume, from `file`, the file's grid as read in
+    /// its own axes: the file's box copied out, then reordered. Keeps the
+    /// sample type and the label mark.
+    pub fn sub_box(
+        &self,
+        file: &Volume,
+        lo: [usize; 3],
+        hi: [usize; 3],
+    ) -> Result<Volume, volray_core::VolumeError> {
+        let (file_lo, file_hi) = self.file_box(lo, hi);
+        let piece = file.sub_box(file_lo, file_hi);
+        let piece_dims = piece.dims();
+        let samples = with_samples!(piece.samples(), |values| Samples::from(reorder(
+            values,
+            piece_dims,
+            self.world_axis,
+            self.flipped
+        )));
+        let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+        let origin =
+            self.origin + DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64) * self.spacing;
+        let mut v = Volume::from_samples(dims, samples)
+            .and_then(|v| v.with_spacing(self.spacing))
+            .and_then(|v| v.with_origin(origin))?;
+        v.set_labels(file.is_labels());
+        Ok(v)
+    }
+
+    /// Each file index axis and the world axis it runs along, e.g.
+    /// `index axis 0 -> -x, index axis 1 -> +y, index axis 2 -> +z`.
+    fn describe(&self) -> String {
+        let names = ["x", "y", "z"];
+        let map: Vec<String> = (0..3)
+            .map(|a| {
+                format!(
+                    "index axis {a} -> {}{}",
+                    if self.flipped[a] { "-" } else { "+" },
+                    names[self.world_axis[a]]
+                )
+            })
+            .collect();
+        map.join(", ")
+    }
 }
 
 /// Permutes (and flips) the axes of `data`: old index axis `a` becomes new

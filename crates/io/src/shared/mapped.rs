@@ -40,8 +40,24 @@ pub enum MapPolicy {
     /// Whenever the format and layout allow (for tests and benchmarks);
     /// read into memory otherwise.
     Always,
+    /// As [`Always`](MapPolicy::Always), and a file whose axes are not x,
+    /// y, z in that order and sense is mapped all the same, in its own
+    /// axis order: the volume read is the file's grid, and
+    /// [`FileInfo::reorientation`](crate::FileInfo::reorientation) says
+    /// how to take the world-aligned volume's boxes from it (for a reader
+    /// of boxes, such as an MPI rank, which reorders only its own box).
+    /// Under the other policies such a file is read into memory and
+    /// reordered, or, mapped because it is over the limit, refused.
+    AlwaysInFileOrder,
     /// Never: a volume over the limit is refused.
     Never,
+}
+
+impl MapPolicy {
+    /// Whether every volume that can be mapped is.
+    pub fn always(self) -> bool {
+        matches!(self, MapPolicy::Always | MapPolicy::AlwaysInFileOrder)
+    }
 }
 
 /// What a reader does with its samples.
@@ -62,7 +78,7 @@ pub(crate) fn plan(
     within_limit: Result<usize, IoError>,
 ) -> Result<Plan, IoError> {
     match within_limit {
-        Ok(_) if policy == MapPolicy::Always && mappable.is_ok() => Ok(Plan::Map),
+        Ok(_) if policy.always() && mappable.is_ok() => Ok(Plan::Map),
         Ok(_) => Ok(Plan::Read),
         Err(IoError::OverMemoryLimit { path, need, limit }) if policy != MapPolicy::Never => {
             match mappable {
@@ -266,6 +282,8 @@ mod tests {
         assert_eq!(plan(IfLarger, yes(), Ok(10)).unwrap(), Plan::Read);
         assert_eq!(plan(Always, yes(), Ok(10)).unwrap(), Plan::Map);
         assert_eq!(plan(Always, no(), Ok(10)).unwrap(), Plan::Read);
+        assert_eq!(plan(AlwaysInFileOrder, yes(), Ok(10)).unwrap(), Plan::Map);
+        assert_eq!(plan(AlwaysInFileOrder, no(), Ok(10)).unwrap(), Plan::Read);
         assert_eq!(plan(IfLarger, yes(), over("x exceed")).unwrap(), Plan::Map);
         let err = plan(IfLarger, no(), over("sizes 9 9 9 (729 values) exceed")).unwrap_err();
         assert_eq!(
