@@ -15,6 +15,7 @@ use thiserror::Error;
 use volray_core::camera::View;
 use volray_core::kernels::gradient::{Differences, magnitude};
 use volray_core::sampling::grid::GridFrame;
+use volray_core::transfer::labels::{LabelError, labels_of};
 use volray_core::{
     Histogram, Image, NonFinite, PartialImage, Piece, RenderError, RenderSettings, Renderer,
     Volume, with_samples,
@@ -418,6 +419,50 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             }
         }
         Ok(whole.filter(|_| self.values_found))
+    }
+
+    /// The distinct labels of the whole volume, sorted, as
+    /// [`labels_of`] finds them in one process: each rank finds those of
+    /// the piece it holds (the pieces cover the volume, and hold nothing
+    /// else), and the sets are joined on every rank. `Ok(None)` for more
+    /// than `max` distinct values; the error of the lowest rank whose
+    /// piece holds a value that is not an integer.
+    pub fn labels(&self, max: usize) -> Result<Result<Option<Vec<i64>>, LabelError>, FrameError> {
+        // On the wire: 0 and the labels (i64 each), 1 for too many, 2 and
+        // the value that is not an integer (f32).
+        let local = self
+            .held
+            .renderer
+            .as_ref()
+            .map_or(Ok(Some(Vec::new())), |r| labels_of(r.volume(), max));
+        let bytes = match &local {
+            Ok(Some(found)) => std::iter::once(0u8)
+                .chain(found.iter().flat_map(|l| l.to_le_bytes()))
+                .collect(),
+            Ok(None) => vec![1u8],
+            Err(LabelError::NotInteger(v)) => [&[2u8][..], &v.to_le_bytes()].concat(),
+            Err(_) => vec![1u8],
+        };
+        let all = agree(self.transport, Ok(bytes))?;
+        let mut union = std::collections::BTreeSet::new();
+        let mut too_many = false;
+        for m in &all {
+            match m.split_first() {
+                Some((0, list)) => union.extend(
+                    list.chunks_exact(8)
+                        .map(|c| i64::from_le_bytes(c.try_into().unwrap())),
+                ),
+                Some((2, v)) if v.len() == 4 => {
+                    let v = f32::from_le_bytes(v.try_into().unwrap());
+                    return Ok(Err(LabelError::NotInteger(v)));
+                }
+                _ => too_many = true,
+            }
+        }
+        if too_many || union.len() > max {
+            return Ok(Ok(None));
+        }
+        Ok(Ok(Some(union.into_iter().collect())))
     }
 
     /// The decomposition of the grid among the ranks.

@@ -39,4 +39,6 @@ pub use error::OptionError;
 pub use option::{Naming, Opt, Plain};
 pub use options::{BlendMode, CameraOptions, LookOptions, Options, SamplingOptions, Tf};
 pub use settings::{named_transfer_function, settings};
-pub use volume::{apply_auto, choose_auto, from_volume, label_transfer_function, volume_labels};
+pub use volume::{
+    apply_auto, choose_auto, from_volume, label_transfer_function, labels_found, volume_labels,
+};

@@ -30,19 +30,27 @@ pub fn from_volume(
 /// The labels of `volume` (`name`), refused where it is not a label
 /// volume.
 pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, OptionError> {
+    labels_found(labels::labels_of(volume, labels::MAX_LABELS), name)
+}
+
+/// The labels found in the volume `name` (by [`labels::labels_of`] with
+/// [`labels::MAX_LABELS`], in one process or joined across the ranks of
+/// a distributed one), refused where it is not a label volume.
+pub fn labels_found(
+    found: Result<Option<Vec<i64>>, labels::LabelError>,
+    name: &str,
+) -> Result<Vec<i64>, OptionError> {
     let refused = |error: String| OptionError::Labels {
         volume: name.to_string(),
         opts: &[Opt::Labels],
         error,
     };
-    labels::labels_of(volume, labels::MAX_LABELS)
-        .map_err(|e| refused(e.to_string()))?
-        .ok_or_else(|| {
-            refused(format!(
-                "more than {} distinct values: not a label volume",
-                labels::MAX_LABELS
-            ))
-        })
+    found.map_err(|e| refused(e.to_string()))?.ok_or_else(|| {
+        refused(format!(
+            "more than {} distinct values: not a label volume",
+            labels::MAX_LABELS
+        ))
+    })
 }
 
 /// With labels, the transfer function of `found` (the labels of the
