@@ -6,10 +6,25 @@
 //! Files are read by range: every rank maps the file (raw, NRRD raw,
 //! MetaImage raw, NIfTI `.nii`, `.npy`, MRC: volray-io's `MapPolicy`) and
 //! copies out its box with its ghost layers, so that only those pages are
-//! read. A file that cannot be mapped (compressed, DICOM, TIFF, HDF5, …)
-//! is read by rank 0, which sends each rank its piece (a note on stderr
-//! says so). Built-in sources generate only each rank's box (the
-//! fractal, a whole-grid process, is generated whole and cut).
+//! read. A file whose axes are stored in another order or sense (a CCP4
+//! map with MAPC/MAPR/MAPS 2,1,3, a LAS NIfTI, an NRRD with a negative
+//! direction) is mapped in its own axis order, and each rank copies the
+//! file's box holding its piece and reorders just that
+//! (`MapPolicy::AlwaysInFileOrder`, volray-io's `Reorientation`). A file
+//! that cannot be mapped (compressed, DICOM, TIFF, HDF5, …) is read by
+//! rank 0, which sends each rank its piece (a note on stderr says so);
+//! the built-in fractal, a whole-grid process, is generated once by rank 0
+//! and sent so. The other built-in sources generate only each rank's box.
+//!
+//! `--max-memory` is per rank and checked before anything of a piece's
+//! size is allocated: each rank's piece with the copies it passes through
+//! (the file's box before it is reordered, the piece before its log10, the
+//! bytes received) and, on rank 0, the volume it reads whole with the
+//! pieces it sends: agreed by every rank before any piece is read.
+//!
+//! `--labels`: each rank finds the labels of its piece, the sets are
+//! joined, and every rank builds the one process's label transfer
+//! function from them.
 
 use crate::error::CliError;
 use crate::flags::{BenchArgs, InputArgs, RenderArgs, ViewArgs};
@@ -18,6 +33,7 @@ use crate::render::{self, OutputKind};
 use crate::session::render_failure;
 use crate::settings::settings;
 use std::time::Duration;
+use volray_core::SampleType;
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
 use volray_core::{Camera, NonFinite, RenderSettings, Volume};
@@ -25,7 +41,7 @@ use volray_distributed::frame::{Distributed, FrameError, RankTimes, Source, agre
 use volray_distributed::kd::Decomposition;
 use volray_distributed::mpi::Mpi;
 use volray_distributed::transport::Transport;
-use volray_io::{MapPolicy, format_bytes};
+use volray_io::{MapPolicy, Reorientation, format_bytes};
 
 /// Whether this process runs under an MPI launcher, and so renders as one
 /// rank of a distributed run.
@@ -35,7 +51,6 @@ pub fn launched() -> bool {
 
 /// `volray render` under `mpirun`: one still image, written by rank 0.
 pub fn render(args: &RenderArgs) -> Result<(), CliError> {
-    refuse_unsupported(&args.input, &args.view.look)?;
     if args.animation.turntable.is_some() || !args.animation.series.is_empty() {
         return Err(CliError::input(
             "under mpirun, render writes one still image: --turntable and series are rendered by one process",
@@ -71,7 +86,7 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     let name = source.name.clone();
     let fail = |e| failure(&args.view, &name, e);
     let mut d = Distributed::read(&mpi, &source, mode).map_err(fail)?;
-    let settings = auto_tf(&d, &args.view, settings).map_err(fail)?;
+    let settings = from_volume(&d, &args.view, &name, settings)?;
     let (image, _) = d.render(&settings).map_err(fail)?;
     if let Some(image) = image {
         render::write_still(args, kind, &image)?;
@@ -88,7 +103,6 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             "under mpirun, bench renders INPUT: --peers runs in one process",
         ));
     }
-    refuse_unsupported(&args.input, &args.view.look)?;
     let base = settings(&args.view)?;
     threads(args.view.threads)?;
     let mpi = initialize()?;
@@ -99,7 +113,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
     let (d, per_frame, walls) = {
         let start = mpi.time();
         let mut d = Distributed::read(&mpi, &source, mode).map_err(fail)?;
-        let base = auto_tf(&d, &args.view, base.clone()).map_err(fail)?;
+        let base = from_volume(&d, &args.view, &name, base.clone())?;
         let read_wall = mpi.time() - start;
         let mut per_frame: Vec<Vec<RankTimes>> = Vec::new();
         let mut walls = Vec::new();
@@ -158,32 +172,40 @@ fn initialize() -> Result<Mpi, CliError> {
     Ok(mpi)
 }
 
-/// `settings` with `--tf auto` (the default) applied: the transfer
-/// function chosen from the whole volume's histogram, summed over the
-/// ranks' owned voxels, exactly as one process chooses it.
-fn auto_tf(
+/// `settings` with what the flags leave to the volume, as one process
+/// takes it ([`crate::render::from_volume`]): with `--labels`, the label
+/// transfer function of the labels every rank found, joined; otherwise
+/// `--tf auto` (the default) chosen from the whole volume's histogram,
+/// summed over the ranks' owned voxels.
+fn from_volume(
     d: &Distributed<'_, Mpi>,
     view: &ViewArgs,
+    name: &str,
     mut settings: RenderSettings,
-) -> Result<RenderSettings, FrameError> {
+) -> Result<RenderSettings, CliError> {
+    let fail = |e| failure(view, name, e);
     let look = crate::settings::look(&view.look);
+    if view.look.labels {
+        let found = d
+            .labels(volray_core::transfer::labels::MAX_LABELS)
+            .map_err(fail)?;
+        let found = volray_options::labels_found(found, name).map_err(crate::settings::refused)?;
+        crate::settings::label_transfer_function(
+            &view.look,
+            &mut settings.transfer_function,
+            &found,
+            name,
+        )?;
+        return Ok(settings);
+    }
     if look.auto_tf()
-        && let Some(histogram) = d.histogram(volray_core::transfer::auto::BINS)?
+        && let Some(histogram) = d
+            .histogram(volray_core::transfer::auto::BINS)
+            .map_err(fail)?
     {
         volray_options::apply_auto(&look, &mut settings.transfer_function, &histogram);
     }
     Ok(settings)
-}
-
-/// What a distributed run cannot do yet, refused in words.
-fn refuse_unsupported(input: &InputArgs, look: &crate::flags::LookArgs) -> Result<(), CliError> {
-    let _ = input;
-    if look.labels {
-        return Err(CliError::input(
-            "--labels: label volumes are rendered by one process (the labels found must be agreed by every rank)",
-        ));
-    }
-    Ok(())
 }
 
 /// A failed distributed step as the CLI's error: the same line on every
@@ -196,22 +218,115 @@ fn failure(view: &ViewArgs, name: &str, e: FrameError) -> CliError {
     }
 }
 
-/// This rank's view of INPUT: the whole volume mapped (or generated), or
-/// the piece rank 0 sent it.
+/// This rank's view of INPUT: the whole volume mapped (in the file's own
+/// axis order where `reorientation` says so), a built-in source's spec,
+/// or the piece rank 0 sent it.
 struct CliSource {
     name: String,
     grid: GridFrame,
+    /// The file mapped: the world-aligned volume, or the file's grid when
+    /// `reorientation` is given.
     whole: Option<Volume>,
-    /// The piece rank 0 read and sent, for a file that cannot be mapped.
+    reorientation: Option<Reorientation>,
+    /// The piece rank 0 read (or generated) and sent.
     sent: Option<Volume>,
     /// `--log`: the whole volume's smallest positive value, which values
     /// `<= 0` take on the log scale (agreed by the ranks).
     log_floor: Option<f32>,
     /// A built-in source's spec: each rank generates its box.
     generate: Option<String>,
+    /// `--log` and `--labels` as given.
+    log: bool,
+    labels: bool,
     max_memory: u64,
     settings: RenderSettings,
     non_finite: NonFinite,
+}
+
+/// How a rank has its piece, for the copies it passes through.
+#[derive(Debug, Clone, Copy)]
+enum Route {
+    /// Copied out of the mapped file in its stored type, and reordered
+    /// into a second copy where the file's axes are not x, y, z.
+    Mapped { stored: SampleType, reordered: bool },
+    /// Generated, as `f32`.
+    Generated,
+    /// Received from rank 0 as `f32` bytes, then decoded.
+    Sent,
+}
+
+/// What rank 0 tells every rank of INPUT once it has opened it.
+struct Header {
+    /// The world-aligned volume's grid.
+    grid: GridFrame,
+    /// Whether every rank maps the file and reads its own box.
+    local: bool,
+    /// Whether NaN marks space the file does not cover.
+    nan_is_empty: bool,
+    stored: SampleType,
+    /// Whether the file's axes must be reordered box by box.
+    reordered: bool,
+}
+
+/// The sample types on the wire, by their index here.
+const SAMPLE_TYPES: [SampleType; 5] = [
+    SampleType::U8,
+    SampleType::I8,
+    SampleType::U16,
+    SampleType::I16,
+    SampleType::F32,
+];
+
+impl Header {
+    fn of(input: &Input) -> Header {
+        let v = &input.volume;
+        let reorientation = (input.file.as_ref()).and_then(|(_, info)| info.reorientation.as_ref());
+        let grid = match reorientation {
+            Some(r) => GridFrame {
+                dims: r.dims(),
+                origin: r.origin,
+                spacing: r.spacing,
+            },
+            None => grid_of(v),
+        };
+        Header {
+            grid,
+            local: v.samples().is_external(),
+            nan_is_empty: input.non_finite(NonFinite::Refuse) == NonFinite::Transparent,
+            stored: v.sample_type(),
+            reordered: reorientation.is_some(),
+        }
+    }
+
+    /// The grid ([`grid_bytes`]), then a byte each: local, NaN is empty,
+    /// the stored type, reordered.
+    fn to_bytes(&self) -> Vec<u8> {
+        let mut out = grid_bytes(&self.grid);
+        let stored = SAMPLE_TYPES.iter().position(|&t| t == self.stored);
+        out.extend([
+            self.local as u8,
+            self.nan_is_empty as u8,
+            stored.unwrap_or(4) as u8,
+            self.reordered as u8,
+        ]);
+        out
+    }
+
+    fn parse(b: &[u8]) -> Header {
+        Header {
+            grid: parse_grid(b),
+            local: b[72] != 0,
+            nan_is_empty: b[73] != 0,
+            stored: SAMPLE_TYPES[(b[74] as usize).min(4)],
+            reordered: b[75] != 0,
+        }
+    }
+}
+
+/// Whether built-in source `spec` is generated whole, whatever box is
+/// asked for (the fractal: midpoint displacement over the whole grid).
+fn generated_whole(spec: &str) -> bool {
+    volray_data::SourceSpec::parse(spec).is_ok_and(|s| s.name == "fractal")
 }
 
 impl CliSource {
@@ -226,47 +341,66 @@ impl CliSource {
         let max_memory = args
             .max_memory
             .unwrap_or_else(volray_io::default_max_memory);
-        if volray_data::is_source_spec(&spec) {
-            return CliSource::generated(mpi, args, view, settings, spec, max_memory, requested);
+        let mut source = CliSource {
+            name: spec.clone(),
+            grid: GridFrame {
+                dims: [0; 3],
+                origin: DVec3::ZERO,
+                spacing: DVec3::ONE,
+            },
+            whole: None,
+            reorientation: None,
+            sent: None,
+            log_floor: None,
+            generate: None,
+            log: view.look.log,
+            labels: view.look.labels,
+            max_memory,
+            settings: settings.clone(),
+            non_finite: requested,
+        };
+        if volray_data::is_source_spec(&spec) && !generated_whole(&spec) {
+            source.generate_boxes(mpi, args, view)?;
+            return Ok(source);
         }
-        let load = || input::load_with(args, MapPolicy::Always);
+        // A file mapped wherever it can be, in its own axis order if need
+        // be; else read whole by rank 0 (a fractal generated whole).
+        let load = || input::load_with(args, MapPolicy::AlwaysInFileOrder);
         // Rank 0 first: whether the file maps, and the grid.
         let first = if mpi.rank() == 0 {
             load().map(Some)
         } else {
             Ok(None)
         };
-        let header = first.as_ref().map(|input| match input {
-            Some(input) => {
-                let local = input.file.is_none() || input.volume.samples().is_external();
-                describe(input, local)
-            }
-            None => Vec::new(),
+        let header = (first.as_ref()).map(|input| {
+            input
+                .as_ref()
+                .map_or_else(Vec::new, |i| Header::of(i).to_bytes())
         });
         let all =
             agree(mpi, header.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
-        let (grid, local, non_finite_empty) = parse_header(&all[0]);
-        let non_finite = if non_finite_empty {
-            NonFinite::Transparent
+        let header = Header::parse(&all[0]);
+        source.grid = header.grid;
+        if header.nan_is_empty {
+            source.non_finite = NonFinite::Transparent;
+        }
+        let route = if header.local {
+            Route::Mapped {
+                stored: header.stored,
+                reordered: header.reordered,
+            }
         } else {
-            requested
+            Route::Sent
         };
-        let max_memory = args
-            .max_memory
-            .unwrap_or_else(volray_io::default_max_memory);
-        let mut source = CliSource {
-            name: spec.clone(),
-            grid,
-            whole: None,
-            sent: None,
-            log_floor: None,
-            max_memory,
-            settings: settings.clone(),
-            non_finite,
-            generate: None,
-        };
-        if local {
-            // Every rank maps the file (or generates the source) itself.
+        // Every rank's piece, and what rank 0 holds while it sends the
+        // pieces, checked against --max-memory before any is read.
+        let mut fits = source.check_piece(mpi, route);
+        if let (true, Ok(Some(input))) = (fits.is_ok() && !header.local, &first) {
+            fits = source.check_scatter(mpi, &input.volume);
+        }
+        agree(mpi, fits.map(|_| Vec::new())).map_err(|e| failure(view, &spec, e))?;
+        if header.local {
+            // Every rank maps the file itself.
             let input = match first {
                 Ok(Some(input)) => Ok(input),
                 _ => load(),
@@ -276,23 +410,32 @@ impl CliSource {
                 .map(|_| Vec::new())
                 .map_err(|e| e.to_string());
             agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
-            source.whole = Some(input.expect("agreed").volume);
+            let input = input.expect("agreed");
+            source.reorientation = input.file.and_then(|(_, info)| info.reorientation);
+            source.whole = Some(input.volume);
             source.agree_log_floor(mpi, view)?;
             return Ok(source);
         }
         // Rank 0 sends each rank its piece.
-        let decomposition = Decomposition::new(grid.dims, mpi.size());
+        let decomposition = Decomposition::new(source.grid.dims, mpi.size());
         if mpi.rank() == 0 {
             let input: Input = first.ok().flatten().expect("rank 0 read the file");
-            eprintln!(
-                "volray: note: {spec}: this format cannot be read by range; rank 0 reads it and sends each rank its piece"
-            );
+            if volray_data::is_source_spec(&spec) {
+                eprintln!(
+                    "volray: note: {spec}: the fractal is generated whole (midpoint displacement over the grid); rank 0 generates it and sends each rank its piece"
+                );
+            } else {
+                eprintln!(
+                    "volray: note: {spec}: this format cannot be read by range; rank 0 reads it and sends each rank its piece"
+                );
+            }
             for (rank, b) in decomposition.boxes.iter().enumerate() {
-                let piece = held_piece(&input.volume, b.lo, b.hi, grid.dims);
-                let bytes = piece.as_ref().map_or_else(Vec::new, encode_piece);
+                let piece = held_piece(&input.volume, b.lo, b.hi, source.grid.dims);
                 if rank == 0 {
                     source.sent = piece;
                 } else {
+                    let bytes = piece.as_ref().map_or_else(Vec::new, encode_piece);
+                    drop(piece);
                     mpi.send(rank, &bytes)
                         .map_err(|e| CliError::io(e.to_string()))?;
                 }
@@ -305,17 +448,15 @@ impl CliSource {
         Ok(source)
     }
 
-    /// A built-in source: every rank generates its own box (the grid from a
-    /// 2³ box of it, the same on every rank).
-    fn generated(
+    /// A built-in source sampled box by box: every rank generates its own
+    /// box (the grid from a 2³ box of it, the same on every rank).
+    fn generate_boxes(
+        &mut self,
         mpi: &Mpi,
         args: &InputArgs,
         view: &ViewArgs,
-        settings: &RenderSettings,
-        spec: String,
-        max_memory: u64,
-        non_finite: NonFinite,
-    ) -> Result<CliSource, CliError> {
+    ) -> Result<(), CliError> {
+        let spec = self.name.clone();
         let probe = input::source_grid(args, &spec).and_then(|n| {
             volray_data::generate_box(&spec, [0; 3], [2; 3])
                 .map(|v| (n, v))
@@ -327,38 +468,126 @@ impl CliSource {
             .map_err(|e| e.to_string());
         agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
         let (n, corner) = probe.expect("agreed");
-        let mut source = CliSource {
-            name: spec.clone(),
-            grid: GridFrame {
-                dims: [n; 3],
-                origin: corner.origin(),
-                spacing: corner.spacing(),
-            },
-            whole: None,
-            sent: None,
-            log_floor: None,
-            max_memory,
-            settings: settings.clone(),
-            non_finite,
-            generate: Some(spec),
+        self.grid = GridFrame {
+            dims: [n; 3],
+            origin: corner.origin(),
+            spacing: corner.spacing(),
         };
-        source.agree_log_floor(mpi, view)?;
-        Ok(source)
+        self.generate = Some(spec.clone());
+        let fits = self.check_piece(mpi, Route::Generated);
+        agree(mpi, fits.map(|_| Vec::new())).map_err(|e| failure(view, &spec, e))?;
+        self.agree_log_floor(mpi, view)
+    }
+
+    /// This rank's held box (its owned box with its ghost layers), or
+    /// `None` if it owns nothing.
+    fn held_box(&self, mpi: &Mpi) -> Option<([usize; 3], [usize; 3])> {
+        let b = Decomposition::new(self.grid.dims, mpi.size()).boxes[mpi.rank()];
+        (!b.is_empty()).then(|| volray_core::Piece::held((b.lo, b.hi), self.grid.dims))
+    }
+
+    /// Whether this rank's piece, had by `route`, fits its `--max-memory`:
+    /// the most of rendering it and of the copies it passes through on
+    /// its way (two at a time: the file's box and its reordering, the
+    /// piece and its log10, the bytes received and the samples decoded),
+    /// decided from the grid alone, before any of it is allocated.
+    fn check_piece(&self, mpi: &Mpi, route: Route) -> Result<(), String> {
+        let Some((lo, hi)) = self.held_box(mpi) else {
+            return Ok(());
+        };
+        let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+        let voxels = dims.iter().map(|&n| n as u128).product::<u128>();
+        let bytes = |t: SampleType| voxels * t.bytes() as u128;
+        let first = match route {
+            Route::Mapped { stored, .. } => stored,
+            Route::Generated | Route::Sent => SampleType::F32,
+        };
+        let last = if self.log { SampleType::F32 } else { first };
+        let mut copies = 0;
+        if let Route::Mapped {
+            reordered: true, ..
+        } = route
+        {
+            copies = copies.max(2 * bytes(first));
+        }
+        if self.log {
+            copies = copies.max(bytes(first) + bytes(SampleType::F32));
+        }
+        if let Route::Sent = route {
+            copies = copies.max(73 + 2 * bytes(SampleType::F32));
+        }
+        let render = crate::memory::render_bytes(
+            (dims, self.grid.spacing, last),
+            &self.settings,
+            self.non_finite,
+            0,
+        );
+        let need = render.max(copies);
+        if need > u128::from(self.max_memory) {
+            let [x, y, z] = dims;
+            return Err(format!(
+                "{}: this rank's piece, {x}x{y}x{z} voxels with its ghost layers, needs {} to read and render, over --max-memory {}: run on more ranks",
+                self.name,
+                format_bytes(need),
+                format_bytes(u128::from(self.max_memory)),
+            ));
+        }
+        Ok(())
+    }
+
+    /// On rank 0, which holds `whole` (read or generated whole) to send
+    /// the pieces: whether the volume, rank 0's own piece and the largest
+    /// piece on its way out (its samples and their bytes) fit
+    /// `--max-memory`, before any piece is cut.
+    fn check_scatter(&self, mpi: &Mpi, whole: &Volume) -> Result<(), String> {
+        let sample = whole.sample_type().bytes() as u128;
+        let held = |(lo, hi): ([usize; 3], [usize; 3])| {
+            (0..3).map(|a| (hi[a] - lo[a]) as u128).product::<u128>()
+        };
+        let d = Decomposition::new(self.grid.dims, mpi.size());
+        let pieces: Vec<u128> = (d.boxes.iter())
+            .map(|b| {
+                if b.is_empty() {
+                    0
+                } else {
+                    held(volray_core::Piece::held((b.lo, b.hi), self.grid.dims))
+                }
+            })
+            .collect();
+        let own = pieces[0] * sample;
+        let largest_out = (pieces[1..].iter())
+            .map(|&n| n * sample + 73 + 4 * n)
+            .max()
+            .unwrap_or(0);
+        let volume = whole.len() as u128 * sample;
+        let need = volume + own + largest_out;
+        if need > u128::from(self.max_memory) {
+            let how = if self.generate.is_some() || volray_data::is_source_spec(&self.name) {
+                "generates the fractal whole"
+            } else {
+                "reads the file whole (its format cannot be read by range)"
+            };
+            return Err(format!(
+                "{}: rank 0 {how} to send each rank its piece: the volume ({}) with the pieces it cuts needs {}, over --max-memory {}",
+                self.name,
+                format_bytes(volume),
+                format_bytes(need),
+                format_bytes(u128::from(self.max_memory)),
+            ));
+        }
+        Ok(())
     }
 
     /// For `--log`: the smallest positive value over every rank's piece
     /// (the pieces cover the volume), as one process takes it over the
     /// whole volume.
     fn agree_log_floor(&mut self, mpi: &Mpi, view: &ViewArgs) -> Result<(), CliError> {
-        if !view.look.log {
+        if !self.log {
             return Ok(());
         }
-        let b = Decomposition::new(self.grid.dims, mpi.size()).boxes[mpi.rank()];
-        let smallest = if b.is_empty() {
-            Ok(None)
-        } else {
-            let (lo, hi) = volray_core::Piece::held((b.lo, b.hi), self.grid.dims);
-            self.raw_piece(lo, hi).map(|p| p.smallest_positive())
+        let smallest = match self.held_box(mpi) {
+            None => Ok(None),
+            Some((lo, hi)) => self.raw_piece(lo, hi).map(|p| p.smallest_positive()),
         };
         let local = smallest.map(|s| s.unwrap_or(f32::INFINITY).to_le_bytes().to_vec());
         let all = agree(mpi, local).map_err(|e| failure(view, &self.name, e))?;
@@ -375,20 +604,20 @@ impl CliSource {
         Ok(())
     }
 
-    /// The voxels `lo..hi` as read or generated, before `--log`.
+    /// The voxels `lo..hi` as read or generated, before `--log` (their
+    /// size checked by [`CliSource::check_piece`] when the source was
+    /// opened).
     fn raw_piece(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
         if let Some(spec) = &self.generate {
-            // Checked before it is made: a box over the limit is refused
-            // without allocating it.
-            let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
-            let grid = (dims, self.grid.spacing, volray_core::SampleType::F32);
-            self.fits(grid)?;
             return volray_data::generate_box(spec, lo, hi).map_err(|e| e.to_string());
         }
-        match (&self.whole, &self.sent) {
-            (Some(whole), _) => Ok(whole.sub_box(lo, hi)),
-            (None, Some(sent)) => Ok(sent.clone()),
-            (None, None) => Err(format!("{}: rank 0 sent no piece", self.name)),
+        match (&self.whole, &self.reorientation, &self.sent) {
+            (Some(file), Some(r), _) => {
+                (r.sub_box(file, lo, hi)).map_err(|e| format!("{}: its piece: {e}", self.name))
+            }
+            (Some(whole), None, _) => Ok(whole.sub_box(lo, hi)),
+            (None, _, Some(sent)) => Ok(sent.clone()),
+            (None, _, None) => Err(format!("{}: rank 0 sent no piece", self.name)),
         }
     }
 }
@@ -402,30 +631,22 @@ fn held_piece(volume: &Volume, lo: [usize; 3], hi: [usize; 3], dims: [usize; 3])
     Some(volume.sub_box(lo, hi))
 }
 
-/// The grid, whether every rank reads its own box, and whether NaN marks
-/// empty space, as rank 0 tells the others.
-fn describe(input: &Input, local: bool) -> Vec<u8> {
-    let v = &input.volume;
-    let nan_is_empty = input.non_finite(NonFinite::Refuse) == NonFinite::Transparent;
-    let mut out = grid_bytes(v);
-    out.push(local as u8);
-    out.push(nan_is_empty as u8);
-    out
+fn grid_of(v: &Volume) -> GridFrame {
+    GridFrame {
+        dims: v.dims(),
+        origin: v.origin(),
+        spacing: v.spacing(),
+    }
 }
 
-/// A volume's grid on the wire: dims (3 × `u64`), origin and spacing
-/// (6 × `f64`), little-endian: 72 bytes.
-fn grid_bytes(v: &Volume) -> Vec<u8> {
+/// A grid on the wire: dims (3 × `u64`), origin and spacing (6 × `f64`),
+/// little-endian: 72 bytes.
+fn grid_bytes(g: &GridFrame) -> Vec<u8> {
     let mut out = Vec::with_capacity(72);
-    for d in v.dims() {
+    for d in g.dims {
         out.extend_from_slice(&(d as u64).to_le_bytes());
     }
-    for x in v
-        .origin()
-        .to_array()
-        .into_iter()
-        .chain(v.spacing().to_array())
-    {
+    for x in g.origin.to_array().into_iter().chain(g.spacing.to_array()) {
         out.extend_from_slice(&x.to_le_bytes());
     }
     out
@@ -442,19 +663,18 @@ fn parse_grid(b: &[u8]) -> GridFrame {
     }
 }
 
-fn parse_header(b: &[u8]) -> (GridFrame, bool, bool) {
-    (parse_grid(b), b[72] != 0, b[73] != 0)
-}
-
-/// A piece on the wire: dims (3 × u64), origin and spacing (6 × f64), the
-/// labels flag, then its samples as little-endian `f32`.
+/// A piece on the wire: its grid ([`grid_bytes`]), the labels flag, then
+/// its samples as little-endian `f32`, written straight from its own
+/// type (no `f32` copy of the piece on the way).
 fn encode_piece(v: &Volume) -> Vec<u8> {
-    let mut out = grid_bytes(v);
+    let mut out = grid_bytes(&grid_of(v));
     out.reserve(1 + 4 * v.len());
     out.push(v.is_labels() as u8);
-    for x in v.samples().to_f32_vec() {
-        out.extend_from_slice(&x.to_le_bytes());
-    }
+    volray_core::with_samples!(v.samples(), |data| {
+        for x in data.iter() {
+            out.extend_from_slice(&volray_core::Sample::to_f32(*x).to_le_bytes());
+        }
+    });
     out
 }
 
@@ -483,29 +703,14 @@ impl Source for CliSource {
 
     fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
         let piece = self.raw_piece(lo, hi)?;
-        let piece = match self.log_floor {
+        let mut piece = match self.log_floor {
             Some(smallest) => piece.to_log10_above(smallest),
             None => piece,
         };
-        self.fits((piece.dims(), piece.spacing(), piece.sample_type()))?;
-        Ok(piece)
-    }
-}
-
-impl CliSource {
-    /// Whether a piece of this grid fits this rank's `--max-memory`.
-    fn fits(&self, grid: ([usize; 3], DVec3, volray_core::SampleType)) -> Result<(), String> {
-        let need = crate::memory::render_bytes(grid, &self.settings, self.non_finite, 0);
-        if need > u128::from(self.max_memory) {
-            let [x, y, z] = grid.0;
-            return Err(format!(
-                "{}: this rank's piece, {x}x{y}x{z} voxels with its ghost layers, needs {} to render, over --max-memory {}: run on more ranks",
-                self.name,
-                format_bytes(need),
-                format_bytes(u128::from(self.max_memory)),
-            ));
+        if self.labels {
+            piece.set_labels(true);
         }
-        Ok(())
+        Ok(piece)
     }
 }
 

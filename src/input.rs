@@ -77,7 +77,7 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
         .max_memory
         .unwrap_or_else(volray_io::default_max_memory);
     let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
-    let (volume, file) = if volray_data::is_source_spec(spec) {
+    let (volume, mut file) = if volray_data::is_source_spec(spec) {
         let n = source_grid(args, spec)? as u64;
         volray_io::check_volume_size(
             Path::new(spec),
@@ -137,11 +137,25 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
         };
         (loaded.volume, Some((loaded.format, loaded.info)))
     };
-    let volume = match args.spacing {
-        Some(s) => volume
+    let reoriented = file
+        .as_mut()
+        .and_then(|(_, info)| info.reorientation.as_mut());
+    let volume = match (args.spacing, reoriented) {
+        // Kept in the file's axes (a distributed render's mapping): the
+        // spacing is the world-aligned volume's, which its boxes take.
+        (Some(s), Some(r)) => {
+            let s = DVec3::from(s);
+            if !(s.is_finite() && s.min_element() > 0.0) {
+                let e = volray_core::VolumeError::BadSpacing(s.x, s.y, s.z);
+                return Err(CliError::input(format!("--spacing: {e}")));
+            }
+            r.spacing = s;
+            volume
+        }
+        (Some(s), None) => volume
             .with_spacing(DVec3::from(s))
             .map_err(|e| CliError::input(format!("--spacing: {e}")))?,
-        None => volume,
+        (None, _) => volume,
     };
     Ok(Described::Volume(Box::new(Input {
         volume,

@@ -264,31 +264,40 @@ fn max_memory_holds_per_rank_so_more_ranks_render_a_bigger_volume() {
     assert!(largest_difference(&one, &four) <= 1);
 }
 
+/// The fractal cloud of `n`³ points as a gzip-compressed NRRD, which no
+/// rank can read by range.
+fn gzip_nrrd(dir: &Path, n: usize) -> PathBuf {
+    let raw = dir.join("f.raw");
+    let size = n.to_string();
+    single(&[
+        "generate",
+        "fractal",
+        "--size",
+        &size,
+        "-o",
+        raw.to_str().unwrap(),
+    ]);
+    let nrrd = dir.join("f.nrrd");
+    let mut file = std::fs::File::create(&nrrd).unwrap();
+    write!(
+        file,
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: {n} {n} {n}\nspacings: 0.5 0.5 0.5\nendian: little\nencoding: gzip\n\n"
+    )
+    .unwrap();
+    let mut gz = flate2::write::GzEncoder::new(file, flate2::Compression::fast());
+    gz.write_all(&std::fs::read(&raw).unwrap()).unwrap();
+    gz.finish().unwrap();
+    std::fs::remove_file(raw).unwrap();
+    nrrd
+}
+
 #[test]
 fn a_compressed_file_is_read_by_rank_zero_and_scattered() {
     if mpirun().is_none() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let raw = dir.path().join("f.raw");
-    single(&[
-        "generate",
-        "fractal",
-        "--size",
-        "33",
-        "-o",
-        raw.to_str().unwrap(),
-    ]);
-    let nrrd = dir.path().join("f.nrrd");
-    let mut file = std::fs::File::create(&nrrd).unwrap();
-    write!(
-        file,
-        "NRRD0004\ntype: float\ndimension: 3\nsizes: 33 33 33\nspacings: 0.5 0.5 0.5\nendian: little\nencoding: gzip\n\n"
-    )
-    .unwrap();
-    let mut gz = flate2::write::GzEncoder::new(file, flate2::Compression::fast());
-    gz.write_all(&std::fs::read(&raw).unwrap()).unwrap();
-    gz.finish().unwrap();
+    let nrrd = gzip_nrrd(dir.path(), 33);
     let args = [nrrd.to_str().unwrap(), "--size", "80x80", "--azimuth", "20"];
     let one = dir.path().join("one.png");
     single(&with_output(&args, one.to_str().unwrap()));
@@ -390,4 +399,263 @@ fn bench_reports_each_ranks_stages() {
         .count();
     assert_eq!(rows, 2, "{stdout}");
     assert!(stdout.contains("2 ranks"), "{stdout}");
+}
+
+/// `target/pyenv`'s python with mrcfile, nibabel and pynrrd (PyPI),
+/// installed if missing (`.ci/run` installs them): the independent
+/// writers of the files whose axes must be reordered.
+fn python_with_writers() -> PathBuf {
+    static PYTHON: OnceLock<PathBuf> = OnceLock::new();
+    PYTHON
+        .get_or_init(|| {
+            let venv = root().join("target/pyenv");
+            let python = venv.join("bin/python");
+            if !python.exists() {
+                let made = Command::new("python3")
+                    .args(["-m", "venv"])
+                    .arg(&venv)
+                    .status()
+                    .expect("python3 is needed to write the test files (as .ci/run installs it)");
+                assert!(made.success(), "python3 -m venv target/pyenv failed");
+            }
+            let has = Command::new(&python)
+                .args(["-c", "import mrcfile, nibabel, nrrd, numpy"])
+                .status()
+                .is_ok_and(|s| s.success());
+            if !has {
+                let pip = Command::new(venv.join("bin/pip"))
+                    .args([
+                        "install", "--quiet", "numpy", "mrcfile", "nibabel", "pynrrd",
+                    ])
+                    .status()
+                    .expect("pip runs");
+                assert!(pip.success(), "pip install mrcfile nibabel pynrrd failed");
+            }
+            python
+        })
+        .clone()
+}
+
+/// Files whose axes run in another order or sense, written by mrcfile
+/// (MAPC/MAPR/MAPS 2,1,3), nibabel (LAS) and pynrrd (index axes along
+/// −z, +x, +y): every rank maps the file and reorders its own box, and
+/// 1 to 4 ranks give one process's image within a level. They were
+/// refused under mpirun before ("the file's axes are not x, y, z").
+#[test]
+fn files_whose_axes_are_reordered_render_as_one_process() {
+    if mpirun().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let wrote = Command::new(python_with_writers())
+        .arg(root().join("tests/mpi_support/write_reordered.py"))
+        .arg(dir.path())
+        .status()
+        .unwrap();
+    assert!(wrote.success(), "writing the reordered files failed");
+    for file in ["perm.mrc", "las.nii", "neg.nhdr"] {
+        let input = dir.path().join(file);
+        let args = [
+            input.to_str().unwrap(),
+            "--size",
+            "72x64",
+            "--azimuth",
+            "35",
+            "--elevation",
+            "25",
+        ];
+        let one = dir.path().join("one.png");
+        single(&with_output(&args, one.to_str().unwrap()));
+        for n in 1..=4 {
+            let out = dir.path().join(format!("{n}.png"));
+            let run = ranks(n, &with_output(&args, out.to_str().unwrap()));
+            let stderr = String::from_utf8_lossy(&run.stderr);
+            assert!(run.status.success(), "{file}, {n} ranks: {stderr}");
+            // Read by range, not by rank 0 and sent.
+            assert!(
+                !stderr.contains("cannot be read by range"),
+                "{file}: {stderr}"
+            );
+            let diff = largest_difference(&one, &out);
+            assert!(diff <= 1, "{file}, {n} ranks: {diff} levels");
+        }
+    }
+}
+
+/// A label volume (nibabel's segmentation): the ranks join the labels
+/// they find, and render as one process does, with `--label-opacity`
+/// and `--show-labels` too; a volume that is not one is refused on
+/// every rank with the one-process message.
+#[test]
+fn label_volumes_render_as_one_process() {
+    if mpirun().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let seg = root().join("crates/io/tests/fixtures/labels/seg.nii.gz");
+    let seg = seg.to_str().unwrap();
+    let cases: [&[&str]; 3] = [
+        &["--labels"],
+        &["--labels", "--label-opacity", "1:0.1,2:1"],
+        &["--labels", "--show-labels", "2,5", "--azimuth", "70"],
+    ];
+    for case in cases {
+        let mut args = vec![seg, "--size", "64x64", "--elevation", "30"];
+        args.extend(case);
+        let one = dir.path().join("one.png");
+        single(&with_output(&args, one.to_str().unwrap()));
+        for n in [2, 3] {
+            let out = dir.path().join(format!("{n}.png"));
+            let run = ranks(n, &with_output(&args, out.to_str().unwrap()));
+            let stderr = String::from_utf8_lossy(&run.stderr);
+            assert!(run.status.success(), "{case:?}, {n} ranks: {stderr}");
+            let diff = largest_difference(&one, &out);
+            assert!(diff <= 1, "{case:?}, {n} ranks: {diff} levels");
+        }
+    }
+    let out = dir.path().join("cloud.png");
+    let single_refusal = Command::new(env!("CARGO_BIN_EXE_volray"))
+        .args(with_output(
+            &["fractal:33", "--labels"],
+            out.to_str().unwrap(),
+        ))
+        .output()
+        .unwrap();
+    let expected = String::from_utf8_lossy(&single_refusal.stderr);
+    let run = ranks(
+        2,
+        &with_output(&["fractal:33", "--labels"], out.to_str().unwrap()),
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    let line = expected
+        .lines()
+        .find(|l| l.starts_with("volray: error:"))
+        .unwrap();
+    assert!(stderr.lines().any(|l| l == line), "{stderr} vs {line}");
+    assert!(!out.exists());
+}
+
+/// `ARGS` under `mpirun -np N`, each rank run by a Python parent that
+/// writes the rank's exact peak resident memory (`ru_maxrss` of its
+/// child, KiB) to a file of its own (lines of ranks sharing stderr can
+/// interleave); the peaks, one per rank.
+fn ranks_with_peak_rss(n: usize, args: &[&str]) -> (Output, Vec<u64>) {
+    let peaks = tempfile::tempdir().unwrap();
+    let wrapper = "import os, resource, subprocess, sys\n\
+        code = subprocess.call(sys.argv[1:])\n\
+        peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss\n\
+        path = os.path.join(os.environ['VOLRAY_PEAKS'], str(os.getpid()))\n\
+        open(path, 'w').write(str(peak))\n\
+        sys.exit(code)";
+    let out = Command::new("timeout")
+        .arg("60")
+        .arg(mpirun().expect("checked by the caller"))
+        .args([
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-np",
+            &n.to_string(),
+        ])
+        .args(["-x", "VOLRAY_PEAKS", "python3", "-c", wrapper])
+        .arg(mpi_volray())
+        .args(args)
+        .env("VOLRAY_PEAKS", peaks.path())
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .output()
+        .unwrap();
+    let peaks = std::fs::read_dir(peaks.path())
+        .unwrap()
+        .map(|f| {
+            let text = std::fs::read_to_string(f.unwrap().path()).unwrap();
+            text.trim().parse().unwrap()
+        })
+        .collect();
+    (out, peaks)
+}
+
+/// A rank over `--max-memory` is refused before it allocates what the
+/// limit is about: its peak resident memory stays under the limit plus
+/// what the binary takes to start and render a tiny volume under
+/// mpirun. Before, each rank copied its whole piece (or generated the
+/// whole fractal) and only then compared it with the limit.
+#[test]
+fn a_rank_over_max_memory_is_refused_before_it_allocates() {
+    if mpirun().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = dir.path().join("tiny.png");
+    let (run, base) = ranks_with_peak_rss(
+        1,
+        &with_output(&["blobs:8", "--size", "8x8"], tiny.to_str().unwrap()),
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let own = base[0];
+    let limit_kib = 40 * 1024;
+    let raw = big_raw(dir.path());
+    let out = dir.path().join("out.png");
+    let mapped = [
+        raw.to_str().unwrap(),
+        "--dims",
+        "257,257,257",
+        "--dtype",
+        "f32",
+        "--size",
+        "64x64",
+        "--max-memory",
+        "40M",
+    ];
+    let cases: [(&str, Vec<&str>, usize); 4] = [
+        // A mapped file's piece (68 MB at one rank).
+        ("mapped piece", mapped.to_vec(), 1),
+        // Its log10 too: 17 MB pieces, whose log would make 2 of them.
+        ("piece and its log", [&mapped[..], &["--log"]].concat(), 2),
+        // The fractal, generated whole (68 MB) once by rank 0.
+        (
+            "fractal",
+            vec!["fractal:257", "--size", "64x64", "--max-memory", "40M"],
+            2,
+        ),
+        // A file rank 0 reads whole to send each rank its piece.
+        ("scattered", vec![], 2),
+    ];
+    let gz = gzip_nrrd(dir.path(), 129);
+    for (name, mut args, n) in cases {
+        if name == "scattered" {
+            // 129³ f32 (8.6 MB) in a gzip NRRD under a 9 MiB limit: rank 0
+            // holds it whole and the pieces it cuts.
+            args = vec![
+                gz.to_str().unwrap(),
+                "--size",
+                "64x64",
+                "--max-memory",
+                "9M",
+            ];
+        }
+        let (run, peaks) = ranks_with_peak_rss(n, &with_output(&args, out.to_str().unwrap()));
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{name}: rendered under the limit");
+        assert!(stderr.contains("--max-memory"), "{name}: {stderr}");
+        assert!(!out.exists());
+        let limit = if name == "scattered" {
+            9 * 1024
+        } else {
+            limit_kib
+        };
+        for peak in &peaks {
+            assert!(
+                *peak < own + limit,
+                "{name}: a rank peaked at {peak} KiB, over the limit {limit} KiB + the binary's own {own} KiB: {stderr}"
+            );
+        }
+        // mpirun may stop the other ranks once the first exits non-zero;
+        // the first to fail has written its peak.
+        assert!(!peaks.is_empty(), "{name}: {stderr}");
+    }
 }
