@@ -223,3 +223,90 @@ fn a_rank_that_cannot_read_its_piece_fails_every_rank_with_its_error() {
     assert_eq!(*rank, 2, "the first rank whose box starts past x = 0");
     assert!(message.contains("scan.raw"), "{message}");
 }
+
+/// A label volume: every rank's labels, joined, are the whole volume's
+/// (each label lies in one rank's piece only, at 3 and 5 ranks), and
+/// the frame with their transfer function is one process's within a
+/// level; a value that is not an integer is found on whichever rank
+/// holds it.
+#[test]
+fn ranks_join_their_labels_into_the_whole_volumes() {
+    use volray_core::transfer::labels::{LabelError, LabelStyle, labels_of, transfer_function};
+    // Label 3 in a corner ball, 7 in the opposite corner, 1 across the
+    // middle: no rank at 3 or more holds all three.
+    let mut volume = Volume::from_fn([30, 26, 22], DVec3::ONE, DVec3::ZERO, |p| {
+        if (p - DVec3::new(5.0, 5.0, 4.0)).length() < 4.0 {
+            3.0
+        } else if (p - DVec3::new(24.0, 20.0, 17.0)).length() < 4.5 {
+            7.0
+        } else if (p - DVec3::new(15.0, 13.0, 11.0)).length() < 6.0 {
+            1.0
+        } else {
+            0.0
+        }
+    })
+    .unwrap();
+    volume.set_labels(true);
+    let found = labels_of(&volume, 256).unwrap().unwrap();
+    assert_eq!(found, vec![0, 1, 3, 7]);
+    let settings = RenderSettings {
+        width: 48,
+        height: 40,
+        transfer_function: transfer_function(&found, &LabelStyle::default()).unwrap(),
+        camera: Camera {
+            azimuth: 35.0,
+            elevation: 20.0,
+            ..Camera::default()
+        },
+        ..RenderSettings::default()
+    };
+    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    for ranks in [1, 3, 5] {
+        let results: Vec<_> = std::thread::scope(|s| {
+            let handles: Vec<_> = (Local::group(ranks).into_iter())
+                .map(|t| {
+                    let (volume, settings) = (&volume, &settings);
+                    s.spawn(move || {
+                        let mut d = Distributed::read(&t, volume, Default::default()).unwrap();
+                        let joined = d.labels(256).unwrap();
+                        (joined, d.render(settings).unwrap().0)
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        for (joined, _) in &results {
+            assert_eq!(
+                joined.as_ref().unwrap().as_deref(),
+                Some(&found[..]),
+                "{ranks} ranks"
+            );
+        }
+        let frame = results[0].1.as_ref().expect("rank 0's frame");
+        let diff = frame.max_abs_diff(&single).unwrap();
+        assert!(diff <= 1.0 / 255.0, "{ranks} ranks: {diff}");
+    }
+    // A half in the far corner: only the last rank's piece holds it.
+    let mut half = volume.values().to_vec();
+    let n = half.len();
+    half[n - 1] = 0.5;
+    let half = Volume::new(volume.dims(), half).unwrap();
+    let joined: Vec<_> = std::thread::scope(|s| {
+        let handles: Vec<_> = (Local::group(3).into_iter())
+            .map(|t| {
+                let half = &half;
+                s.spawn(move || {
+                    let d = Distributed::read(&t, half, Default::default()).unwrap();
+                    d.labels(256).unwrap()
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for j in joined {
+        assert!(
+            matches!(j, Err(LabelError::NotInteger(v)) if v == 0.5),
+            "{j:?}"
+        );
+    }
+}
