@@ -1,11 +1,11 @@
-//! Post-classified compositing on its fast path (`cpu/post.rs`),
+//! Post-classified compositing on its fast path (`cpu/post/`),
 //! held to the reference path (the oracle) within 1/255 per channel: a
 //! smooth ball, the Marschner–Lobb signal and a step edge; views along an
 //! axis, oblique and in perspective (the eye outside and inside the
 //! volume); steps of 0.5 and 1; lit and unlit; crop boxes, clip planes and
 //! jitter; Levoy's iso-surfaces and gradient-magnitude opacity;
 //! anisotropic spacing. Also: bit-identical images for any thread count.
-//! (The brick walk's skipping is tested in `cpu/post.rs`, where its work
+//! (The brick walk's skipping is tested in `cpu/post/skipping.rs`, where its work
 //! counts can be seen.)
 
 mod common;
