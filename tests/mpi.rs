@@ -437,8 +437,9 @@ fn python_with_writers() -> PathBuf {
 }
 
 /// Files whose axes run in another order or sense, written by mrcfile
-/// (MAPC/MAPR/MAPS 2,1,3), nibabel (LAS) and pynrrd (index axes along
-/// −z, +x, +y): every rank maps the file and reorders its own box, and
+/// (MAPC/MAPR/MAPS 2,1,3), nibabel (LAS), pynrrd (index axes along
+/// −z, +x, +y) and numpy (`np.save`, C order: z fastest): every rank
+/// maps the file and reorders its own box, and
 /// 1 to 4 ranks give one process's image within a level. They were
 /// refused under mpirun before ("the file's axes are not x, y, z").
 #[test]
@@ -453,7 +454,7 @@ fn files_whose_axes_are_reordered_render_as_one_process() {
         .status()
         .unwrap();
     assert!(wrote.success(), "writing the reordered files failed");
-    for file in ["perm.mrc", "las.nii", "neg.nhdr"] {
+    for file in ["perm.mrc", "las.nii", "neg.nhdr", "c.npy"] {
         let input = dir.path().join(file);
         let args = [
             input.to_str().unwrap(),

@@ -5,7 +5,8 @@ each by the tool its community uses, for tests/mpi.rs:
   (columns along y, rows along x), as crystallographic maps often are;
 - las.nii: a NIfTI image (nibabel) whose first axis runs along -x (LAS);
 - neg.nhdr + neg.raw: a detached NRRD (pynrrd) whose index axes run along
-  -z, +x, +y.
+  -z, +x, +y;
+- c.npy: numpy's own np.save of a[x, y, z], in C order (z fastest).
 
 All are f32 and uncompressed, so that every rank maps them and reorders
 its own box. The field is the same smooth, asymmetric one in world
@@ -66,6 +67,8 @@ def main(out):
         "endian": "little",
     }
     nrrd.write(str(out / "neg.nhdr"), g, header, detached_header=True, index_order="F")
+
+    np.save(out / "c.npy", f)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ use self::header::{Elem, Header, MAGIC, descr_name, read_header};
 use crate::atomic::write_atomically;
 use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
+use crate::shared::geometry::Reorientation;
 use crate::shared::input::{open_input, read_samples};
 use crate::shared::limits::check_dims;
 use crate::shared::mapped::{self, MapPolicy, Plan};
@@ -77,8 +78,11 @@ fn read_npy_with_info(
     // read_header checked count · size against the file, so no overflow.
     let stored = header.elem.stored();
     let count = nx * ny * nz;
+    // C order has z fastest: mapped only in the file's own axis order
+    // (z, y, x), for a reader of boxes that transposes each box.
+    let in_file_order = !header.fortran_order && policy == MapPolicy::AlwaysInFileOrder;
     let mappable = match header.elem {
-        _ if !header.fortran_order => Err(
+        _ if !header.fortran_order && !in_file_order => Err(
             "C order: a[x, y, z] has z fastest and is transposed as it is read; save it with np.asfortranarray".to_string(),
         ),
         Elem::Plain(d, e) => mapped::mappable(d, e, header.data_offset),
@@ -114,11 +118,27 @@ fn read_npy_with_info(
         ),
         ("shape".into(), format!("({nx}, {ny}, {nz})")),
     ];
-    if !header.fortran_order {
-        info.notes
-            .push("C order: the array a[x, y, z] was transposed to x fastest".into());
-    }
-    let volume = Volume::from_samples(header.shape, data).map_err(|e| IoError::volume(path, e))?;
+    let dims = if plan == Plan::Map && !header.fortran_order {
+        // Index axes z, y, x in the file, each along its world axis.
+        info.notes.push(
+            "C order, mapped in the file's own axis order (z fastest); each box read is transposed to x fastest".into(),
+        );
+        info.reorientation = Some(Reorientation {
+            file_dims: [nz, ny, nx],
+            world_axis: [2, 1, 0],
+            flipped: [false; 3],
+            spacing: volray_core::glam::DVec3::ONE,
+            origin: volray_core::glam::DVec3::ZERO,
+        });
+        [nz, ny, nx]
+    } else {
+        if !header.fortran_order {
+            info.notes
+                .push("C order: the array a[x, y, z] was transposed to x fastest".into());
+        }
+        header.shape
+    };
+    let volume = Volume::from_samples(dims, data).map_err(|e| IoError::volume(path, e))?;
     if plan == Plan::Map {
         info.notes.push(mapped::mapped_note(&volume));
     }
