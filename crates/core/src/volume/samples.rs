@@ -243,6 +243,35 @@ impl Samples {
     }
 }
 
+impl Samples {
+    /// Passes the samples to `f` as little-endian bytes of their own type,
+    /// in order, `chunk` samples at a time (the last chunk may be
+    /// shorter): the bytes a file stores them as. On a little-endian
+    /// machine these are the samples' own bytes, no copy; elsewhere each
+    /// chunk is swapped through one scratch buffer. Stops at `f`'s first
+    /// error.
+    pub fn try_for_each_le_chunk<E>(
+        &self,
+        chunk: usize,
+        mut f: impl FnMut(&[u8]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let chunk = chunk.max(1);
+        let mut scratch: Vec<u8> = Vec::new();
+        with_samples!(self, |data| {
+            data.chunks(chunk).try_for_each(|c| {
+                let bytes: &[u8] = bytemuck::cast_slice(c);
+                if cfg!(target_endian = "little") {
+                    return f(bytes);
+                }
+                let size = std::mem::size_of_val(&c[0]);
+                scratch.clear();
+                scratch.extend(bytes.chunks_exact(size).flat_map(|b| b.iter().rev()));
+                f(&scratch)
+            })
+        })
+    }
+}
+
 impl From<Vec<f32>> for Samples {
     fn from(v: Vec<f32>) -> Self {
         Samples::F32(Store::Owned(v))
@@ -290,6 +319,33 @@ mod tests {
         assert_eq!((-128i8).to_f32(), -128.0);
         assert_eq!(255u8.to_f32(), 255.0);
         assert!(!f32::NAN.is_finite() && Sample::is_finite(7u8));
+    }
+
+    #[test]
+    fn samples_pass_as_little_endian_bytes_of_their_own_type() {
+        let mut out = Vec::new();
+        let s = Samples::from(vec![0x0102u16, 0xfffe, 7]);
+        s.try_for_each_le_chunk(2, |b| {
+            out.push(b.to_vec());
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+        assert_eq!(out, vec![vec![2, 1, 0xfe, 0xff], vec![7, 0]]);
+        let mut all = Vec::new();
+        Samples::from(vec![1.5f32, -2.0])
+            .try_for_each_le_chunk(8, |b| {
+                all.extend_from_slice(b);
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+        let expect: Vec<u8> = [1.5f32, -2.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        assert_eq!(all, expect);
+        let err = Samples::from(vec![1i8, 2, 3])
+            .try_for_each_le_chunk(1, |b| if b == [2] { Err("stop") } else { Ok(()) });
+        assert_eq!(err, Err("stop"));
     }
 
     #[test]

@@ -155,17 +155,15 @@ fn read_raw_limited(
         .map_err(|e| IoError::volume(path, e))
 }
 
-/// Writes `volume` to `path` as raw little-endian `f32` samples, x fastest,
-/// atomically: the layout `--dims NX,NY,NZ --dtype f32 --endian little`
-/// reads back. Spacing and origin are not stored.
+/// Writes `volume` to `path` as raw little-endian samples of its own type,
+/// x fastest, atomically: the layout `--dims NX,NY,NZ --dtype T --endian
+/// little` reads back (`T` its sample type's name: `u8`, `i8`, `u16`,
+/// `i16`, `f32`). Spacing and origin are not stored.
 pub fn write_raw(path: &Path, volume: &Volume) -> Result<(), IoError> {
     write_atomically(path, |w| {
-        let mut buf = Vec::with_capacity(4 * 4096);
-        volume.samples().try_for_each_f32_chunk(4096, |chunk| {
-            buf.clear();
-            buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
-            w.write_all(&buf)
-        })?;
+        volume
+            .samples()
+            .try_for_each_le_chunk(1 << 16, |bytes| w.write_all(bytes))?;
         Ok(())
     })
 }

@@ -194,12 +194,13 @@ fn read_data<T: Stored>(
 }
 
 /// Writes `volume` to `path` as a `.npy` file, atomically: format version
-/// 1.0, `descr` `'<f4'`, Fortran order, shape `(nx, ny, nz)`, so that
+/// 1.0, `descr` of its own sample type (`'|u1'`, `'|i1'`, `'<u2'`,
+/// `'<i2'`, `'<f4'`), Fortran order, shape `(nx, ny, nz)`, so that
 /// `np.load(path)[x, y, z]` is the voxel at `(x, y, z)`. The header is
 /// padded so the data starts at a multiple of 64 bytes. Spacing and origin
 /// are not stored: `.npy` has no place for them.
 pub fn write_npy(path: &Path, volume: &Volume) -> Result<(), IoError> {
-    let header = header_text(volume.dims());
+    let header = header_text(volume.dims(), volume.sample_type());
     let len = u16::try_from(header.len()).map_err(|_| {
         IoError::npy(
             path,
@@ -211,22 +212,28 @@ pub fn write_npy(path: &Path, volume: &Volume) -> Result<(), IoError> {
         w.write_all(&[1, 0])?;
         w.write_all(&len.to_le_bytes())?;
         w.write_all(header.as_bytes())?;
-        let mut buf = Vec::with_capacity(4 * 8192);
-        volume.samples().try_for_each_f32_chunk(8192, |chunk| {
-            buf.clear();
-            buf.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
-            w.write_all(&buf)
-        })?;
+        volume
+            .samples()
+            .try_for_each_le_chunk(1 << 16, |bytes| w.write_all(bytes))?;
         Ok(())
     })
 }
 
-/// The version-1.0 header for a Fortran-order `<f4` array of `dims`,
-/// padded with spaces and ended with a newline so that the 10-byte
-/// preamble plus the header is a multiple of [`ALIGN`].
-fn header_text(dims: [usize; 3]) -> String {
+/// The version-1.0 header for a Fortran-order array of `dims` samples of
+/// type `t` (little-endian), padded with spaces and ended with a newline
+/// so that the 10-byte preamble plus the header is a multiple of
+/// [`ALIGN`].
+fn header_text(dims: [usize; 3], t: volray_core::SampleType) -> String {
+    use volray_core::SampleType::*;
+    let descr = match t {
+        U8 => "|u1",
+        I8 => "|i1",
+        U16 => "<u2",
+        I16 => "<i2",
+        F32 => "<f4",
+    };
     let mut h = format!(
-        "{{'descr': '<f4', 'fortran_order': True, 'shape': ({}, {}, {}), }}",
+        "{{'descr': '{descr}', 'fortran_order': True, 'shape': ({}, {}, {}), }}",
         dims[0], dims[1], dims[2]
     );
     let unpadded = 10 + h.len() + 1;

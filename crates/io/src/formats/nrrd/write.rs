@@ -1,16 +1,28 @@
-//! Writing a [`Volume`] as an attached NRRD file: `float` samples, raw
+//! Writing a [`Volume`] as an attached NRRD file: samples in the volume's
+//! own type (`uint8`, `int8`, `uint16`, `int16`, `float`), raw
 //! little-endian, in a 3-D space whose `space directions` and `space
 //! origin` carry the volume's spacing and origin exactly.
 
 use std::path::Path;
 
-use volray_core::Volume;
+use volray_core::{SampleType, Volume};
 
 use crate::atomic::write_atomically;
 use crate::error::IoError;
 
-/// Samples converted per write: bounds the scratch buffer.
+/// Samples per write.
 const CHUNK: usize = 1 << 16;
+
+/// The NRRD `type` of samples of type `t` (teem's spellings).
+fn nrrd_type(t: SampleType) -> &'static str {
+    match t {
+        SampleType::U8 => "uint8",
+        SampleType::I8 => "int8",
+        SampleType::U16 => "uint16",
+        SampleType::I16 => "int16",
+        SampleType::F32 => "float",
+    }
+}
 
 /// Writes `volume` to `path` as a NRRD file (format version 4, attached
 /// data), atomically: a failed write leaves no partial file.
@@ -41,7 +53,7 @@ pub fn write_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
          # Complete NRRD file format specification at:\n\
          # http://teem.sourceforge.net/nrrd/format.html\n\
          # written by volray\n\
-         type: float\n\
+         type: {}\n\
          dimension: 3\n\
          space dimension: 3\n\
          sizes: {nx} {ny} {nz}\n\
@@ -51,16 +63,19 @@ pub fn write_nrrd(path: &Path, volume: &Volume) -> Result<(), IoError> {
          encoding: raw\n\
          space origin: ({:?},{:?},{:?})\n\
          \n",
-        s.x, s.y, s.z, o.x, o.y, o.z
+        nrrd_type(volume.sample_type()),
+        s.x,
+        s.y,
+        s.z,
+        o.x,
+        o.y,
+        o.z
     );
     write_atomically(path, |w| {
         w.write_all(header.as_bytes())?;
-        let mut bytes = Vec::with_capacity(CHUNK * 4);
-        volume.samples().try_for_each_f32_chunk(CHUNK, |chunk| {
-            bytes.clear();
-            bytes.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
-            w.write_all(&bytes)
-        })?;
+        volume
+            .samples()
+            .try_for_each_le_chunk(CHUNK, |bytes| w.write_all(bytes))?;
         Ok(())
     })
 }
