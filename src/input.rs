@@ -117,6 +117,8 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
             raw,
             frame: args.frame,
             array: args.array.clone(),
+            level: args.level,
+            channel: args.channel,
             max_memory,
             // A volume over --max-memory is mapped from its file where its
             // format allows (volray-io's MapPolicy), refused otherwise.
@@ -173,9 +175,10 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
 pub fn source_grid(args: &InputArgs, spec: &str) -> Result<usize, CliError> {
     let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
     let file_flags = args.format.is_some() || args.frame.is_some() || args.array.is_some();
-    if raw_flags || file_flags {
+    let zarr_flags = args.level.is_some() || args.channel.is_some();
+    if raw_flags || file_flags || zarr_flags {
         return Err(CliError::input(format!(
-            "{spec}: --dims, --dtype, --endian, --format, --frame and --array apply to files only, not to built-in sources"
+            "{spec}: --dims, --dtype, --endian, --format, --frame, --array, --level and --channel apply to files only, not to built-in sources"
         )));
     }
     source_points(spec)

@@ -1,6 +1,6 @@
 //! Where the volume comes from and how to read it: INPUT and the reading
 //! options (`--dims`, `--dtype`, `--endian`, `--spacing`, `--format`,
-//! `--frame`, `--array`, `--max-memory`), which `render`, `bench` and
+//! `--frame`, `--array`, `--level`, `--channel`, `--max-memory`), which `render`, `bench` and
 //! `info` share. `input.rs` (beside `main.rs`) reads the volume they
 //! describe.
 
@@ -56,6 +56,16 @@ pub struct InputArgs {
     #[arg(long, value_name = "NAME")]
     pub array: Option<String>,
 
+    /// Zarr/OME-Zarr: which resolution level of a multiscale image, 0 the
+    /// finest (`volray info` lists them) [default: 0].
+    #[arg(long, value_name = "N", value_parser = parse_level)]
+    pub level: Option<usize>,
+
+    /// Zarr/OME-Zarr: which channel (the image's `c` axis), from 0
+    /// [default: 0].
+    #[arg(long, value_name = "N")]
+    pub channel: Option<usize>,
+
     /// The most memory the volume may take, read and rendered: bytes, or
     /// a number with K, M, G or T (powers of 1024), e.g. 512M, 4G, 1.5GiB.
     /// A file whose header asks for more, or a volume whose rendering may
@@ -63,4 +73,17 @@ pub struct InputArgs {
     /// the physical memory].
     #[arg(long, value_name = "SIZE", value_parser = volray_io::parse_size, allow_hyphen_values = true)]
     pub max_memory: Option<u64>,
+}
+
+/// A `--level`: a level number. `auto` (the level the view needs) will
+/// come with lazy, bricked reading; until then it is refused by name.
+fn parse_level(text: &str) -> Result<usize, String> {
+    match text.trim() {
+        "auto" => Err(
+            "--level auto is not supported yet (it comes with lazy, bricked reading): give a level number, 0 the finest".to_string(),
+        ),
+        t => t.parse().map_err(|_| {
+            format!("\"{text}\" is not a level: give a level number, 0 the finest")
+        }),
+    }
 }

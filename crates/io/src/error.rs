@@ -114,6 +114,11 @@ pub enum IoError {
     #[error("{}: frame selection does not apply to {format} files: they hold one volume", path.display())]
     FrameNotApplicable { path: PathBuf, format: &'static str },
 
+    /// A resolution level or channel ([`ReadOptions::level`],
+    /// [`ReadOptions::channel`]) chosen in a file whose format has neither.
+    #[error("{}: level and channel selection apply to Zarr/OME-Zarr images only, not to {format} files", path.display())]
+    LevelNotApplicable { path: PathBuf, format: &'static str },
+
     /// A frame ([`ReadOptions::frame`]) the file does not hold. `held` says
     /// what it holds, e.g. `the file holds 2 volumes (dim[4]), numbered from 0`.
     #[error("{}: frame {frame} is out of range: {held}", path.display())]
@@ -216,6 +221,7 @@ impl IoError {
             | IoError::UnknownFormat { .. }
             | IoError::RawOptionsNotApplicable { .. }
             | IoError::FrameNotApplicable { .. }
+            | IoError::LevelNotApplicable { .. }
             | IoError::FrameOutOfRange { .. }
             | IoError::FrameNeeded { .. }
             | IoError::ArrayNotApplicable { .. }
@@ -243,6 +249,7 @@ impl IoError {
             | IoError::UnknownFormat { path }
             | IoError::RawOptionsNotApplicable { path, .. }
             | IoError::FrameNotApplicable { path, .. }
+            | IoError::LevelNotApplicable { path, .. }
             | IoError::FrameOutOfRange { path, .. }
             | IoError::FrameNeeded { path, .. }
             | IoError::ArrayNotApplicable { path, .. }

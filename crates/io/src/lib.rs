@@ -41,6 +41,7 @@
 //! | CCP4/MRC `.map`, `.mrc` | `formats/mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin; skewed: a whole cell resampled periodically, a part (or more) over its box, NaN outside ([`FileInfo::nan_is_empty`]) |
 //! | VASP CHGCAR/CHG | `formats/chgcar/` | divided by the cell volume; periodic plane added; spin blocks as frames; known by content too |
 //! | MINC2 `.mnc` | `formats/minc.rs` | on the HDF5 layer; dimorder, steps, starts, direction cosines; image-min/max scaling as nibabel |
+//! | Zarr v2/v3, OME-Zarr 0.4/0.5 (a directory) | `formats/zarr/` | through `zarrs` (blosc, zstd, gzip, sharding, fill values); known by `zarr.json`/`.zarray`/`.zgroup`; levels ([`ReadOptions::level`]), time points, channels ([`ReadOptions::channel`]) |
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is
@@ -117,7 +118,9 @@ pub use formats::raw::{RawOptions, read_raw, write_raw};
 pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
-pub use read::{FileInfo, FlatImage, Loaded, ReadOptions, read, read_volume, split_hdf5_path};
+pub use read::{
+    FileInfo, FlatImage, LevelInfo, Loaded, ReadOptions, read, read_volume, split_hdf5_path,
+};
 pub use shared::compress::{Compression, inflate_exact};
 pub use shared::geometry::{Reorientation, grid_to_volume};
 pub use shared::limits::{

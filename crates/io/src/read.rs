@@ -33,6 +33,12 @@ pub struct ReadOptions {
     /// Which named array of a file holding several (the CLI's `--array`):
     /// VTK point or cell data arrays.
     pub array: Option<String>,
+    /// Which resolution level of a multiscale image (the CLI's `--level`),
+    /// 0 the finest: the `datasets` of an OME-Zarr image.
+    pub level: Option<usize>,
+    /// Which channel of an image holding several (the CLI's `--channel`),
+    /// counted from 0: an OME-Zarr image's `c` axis.
+    pub channel: Option<usize>,
     /// The most bytes the decoded volume and the reader's whole-payload
     /// buffers may take (the CLI's `--max-memory`): a header asking for
     /// more is refused before anything is allocated (see
@@ -53,6 +59,8 @@ impl Default for ReadOptions {
             raw: None,
             frame: None,
             array: None,
+            level: None,
+            channel: None,
             max_memory: default_max_memory(),
             map: MapPolicy::IfLarger,
         }
@@ -139,6 +147,35 @@ pub struct FileInfo {
     /// [`MapPolicy::AlwaysInFileOrder`]): how to take the world-aligned
     /// volume's boxes from it.
     pub reorientation: Option<Reorientation>,
+    /// The resolution levels of a multiscale image (OME-Zarr), finest
+    /// first; one for a bare Zarr array, none for other formats.
+    pub levels: Vec<LevelInfo>,
+    /// Which of them was read.
+    pub level: usize,
+}
+
+/// One resolution level of a multiscale image, for `volray info`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LevelInfo {
+    /// The level's array, relative to the image (empty for a bare array).
+    pub path: String,
+    /// The array's shape in its own axis order (t, c, z, y, x).
+    pub shape: Vec<u64>,
+    /// Samples along x, y and z.
+    pub dims: [usize; 3],
+    /// Spacing and origin along x, y and z.
+    pub spacing: [f64; 3],
+    pub origin: [f64; 3],
+    /// The chunk shape (the inner chunk of a sharded array), and the
+    /// shard shape, in the array's axis order.
+    pub chunk_shape: Option<Vec<u64>>,
+    pub shard_shape: Option<Vec<u64>>,
+    /// The codecs, in order, e.g. `bytes, zstd` or `blosc (lz4)`.
+    pub codecs: String,
+    /// The bytes the level's chunk files take on disk.
+    pub bytes_stored: u64,
+    /// The bytes one volume of it (a time point and channel) takes in memory.
+    pub bytes_in_memory: u64,
 }
 
 impl FileInfo {
@@ -179,6 +216,12 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
     if opts.frame.is_some() && !spec.frames {
         return Err(IoError::FrameNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    if (opts.level.is_some() || opts.channel.is_some()) && !spec.levels {
+        return Err(IoError::LevelNotApplicable {
             path: path.to_path_buf(),
             format: spec.description,
         });
@@ -228,7 +271,15 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
         return Ok(VolumeFormat::Hdf5);
     }
     if path.is_dir() {
-        return Ok(VolumeFormat::Dicom);
+        // Zarr groups and arrays by their metadata files; any other
+        // directory is a DICOM series (or a `.zarr` missing its metadata).
+        let zarr = crate::formats::zarr::is_zarr_dir(path)
+            || VolumeFormat::from_path(path) == Some(VolumeFormat::Zarr);
+        return Ok(if zarr {
+            VolumeFormat::Zarr
+        } else {
+            VolumeFormat::Dicom
+        });
     }
     if let Some(format) = VolumeFormat::from_path(path) {
         return Ok(format);

@@ -263,6 +263,8 @@ pub fn read(
             raw,
             frame,
             array,
+            level: None,
+            channel: None,
             max_memory,
             // The samples move into a numpy array, which owns its memory.
             map: MapPolicy::Never,

@@ -28,6 +28,7 @@ pub(crate) mod raw;
 pub(crate) mod tiff;
 pub(crate) mod vti;
 pub(crate) mod vtk_legacy;
+pub(crate) mod zarr;
 
 use std::fmt;
 use std::path::Path;
@@ -70,6 +71,8 @@ pub enum VolumeFormat {
     Chgcar,
     /// MINC2 (`.mnc`): HDF5 in libminc's layout.
     Minc,
+    /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
+    Zarr,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -99,6 +102,10 @@ pub(crate) struct FormatSpec {
     /// Whether a file may hold several named arrays, one of which
     /// [`ReadOptions::array`] picks.
     pub arrays: bool,
+    /// Whether a file may hold several resolution levels, one of which
+    /// [`ReadOptions::level`] picks, and several channels, one of which
+    /// [`ReadOptions::channel`] picks.
+    pub levels: bool,
     /// The reader.
     pub read: fn(&Path, &ReadOptions) -> Result<Loaded, IoError>,
 }
@@ -154,6 +161,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::NONE,
         frames: false,
         arrays: false,
+        levels: false,
         read: raw::read,
     },
     FormatSpec {
@@ -166,6 +174,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(0, b"\x93NUMPY")]),
         frames: false,
         arrays: false,
+        levels: false,
         read: npy::read,
     },
     FormatSpec {
@@ -178,6 +187,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(0, b"NRRD000")]),
         frames: true,
         arrays: false,
+        levels: false,
         read: nrrd::read,
     },
     FormatSpec {
@@ -193,6 +203,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         },
         frames: true,
         arrays: false,
+        levels: false,
         read: metaimage::read,
     },
     FormatSpec {
@@ -215,6 +226,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         },
         frames: true,
         arrays: false,
+        levels: false,
         read: nifti::read,
     },
     FormatSpec {
@@ -227,6 +239,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(0, b"# vtk DataFile")]),
         frames: false,
         arrays: true,
+        levels: false,
         read: vtk_legacy::read,
     },
     FormatSpec {
@@ -242,6 +255,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         },
         frames: false,
         arrays: true,
+        levels: false,
         read: vti::read,
     },
     FormatSpec {
@@ -254,6 +268,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(128, b"DICM")]),
         frames: true,
         arrays: false,
+        levels: false,
         read: dicom::read,
     },
     FormatSpec {
@@ -267,6 +282,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(0, b"II*\0"), (0, b"MM\0*"), (0, b"II+\0"), (0, b"MM\0+")]),
         frames: true,
         arrays: false,
+        levels: false,
         read: tiff::read,
     },
     FormatSpec {
@@ -279,6 +295,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(0, b"\x89HDF\r\n\x1a\n")]),
         frames: true,
         arrays: false,
+        levels: false,
         read: hdf5::read,
     },
     FormatSpec {
@@ -294,6 +311,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         },
         frames: true,
         arrays: false,
+        levels: false,
         read: cube::read,
     },
     FormatSpec {
@@ -306,6 +324,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::strong(&[(208, b"MAP ")]),
         frames: false,
         arrays: false,
+        levels: false,
         read: mrc::read,
     },
     FormatSpec {
@@ -323,6 +342,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         },
         frames: true,
         arrays: false,
+        levels: false,
         read: chgcar::read,
     },
     FormatSpec {
@@ -337,7 +357,24 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         magic: Magic::NONE,
         frames: true,
         arrays: false,
+        levels: false,
         read: minc::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Zarr,
+        name: "zarr",
+        description: "Zarr/OME-Zarr",
+        // A directory is known by its metadata files (read.rs), whatever
+        // its name; the extension only sends a `.zarr` path that is no
+        // Zarr store to the Zarr reader, which says what is missing.
+        extensions: &["zarr", "ome.zarr"],
+        name_stems: &[],
+        known_as: "Zarr/OME-Zarr (a directory)",
+        magic: Magic::NONE,
+        frames: true,
+        arrays: false,
+        levels: true,
+        read: zarr::read,
     },
 ];
 
@@ -587,13 +624,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 14);
+        assert_eq!(VolumeFormat::ALL.len(), 15);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

@@ -1,0 +1,195 @@
+//! Reading the samples of one Zarr array through `zarrs`: opening the
+//! array (v2 or v3, whichever metadata file the directory holds), its
+//! sample type, and [`read_box`], which reads any box of it. The eager
+//! reader calls [`read_box`] for a whole 3-D volume; a lazy, bricked
+//! reader can call it per brick.
+//!
+//! `zarrs` does the chunk grid, the codecs (blosc, zstd, gzip, sharding,
+//! crc32c, transpose), fill values and missing chunks (read as the fill
+//! value, as the Zarr specifications say). Before it decodes anything,
+//! the box and the chunk (the shard, for a sharded array: the unit
+//! `zarrs` may hold decoded) are checked against the memory limit, so a
+//! metadata file that lies about its shapes is refused before a buffer
+//! of that size exists.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use volray_core::Samples;
+use zarrs::array::data_type::{
+    Float32DataType, Float64DataType, Int8DataType, Int16DataType, Int32DataType, Int64DataType,
+    UInt8DataType, UInt16DataType, UInt32DataType, UInt64DataType,
+};
+use zarrs::array::{Array, ArraySubset, ElementOwned};
+use zarrs::filesystem::FilesystemStore;
+
+use crate::IoError;
+use crate::shared::limits::check_volume_size;
+
+/// An open Zarr array on the file system.
+pub(crate) type ZarrArray = Array<FilesystemStore>;
+
+/// The sample types volray reads from Zarr, and how each is kept: `u8`,
+/// `i8`, `u16`, `i16` and `f32` as stored, the others as `f32`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ZarrType {
+    U8,
+    I8,
+    U16,
+    I16,
+    F32,
+    U32,
+    I32,
+    U64,
+    I64,
+    F64,
+}
+
+impl ZarrType {
+    /// The type of `array`, or an error naming the one it has.
+    fn of(path: &Path, array: &ZarrArray) -> Result<Self, IoError> {
+        let dt = array.data_type();
+        let found = [
+            (dt.is::<UInt8DataType>(), ZarrType::U8),
+            (dt.is::<Int8DataType>(), ZarrType::I8),
+            (dt.is::<UInt16DataType>(), ZarrType::U16),
+            (dt.is::<Int16DataType>(), ZarrType::I16),
+            (dt.is::<Float32DataType>(), ZarrType::F32),
+            (dt.is::<UInt32DataType>(), ZarrType::U32),
+            (dt.is::<Int32DataType>(), ZarrType::I32),
+            (dt.is::<UInt64DataType>(), ZarrType::U64),
+            (dt.is::<Int64DataType>(), ZarrType::I64),
+            (dt.is::<Float64DataType>(), ZarrType::F64),
+        ]
+        .into_iter()
+        .find_map(|(is, t)| is.then_some(t));
+        found.ok_or_else(|| {
+            let name = serde_json::to_value(array.metadata())
+                .ok()
+                .and_then(|m| m.get("data_type").or_else(|| m.get("dtype")).cloned())
+                .map_or_else(|| "?".to_string(), |v| v.to_string());
+            IoError::invalid(
+                path,
+                format!(
+                    "Zarr data type {name} is not supported: volray reads (u)int8 to (u)int64, float32 and float64"
+                ),
+            )
+        })
+    }
+
+    /// The name `volray info` shows.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            ZarrType::U8 => "uint8",
+            ZarrType::I8 => "int8",
+            ZarrType::U16 => "uint16",
+            ZarrType::I16 => "int16",
+            ZarrType::F32 => "float32",
+            ZarrType::U32 => "uint32",
+            ZarrType::I32 => "int32",
+            ZarrType::U64 => "uint64",
+            ZarrType::I64 => "int64",
+            ZarrType::F64 => "float64",
+        }
+    }
+
+    /// Bytes a value takes as stored.
+    pub(crate) fn size(self) -> u64 {
+        match self {
+            ZarrType::U8 | ZarrType::I8 => 1,
+            ZarrType::U16 | ZarrType::I16 => 2,
+            ZarrType::F32 | ZarrType::U32 | ZarrType::I32 => 4,
+            ZarrType::U64 | ZarrType::I64 | ZarrType::F64 => 8,
+        }
+    }
+
+    /// Bytes a value takes while it is read: the stored value, plus the
+    /// `f32` it becomes for the types volray does not keep.
+    pub(crate) fn read_bytes(self) -> u64 {
+        match self {
+            ZarrType::U8 | ZarrType::I8 | ZarrType::U16 | ZarrType::I16 | ZarrType::F32 => {
+                self.size()
+            }
+            _ => self.size() + 4,
+        }
+    }
+
+    /// Bytes a value takes in memory once read.
+    pub(crate) fn kept_bytes(self) -> u64 {
+        self.size().min(4)
+    }
+}
+
+/// One line from a `zarrs` error (some span lines), after the file.
+pub(crate) fn zarr_error(path: &Path, what: &str, error: impl std::fmt::Display) -> IoError {
+    let text = error.to_string().replace('\n', " ");
+    IoError::invalid(path, format!("{what}: {text}"))
+}
+
+/// Opens the array at `dir` (a directory holding `zarr.json` or
+/// `.zarray`) and finds its sample type.
+pub(crate) fn open_array(dir: &Path) -> Result<(ZarrArray, ZarrType), IoError> {
+    let store =
+        FilesystemStore::new(dir).map_err(|e| zarr_error(dir, "cannot open Zarr store", e))?;
+    let array = Array::open(Arc::new(store), "/")
+        .map_err(|e| zarr_error(dir, "not a readable Zarr array", e))?;
+    let ty = ZarrType::of(dir, &array)?;
+    Ok((array, ty))
+}
+
+/// The shape of the chunks `zarrs` decodes whole: the regular grid's
+/// chunk (a shard, for a sharded array), or `None` for an irregular grid.
+pub(crate) fn chunk_shape(array: &ZarrArray) -> Option<Vec<u64>> {
+    let origin = vec![0; array.dimensionality()];
+    let shape = array.chunk_shape(&origin).ok()?;
+    Some(shape.iter().map(|n| n.get()).collect())
+}
+
+/// Reads the box `start .. start + shape` of `array` (its own axis
+/// order, the last axis fastest), C order: for a box whose last three
+/// axes are z, y, x, that is volray's x-fastest layout. Types volray
+/// does not keep become `f32`. The box and the array's chunk are checked
+/// against `max_memory` first.
+pub(crate) fn read_box(
+    path: &Path,
+    array: &ZarrArray,
+    ty: ZarrType,
+    start: &[u64],
+    shape: &[u64],
+    max_memory: u64,
+) -> Result<Samples, IoError> {
+    check_volume_size(path, "Zarr box", shape, ty.read_bytes(), max_memory)?;
+    if let Some(chunk) = chunk_shape(array) {
+        check_volume_size(path, "Zarr chunk shape", &chunk, ty.size(), max_memory)?;
+    }
+    let subset = ArraySubset::new_with_start_shape(start.to_vec(), shape.to_vec())
+        .map_err(|e| zarr_error(path, "Zarr box", e))?;
+    Ok(match ty {
+        ZarrType::U8 => elements::<u8>(path, array, &subset)?.into(),
+        ZarrType::I8 => elements::<i8>(path, array, &subset)?.into(),
+        ZarrType::U16 => elements::<u16>(path, array, &subset)?.into(),
+        ZarrType::I16 => elements::<i16>(path, array, &subset)?.into(),
+        ZarrType::F32 => elements::<f32>(path, array, &subset)?.into(),
+        // Wider types: f32 holds integers up to 2^24 exactly, and rounds
+        // the rest to 24 significant bits, as every other reader does.
+        ZarrType::U32 => widen(elements::<u32>(path, array, &subset)?, |v| v as f32),
+        ZarrType::I32 => widen(elements::<i32>(path, array, &subset)?, |v| v as f32),
+        ZarrType::U64 => widen(elements::<u64>(path, array, &subset)?, |v| v as f32),
+        ZarrType::I64 => widen(elements::<i64>(path, array, &subset)?, |v| v as f32),
+        ZarrType::F64 => widen(elements::<f64>(path, array, &subset)?, |v| v as f32),
+    })
+}
+
+fn elements<T: ElementOwned>(
+    path: &Path,
+    array: &ZarrArray,
+    subset: &ArraySubset,
+) -> Result<Vec<T>, IoError> {
+    array
+        .retrieve_array_subset::<Vec<T>>(subset)
+        .map_err(|e| zarr_error(path, "cannot read Zarr chunks", e))
+}
+
+fn widen<T: Copy>(values: Vec<T>, to_f32: impl Fn(T) -> f32) -> Samples {
+    values.into_iter().map(to_f32).collect::<Vec<f32>>().into()
+}

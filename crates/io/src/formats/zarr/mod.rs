@@ -1,0 +1,353 @@
+//! Zarr arrays (v2 and v3) and OME-Zarr images (0.4 on Zarr v2, 0.5 on
+//! Zarr v3), read whole into memory, one level, time point and channel
+//! at a time.
+//!
+//! The path is a directory: an OME-Zarr image (a group whose attributes
+//! hold `multiscales`, see `ome.rs`), or a bare array (`zarr.json` or
+//! `.zarray`). Directories are recognised by those files (`store.rs`),
+//! not by their name. The samples are read through the `zarrs` crate
+//! (`chunks.rs`), which does the codecs, fill values and missing chunks.
+//!
+//! Axes: OME-Zarr orders an image's axes time, channel, then space
+//! z, y, x, each array in C order (the last index fastest), so the
+//! samples of one time point and channel are volray's own layout, x
+//! fastest: no transpose. A bare array is read as (z, y, x), (t, z, y,
+//! x) or (t, c, z, y, x) by its number of dimensions. `ReadOptions`
+//! chooses the level (`level`, 0 the finest), the time point (`frame`)
+//! and the channel (`channel`); each level's `scale` and `translation`
+//! give its spacing and origin.
+
+mod chunks;
+mod ome;
+mod store;
+
+pub(crate) use store::is_zarr_dir;
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use volray_core::Volume;
+use volray_core::glam::DVec3;
+use zarrs::array::{ArrayMetadata, ArrayShardedExt};
+
+use crate::{FileInfo, IoError, LevelInfo, Loaded, ReadOptions, VolumeFormat};
+use chunks::{ZarrArray, ZarrType, open_array, read_box};
+use ome::{Axis, AxisKind, Level};
+use store::NodeKind;
+
+/// Reads one level, time point and channel of the image or array at `path`.
+pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let (kind, attrs) = store::node(path)?;
+    let image = match kind {
+        NodeKind::Array => None,
+        NodeKind::Group => Some(ome::multiscale(path, &attrs)?.ok_or_else(|| {
+            IoError::invalid(
+                path,
+                "a Zarr group without OME-Zarr \"multiscales\": give the path of an array in it",
+            )
+        })?),
+    };
+    let (axes, levels) = match &image {
+        Some(m) => (m.axes.clone(), m.levels.clone()),
+        None => {
+            let (array, _) = open_array(path)?;
+            let axes = bare_axes(path, array.dimensionality())?;
+            let n = axes.len();
+            let level = Level {
+                path: String::new(),
+                scale: vec![1.0; n],
+                translation: vec![0.0; n],
+            };
+            (axes, vec![level])
+        }
+    };
+    let layout = Layout::of(path, &axes)?;
+
+    let chosen = opts.level.unwrap_or(0);
+    if chosen >= levels.len() {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "level {chosen} is out of range: the image holds {} level{} (multiscales datasets), numbered from 0",
+                levels.len(),
+                if levels.len() == 1 { "" } else { "s" }
+            ),
+        ));
+    }
+    let mut opened = Vec::with_capacity(levels.len());
+    let mut infos = Vec::with_capacity(levels.len());
+    for level in &levels {
+        let dir = level_dir(path, level);
+        let (array, ty) = open_array(&dir)?;
+        if array.dimensionality() != axes.len() {
+            return Err(IoError::invalid(
+                &dir,
+                format!(
+                    "the array has {} dimensions but the image has {} axes",
+                    array.dimensionality(),
+                    axes.len()
+                ),
+            ));
+        }
+        infos.push(level_info(&dir, level, &array, ty, &layout));
+        opened.push((dir, array, ty));
+    }
+    let (dir, array, ty) = &opened[chosen];
+    let shape = array.shape().to_vec();
+
+    let frames = layout.time.map_or(1, |t| shape[t]);
+    let frame = opts.frame.unwrap_or(0);
+    if frame as u64 >= frames {
+        return Err(IoError::frame_out_of_range(
+            path,
+            frame,
+            format!(
+                "the image holds {frames} time point{} (axis \"t\"), numbered from 0",
+                if frames == 1 { "" } else { "s" }
+            ),
+        ));
+    }
+    let channels = layout.channel.map_or(1, |c| shape[c]);
+    let channel = opts.channel.unwrap_or(0);
+    if channel as u64 >= channels {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "channel {channel} is out of range: the image holds {channels} channel{} (axis \"c\"), numbered from 0",
+                if channels == 1 { "" } else { "s" }
+            ),
+        ));
+    }
+    let mut start = vec![0u64; shape.len()];
+    let mut size = shape.clone();
+    for (axis, index) in [
+        (layout.time, frame as u64),
+        (layout.channel, channel as u64),
+    ] {
+        if let Some(a) = axis {
+            start[a] = index;
+            size[a] = 1;
+        }
+    }
+    let samples = read_box(dir, array, *ty, &start, &size, opts.max_memory)?;
+    let info = &infos[chosen];
+    let volume = Volume::from_samples(info.dims, samples)
+        .and_then(|v| v.with_spacing(DVec3::from(info.spacing)))
+        .and_then(|v| v.with_origin(DVec3::from(info.origin)))
+        .map_err(|e| IoError::volume(path, e))?;
+
+    let mut file_info = FileInfo::new(ty.name());
+    let format = match array.metadata() {
+        ArrayMetadata::V2(_) => "2",
+        ArrayMetadata::V3(_) => "3",
+    };
+    file_info.header.push(("zarr_format".into(), format.into()));
+    let names: Vec<&str> = axes.iter().map(|a| a.name.as_str()).collect();
+    file_info.header.push(("axes".into(), names.join(" ")));
+    if let Some(m) = &image {
+        file_info
+            .header
+            .push(("OME-Zarr version".into(), m.version.clone()));
+        file_info
+            .header
+            .push(("levels".into(), levels.len().to_string()));
+        if m.has_omero {
+            file_info
+                .notes
+                .push("omero rendering hints (channel windows and colours) are not read".into());
+        }
+    }
+    if channels > 1 {
+        file_info
+            .header
+            .push(("channels".into(), channels.to_string()));
+        file_info
+            .notes
+            .push(format!("channel {channel} of {channels} read"));
+    }
+    file_info.length_unit = layout.unit.clone();
+    file_info.frames = frames as usize;
+    file_info.frame = frame;
+    file_info.levels = infos;
+    file_info.level = chosen;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Zarr,
+        info: file_info,
+    })
+}
+
+/// The directory of a level's array.
+fn level_dir(root: &Path, level: &Level) -> PathBuf {
+    level.path.split('/').fold(root.to_path_buf(), |p, part| {
+        if part.is_empty() { p } else { p.join(part) }
+    })
+}
+
+/// The axes of a bare array, by its number of dimensions.
+fn bare_axes(path: &Path, n: usize) -> Result<Vec<Axis>, IoError> {
+    let names: &[&str] = match n {
+        3 => &["z", "y", "x"],
+        4 => &["t", "z", "y", "x"],
+        5 => &["t", "c", "z", "y", "x"],
+        _ => {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "a Zarr array of {n} dimensions: volray reads (z, y, x), (t, z, y, x) and (t, c, z, y, x)"
+                ),
+            ));
+        }
+    };
+    Ok(names
+        .iter()
+        .map(|&name| Axis {
+            name: name.to_string(),
+            kind: match name {
+                "t" => AxisKind::Time,
+                "c" => AxisKind::Channel,
+                _ => AxisKind::Space,
+            },
+            unit: None,
+        })
+        .collect())
+}
+
+/// Where the time and channel axes are, and the space axes' unit.
+struct Layout {
+    time: Option<usize>,
+    channel: Option<usize>,
+    /// The space axes' length unit, when they agree on one.
+    unit: Option<String>,
+    /// How many axes there are: the last three are z, y, x.
+    n: usize,
+}
+
+impl Layout {
+    /// Checks that the image has three space axes, last, and at most one
+    /// time and one channel axis.
+    fn of(path: &Path, axes: &[Axis]) -> Result<Self, IoError> {
+        let n = axes.len();
+        let find = |kind| {
+            let mut at = axes.iter().enumerate().filter(|(_, a)| a.kind == kind);
+            let first = at.next().map(|(i, _)| i);
+            (first, at.next().is_some())
+        };
+        let (time, two_times) = find(AxisKind::Time);
+        let (channel, two_channels) = find(AxisKind::Channel);
+        let space = axes.iter().filter(|a| a.kind == AxisKind::Space).count();
+        let names: Vec<&str> = axes.iter().map(|a| a.name.as_str()).collect();
+        if two_times
+            || two_channels
+            || space != 3
+            || axes[n - 3..].iter().any(|a| a.kind != AxisKind::Space)
+        {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "axes [{}]: volray reads three space axes (z, y, x) last, after at most one time and one channel axis",
+                    names.join(", ")
+                ),
+            ));
+        }
+        let units: Vec<&Option<String>> = axes[n - 3..].iter().map(|a| &a.unit).collect();
+        let unit = units
+            .iter()
+            .all(|u| *u == units[0])
+            .then(|| units[0].clone())
+            .flatten();
+        Ok(Layout {
+            time,
+            channel,
+            unit,
+            n,
+        })
+    }
+
+    /// The last three values of a per-axis list, as x, y, z.
+    fn xyz<T: Copy>(&self, values: &[T]) -> [T; 3] {
+        [values[self.n - 1], values[self.n - 2], values[self.n - 3]]
+    }
+}
+
+/// What `volray info` shows of one level.
+fn level_info(
+    dir: &Path,
+    level: &Level,
+    array: &ZarrArray,
+    ty: ZarrType,
+    layout: &Layout,
+) -> LevelInfo {
+    let shape = array.shape().to_vec();
+    let dims = layout
+        .xyz(&shape)
+        .map(|d| usize::try_from(d).unwrap_or(usize::MAX));
+    let (chunk, shard) = match (array.is_sharded(), array.subchunk_shape()) {
+        (true, Some(inner)) => (
+            Some(inner.iter().map(|n| n.get()).collect()),
+            chunks::chunk_shape(array),
+        ),
+        _ => (chunks::chunk_shape(array), None),
+    };
+    let volume_values = dims.iter().fold(1u64, |p, &d| p.saturating_mul(d as u64));
+    LevelInfo {
+        path: level.path.clone(),
+        shape,
+        dims,
+        spacing: layout.xyz(&level.scale),
+        origin: layout.xyz(&level.translation),
+        chunk_shape: chunk,
+        shard_shape: shard,
+        codecs: codecs(&serde_json::to_value(array.metadata()).unwrap_or(Value::Null)),
+        bytes_stored: store::stored_bytes(dir),
+        bytes_in_memory: volume_values.saturating_mul(ty.kept_bytes()),
+    }
+}
+
+/// The codecs of an array's metadata, in order, for `volray info`:
+/// `bytes, zstd` (v3), `sharding_indexed(bytes, blosc)`, `blosc (lz4)` (v2).
+fn codecs(meta: &Value) -> String {
+    fn named(list: &[Value]) -> Vec<String> {
+        list.iter()
+            .map(|c| {
+                let name = c.get("name").and_then(Value::as_str).unwrap_or("?");
+                let config = c.get("configuration");
+                match config
+                    .and_then(|c| c.get("codecs"))
+                    .and_then(Value::as_array)
+                {
+                    Some(inner) => format!("{name}({})", named(inner).join(", ")),
+                    None => match config.and_then(|c| c.get("cname")).and_then(Value::as_str) {
+                        Some(cname) => format!("{name} ({cname})"),
+                        None => name.to_string(),
+                    },
+                }
+            })
+            .collect()
+    }
+    if let Some(list) = meta.get("codecs").and_then(Value::as_array) {
+        return named(list).join(", ");
+    }
+    // v2: filters, then the compressor.
+    let mut parts: Vec<String> = meta
+        .get("filters")
+        .and_then(Value::as_array)
+        .map(|f| {
+            f.iter()
+                .filter_map(|c| c.get("id")?.as_str().map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default();
+    if let Some(c) = meta.get("compressor").filter(|c| !c.is_null()) {
+        let id = c.get("id").and_then(Value::as_str).unwrap_or("?");
+        parts.push(match c.get("cname").and_then(Value::as_str) {
+            Some(cname) => format!("{id} ({cname})"),
+            None => id.to_string(),
+        });
+    }
+    if parts.is_empty() {
+        "none".to_string()
+    } else {
+        parts.join(", ")
+    }
+}
