@@ -180,20 +180,5 @@ pub fn fractal_params(a: &FractalArgs) -> FractalParams {
 /// Writes `volume` in the format `path`'s extension names: `.npy`, `.raw`
 /// (little-endian f32, x fastest) or `.nrrd` (with spacing and origin).
 fn write(volume: &Volume, path: &Path) -> Result<(), CliError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("npy") => volray_io::write_npy(path, volume)?,
-        Some("raw") => volray_io::write_raw(path, volume)?,
-        Some("nrrd") => volray_io::write_nrrd(path, volume)?,
-        _ => {
-            return Err(CliError::input(format!(
-                "{}: unknown output format: use .nrrd (keeps spacing and origin), .npy or .raw (f32, little-endian, x fastest)",
-                path.display()
-            )));
-        }
-    }
-    Ok(())
+    crate::convert::write_volume(volume, path, crate::convert::OutputFormat::of(path)?)
 }

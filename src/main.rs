@@ -10,7 +10,8 @@
 //! - one module per subcommand: `render.rs` (one still image, and the
 //!   checks before any work) with `animate.rs` (turntables and series),
 //!   `bench.rs` (with `bench/peers.rs` and `bench/vtk.rs`), `info.rs`,
-//!   `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
+//!   `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
+//!   writes with), `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
 //!   `view/reproduce.rs`: the page's state as a `volray render` command);
 //! - what they share: `input.rs` (reading INPUT), `settings.rs` (the flags
 //!   as volray-core's `RenderSettings`), `session.rs` (loading, the
@@ -30,6 +31,7 @@ mod output;
 
 mod animate;
 mod bench;
+mod convert;
 #[cfg(feature = "mpi")]
 mod distributed;
 mod error;
@@ -70,6 +72,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Info(args) => info::run(args),
+        Command::Convert(args) => convert::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Paper(args) => paper::run(args),
         Command::View(args) => view::run(args),

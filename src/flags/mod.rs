@@ -10,7 +10,7 @@
 //!   (the step, jitter, the path, non-finite values), and `--threads`;
 //! - `output.rs` and `animation.rs`: render's output file, and its
 //!   turntables and series;
-//! - `render.rs`, `bench.rs`, `info.rs`, `generate.rs`, `paper.rs`,
+//! - `render.rs`, `bench.rs`, `info.rs`, `convert.rs`, `generate.rs`, `paper.rs`,
 //!   `viewer.rs` (`volray view`): each subcommand's arguments (`bench.rs`
 //!   also says which groups `--peers` refuses);
 //! - `parse.rs`: the value parsers, and clap's errors on one line.
@@ -18,6 +18,7 @@
 mod animation;
 mod bench;
 mod camera;
+mod convert;
 mod generate;
 mod info;
 mod input;
@@ -32,6 +33,7 @@ mod viewer;
 
 pub use bench::BenchArgs;
 pub use camera::CameraArgs;
+pub use convert::ConvertArgs;
 pub use generate::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 pub use info::InfoArgs;
 pub use input::InputArgs;
@@ -71,6 +73,10 @@ pub enum Command {
     /// Describe a volume: format, dims, spacing, origin, sample type, value
     /// range, a histogram, and what the header said versus what was used.
     Info(InfoArgs),
+    /// Write a volume volray reads to another format: NRRD (keeps spacing
+    /// and origin), .npy or raw, its samples in their type. A volume over
+    /// --max-memory that maps from its file converts in bounded memory.
+    Convert(ConvertArgs),
     /// Write a generated volume to a file: a hydrogen-atom density or a
     /// fractal cloud (the paper's two test data sets).
     Generate(GenerateArgs),

@@ -1,0 +1,242 @@
+//! `volray convert INPUT -o OUT`: a volume volray reads, written as NRRD,
+//! `.npy` or raw in its own sample type, reads back as the same volume
+//! (NRRD with its spacing and origin); numpy and pynrrd read what it
+//! wrote as the same values; a file over `--max-memory` that maps
+//! converts from its mapping; what cannot be converted is refused with a
+//! one-line error and leaves no file.
+
+mod common;
+
+use common::{stderr, volray};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use volray_core::Volume;
+use volray_io::{DType, RawOptions, ReadOptions, read};
+
+fn fixture(dir: &str, name: &str) -> String {
+    let p: PathBuf = [
+        env!("CARGO_MANIFEST_DIR"),
+        "crates/io/tests/fixtures",
+        dir,
+        name,
+    ]
+    .iter()
+    .collect();
+    p.to_str().unwrap().to_string()
+}
+
+fn read_volume(path: &Path) -> Volume {
+    read(path, &ReadOptions::default()).unwrap().volume
+}
+
+fn convert(args: &[&str]) -> std::process::Output {
+    let mut all = vec!["convert"];
+    all.extend(args);
+    volray(&all)
+}
+
+/// A `u16` NIfTI and an LPS NRRD (flipped axes, read reordered) to each
+/// format: the same samples in the same type, NRRD keeping the geometry.
+#[test]
+fn a_converted_volume_reads_back_as_the_volume_read() {
+    let dir = tempfile::tempdir().unwrap();
+    for input in [
+        fixture("nifti", "u16.nii"),
+        fixture("nifti", "flipped.nii"),
+        fixture("nrrd", "i8.nrrd"),
+    ] {
+        let original = read_volume(Path::new(&input));
+        let nrrd = dir.path().join("v.nrrd");
+        let run = convert(&[&input, "-o", nrrd.to_str().unwrap()]);
+        assert!(run.status.success(), "{input}: {}", stderr(&run));
+        assert!(stderr(&run).contains("wrote"), "{}", stderr(&run));
+        assert_eq!(read_volume(&nrrd), original, "{input} as NRRD");
+
+        let npy = dir.path().join("v.npy");
+        assert!(
+            convert(&[&input, "-o", npy.to_str().unwrap()])
+                .status
+                .success()
+        );
+        let back = read_volume(&npy);
+        assert_eq!(
+            back.sample_type(),
+            original.sample_type(),
+            "{input} as .npy"
+        );
+        assert_eq!(back.values(), original.values(), "{input} as .npy");
+
+        let raw = dir.path().join("v.raw");
+        let run = convert(&[&input, "-o", raw.to_str().unwrap()]);
+        assert!(run.status.success());
+        let t = original.sample_type().name();
+        let [nx, ny, nz] = original.dims();
+        let said = format!("--dims {nx},{ny},{nz} --dtype {t} --endian little");
+        assert!(stderr(&run).contains(&said), "{}", stderr(&run));
+        let opts = ReadOptions {
+            raw: Some(RawOptions::new([nx, ny, nz], t.parse::<DType>().unwrap())),
+            ..ReadOptions::default()
+        };
+        assert_eq!(
+            read(&raw, &opts).unwrap().volume.values(),
+            original.values()
+        );
+    }
+}
+
+/// numpy and pynrrd (target/pyenv, as `.ci/run` makes it) read volray's
+/// `.npy` and NRRD as the voxels volray read: shape, dtype, every value
+/// at `a[x, y, z]`, and NRRD's spacing and origin.
+#[test]
+fn numpy_and_pynrrd_read_what_convert_wrote() {
+    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
+    let has = Command::new(&python)
+        .args(["-c", "import numpy, nrrd"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "target/pyenv with numpy and pynrrd is needed (.ci/run makes it)"
+        );
+        eprintln!("skipped: target/pyenv has no numpy and pynrrd (.ci/run makes it)");
+        return;
+    }
+    for name in ["flipped.nii", "u16.nii"] {
+        python_reads(&python, &fixture("nifti", name));
+    }
+}
+
+/// numpy and pynrrd read `input` converted as volray reads it.
+fn python_reads(python: &Path, input: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let original = read_volume(Path::new(input));
+    let npy = dir.path().join("v.npy");
+    let nrrd = dir.path().join("v.nrrd");
+    for out in [&npy, &nrrd] {
+        assert!(
+            convert(&[input, "-o", out.to_str().unwrap()])
+                .status
+                .success()
+        );
+    }
+    // volray's own values, x fastest, for Python to compare with.
+    let expect = dir.path().join("expect.txt");
+    let text: Vec<String> = original.values().iter().map(|v| format!("{v}")).collect();
+    std::fs::write(&expect, text.join("\n")).unwrap();
+    let [nx, ny, nz] = original.dims();
+    let (s, o) = (original.spacing(), original.origin());
+    let script = format!(
+        r#"
+import sys, numpy as np, nrrd
+expect = np.loadtxt(sys.argv[3]).reshape(({nz}, {ny}, {nx})).transpose(2, 1, 0)
+a = np.load(sys.argv[1])
+assert a.shape == ({nx}, {ny}, {nz}), a.shape
+assert a.dtype == np.dtype("{dtype}"), a.dtype
+assert np.array_equal(a.astype(np.float64), expect), "npy values"
+b, h = nrrd.read(sys.argv[2])
+assert b.shape == ({nx}, {ny}, {nz}), b.shape
+assert b.dtype == np.dtype("{dtype}"), b.dtype
+assert np.array_equal(b.astype(np.float64), expect), "nrrd values"
+assert np.allclose(np.diag(h["space directions"]), [{sx}, {sy}, {sz}], rtol=0, atol=1e-12), h
+assert np.allclose(h["space origin"], [{ox}, {oy}, {oz}], rtol=0, atol=1e-9), h
+print("ok")
+"#,
+        dtype = match original.sample_type() {
+            volray_core::SampleType::U8 => "uint8",
+            volray_core::SampleType::I8 => "int8",
+            volray_core::SampleType::U16 => "uint16",
+            volray_core::SampleType::I16 => "int16",
+            volray_core::SampleType::F32 => "float32",
+        },
+        sx = s.x,
+        sy = s.y,
+        sz = s.z,
+        ox = o.x,
+        oy = o.y,
+        oz = o.z,
+    );
+    let out = Command::new(python)
+        .args(["-c", &script])
+        .args([&npy, &nrrd, &expect])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success() && String::from_utf8_lossy(&out.stdout).trim() == "ok",
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A raw file over `--max-memory` maps and converts from its mapping (read
+/// whole it would be refused: the limit is a tenth of it); a compressed
+/// one over the limit is refused, with the reason, and writes nothing.
+#[test]
+fn a_file_over_the_memory_limit_converts_from_its_mapping_or_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 40usize;
+    let values: Vec<u16> = (0..n * n * n).map(|i| (i * 7 % 65521) as u16).collect();
+    let raw = dir.path().join("big.raw");
+    std::fs::write(
+        &raw,
+        values
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    )
+    .unwrap();
+    let out = dir.path().join("big.nrrd");
+    let run = convert(&[
+        raw.to_str().unwrap(),
+        "--dims",
+        "40,40,40",
+        "--dtype",
+        "u16",
+        "--max-memory",
+        "12K",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let back = read_volume(&out);
+    assert_eq!(back.sample_type(), volray_core::SampleType::U16);
+    let expect: Vec<f32> = values.iter().map(|&v| f32::from(v)).collect();
+    assert_eq!(back.values(), expect);
+
+    let gz = fixture("nrrd", "u8_gzip.nrrd");
+    let refused = dir.path().join("gz.npy");
+    let run = convert(&[&gz, "--max-memory", "10", "-o", refused.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert!(
+        stderr(&run).contains("cannot be mapped"),
+        "{}",
+        stderr(&run)
+    );
+    assert_eq!(stderr(&run).lines().count(), 1, "{}", stderr(&run));
+    assert!(!refused.exists());
+}
+
+#[test]
+fn an_unknown_format_or_the_input_itself_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = fixture("nifti", "u16.nii");
+    let out = dir.path().join("v.png");
+    let run = convert(&[&input, "-o", out.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(
+        stderr(&run).contains("unknown output format"),
+        "{}",
+        stderr(&run)
+    );
+    assert!(!out.exists());
+    // The input itself, by another name: refused before reading.
+    let copy = dir.path().join("u16.npy");
+    std::fs::copy(&input, dir.path().join("keep.nii")).unwrap();
+    std::fs::hard_link(dir.path().join("keep.nii"), &copy).unwrap();
+    let keep = dir.path().join("keep.nii");
+    let before = std::fs::read(&keep).unwrap();
+    let run = convert(&[keep.to_str().unwrap(), "-o", copy.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert_eq!(std::fs::read(&keep).unwrap(), before);
+}
