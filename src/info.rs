@@ -200,6 +200,30 @@ fn print_stored(i: &FileInfo) {
             i.frames
         );
     }
+    if !i.levels.is_empty() {
+        outln!(
+            "levels:    {} (read: {}; --level picks another)",
+            i.levels.len(),
+            i.level
+        );
+        let shape = |s: &Option<Vec<u64>>| {
+            s.as_ref().map_or("-".to_string(), |s| {
+                s.iter().map(u64::to_string).collect::<Vec<_>>().join("x")
+            })
+        };
+        for (n, l) in i.levels.iter().enumerate() {
+            let [x, y, z] = l.dims;
+            let [sx, sy, sz] = l.spacing;
+            outln!(
+                "  {n}: {x} x {y} x {z}, spacing {sx}, {sy}, {sz}; chunks {}, shards {}; codecs {}; {} stored, {} in memory",
+                shape(&l.chunk_shape),
+                shape(&l.shard_shape),
+                l.codecs,
+                volray_io::format_bytes(u128::from(l.bytes_stored)),
+                volray_io::format_bytes(u128::from(l.bytes_in_memory))
+            );
+        }
+    }
     if !i.arrays.is_empty() {
         outln!(
             "arrays:    {} (read: {}; --array picks another)",
@@ -240,4 +264,24 @@ fn add_file_json(out: &mut Value, i: &FileInfo) {
     );
     out["notes"] = json!(i.notes);
     out["nan_is_empty"] = json!(i.nan_is_empty);
+    // Multiscale images (OME-Zarr): every level; the keys above describe
+    // the one read.
+    out["level"] = json!(i.level);
+    out["levels"] = json!(
+        i.levels
+            .iter()
+            .map(|l| json!({
+                "path": l.path,
+                "shape": l.shape,
+                "dims": l.dims,
+                "spacing": l.spacing,
+                "origin": l.origin,
+                "chunk_shape": l.chunk_shape,
+                "shard_shape": l.shard_shape,
+                "codecs": l.codecs,
+                "bytes_stored": l.bytes_stored,
+                "bytes_in_memory": l.bytes_in_memory,
+            }))
+            .collect::<Vec<_>>()
+    );
 }

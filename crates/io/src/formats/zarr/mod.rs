@@ -310,7 +310,11 @@ fn codecs(meta: &Value) -> String {
     fn named(list: &[Value]) -> Vec<String> {
         list.iter()
             .map(|c| {
-                let name = c.get("name").and_then(Value::as_str).unwrap_or("?");
+                // A codec without configuration may be its bare name.
+                let name = c
+                    .as_str()
+                    .or_else(|| c.get("name").and_then(Value::as_str))
+                    .unwrap_or("?");
                 let config = c.get("configuration");
                 match config
                     .and_then(|c| c.get("codecs"))
