@@ -351,4 +351,14 @@ fn a_zarr_directory_is_known_by_its_metadata_not_its_name() {
     let empty = tempfile::tempdir().unwrap();
     let (text, _) = refused(empty.path(), &ReadOptions::default());
     assert!(text.to_lowercase().contains("dicom"), "{text}");
+    // A `.zarr` directory missing its metadata says so.
+    let bare = empty.path().join("scan.zarr");
+    fs::create_dir(&bare).unwrap();
+    let (text, _) = refused(&bare, &ReadOptions::default());
+    assert!(
+        text.ends_with(
+            "not a Zarr group or array: no zarr.json (v3), .zarray, .zgroup or .zattrs (v2)"
+        ),
+        "{text}"
+    );
 }
