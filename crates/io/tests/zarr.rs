@@ -81,8 +81,9 @@ fn assert_same_values(loaded: &Loaded, npy: &Path) {
     assert_eq!(differ, None, "{}: first differing index", npy.display());
 }
 
-const PLAIN: [&str; 6] = [
+const PLAIN: [&str; 7] = [
     "v2_gzip",
+    "v2_forder",
     "v2_blosc",
     "v2_zstd_u16",
     "v3_zstd",
@@ -111,6 +112,7 @@ fn every_value_of_each_plain_zarr_array_equals_the_writers() {
     assert_eq!(format!("{:?}", kept("v2_gzip")), "I16");
     assert_eq!(format!("{:?}", kept("v3_sharded_blosc")), "U8");
     assert_eq!(format!("{:?}", kept("v3_gzip_f64")), "F32");
+    assert_eq!(format!("{:?}", kept("v2_forder")), "I8");
 }
 
 #[test]

@@ -59,6 +59,9 @@ plain("v2_blosc", (4, 5, 9), (3, 3, 3), "float32", 2, 2,
       compressors=numcodecs.Blosc(cname="lz4", clevel=5, shuffle=numcodecs.Blosc.SHUFFLE))
 plain("v2_zstd_u16", (3, 4, 5), (2, 2, 2), "uint16", 2, 3,
       compressors=numcodecs.Zstd(level=3))
+# Fortran order: zarrs reads it through the transpose codec.
+plain("v2_forder", (3, 4, 5), (2, 3, 2), "int8", 2, 9, order="F",
+      compressors=numcodecs.Zstd(level=1))
 plain("v3_zstd", (5, 6, 7), (2, 3, 4), "uint16", 3, 4, fill=9, hole=True,
       compressors=ZstdCodec(level=3))
 plain("v3_gzip_f64", (3, 4, 6), (3, 4, 6), "float64", 3, 5,
