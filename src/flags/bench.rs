@@ -120,8 +120,9 @@ mod tests {
             .collect();
         // The 41 flags of the list this replaced (all but INPUT of the
         // input options, and all but --threads of the view options), and
-        // --labels, --label-opacity and --show-labels since.
-        assert_eq!(flags.len(), 44);
+        // --labels, --label-opacity, --show-labels, --level and --channel
+        // since.
+        assert_eq!(flags.len(), 46);
         for arg in flags {
             let given = given(arg);
             let given: Vec<&str> = given.iter().map(String::as_str).collect();
