@@ -205,14 +205,17 @@ impl Volume {
     }
 }
 
-/// `read(path, *, format=None, frame=None, array=None, dims=None,
-/// dtype=None, endian=None, spacing=None, max_memory=None)`: the volume
+/// `read(path, *, format=None, frame=None, array=None, level=None,
+/// channel=None, dims=None, dtype=None, endian=None, spacing=None,
+/// max_memory=None)`: the volume
 /// in a file of any format volray reads (or a built-in source such as
 /// `"hydrogen:4,2,1"`), its samples moved into a numpy array without a
-/// copy, read-only (`volume.data.copy()` is a writeable copy). `dims`,
-/// `dtype` and `endian` describe a raw file.
+/// copy, read-only (`volume.data.copy()` is a writeable copy). `level`
+/// and `channel` pick a level and a channel of an OME-Zarr image (the
+/// command line's `--level` and `--channel`; 0 by default), `frame` its
+/// time point. `dims`, `dtype` and `endian` describe a raw file.
 #[pyfunction]
-#[pyo3(signature = (path, *, format=None, frame=None, array=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
+#[pyo3(signature = (path, *, format=None, frame=None, array=None, level=None, channel=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn read(
     py: Python<'_>,
@@ -220,6 +223,8 @@ pub fn read(
     format: Option<&str>,
     frame: Option<usize>,
     array: Option<String>,
+    level: Option<usize>,
+    channel: Option<usize>,
     dims: Option<[usize; 3]>,
     dtype: Option<&str>,
     endian: Option<&str>,
@@ -229,6 +234,11 @@ pub fn read(
     let spec = path.to_string_lossy().to_string();
     let max_memory = max_memory.unwrap_or_else(volray_io::default_max_memory);
     let (volume, file) = if volray_data::is_source_spec(&spec) {
+        if level.is_some() || channel.is_some() {
+            return Err(value_error(format!(
+                "{spec}: level and channel pick a level and a channel of an OME-Zarr image, not of a built-in source"
+            )));
+        }
         let volume = py
             .detach(|| volray_data::generate(&spec))
             .map_err(|e| value_error(e.to_string()))?;
@@ -263,8 +273,8 @@ pub fn read(
             raw,
             frame,
             array,
-            level: None,
-            channel: None,
+            level,
+            channel,
             max_memory,
             // The samples move into a numpy array, which owns its memory.
             map: MapPolicy::Never,

@@ -204,6 +204,8 @@ def read(
     format: Optional[str] = None,
     frame: Optional[int] = None,
     array: Optional[str] = None,
+    level: Optional[int] = None,
+    channel: Optional[int] = None,
     dims: Optional[Tuple[int, int, int]] = None,
     dtype: Optional[str] = None,
     endian: Optional[Literal["little", "big"]] = None,
