@@ -147,6 +147,34 @@ impl Volume {
         self.sample.name()
     }
 
+    /// The resolution levels of the multiscale image (OME-Zarr) this
+    /// volume is one level of, finest first, each a dict: `path`, `dims`
+    /// (x, y, z), `spacing`, `origin`, `chunk_shape` and `shard_shape`
+    /// (in the array's axis order), `codecs`, `bytes_stored` (its chunk
+    /// files) and `bytes_in_memory` (one time point and channel); empty
+    /// for a file with one level, an array or a built-in source.
+    /// `volray.read(path, level=N)` reads level N.
+    #[getter]
+    fn levels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let levels = PyList::empty(py);
+        if let Some((_, info)) = &self.file {
+            for l in &info.levels {
+                let d = PyDict::new(py);
+                d.set_item("path", &l.path)?;
+                d.set_item("dims", (l.dims[0], l.dims[1], l.dims[2]))?;
+                d.set_item("spacing", (l.spacing[0], l.spacing[1], l.spacing[2]))?;
+                d.set_item("origin", (l.origin[0], l.origin[1], l.origin[2]))?;
+                d.set_item("chunk_shape", l.chunk_shape.clone())?;
+                d.set_item("shard_shape", l.shard_shape.clone())?;
+                d.set_item("codecs", &l.codecs)?;
+                d.set_item("bytes_stored", l.bytes_stored)?;
+                d.set_item("bytes_in_memory", l.bytes_in_memory)?;
+                levels.append(d)?;
+            }
+        }
+        Ok(levels)
+    }
+
     /// What `volray info` says of the volume: its format, dims, sample
     /// type, spacing, origin, value statistics, and for a file the type
     /// stored, frames, arrays, header fields and the notes on how it was

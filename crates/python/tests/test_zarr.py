@@ -46,6 +46,14 @@ def test_read_takes_a_level_a_channel_and_a_time_point(stores, name):
     assert full.origin == pytest.approx((1.5, -3.0, 10.0))
     assert coarse.spacing == pytest.approx((0.5, 1.0, 2.0))
     assert coarse.origin == pytest.approx((1.625, -2.75, 10.0))
+    # Every level is listed, whichever was read, as read at that level.
+    for v in (full, coarse):
+        assert [lv["dims"] for lv in v.levels] == [full.data.shape, coarse.data.shape]
+        assert v.levels[1]["spacing"] == pytest.approx(coarse.spacing)
+        assert v.levels[1]["origin"] == pytest.approx(coarse.origin)
+        assert v.levels[0]["bytes_stored"] > 0
+        assert v.levels[0]["bytes_in_memory"] == full.data.nbytes
+    assert volray.read("hydrogen:2,1,0,grid=20").levels == []
 
 
 def test_a_level_or_channel_out_of_range_or_on_a_source_raises(stores):
