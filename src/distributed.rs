@@ -562,7 +562,7 @@ impl CliSource {
         let volume = whole.len() as u128 * sample;
         let need = volume + own + largest_out;
         if need > u128::from(self.max_memory) {
-            let how = if self.generate.is_some() || volray_data::is_source_spec(&self.name) {
+            let how = if volray_data::is_source_spec(&self.name) {
                 "generates the fractal whole"
             } else {
                 "reads the file whole (its format cannot be read by range)"

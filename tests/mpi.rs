@@ -115,6 +115,25 @@ fn with_output<'a>(args: &[&'a str], out: &'a str) -> Vec<&'a str> {
     v
 }
 
+/// Renders `args` in one process, then under `mpirun` at each of
+/// `counts` ranks: every run succeeds and its image is within one 8-bit
+/// level of the one process's. The ranks' stderr, for more checks.
+fn ranks_match_one_process(dir: &Path, what: &str, args: &[&str], counts: &[usize]) -> Vec<String> {
+    let one = dir.join("one.png");
+    single(&with_output(args, one.to_str().unwrap()));
+    let mut stderrs = Vec::new();
+    for &n in counts {
+        let out = dir.join(format!("{n}.png"));
+        let run = ranks(n, &with_output(args, out.to_str().unwrap()));
+        let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+        assert!(run.status.success(), "{what}, {n} ranks: {stderr}");
+        let diff = largest_difference(&one, &out);
+        assert!(diff <= 1, "{what}, {n} ranks: {diff} levels");
+        stderrs.push(stderr);
+    }
+    stderrs
+}
+
 #[test]
 fn one_to_four_ranks_render_the_one_process_image_within_a_level() {
     if mpirun().is_none() {
@@ -170,19 +189,7 @@ fn one_to_four_ranks_render_the_one_process_image_within_a_level() {
     for (name, args) in cases {
         let mut args = args.to_vec();
         args.extend(["--size", "96x80"]);
-        let one = dir.path().join("one.png");
-        single(&with_output(&args, one.to_str().unwrap()));
-        for n in 1..=4 {
-            let out = dir.path().join(format!("{n}.png"));
-            let run = ranks(n, &with_output(&args, out.to_str().unwrap()));
-            assert!(
-                run.status.success(),
-                "{name}, {n} ranks: {}",
-                String::from_utf8_lossy(&run.stderr)
-            );
-            let diff = largest_difference(&one, &out);
-            assert!(diff <= 1, "{name}, {n} ranks: {diff} levels");
-        }
+        ranks_match_one_process(dir.path(), name, &args, &[1, 2, 3, 4]);
     }
 }
 
@@ -465,20 +472,12 @@ fn files_whose_axes_are_reordered_render_as_one_process() {
             "--elevation",
             "25",
         ];
-        let one = dir.path().join("one.png");
-        single(&with_output(&args, one.to_str().unwrap()));
-        for n in 1..=4 {
-            let out = dir.path().join(format!("{n}.png"));
-            let run = ranks(n, &with_output(&args, out.to_str().unwrap()));
-            let stderr = String::from_utf8_lossy(&run.stderr);
-            assert!(run.status.success(), "{file}, {n} ranks: {stderr}");
+        for stderr in ranks_match_one_process(dir.path(), file, &args, &[1, 2, 3, 4]) {
             // Read by range, not by rank 0 and sent.
             assert!(
                 !stderr.contains("cannot be read by range"),
                 "{file}: {stderr}"
             );
-            let diff = largest_difference(&one, &out);
-            assert!(diff <= 1, "{file}, {n} ranks: {diff} levels");
         }
     }
 }
@@ -503,16 +502,7 @@ fn label_volumes_render_as_one_process() {
     for case in cases {
         let mut args = vec![seg, "--size", "64x64", "--elevation", "30"];
         args.extend(case);
-        let one = dir.path().join("one.png");
-        single(&with_output(&args, one.to_str().unwrap()));
-        for n in [2, 3] {
-            let out = dir.path().join(format!("{n}.png"));
-            let run = ranks(n, &with_output(&args, out.to_str().unwrap()));
-            let stderr = String::from_utf8_lossy(&run.stderr);
-            assert!(run.status.success(), "{case:?}, {n} ranks: {stderr}");
-            let diff = largest_difference(&one, &out);
-            assert!(diff <= 1, "{case:?}, {n} ranks: {diff} levels");
-        }
+        ranks_match_one_process(dir.path(), &format!("{case:?}"), &args, &[2, 3]);
     }
     let out = dir.path().join("cloud.png");
     let single_refusal = Command::new(env!("CARGO_BIN_EXE_volray"))
