@@ -701,7 +701,20 @@ impl Source for CliSource {
         self.grid
     }
 
-    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    /// The mapped file's type; generated and sent pieces, and values on
+    /// the log scale, are `f32`.
+    fn sample_type(&self) -> SampleType {
+        match (&self.whole, self.log) {
+            (Some(whole), false) => whole.sample_type(),
+            _ => SampleType::F32,
+        }
+    }
+
+    fn is_labels(&self) -> bool {
+        self.labels
+    }
+
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
         let piece = self.raw_piece(lo, hi)?;
         let mut piece = match self.log_floor {
             Some(smallest) => piece.to_log10_above(smallest),

@@ -118,5 +118,5 @@ pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;
 pub use volume::{
     External, ExternalBytes, ExternalError, Sample, SampleType, Samples, Store, Volume,
-    VolumeError, checked_point_count,
+    VolumeError, VolumeSource, check_box, checked_point_count,
 };

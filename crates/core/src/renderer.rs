@@ -392,23 +392,12 @@ impl<'v> Renderer<'v> {
 
     /// The classifier `settings` describe for this volume.
     pub(crate) fn classifier(&self, settings: &RenderSettings) -> Classifier {
-        let mut classifier = Classifier::from_transfer_function(
-            &settings.transfer_function,
+        Classifier::for_frame(
+            settings,
             self.value_range_of(settings),
-            settings.opacity_ramp,
-            settings.step as f32,
-        );
-        if let Some(iso) = settings.iso {
-            let voxel_size = self.volume.spacing().min_element() as f32;
-            classifier = classifier.with_iso(iso, voxel_size, self.max_gradient_of(settings));
-        }
-        if let Some(range) = settings.gradient_opacity {
-            let max = settings
-                .gradient_opacity_max
-                .unwrap_or_else(|| self.max_gradient_of(settings));
-            classifier = classifier.with_gradient_opacity(range, max);
-        }
-        classifier
+            self.volume.spacing().min_element() as f32,
+            || self.max_gradient_of(settings),
+        )
     }
 
     /// The volume's min/max bricks, found on the first frame that needs them.

@@ -21,30 +21,10 @@ use volray_core::{
     Volume, with_samples,
 };
 
-/// Where a rank's piece comes from.
-pub trait Source {
-    /// The whole volume's grid.
-    fn grid(&self) -> GridFrame;
-    /// The voxels `lo..hi` (half-open) of the whole grid as a volume: a
-    /// one-line error naming the file and the problem if they cannot be
-    /// read, or do not fit this rank's memory.
-    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String>;
-}
-
-/// A volume in memory is a source of its boxes.
-impl Source for Volume {
-    fn grid(&self) -> GridFrame {
-        GridFrame {
-            dims: self.dims(),
-            origin: self.origin(),
-            spacing: self.spacing(),
-        }
-    }
-
-    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
-        Ok(self.sub_box(lo, hi))
-    }
-}
+/// Where a rank's piece comes from: volray-core's one interface to
+/// voxels, box by box (a volume in memory, a mapped file, a chunked
+/// store).
+pub use volray_core::VolumeSource as Source;
 
 /// Why a distributed frame failed: the same on every rank.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -199,7 +179,7 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
         let read = if owned_box.is_empty() {
             Ok(None)
         } else {
-            (source.read(lo, hi))
+            (source.read_box(lo, hi))
                 .and_then(|v| {
                     Renderer::owning(v, non_finite).map_err(|e| format!("its piece: {e}"))
                 })
@@ -488,7 +468,7 @@ fn blank(settings: &RenderSettings) -> PartialImage {
 
 /// The largest gradient magnitude at the owned voxels of a piece held
 /// from whole-grid voxel `offset`.
-fn owned_max_gradient(
+pub(crate) fn owned_max_gradient(
     volume: &Volume,
     offset: [usize; 3],
     (lo, hi): ([usize; 3], [usize; 3]),

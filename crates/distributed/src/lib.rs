@@ -46,5 +46,6 @@ pub mod kd;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 pub mod schedule;
+pub mod streamed;
 pub mod transport;
 pub mod wire;

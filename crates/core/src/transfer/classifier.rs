@@ -131,6 +131,35 @@ impl Classifier {
         Classifier::new(domain, opacity, tf.color.clone(), step_voxels)
     }
 
+    /// The classifier a frame of `settings` uses for a volume whose values
+    /// span `value_range` (the transfer function's domain when it names
+    /// none), whose smallest spacing is `voxel_size`, and whose largest
+    /// gradient magnitude `max_gradient` gives (asked only for an
+    /// iso-surface or gradient opacity without its own maximum): one
+    /// definition for a renderer and for a renderer of pieces deciding
+    /// which pieces to read.
+    pub fn for_frame(
+        settings: &crate::RenderSettings,
+        value_range: (f32, f32),
+        voxel_size: f32,
+        max_gradient: impl Fn() -> f32,
+    ) -> Self {
+        let mut classifier = Classifier::from_transfer_function(
+            &settings.transfer_function,
+            value_range,
+            settings.opacity_ramp,
+            settings.step as f32,
+        );
+        if let Some(iso) = settings.iso {
+            classifier = classifier.with_iso(iso, voxel_size, max_gradient());
+        }
+        if let Some(range) = settings.gradient_opacity {
+            let max = settings.gradient_opacity_max.unwrap_or_else(&max_gradient);
+            classifier = classifier.with_gradient_opacity(range, max);
+        }
+        classifier
+    }
+
     /// The normalised scalar `t` of value `f`.
     #[inline]
     pub fn normalise(&self, f: f32) -> f32 {

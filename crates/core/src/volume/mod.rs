@@ -9,9 +9,11 @@
 //! decades on a log scale.
 
 mod samples;
+mod source;
 mod store;
 
 pub use samples::{Sample, SampleType, Samples};
+pub use source::{VolumeSource, check_box};
 pub use store::{External, ExternalBytes, ExternalError, Store};
 
 use glam::DVec3;

@@ -1,0 +1,253 @@
+//! Out-of-core frames: a volume rendered piece by piece from its source
+//! under a memory budget gives the frame one process renders from the
+//! whole volume, within 1/255 per channel, for every case the ranks are
+//! held to; it reads no piece that is transparent or hidden; no piece it
+//! reads is larger than the budget allows; and a failed read is an error.
+
+use std::sync::Arc;
+use std::sync::Mutex;
+use volray_core::glam::DVec3;
+use volray_core::sampling::grid::GridFrame;
+use volray_core::{
+    Histogram, MemoryBound, NonFinite, RenderSettings, Renderer, SampleType, TransferFunction,
+    Volume, VolumeSource,
+};
+use volray_distributed::streamed::{StreamError, Streamed};
+
+mod common;
+use common::{cases, colorful, volume};
+
+/// A volume that records every box read from it.
+struct Counted {
+    volume: Volume,
+    reads: Mutex<Vec<([usize; 3], [usize; 3])>>,
+}
+
+impl Counted {
+    fn new(volume: Volume) -> Arc<Counted> {
+        Arc::new(Counted {
+            volume,
+            reads: Mutex::new(Vec::new()),
+        })
+    }
+
+    fn take(&self) -> Vec<([usize; 3], [usize; 3])> {
+        std::mem::take(&mut self.reads.lock().unwrap())
+    }
+}
+
+impl VolumeSource for Counted {
+    fn grid(&self) -> GridFrame {
+        self.volume.grid()
+    }
+    fn sample_type(&self) -> SampleType {
+        self.volume.sample_type()
+    }
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        self.reads.lock().unwrap().push((lo, hi));
+        self.volume.read_box(lo, hi)
+    }
+}
+
+/// A budget for frames of `settings` of `volume` in about `share` pieces:
+/// two frames (the pieces' partial images composited) and a `share`th of
+/// the rest of the bound on a frame of all of it, with no cache.
+fn budget(volume: &Volume, settings: &RenderSettings, share: u64) -> u64 {
+    let b = MemoryBound::for_volume(volume, settings, NonFinite::Refuse, 0);
+    (2 * b.frame + (b.total() - b.frame) / u128::from(share)) as u64
+}
+
+/// Settings for a frame small beside the volume.
+fn small() -> RenderSettings {
+    RenderSettings {
+        width: 24,
+        height: 24,
+        ..RenderSettings::default()
+    }
+}
+
+#[test]
+fn frames_rendered_piece_by_piece_equal_the_whole_volumes_within_a_level() {
+    let volume = volume();
+    let renderer = Renderer::new(&volume).unwrap();
+    let mut worst: f32 = 0.0;
+    for (name, settings) in cases() {
+        // Frames small beside the volume, so that its pieces are what the
+        // budget divides.
+        let settings = RenderSettings {
+            width: 32,
+            height: 28,
+            ..settings
+        };
+        let single = renderer.render(&settings).unwrap();
+        let mut seen = Vec::new();
+        for share in [1, 2, 4] {
+            let budget = budget(&volume, &settings, share);
+            let source = Counted::new(volume.clone());
+            let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+            let (frame, times) = streamed.render(&settings, &|_| {}).unwrap();
+            let diff = frame.max_abs_diff(&single).unwrap();
+            worst = worst.max(diff);
+            assert!(
+                diff <= 1.0 / 255.0,
+                "{name}, {} pieces: {diff}",
+                times.pieces
+            );
+            // No piece read is over the budget's bound.
+            for (lo, hi) in source.take() {
+                let dims = std::array::from_fn(|a| hi[a] - lo[a]);
+                let piece = Volume::from_fn(dims, volume.spacing(), DVec3::ZERO, |_| 0.0).unwrap();
+                assert!(
+                    MemoryBound::for_volume(&piece, &settings, NonFinite::Refuse, 0).total()
+                        <= u128::from(budget),
+                    "{name}: a piece of {dims:?} over {budget} bytes"
+                );
+            }
+            seen.push(times.pieces);
+        }
+        assert!(
+            seen[0] == 1 && seen[1] > 1 && seen[2] > seen[1],
+            "{name}: pieces {seen:?}"
+        );
+    }
+    println!("largest difference from the whole volume: {worst:e}");
+}
+
+#[test]
+fn transparent_pieces_are_not_read_once_their_range_is_known() {
+    // One blob in a corner of a 40³ grid, zero elsewhere, under a transfer
+    // function with its own domain in which zero is transparent.
+    let volume = Volume::from_fn([40; 3], DVec3::ONE, DVec3::ZERO, |p| {
+        (1.0 - (p - DVec3::splat(8.0)).length() / 6.0).max(0.0) as f32
+    })
+    .unwrap();
+    let mut tf = colorful();
+    tf.domain = Some((0.0, 1.0));
+    let settings = RenderSettings {
+        width: 48,
+        height: 48,
+        transfer_function: tf,
+        ..RenderSettings::default()
+    };
+    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let source = Counted::new(volume.clone());
+    let budget = budget(&volume, &settings, 10);
+    let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+    let (first, t1) = streamed.render(&settings, &|_| {}).unwrap();
+    // The domain is given: no pass for statistics, every piece read once.
+    assert_eq!(t1.statistics_pieces, 0);
+    assert_eq!(source.take().len(), t1.read_pieces);
+    let (second, t2) = streamed.render(&settings, &|_| {}).unwrap();
+    let reads = source.take();
+    assert_eq!(reads.len(), t2.read_pieces);
+    assert!(
+        t2.read_pieces >= 1 && t2.read_pieces * 4 <= t2.pieces,
+        "read {} of {} pieces",
+        t2.read_pieces,
+        t2.pieces
+    );
+    // Only pieces near the blob: every box read starts within its reach.
+    assert!(
+        reads.iter().all(|(lo, _)| lo.iter().all(|&i| i <= 15)),
+        "{reads:?}"
+    );
+    assert!(first.max_abs_diff(&single).unwrap() <= 1.0 / 255.0);
+    assert_eq!(first, second);
+}
+
+#[test]
+fn pieces_behind_an_opaque_wall_are_not_read() {
+    // The default camera looks along -x: a slab at high x is in front,
+    // opaque enough to stop every ray; the volume behind it varies, so it
+    // is not transparent.
+    let volume = Volume::from_fn([64, 32, 32], DVec3::ONE, DVec3::ZERO, |p| {
+        if p.x > 52.0 {
+            1.0
+        } else {
+            0.5 + 0.3 * (p.y * 0.3).sin() as f32
+        }
+    })
+    .unwrap();
+    let tf = TransferFunction::from_json(
+        r#"{"domain": [0, 1], "opacity": [[0, 0], [0.2, 0.3], [1, 1]]}"#,
+    )
+    .unwrap();
+    let settings = RenderSettings {
+        width: 40,
+        height: 40,
+        transfer_function: tf,
+        ..RenderSettings::default()
+    };
+    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let source = Counted::new(volume.clone());
+    let budget = budget(&volume, &settings, 6);
+    let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+    let (frame, times) = streamed.render(&settings, &|_| {}).unwrap();
+    assert!(frame.max_abs_diff(&single).unwrap() <= 1.0 / 255.0);
+    let reads = source.take();
+    assert!(times.pieces >= 4, "{times:?}");
+    assert!(
+        times.read_pieces < times.pieces,
+        "every piece read: {reads:?}"
+    );
+}
+
+#[test]
+fn the_histogram_counted_by_pieces_is_the_whole_volumes() {
+    let volume = volume();
+    let settings = small();
+    let budget = budget(&volume, &settings, 6);
+    let mut streamed = Streamed::new(Arc::new(volume.clone()), NonFinite::Refuse, budget);
+    streamed.render(&settings, &|_| {}).unwrap();
+    assert!(streamed.pieces() > 1);
+    let pieces = streamed.histogram(64).unwrap().unwrap();
+    let whole = Histogram::of(&volume, 64).unwrap();
+    assert_eq!((pieces.min, pieces.max), (whole.min, whole.max));
+    assert_eq!(pieces.counts, whole.counts);
+    assert!((pieces.mean - whole.mean).abs() < 1e-9 * whole.mean.abs().max(1.0));
+}
+
+/// A source whose reads past x = 0 fail.
+struct Failing(Volume);
+
+impl VolumeSource for Failing {
+    fn grid(&self) -> GridFrame {
+        self.0.grid()
+    }
+    fn sample_type(&self) -> SampleType {
+        self.0.sample_type()
+    }
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        if lo[0] > 0 {
+            return Err("scan.zarr: chunk c/0/0/1 is truncated".into());
+        }
+        self.0.read_box(lo, hi)
+    }
+}
+
+#[test]
+fn a_failed_read_fails_the_frame_with_the_sources_message() {
+    let volume = volume();
+    let settings = small();
+    let budget = budget(&volume, &settings, 6);
+    let mut streamed = Streamed::new(Arc::new(Failing(volume)), NonFinite::Refuse, budget);
+    match streamed.render(&settings, &|_| {}) {
+        Err(e) => assert_eq!(
+            e,
+            StreamError::Read("scan.zarr: chunk c/0/0/1 is truncated".into())
+        ),
+        Ok((_, times)) => panic!("rendered: {times:?}"),
+    }
+}
+
+#[test]
+fn a_budget_too_small_for_any_piece_is_refused() {
+    let volume = volume();
+    let settings = RenderSettings::default();
+    let mut streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 1000);
+    match streamed.render(&settings, &|_| {}) {
+        Err(StreamError::TooLarge(m)) => assert!(m.contains("does not fit 1000 bytes"), "{m}"),
+        Err(e) => panic!("{e}"),
+        Ok((_, times)) => panic!("rendered: {times:?}"),
+    }
+}
