@@ -6,8 +6,9 @@
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use volray_core::Volume;
+use volray_core::{Volume, VolumeSource};
 
 use crate::formats::VolumeFormat;
 use crate::shared::geometry::Reorientation;
@@ -208,30 +209,7 @@ pub fn read_volume(path: &Path, raw: Option<&RawOptions>) -> Result<Volume, IoEr
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let format = detect(path, opts)?;
     let spec = format.spec();
-    if opts.raw.is_some() && format != VolumeFormat::Raw {
-        return Err(IoError::RawOptionsNotApplicable {
-            path: path.to_path_buf(),
-            format: spec.description,
-        });
-    }
-    if opts.frame.is_some() && !spec.frames {
-        return Err(IoError::FrameNotApplicable {
-            path: path.to_path_buf(),
-            format: spec.description,
-        });
-    }
-    if (opts.level.is_some() || opts.channel.is_some()) && !spec.levels {
-        return Err(IoError::LevelNotApplicable {
-            path: path.to_path_buf(),
-            format: spec.description,
-        });
-    }
-    if opts.array.is_some() && !spec.arrays {
-        return Err(IoError::ArrayNotApplicable {
-            path: path.to_path_buf(),
-            format: spec.description,
-        });
-    }
+    check_options(path, format, opts)?;
     let loaded = (spec.read)(path, opts).map_err(|e| match e {
         IoError::FlatImage { path, mut image } => {
             image.format = format;
@@ -260,6 +238,65 @@ pub fn split_hdf5_path(path: &Path) -> Option<(PathBuf, String)> {
         let at = lower.find(ext)? + ext.len() - 1;
         Some((PathBuf::from(&s[..at]), s[at + 1..].to_string()))
     })
+}
+
+/// Refuses the options that do not apply to `format`.
+fn check_options(path: &Path, format: VolumeFormat, opts: &ReadOptions) -> Result<(), IoError> {
+    let spec = format.spec();
+    if opts.raw.is_some() && format != VolumeFormat::Raw {
+        return Err(IoError::RawOptionsNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    if opts.frame.is_some() && !spec.frames {
+        return Err(IoError::FrameNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    if (opts.level.is_some() || opts.channel.is_some()) && !spec.levels {
+        return Err(IoError::LevelNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    if opts.array.is_some() && !spec.arrays {
+        return Err(IoError::ArrayNotApplicable {
+            path: path.to_path_buf(),
+            format: spec.description,
+        });
+    }
+    Ok(())
+}
+
+/// A volume opened without reading its samples: a source of boxes of it
+/// (see [`VolumeSource`]), and what its metadata says.
+pub struct Lazy {
+    pub source: Arc<dyn VolumeSource>,
+    pub format: VolumeFormat,
+    pub info: FileInfo,
+}
+
+/// Opens `path` as a source of boxes, reading no sample, where its format
+/// is stored in chunks that can be read box by box (Zarr, OME-Zarr):
+/// what an out-of-core render and the ranks of an MPI render read their
+/// pieces from. `Ok(None)` for the other formats, which [`read`] reads
+/// whole or maps. The options are those of [`read`], checked alike.
+pub fn open_lazy(path: &Path, opts: &ReadOptions) -> Result<Option<Lazy>, IoError> {
+    let format = detect(path, opts)?;
+    check_options(path, format, opts)?;
+    match format {
+        VolumeFormat::Zarr => {
+            let (level, info) = crate::formats::zarr::open(path, opts)?;
+            Ok(Some(Lazy {
+                source: Arc::new(level),
+                format,
+                info,
+            }))
+        }
+        _ => Ok(None),
+    }
 }
 
 /// The format to read `path` as: see [`read`].

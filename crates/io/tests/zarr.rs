@@ -16,7 +16,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 use volray_core::glam::DVec3;
-use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, open_lazy, read};
 
 /// The workspace's `target/pyenv` python.
 fn python() -> PathBuf {
@@ -179,6 +179,61 @@ fn ome_zarr_levels_time_points_and_channels_equal_the_writers_with_their_geometr
         assert_eq!(levels[0].spacing, [0.25, 0.5, 2.0]);
         assert_eq!(levels[1].origin, [1.625, -2.75, 10.0]);
     }
+}
+
+#[test]
+fn every_box_read_lazily_equals_the_same_box_of_the_level_read_whole() {
+    let Some(dir) = stores() else { return };
+    let cases = [
+        ("v3_sharded_blosc", opts(None, None, None)),
+        ("v2_blosc", opts(None, None, None)),
+        ("v3_gzip_f64", opts(None, None, None)),
+        ("ome05", opts(Some(0), Some(1), Some(2))),
+        ("ome04", opts(Some(1), Some(0), Some(1))),
+    ];
+    for (name, o) in cases {
+        let path = dir.join(format!("{name}.zarr"));
+        let whole = load(&path, &o).volume;
+        let lazy = open_lazy(&path, &o)
+            .unwrap()
+            .expect("a Zarr store opens lazily");
+        let source = &lazy.source;
+        assert_eq!(source.grid().dims, whole.dims(), "{name}");
+        assert_eq!(source.grid().spacing, whole.spacing(), "{name}");
+        assert_eq!(source.grid().origin, whole.origin(), "{name}");
+        assert_eq!(source.sample_type(), whole.sample_type(), "{name}");
+        let d = whole.dims();
+        // Every box of at least 2 voxels a side on a coarse lattice of corners.
+        let ends = |n: usize| -> Vec<(usize, usize)> {
+            let cuts: Vec<usize> = (0..=n).step_by(n.div_ceil(3).max(1)).chain([n]).collect();
+            let mut out = Vec::new();
+            for &lo in &cuts {
+                for &hi in &cuts {
+                    if lo + 2 <= hi && hi <= n {
+                        out.push((lo, hi));
+                    }
+                }
+            }
+            out
+        };
+        let mut boxes = 0;
+        for &(x0, x1) in &ends(d[0]) {
+            for &(y0, y1) in &ends(d[1]) {
+                for &(z0, z1) in &ends(d[2]) {
+                    let (lo, hi) = ([x0, y0, z0], [x1, y1, z1]);
+                    let got = source.read_box(lo, hi).unwrap();
+                    assert_eq!(got, whole.sub_box(lo, hi), "{name} box {lo:?}..{hi:?}");
+                    boxes += 1;
+                }
+            }
+        }
+        assert!(boxes >= 8, "{name}: {boxes} boxes");
+        let e = source.read_box([0; 3], [d[0] + 1, d[1], d[2]]).unwrap_err();
+        assert!(e.contains(name) && e.contains("inside the"), "{e}");
+    }
+    // Formats read whole or mapped are not opened lazily.
+    let npy = dir.join("v2_gzip.npy");
+    assert!(open_lazy(&npy, &ReadOptions::default()).unwrap().is_none());
 }
 
 #[test]

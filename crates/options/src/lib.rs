@@ -28,6 +28,7 @@
 //! ```
 
 mod blame;
+pub mod level;
 mod error;
 mod option;
 mod options;

@@ -280,6 +280,22 @@ impl View {
         }
     }
 
+    /// The world size of one pixel where the view first meets the box
+    /// `bounds`: an orthographic pixel's size; for a perspective view, the
+    /// size of a pixel at the point of the box nearest the eye (0 with the
+    /// eye inside the box). The detail a picture of the box can show: a
+    /// grid whose voxels are no larger shows all of it (what `--level
+    /// auto` chooses a multiscale image's level by).
+    pub fn pixel_footprint(&self, bounds: (DVec3, DVec3)) -> f64 {
+        match self {
+            View::Orthographic(v) => v.pixel_size,
+            View::Perspective(v) => {
+                let nearest = v.eye.clamp(bounds.0, bounds.1);
+                v.eye.distance(nearest) * v.pixel_size
+            }
+        }
+    }
+
     /// Continuous image coordinates (column, row) of the world point `p`:
     /// pixel (c, r) covers `[c, c+1) × [r, r+1)`. `None` for a point on or
     /// behind the eye's plane in a perspective view.

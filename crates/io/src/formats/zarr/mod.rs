@@ -18,25 +18,38 @@
 //! give its spacing and origin.
 
 mod chunks;
+mod lazy;
 mod ome;
 mod store;
 
+pub(crate) use lazy::ZarrLevel;
 pub(crate) use store::is_zarr_dir;
 
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use volray_core::Volume;
-use volray_core::glam::DVec3;
 use zarrs::array::{ArrayMetadata, ArrayShardedExt};
 
 use crate::{FileInfo, IoError, LevelInfo, Loaded, ReadOptions, VolumeFormat};
-use chunks::{ZarrArray, ZarrType, open_array, read_box};
+use chunks::{ZarrArray, ZarrType, open_array};
 use ome::{Axis, AxisKind, Level};
 use store::NodeKind;
 
 /// Reads one level, time point and channel of the image or array at `path`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let (level, info) = open(path, opts)?;
+    let volume = level.read_whole()?;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Zarr,
+        info,
+    })
+}
+
+/// Opens one level, time point and channel of the image or array at
+/// `path` without reading a sample: the level as a source of boxes (see
+/// `lazy.rs`), and what the metadata says.
+pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileInfo), IoError> {
     let (kind, attrs) = store::node(path)?;
     let image = match kind {
         NodeKind::Array => None,
@@ -92,7 +105,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         infos.push(level_info(&dir, level, &array, ty, &layout));
         opened.push((dir, array, ty));
     }
-    let (dir, array, ty) = &opened[chosen];
+    let (dir, array, ty) = opened.swap_remove(chosen);
     let shape = array.shape().to_vec();
 
     let frames = layout.time.map_or(1, |t| shape[t]);
@@ -119,22 +132,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     }
     let mut start = vec![0u64; shape.len()];
-    let mut size = shape.clone();
     for (axis, index) in [
         (layout.time, frame as u64),
         (layout.channel, channel as u64),
     ] {
         if let Some(a) = axis {
             start[a] = index;
-            size[a] = 1;
         }
     }
-    let samples = read_box(dir, array, *ty, &start, &size, opts.max_memory)?;
-    let info = &infos[chosen];
-    let volume = Volume::from_samples(info.dims, samples)
-        .and_then(|v| v.with_spacing(DVec3::from(info.spacing)))
-        .and_then(|v| v.with_origin(DVec3::from(info.origin)))
-        .map_err(|e| IoError::volume(path, e))?;
 
     let mut file_info = FileInfo::new(ty.name());
     let format = match array.metadata() {
@@ -168,13 +173,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     file_info.length_unit = layout.unit.clone();
     file_info.frames = frames as usize;
     file_info.frame = frame;
+    let level = ZarrLevel::new(
+        path,
+        &dir,
+        array,
+        ty,
+        start,
+        &infos[chosen],
+        opts.max_memory,
+    )?;
     file_info.levels = infos;
     file_info.level = chosen;
-    Ok(Loaded {
-        volume,
-        format: VolumeFormat::Zarr,
-        info: file_info,
-    })
+    Ok((level, file_info))
 }
 
 /// The directory of a level's array.
