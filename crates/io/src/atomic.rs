@@ -212,6 +212,183 @@ pub(crate) fn publish_all(files: Vec<PendingFile>) -> Result<Vec<PathBuf>, IoErr
     }
 }
 
+/// A directory being written (a Zarr store: many files) that appears at
+/// its path only when complete, as [`AtomicFile`] does for one file.
+///
+/// The contents go to a temporary directory beside the destination
+/// (`.NAME.XXXXXX.tmp`), listed in the registry, so that a failure
+/// (dropping the `AtomicDir`) or a signal ([`remove_unfinished_files`])
+/// deletes it and leaves any existing directory at the path untouched.
+/// [`commit`](AtomicDir::commit) syncs every file, then renames the
+/// directory into place; an existing directory at the path is renamed
+/// aside first and deleted after, both renames under the registry's lock,
+/// so a signal finds either the old directory or the new one in place.
+/// Only what `replaceable` accepts is ever replaced.
+#[derive(Debug)]
+pub struct AtomicDir {
+    tmp: PathBuf,
+    path: PathBuf,
+    parent: PathBuf,
+    replaceable: fn(&Path) -> Result<(), String>,
+    committed: bool,
+    /// Dropped (unlisted) after the directory is renamed or deleted.
+    _registered: Registered,
+}
+
+impl AtomicDir {
+    /// Starts writing the directory `path`: checks its parent, and that an
+    /// existing `path` may be replaced (`replaceable` returns why not),
+    /// then creates the temporary directory, with the permissions an
+    /// ordinary new directory gets (`0o777` less the umask on Unix).
+    pub fn create(
+        path: &Path,
+        replaceable: fn(&Path) -> Result<(), String>,
+    ) -> Result<Self, IoError> {
+        let parent = destination_parent(path)?;
+        check_replaceable(path, replaceable)?;
+        let mut builder = tempfile::Builder::new();
+        let prefix = match path.file_name() {
+            Some(name) => format!(".{}.", name.to_string_lossy()),
+            None => ".volray.".to_string(),
+        };
+        builder.prefix(&prefix).suffix(".tmp");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o777));
+        }
+        let mut live = registry();
+        let tmp = builder
+            .tempdir_in(&parent)
+            .map_err(|e| IoError::os(path, "create a temporary directory for", e))?
+            .keep();
+        live.push(tmp.clone());
+        let registered = Registered(tmp.clone());
+        drop(live);
+        Ok(AtomicDir {
+            tmp,
+            path: path.to_path_buf(),
+            parent,
+            replaceable,
+            committed: false,
+            _registered: registered,
+        })
+    }
+
+    /// The temporary directory, to write the contents in.
+    pub fn dir(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// The path the directory will have.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Runs `write` (a write into the temporary directory) under the
+    /// registry's lock: a signal's [`remove_unfinished_files`] waits for
+    /// it to finish, and once that has begun `write` never starts (it
+    /// waits for the exit), so nothing is written into the directory
+    /// after it is deleted. `write` must not create or commit another
+    /// [`AtomicFile`] or [`AtomicDir`] (it would wait for itself).
+    pub fn while_live<R>(&self, write: impl FnOnce(&Path) -> R) -> R {
+        let _live = registry();
+        write(&self.tmp)
+    }
+
+    /// Syncs every file to disk and renames the temporary directory to the
+    /// destination, replacing an existing directory there (checked again
+    /// with `replaceable`).
+    pub fn commit(mut self) -> Result<(), IoError> {
+        sync_tree(&self.tmp).map_err(|e| IoError::os(&self.path, "sync", e))?;
+        let mut live = registry();
+        let mut aside = None;
+        if std::fs::symlink_metadata(&self.path).is_ok() {
+            if let Err(e) = check_replaceable(&self.path, self.replaceable) {
+                drop(live);
+                return Err(e);
+            }
+            // An empty directory to rename the old one over.
+            let old = tempfile::Builder::new()
+                .prefix(&format!(
+                    ".{}.",
+                    self.path.file_name().unwrap_or_default().to_string_lossy()
+                ))
+                .suffix(".old")
+                .tempdir_in(&self.parent)
+                .map_err(|e| IoError::os(&self.path, "create a temporary directory for", e))?
+                .keep();
+            if let Err(e) = std::fs::rename(&self.path, &old) {
+                let _ = std::fs::remove_dir(&old);
+                drop(live);
+                return Err(IoError::os(&self.path, "replace", e));
+            }
+            aside = Some(old);
+        }
+        if let Err(e) = std::fs::rename(&self.tmp, &self.path) {
+            if let Some(old) = &aside {
+                let _ = std::fs::rename(old, &self.path);
+            }
+            drop(live);
+            return Err(IoError::os(&self.path, "replace", e));
+        }
+        self.committed = true;
+        // The old directory is listed until it is deleted, so that a
+        // signal meanwhile deletes the rest of it.
+        let old = aside.map(|old| {
+            live.push(old.clone());
+            Registered(old)
+        });
+        drop(live);
+        if let Some(old) = &old {
+            let _ = std::fs::remove_dir_all(&old.0);
+        }
+        drop(old);
+        sync_dir(&self.parent);
+        Ok(())
+    }
+}
+
+impl Drop for AtomicDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.tmp);
+        }
+    }
+}
+
+/// Refuses an existing `path` that `replaceable` does not accept.
+fn check_replaceable(
+    path: &Path,
+    replaceable: fn(&Path) -> Result<(), String>,
+) -> Result<(), IoError> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return Ok(());
+    }
+    replaceable(path).map_err(|reason| IoError::BadDestination {
+        path: path.to_path_buf(),
+        reason,
+    })
+}
+
+/// Syncs every file and directory under `root` (and `root`) to disk.
+fn sync_tree(root: &Path) -> io::Result<()> {
+    let mut pending = vec![root.to_path_buf()];
+    while let Some(d) = pending.pop() {
+        for entry in std::fs::read_dir(&d)? {
+            let entry = entry?;
+            let kind = entry.file_type()?;
+            if kind.is_dir() {
+                pending.push(entry.path());
+            } else if kind.is_file() {
+                std::fs::File::open(entry.path())?.sync_all()?;
+            }
+        }
+        sync_dir(&d);
+    }
+    Ok(())
+}
+
 /// The temporary files of the live [`AtomicFile`]s.
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
@@ -246,7 +423,13 @@ pub fn remove_unfinished_files() -> usize {
     let live = registry();
     let mut removed = 0;
     for path in live.iter() {
-        if std::fs::remove_file(path).is_ok() {
+        // An [`AtomicDir`]'s temporary directory, or a file.
+        let gone = if path.is_dir() {
+            std::fs::remove_dir_all(path)
+        } else {
+            std::fs::remove_file(path)
+        };
+        if gone.is_ok() {
             removed += 1;
         }
     }
@@ -257,15 +440,23 @@ pub fn remove_unfinished_files() -> usize {
 /// The directory `path` will be created in, checked to exist, with `path`
 /// checked not to be a directory itself.
 fn destination_dir(path: &Path) -> Result<PathBuf, IoError> {
+    if path.is_dir() && !path.as_os_str().is_empty() {
+        return Err(IoError::BadDestination {
+            path: path.to_path_buf(),
+            reason: "it is a directory".to_string(),
+        });
+    }
+    destination_parent(path)
+}
+
+/// The directory `path` will be created in, checked to exist.
+fn destination_parent(path: &Path) -> Result<PathBuf, IoError> {
     let bad = |reason: &str| IoError::BadDestination {
         path: path.to_path_buf(),
         reason: reason.to_string(),
     };
     if path.as_os_str().is_empty() {
         return Err(bad("empty file name"));
-    }
-    if path.is_dir() {
-        return Err(bad("it is a directory"));
     }
     if path.file_name().is_none() {
         // "..", "/", "a/.." and the like name no file.
@@ -399,5 +590,68 @@ mod tests {
         let err = write_atomically(&file.join("out.png"), |w| w.write_all(b"x")).unwrap_err();
         assert!(err.to_string().contains("is not a directory"), "{err}");
         assert_eq!(fs::read(&file).unwrap(), b"f");
+    }
+    fn zarr_only(path: &Path) -> Result<(), String> {
+        if path.join("zarr.json").is_file() {
+            Ok(())
+        } else {
+            Err("not a store".to_string())
+        }
+    }
+
+    #[test]
+    fn a_directory_appears_whole_or_not_at_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.zarr");
+        // Dropped before commit: nothing left, and unlisted.
+        let dropped = AtomicDir::create(&p, zarr_only).unwrap();
+        fs::write(dropped.dir().join("zarr.json"), b"{}").unwrap();
+        let tmp = dropped.dir().to_path_buf();
+        assert!(listed(&tmp));
+        drop(dropped);
+        assert!(!tmp.exists() && !listed(&tmp));
+        assert!(entries(dir.path()).is_empty());
+
+        let first = AtomicDir::create(&p, zarr_only).unwrap();
+        fs::create_dir(first.dir().join("0")).unwrap();
+        fs::write(first.dir().join("0/a"), b"first").unwrap();
+        fs::write(first.dir().join("zarr.json"), b"{}").unwrap();
+        assert!(!p.exists());
+        first.commit().unwrap();
+        assert_eq!(fs::read(p.join("0/a")).unwrap(), b"first");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            // An ordinary new directory's, not a temporary one's 0o700.
+            let probe = dir.path().join("probe");
+            fs::create_dir(&probe).unwrap();
+            let mode = |p: &Path| fs::metadata(p).unwrap().permissions().mode();
+            assert_eq!(mode(&p), mode(&probe));
+            fs::remove_dir(&probe).unwrap();
+        }
+
+        // A second replaces it whole: no file of the first is left.
+        let second = AtomicDir::create(&p, zarr_only).unwrap();
+        fs::write(second.dir().join("zarr.json"), b"{\"v\": 2}").unwrap();
+        second.commit().unwrap();
+        assert_eq!(fs::read(p.join("zarr.json")).unwrap(), b"{\"v\": 2}");
+        assert!(!p.join("0").exists());
+        assert_eq!(entries(dir.path()), ["out.zarr"]);
+
+        // What the check refuses is left alone, at create and at commit.
+        let other = dir.path().join("other");
+        fs::create_dir(&other).unwrap();
+        fs::write(other.join("keep"), b"k").unwrap();
+        let err = AtomicDir::create(&other, zarr_only).unwrap_err();
+        assert!(
+            err.to_string().ends_with("cannot write: not a store"),
+            "{err}"
+        );
+        let late = dir.path().join("late");
+        let pending = AtomicDir::create(&late, zarr_only).unwrap();
+        fs::write(&late, b"appeared meanwhile").unwrap();
+        assert!(pending.commit().is_err());
+        assert_eq!(fs::read(&late).unwrap(), b"appeared meanwhile");
+        assert_eq!(entries(dir.path()), ["late", "other", "out.zarr"]);
     }
 }

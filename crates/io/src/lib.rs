@@ -11,7 +11,9 @@
 //! spacing and origin) plus a [`FileInfo`] saying what the header said and
 //! what was done with it; [`write_png`], [`write_exr`] and [`Animation`]
 //! turn [`Image`](volray_core::Image)s into pictures, and [`write_nrrd`],
-//! [`write_npy`] and [`write_raw`] write volumes. Every file is written
+//! [`write_npy`] and [`write_raw`] write volumes, [`write_ome_zarr`] an
+//! OME-Zarr image with its pyramid (from any
+//! [`VolumeSource`](volray_core::VolumeSource), in bounded memory). Every file is written
 //! through [`write_atomically`] or [`AtomicFile`], so a failed write never
 //! leaves a half-written file. Errors are [`IoError`]s: one-line messages
 //! that name the file and the field, split by [`IoError::is_io_failure`]
@@ -106,7 +108,7 @@ mod images;
 mod read;
 mod shared;
 
-pub use atomic::{AtomicFile, remove_unfinished_files, write_atomically};
+pub use atomic::{AtomicDir, AtomicFile, remove_unfinished_files, write_atomically};
 pub use dtype::{
     DType, Endian, ParseNameError, bytes_to_f32, bytes_to_samples, extend_f32, f16_to_f32,
 };
@@ -115,6 +117,9 @@ pub use formats::VolumeFormat;
 pub use formats::npy::{read_npy, write_npy};
 pub use formats::nrrd::write_nrrd;
 pub use formats::raw::{RawOptions, read_raw, write_raw};
+pub use formats::zarr::{
+    OmeZarrOptions, OmeZarrWritten, WrittenLevel, ZarrVersion, write_ome_zarr,
+};
 pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};

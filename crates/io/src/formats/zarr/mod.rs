@@ -21,9 +21,11 @@ mod chunks;
 mod lazy;
 mod ome;
 mod store;
+mod write;
 
 pub(crate) use lazy::ZarrLevel;
 pub(crate) use store::is_zarr_dir;
+pub use write::{OmeZarrOptions, OmeZarrWritten, WrittenLevel, ZarrVersion, write_ome_zarr};
 
 use std::path::{Path, PathBuf};
 
