@@ -240,3 +240,161 @@ fn an_unknown_format_or_the_input_itself_is_refused() {
     assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
     assert_eq!(std::fs::read(&keep).unwrap(), before);
 }
+
+/// `convert fractal:33 -o x.ome.zarr --chunk 16`: three levels; level 0
+/// renders as the fractal itself (within 1/255), the coarser levels
+/// render too; `--zarr-version 2` writes OME-Zarr 0.4 (`.zgroup`,
+/// `.zattrs`, `.zarray`) that renders the same.
+#[test]
+fn an_ome_zarr_image_renders_as_its_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let render = |input: &str, extra: &[&str], out: &str| {
+        let mut args = vec!["render", input, "--size", "64x48", "-o", out];
+        args.extend(extra);
+        let run = volray(&args);
+        assert!(run.status.success(), "{input}: {}", stderr(&run));
+        common::Picture::read(Path::new(out))
+    };
+    let direct = render("fractal:33", &[], &png("direct.png"));
+    for (version, marker) in [("3", "zarr.json"), ("2", ".zgroup")] {
+        let store = dir.path().join(format!("v{version}.ome.zarr"));
+        let s = store.to_str().unwrap();
+        let run = convert(&[
+            "fractal:33",
+            "-o",
+            s,
+            "--chunk",
+            "16",
+            "--zarr-version",
+            version,
+        ]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let said = stderr(&run);
+        let ome = if version == "3" { "0.5" } else { "0.4" };
+        assert!(
+            said.contains(&format!("OME-Zarr {ome} (Zarr v{version})"))
+                && said.contains("3 levels (block means): 33x33x33, 17x17x17, 9x9x9"),
+            "{said}"
+        );
+        assert_eq!(said.lines().count(), 1, "{said}");
+        assert!(store.join(marker).is_file());
+        if version == "2" {
+            assert!(store.join(".zattrs").is_file() && store.join("0/.zarray").is_file());
+            let attrs = std::fs::read_to_string(store.join(".zattrs")).unwrap();
+            assert!(attrs.contains("\"version\": \"0.4\""), "{attrs}");
+        }
+        let from_store = render(s, &[], &png(&format!("v{version}.png")));
+        assert!(direct.max_diff(&from_store) <= 1, "v{version}");
+        let coarse = render(s, &["--level", "2"], &png("coarse.png"));
+        assert_eq!((coarse.width, coarse.height), (64, 48));
+    }
+}
+
+/// The OME-Zarr flags apply to OME-Zarr output only; an existing
+/// directory that is no Zarr store is not replaced.
+#[test]
+fn zarr_flags_with_a_file_output_and_a_foreign_directory_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let nrrd = dir.path().join("v.nrrd");
+    for flags in [
+        &["--zarr-version", "2"][..],
+        &["--chunk", "16"],
+        &["--labels"],
+    ] {
+        let mut args = vec!["blobs:8", "-o", nrrd.to_str().unwrap()];
+        args.extend(flags);
+        let run = convert(&args);
+        assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+        assert!(
+            stderr(&run).contains(&format!("{} appl", flags[0]))
+                && stderr(&run).contains("to OME-Zarr output only"),
+            "{}",
+            stderr(&run)
+        );
+        assert!(!nrrd.exists());
+    }
+    let run = convert(&["blobs:8", "-o", "x.zarr", "--zarr-version", "4"]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert!(
+        stderr(&run).contains("not a Zarr version"),
+        "{}",
+        stderr(&run)
+    );
+
+    let photos = dir.path().join("photos.zarr");
+    std::fs::create_dir(&photos).unwrap();
+    std::fs::write(photos.join("a.jpg"), b"jpeg").unwrap();
+    let run = convert(&["blobs:8", "-o", photos.to_str().unwrap()]);
+    assert!(!run.status.success());
+    assert!(
+        stderr(&run).contains("is not a Zarr store"),
+        "{}",
+        stderr(&run)
+    );
+    assert_eq!(std::fs::read(photos.join("a.jpg")).unwrap(), b"jpeg");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+/// zarr-python, ome-zarr-py and ome-zarr-models (target/pyenv, as
+/// `.ci/run` makes it) read what `convert` wrote from numpy's `.npy`: the
+/// same values (every one, level 0), levels that numpy's own block means
+/// give, ome-zarr-py's list of levels and transformations, and the
+/// metadata validated against NGFF 0.5 and 0.4.
+#[test]
+fn zarr_python_and_ome_zarr_read_what_convert_wrote() {
+    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
+    let has = Command::new(&python)
+        .args(["-c", "import numpy, zarr, ome_zarr, ome_zarr_models"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "target/pyenv with zarr, ome-zarr and ome-zarr-models is needed (.ci/run makes it)"
+        );
+        eprintln!(
+            "skipped: target/pyenv has no zarr, ome-zarr or ome-zarr-models (.ci/run installs them)"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/convert/check_ome_zarr.py");
+    let py = |args: &[&std::ffi::OsStr]| {
+        let out = Command::new(&python)
+            .arg(&script)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success()
+                && String::from_utf8_lossy(&out.stdout)
+                    .trim_end()
+                    .ends_with("ok"),
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let npy = dir.path().join("in.npy");
+    py(&["write".as_ref(), npy.as_os_str()]);
+    for version in ["3", "2"] {
+        let store = dir.path().join(format!("v{version}.ome.zarr"));
+        let run = convert(&[
+            npy.to_str().unwrap(),
+            "-o",
+            store.to_str().unwrap(),
+            "--chunk",
+            "8",
+            "--zarr-version",
+            version,
+        ]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        py(&[
+            "check".as_ref(),
+            npy.as_os_str(),
+            store.as_os_str(),
+            version.as_ref(),
+        ]);
+    }
+}
