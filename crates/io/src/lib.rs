@@ -13,9 +13,10 @@
 //! turn [`Image`](volray_core::Image)s into pictures, and [`write_nrrd`],
 //! [`write_npy`] and [`write_raw`] write volumes, [`write_ome_zarr`] an
 //! OME-Zarr image with its pyramid (from any
-//! [`VolumeSource`](volray_core::VolumeSource), in bounded memory). Every file is written
-//! through [`write_atomically`] or [`AtomicFile`], so a failed write never
-//! leaves a half-written file. Errors are [`IoError`]s: one-line messages
+//! [`VolumeSource`](volray_core::VolumeSource), in bounded memory). Every
+//! file is written through [`write_atomically`] or [`AtomicFile`] (a Zarr
+//! store through [`AtomicDir`]), so a failed write never leaves a
+//! half-written file. Errors are [`IoError`]s: one-line messages
 //! that name the file and the field, split by [`IoError::is_io_failure`]
 //! into operating-system failures and bad input; an error a reader option
 //! caused (a frame out of range, the memory limit) has a variant of its
