@@ -10,24 +10,54 @@
 //! the box and the chunk (the shard, for a sharded array: the unit
 //! `zarrs` may hold decoded) are checked against the memory limit, so a
 //! metadata file that lies about its shapes is refused before a buffer
-//! of that size exists.
+//! of that size exists; what `zarrs` reads and decodes is checked on the
+//! way (`guard.rs`).
 
+use std::ops::Deref;
 use std::path::Path;
 use std::sync::Arc;
 
 use volray_core::Samples;
+use zarrs::array::codec::BloscCodec;
 use zarrs::array::data_type::{
     Float32DataType, Float64DataType, Int8DataType, Int16DataType, Int32DataType, Int64DataType,
     UInt8DataType, UInt16DataType, UInt32DataType, UInt64DataType,
 };
-use zarrs::array::{Array, ArraySubset, ElementOwned};
+use zarrs::array::{Array, ArrayMetadata, ArrayShardedExt, ArraySubset, ElementOwned};
+use zarrs::convert::array_metadata_v2_to_v3;
 use zarrs::filesystem::FilesystemStore;
+use zarrs::plugin::ExtensionAliasesV2;
 
+use super::guard::{self, CheckedStore};
 use crate::IoError;
 use crate::shared::limits::check_volume_size;
 
-/// An open Zarr array on the file system.
-pub(crate) type ZarrArray = Array<FilesystemStore>;
+/// An open Zarr array on the file system: as its metadata describes it
+/// (what `volray info` shows), and, where that differs, as its chunks
+/// are decoded.
+pub(crate) struct ZarrArray {
+    array: Array<CheckedStore>,
+    /// A Zarr v2 array with a blosc compressor, opened again through v3
+    /// metadata: `zarrs` builds a v2 blosc compressor itself rather than
+    /// through its codec registry, so without this its chunks would skip
+    /// the checked blosc codec (`guard.rs`).
+    decoder: Option<Array<CheckedStore>>,
+}
+
+impl ZarrArray {
+    /// The array that decodes the chunks.
+    fn reader(&self) -> &Array<CheckedStore> {
+        self.decoder.as_ref().unwrap_or(&self.array)
+    }
+}
+
+impl Deref for ZarrArray {
+    type Target = Array<CheckedStore>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.array
+    }
+}
 
 /// The sample types volray reads from Zarr, and how each is kept: `u8`,
 /// `i8`, `u16`, `i16` and `f32` as stored, the others as `f32`.
@@ -47,7 +77,7 @@ pub(crate) enum ZarrType {
 
 impl ZarrType {
     /// The type of `array`, or an error naming the one it has.
-    fn of(path: &Path, array: &ZarrArray) -> Result<Self, IoError> {
+    fn of(path: &Path, array: &Array<CheckedStore>) -> Result<Self, IoError> {
         let dt = array.data_type();
         let found = [
             (dt.is::<UInt8DataType>(), ZarrType::U8),
@@ -127,14 +157,65 @@ pub(crate) fn zarr_error(path: &Path, what: &str, error: impl std::fmt::Display)
 }
 
 /// Opens the array at `dir` (a directory holding `zarr.json` or
-/// `.zarray`) and finds its sample type.
-pub(crate) fn open_array(dir: &Path) -> Result<(ZarrArray, ZarrType), IoError> {
+/// `.zarray`) and finds its sample type. No read of its files may exceed
+/// `max_memory` bytes.
+pub(crate) fn open_array(dir: &Path, max_memory: u64) -> Result<(ZarrArray, ZarrType), IoError> {
+    guard::install();
     let store =
         FilesystemStore::new(dir).map_err(|e| zarr_error(dir, "cannot open Zarr store", e))?;
-    let array = Array::open(Arc::new(store), "/")
-        .map_err(|e| zarr_error(dir, "not a readable Zarr array", e))?;
+    let store = Arc::new(CheckedStore::new(store, max_memory));
+    let not_readable = |e| zarr_error(dir, "not a readable Zarr array", e);
+    let array = Array::open(store.clone(), "/").map_err(not_readable)?;
     let ty = ZarrType::of(dir, &array)?;
-    Ok((array, ty))
+    check_subchunks(dir, &array)?;
+    let decoder = match array.metadata() {
+        ArrayMetadata::V2(v2)
+            if v2
+                .compressor
+                .as_ref()
+                .is_some_and(|c| BloscCodec::matches_name_v2(c.id())) =>
+        {
+            let v3 = array_metadata_v2_to_v3(v2)
+                .map_err(|e| zarr_error(dir, "not a readable Zarr array", e))?;
+            Some(
+                Array::new_with_metadata(store, "/", ArrayMetadata::V3(v3))
+                    .map_err(not_readable)?,
+            )
+        }
+        _ => None,
+    };
+    Ok((ZarrArray { array, decoder }, ty))
+}
+
+/// Refuses a sharded array whose subchunks do not tile its shards (zarrs
+/// finds out only when it reads one, in its own words).
+fn check_subchunks(dir: &Path, array: &Array<CheckedStore>) -> Result<(), IoError> {
+    let (Some(subchunk), Ok(shard)) = (
+        array.subchunk_shape(),
+        array.chunk_shape(&vec![0; array.dimensionality()]),
+    ) else {
+        return Ok(());
+    };
+    let tiles = subchunk.len() == shard.len()
+        && shard
+            .iter()
+            .zip(&subchunk)
+            .all(|(s, c)| s.get() % c.get() == 0);
+    if tiles {
+        return Ok(());
+    }
+    let list = |shape: &[std::num::NonZeroU64]| {
+        let sizes: Vec<String> = shape.iter().map(|n| n.to_string()).collect();
+        format!("[{}]", sizes.join(", "))
+    };
+    Err(IoError::invalid(
+        dir,
+        format!(
+            "the subchunk shape {} does not divide the shard shape {} (sharding_indexed)",
+            list(&subchunk),
+            list(&shard)
+        ),
+    ))
 }
 
 /// The shape of the chunks `zarrs` decodes whole: the regular grid's
@@ -164,6 +245,7 @@ pub(crate) fn read_box(
     }
     let subset = ArraySubset::new_with_start_shape(start.to_vec(), shape.to_vec())
         .map_err(|e| zarr_error(path, "Zarr box", e))?;
+    let array = array.reader();
     Ok(match ty {
         ZarrType::U8 => elements::<u8>(path, array, &subset)?.into(),
         ZarrType::I8 => elements::<i8>(path, array, &subset)?.into(),
@@ -182,7 +264,7 @@ pub(crate) fn read_box(
 
 fn elements<T: ElementOwned>(
     path: &Path,
-    array: &ZarrArray,
+    array: &Array<CheckedStore>,
     subset: &ArraySubset,
 ) -> Result<Vec<T>, IoError> {
     array

@@ -6,7 +6,11 @@
 //! hold `multiscales`, see `ome.rs`), or a bare array (`zarr.json` or
 //! `.zarray`). Directories are recognised by those files (`store.rs`),
 //! not by their name. The samples are read through the `zarrs` crate
-//! (`chunks.rs`), which does the codecs, fill values and missing chunks.
+//! (`chunks.rs`), which does the codecs, fill values and missing chunks;
+//! what it reads is checked before it decodes or allocates for it
+//! (`guard.rs`: compressed chunks that would inflate past their size,
+//! shard indexes pointing outside their shard, reads past a file's end
+//! or over the memory limit).
 //!
 //! Axes: OME-Zarr orders an image's axes time, channel, then space
 //! z, y, x, each array in C order (the last index fastest), so the
@@ -18,6 +22,7 @@
 //! give its spacing and origin.
 
 mod chunks;
+mod guard;
 mod lazy;
 mod ome;
 mod store;
@@ -65,7 +70,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
     let (axes, levels) = match &image {
         Some(m) => (m.axes.clone(), m.levels.clone()),
         None => {
-            let (array, _) = open_array(path)?;
+            let (array, _) = open_array(path, opts.max_memory)?;
             let axes = bare_axes(path, array.dimensionality())?;
             let n = axes.len();
             let level = Level {
@@ -93,7 +98,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
     let mut infos = Vec::with_capacity(levels.len());
     for level in &levels {
         let dir = level_dir(path, level);
-        let (array, ty) = open_array(&dir)?;
+        let (array, ty) = open_array(&dir, opts.max_memory)?;
         if array.dimensionality() != axes.len() {
             return Err(IoError::invalid(
                 &dir,

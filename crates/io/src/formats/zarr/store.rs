@@ -14,12 +14,12 @@ use serde_json::Value;
 use crate::IoError;
 
 /// The metadata files that make a directory a Zarr node.
-const MARKERS: [&str; 4] = ["zarr.json", ".zarray", ".zgroup", ".zattrs"];
+pub(crate) const MARKERS: [&str; 4] = ["zarr.json", ".zarray", ".zgroup", ".zattrs"];
 
 /// The most bytes a metadata file may hold: OME metadata for a pyramid of
 /// many levels and channels is a few KiB; anything near this is no
 /// metadata file.
-const MAX_METADATA_BYTES: u64 = 16 << 20;
+pub(crate) const MAX_METADATA_BYTES: u64 = 16 << 20;
 
 /// Whether `dir` is a Zarr group or array: it holds a metadata file.
 pub(crate) fn is_zarr_dir(dir: &Path) -> bool {
