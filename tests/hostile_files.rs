@@ -3,7 +3,7 @@
 //! dimensions, non-finite spacings, unknown types, wrong magic numbers and
 //! compressed streams cut short, all made at test time from the valid
 //! fixtures in `crates/io/tests/fixtures` (written by each format's own
-//! tools).
+//! tools), and Zarr stores written here by hand.
 //!
 //! Each case runs `volray info FILE` (some also `volray render FILE -o
 //! out.png`) as a child process under `ulimit -v` (a lying header must not
@@ -1411,6 +1411,193 @@ fn minc_cases() -> Cases {
     c
 }
 
+// ----------------------------------------------------------------- Zarr
+
+/// `zarr.json` of a Zarr v3 uint16 array of `shape`, one chunk of
+/// `chunk`, through `codecs`.
+fn zarr_v3(
+    shape: serde_json::Value,
+    chunk: serde_json::Value,
+    codecs: serde_json::Value,
+) -> Vec<u8> {
+    serde_json::json!({
+        "zarr_format": 3,
+        "node_type": "array",
+        "shape": shape,
+        "data_type": "uint16",
+        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": chunk}},
+        "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
+        "fill_value": 0,
+        "codecs": codecs,
+    })
+    .to_string()
+    .into_bytes()
+}
+
+/// Hand-written Zarr and OME-Zarr stores that lie (the reader's own tests,
+/// `crates/io/tests/zarr_hostile.rs`, have many more): each a directory
+/// `s.zarr` read by the command.
+fn zarr_cases() -> Cases {
+    use serde_json::json;
+    let mut c = Cases::new("zarr");
+    let bytes = || json!([{"name": "bytes", "configuration": {"endian": "little"}}]);
+    let with = |codec: serde_json::Value| json!([{"name": "bytes", "configuration": {"endian": "little"}}, codec]);
+    let small = |codecs| zarr_v3(json!([2, 3, 4]), json!([2, 3, 4]), codecs);
+    let ramp: Vec<u8> = (0..24u16).flat_map(u16::to_le_bytes).collect();
+    let mut case = |name: &str, files: Vec<(&str, Vec<u8>)>| {
+        let files = files
+            .into_iter()
+            .map(|(f, b)| (format!("s.zarr/{f}"), b))
+            .collect();
+        c.many(name, files, "s.zarr", Expect::Bad);
+    };
+    case(
+        "zarr.json cut short",
+        vec![("zarr.json", small(bytes())[..40].to_vec())],
+    );
+    case("zarr.json a list", vec![("zarr.json", b"[]".to_vec())]);
+    let huge = 1u64 << 40;
+    case(
+        "shape 2^40 cubed",
+        vec![(
+            "zarr.json",
+            zarr_v3(json!([huge, huge, huge]), json!([huge, 1, 1]), bytes()),
+        )],
+    );
+    case(
+        "chunk shape 0",
+        vec![(
+            "zarr.json",
+            zarr_v3(json!([2, 3, 4]), json!([2, 0, 4]), bytes()),
+        )],
+    );
+    // A zstd frame declaring 2^40 bytes (one RLE block of 48).
+    let mut zstd = vec![0x28, 0xb5, 0x2f, 0xfd, 0xe0];
+    zstd.extend(huge.to_le_bytes());
+    zstd.extend([0x83, 0x01, 0x00, 0x07]);
+    case(
+        "a zstd chunk declaring 2^40 bytes",
+        vec![
+            (
+                "zarr.json",
+                small(with(
+                    json!({"name": "zstd", "configuration": {"level": 3, "checksum": false}}),
+                )),
+            ),
+            ("c/0/0/0", zstd),
+        ],
+    );
+    // A blosc header declaring 2 GiB.
+    let mut blosc = vec![2, 1, 1, 2];
+    blosc.extend(0x7fff_ff00u32.to_le_bytes());
+    blosc.extend(0x1_0000u32.to_le_bytes());
+    blosc.extend(32u32.to_le_bytes());
+    blosc.resize(32, 0);
+    let blosc_config = json!({"name": "blosc", "configuration": {
+        "cname": "lz4", "clevel": 5, "shuffle": "shuffle", "typesize": 2, "blocksize": 0
+    }});
+    case(
+        "a blosc chunk declaring 2 GiB",
+        vec![
+            ("zarr.json", small(with(blosc_config))),
+            ("c/0/0/0", blosc.clone()),
+        ],
+    );
+    let zarray = json!({
+        "zarr_format": 2, "shape": [2, 3, 4], "chunks": [2, 3, 4], "dtype": "<u2",
+        "compressor": {"id": "blosc", "cname": "lz4", "clevel": 5, "shuffle": 1, "blocksize": 0},
+        "fill_value": 0, "order": "C", "filters": null,
+    });
+    case(
+        "a v2 blosc chunk declaring 2 GiB",
+        vec![
+            (".zarray", zarray.to_string().into_bytes()),
+            ("0.0.0", blosc),
+        ],
+    );
+    let gz = gzip(&ramp);
+    case(
+        "a gzip chunk cut short",
+        vec![
+            (
+                "zarr.json",
+                small(with(json!({"name": "gzip", "configuration": {"level": 5}}))),
+            ),
+            ("c/0/0/0", gz[..gz.len() - 6].to_vec()),
+        ],
+    );
+    // A shard of 2 x 4 x 4 in subchunks of 2 x 2 x 2 (16 bytes each), its
+    // index (offset, nbytes) at the end.
+    let sharded = |inner: serde_json::Value| {
+        zarr_v3(
+            json!([2, 4, 4]),
+            json!([2, 4, 4]),
+            json!([{"name": "sharding_indexed", "configuration": {
+                "chunk_shape": inner, "codecs": bytes(), "index_codecs": bytes(),
+            }}]),
+        )
+    };
+    let shard = |index: [u64; 8]| {
+        let mut s: Vec<u8> = (0..32u16).flat_map(u16::to_le_bytes).collect();
+        s.extend(index.iter().flat_map(|v| v.to_le_bytes()));
+        s
+    };
+    for (what, index) in [
+        ("past the end", [0, 16, 16, 16, 32, 16, 48, 1000]),
+        ("overflowing", [0, 16, u64::MAX - 8, 16, 32, 16, 48, 16]),
+        ("of 2^40 bytes", [0, huge, 16, 16, 32, 16, 48, 16]),
+    ] {
+        case(
+            &format!("a shard index {what}"),
+            vec![
+                ("zarr.json", sharded(json!([2, 2, 2]))),
+                ("c/0/0/0", shard(index)),
+            ],
+        );
+    }
+    case(
+        "subchunks not dividing the shard",
+        vec![
+            ("zarr.json", sharded(json!([2, 3, 4]))),
+            ("c/0/0/0", shard([0, 16, 16, 16, 32, 16, 48, 16])),
+        ],
+    );
+    // OME-Zarr 0.5: one level "0".
+    let ome = |datasets: serde_json::Value| {
+        json!({
+            "zarr_format": 3, "node_type": "group",
+            "attributes": {"ome": {"version": "0.5", "multiscales": [{
+                "axes": ["z", "y", "x"], "datasets": datasets,
+            }]}},
+        })
+        .to_string()
+        .into_bytes()
+    };
+    let level = |path: &str, scale: serde_json::Value| json!({"path": path, "coordinateTransformations": [{"type": "scale", "scale": scale}]});
+    for (what, datasets) in [
+        (
+            "a level outside the store",
+            json!([level("../..", json!([1, 1, 1]))]),
+        ),
+        (
+            "a missing level",
+            json!([level("0", json!([1, 1, 1])), level("1", json!([2, 2, 2]))]),
+        ),
+        ("a scale of 0", json!([level("0", json!([1, 0, 1]))])),
+        ("no levels", json!([])),
+    ] {
+        case(
+            &format!("OME-Zarr with {what}"),
+            vec![
+                ("zarr.json", ome(datasets)),
+                ("0/zarr.json", small(bytes())),
+                ("0/c/0/0/0", ramp.clone()),
+            ],
+        );
+    }
+    c
+}
+
 // -------------------------------------------------------------- running
 
 /// What one run of a case did wrong, if anything.
@@ -1522,6 +1709,7 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         hdf5_cases(),
         minc_cases(),
         flat_cases(),
+        zarr_cases(),
     ];
     for g in groups {
         all.extend(g.list);
