@@ -27,7 +27,7 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
@@ -86,6 +86,9 @@ for t in $targets; do
         add minc 00 "$fix"/minc/*.mnc
         add minc 02 "$fix"/minc/series_u8.mnc
         ;;
+    # Only the committed seeds (make_zarr_seeds.py): a store is two files
+    # packed into one input (fuzz_targets/zarr.rs).
+    zarr) ;;
     *) echo "seed.sh: unknown target $t" >&2; exit 1 ;;
     esac
     [ -d "$here/seeds/$t" ] && [ "$t" != raw ] && add "$t" none "$here"/seeds/"$t"/*

@@ -117,6 +117,33 @@ pub fn read_with(path: &Path, opts: &ReadOptions) {
     }
 }
 
+/// Opens `path` lazily, as a source of boxes (a chunked store: Zarr),
+/// and reads the box of the first half of each axis (at least 2 voxels),
+/// so that the readers of part of a chunk or shard are fuzzed too; a
+/// refusal (of the store, or of the box) must be one line naming the file.
+pub fn read_lazy_half(path: &Path, opts: &ReadOptions) {
+    match volray_io::open_lazy(path, opts) {
+        Ok(Some(lazy)) => {
+            let dims = lazy.source.grid().dims;
+            // Boxes are at least 2 voxels a side.
+            let hi = dims.map(|d| d.div_ceil(2).max(2).min(d));
+            match lazy.source.read_box([0; 3], hi) {
+                Ok(v) => {
+                    std::hint::black_box((v.value_range(), v.count_non_finite()));
+                }
+                Err(message) => {
+                    assert!(
+                        !message.contains('\n') && message.contains(SCRATCH_PREFIX),
+                        "a box's error is not one line naming the file: {message:?}"
+                    );
+                }
+            }
+        }
+        Ok(None) => {}
+        Err(err) => check_error(&err),
+    }
+}
+
 /// The project's rule for errors: one line, naming the file. The file
 /// named may be a companion in the same directory (a detached header's
 /// data file) or the input under another spelling (`file.h5:/dataset`),
