@@ -8,6 +8,7 @@ use volray_core::{NonFinite, Volume};
 use volray_io::{
     DType, Endian, FileInfo, FlatImage, IoError, MapPolicy, RawOptions, ReadOptions, VolumeFormat,
 };
+use volray_options::level::LevelChoice;
 
 /// What `volray render` shows when given no input.
 pub const DEMO: &str = "blobs:64";
@@ -76,7 +77,6 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
     let max_memory = args
         .max_memory
         .unwrap_or_else(volray_io::default_max_memory);
-    let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
     let (volume, mut file) = if volray_data::is_source_spec(spec) {
         let n = source_grid(args, spec)? as u64;
         volray_io::check_volume_size(
@@ -89,41 +89,7 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
         (volray_data::generate(spec)?, None)
     } else {
         let path = PathBuf::from(spec);
-        let format = match &args.format {
-            Some(f) => Some(
-                f.parse::<VolumeFormat>()
-                    .map_err(|e| CliError::input(format!("--format: {e}")))?,
-            ),
-            None => None,
-        };
-        // Raw layout flags on a file that names another format (`a.npy
-        // --dtype u8`) are misplaced, not a raw file missing its --dims.
-        if raw_flags
-            && format.is_none()
-            && let Some(named) = VolumeFormat::from_path(&path).filter(|f| *f != VolumeFormat::Raw)
-        {
-            return Err(CliError::input(format!(
-                "{spec}: --dims, --dtype and --endian describe raw files; this is a {} file (give --format raw to read it as raw)",
-                named.description()
-            )));
-        }
-        let raw = if raw_flags || format == Some(VolumeFormat::Raw) {
-            Some(raw_options(args, &path)?)
-        } else {
-            None
-        };
-        let opts = ReadOptions {
-            format,
-            raw,
-            frame: args.frame,
-            array: args.array.clone(),
-            level: args.level,
-            channel: args.channel,
-            max_memory,
-            // A volume over --max-memory is mapped from its file where its
-            // format allows (volray-io's MapPolicy), refused otherwise.
-            map,
-        };
+        let opts = read_options(args, spec, &path, max_memory, map)?;
         let loaded = match volray_io::read(&path, &opts) {
             Ok(loaded) => loaded,
             Err(IoError::FlatImage { mut image, .. }) => {
@@ -167,6 +133,54 @@ fn describe_with(args: &InputArgs, map: MapPolicy) -> Result<Described, CliError
     })))
 }
 
+/// The reader's options for the file `path` (INPUT as given: `spec`)
+/// from the input flags: the format, a raw layout, the frame, array,
+/// level and channel, the memory limit and the mapping policy.
+pub fn read_options(
+    args: &InputArgs,
+    spec: &str,
+    path: &Path,
+    max_memory: u64,
+    map: MapPolicy,
+) -> Result<ReadOptions, CliError> {
+    let raw_flags = args.dims.is_some() || args.dtype.is_some() || args.endian.is_some();
+    let format = match &args.format {
+        Some(f) => Some(
+            f.parse::<VolumeFormat>()
+                .map_err(|e| CliError::input(format!("--format: {e}")))?,
+        ),
+        None => None,
+    };
+    // Raw layout flags on a file that names another format (`a.npy
+    // --dtype u8`) are misplaced, not a raw file missing its --dims.
+    if raw_flags
+        && format.is_none()
+        && let Some(named) = VolumeFormat::from_path(path).filter(|f| *f != VolumeFormat::Raw)
+    {
+        return Err(CliError::input(format!(
+            "{spec}: --dims, --dtype and --endian describe raw files; this is a {} file (give --format raw to read it as raw)",
+            named.description()
+        )));
+    }
+    let raw = if raw_flags || format == Some(VolumeFormat::Raw) {
+        Some(raw_options(args, path)?)
+    } else {
+        None
+    };
+    Ok(ReadOptions {
+        format,
+        raw,
+        frame: args.frame,
+        array: args.array.clone(),
+        level: level_number(args)?,
+        channel: args.channel,
+        max_memory,
+        // A volume over --max-memory is mapped from its file where its
+        // format allows (volray-io's MapPolicy), refused otherwise.
+        map,
+    })
+}
+
 /// Points per side of the cube grid the built-in source `spec` samples,
 /// parsed as the source itself parses it (every built-in source is an
 /// N³ grid), so that its size is checked before it is generated.
@@ -182,6 +196,19 @@ pub fn source_grid(args: &InputArgs, spec: &str) -> Result<usize, CliError> {
         )));
     }
     source_points(spec)
+}
+
+/// `--level` as a number: `auto` needs the picture it is chosen for, so
+/// only `render`'s still images take it (see `streamed.rs`); elsewhere it
+/// is refused.
+fn level_number(args: &InputArgs) -> Result<Option<usize>, CliError> {
+    match args.level {
+        None => Ok(None),
+        Some(LevelChoice::Index(n)) => Ok(Some(n)),
+        Some(LevelChoice::Auto) => Err(CliError::input(
+            "--level auto chooses the level a still image needs (volray render ... -o OUT.png): give a level number here, 0 the finest",
+        )),
+    }
 }
 
 fn source_points(spec: &str) -> Result<usize, CliError> {

@@ -46,6 +46,7 @@ mod paper;
 mod render;
 mod session;
 mod settings;
+mod streamed;
 mod view;
 
 use flags::Command;

@@ -3,13 +3,15 @@
 
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::RenderArgs;
+use crate::flags::{InputArgs, RenderArgs};
 use crate::input;
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
 use crate::settings::settings;
+use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
 use volray_core::RenderSettings;
 use volray_io::{Animation, AnimationKind, BitDepth};
+use volray_options::level::LevelChoice;
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let specs = specs(args);
@@ -62,7 +64,24 @@ fn still(
     pool: &rayon::ThreadPool,
     kind: OutputKind,
 ) -> Result<(), CliError> {
-    let mut input = load(&args.input, args.view.look.log)?;
+    let input_args = match crate::streamed::plan(&args.input, &args.view, settings)? {
+        Plan::Streamed(mut streamed) => {
+            let settings = &streamed.settings_from_volume(&args.view, settings.clone())?;
+            let bar = progress_bar((settings.width * settings.height) as u64);
+            let (image, times) =
+                pool.install(|| streamed.render(&args.view, settings, &|n| bar.inc(n as u64)))?;
+            bar.finish_and_clear();
+            write_still(args, kind, &image)?;
+            eprintln!("{}", streamed.note(&times));
+            return Ok(());
+        }
+        // `--level auto` resolved to a level number.
+        Plan::Whole { level } => InputArgs {
+            level: level.map(LevelChoice::Index),
+            ..args.input.clone()
+        },
+    };
+    let mut input = load(&input_args, args.view.look.log)?;
     let settings = &from_volume(args, settings, &mut input)?;
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);

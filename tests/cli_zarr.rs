@@ -119,7 +119,7 @@ fn level_flags_are_refused_where_they_cannot_apply() {
     };
     refused(
         &["info", path, "--level", "auto"],
-        "--level auto is not supported yet",
+        "--level auto chooses the level a still image needs",
     );
     refused(&["info", path, "--level", "1.5"], "\"1.5\" is not a level");
     refused(

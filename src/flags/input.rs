@@ -6,6 +6,7 @@
 
 use super::parse::{parse_dims, parse_spacing};
 use clap::Args;
+use volray_options::level::LevelChoice;
 
 /// Where the volume comes from and how to read it.
 #[derive(Debug, Clone, Args)]
@@ -57,9 +58,10 @@ pub struct InputArgs {
     pub array: Option<String>,
 
     /// Zarr/OME-Zarr: which resolution level of a multiscale image, 0 the
-    /// finest (`volray info` lists them) [default: 0].
-    #[arg(long, value_name = "N", value_parser = parse_level)]
-    pub level: Option<usize>,
+    /// finest (`volray info` lists them), or `auto` (render): the
+    /// coarsest level whose voxels are no larger than a pixel [default: 0].
+    #[arg(long, value_name = "N|auto", value_parser = parse_level)]
+    pub level: Option<LevelChoice>,
 
     /// Zarr/OME-Zarr: which channel (the image's `c` axis), from 0
     /// [default: 0].
@@ -75,15 +77,7 @@ pub struct InputArgs {
     pub max_memory: Option<u64>,
 }
 
-/// A `--level`: a level number. `auto` (the level the view needs) will
-/// come with lazy, bricked reading; until then it is refused by name.
-fn parse_level(text: &str) -> Result<usize, String> {
-    match text.trim() {
-        "auto" => Err(
-            "--level auto is not supported yet (it comes with lazy, bricked reading): give a level number, 0 the finest".to_string(),
-        ),
-        t => t.parse().map_err(|_| {
-            format!("\"{text}\" is not a level: give a level number, 0 the finest")
-        }),
-    }
+/// A `--level`: `auto` or a level number.
+fn parse_level(text: &str) -> Result<LevelChoice, String> {
+    text.trim().parse()
 }

@@ -60,9 +60,10 @@ use volray_core::camera::View;
 use volray_core::kernels::composite::TERMINATION_TRANSMITTANCE;
 use volray_core::sampling::grid::GridFrame;
 use volray_core::transfer::classifier::Classifier;
+use volray_core::transfer::labels::{LabelError, labels_of};
 use volray_core::{
     Blend, DEFAULT_CACHE_BUDGET, Histogram, Image, MemoryBound, NonFinite, PartialImage,
-    PartialPixels, Piece, RenderError, RenderSettings, Renderer, VolumeSource,
+    PartialPixels, Piece, RenderError, RenderSettings, Renderer, Volume, VolumeSource,
 };
 
 /// Why a streamed frame failed.
@@ -113,6 +114,8 @@ pub struct Streamed {
     known: Vec<Known>,
     /// The renderer of the one piece, when the whole volume fits in one.
     whole: Option<Renderer<'static>>,
+    /// Whether the pieces are read as labels.
+    labels: bool,
 }
 
 impl Streamed {
@@ -121,6 +124,7 @@ impl Streamed {
     /// values are handled as `non_finite` says. Reads nothing yet.
     pub fn new(source: Arc<dyn VolumeSource>, non_finite: NonFinite, budget: u64) -> Self {
         let grid = source.grid();
+        let labels = source.is_labels();
         Streamed {
             decomposition: Decomposition::new(grid.dims, 1),
             known: vec![Known::default()],
@@ -129,7 +133,15 @@ impl Streamed {
             non_finite,
             budget,
             whole: None,
+            labels,
         }
+    }
+
+    /// The same, its values read as labels (a segmentation) or not.
+    pub fn with_labels(mut self, labels: bool) -> Self {
+        self.labels = labels;
+        self.whole = None;
+        self
     }
 
     /// The whole volume's grid.
@@ -209,7 +221,7 @@ impl Streamed {
             }
             let start = Instant::now();
             let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
-            let volume = self.source.read_box(lo, hi).map_err(StreamError::Read)?;
+            let volume = self.read(lo, hi)?;
             times.read_pieces += 1;
             times.read_voxels += volume.len() as u64;
             let renderer = Renderer::owning(volume, self.non_finite)?.with_cache_budget(cache);
@@ -268,7 +280,15 @@ impl Streamed {
     /// piece's owned voxels: the same counts as in one process. Reads every
     /// piece (twice the first time: once for the range). `None` for a
     /// volume with no finite value.
-    pub fn histogram(&mut self, bins: usize) -> Result<Option<Histogram>, StreamError> {
+    /// The pieces are those of frames of `settings` (histograms come
+    /// before the frame whose transfer function they choose).
+    pub fn histogram(
+        &mut self,
+        settings: &RenderSettings,
+        bins: usize,
+    ) -> Result<Option<Histogram>, StreamError> {
+        self.split_for(settings)?;
+        self.keep_whole()?;
         if let Some(r) = &self.whole {
             return Ok(Histogram::of(r.volume(), bins));
         }
@@ -281,10 +301,7 @@ impl Streamed {
             if owned.is_empty() {
                 continue;
             }
-            let volume = self
-                .source
-                .read_box(owned.lo, owned.hi)
-                .map_err(StreamError::Read)?;
+            let volume = self.read(owned.lo, owned.hi)?;
             let part = Histogram::of_box(&volume, ([0; 3], volume.dims()), range, bins);
             match &mut whole {
                 Some(h) => h.merge(&part),
@@ -292,6 +309,55 @@ impl Streamed {
             }
         }
         Ok(whole)
+    }
+
+    /// The distinct labels of the whole volume, sorted, as
+    /// [`labels_of`] finds them in one volume: found piece by piece over
+    /// each piece's owned voxels (the pieces tile the grid) and joined.
+    /// `Ok(None)` for more than `max` distinct values.
+    /// The pieces are those of frames of `settings`.
+    pub fn labels(
+        &mut self,
+        settings: &RenderSettings,
+        max: usize,
+    ) -> Result<Result<Option<Vec<i64>>, LabelError>, StreamError> {
+        self.split_for(settings)?;
+        self.keep_whole()?;
+        if let Some(r) = &self.whole {
+            return Ok(labels_of(r.volume(), max));
+        }
+        let mut union = std::collections::BTreeSet::new();
+        for owned in self.decomposition.boxes.clone() {
+            if owned.is_empty() {
+                continue;
+            }
+            let volume = self.read(owned.lo, owned.hi)?;
+            match labels_of(&volume, max) {
+                Ok(Some(found)) => union.extend(found),
+                Ok(None) => return Ok(Ok(None)),
+                Err(e) => return Ok(Err(e)),
+            }
+            if union.len() > max {
+                return Ok(Ok(None));
+            }
+        }
+        Ok(Ok(Some(union.into_iter().collect())))
+    }
+
+    /// With one piece, reads it (once) and keeps its renderer.
+    fn keep_whole(&mut self) -> Result<(), StreamError> {
+        if self.pieces() == 1 && self.whole.is_none() {
+            let volume = self.read([0; 3], self.grid.dims)?;
+            self.whole = Some(Renderer::owning(volume, self.non_finite)?);
+        }
+        Ok(())
+    }
+
+    /// The voxels `lo..hi` of the source, marked as labels when they are.
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, StreamError> {
+        let mut volume = self.source.read_box(lo, hi).map_err(StreamError::Read)?;
+        volume.set_labels(self.labels);
+        Ok(volume)
     }
 
     /// Reads the pieces whose value range (and largest gradient, if
@@ -306,7 +372,7 @@ impl Streamed {
                 continue;
             }
             let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
-            let volume = self.source.read_box(lo, hi).map_err(StreamError::Read)?;
+            let volume = self.read(lo, hi)?;
             read += 1;
             let renderer = Renderer::owning(volume, self.non_finite)?;
             let volume = renderer.volume();
@@ -330,14 +396,9 @@ impl Streamed {
     ) -> Result<(Image, StreamTimes), StreamError> {
         if self.whole.is_none() {
             let start = Instant::now();
-            let dims = self.grid.dims;
-            let volume = self
-                .source
-                .read_box([0; 3], dims)
-                .map_err(StreamError::Read)?;
+            self.keep_whole()?;
             times.read_pieces = 1;
-            times.read_voxels = volume.len() as u64;
-            self.whole = Some(Renderer::owning(volume, self.non_finite)?);
+            times.read_voxels = self.grid.dims.iter().map(|&n| n as u64).product();
             times.read = start.elapsed();
         }
         let renderer = self

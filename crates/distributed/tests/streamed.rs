@@ -200,7 +200,7 @@ fn the_histogram_counted_by_pieces_is_the_whole_volumes() {
     let mut streamed = Streamed::new(Arc::new(volume.clone()), NonFinite::Refuse, budget);
     streamed.render(&settings, &|_| {}).unwrap();
     assert!(streamed.pieces() > 1);
-    let pieces = streamed.histogram(64).unwrap().unwrap();
+    let pieces = streamed.histogram(&settings, 64).unwrap().unwrap();
     let whole = Histogram::of(&volume, 64).unwrap();
     assert_eq!((pieces.min, pieces.max), (whole.min, whole.max));
     assert_eq!(pieces.counts, whole.counts);
@@ -250,4 +250,45 @@ fn a_budget_too_small_for_any_piece_is_refused() {
         Err(e) => panic!("{e}"),
         Ok((_, times)) => panic!("rendered: {times:?}"),
     }
+}
+
+#[test]
+fn a_label_volume_in_pieces_has_the_wholes_labels_and_frame() {
+    use volray_core::transfer::labels::{LabelStyle, MAX_LABELS, labels_of, transfer_function};
+    // Three labelled balls on a background of 0.
+    let volume = Volume::from_fn([30, 28, 26], DVec3::ONE, DVec3::ZERO, |p| {
+        let balls = [
+            (DVec3::new(8.0, 8.0, 8.0), 1.0),
+            (DVec3::new(20.0, 18.0, 14.0), 7.0),
+        ];
+        (balls.iter())
+            .find(|(c, _)| (p - *c).length() < 6.0)
+            .map_or(if p.z > 22.0 { 3.0 } else { 0.0 }, |(_, l)| *l)
+    })
+    .unwrap()
+    .as_labels();
+    let found = labels_of(&volume, MAX_LABELS).unwrap().unwrap();
+    assert_eq!(found, vec![0, 1, 3, 7]);
+    let settings = RenderSettings {
+        transfer_function: transfer_function(&found, &LabelStyle::default()).unwrap(),
+        ..small()
+    };
+    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let budget = budget(&volume, &settings, 5);
+    // The source does not say its values are labels: the renderer of pieces is told.
+    let plain = Counted::new({
+        let mut v = volume.clone();
+        v.set_labels(false);
+        v
+    });
+    let mut streamed = Streamed::new(plain, NonFinite::Refuse, budget).with_labels(true);
+    let (frame, times) = streamed.render(&settings, &|_| {}).unwrap();
+    assert!(times.pieces > 1, "{times:?}");
+    assert_eq!(
+        streamed.labels(&settings, MAX_LABELS).unwrap().unwrap(),
+        Some(found)
+    );
+    assert!(streamed.labels(&settings, 2).unwrap().unwrap().is_none());
+    let diff = frame.max_abs_diff(&single).unwrap();
+    assert!(diff <= 1.0 / 255.0, "{diff}");
 }

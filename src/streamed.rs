@@ -1,0 +1,227 @@
+//! `volray render` of a chunked volume (Zarr, OME-Zarr): which level
+//! (`--level auto`), and, where that level is too large to render whole
+//! under `--max-memory`, rendering it piece by piece from its chunks
+//! (volray-distributed's `Streamed`), never reading it whole.
+//!
+//! The order: the file is opened from its metadata alone; `--level auto`
+//! picks the level for the picture (volray-options' `level`); the level's
+//! frame is bounded as a whole volume's would be (`memory.rs`). Within
+//! `--max-memory` it is read whole and rendered as any file is (the same
+//! pixels as `--level N`); beyond it, in pieces of at most
+//! [`PIECE_BUDGET`] each.
+
+use crate::error::CliError;
+use crate::flags::{InputArgs, ViewArgs};
+use crate::input;
+use crate::session::render_failure;
+use std::path::{Path, PathBuf};
+use volray_core::glam::DVec3;
+use volray_core::{Image, NonFinite, RenderSettings};
+use volray_distributed::streamed::{StreamError, StreamTimes, Streamed};
+use volray_io::{Lazy, MapPolicy, format_bytes};
+use volray_options::level::{LevelChoice, auto_level};
+
+/// The most one piece's frame may take (volray-core's bound: the piece
+/// read, the renderer's structures for a dense piece, its frame), however
+/// much `--max-memory` allows: larger pieces cut fewer ghost layers and
+/// take fewer reads, but past a few hundred megabytes of samples a piece
+/// costs memory and buys nothing. A 1 GiB bound holds a 2 byte piece of
+/// about 300³ voxels.
+pub const PIECE_BUDGET: u64 = 1 << 30;
+
+/// How INPUT is rendered.
+pub enum Plan {
+    /// Read whole (or mapped), as every file is: at this level, if any.
+    Whole { level: Option<usize> },
+    /// Rendered piece by piece from its chunks.
+    Streamed(Box<StreamedInput>),
+}
+
+/// A chunked volume rendered piece by piece.
+pub struct StreamedInput {
+    pub name: String,
+    pub streamed: Streamed,
+    /// What the note after a frame says: the level, and why in pieces.
+    level: usize,
+    whole: u128,
+    max_memory: u64,
+}
+
+/// Decides how INPUT is rendered for frames of `settings`: opens a
+/// chunked file from its metadata, picks its level, and streams it when
+/// that level's frame would not fit `--max-memory` whole. Other inputs
+/// (built-in sources, formats read whole or mapped) are read whole.
+pub fn plan(
+    args: &InputArgs,
+    view: &ViewArgs,
+    settings: &RenderSettings,
+) -> Result<Plan, CliError> {
+    let spec = args.input.as_deref().unwrap_or(input::DEMO);
+    let requested = args.level;
+    if volray_data::is_source_spec(spec) {
+        return Ok(Plan::Whole { level: None });
+    }
+    let max_memory = args
+        .max_memory
+        .unwrap_or_else(volray_io::default_max_memory);
+    let path = PathBuf::from(spec);
+    let fixed = match requested {
+        Some(LevelChoice::Index(n)) => Some(n),
+        _ => None,
+    };
+    let numbered = InputArgs {
+        level: fixed.map(LevelChoice::Index),
+        ..args.clone()
+    };
+    let opts = input::read_options(&numbered, spec, &path, max_memory, MapPolicy::IfLarger)?;
+    let Some(mut lazy) = volray_io::open_lazy(&path, &opts)? else {
+        if requested == Some(LevelChoice::Auto) {
+            return Err(CliError::input(format!(
+                "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
+            )));
+        }
+        return Ok(Plan::Whole { level: fixed });
+    };
+    if requested == Some(LevelChoice::Auto) {
+        let chosen = choose_level(spec, &lazy, settings)?;
+        if chosen != lazy.info.level {
+            let opts = volray_io::ReadOptions {
+                level: Some(chosen),
+                ..opts
+            };
+            lazy = volray_io::open_lazy(&path, &opts)?.expect("the same store");
+        }
+    }
+    let level = lazy.info.level;
+    let grid = lazy.source.grid();
+    let mode: NonFinite = view.sampling.nonfinite.into();
+    let sample = lazy.source.sample_type();
+    let need = crate::memory::render_bytes((grid.dims, grid.spacing, sample), settings, mode, 0);
+    if need <= u128::from(max_memory) {
+        return Ok(Plan::Whole { level: Some(level) });
+    }
+    if view.look.log {
+        return Err(CliError::input(format!(
+            "{spec}: level {level} may take up to {} to render whole, more than --max-memory {}, and --log is not yet taken piece by piece: raise --max-memory, or pick a coarser --level",
+            format_bytes(need),
+            format_bytes(u128::from(max_memory))
+        )));
+    }
+    let budget = max_memory.min(PIECE_BUDGET);
+    let streamed = Streamed::new(lazy.source, mode, budget).with_labels(view.look.labels);
+    Ok(Plan::Streamed(Box::new(StreamedInput {
+        name: spec.to_string(),
+        streamed,
+        level,
+        whole: need,
+        max_memory,
+    })))
+}
+
+/// The level `--level auto` takes for frames of `settings`, said on
+/// stderr.
+fn choose_level(spec: &str, lazy: &Lazy, settings: &RenderSettings) -> Result<usize, CliError> {
+    let levels = &lazy.info.levels;
+    let Some(finest) = levels.first() else {
+        return Ok(0);
+    };
+    let spacings: Vec<DVec3> = levels.iter().map(|l| DVec3::from(l.spacing)).collect();
+    let origin = DVec3::from(finest.origin);
+    let dims = DVec3::new(
+        finest.dims[0] as f64 - 1.0,
+        finest.dims[1] as f64 - 1.0,
+        finest.dims[2] as f64 - 1.0,
+    );
+    let bounds = (origin, origin + dims * DVec3::from(finest.spacing));
+    let chosen = auto_level(&spacings, bounds, settings)
+        .map_err(|e| CliError::input(format!("{spec}: {e}")))?;
+    let [x, y, z] = levels[chosen].dims;
+    eprintln!(
+        "volray: {}: level {chosen} of {} ({x}x{y}x{z}), the coarsest whose voxels are no larger than a pixel (--level auto)",
+        display(spec),
+        levels.len()
+    );
+    Ok(chosen)
+}
+
+fn display(spec: &str) -> String {
+    Path::new(spec).display().to_string()
+}
+
+impl StreamedInput {
+    /// `settings` with what the flags leave to the volume (`--labels`,
+    /// `--tf auto`), found piece by piece.
+    pub fn settings_from_volume(
+        &mut self,
+        view: &ViewArgs,
+        mut settings: RenderSettings,
+    ) -> Result<RenderSettings, CliError> {
+        let look = crate::settings::look(&view.look);
+        let name = self.name.clone();
+        if view.look.labels {
+            let found = self
+                .streamed
+                .labels(&settings, volray_core::transfer::labels::MAX_LABELS)
+                .map_err(|e| self.failure(view, e))?;
+            let found =
+                volray_options::labels_found(found, &name).map_err(crate::settings::refused)?;
+            crate::settings::label_transfer_function(
+                &view.look,
+                &mut settings.transfer_function,
+                &found,
+                &name,
+            )?;
+            return Ok(settings);
+        }
+        if look.auto_tf()
+            && let Some(histogram) = self
+                .streamed
+                .histogram(&settings, volray_core::transfer::auto::BINS)
+                .map_err(|e| self.failure(view, e))?
+        {
+            volray_options::apply_auto(&look, &mut settings.transfer_function, &histogram);
+        }
+        Ok(settings)
+    }
+
+    /// One frame.
+    pub fn render(
+        &mut self,
+        view: &ViewArgs,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<(Image, StreamTimes), CliError> {
+        self.streamed
+            .render(settings, progress)
+            .map_err(|e| self.failure(view, e))
+    }
+
+    /// The line that says how a frame was rendered.
+    pub fn note(&self, times: &StreamTimes) -> String {
+        let [x, y, z] = self.streamed.grid().dims;
+        format!(
+            "volray: {}: level {} ({x}x{y}x{z}) rendered in pieces, as it may take up to {} whole, over --max-memory {}: {} of {} pieces read ({} voxels), {:.2} s reading, {:.2} s rendering",
+            display(&self.name),
+            self.level,
+            format_bytes(self.whole),
+            format_bytes(u128::from(self.max_memory)),
+            times.read_pieces,
+            times.pieces,
+            times.read_voxels,
+            times.read.as_secs_f64(),
+            times.render.as_secs_f64()
+        )
+    }
+
+    /// A failed step as the CLI's error.
+    fn failure(&self, view: &ViewArgs, e: StreamError) -> CliError {
+        match e {
+            StreamError::Read(message) => CliError::io(message),
+            StreamError::TooLarge(message) => CliError::input(format!(
+                "{}: {message}: raise --max-memory, or pick a coarser --level",
+                self.name
+            )),
+            StreamError::Render(e) => render_failure(view, &self.name, e),
+        }
+    }
+}

@@ -1,0 +1,207 @@
+//! `volray render` of an OME-Zarr image that `--max-memory` will not let
+//! it read whole: rendered piece by piece from its chunks, the same
+//! picture as the image read whole within a level; and `--level auto`
+//! choosing the level the picture needs. The image is written here by
+//! hand (Zarr v3, the `bytes` codec, 16³ chunks), so these tests need no
+//! Python; zarr-python's stores are read in `crates/io/tests/zarr.rs`.
+
+mod common;
+
+use std::fs;
+use std::path::Path;
+
+use common::{Picture, stderr, volray};
+use serde_json::json;
+
+/// The image's finest level, (x, y, z).
+const DIMS: [usize; 3] = [48, 40, 36];
+const CHUNK: usize = 16;
+
+/// A smooth u16 field: two blobs over a ramp.
+fn value(x: usize, y: usize, z: usize) -> u16 {
+    let p = [x as f64, y as f64, z as f64];
+    let blob = |c: [f64; 3], r: f64| {
+        let d2: f64 = (0..3).map(|a| (p[a] - c[a]).powi(2)).sum();
+        (-d2 / (2.0 * r * r)).exp()
+    };
+    let v = 30000.0 * blob([16.0, 14.0, 12.0], 6.0) + 20000.0 * blob([32.0, 26.0, 24.0], 5.0);
+    (v + 40.0 * p[2]) as u16
+}
+
+/// One level of `dims` (x, y, z) at `dir`, `at(x, y, z)` its values, in
+/// chunks of 16³ (z, y, x) stored little-endian.
+fn write_level(dir: &Path, dims: [usize; 3], at: &dyn Fn(usize, usize, usize) -> u16) {
+    let shape = [dims[2], dims[1], dims[0]];
+    let meta = json!({
+        "zarr_format": 3,
+        "node_type": "array",
+        "shape": shape,
+        "data_type": "uint16",
+        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [CHUNK, CHUNK, CHUNK]}},
+        "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
+        "fill_value": 0,
+        "codecs": [{"name": "bytes", "configuration": {"endian": "little"}}],
+    });
+    fs::create_dir_all(dir).unwrap();
+    fs::write(dir.join("zarr.json"), meta.to_string()).unwrap();
+    let chunks = shape.map(|n| n.div_ceil(CHUNK));
+    for cz in 0..chunks[0] {
+        for cy in 0..chunks[1] {
+            for cx in 0..chunks[2] {
+                let mut bytes = Vec::with_capacity(2 * CHUNK.pow(3));
+                for z in cz * CHUNK..(cz + 1) * CHUNK {
+                    for y in cy * CHUNK..(cy + 1) * CHUNK {
+                        for x in cx * CHUNK..(cx + 1) * CHUNK {
+                            // Past the array's edge: the fill value.
+                            let inside = x < dims[0] && y < dims[1] && z < dims[2];
+                            let v = if inside { at(x, y, z) } else { 0 };
+                            bytes.extend_from_slice(&v.to_le_bytes());
+                        }
+                    }
+                }
+                let file = dir.join(format!("c/{cz}/{cy}/{cx}"));
+                fs::create_dir_all(file.parent().unwrap()).unwrap();
+                fs::write(file, bytes).unwrap();
+            }
+        }
+    }
+}
+
+/// An OME-Zarr 0.5 image of three levels, each halving every axis (2³
+/// block means), unit spacing at level 0.
+fn write_image(root: &Path) {
+    write_level(&root.join("0"), DIMS, &value);
+    let mut dims = DIMS;
+    let mut scale = 1.0;
+    let mut datasets = vec![json!({"path": "0", "coordinateTransformations": [
+        {"type": "scale", "scale": [1.0, 1.0, 1.0]}]})];
+    for level in 1..3 {
+        let factor = 1usize << level;
+        dims = dims.map(|n| n.div_ceil(2));
+        scale *= 2.0;
+        let mean = move |x: usize, y: usize, z: usize| {
+            let mut sum = 0.0;
+            let mut n = 0.0;
+            for k in z * factor..((z + 1) * factor).min(DIMS[2]) {
+                for j in y * factor..((y + 1) * factor).min(DIMS[1]) {
+                    for i in x * factor..((x + 1) * factor).min(DIMS[0]) {
+                        sum += f64::from(value(i, j, k));
+                        n += 1.0;
+                    }
+                }
+            }
+            (sum / n).round() as u16
+        };
+        write_level(&root.join(level.to_string()), dims, &mean);
+        let shift = (scale - 1.0) / 2.0;
+        datasets.push(
+            json!({"path": level.to_string(), "coordinateTransformations": [
+            {"type": "scale", "scale": [scale, scale, scale]},
+            {"type": "translation", "translation": [shift, shift, shift]}]}),
+        );
+    }
+    let meta = json!({
+        "zarr_format": 3,
+        "node_type": "group",
+        "attributes": {"ome": {"version": "0.5", "multiscales": [{
+            "axes": [
+                {"name": "z", "type": "space"},
+                {"name": "y", "type": "space"},
+                {"name": "x", "type": "space"},
+            ],
+            "datasets": datasets,
+        }]}},
+    });
+    fs::write(root.join("zarr.json"), meta.to_string()).unwrap();
+}
+
+/// Renders `args` to `out`, asserting success; its stderr.
+fn render(args: &[&str], out: &Path) -> String {
+    let all = [&["render"], args, &["-o", out.to_str().unwrap()]].concat();
+    let result = volray(&all);
+    assert!(result.status.success(), "{all:?}: {}", stderr(&result));
+    stderr(&result)
+}
+
+const LOOK: [&str; 6] = ["--preset", "mr", "--range", "0,32000", "--size", "40x36"];
+
+#[test]
+fn a_level_over_max_memory_renders_piece_by_piece_as_it_would_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let path = image.to_str().unwrap();
+    let (whole, pieces) = (dir.path().join("whole.png"), dir.path().join("pieces.png"));
+    let said = render(&[&[path, "--level", "0"], &LOOK[..]].concat(), &whole);
+    assert!(!said.contains("pieces"), "{said}");
+    // 48·40·36 u16 voxels take 138 kB: 100 kB cannot hold them whole, but
+    // it holds pieces of them and their frames.
+    let said = render(
+        &[&[path, "--level", "0", "--max-memory", "100K"], &LOOK[..]].concat(),
+        &pieces,
+    );
+    assert!(said.contains("in pieces"), "{said}");
+    let picture = Picture::read(&whole);
+    assert!(picture.rgb.iter().any(|p| *p != picture.rgb[0]), "blank");
+    let diff = Picture::read(&pieces).max_diff(&picture);
+    assert!(diff <= 1, "{diff}");
+    // The value range the preset's window does not give is found piece by
+    // piece too: --tf auto (a histogram) and a colour map over the data.
+    for extra in [&["--tf", "auto"][..], &["--colormap", "viridis"][..]] {
+        let args = [&[path, "--size", "40x36"], extra].concat();
+        render(&args, &whole);
+        let limited = [&args[..], &["--max-memory", "100K"]].concat();
+        let said = render(&limited, &pieces);
+        assert!(said.contains("in pieces"), "{extra:?}: {said}");
+        let diff = Picture::read(&pieces).max_diff(&Picture::read(&whole));
+        assert!(diff <= 1, "{extra:?}: {diff}");
+    }
+}
+
+#[test]
+fn level_auto_takes_the_coarsest_level_no_coarser_than_a_pixel() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let path = image.to_str().unwrap();
+    let out = |name: &str| dir.path().join(name);
+    // Seen from +x, the 39 x 35 face fitted: 1.08 units a pixel at 36
+    // rows (level 0, spacing 1); 2.06 at 17 (level 1, spacing 2); 4.4 at
+    // 8 (level 2, spacing 4).
+    for (height, level) in [("36", 0), ("17", 1), ("8", 2)] {
+        let size = ["--size", height, "--preset", "mr", "--range", "0,32000"];
+        let said = render(
+            &[&[path, "--level", "auto"], &size[..]].concat(),
+            &out("auto.png"),
+        );
+        assert!(
+            said.contains(&format!("level {level} of 3")),
+            "{height}: {said}"
+        );
+        let n = level.to_string();
+        render(
+            &[&[path, "--level", n.as_str()], &size[..]].concat(),
+            &out("fixed.png"),
+        );
+        assert_eq!(
+            Picture::read(&out("auto.png")),
+            Picture::read(&out("fixed.png")),
+            "{height}"
+        );
+    }
+    // A file of one level: refused by name.
+    let raw = dir.path().join("v.npy");
+    let made = volray(&["convert", "sphere:8", "-o", raw.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let refused = volray(&[
+        "render",
+        raw.to_str().unwrap(),
+        "--level",
+        "auto",
+        "-o",
+        "x.png",
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let err = stderr(&refused);
+    assert!(err.contains("--level") && err.lines().count() == 1, "{err}");
+}
