@@ -20,6 +20,7 @@
 use crate::error::CliError;
 use crate::flags::RenderArgs;
 use crate::session::{load, progress_bar, render_failure, renderer_for};
+use crate::streamed::Plan;
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
@@ -35,7 +36,24 @@ pub fn turntable(
     pool: &ThreadPool,
     frames: usize,
 ) -> Result<(), CliError> {
-    let mut input = load(&args.input, args.view.look.log)?;
+    // The level and the road (whole or in pieces) are chosen for the
+    // first frame: the framing fits the bounding sphere, so every frame
+    // shows the volume at one scale.
+    let first = turntable_frame(base, 0, frames);
+    let input_args = match crate::streamed::plan(&args.input, &args.view, &first)? {
+        Plan::Streamed(mut streamed) => {
+            let base = &streamed.settings_from_volume(&args.view, base.clone())?;
+            let mut writer = Writer::new(args, base, frames)?;
+            for i in 0..frames {
+                let frame = turntable_frame(base, i, frames);
+                let (image, _) = pool.install(|| streamed.render(&args.view, &frame, &|_| {}))?;
+                writer.push(&image)?;
+            }
+            return writer.finish();
+        }
+        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
+    };
+    let mut input = load(&input_args, args.view.look.log)?;
     let base = &crate::render::from_volume(args, base, &mut input)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;

@@ -3,7 +3,7 @@
 
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::{InputArgs, RenderArgs};
+use crate::flags::RenderArgs;
 use crate::input;
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
 use crate::settings::settings;
@@ -11,7 +11,6 @@ use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
 use volray_core::RenderSettings;
 use volray_io::{Animation, AnimationKind, BitDepth};
-use volray_options::level::LevelChoice;
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let specs = specs(args);
@@ -75,11 +74,7 @@ fn still(
             eprintln!("{}", streamed.note(&times));
             return Ok(());
         }
-        // `--level auto` resolved to a level number.
-        Plan::Whole { level } => InputArgs {
-            level: level.map(LevelChoice::Index),
-            ..args.input.clone()
-        },
+        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
     let settings = &from_volume(args, settings, &mut input)?;

@@ -118,6 +118,16 @@ pub fn plan(
     })))
 }
 
+/// The input flags reading INPUT whole at `level` (`--level auto`
+/// resolved to a number).
+pub fn at_level(args: &InputArgs, level: Option<usize>) -> InputArgs {
+    InputArgs {
+        // Unresolved (a built-in source): as given, for the reader to refuse.
+        level: level.map(LevelChoice::Index).or(args.level),
+        ..args.clone()
+    }
+}
+
 /// The level `--level auto` takes for frames of `settings`, said on
 /// stderr.
 fn choose_level(spec: &str, lazy: &Lazy, settings: &RenderSettings) -> Result<usize, CliError> {

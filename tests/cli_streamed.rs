@@ -205,3 +205,33 @@ fn level_auto_takes_the_coarsest_level_no_coarser_than_a_pixel() {
     let err = stderr(&refused);
     assert!(err.contains("--level") && err.lines().count() == 1, "{err}");
 }
+
+#[test]
+fn a_turntable_of_a_level_over_max_memory_turns_piece_by_piece() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let path = image.to_str().unwrap();
+    let whole = dir.path().join("whole_%02d.png");
+    let pieces = dir.path().join("pieces_%02d.png");
+    let turn = ["--turntable", "3"];
+    render(&[&[path], &LOOK[..], &turn[..]].concat(), &whole);
+    let said = render(
+        &[&[path, "--max-memory", "100K"], &LOOK[..], &turn[..]].concat(),
+        &pieces,
+    );
+    assert!(said.is_empty() || !said.contains("error"), "{said}");
+    for i in 0..3 {
+        let a = Picture::read(&dir.path().join(format!("whole_{i:02}.png")));
+        let b = Picture::read(&dir.path().join(format!("pieces_{i:02}.png")));
+        assert!(a.max_diff(&b) <= 1, "frame {i}: {}", a.max_diff(&b));
+    }
+    // Built-in sources have no levels, auto or not.
+    let out = volray(&["render", "sphere:8", "--level", "auto", "-o", "x.png"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("apply to files only"),
+        "{}",
+        stderr(&out)
+    );
+}
