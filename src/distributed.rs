@@ -230,6 +230,9 @@ struct CliSource {
     reorientation: Option<Reorientation>,
     /// The piece rank 0 read (or generated) and sent.
     sent: Option<Volume>,
+    /// A chunked store (Zarr, OME-Zarr) opened from its metadata: every
+    /// rank reads the chunks of its own box.
+    chunked: Option<std::sync::Arc<dyn Source>>,
     /// `--log`: the whole volume's smallest positive value, which values
     /// `<= 0` take on the log scale (agreed by the ranks).
     log_floor: Option<f32>,
@@ -249,6 +252,8 @@ enum Route {
     /// Copied out of the mapped file in its stored type, and reordered
     /// into a second copy where the file's axes are not x, y, z.
     Mapped { stored: SampleType, reordered: bool },
+    /// Decoded from the chunks of a chunked store in its stored type.
+    Chunked { stored: SampleType },
     /// Generated, as `f32`.
     Generated,
     /// Received from rank 0 as `f32` bytes, then decoded.
@@ -351,6 +356,7 @@ impl CliSource {
             whole: None,
             reorientation: None,
             sent: None,
+            chunked: None,
             log_floor: None,
             generate: None,
             log: view.look.log,
@@ -362,6 +368,28 @@ impl CliSource {
         if volray_data::is_source_spec(&spec) && !generated_whole(&spec) {
             source.generate_boxes(mpi, args, view)?;
             return Ok(source);
+        }
+        // A chunked store: every rank opens it from its metadata and
+        // decodes the chunks of its own box, and nothing else.
+        if !volray_data::is_source_spec(&spec) {
+            let path = std::path::PathBuf::from(&spec);
+            let opened = input::read_options(args, &spec, &path, max_memory, MapPolicy::IfLarger)
+                .and_then(|opts| volray_io::open_lazy(&path, &opts).map_err(CliError::from));
+            let status = opened
+                .as_ref()
+                .map(|lazy| vec![u8::from(lazy.is_some())])
+                .map_err(|e| e.to_string());
+            let all = agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
+            if all.iter().all(|m| m.first() == Some(&1)) {
+                let lazy = opened.ok().flatten().expect("agreed");
+                source.grid = lazy.source.grid();
+                let stored = lazy.source.sample_type();
+                source.chunked = Some(lazy.source);
+                let fits = source.check_piece(mpi, Route::Chunked { stored });
+                agree(mpi, fits.map(|_| Vec::new())).map_err(|e| failure(view, &spec, e))?;
+                source.agree_log_floor(mpi, view)?;
+                return Ok(source);
+            }
         }
         // A file mapped wherever it can be, in its own axis order if need
         // be; else read whole by rank 0 (a fractal generated whole).
@@ -499,7 +527,7 @@ impl CliSource {
         let voxels = dims.iter().map(|&n| n as u128).product::<u128>();
         let bytes = |t: SampleType| voxels * t.bytes() as u128;
         let first = match route {
-            Route::Mapped { stored, .. } => stored,
+            Route::Mapped { stored, .. } | Route::Chunked { stored } => stored,
             Route::Generated | Route::Sent => SampleType::F32,
         };
         let last = if self.log { SampleType::F32 } else { first };
@@ -611,6 +639,9 @@ impl CliSource {
         if let Some(spec) = &self.generate {
             return volray_data::generate_box(spec, lo, hi).map_err(|e| e.to_string());
         }
+        if let Some(chunked) = &self.chunked {
+            return chunked.read_box(lo, hi);
+        }
         match (&self.whole, &self.reorientation, &self.sent) {
             (Some(file), Some(r), _) => {
                 (r.sub_box(file, lo, hi)).map_err(|e| format!("{}: its piece: {e}", self.name))
@@ -704,6 +735,9 @@ impl Source for CliSource {
     /// The mapped file's type; generated and sent pieces, and values on
     /// the log scale, are `f32`.
     fn sample_type(&self) -> SampleType {
+        if let (Some(chunked), false) = (&self.chunked, self.log) {
+            return chunked.sample_type();
+        }
         match (&self.whole, self.log) {
             (Some(whole), false) => whole.sample_type(),
             _ => SampleType::F32,

@@ -317,6 +317,41 @@ fn a_compressed_file_is_read_by_rank_zero_and_scattered() {
 }
 
 #[test]
+fn each_rank_reads_the_chunks_of_its_own_box_of_an_ome_zarr_image() {
+    if mpirun().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // The 129³ fractal written by volray convert: 64³ chunks, zstd.
+    let store = dir.path().join("f129.ome.zarr");
+    single(&["convert", "fractal:129", "-o", store.to_str().unwrap()]);
+    let args = [
+        store.to_str().unwrap(),
+        "--size",
+        "96x96",
+        "--azimuth",
+        "30",
+    ];
+    let stderrs = ranks_match_one_process(dir.path(), "OME-Zarr", &args, &[2, 3, 4]);
+    for stderr in &stderrs {
+        assert!(!stderr.contains("rank 0 reads it"), "{stderr}");
+    }
+    // Read by range: under a limit the 8.6 MB of samples exceed, four ranks
+    // each read and render their own quarter, the same picture.
+    let limited = [&args[..], &["--max-memory", "8M"]].concat();
+    let one = dir.path().join("limited1.png");
+    let refused = ranks(1, &with_output(&limited, one.to_str().unwrap()));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success(), "one rank rendered under 8M");
+    assert!(err.contains("over --max-memory 8 MiB"), "{err}");
+    let four = dir.path().join("limited4.png");
+    let run = ranks(4, &with_output(&limited, four.to_str().unwrap()));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{err}");
+    assert!(largest_difference(&dir.path().join("one.png"), &four) <= 1);
+}
+
+#[test]
 fn a_rank_that_cannot_read_ends_every_rank_with_one_error_and_no_file() {
     if mpirun().is_none() {
         return;

@@ -240,7 +240,14 @@ pub(crate) fn read_box(
     max_memory: u64,
 ) -> Result<Samples, IoError> {
     check_volume_size(path, "Zarr box", shape, ty.read_bytes(), max_memory)?;
-    if let Some(chunk) = chunk_shape(array) {
+    // The unit `zarrs` holds decoded beside the box: a chunk, or for a
+    // sharded array one inner chunk (it decodes a shard's inner chunks
+    // through the shard index, one by one, into the box).
+    let unit = match (array.is_sharded(), array.subchunk_shape()) {
+        (true, Some(inner)) => Some(inner.iter().map(|n| n.get()).collect()),
+        _ => chunk_shape(array),
+    };
+    if let Some(chunk) = unit {
         check_volume_size(path, "Zarr chunk shape", &chunk, ty.size(), max_memory)?;
     }
     let subset = ArraySubset::new_with_start_shape(start.to_vec(), shape.to_vec())
