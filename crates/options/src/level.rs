@@ -1,4 +1,4 @@
-//! `--level auto` (`level="auto"` in Python): which level of a multiscale
+//! `--level auto`: which level of a multiscale
 //! image a view needs, so that a picture of a huge pyramid reads what it
 //! can show and no more (neuroglancer's and BigDataViewer's rule, for one
 //! frame).
