@@ -145,6 +145,10 @@ pub fn write_ome_zarr(
     source: &dyn VolumeSource,
     options: &OmeZarrOptions,
 ) -> Result<OmeZarrWritten, IoError> {
+    // The checked codecs registered before this thread builds any codec
+    // (their registration takes zarrs' registry lock once, here, not
+    // while another thread's writer holds it).
+    super::guard::install();
     if options.chunk < 2 || options.shard < 2 {
         return Err(IoError::invalid(
             path,
