@@ -8,8 +8,22 @@ use volray_core::Histogram;
 use volray_core::transfer::labels;
 use volray_io::{FileInfo, FlatImage};
 
+/// The most a chunked level may take in memory for `info` to read it for
+/// its statistics (or a quarter of `--max-memory`, if less); a larger
+/// one's statistics come from the finest level under it (block means:
+/// within the level's range), and only its metadata is read, so that
+/// `info` on a pyramid of any size answers at once.
+const VALUES_READ_LIMIT: u64 = 64 << 20;
+
 pub fn run(args: &InfoArgs) -> Result<(), CliError> {
-    let input = match input::describe(&args.input)? {
+    // A chunked level larger than VALUES_READ_LIMIT: its metadata, and the
+    // statistics of a smaller level.
+    let chunked = large_chunked_level(&args.input)?;
+    let described = match &chunked {
+        Some((_, k)) => input::describe(&crate::streamed::at_level(&args.input, Some(*k)))?,
+        None => input::describe(&args.input)?,
+    };
+    let input = match described {
         Described::Volume(input) => input,
         Described::Image { name, image } => {
             describe_image(&name, &image, args.json);
@@ -22,13 +36,30 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     // likely a segmentation.
     let labels = (labels::labels_of(v, SUGGEST_LABELS).ok().flatten())
         .filter(|found| found.len() * 16 <= v.len());
-    let (format, info) = match &input.file {
-        Some((format, info)) => (format.description().to_string(), Some(info)),
-        None => ("built-in source".to_string(), None),
+    let (format, info) = match (&chunked, &input.file) {
+        (Some((lazy, _)), _) => (lazy.format.description().to_string(), Some(&lazy.info)),
+        (None, Some((format, info))) => (format.description().to_string(), Some(info)),
+        (None, None) => ("built-in source".to_string(), None),
     };
+    // What is shown of the volume: the level asked for, whichever level
+    // the statistics came from.
+    let grid = match &chunked {
+        Some((lazy, _)) => lazy.source.grid(),
+        None => volray_core::VolumeSource::grid(v),
+    };
+    let values_from = chunked.as_ref().map(|(lazy, k)| {
+        let l = &lazy.info.levels[*k];
+        (*k, l.dims)
+    });
+    let kept = match &chunked {
+        Some((lazy, _)) => lazy.source.sample_type(),
+        None => v.sample_type(),
+    };
+    let mapped = chunked.is_none() && v.samples().is_external();
+    let points: usize = grid.dims.iter().product();
     let unit = info.and_then(|i| i.length_unit.clone());
-    let [nx, ny, nz] = v.dims();
-    let (s, o) = (v.spacing(), v.origin());
+    let [nx, ny, nz] = grid.dims;
+    let (s, o) = (grid.spacing, grid.origin);
 
     if args.json {
         let histogram = hist.as_ref().map(|h| {
@@ -43,12 +74,13 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             "input": input.name,
             "format": format,
             "dims": [nx, ny, nz],
-            "sample_type": v.sample_type().name(),
-            "mapped": v.samples().is_external(),
+            "sample_type": kept.name(),
+            "mapped": mapped,
             "spacing": [s.x, s.y, s.z],
             "origin": [o.x, o.y, o.z],
             "length_unit": unit,
             "values": histogram,
+            "values_level": values_from.map(|(k, _)| k),
             "labels": labels,
         });
         if let Some(i) = info {
@@ -67,26 +99,26 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     if let Some(i) = info {
         print_stored(i);
     }
-    outln!("dims:      {nx} x {ny} x {nz} ({} points)", v.len());
-    let kept = v.sample_type();
+    outln!("dims:      {nx} x {ny} x {nz} ({points} points)");
     outln!(
         "in memory: {}{} ({} a voxel, {})",
-        if v.samples().is_external() {
-            "mapped from the file, "
-        } else {
-            ""
-        },
+        if mapped { "mapped from the file, " } else { "" },
         kept.name(),
         match kept.bytes() {
             1 => "1 byte".to_string(),
             n => format!("{n} bytes"),
         },
-        volray_io::format_bytes((kept.bytes() * v.len()) as u128)
+        volray_io::format_bytes((kept.bytes() * points) as u128)
     );
     outln!("spacing:   {}, {}, {}{unit_suffix}", s.x, s.y, s.z);
     outln!("origin:    {}, {}, {}{unit_suffix}", o.x, o.y, o.z);
-    let e = v.extent();
+    let e = grid.extent();
     outln!("extent:    {}, {}, {}{unit_suffix}", e.x, e.y, e.z);
+    if let Some((k, [x, y, z])) = values_from {
+        outln!(
+            "           values below from level {k} ({x} x {y} x {z}), block means of this one: its range lies within this level's (only the metadata of a level this large is read)"
+        );
+    }
     match &hist {
         None => outln!("values:    no finite values"),
         Some(h) => {
@@ -131,6 +163,44 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         print_header_and_notes(i);
     }
     Ok(())
+}
+
+/// A chunked level (Zarr, OME-Zarr) over [`VALUES_READ_LIMIT`] in memory,
+/// opened from its metadata, and the level whose statistics `info` reads
+/// instead: the finest under the limit, else the coarsest.
+fn large_chunked_level(
+    args: &crate::flags::InputArgs,
+) -> Result<Option<(volray_io::Lazy, usize)>, CliError> {
+    let spec = args.input.as_deref().unwrap_or(input::DEMO);
+    if volray_data::is_source_spec(spec) {
+        return Ok(None);
+    }
+    let max_memory = args
+        .max_memory
+        .unwrap_or_else(volray_io::default_max_memory);
+    let path = std::path::PathBuf::from(spec);
+    let opts = input::read_options(
+        args,
+        spec,
+        &path,
+        max_memory,
+        volray_io::MapPolicy::IfLarger,
+    )?;
+    let Some(lazy) = volray_io::open_lazy(&path, &opts)? else {
+        return Ok(None);
+    };
+    let levels = &lazy.info.levels;
+    let chosen = lazy.info.level;
+    let limit = VALUES_READ_LIMIT.min(max_memory / 4);
+    let small = |k: &usize| levels[*k].bytes_in_memory <= limit;
+    if levels.is_empty() || small(&chosen) {
+        return Ok(None);
+    }
+    let k = (chosen..levels.len())
+        .find(small)
+        .unwrap_or(levels.len() - 1);
+    // No coarser level: the statistics are the level's own, read whole.
+    Ok((k != chosen).then_some((lazy, k)))
 }
 
 /// `info` suggests `--labels` for integer volumes with at most this many

@@ -235,3 +235,31 @@ fn a_turntable_of_a_level_over_max_memory_turns_piece_by_piece() {
         stderr(&out)
     );
 }
+
+#[test]
+fn info_reads_the_metadata_of_a_large_level_and_the_values_of_a_smaller_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let path = image.to_str().unwrap();
+    let info = |extra: &[&str]| -> serde_json::Value {
+        let out = volray(&[&["info", path, "--json"], extra].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        serde_json::from_str(&common::stdout(&out)).unwrap()
+    };
+    // Level 0 takes 138 kB: under 100 kB / 4, level 1 (17 kB) gives the values.
+    let small = info(&["--max-memory", "100K"]);
+    assert_eq!(small["dims"], json!([48, 40, 36]));
+    assert_eq!(small["level"], 0);
+    assert_eq!(small["values_level"], 1);
+    // With room, the level's own values.
+    let whole = info(&[]);
+    assert_eq!(whole["values_level"], serde_json::Value::Null);
+    assert_eq!(whole["dims"], small["dims"]);
+    assert_eq!(whole["spacing"], small["spacing"]);
+    let (lo, hi) = (&whole["values"], &small["values"]);
+    // Block means lie within the level's range.
+    assert!(hi["min"].as_f64() >= lo["min"].as_f64(), "{hi} {lo}");
+    assert!(hi["max"].as_f64() <= lo["max"].as_f64(), "{hi} {lo}");
+    assert!(hi["max"].as_f64().unwrap() < lo["max"].as_f64().unwrap());
+}

@@ -4,7 +4,7 @@
 //! frame).
 //!
 //! The rule: the coarsest level whose voxels are no larger than a pixel's
-//! footprint ([`View::pixel_footprint`]: an orthographic pixel's size;
+//! footprint (within [`SLACK`]) ([`View::pixel_footprint`]: an orthographic pixel's size;
 //! in perspective, a pixel's size at the point of the volume nearest the
 //! eye), a voxel measured by its largest spacing. A finer level would add
 //! detail no pixel shows; a coarser one would blur what the picture can
@@ -22,13 +22,16 @@
 //! let bounds = (DVec3::ZERO, DVec3::splat(2047.0));
 //! let settings = RenderSettings { width: 1024, height: 1024, ..RenderSettings::default() };
 //! // The default framing fits the face seen, 2047 µm over 1024 pixels:
-//! // 2 µm a pixel, so level 1 (2 µm voxels).
+//! // 2 µm a pixel (less 0.05 %), so level 1 (2 µm voxels).
 //! assert_eq!(auto_level(&spacings, bounds, &settings).unwrap(), 1);
 //! ```
 
 use volray_core::RenderSettings;
 use volray_core::camera::{CameraError, View};
 use volray_core::glam::DVec3;
+
+/// How much coarser than a pixel's footprint a level's voxels may be.
+pub const SLACK: f64 = 1.0 / 32.0;
 
 /// A level asked for: chosen for the view, or by number (0 the finest).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,9 +64,12 @@ pub fn auto_level(
 ) -> Result<usize, CameraError> {
     let view = View::frame(&settings.camera, bounds, settings.width, settings.height)?;
     let footprint = view.pixel_footprint(bounds);
-    // A hair of tolerance: a level exactly a pixel's size qualifies, even
-    // after the framing's rounding.
-    let fits = |s: &DVec3| s.max_element() <= footprint * (1.0 + 1e-9);
+    // A little slack: the framed box spans n − 1 voxel gaps of a grid of
+    // n points, so a 2048³ box at 1024 pixels measures 2047/1024 units a
+    // pixel, and the level of 2-unit voxels (which the picture cannot tell
+    // from level 0) would miss by 0.05 %. 1/32 allows that gap for any
+    // grid of 33 points or more, and never takes a level half as fine.
+    let fits = |s: &DVec3| s.max_element() <= footprint * (1.0 + SLACK);
     Ok(spacings.iter().rposition(fits).unwrap_or(0))
 }
 
@@ -109,6 +115,25 @@ mod tests {
         assert_eq!(at(8000, 1.0), 0);
         // A tiny one the coarsest there is.
         assert_eq!(at(2, 1.0), 5);
+    }
+
+    #[test]
+    fn a_level_a_grid_gap_coarser_than_a_pixel_still_qualifies() {
+        // 2048 points a side: 2047 units over 1024 pixels, 1.999 a pixel.
+        let bounds = (DVec3::ZERO, DVec3::splat(2047.0));
+        let spacings: Vec<DVec3> = (0..6).map(|k| DVec3::splat(f64::from(1u32 << k))).collect();
+        let at = |pixels: usize| {
+            let settings = RenderSettings {
+                width: pixels,
+                height: pixels,
+                ..RenderSettings::default()
+            };
+            auto_level(&spacings, bounds, &settings).unwrap()
+        };
+        assert_eq!(at(1024), 1);
+        assert_eq!(at(512), 2);
+        // 1.93 units a pixel: 2-unit voxels are 3.5 % too coarse.
+        assert_eq!(at(1060), 0);
     }
 
     #[test]
