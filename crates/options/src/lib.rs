@@ -28,8 +28,8 @@
 //! ```
 
 mod blame;
-pub mod level;
 mod error;
+pub mod level;
 mod option;
 mod options;
 mod settings;
