@@ -42,10 +42,10 @@
 //! use volray_core::{NonFinite, RenderSettings, Volume};
 //! use volray_distributed::streamed::Streamed;
 //!
-//! let volume = Volume::from_fn([24; 3], DVec3::ONE, DVec3::ZERO, |p| p.x as f32).unwrap();
+//! let volume = Volume::from_fn([40; 3], DVec3::ONE, DVec3::ZERO, |p| p.x as f32).unwrap();
 //! let settings = RenderSettings { width: 32, height: 32, ..RenderSettings::default() };
-//! // A budget of 150 kB: the 24³ volume is rendered in several pieces.
-//! let mut streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 150_000);
+//! // A budget of 200 kB: the 40³ volume (256 kB) is rendered in several pieces.
+//! let mut streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 200_000);
 //! let (image, times) = streamed.render(&settings, &|_| {}).unwrap();
 //! assert!(times.pieces > 1 && times.read_pieces <= times.pieces);
 //! assert_eq!((image.width(), image.height()), (32, 32));
