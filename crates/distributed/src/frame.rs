@@ -304,10 +304,7 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             settings.height,
         )
         .map_err(RenderError::from)?;
-        let viewpoint = match &view {
-            View::Orthographic(v) => Viewpoint::Direction(v.direction),
-            View::Perspective(v) => Viewpoint::Eye(v.eye),
-        };
+        let viewpoint = Viewpoint::of(&view);
         let rendered = match &self.held.renderer {
             Some(r) => r.render_partial_timed(&settings, &|_| {}).map(Some),
             None => settings.validate().map(|_| None).map_err(RenderError::from),
@@ -457,7 +454,7 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
 }
 
 /// A partial image with nothing in it, for a rank with an empty box.
-fn blank(settings: &RenderSettings) -> PartialImage {
+pub(crate) fn blank(settings: &RenderSettings) -> PartialImage {
     let (w, h) = (settings.width, settings.height);
     if settings.blend.is_projection() {
         PartialImage::projection(w, h, settings.blend)

@@ -59,6 +59,14 @@ pub enum Viewpoint {
 }
 
 impl Viewpoint {
+    /// Where the rays of a framed view come from.
+    pub fn of(view: &volray_core::camera::View) -> Self {
+        match view {
+            volray_core::camera::View::Orthographic(v) => Viewpoint::Direction(v.direction),
+            volray_core::camera::View::Perspective(v) => Viewpoint::Eye(v.eye),
+        }
+    }
+
     /// Whether the low side of the world plane `p[axis] = at` is in front.
     /// Where it does not matter (rays parallel to the plane, or an eye on
     /// it, whose rays each stay on one side), the low side.

@@ -51,7 +51,7 @@
 //! assert_eq!((image.width(), image.height()), (32, 32));
 //! ```
 
-use crate::frame::owned_max_gradient;
+use crate::frame::{blank, owned_max_gradient};
 use crate::kd::{Decomposition, Viewpoint, VoxelBox};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -196,10 +196,7 @@ impl Streamed {
             settings.height,
         )
         .map_err(RenderError::from)?;
-        let viewpoint = match &view {
-            View::Orthographic(v) => Viewpoint::Direction(v.direction),
-            View::Perspective(v) => Viewpoint::Eye(v.eye),
-        };
+        let viewpoint = Viewpoint::of(&view);
         let mut image: Option<PartialImage> = None;
         for index in self.decomposition.front_to_back(&viewpoint, &self.grid) {
             let owned = self.decomposition.boxes[index];
@@ -508,14 +505,4 @@ fn hidden(image: &PartialImage, view: &View, grid: &GridFrame, owned: VoxelBox) 
     let (c0, c1) = (clamp(x0.floor() - 1.0, w), clamp(x1.ceil() + 1.0, w));
     let (r0, r1) = (clamp(y0.floor() - 1.0, h), clamp(y1.ceil() + 1.0, h));
     (r0..r1).all(|r| (c0..c1).all(|c| pixels[r * w + c][3] < TERMINATION_TRANSMITTANCE))
-}
-
-/// A partial image with nothing in it.
-fn blank(settings: &RenderSettings) -> PartialImage {
-    let (w, h) = (settings.width, settings.height);
-    if settings.blend.is_projection() {
-        PartialImage::projection(w, h, settings.blend)
-    } else {
-        PartialImage::composite(w, h)
-    }
 }
