@@ -8,26 +8,18 @@
 //! frame is bounded as a whole volume's would be (`memory.rs`). Within
 //! `--max-memory` it is read whole and rendered as any file is (the same
 //! pixels as `--level N`); beyond it, in pieces of at most
-//! [`PIECE_BUDGET`] each.
+//! [`volray_lazy::PIECE_BUDGET`] each.
 
 use crate::error::CliError;
 use crate::flags::{InputArgs, ViewArgs};
 use crate::input;
 use crate::session::render_failure;
 use std::path::{Path, PathBuf};
-use volray_core::glam::DVec3;
 use volray_core::{Image, NonFinite, RenderSettings};
 use volray_distributed::streamed::{StreamError, StreamTimes, Streamed};
-use volray_io::{Lazy, MapPolicy, format_bytes};
-use volray_options::level::{LevelChoice, auto_level};
-
-/// The most one piece's frame may take (volray-core's bound: the piece
-/// read, the renderer's structures for a dense piece, its frame), however
-/// much `--max-memory` allows: larger pieces cut fewer ghost layers and
-/// take fewer reads, but past a few hundred megabytes of samples a piece
-/// costs memory and buys nothing. A 1 GiB bound holds a 2 byte piece of
-/// about 300³ voxels.
-pub const PIECE_BUDGET: u64 = 1 << 30;
+use volray_io::{MapPolicy, format_bytes};
+use volray_lazy::{Chunked, Plan as LazyPlan};
+use volray_options::level::LevelChoice;
 
 /// How INPUT is rendered.
 pub enum Plan {
@@ -74,7 +66,7 @@ pub fn plan(
         ..args.clone()
     };
     let opts = input::read_options(&numbered, spec, &path, max_memory, MapPolicy::IfLarger)?;
-    let Some(mut lazy) = volray_io::open_lazy(&path, &opts)? else {
+    let Some(mut chunked) = Chunked::open(&path, &opts)? else {
         if requested == Some(LevelChoice::Auto) {
             return Err(CliError::input(format!(
                 "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
@@ -83,39 +75,40 @@ pub fn plan(
         return Ok(Plan::Whole { level: fixed });
     };
     if requested == Some(LevelChoice::Auto) {
-        let chosen = choose_level(spec, &lazy, settings)?;
-        if chosen != lazy.info.level {
-            let opts = volray_io::ReadOptions {
-                level: Some(chosen),
-                ..opts
-            };
-            lazy = volray_io::open_lazy(&path, &opts)?.expect("the same store");
-        }
+        let chosen = chunked
+            .auto_level(settings)
+            .map_err(|e| CliError::input(format!("{spec}: {e}")))?;
+        let levels = chunked.levels();
+        let [x, y, z] = levels[chosen].dims;
+        eprintln!(
+            "volray: {}: level {chosen} of {} ({x}x{y}x{z}), the coarsest whose voxels are no larger than a pixel (--level auto)",
+            display(spec),
+            levels.len()
+        );
+        chunked = chunked.at_level(chosen)?;
     }
-    let level = lazy.info.level;
-    let grid = lazy.source.grid();
     let mode: NonFinite = view.sampling.nonfinite.into();
-    let sample = lazy.source.sample_type();
-    let need = crate::memory::render_bytes((grid.dims, grid.spacing, sample), settings, mode, 0);
-    if need <= u128::from(max_memory) {
-        return Ok(Plan::Whole { level: Some(level) });
-    }
-    if view.look.log {
-        return Err(CliError::input(format!(
+    // A 16-bit PNG quantises the frame first: 8 bytes a pixel (memory.rs).
+    let png = 8 * settings.width as u128 * settings.height as u128;
+    match chunked.plan(settings, mode, max_memory, png) {
+        LazyPlan::Whole { level, .. } => Ok(Plan::Whole { level: Some(level) }),
+        LazyPlan::Pieces { level, need, .. } if view.look.log => Err(CliError::input(format!(
             "{spec}: level {level} may take up to {} to render whole, more than --max-memory {}, and --log is not yet taken piece by piece: raise --max-memory, or pick a coarser --level",
             format_bytes(need),
             format_bytes(u128::from(max_memory))
-        )));
+        ))),
+        LazyPlan::Pieces {
+            level,
+            need,
+            streamed,
+        } => Ok(Plan::Streamed(Box::new(StreamedInput {
+            name: spec.to_string(),
+            streamed: streamed.with_labels(view.look.labels),
+            level,
+            whole: need,
+            max_memory,
+        }))),
     }
-    let budget = max_memory.min(PIECE_BUDGET);
-    let streamed = Streamed::new(lazy.source, mode, budget).with_labels(view.look.labels);
-    Ok(Plan::Streamed(Box::new(StreamedInput {
-        name: spec.to_string(),
-        streamed,
-        level,
-        whole: need,
-        max_memory,
-    })))
 }
 
 /// The input flags reading INPUT whole at `level` (`--level auto`
@@ -126,32 +119,6 @@ pub fn at_level(args: &InputArgs, level: Option<usize>) -> InputArgs {
         level: level.map(LevelChoice::Index).or(args.level),
         ..args.clone()
     }
-}
-
-/// The level `--level auto` takes for frames of `settings`, said on
-/// stderr.
-fn choose_level(spec: &str, lazy: &Lazy, settings: &RenderSettings) -> Result<usize, CliError> {
-    let levels = &lazy.info.levels;
-    let Some(finest) = levels.first() else {
-        return Ok(0);
-    };
-    let spacings: Vec<DVec3> = levels.iter().map(|l| DVec3::from(l.spacing)).collect();
-    let origin = DVec3::from(finest.origin);
-    let dims = DVec3::new(
-        finest.dims[0] as f64 - 1.0,
-        finest.dims[1] as f64 - 1.0,
-        finest.dims[2] as f64 - 1.0,
-    );
-    let bounds = (origin, origin + dims * DVec3::from(finest.spacing));
-    let chosen = auto_level(&spacings, bounds, settings)
-        .map_err(|e| CliError::input(format!("{spec}: {e}")))?;
-    let [x, y, z] = levels[chosen].dims;
-    eprintln!(
-        "volray: {}: level {chosen} of {} ({x}x{y}x{z}), the coarsest whose voxels are no larger than a pixel (--level auto)",
-        display(spec),
-        levels.len()
-    );
-    Ok(chosen)
 }
 
 fn display(spec: &str) -> String {

@@ -1,0 +1,209 @@
+//! Volumes that stay in their files until a frame needs them: a chunked,
+//! multiscale file (Zarr, OME-Zarr) opened from its metadata alone, the
+//! level of detail a frame needs (`--level auto`), and the choice between
+//! reading that level whole and rendering it piece by piece from its
+//! chunks under a memory limit. The command line, the Python module and
+//! the viewer all decide through this crate, so the same file and options
+//! read the same level and take the same path in each.
+//!
+//! The order of use:
+//! 1. [`Chunked::open`]: `Ok(None)` for a file that is not stored in
+//!    chunks (read it whole or map it, as `volray_io::read` does);
+//! 2. [`Chunked::auto_level`] for `--level auto`, then [`Chunked::at_level`];
+//! 3. [`Chunked::plan`]: [`Plan::Whole`] when the level's frame fits the
+//!    memory limit (read it with `volray_io::read` at that level: the same
+//!    pixels as any file), else [`Plan::Pieces`], a
+//!    [`Streamed`] render that reads at most [`PIECE_BUDGET`] at a time.
+//!
+//! ```
+//! use volray_core::{RenderSettings, NonFinite, Volume};
+//! use volray_io::{OmeZarrOptions, ReadOptions, write_ome_zarr};
+//! use volray_lazy::{Chunked, Plan};
+//!
+//! // A 64³ ramp written as an OME-Zarr pyramid of 16³ chunks: levels
+//! // 64³, 32³ and 16³.
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("ramp.ome.zarr");
+//! let values: Vec<f32> = (0..64 * 64 * 64).map(|i| (i % 64) as f32).collect();
+//! let volume = Volume::new([64; 3], values).unwrap();
+//! let options = OmeZarrOptions { chunk: 16, shard: 32, ..OmeZarrOptions::default() };
+//! write_ome_zarr(&path, &volume, &options).unwrap();
+//!
+//! let chunked = Chunked::open(&path, &ReadOptions::default()).unwrap().unwrap();
+//! assert_eq!(chunked.levels().len(), 3);
+//! // A 32² picture resolves no more than level 1.
+//! let settings = RenderSettings { width: 32, height: 32, ..RenderSettings::default() };
+//! let level = chunked.auto_level(&settings).unwrap();
+//! assert_eq!(level, 1);
+//! let chunked = chunked.at_level(level).unwrap();
+//! assert_eq!(chunked.source().grid().dims, [32; 3]);
+//! // 1 MiB holds the 32³ level's frame: read it whole.
+//! match chunked.plan(&settings, NonFinite::default(), 1 << 20, 0) {
+//!     Plan::Whole { level: 1, .. } => {}
+//!     _ => panic!("a 32³ level is read whole"),
+//! }
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use volray_core::camera::CameraError;
+use volray_core::glam::DVec3;
+use volray_core::{MemoryBound, NonFinite, RenderSettings, VolumeSource};
+use volray_distributed::streamed::Streamed;
+use volray_io::{FileInfo, IoError, Lazy, LevelInfo, ReadOptions};
+
+/// The most one piece's frame may take (volray-core's bound: the piece
+/// read, the renderer's structures for a dense piece, its frame), however
+/// much the memory limit allows: larger pieces cut fewer ghost layers and
+/// take fewer reads, but past a few hundred megabytes of samples a piece
+/// costs memory and buys nothing. A 1 GiB bound holds a 2 byte piece of
+/// about 300³ voxels.
+pub const PIECE_BUDGET: u64 = 1 << 30;
+
+/// A chunked file, opened at one level (and time point and channel)
+/// without reading a sample.
+pub struct Chunked {
+    path: PathBuf,
+    opts: ReadOptions,
+    lazy: Lazy,
+}
+
+/// How a level is rendered for frames of given settings.
+pub enum Plan {
+    /// Its frame fits the memory limit: read the level whole (`need`
+    /// bytes at most, the volume included), as any file is.
+    Whole { level: usize, need: u128 },
+    /// Its frame would take `need` bytes whole, over the limit: rendered
+    /// piece by piece, never read whole.
+    Pieces {
+        level: usize,
+        need: u128,
+        streamed: Box<Streamed>,
+    },
+}
+
+impl Chunked {
+    /// Opens `path` from its metadata at the level, time point and channel
+    /// `opts` names (level 0 unless `opts.level` says). `Ok(None)` for a
+    /// file not stored in chunks, which `volray_io::read` reads whole or
+    /// maps.
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Option<Chunked>, IoError> {
+        Ok(volray_io::open_lazy(path, opts)?.map(|lazy| Chunked {
+            path: path.to_path_buf(),
+            opts: opts.clone(),
+            lazy,
+        }))
+    }
+
+    /// Every level of the image, finest first (one for a bare array).
+    pub fn levels(&self) -> &[LevelInfo] {
+        &self.lazy.info.levels
+    }
+
+    /// The level open, 0 the finest.
+    pub fn level(&self) -> usize {
+        self.lazy.info.level
+    }
+
+    /// What the metadata says of the level open.
+    pub fn info(&self) -> &FileInfo {
+        &self.lazy.info
+    }
+
+    /// The level open, as a source of boxes.
+    pub fn source(&self) -> &Arc<dyn VolumeSource> {
+        &self.lazy.source
+    }
+
+    /// The read options that open this level: `volray_io::read` with them
+    /// reads it whole.
+    pub fn read_options(&self) -> ReadOptions {
+        ReadOptions {
+            level: Some(self.level()),
+            ..self.opts.clone()
+        }
+    }
+
+    /// The file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The level open, its source and metadata.
+    pub fn into_lazy(self) -> Lazy {
+        self.lazy
+    }
+
+    /// The level a frame of `settings` needs (volray-options'
+    /// [`auto_level`](volray_options::level::auto_level): the coarsest
+    /// whose voxels are no larger than a pixel's footprint), the view
+    /// framed on the finest level's box. An error only where the camera
+    /// cannot frame that box.
+    pub fn auto_level(&self, settings: &RenderSettings) -> Result<usize, CameraError> {
+        let levels = self.levels();
+        let Some(finest) = levels.first() else {
+            return Ok(0);
+        };
+        let spacings: Vec<DVec3> = levels.iter().map(|l| DVec3::from(l.spacing)).collect();
+        let origin = DVec3::from(finest.origin);
+        let span = DVec3::from(finest.dims.map(|n| n.saturating_sub(1) as f64));
+        let bounds = (origin, origin + span * DVec3::from(finest.spacing));
+        volray_options::level::auto_level(&spacings, bounds, settings)
+    }
+
+    /// The same file at level `level`: itself if that level is open,
+    /// else reopened from the metadata.
+    pub fn at_level(self, level: usize) -> Result<Chunked, IoError> {
+        if level == self.level() {
+            return Ok(self);
+        }
+        let opts = ReadOptions {
+            level: Some(level),
+            ..self.opts
+        };
+        Chunked::open(&self.path, &opts)?
+            .ok_or_else(|| IoError::invalid(&self.path, "the store changed while it was open"))
+    }
+
+    /// The most bytes a frame of `settings` may take with the level read
+    /// whole, the volume included (volray-core's [`MemoryBound`], no
+    /// brick cache).
+    pub fn whole_bytes(&self, settings: &RenderSettings, non_finite: NonFinite) -> u128 {
+        let grid = self.source().grid();
+        MemoryBound::new(
+            grid.dims,
+            grid.spacing,
+            self.source().sample_type(),
+            settings,
+            non_finite,
+            0,
+        )
+        .total()
+    }
+
+    /// How frames of `settings` render the level under `max_memory`:
+    /// whole when [`whole_bytes`](Self::whole_bytes) plus the front end's
+    /// `extra` (say, a 16-bit PNG's buffer) fits, else in pieces of at
+    /// most min(`max_memory`, [`PIECE_BUDGET`]).
+    pub fn plan(
+        &self,
+        settings: &RenderSettings,
+        non_finite: NonFinite,
+        max_memory: u64,
+        extra: u128,
+    ) -> Plan {
+        let level = self.level();
+        let need = self.whole_bytes(settings, non_finite) + extra;
+        if need <= u128::from(max_memory) {
+            return Plan::Whole { level, need };
+        }
+        let budget = max_memory.min(PIECE_BUDGET);
+        let streamed = Streamed::new(Arc::clone(self.source()), non_finite, budget);
+        Plan::Pieces {
+            level,
+            need,
+            streamed: Box::new(streamed),
+        }
+    }
+}
