@@ -54,6 +54,7 @@
 use crate::frame::{blank, owned_max_gradient};
 use crate::kd::{Decomposition, Viewpoint, VoxelBox};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 use volray_core::camera::View;
@@ -166,6 +167,28 @@ impl Streamed {
         settings: &RenderSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<(Image, StreamTimes), StreamError> {
+        self.render_stoppable(settings, progress, &AtomicBool::new(false))
+    }
+
+    /// [`Self::render`], stopped when `stop` is set (by another thread: a
+    /// viewer whose view moved on): checked before each piece is read and
+    /// after each piece is rendered (and, for a volume in one piece, by
+    /// volray-core's casters before each tile); the answer is then
+    /// [`RenderError::Stopped`]. What was learnt of the pieces read so far
+    /// is kept.
+    pub fn render_stoppable(
+        &mut self,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(usize) + Sync),
+        stop: &AtomicBool,
+    ) -> Result<(Image, StreamTimes), StreamError> {
+        let stopped = || -> Result<(), StreamError> {
+            if stop.load(Ordering::Relaxed) {
+                Err(StreamError::Render(RenderError::Stopped))
+            } else {
+                Ok(())
+            }
+        };
         settings.validate().map_err(RenderError::from)?;
         let cache = self.split_for(settings)?;
         let mut times = StreamTimes {
@@ -173,7 +196,7 @@ impl Streamed {
             ..StreamTimes::default()
         };
         if self.pieces() == 1 {
-            return self.render_whole(settings, cache, progress, times);
+            return self.render_whole(settings, cache, progress, stop, times);
         }
         let needs_range =
             settings.blend.is_projection() || settings.transfer_function.domain.is_none();
@@ -216,6 +239,7 @@ impl Streamed {
             {
                 continue;
             }
+            stopped()?;
             let start = Instant::now();
             let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
             let volume = self.read(lo, hi)?;
@@ -236,6 +260,7 @@ impl Streamed {
                 ..settings.clone()
             };
             let partial = renderer.render_partial(&piece, progress)?;
+            stopped()?;
             image = Some(match image {
                 None => partial,
                 Some(mut front) => {
@@ -389,6 +414,7 @@ impl Streamed {
         settings: &RenderSettings,
         cache: usize,
         progress: &(dyn Fn(usize) + Sync),
+        stop: &AtomicBool,
         mut times: StreamTimes,
     ) -> Result<(Image, StreamTimes), StreamError> {
         if self.whole.is_none() {
@@ -404,7 +430,7 @@ impl Streamed {
             .expect("read above")
             .with_cache_budget(cache);
         let start = Instant::now();
-        let image = renderer.render_with_progress(settings, progress);
+        let image = renderer.render_stoppable(settings, progress, stop);
         self.whole = Some(renderer);
         times.render = start.elapsed();
         Ok((image?, times))

@@ -292,3 +292,63 @@ fn a_label_volume_in_pieces_has_the_wholes_labels_and_frame() {
     let diff = frame.max_abs_diff(&single).unwrap();
     assert!(diff <= 1.0 / 255.0, "{diff}");
 }
+
+/// A volume that sets a stop flag when its first box is read: a viewer's
+/// view moving on while a frame reads its pieces.
+struct StopsAfterARead {
+    volume: Volume,
+    stop: Arc<std::sync::atomic::AtomicBool>,
+    reads: std::sync::atomic::AtomicUsize,
+}
+
+impl VolumeSource for StopsAfterARead {
+    fn grid(&self) -> GridFrame {
+        self.volume.grid()
+    }
+    fn sample_type(&self) -> SampleType {
+        self.volume.sample_type()
+    }
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        use std::sync::atomic::Ordering;
+        self.reads.fetch_add(1, Ordering::SeqCst);
+        self.stop.store(true, Ordering::SeqCst);
+        self.volume.read_box(lo, hi)
+    }
+}
+
+#[test]
+fn a_frame_whose_stop_flag_is_set_reads_no_further_piece_and_says_stopped() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use volray_core::RenderError;
+    let volume = volume();
+    let settings = RenderSettings {
+        transfer_function: TransferFunction {
+            domain: Some((0.0, 1.0)),
+            ..TransferFunction::default()
+        },
+        ..small()
+    };
+    let budget = budget(&volume, &settings, 6);
+    let source = Arc::new(StopsAfterARead {
+        volume: volume.clone(),
+        stop: Arc::new(AtomicBool::new(false)),
+        reads: AtomicUsize::new(0),
+    });
+    let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+    match streamed.render_stoppable(&settings, &|_| {}, &source.stop) {
+        Err(StreamError::Render(RenderError::Stopped)) => {}
+        Err(e) => panic!("{e}"),
+        Ok((_, times)) => panic!("rendered: {times:?}"),
+    }
+    assert!(streamed.pieces() > 1);
+    assert_eq!(source.reads.load(Ordering::SeqCst), 1);
+    // Cleared, the same renderer finishes the frame: the whole volume's.
+    source.stop.store(false, Ordering::SeqCst);
+    let never = AtomicBool::new(false);
+    let (frame, times) = streamed
+        .render_stoppable(&settings, &|_| {}, &never)
+        .unwrap();
+    let whole = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    assert!(frame.max_abs_diff(&whole).unwrap() <= 1.0 / 255.0);
+    assert!(times.pieces > 1);
+}
