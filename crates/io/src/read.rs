@@ -227,17 +227,20 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 }
 
 /// Splits `file.h5:/group/dataset` into the file and the dataset path,
-/// if `path` has that shape and is not itself an existing file.
+/// if `path` has that shape and is not itself an existing file; a
+/// NetCDF-4 file is an HDF5 file, so `file.nc:/variable` too.
 pub fn split_hdf5_path(path: &Path) -> Option<(PathBuf, String)> {
     if path.exists() {
         return None;
     }
     let s = path.to_str()?;
     let lower = s.to_ascii_lowercase();
-    [".h5:", ".hdf5:", ".he5:"].iter().find_map(|ext| {
-        let at = lower.find(ext)? + ext.len() - 1;
-        Some((PathBuf::from(&s[..at]), s[at + 1..].to_string()))
-    })
+    [".h5:", ".hdf5:", ".he5:", ".nc:", ".nc4:"]
+        .iter()
+        .find_map(|ext| {
+            let at = lower.find(ext)? + ext.len() - 1;
+            Some((PathBuf::from(&s[..at]), s[at + 1..].to_string()))
+        })
 }
 
 /// Refuses the options that do not apply to `format`.
@@ -255,7 +258,10 @@ fn check_options(path: &Path, format: VolumeFormat, opts: &ReadOptions) -> Resul
             format: spec.description,
         });
     }
-    if (opts.level.is_some() || opts.channel.is_some()) && !spec.levels {
+    // An HDF5 dataset is one level, level 0: `render` names it when it
+    // reads whole what it opened box by box (`open_lazy`).
+    let one_level = format == VolumeFormat::Hdf5 && opts.level == Some(0);
+    if ((opts.level.is_some() && !one_level) || opts.channel.is_some()) && !spec.levels {
         return Err(IoError::LevelNotApplicable {
             path: path.to_path_buf(),
             format: spec.description,
@@ -279,10 +285,13 @@ pub struct Lazy {
 }
 
 /// Opens `path` as a source of boxes, reading no sample, where its format
-/// is stored in chunks that can be read box by box (Zarr, OME-Zarr):
-/// what an out-of-core render and the ranks of an MPI render read their
-/// pieces from. `Ok(None)` for the other formats, which [`read`] reads
-/// whole or maps. The options are those of [`read`], checked alike.
+/// can be read box by box (Zarr, OME-Zarr, HDF5 datasets and so NetCDF-4
+/// variables: chunk by chunk, or row by row of contiguous data): what an
+/// out-of-core render and the ranks of an MPI render read their pieces
+/// from. `Ok(None)` for the other formats, which [`read`] reads whole or
+/// maps (and for an HDF5 file that is MINC2's, or holds a 2-D image). The
+/// options are those of [`read`], checked alike; a format read box by
+/// box holds one level at least, so `--level 0` applies to HDF5 too.
 pub fn open_lazy(path: &Path, opts: &ReadOptions) -> Result<Option<Lazy>, IoError> {
     let format = detect(path, opts)?;
     check_options(path, format, opts)?;
@@ -295,6 +304,13 @@ pub fn open_lazy(path: &Path, opts: &ReadOptions) -> Result<Option<Lazy>, IoErro
                 info,
             }))
         }
+        VolumeFormat::Hdf5 => Ok(crate::formats::hdf5_lazy::open(path, opts)?.map(
+            |(source, info)| Lazy {
+                source: Arc::new(source),
+                format,
+                info,
+            },
+        )),
         _ => Ok(None),
     }
 }

@@ -42,9 +42,95 @@ const MAX_DEPTH: usize = 32;
 /// Datasets listed in an error, at most.
 const LISTED: usize = 10;
 
+/// A dataset named (or found) and checked, its metadata read, nothing of
+/// its samples: what the eager reader ([`read`]) and the lazy source
+/// (`hdf5_lazy.rs`) both start from.
+pub(crate) struct Opened {
+    /// The HDF5 file's own path (without `:/dataset`).
+    pub file_path: PathBuf,
+    pub h5: h5::H5File,
+    /// The dataset's absolute path in the file.
+    pub name: String,
+    pub dataset: Dataset,
+    pub sample: h5::NumericType,
+    pub shape: Vec<usize>,
+    /// Volumes along the first axis of a 4-D dataset (1 otherwise), and
+    /// the one read.
+    pub frames: usize,
+    pub frame: usize,
+    /// A 4-D dataset (a series a[t, x, y, z]).
+    pub series: bool,
+    /// Samples along x, y, z (a 2-D image: z is 1).
+    pub dims: [usize; 3],
+    pub info: FileInfo,
+    pub spacing: DVec3,
+    pub origin: DVec3,
+}
+
+/// What a path opens as: a dataset, or a MINC2 file (read by `minc.rs`).
+pub(crate) enum Found {
+    Dataset(Box<Opened>),
+    Minc(PathBuf),
+}
+
 /// Reads the dataset `path` names (`file.h5:/dataset`, or `file.h5`
 /// holding a single volume).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let o = match open(path, opts)? {
+        Found::Minc(file_path) => return super::minc::read(&file_path, opts),
+        Found::Dataset(o) => *o,
+    };
+    let Opened {
+        file_path,
+        h5,
+        name,
+        dataset,
+        sample,
+        shape,
+        frames,
+        frame,
+        series,
+        dims,
+        mut info,
+        spacing,
+        origin,
+    } = o;
+    let what =
+        |reason: String| IoError::invalid(&file_path, format!("HDF5 dataset \"{name}\": {reason}"));
+    let slabs = Slabs::new(
+        &dataset,
+        &shape,
+        frames,
+        series.then_some(frame),
+        sample.size,
+    );
+    let voxels = slabs.check(
+        &file_path,
+        &format!("dataset shape {shape:?}"),
+        h5.len,
+        sample.stored,
+        opts.max_memory,
+    )?;
+    let data =
+        read_as_stored!(sample.stored, |T| read_volume::<T>(&slabs, dims, voxels)).map_err(what)?;
+    let steps = [
+        DVec3::X * spacing.x,
+        DVec3::Y * spacing.y,
+        DVec3::Z * spacing.z,
+    ];
+    let volume = grid_to_volume(&file_path, dims, data, steps, origin, &mut info)?;
+    Ok(Loaded {
+        volume,
+        format: VolumeFormat::Hdf5,
+        info,
+    })
+}
+
+/// Opens the dataset `path` names (see [`read`]) and reads its metadata:
+/// type, shape, the frame asked for, geometry and what `volray info`
+/// shows. A file holding MINC2's layout, named without a dataset, is
+/// MINC2's.
+pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let (file_path, dataset_path): (PathBuf, Option<String>) = match split_hdf5_path(path) {
         Some((file, dataset)) => (file, Some(dataset)),
         None => (path.to_path_buf(), None),
@@ -53,7 +139,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let fail = |reason: String| IoError::invalid(&file_path, reason);
     let root = h5.file.root();
     if dataset_path.is_none() && h5.file.group("minc-2.0").is_ok() {
-        return super::minc::read(&file_path, opts);
+        return Ok(Found::Minc(file_path));
     }
 
     let (name, dataset) = match &dataset_path {
@@ -118,20 +204,6 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     }
     let series = frames > 1 || shape.len() == 4;
-    let slabs = Slabs::new(
-        &dataset,
-        &shape,
-        frames,
-        series.then_some(frame),
-        sample.size,
-    );
-    let voxels = slabs.check(
-        &file_path,
-        &format!("dataset shape {shape:?}"),
-        h5.len,
-        sample.stored,
-        opts.max_memory,
-    )?;
 
     let attrs = sorted_attrs(dataset.attrs());
     let mut info = FileInfo::new(sample.name.clone());
@@ -147,20 +219,21 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
             .push(format!("volume {frame} of {frames} read (first axis: t)"));
     }
     let (spacing, origin) = geometry(&attrs, series, &mut info).map_err(what)?;
-
-    let data =
-        read_as_stored!(sample.stored, |T| read_volume::<T>(&slabs, dims, voxels)).map_err(what)?;
-    let steps = [
-        DVec3::X * spacing.x,
-        DVec3::Y * spacing.y,
-        DVec3::Z * spacing.z,
-    ];
-    let volume = grid_to_volume(&file_path, dims, data, steps, origin, &mut info)?;
-    Ok(Loaded {
-        volume,
-        format: VolumeFormat::Hdf5,
+    Ok(Found::Dataset(Box::new(Opened {
+        file_path,
+        h5,
+        name,
+        dataset,
+        sample,
+        shape,
+        frames,
+        frame,
+        series,
+        dims,
         info,
-    })
+        spacing,
+        origin,
+    })))
 }
 
 /// Reads one volume into an x-fastest buffer: the dataset's first axis

@@ -33,7 +33,7 @@ thread_local! {
 }
 
 /// Samples read per slab: [`SLAB_SAMPLES`], or what a test set.
-fn slab_samples() -> usize {
+pub(crate) fn slab_samples() -> usize {
     #[cfg(test)]
     return TEST_SLABS.with(|t| t.get().0);
     #[cfg(not(test))]
@@ -149,7 +149,7 @@ pub(crate) fn shape(dataset: &Dataset) -> Result<Vec<usize>, String> {
 /// where one chunk is larger than that, as many rows as fit `slab` (at
 /// least one), so that a header's chunk size cannot make the scratch
 /// buffer large.
-fn slab_rows(row: usize, chunk0: usize, slab: usize) -> usize {
+pub(crate) fn slab_rows(row: usize, chunk0: usize, slab: usize) -> usize {
     let row = row.max(1);
     let chunk0 = chunk0.max(1);
     if row.saturating_mul(chunk0) <= slab {
@@ -169,6 +169,35 @@ fn chunk_along(dataset: &Dataset, axis: usize) -> usize {
         .and_then(|n| usize::try_from(n).ok())
         .unwrap_or(1)
         .max(1)
+}
+
+/// Checks that a dataset of `shape` and samples of `sample_size` bytes
+/// could come out of a file of `file_len` bytes: at most
+/// [`MAX_INFLATION`] times its length, or [`SMALL_FILE_ALLOWANCE`]
+/// (deflate inflates at most about 1032:1). Returns its samples. `what`
+/// names the shape for messages.
+pub(crate) fn check_stored(
+    path: &Path,
+    what: &str,
+    shape: &[usize],
+    sample_size: usize,
+    file_len: u64,
+) -> Result<usize, IoError> {
+    let dims64: Vec<u64> = shape.iter().map(|&n| n as u64).collect();
+    let values = count_values(path, what, &dims64)?;
+    let budget = file_len
+        .saturating_mul(MAX_INFLATION)
+        .max(SMALL_FILE_ALLOWANCE);
+    let bytes = (values as u64).saturating_mul(sample_size as u64);
+    if bytes > budget {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "{what} of {sample_size}-byte samples is {bytes} bytes, more than a {file_len}-byte file can hold even compressed"
+            ),
+        ));
+    }
+    Ok(values)
 }
 
 /// How one volume of a dataset is read: the volume is the last three
@@ -230,21 +259,8 @@ impl<'d> Slabs<'d> {
         kept: SampleType,
         max_memory: u64,
     ) -> Result<usize, IoError> {
-        let dims64: Vec<u64> = self.shape.iter().map(|&n| n as u64).collect();
-        let values = count_values(path, what, &dims64)?;
-        let budget = file_len
-            .saturating_mul(MAX_INFLATION)
-            .max(SMALL_FILE_ALLOWANCE);
         let sample_size = self.sample_size;
-        let bytes = (values as u64).saturating_mul(sample_size as u64);
-        if bytes > budget {
-            return Err(IoError::invalid(
-                path,
-                format!(
-                    "{what} of {sample_size}-byte samples is {bytes} bytes, more than a {file_len}-byte file can hold even compressed"
-                ),
-            ));
-        }
+        let values = check_stored(path, what, self.shape, sample_size, file_len)?;
         let volume = values / self.frames.max(1);
         let peak = volume as u128 * kept.bytes() as u128
             + self.scratch() as u128 * (8 + sample_size as u128);
