@@ -125,8 +125,13 @@ pub struct FrameTimes {
     /// Occupied bricks.
     pub bricks: usize,
     /// Bricks lit for the frame: those a ray sampled before it
-    /// terminated (hidden and off-screen bricks are not lit).
+    /// terminated (hidden and off-screen bricks are not lit). A brick lit
+    /// more than once (for several tiles, when the cache budget does not
+    /// hold the bricks in use) counts each time.
     pub lit: usize,
+    /// Bricks classified during the frame because the cache of classified
+    /// bricks did not hold them (counted each time, as `lit`).
+    pub classified: usize,
     /// Bytes of classified and lit bricks the caches hold after the frame
     /// (at most the [cache budget](Renderer::with_cache_budget)).
     pub cached_bytes: usize,
@@ -607,7 +612,8 @@ impl<'v> Renderer<'v> {
         let bins = TileBins::new(&state.bricks, &frame.sampling, &frame.view);
         let t2 = Instant::now();
         let light = Self::light(settings, &frame.view);
-        let number = state.lit.next_frame();
+        let number = state.lit.next_frame(bins.entries());
+        let classified_before = state.bricks.classified_count();
         let source = Source {
             volume: &self.volume,
             classifier: &state.classifier,
@@ -636,6 +642,7 @@ impl<'v> Renderer<'v> {
         times.cast = t3 - t2;
         times.bricks = state.bricks.len();
         times.lit = lighting.count();
+        times.classified = state.bricks.classified_count() - classified_before;
         times.cached_bytes = state.bricks.slot_bytes() + state.lit.bytes();
         times
     }

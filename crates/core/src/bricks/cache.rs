@@ -8,9 +8,18 @@
 //! the buffer is (re)filled, into the entry's own buffer if it has one,
 //! else into a new one while the budget allows, else into one taken from
 //! a brick that no recent frame used (a clock hand sweeps the entries for
-//! one), else into the caller's scratch buffer (on its stack), used once. So the cache never exceeds its budget, a volume whose bricks
-//! all fit behaves as if there were no budget, and a larger one keeps what
-//! the last frames used and recomputes the rest.
+//! one), else into the caller's scratch buffer (on its stack), used once.
+//! So the cache never exceeds its budget, a volume whose bricks all fit
+//! behaves as if there were no budget, and a larger one keeps what the
+//! last frames used and recomputes the rest.
+//!
+//! A caller that knows a brick's buffer will not be asked for again (the
+//! lit bricks: once the last tile that lists a brick is done with it, see
+//! [`crate::cpu::lit_bricks`]) gives it back ([`BrickCache::release`]) to a
+//! pool, from which the next brick takes it before any is allocated or
+//! taken from another entry. The buffers then hold the bricks in use, not
+//! the first ones a frame asked for, and a budget smaller than all the
+//! bricks still fills each brick once a frame when the bricks in use fit.
 //!
 //! The policy is by frame rather than least-recently-used because a frame
 //! visits bricks in an order (tiles, front to back) that repeats from
@@ -25,7 +34,7 @@
 
 use std::ops::Deref;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::{RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::sync::{Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// How many entries the clock hand looks at for a buffer to take before
 /// giving up and filling a temporary one.
@@ -63,6 +72,12 @@ pub(crate) struct BrickCache<T> {
     valid: fn(f: u64, now: u64) -> bool,
     /// Whether a buffer last used in frame `f` may be taken in frame `now`.
     evictable: fn(f: u64, now: u64) -> bool,
+    /// Buffers given back ([`Self::release`]), reused first. Made with room
+    /// for every buffer the budget allows (at most one per entry: a buffer
+    /// is allocated only while the pool is empty), so it never grows.
+    pool: Mutex<Vec<Box<T>>>,
+    /// Buffers filled, into the cache or a scratch buffer ([`Self::fills`]).
+    fills: AtomicUsize,
 }
 
 struct Entry<T> {
@@ -72,8 +87,9 @@ struct Entry<T> {
 }
 
 impl<T> BrickCache<T> {
-    /// Bytes an entry takes beside its buffer.
-    pub const BYTES_PER_ENTRY: usize = size_of::<Entry<T>>();
+    /// Bytes an entry takes beside its buffer: the entry, and its
+    /// buffer's place in the pool.
+    pub const BYTES_PER_ENTRY: usize = size_of::<Entry<T>>() + size_of::<Box<T>>();
 
     /// A cache of `count` entries holding at most `budget` bytes of
     /// buffers. `valid` and `evictable` give the policy (see the module
@@ -96,7 +112,47 @@ impl<T> BrickCache<T> {
             hand: AtomicUsize::new(0),
             valid,
             evictable,
+            pool: Mutex::new(Vec::with_capacity(
+                count.min(budget / size_of::<T>().max(1)),
+            )),
+            fills: AtomicUsize::new(0),
         }
+    }
+
+    /// Gives entry `n`'s buffer back to the pool, if it has one: the
+    /// caller knows that no one will ask for brick `n` again until it is
+    /// refilled. The caller must hold no reference into this cache (it
+    /// waits for the entry's lock).
+    pub fn release(&self, n: usize) {
+        let entry = &self.entries[n];
+        let taken = {
+            let mut buffer = entry.buffer.write().unwrap_or_else(|e| e.into_inner());
+            entry.frame.store(0, Ordering::Release);
+            buffer.take()
+        };
+        if let Some(buffer) = taken {
+            self.pool
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(buffer);
+        }
+    }
+
+    /// Gives every buffer back to the pool (between frames, when every
+    /// buffer is stale).
+    pub fn release_all(&mut self) {
+        let pool = self.pool.get_mut().unwrap_or_else(|e| e.into_inner());
+        for entry in &mut self.entries {
+            *entry.frame.get_mut() = 0;
+            let buffer = entry.buffer.get_mut().unwrap_or_else(|e| e.into_inner());
+            pool.extend(buffer.take());
+        }
+    }
+
+    /// How many times a buffer was filled, into the cache or a scratch
+    /// buffer, since the cache was made.
+    pub fn fills(&self) -> usize {
+        self.fills.load(Ordering::Relaxed)
     }
 
     /// Puts `buffer` into entry `n`, which has none, if the budget has
@@ -153,6 +209,7 @@ impl<T> BrickCache<T> {
         // Another thread may have filled it meanwhile.
         let valid = buffer.is_some() && (self.valid)(entry.frame.load(Ordering::Acquire), now);
         if !valid {
+            self.fills.fetch_add(1, Ordering::Relaxed);
             if buffer.is_none() {
                 *buffer = self.reserve(n, now, &blank);
             }
@@ -176,9 +233,12 @@ impl<T> BrickCache<T> {
         CacheRef::Cached(buffer)
     }
 
-    /// A buffer for entry `n`: a new one if the budget allows, else one
-    /// taken from an evictable entry, else `None`.
+    /// A buffer for entry `n`: one given back, else a new one if the
+    /// budget allows, else one taken from an evictable entry, else `None`.
     fn reserve(&self, n: usize, now: u64, blank: &impl Fn() -> Box<T>) -> Option<Box<T>> {
+        if let Some(buffer) = self.pool.lock().unwrap_or_else(|e| e.into_inner()).pop() {
+            return Some(buffer);
+        }
         if self.reserve_bytes() {
             return Some(blank());
         }

@@ -261,6 +261,13 @@ impl ClassifiedBricks {
         )
     }
 
+    /// How many times a brick was classified on demand since the bricks
+    /// were made (into the cache or, where it had no room, a scratch
+    /// buffer); bricks classified when they were made do not count.
+    pub fn classified_count(&self) -> usize {
+        self.voxels.fills()
+    }
+
     /// Bytes of classified slots held now.
     pub fn slot_bytes(&self) -> usize {
         self.voxels.bytes()

@@ -441,6 +441,12 @@ impl<'a> Rays<'a> {
                 steppings,
             );
         }
+        // The tile is done with every brick of its list, reached or not:
+        // the lit-brick cache gives a brick's buffer back after its last
+        // tile (see `LitBricks`).
+        for &n in list {
+            scene.lit.done(n as usize);
+        }
     }
 
     /// Takes the samples of every ray of a tile (`states`, as in

@@ -179,6 +179,12 @@ impl TileBins {
         &self.entries[self.start[t] as usize..self.start[t + 1] as usize]
     }
 
+    /// Every tile's list, one after the other: each occupied brick once
+    /// per tile that lists it.
+    pub fn entries(&self) -> &[u32] {
+        &self.entries
+    }
+
     /// Entries in all lists.
     #[cfg(test)]
     pub fn len(&self) -> usize {
