@@ -294,6 +294,26 @@ fn print_stored(i: &FileInfo) {
             );
         }
     }
+    if let Some(o) = &i.omero {
+        let mut parts = Vec::new();
+        if let Some((start, end, min, max)) = o.window {
+            let range = match (min, max) {
+                (Some(lo), Some(hi)) => format!(" of {lo}..{hi}"),
+                _ => String::new(),
+            };
+            parts.push(format!("window {start}..{end}{range}"));
+        }
+        if let Some(c) = &o.color {
+            parts.push(format!("colour #{c}"));
+        }
+        if let Some(l) = &o.label {
+            parts.push(format!("label \"{l}\""));
+        }
+        if let Some(a) = o.active {
+            parts.push(if a { "shown" } else { "hidden" }.to_string());
+        }
+        outln!("omero:     channel {}: {}", o.channel, parts.join(", "));
+    }
     if !i.arrays.is_empty() {
         outln!(
             "arrays:    {} (read: {}; --array picks another)",
@@ -334,6 +354,16 @@ fn add_file_json(out: &mut Value, i: &FileInfo) {
     );
     out["notes"] = json!(i.notes);
     out["nan_is_empty"] = json!(i.nan_is_empty);
+    // OME-Zarr's rendering hints for the channel read.
+    out["omero"] = json!(i.omero.as_ref().map(|o| json!({
+        "channel": o.channel,
+        "label": o.label,
+        "color": o.color,
+        "active": o.active,
+        "window": o.window.map(|(start, end, min, max)| json!({
+            "start": start, "end": end, "min": min, "max": max,
+        })),
+    })));
     // Multiscale images (OME-Zarr): every level; the keys above describe
     // the one read.
     out["level"] = json!(i.level);

@@ -79,7 +79,7 @@ fn format_frame_and_array_options() {
     );
     refused(
         &["info", C_F4, "--array", "rho"],
-        "--array applies to VTK files only",
+        "--array applies to VTK files and OME-Zarr plates and collections only",
     );
     refused(
         &["info", "sphere:9", "--format", "npy"],

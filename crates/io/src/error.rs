@@ -140,7 +140,7 @@ pub enum IoError {
 
     /// A named array ([`ReadOptions::array`]) chosen in a file whose format
     /// has none.
-    #[error("{}: array selection applies to VTK files only, not to {format} files", path.display())]
+    #[error("{}: array selection applies to VTK files and OME-Zarr plates and collections only, not to {format} files", path.display())]
     ArrayNotApplicable { path: PathBuf, format: &'static str },
 
     /// A named array ([`ReadOptions::array`]) the file does not hold; `held`

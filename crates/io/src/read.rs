@@ -32,7 +32,8 @@ pub struct ReadOptions {
     /// a DICOM directory.
     pub frame: Option<usize>,
     /// Which named array of a file holding several (the CLI's `--array`):
-    /// VTK point or cell data arrays.
+    /// VTK point or cell data arrays; the image of an OME-Zarr plate
+    /// (`A/1/0`: row, column, field) or collection (`0`, a series).
     pub array: Option<String>,
     /// Which resolution level of a multiscale image (the CLI's `--level`),
     /// 0 the finest: the `datasets` of an OME-Zarr image.
@@ -136,7 +137,8 @@ pub struct FileInfo {
     pub frames: usize,
     /// Which of them was read.
     pub frame: usize,
-    /// The named arrays the file holds (VTK), if any, and the one read.
+    /// The named arrays the file holds (VTK; an OME-Zarr plate's or
+    /// collection's images), if any, and the one read.
     pub arrays: Vec<String>,
     pub array: Option<String>,
     /// The volume's NaN values are space the file does not cover (the
@@ -153,6 +155,24 @@ pub struct FileInfo {
     pub levels: Vec<LevelInfo>,
     /// Which of them was read.
     pub level: usize,
+    /// The OME-Zarr `omero` rendering hints of the channel read, if any.
+    pub omero: Option<OmeroChannel>,
+}
+
+/// An OME-Zarr image's `omero` rendering hints for one channel: what its
+/// viewer would show it with.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct OmeroChannel {
+    /// The channel (index along `c`) these are the hints of.
+    pub channel: usize,
+    pub label: Option<String>,
+    /// `RRGGBB`, upper case, without `#`.
+    pub color: Option<String>,
+    /// Whether the channel is shown.
+    pub active: Option<bool>,
+    /// The display window `start`..`end`, within the data's `min`..`max`
+    /// where given.
+    pub window: Option<(f64, f64, Option<f64>, Option<f64>)>,
 }
 
 /// One resolution level of a multiscale image, for `volray info`.

@@ -373,7 +373,7 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         known_as: "Zarr/OME-Zarr (a directory)",
         magic: Magic::NONE,
         frames: true,
-        arrays: false,
+        arrays: true,
         levels: true,
         read: zarr::read,
     },

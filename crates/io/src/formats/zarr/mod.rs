@@ -57,6 +57,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 /// `path` without reading a sample: the level as a source of boxes (see
 /// `lazy.rs`), and what the metadata says.
 pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileInfo), IoError> {
+    let (image_path, held) = ome::choose_image(path, opts.array.as_deref())?;
+    let path = image_path.as_path();
     let (kind, attrs) = store::node(path)?;
     let image = match kind {
         NodeKind::Array => None,
@@ -163,11 +165,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
         file_info
             .header
             .push(("levels".into(), levels.len().to_string()));
-        if m.has_omero {
-            file_info
-                .notes
-                .push("omero rendering hints (channel windows and colours) are not read".into());
-        }
+        file_info.omero = ome::omero(&attrs, opts.channel.unwrap_or(0));
     }
     if channels > 1 {
         file_info
@@ -191,6 +189,10 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
     )?;
     file_info.levels = infos;
     file_info.level = chosen;
+    if let Some(name) = &opts.array {
+        file_info.array = Some(name.clone());
+        file_info.arrays = held;
+    }
     Ok((level, file_info))
 }
 

@@ -17,15 +17,28 @@
 //! so each level's spacing is `global_scale · scale` and its origin
 //! `global_scale · translation + global_translation`. Only the first
 //! multiscale is read (the specification allows several; writers make
-//! one). `omero` rendering hints (channel windows and colours) are not
-//! read yet. Parsed with `serde_json` by hand rather than with the
+//! one). The `omero` rendering hints of the channel read (its window,
+//! colour, label, whether it is shown) go to `volray info` ([`omero`]).
+//!
+//! An image inside a plate (`plate`: wells, each a group whose `well`
+//! lists its fields, the images) or a collection (a group of image
+//! groups, as bioformats2raw writes: `OME/` beside series `0/`, `1/`,
+//! ...) is named by `--array` ([`choose_image`]); without it, the error
+//! lists the images held. Parsed with `serde_json` by hand rather than with the
 //! `ome_zarr_metadata` crate: a few fields, and errors that name them.
 
 use std::path::Path;
 
 use serde_json::Value;
 
-use crate::IoError;
+use super::store::{self, NodeKind};
+use crate::{IoError, OmeroChannel};
+
+/// Images listed in an error, at most.
+const LISTED: usize = 10;
+/// Images looked for in a plate or collection, at most (a 1536-well
+/// plate of a few fields each).
+const MAX_IMAGES: usize = 100_000;
 
 /// What an axis of an OME-Zarr image is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,8 +72,6 @@ pub(crate) struct Multiscale {
     pub version: String,
     pub axes: Vec<Axis>,
     pub levels: Vec<Level>,
-    /// The image holds `omero` rendering hints (not read yet).
-    pub has_omero: bool,
 }
 
 /// The image a group's attributes describe, or `None` if they hold no
@@ -125,7 +136,6 @@ pub(crate) fn multiscale(path: &Path, attrs: &Value) -> Result<Option<Multiscale
         version,
         axes,
         levels,
-        has_omero: root.get("omero").is_some() || attrs.get("omero").is_some(),
     }))
 }
 
@@ -184,4 +194,183 @@ fn transforms(list: Option<&Value>, n: usize) -> Result<(Vec<f64>, Vec<f64>), St
         return Err(format!("scale {scale:?} must be positive"));
     }
     Ok((scale, translation))
+}
+
+/// The attributes' OME root: `ome` in 0.5, the attributes themselves in 0.4.
+fn ome_root(attrs: &Value) -> &Value {
+    attrs.get("ome").unwrap_or(attrs)
+}
+
+/// Whether a group's attributes describe an image.
+fn is_image(attrs: &Value) -> bool {
+    ome_root(attrs).get("multiscales").is_some()
+}
+
+/// A relative path inside a store: no climbing out, no empty parts.
+fn inside(path: &str) -> bool {
+    !path.is_empty()
+        && !path.starts_with('/')
+        && path
+            .split('/')
+            .all(|p| !p.is_empty() && p != "." && p != "..")
+}
+
+/// The image `array` names inside the group at `path` (a plate or a
+/// collection), or `path` itself without `array`; and the images the
+/// group holds when `array` was given. Without `array`, a group that is
+/// a plate or a collection and no image is refused, listing its images.
+pub(crate) fn choose_image(
+    path: &Path,
+    array: Option<&str>,
+) -> Result<(std::path::PathBuf, Vec<String>), IoError> {
+    let Some(name) = array else {
+        if let Ok((NodeKind::Group, attrs)) = store::node(path)
+            && !is_image(&attrs)
+        {
+            let (what, images) = images_in(path, &attrs);
+            if !images.is_empty() {
+                let mut shown: Vec<String> = images.iter().take(LISTED).cloned().collect();
+                if images.len() > LISTED {
+                    shown.push(format!("and {} more", images.len() - LISTED));
+                }
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "an OME-Zarr {what} of {} image{}: name one with --array PATH ({})",
+                        images.len(),
+                        if images.len() == 1 { "" } else { "s" },
+                        shown.join(", ")
+                    ),
+                ));
+            }
+        }
+        return Ok((path.to_path_buf(), Vec::new()));
+    };
+    let name = name.trim_matches('/');
+    let held = match store::node(path) {
+        Ok((NodeKind::Group, attrs)) => images_in(path, &attrs).1,
+        _ => Vec::new(),
+    };
+    let target = path.join(name);
+    if !inside(name) || !store::is_zarr_dir(&target) {
+        let listed = if held.is_empty() {
+            "it holds no plate or collection of images".to_string()
+        } else {
+            let mut shown: Vec<String> = held.iter().take(LISTED).cloned().collect();
+            if held.len() > LISTED {
+                shown.push(format!("and {} more", held.len() - LISTED));
+            }
+            format!("its images: {}", shown.join(", "))
+        };
+        return Err(IoError::invalid(
+            path,
+            format!("--array \"{name}\" is no Zarr group or array in the store; {listed}"),
+        ));
+    }
+    Ok((target, held))
+}
+
+/// What the group is (`plate`, `collection`) and the images in it, in
+/// order: a plate's wells' fields (`A/1/0`), else the series of a
+/// bioformats2raw layout (`OME/`'s `series`, else `0`, `1`, ...), else the
+/// subgroups that are images, in name order.
+fn images_in(path: &Path, attrs: &Value) -> (&'static str, Vec<String>) {
+    let root = ome_root(attrs);
+    if let Some(wells) = root
+        .get("plate")
+        .and_then(|p| p.get("wells"))
+        .and_then(Value::as_array)
+    {
+        let mut images = Vec::new();
+        for well in wells {
+            let Some(w) = well
+                .get("path")
+                .and_then(Value::as_str)
+                .filter(|w| inside(w))
+            else {
+                continue;
+            };
+            let Ok((_, wattrs)) = store::node(&path.join(w)) else {
+                continue;
+            };
+            let fields = ome_root(&wattrs)
+                .get("well")
+                .and_then(|w| w.get("images"))
+                .and_then(Value::as_array)
+                .cloned()
+                .unwrap_or_default();
+            for f in &fields {
+                if let Some(p) = f.get("path").and_then(Value::as_str).filter(|p| inside(p)) {
+                    images.push(format!("{w}/{p}"));
+                }
+                if images.len() >= MAX_IMAGES {
+                    return ("plate", images);
+                }
+            }
+        }
+        return ("plate", images);
+    }
+    // bioformats2raw: OME/.zattrs (or zarr.json) lists the series.
+    if let Ok((_, ome)) = store::node(&path.join("OME"))
+        && let Some(series) = ome_root(&ome).get("series").and_then(Value::as_array)
+    {
+        let images: Vec<String> = series
+            .iter()
+            .filter_map(Value::as_str)
+            .filter(|s| inside(s))
+            .take(MAX_IMAGES)
+            .map(str::to_string)
+            .collect();
+        if !images.is_empty() {
+            return ("collection", images);
+        }
+    }
+    let mut names: Vec<String> = std::fs::read_dir(path)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter_map(|e| e.file_name().to_str().map(str::to_string))
+                .take(MAX_IMAGES)
+                .collect()
+        })
+        .unwrap_or_default();
+    // Numbered series in numeric order, then names.
+    names.sort_by_key(|n| (n.parse::<u64>().unwrap_or(u64::MAX), n.clone()));
+    let images = names
+        .into_iter()
+        .filter(|n| matches!(store::node(&path.join(n)), Ok((NodeKind::Group, a)) if is_image(&a)))
+        .collect();
+    ("collection", images)
+}
+
+/// The `omero` rendering hints of channel `channel`, if the image gives
+/// any: `omero.channels[channel]`'s `window` (`start`, `end`, `min`,
+/// `max`), `color` (hex RGB), `label` and `active`.
+pub(crate) fn omero(attrs: &Value, channel: usize) -> Option<OmeroChannel> {
+    let c = ome_root(attrs)
+        .get("omero")
+        .or_else(|| attrs.get("omero"))?
+        .get("channels")?
+        .as_array()?
+        .get(channel)?;
+    let number = |w: &Value, k: &str| w.get(k).and_then(Value::as_f64).filter(|v| v.is_finite());
+    let window = c.get("window").map(|w| {
+        [
+            number(w, "start"),
+            number(w, "end"),
+            number(w, "min"),
+            number(w, "max"),
+        ]
+    });
+    let color = c
+        .get("color")
+        .and_then(Value::as_str)
+        .map(|s| s.trim_start_matches('#').to_ascii_uppercase())
+        .filter(|s| s.len() == 6 && s.chars().all(|ch| ch.is_ascii_hexdigit()));
+    Some(OmeroChannel {
+        channel,
+        label: c.get("label").and_then(Value::as_str).map(str::to_string),
+        color,
+        active: c.get("active").and_then(Value::as_bool),
+        window: window.and_then(|[s, e, lo, hi]| Some((s?, e?, lo, hi))),
+    })
 }
