@@ -90,7 +90,9 @@ fn naming_flags(e: &IoError) -> String {
             format!("{file}: {held}; pick one with --frame N: {choices}")
         }
         IoError::ArrayNotApplicable { format, .. } => {
-            format!("{file}: --array applies to VTK files and OME-Zarr plates and collections only, not to {format} files")
+            format!(
+                "{file}: --array applies to VTK files and OME-Zarr plates and collections only, not to {format} files"
+            )
         }
         IoError::NoSuchArray { name, held, .. } => {
             format!("{file}: no array named \"{name}\" (--array): {held}")
