@@ -171,8 +171,8 @@ impl Streamed {
     }
 
     /// [`Self::render`], stopped when `stop` is set (by another thread: a
-    /// viewer whose view moved on): checked before each piece is read and
-    /// after each piece is rendered (and, for a volume in one piece, by
+    /// viewer whose view moved on): checked before each piece is read
+    /// (for the statistics pass too) and after each piece is rendered (and, for a volume in one piece, by
     /// volray-core's casters before each tile); the answer is then
     /// [`RenderError::Stopped`]. What was learnt of the pieces read so far
     /// is kept.
@@ -204,7 +204,7 @@ impl Streamed {
             || (settings.gradient_opacity.is_some() && settings.gradient_opacity_max.is_none());
         let start = Instant::now();
         if needs_range || needs_gradient {
-            times.statistics_pieces = self.learn(needs_range, needs_gradient)?;
+            times.statistics_pieces = self.learn(needs_range, needs_gradient, stop)?;
         }
         times.read += start.elapsed();
         let value_range = self.value_range().unwrap_or((0.0, 0.0));
@@ -314,7 +314,7 @@ impl Streamed {
         if let Some(r) = &self.whole {
             return Ok(Histogram::of(r.volume(), bins));
         }
-        self.learn(true, false)?;
+        self.learn(true, false, &AtomicBool::new(false))?;
         let Some(range) = self.value_range() else {
             return Ok(None);
         };
@@ -384,7 +384,13 @@ impl Streamed {
 
     /// Reads the pieces whose value range (and largest gradient, if
     /// `gradient`) is not known yet, keeping only those: the number read.
-    fn learn(&mut self, range: bool, gradient: bool) -> Result<usize, StreamError> {
+    /// Stopped before a piece is read when `stop` is set.
+    fn learn(
+        &mut self,
+        range: bool,
+        gradient: bool,
+        stop: &AtomicBool,
+    ) -> Result<usize, StreamError> {
         let mut read = 0;
         for (index, owned) in self.decomposition.boxes.clone().into_iter().enumerate() {
             let known = self.known[index];
@@ -392,6 +398,9 @@ impl Streamed {
                 (range && known.range.is_none()) || (gradient && known.max_gradient.is_none());
             if owned.is_empty() || !missing {
                 continue;
+            }
+            if stop.load(Ordering::Relaxed) {
+                return Err(StreamError::Render(RenderError::Stopped));
             }
             let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
             let volume = self.read(lo, hi)?;

@@ -66,6 +66,7 @@ impl Start<'_> {
                 .map(|f| f.points().iter().map(|(t, [a])| [*t, *a]).collect()),
             start_window,
             colormaps,
+            levels: None,
         }
     }
 }

@@ -199,13 +199,46 @@ impl Costs {
     /// part, held until the socket has sent it.
     pub fn frame(&self, volume: &Volume, settings: &RenderSettings) -> (u128, u128) {
         let bound = MemoryBound::for_volume(volume, settings, self.non_finite, self.cache_budget);
+        self.frame_of(&bound, settings, self.tab)
+    }
+
+    /// [`Self::frame`] for a frame whose volume's bound is `bound`, its
+    /// renderer's structures `reserved` already.
+    pub fn frame_of(
+        &self,
+        bound: &MemoryBound,
+        settings: &RenderSettings,
+        reserved: u128,
+    ) -> (u128, u128) {
         let pixels = settings.width as u128 * settings.height as u128;
         let message = 4 * pixels + MESSAGE_OVERHEAD;
-        let path = (bound.cleaned + bound.path).saturating_sub(self.tab);
+        let path = (bound.cleaned + bound.path).saturating_sub(reserved);
         (
             bound.frame + path + ENCODE_BYTES_PER_PIXEL * pixels + MESSAGE_OVERHEAD,
             message,
         )
+    }
+
+    /// What a frame rendered piece by piece adds beyond its pieces'
+    /// budget: the finished image (32 bytes a pixel at most, a
+    /// projection's), its encoding and message.
+    pub fn pieces_frame(&self, settings: &RenderSettings) -> (u128, u128) {
+        let pixels = settings.width as u128 * settings.height as u128;
+        let message = 4 * pixels + MESSAGE_OVERHEAD;
+        (
+            (32 + ENCODE_BYTES_PER_PIXEL) * pixels + MESSAGE_OVERHEAD,
+            message,
+        )
+    }
+
+    /// How non-finite values are rendered, and each renderer's brick
+    /// caches' budget.
+    pub fn non_finite(&self) -> NonFinite {
+        self.non_finite
+    }
+
+    pub fn cache_budget(&self) -> usize {
+        self.cache_budget
     }
 }
 

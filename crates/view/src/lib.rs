@@ -42,6 +42,7 @@ mod ledger;
 mod mailbox;
 mod page;
 mod protocol;
+mod pyramid;
 mod reproduce;
 mod server;
 mod session;
@@ -51,9 +52,11 @@ mod token;
 
 pub use hello::Start;
 pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
-pub use protocol::{Basis, FrameHeader, Hello, Quality, ServerMessage};
+pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage};
+pub use pyramid::{CACHED_LEVELS, DRAFT_SHARE, Pyramid, PyramidError};
 pub use reproduce::{Refusal, Reproduce, Reproduction};
 pub use server::{ServeError, Server, Stopper};
+pub use session::draft_side;
 pub use state::{
     BlendMode, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState, WHITE, ZOOM_RANGE,
 };
@@ -85,6 +88,11 @@ pub struct Viewer {
     /// The most tabs rendering at once (each has a thread), whatever the
     /// memory allows.
     pub max_sessions: usize,
+    /// A multiscale volume served level by level (`pyramid.rs`), and the
+    /// level `volume` is: read whole by the caller for [`Start::hello`],
+    /// it is the first level the server holds, and the tabs render the
+    /// pyramid's levels instead of it.
+    pub levels: Option<(Pyramid, usize)>,
 }
 
 /// A viewer that could not start.
@@ -113,10 +121,27 @@ impl Viewer {
             self.max_memory,
         );
         let ledger = ledger::Ledger::new(self.max_memory);
-        let volume = ledger.reserve("the volume", costs.volume)?;
+        let (held, levels, volume) = match self.levels {
+            None => (
+                ledger.reserve("the volume", costs.volume)?,
+                None,
+                self.volume,
+            ),
+            Some((pyramid, level)) => {
+                // The level read for the page's first message is the
+                // first the server holds, its bytes reserved while held.
+                let [x, y, z] = self.volume.dims();
+                let what = format!("level {level} ({x}x{y}x{z}) read whole");
+                let held = ledger.reserve(&what, costs.volume)?;
+                let levels = pyramid::Levels::new(pyramid);
+                let kept = levels.keep(level, Arc::unwrap_or_clone(self.volume), held);
+                let nothing = ledger.reserve("nothing", 0)?;
+                (nothing, Some(Arc::new(levels)), Arc::new(kept))
+            }
+        };
         let hello = ServerMessage::Hello(Box::new(self.hello)).to_json();
         let shared = session::Shared {
-            volume: self.volume,
+            volume,
             non_finite: self.non_finite,
             cache_budget,
             reproduce: self.reproduce,
@@ -125,7 +150,8 @@ impl Viewer {
             max_sessions: self.max_sessions,
             ledger,
             costs,
+            levels,
         };
-        Ok(Server::bind(addr, token, hello, shared, volume)?)
+        Ok(Server::bind(addr, token, hello, shared, held)?)
     }
 }

@@ -144,6 +144,25 @@ pub struct FrameHeader {
     /// The transfer-function file it names: name and JSON.
     pub tf_file: Option<(String, String)>,
     pub basis: Basis,
+    /// The level of a multiscale volume the frame shows (absent for a
+    /// volume of one level read whole).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub level: Option<LevelShown>,
+}
+
+/// Which level of a multiscale volume a frame shows, and how it was read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct LevelShown {
+    /// The level, 0 the finest.
+    pub index: usize,
+    /// The levels the volume has.
+    pub count: usize,
+    pub dims: [usize; 3],
+    /// The pieces it was rendered in: 1 when held whole.
+    pub pieces: usize,
+    /// The pieces (or whole levels) read for this frame; the others were
+    /// held already, transparent or hidden.
+    pub read: usize,
 }
 
 /// `header` and `image` as one binary message.
@@ -181,6 +200,12 @@ pub struct Hello {
     pub start_window: [f64; 2],
     /// Each colour choice and its colours at evenly spaced `t`, to draw.
     pub colormaps: Vec<(String, Vec<[f32; 3]>)>,
+    /// A multiscale volume's levels' dims, finest first (absent for a
+    /// volume of one level read whole: then `dims` are its, else the
+    /// finest level's, while `range` and `histogram` are those of the
+    /// level the first drafts show).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub levels: Option<Vec<[usize; 3]>>,
 }
 
 /// A message from the server as text.
@@ -290,6 +315,7 @@ mod tests {
                 up: [0.0, 0.0, 1.0],
                 pixels_per_unit: 2.0,
             },
+            level: None,
         };
         let message = frame_message(&header, b"IMAGE");
         let n = u32::from_le_bytes(message[..4].try_into().unwrap()) as usize;
@@ -298,6 +324,23 @@ mod tests {
         assert_eq!(json["quality"], "full");
         assert_eq!(json["basis"]["pixels_per_unit"], 2.0);
         assert_eq!(&message[4 + n..], b"IMAGE");
+        // A volume of one level says nothing of levels; a pyramid's does.
+        assert!(json.get("level").is_none());
+        let leveled = FrameHeader {
+            level: Some(LevelShown {
+                index: 2,
+                count: 5,
+                dims: [256; 3],
+                pieces: 1,
+                read: 0,
+            }),
+            ..header
+        };
+        let message = frame_message(&leveled, b"");
+        let json: serde_json::Value = serde_json::from_slice(&message[4..]).unwrap();
+        assert_eq!(json["level"]["index"], 2);
+        assert_eq!(json["level"]["count"], 5);
+        assert_eq!(json["level"]["dims"], serde_json::json!([256, 256, 256]));
         let error = ServerMessage::Error {
             seq: Some(4),
             message: "no".into(),

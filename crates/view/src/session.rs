@@ -20,7 +20,10 @@
 use crate::encode::{self, DRAFT_QUALITY};
 use crate::ledger::{Costs, Ledger, Overdrawn, Reservation};
 use crate::mailbox::Mailbox;
-use crate::protocol::{Basis, FrameHeader, Quality, Request, ServerMessage, frame_message};
+use crate::protocol::{
+    Basis, FrameHeader, LevelShown, Quality, Request, ServerMessage, frame_message,
+};
+use crate::pyramid::{LevelError, Levels};
 use crate::reproduce::{Refusal, Reproduce};
 use crate::stats::Stats;
 use std::sync::Arc;
@@ -28,7 +31,8 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use tokio::sync::mpsc;
 use volray_core::camera::View;
-use volray_core::{NonFinite, RenderError, RenderSettings, Renderer, Volume};
+use volray_core::{Image, NonFinite, RenderError, RenderSettings, Renderer, Volume};
+use volray_distributed::streamed::{StreamError, Streamed};
 
 /// What the renderer thread sends to the tab's socket.
 #[derive(Debug)]
@@ -54,6 +58,9 @@ pub struct Shared {
     /// The memory limit, and what the tabs and frames reserve from it.
     pub ledger: Arc<Ledger>,
     pub costs: Costs,
+    /// A multiscale volume served level by level (`pyramid.rs`): then
+    /// the tabs render its levels, not `volume`.
+    pub levels: Option<Arc<Levels>>,
 }
 
 /// A tab that could not be given a renderer.
@@ -78,6 +85,17 @@ enum FrameError {
     Render(#[from] RenderError),
     #[error("{0}")]
     Encode(#[from] encode::EncodeError),
+    #[error("{0}")]
+    Level(#[from] LevelError),
+    /// A level too large for any piece to fit what the limit has left.
+    #[error("{0}")]
+    Pieces(String),
+}
+
+impl From<volray_core::camera::CameraError> for FrameError {
+    fn from(e: volray_core::camera::CameraError) -> Self {
+        FrameError::Render(e.into())
+    }
 }
 
 /// Starts a tab's renderer thread, which serves `mailbox` until it closes
@@ -91,9 +109,13 @@ pub fn spawn(
 ) -> Result<(), SpawnError> {
     let open =
         (shared.stats.open(shared.max_sessions)).ok_or(SpawnError::TooMany(shared.max_sessions))?;
-    let held = shared
-        .ledger
-        .reserve("another tab's renderer", shared.costs.tab)?;
+    // A pyramid's tabs reserve a renderer for each level they hold.
+    let tab_bytes = match shared.levels {
+        Some(_) => 0,
+        None => shared.costs.tab,
+    };
+    let held = shared.ledger.reserve("another tab's renderer", tab_bytes)?;
+    let levels = shared.levels.clone();
     let volume = Arc::clone(&shared.volume);
     let reproduce = Arc::clone(&shared.reproduce);
     let pool = Arc::clone(&shared.pool);
@@ -107,19 +129,26 @@ pub fn spawn(
         .spawn(move || {
             // Given back when the renderer is freed, after it.
             let (_open, _held) = (open, held);
-            let renderer = match Renderer::with_non_finite(&volume, non_finite) {
-                Ok(r) => r.with_cache_budget(cache_budget),
-                Err(e) => {
-                    let message = ServerMessage::Error {
-                        seq: None,
-                        message: e.to_string(),
-                    };
-                    let _ = out.blocking_send(Outgoing::Text(message.to_json()));
-                    return;
-                }
+            let source = match levels {
+                Some(levels) => Source::Levels(LevelTab {
+                    levels,
+                    renderers: Vec::new(),
+                    streamed: None,
+                }),
+                None => match Renderer::with_non_finite(&volume, non_finite) {
+                    Ok(r) => Source::Whole(r.with_cache_budget(cache_budget)),
+                    Err(e) => {
+                        let message = ServerMessage::Error {
+                            seq: None,
+                            message: e.to_string(),
+                        };
+                        let _ = out.blocking_send(Outgoing::Text(message.to_json()));
+                        return;
+                    }
+                },
             };
-            let tab = Tab {
-                renderer,
+            let mut tab = Tab {
+                source,
                 reproduce: &*reproduce,
                 pool: &pool,
                 stats: &stats,
@@ -162,9 +191,17 @@ pub fn spawn(
     Ok(())
 }
 
+/// What a tab renders: the volume, or a pyramid's levels.
+// One per tab, on its thread's stack: the sizes do not matter.
+#[allow(clippy::large_enum_variant)]
+enum Source<'a> {
+    Whole(Renderer<'a>),
+    Levels(LevelTab),
+}
+
 /// A tab's renderer and what it reports to.
 struct Tab<'a> {
-    renderer: Renderer<'a>,
+    source: Source<'a>,
     reproduce: &'a dyn Reproduce,
     pool: &'a rayon::ThreadPool,
     stats: &'a Stats,
@@ -172,37 +209,56 @@ struct Tab<'a> {
     costs: Costs,
 }
 
+/// A frame rendered, before it is encoded.
+struct Drawn {
+    image: Image,
+    basis: Basis,
+    level: Option<LevelShown>,
+    /// The frame's bytes, and the part the message keeps until sent.
+    reserved: Reservation,
+    message_bytes: u128,
+}
+
 impl Tab<'_> {
     /// The frame `request` asks for, as a binary message, and the bytes
     /// reserved for the message until it is sent; stopped when `stop` is
     /// set.
     fn frame(
-        &self,
+        &mut self,
         request: &Request,
         stop: &AtomicBool,
     ) -> Result<(Vec<u8>, Reservation), FrameError> {
         let reproduction = self.reproduce.reproduce(&request.state)?;
-        let basis = basis(&self.renderer, &reproduction.settings)?;
+        let full = &reproduction.settings;
         let settings = match request.quality {
             Quality::Draft => RenderSettings {
-                width: draft_side(reproduction.settings.width),
-                height: draft_side(reproduction.settings.height),
-                ..reproduction.settings
+                width: draft_side(full.width),
+                height: draft_side(full.height),
+                ..full.clone()
             },
-            Quality::Full | Quality::Save => reproduction.settings,
+            Quality::Full | Quality::Save => full.clone(),
         };
-        let (bytes, message_bytes) = self.costs.frame(self.renderer.volume(), &settings);
         let what = format!("a {}x{} frame", settings.width, settings.height);
-        let mut reserved = self.ledger.reserve(&what, bytes)?;
         let start = Instant::now();
-        let image = {
-            let _rendering = self.stats.rendering();
-            let renderer = &self.renderer;
-            // A fresh frame buffer each time (not one kept across frames):
-            // what a tab holds between frames is then its caches alone.
-            self.pool
-                .install(|| renderer.render_stoppable(&settings, &|_| {}, stop))?
+        let cx = Context {
+            pool: self.pool,
+            stats: self.stats,
+            ledger: self.ledger,
+            costs: self.costs,
+            stop,
+            what: &what,
         };
+        let drawn = match &mut self.source {
+            Source::Whole(renderer) => cx.whole(renderer, full, &settings)?,
+            Source::Levels(tab) => tab.draw(&cx, request.quality, full, &settings)?,
+        };
+        let Drawn {
+            image,
+            basis,
+            level,
+            mut reserved,
+            message_bytes,
+        } = drawn;
         let rendered = Instant::now();
         let mut rgb = Vec::new();
         let (mime, bytes) = match request.quality {
@@ -221,12 +277,223 @@ impl Tab<'_> {
             command: reproduction.command,
             tf_file: reproduction.tf_file,
             basis,
+            level,
         };
         // The pixels are given back here; the message's bytes when sent.
         Ok((
             frame_message(&header, &bytes),
             reserved.split_off(message_bytes),
         ))
+    }
+}
+
+/// What rendering a frame reports to and is stopped by.
+struct Context<'a> {
+    pool: &'a rayon::ThreadPool,
+    stats: &'a Stats,
+    ledger: &'a Arc<Ledger>,
+    costs: Costs,
+    stop: &'a AtomicBool,
+    /// "a WxH frame", for a refusal.
+    what: &'a str,
+}
+
+impl Context<'_> {
+    /// A frame of `settings` from `renderer`, whose tab reserved
+    /// `reserved` for its structures; its basis is that of `full`.
+    fn whole(
+        &self,
+        renderer: &Renderer,
+        full: &RenderSettings,
+        settings: &RenderSettings,
+    ) -> Result<Drawn, FrameError> {
+        let basis = basis(renderer, full)?;
+        let (bytes, message_bytes) = self.costs.frame(renderer.volume(), settings);
+        let reserved = self.ledger.reserve(self.what, bytes)?;
+        let image = self.render(renderer, settings)?;
+        Ok(Drawn {
+            image,
+            basis,
+            level: None,
+            reserved,
+            message_bytes,
+        })
+    }
+
+    fn render(&self, renderer: &Renderer, settings: &RenderSettings) -> Result<Image, FrameError> {
+        let _rendering = self.stats.rendering();
+        // A fresh frame buffer each time (not one kept across frames):
+        // what a tab holds between frames is then its caches alone.
+        Ok(self
+            .pool
+            .install(|| renderer.render_stoppable(settings, &|_| {}, self.stop))?)
+    }
+}
+
+/// A tab's part of a pyramid: its renderers of the levels held whole and
+/// the still's level rendered piece by piece.
+struct LevelTab {
+    levels: Arc<Levels>,
+    /// Renderers of levels held whole, the last used last, with the
+    /// bytes reserved for their structures; at most two (the drafts' and
+    /// the still's level).
+    renderers: Vec<(usize, Renderer<'static>, Reservation)>,
+    /// A level rendered piece by piece, with its budget: kept so that
+    /// what it learnt of its pieces (their value ranges) serves the next
+    /// still.
+    streamed: Option<(usize, u64, Streamed)>,
+}
+
+impl LevelTab {
+    /// A frame of `settings` (the full-size frame's `full`): a draft from
+    /// a coarse level held whole, a still from the level it needs, whole
+    /// if it fits what the memory limit has left, else in pieces.
+    fn draw(
+        &mut self,
+        cx: &Context,
+        quality: Quality,
+        full: &RenderSettings,
+        settings: &RenderSettings,
+    ) -> Result<Drawn, FrameError> {
+        let levels = Arc::clone(&self.levels);
+        let pyramid = &levels.pyramid;
+        let non_finite = cx.costs.non_finite();
+        settings.validate().map_err(RenderError::from)?;
+        let still = pyramid.still_level(full)?;
+        let grid = pyramid.grid(still);
+        let basis = basis_of(&View::frame(
+            &full.camera,
+            grid.bounds(),
+            full.width,
+            full.height,
+        )?);
+        let limit = cx.ledger.limit();
+        let (level, whole) = match quality {
+            Quality::Draft => match pyramid.draft_level(settings, still, non_finite, limit)? {
+                Some(level) => (level, true),
+                // Even the coarsest level is too large to hold: in pieces.
+                None => (pyramid.len() - 1, false),
+            },
+            Quality::Full | Quality::Save => {
+                let (extra, _) = cx.costs.pieces_frame(settings);
+                let held = if levels.is_held(still) {
+                    pyramid.volume_bytes(still)
+                } else {
+                    0
+                };
+                let need =
+                    (pyramid.whole_bytes(still, settings, non_finite) + extra).saturating_sub(held);
+                let free = limit.saturating_sub(cx.ledger.held());
+                (still, need <= free)
+            }
+        };
+        let (image, shown, reserved, message_bytes) = if whole {
+            self.whole(cx, level, settings)?
+        } else {
+            self.pieces(cx, level, settings)?
+        };
+        Ok(Drawn {
+            image,
+            basis,
+            level: Some(shown),
+            reserved,
+            message_bytes,
+        })
+    }
+
+    /// A frame of level `level` held whole.
+    fn whole(
+        &mut self,
+        cx: &Context,
+        level: usize,
+        settings: &RenderSettings,
+    ) -> Result<(Image, LevelShown, Reservation, u128), FrameError> {
+        let levels = &self.levels;
+        let pyramid = &levels.pyramid;
+        let non_finite = cx.costs.non_finite();
+        let cache_budget = cx.costs.cache_budget();
+        let read = usize::from(!levels.is_held(level));
+        let index = match self.renderers.iter().position(|(l, ..)| *l == level) {
+            Some(i) => i,
+            None => {
+                // This tab lets go of its renderers of other levels but
+                // the last one used (the drafts' or the still's).
+                let over = self.renderers.len().saturating_sub(1);
+                self.renderers.drain(..over);
+                let volume = levels.whole(level, cx.ledger)?;
+                let bound = pyramid.bound(level, settings, non_finite, cache_budget);
+                let what = format!("a renderer of level {level}");
+                let structures = cx.ledger.reserve(&what, bound.cleaned + bound.path)?;
+                let renderer =
+                    Renderer::owning(volume, non_finite)?.with_cache_budget(cache_budget);
+                self.renderers.push((level, renderer, structures));
+                self.renderers.len() - 1
+            }
+        };
+        let entry = self.renderers.remove(index);
+        self.renderers.push(entry);
+        let (_, renderer, structures) = self.renderers.last().expect("pushed above");
+        let bound = pyramid.bound(level, settings, non_finite, cache_budget);
+        let (bytes, message_bytes) = cx.costs.frame_of(&bound, settings, structures.bytes());
+        let reserved = cx.ledger.reserve(cx.what, bytes)?;
+        let image = cx.render(renderer, settings)?;
+        let shown = LevelShown {
+            index: level,
+            count: pyramid.len(),
+            dims: pyramid.grid(level).dims,
+            pieces: 1,
+            read,
+        };
+        Ok((image, shown, reserved, message_bytes))
+    }
+
+    /// A frame of level `level` rendered piece by piece, in pieces that
+    /// fit what the memory limit has left (at most
+    /// [`volray_lazy::PIECE_BUDGET`]).
+    fn pieces(
+        &mut self,
+        cx: &Context,
+        level: usize,
+        settings: &RenderSettings,
+    ) -> Result<(Image, LevelShown, Reservation, u128), FrameError> {
+        let pyramid = &self.levels.pyramid;
+        let non_finite = cx.costs.non_finite();
+        let (extra, message_bytes) = cx.costs.pieces_frame(settings);
+        let free = (cx.ledger.limit())
+            .saturating_sub(cx.ledger.held())
+            .saturating_sub(extra);
+        let budget = u64::try_from(free)
+            .unwrap_or(u64::MAX)
+            .min(volray_lazy::PIECE_BUDGET);
+        let keep = matches!(&self.streamed, Some((l, b, _)) if *l == level && *b <= budget);
+        if !keep {
+            let source = Arc::clone(pyramid.source(level));
+            let streamed = Streamed::new(source, non_finite, budget).with_labels(pyramid.labels());
+            self.streamed = Some((level, budget, streamed));
+        }
+        let (_, budget, streamed) = self.streamed.as_mut().expect("set above");
+        let reserved = cx.ledger.reserve(cx.what, extra + u128::from(*budget))?;
+        let rendered = {
+            let _rendering = cx.stats.rendering();
+            cx.pool
+                .install(|| streamed.render_stoppable(settings, &|_| {}, cx.stop))
+        };
+        let [x, y, z] = pyramid.grid(level).dims;
+        let (image, times) = rendered.map_err(|e| match e {
+            StreamError::Render(e) => FrameError::Render(e),
+            StreamError::Read(m) => FrameError::Level(LevelError::Read(m)),
+            StreamError::TooLarge(m) => FrameError::Pieces(format!(
+                "level {level} ({x}x{y}x{z}) in pieces: {m}: wait for the other tabs' frames, or raise --max-memory"
+            )),
+        })?;
+        let shown = LevelShown {
+            index: level,
+            count: pyramid.len(),
+            dims: [x, y, z],
+            pieces: times.pieces,
+            read: times.read_pieces,
+        };
+        Ok((image, shown, reserved, message_bytes))
     }
 }
 
@@ -238,7 +505,12 @@ pub fn draft_side(full: usize) -> usize {
 /// The screen axes of the full-size view of `settings`, for panning.
 fn basis(renderer: &Renderer, settings: &RenderSettings) -> Result<Basis, RenderError> {
     let frame = renderer.prepare(settings)?;
-    let (reference, right, up, units_per_pixel) = match frame.view {
+    Ok(basis_of(&frame.view))
+}
+
+/// The screen axes of `view`.
+fn basis_of(view: &View) -> Basis {
+    let (reference, right, up, units_per_pixel) = match *view {
         View::Orthographic(v) => (v.centre, v.right, v.up, v.pixel_size),
         View::Perspective(v) => (
             v.reference,
@@ -247,12 +519,12 @@ fn basis(renderer: &Renderer, settings: &RenderSettings) -> Result<Basis, Render
             v.pixel_size * (v.reference - v.eye).length(),
         ),
     };
-    Ok(Basis {
+    Basis {
         reference: reference.to_array(),
         right: right.to_array(),
         up: up.to_array(),
         pixels_per_unit: 1.0 / units_per_pixel,
-    })
+    }
 }
 
 #[cfg(test)]
@@ -333,6 +605,7 @@ mod tests {
             max_sessions,
             ledger: Ledger::new(limit),
             costs,
+            levels: None,
         }
     }
 
@@ -537,6 +810,280 @@ mod tests {
         b.close();
         assert!(a_rx.blocking_recv().is_none() && b_rx.blocking_recv().is_none());
         assert_eq!(shared.ledger.held(), 0);
+    }
+
+    /// Every box read from a pyramid's levels: (level, lo, hi).
+    type Reads = Arc<std::sync::Mutex<Vec<(usize, [usize; 3], [usize; 3])>>>;
+
+    /// A level that records every box read from it.
+    struct Counted {
+        level: usize,
+        source: Arc<dyn volray_core::VolumeSource>,
+        reads: Reads,
+    }
+
+    impl volray_core::VolumeSource for Counted {
+        fn grid(&self) -> volray_core::sampling::grid::GridFrame {
+            self.source.grid()
+        }
+        fn sample_type(&self) -> volray_core::SampleType {
+            self.source.sample_type()
+        }
+        fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+            self.reads.lock().unwrap().push((self.level, lo, hi));
+            self.source.read_box(lo, hi)
+        }
+    }
+
+    /// A 64³ OME-Zarr pyramid of 16³ chunks (levels 64³, 32³, 16³): its
+    /// directory and path.
+    fn pyramid_file() -> (tempfile::TempDir, std::path::PathBuf) {
+        use volray_io::{OmeZarrOptions, write_ome_zarr};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("blob.ome.zarr");
+        let volume = Volume::from_fn([64; 3], DVec3::ONE, DVec3::ZERO, |p| {
+            let d = (p - DVec3::new(30.0, 34.0, 28.0)).length();
+            ((1.0 - d / 26.0).max(0.0) * (1.0 + 0.3 * (p.x * 0.4).sin())) as f32
+        })
+        .unwrap();
+        let options = OmeZarrOptions {
+            chunk: 16,
+            shard: 32,
+            ..OmeZarrOptions::default()
+        };
+        write_ome_zarr(&path, &volume, &options).unwrap();
+        (dir, path)
+    }
+
+    /// Level `level` of `path` read whole, as `volray render --level N`
+    /// reads it.
+    fn read_level(path: &std::path::Path, level: usize) -> Volume {
+        let opts = volray_io::ReadOptions {
+            level: Some(level),
+            ..volray_io::ReadOptions::default()
+        };
+        volray_io::read(path, &opts).unwrap().volume
+    }
+
+    /// A server of the pyramid at `path` under `limit` bytes, its stills
+    /// at `still` (`None`: auto), and the log of what its levels read.
+    fn pyramid_shared(
+        path: &std::path::Path,
+        limit: u128,
+        still: Option<usize>,
+    ) -> (Shared, Reads) {
+        let reads = Reads::default();
+        let sources = (0..3)
+            .map(|level| {
+                let opts = volray_io::ReadOptions {
+                    level: Some(level),
+                    ..volray_io::ReadOptions::default()
+                };
+                let lazy = volray_io::open_lazy(path, &opts).unwrap().unwrap();
+                Arc::new(Counted {
+                    level,
+                    source: lazy.source,
+                    reads: Arc::clone(&reads),
+                }) as Arc<dyn volray_core::VolumeSource>
+            })
+            .collect();
+        let pyramid = crate::pyramid::Pyramid::new(sources, still).unwrap();
+        let mut shared = shared_with(Arc::new(Plain::default()), limit, 1);
+        // No brick caches: what a level's renderer holds is its frame's.
+        shared.cache_budget = 0;
+        let start = RenderSettings::default();
+        shared.costs = Costs::new(&shared.volume, &start, NonFinite::Refuse, 0);
+        shared.levels = Some(Arc::new(Levels::new(pyramid)));
+        (shared, reads)
+    }
+
+    /// The frame of `request` from a tab of `shared`: its header and image.
+    fn one_frame(
+        mailbox: &Mailbox<Request>,
+        rx: &mut mpsc::Receiver<Outgoing>,
+        request: Request,
+    ) -> (serde_json::Value, Vec<u8>) {
+        mailbox.put(Slot::Latest, request);
+        match rx.blocking_recv() {
+            Some(Outgoing::Frame(message, _)) => {
+                let n = u32::from_le_bytes(message[..4].try_into().unwrap()) as usize;
+                (header(&message), message[4 + n..].to_vec())
+            }
+            Some(Outgoing::Text(text)) => panic!("{text}"),
+            None => panic!("no frame"),
+        }
+    }
+
+    /// 8-bit RGB pixels of a PNG.
+    fn pixels(png: &[u8]) -> Vec<u8> {
+        let mut reader = png::Decoder::new(std::io::Cursor::new(png))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        buf.truncate(info.buffer_size());
+        buf
+    }
+
+    #[test]
+    fn a_pyramids_drafts_show_a_coarser_level_held_whole_and_its_still_the_level_auto_chooses() {
+        let (_dir, path) = pyramid_file();
+        let (shared, reads) = pyramid_shared(&path, 1 << 30, None);
+        let pyramid = &shared.levels.as_ref().unwrap().pyramid;
+        let full = RenderSettings {
+            width: 64,
+            height: 64,
+            ..RenderSettings::default()
+        };
+        let draft = RenderSettings {
+            width: 32,
+            height: 32,
+            ..full.clone()
+        };
+        let still = pyramid.auto_level(&full).unwrap();
+        let coarse = pyramid.auto_level(&draft).unwrap();
+        assert!(coarse > still, "draft {coarse}, still {still}");
+        let mailbox = Arc::new(Mailbox::default());
+        let (tx, mut rx) = mpsc::channel(1);
+        spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+
+        // A drag: the coarse level, read whole once, then held.
+        let (h, _) = one_frame(&mailbox, &mut rx, request(1, Quality::Draft, 64, 30.0));
+        assert_eq!(h["level"]["index"], coarse);
+        assert_eq!(h["level"]["count"], 3);
+        assert_eq!(
+            (h["level"]["pieces"].as_u64(), h["level"]["read"].as_u64()),
+            (Some(1), Some(1))
+        );
+        let dims = pyramid.grid(coarse).dims;
+        assert_eq!(*reads.lock().unwrap(), [(coarse, [0; 3], dims)]);
+        let (h, _) = one_frame(&mailbox, &mut rx, request(2, Quality::Draft, 64, 40.0));
+        assert_eq!(
+            (h["level"]["index"].as_u64(), h["level"]["read"].as_u64()),
+            (Some(coarse as u64), Some(0))
+        );
+        assert_eq!(reads.lock().unwrap().len(), 1, "a drag reads nothing more");
+
+        // Still: the level auto chooses, whole: the frame `volray render
+        // --level N` renders of it, byte for byte.
+        let (h, png) = one_frame(&mailbox, &mut rx, request(3, Quality::Full, 64, 40.0));
+        assert_eq!(h["level"]["index"], still);
+        assert_eq!(h["level"]["pieces"], 1);
+        let dims = pyramid.grid(still).dims;
+        assert_eq!(reads.lock().unwrap()[1..], [(still, [0; 3], dims)]);
+        let volume = read_level(&path, still);
+        let mut settings = full.clone();
+        settings.camera.azimuth = 40.0;
+        let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+        assert_eq!(png, encode::png(&reference, &mut Vec::new()).unwrap());
+        mailbox.close();
+        assert!(rx.blocking_recv().is_none());
+        drop(shared.levels);
+        assert_eq!(shared.ledger.held(), 0, "every level's bytes given back");
+    }
+
+    #[test]
+    fn a_still_beyond_the_memory_left_is_rendered_in_pieces_never_read_whole_within_a_level() {
+        let (_dir, path) = pyramid_file();
+        let full = RenderSettings {
+            width: 64,
+            height: 64,
+            ..RenderSettings::default()
+        };
+        // Level 0's still does not fit: what reading it whole takes, less
+        // a byte; the drafts' level fits a quarter of that.
+        let (probe, _) = pyramid_shared(&path, u128::MAX, Some(0));
+        let pyramid = &probe.levels.as_ref().unwrap().pyramid;
+        let nf = NonFinite::Refuse;
+        let whole = pyramid.whole_bytes(0, &full, nf) + probe.costs.pieces_frame(&full).0;
+        let limit = whole - 1;
+        let draft = RenderSettings {
+            width: 32,
+            height: 32,
+            ..full.clone()
+        };
+        let coarse = pyramid.draft_level(&draft, 0, nf, limit).unwrap().unwrap();
+        assert!(coarse > 0);
+        let (shared, reads) = pyramid_shared(&path, limit, Some(0));
+        let mailbox = Arc::new(Mailbox::default());
+        let (tx, mut rx) = mpsc::channel(1);
+        spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+        let (h, _) = one_frame(&mailbox, &mut rx, request(1, Quality::Draft, 64, 20.0));
+        assert_eq!(h["level"]["index"], coarse);
+        let (h, png) = one_frame(&mailbox, &mut rx, request(2, Quality::Full, 64, 20.0));
+        assert_eq!(h["level"]["index"], 0);
+        let pieces = h["level"]["pieces"].as_u64().unwrap();
+        assert!(pieces > 1, "{h}");
+        // Level 0 was never read whole; no level read whole was larger
+        // than the limit allows.
+        let log = reads.lock().unwrap().clone();
+        assert!(log.iter().any(|(l, ..)| *l == 0));
+        for (level, lo, hi) in log {
+            let dims = pyramid.grid(level).dims;
+            assert!(
+                level != 0 || (lo, hi) != ([0; 3], dims),
+                "level 0 read whole"
+            );
+            if (lo, hi) == ([0; 3], dims) {
+                assert!(pyramid.volume_bytes(level) <= limit / crate::pyramid::DRAFT_SHARE);
+            }
+        }
+        // Within a level (1/255) of level 0 rendered whole.
+        let volume = read_level(&path, 0);
+        let mut settings = full.clone();
+        settings.camera.azimuth = 20.0;
+        let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+        let expected = pixels(&encode::png(&reference, &mut Vec::new()).unwrap());
+        let got = pixels(&png);
+        assert_eq!(got.len(), expected.len());
+        let worst = got
+            .iter()
+            .zip(&expected)
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap();
+        assert!(worst <= 1, "{worst}/255");
+        mailbox.close();
+        assert!(rx.blocking_recv().is_none());
+        assert!(shared.ledger.held() <= limit);
+    }
+
+    #[test]
+    fn a_still_in_pieces_superseded_before_it_starts_reads_nothing_and_the_newer_frame_is_sent() {
+        let (_dir, path) = pyramid_file();
+        let (probe, _) = pyramid_shared(&path, u128::MAX, Some(0));
+        let full = RenderSettings {
+            width: 64,
+            height: 64,
+            ..RenderSettings::default()
+        };
+        let pyramid = &probe.levels.as_ref().unwrap().pyramid;
+        let limit = pyramid.whole_bytes(0, &full, NonFinite::Refuse) - 1;
+        let plain = Arc::new(Plain::default());
+        let (mut shared, reads) = pyramid_shared(&path, limit, Some(0));
+        shared.reproduce = Arc::clone(&plain) as Arc<dyn Reproduce>;
+        let mailbox = Arc::new(Mailbox::default());
+        let page = Arc::clone(&mailbox);
+        *plain.meanwhile.lock().unwrap() = Some((
+            1.0,
+            Box::new(move || page.put(Slot::Latest, request(2, Quality::Draft, 64, 2.0))),
+        ));
+        mailbox.put(Slot::Latest, request(1, Quality::Full, 64, 1.0));
+        let (tx, mut rx) = mpsc::channel(1);
+        spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+        let Some(Outgoing::Frame(message, _)) = rx.blocking_recv() else {
+            panic!("no frame")
+        };
+        let h = header(&message);
+        assert_eq!(h["seq"], 2);
+        assert!(h["level"]["index"].as_u64().unwrap() > 0);
+        assert_eq!(shared.stats.stopped(), 1);
+        // Only the draft's level was read: the still stopped before its
+        // first piece.
+        let log = reads.lock().unwrap().clone();
+        assert!(log.iter().all(|(l, ..)| *l > 0), "{log:?}");
+        mailbox.close();
+        assert!(rx.blocking_recv().is_none());
     }
 
     #[test]
