@@ -41,6 +41,8 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
         (None, Some((format, info))) => (format.description().to_string(), Some(info)),
         (None, None) => ("built-in source".to_string(), None),
     };
+    let info = info.map(with_bytes_stored);
+    let info = info.as_ref();
     // What is shown of the volume: the level asked for, whichever level
     // the statistics came from.
     let grid = match &chunked {
@@ -261,6 +263,31 @@ fn describe_image(name: &str, image: &FlatImage, as_json: bool) {
 }
 
 /// The stored type, and the frames and arrays a file holds.
+/// The most chunk files `volray info` counts a level's stored bytes over:
+/// walking them takes about 4 µs a file here (262 144 shards of a 16384³
+/// level: 1 s), so a level of millions of chunks is left uncounted.
+const COUNTED_FILES: usize = 100_000;
+
+/// `info` with each level's stored bytes counted, where it has no more
+/// than [`COUNTED_FILES`] files.
+fn with_bytes_stored(info: &FileInfo) -> FileInfo {
+    let mut info = info.clone();
+    for l in &mut info.levels {
+        l.bytes_stored = l
+            .bytes_stored
+            .or_else(|| l.count_bytes_stored(COUNTED_FILES));
+    }
+    info
+}
+
+/// A level's stored bytes as `volray info` says them.
+fn stored(l: &volray_io::LevelInfo) -> String {
+    l.bytes_stored.map_or_else(
+        || format!("over {COUNTED_FILES} chunk files (not counted)"),
+        |b| volray_io::format_bytes(u128::from(b)),
+    )
+}
+
 fn print_stored(i: &FileInfo) {
     outln!("stored as: {}", i.stored_type);
     if i.frames > 1 {
@@ -289,7 +316,7 @@ fn print_stored(i: &FileInfo) {
                 shape(&l.chunk_shape),
                 shape(&l.shard_shape),
                 l.codecs,
-                volray_io::format_bytes(u128::from(l.bytes_stored)),
+                stored(l),
                 volray_io::format_bytes(u128::from(l.bytes_in_memory))
             );
         }

@@ -193,10 +193,25 @@ pub struct LevelInfo {
     pub shard_shape: Option<Vec<u64>>,
     /// The codecs, in order, e.g. `bytes, zstd` or `blosc (lz4)`.
     pub codecs: String,
-    /// The bytes the level's chunk files take on disk.
-    pub bytes_stored: u64,
+    /// The level's directory.
+    pub dir: PathBuf,
+    /// The bytes the level's chunk files take on disk, where counted:
+    /// opening a level does not count them (a level of 64³ chunks of a
+    /// 16384³ image is 16 million files); see
+    /// [`count_bytes_stored`](Self::count_bytes_stored).
+    pub bytes_stored: Option<u64>,
     /// The bytes one volume of it (a time point and channel) takes in memory.
     pub bytes_in_memory: u64,
+}
+
+impl LevelInfo {
+    /// The bytes the level's chunk files take on disk, counted file by
+    /// file: `None` past `max_files` files (the walk is a statistic for
+    /// `volray info`, and would take minutes on a level of millions of
+    /// chunks). Hard-linked files count once for each name.
+    pub fn count_bytes_stored(&self, max_files: usize) -> Option<u64> {
+        crate::formats::zarr::stored_bytes(&self.dir, max_files)
+    }
 }
 
 impl FileInfo {

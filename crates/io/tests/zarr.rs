@@ -255,7 +255,10 @@ fn info_gives_each_levels_chunks_shards_codecs_and_bytes() {
         .iter()
         .map(|s| fs::metadata(path.join(s)).unwrap().len())
         .sum();
-    assert_eq!(level.bytes_stored, shards);
+    // Not counted on opening; counted on asking, and not past a limit.
+    assert_eq!(level.bytes_stored, None);
+    assert_eq!(level.count_bytes_stored(2), Some(shards));
+    assert_eq!(level.count_bytes_stored(1), None);
     let v2 = load(&dir.join("v2_blosc.zarr"), &ReadOptions::default());
     assert_eq!(v2.info.levels[0].codecs, "blosc (lz4)");
     assert_eq!(v2.info.levels[0].bytes_in_memory, 4 * 5 * 9 * 4);

@@ -29,7 +29,7 @@ mod store;
 mod write;
 
 pub(crate) use lazy::ZarrLevel;
-pub(crate) use store::is_zarr_dir;
+pub(crate) use store::{is_zarr_dir, stored_bytes};
 pub use write::{OmeZarrOptions, OmeZarrWritten, WrittenLevel, ZarrVersion, write_ome_zarr};
 
 use std::path::{Path, PathBuf};
@@ -318,7 +318,8 @@ fn level_info(
         chunk_shape: chunk,
         shard_shape: shard,
         codecs: codecs(&serde_json::to_value(array.metadata()).unwrap_or(Value::Null)),
-        bytes_stored: store::stored_bytes(dir),
+        dir: dir.to_path_buf(),
+        bytes_stored: None,
         bytes_in_memory: volume_values.saturating_mul(ty.kept_bytes()),
     }
 }

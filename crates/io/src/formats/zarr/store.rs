@@ -100,9 +100,11 @@ fn read_json(path: &Path) -> Result<Value, IoError> {
 /// The bytes an array's chunk files take on disk: every file below `dir`
 /// but its metadata files (chunks of v2 arrays sit beside `.zarray`, of
 /// v3 arrays under `c/`, shards alike). Unreadable entries count as 0:
-/// this is a statistic for `volray info`, not a check.
-pub(crate) fn stored_bytes(dir: &Path) -> u64 {
+/// this is a statistic for `volray info`, not a check. `None` once more
+/// than `max_files` files are found.
+pub(crate) fn stored_bytes(dir: &Path, max_files: usize) -> Option<u64> {
     let mut total = 0;
+    let mut files = 0usize;
     let mut pending = vec![dir.to_path_buf()];
     while let Some(d) = pending.pop() {
         let Ok(entries) = std::fs::read_dir(&d) else {
@@ -116,9 +118,13 @@ pub(crate) fn stored_bytes(dir: &Path) -> u64 {
             if kind.is_dir() {
                 pending.push(entry.path());
             } else if kind.is_file() && !MARKERS.iter().any(|m| name == *m) {
+                files += 1;
+                if files > max_files {
+                    return None;
+                }
                 total += entry.metadata().map_or(0, |m| m.len());
             }
         }
     }
-    total
+    Some(total)
 }

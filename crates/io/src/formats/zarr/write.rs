@@ -208,7 +208,7 @@ pub fn write_ome_zarr(
                 origin: l.origin.to_array(),
                 chunk: l.chunk,
                 shard: (options.zarr_version == ZarrVersion::V3).then_some(l.tile),
-                bytes_stored: stored_bytes(&root.join(k.to_string())),
+                bytes_stored: stored_bytes(&root.join(k.to_string()), usize::MAX).unwrap_or(0),
             })
             .collect(),
         codec: match options.zarr_version {
