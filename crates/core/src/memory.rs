@@ -28,7 +28,6 @@ use crate::kernels::gradient;
 use crate::kernels::projection::Projected;
 use crate::non_finite::{self, NonFinite};
 use crate::reference::{self, stage1};
-use crate::renderer::split_budget;
 use crate::settings::{Blend, Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
 use crate::volume::{SampleType, Volume};
 use crate::{bricks, image::Image};
@@ -161,11 +160,11 @@ fn bricked_path(grid: BrickGrid, settings: &RenderSettings, cache_budget: usize)
     let per_occupied = bricks::occupied::BYTES_PER_OCCUPIED_BRICK
         + lit_bricks::BYTES_PER_OCCUPIED_BRICK
         + tiles::BYTES_PER_OCCUPIED_BRICK;
-    // The slots, classified and lit, as far as the budget's shares go.
-    let (slot_budget, lit_budget) = split_budget(cache_budget);
-    let slots = (bricks * bricks::occupied::SLOT_BYTES_PER_OCCUPIED_BRICK as u128)
-        .min(slot_budget as u128)
-        + (bricks * lit_bricks::SLOT_BYTES_PER_OCCUPIED_BRICK as u128).min(lit_budget as u128);
+    // The slots, classified and lit, as far as the budget they share goes.
+    let slots = (bricks
+        * (bricks::occupied::SLOT_BYTES_PER_OCCUPIED_BRICK
+            + lit_bricks::SLOT_BYTES_PER_OCCUPIED_BRICK) as u128)
+        .min(cache_budget as u128);
     let tiles_x = settings.width.div_ceil(tiles::TILE) as u128;
     let tiles_y = settings.height.div_ceil(tiles::TILE) as u128;
     let tile_count = tiles_x * tiles_y;

@@ -22,8 +22,9 @@
 //! [`NonFinite::Transparent`] renders them as empty space, from a cleaned
 //! copy and a mask (see [`NonFinite`](crate::NonFinite) for the exact rules).
 
+use crate::bricks::cache::Budget;
 use crate::bricks::macrocells::Macrocells;
-use crate::bricks::occupied::{ClassifiedBricks, Source};
+use crate::bricks::occupied::{Classified, ClassifiedBricks, Source};
 use crate::camera::View;
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::projection as intensity;
@@ -93,14 +94,6 @@ fn verify(volume: &Volume) -> Result<(), RenderError> {
 /// lit bricks: 1 GiB, which holds every brick of the peers' volumes (257³:
 /// 100 MiB) and keeps a 1024³ CT's frames within a few GiB.
 pub const DEFAULT_CACHE_BUDGET: usize = 1 << 30;
-
-/// The bricked fast path's budget split between classified slots (8 bytes
-/// a slot) and lit ones (16): a third and two thirds, the same number of
-/// bricks each.
-pub(crate) fn split_budget(budget: usize) -> (usize, usize) {
-    let slots = budget / 3;
-    (slots, budget - slots)
-}
 
 /// The fast path's state kept between frames.
 struct FastState {
@@ -590,7 +583,6 @@ impl<'v> Renderer<'v> {
         let t0 = Instant::now();
         let mask = self.non_finite.as_ref();
         let masked = |v: usize| mask.is_some_and(|m| m.contains(v));
-        let (slot_budget, lit_budget) = split_budget(self.cache_budget);
         if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
             // Drop the old bricks before building the new ones.
             *guard = None;
@@ -599,8 +591,11 @@ impl<'v> Renderer<'v> {
                 classifier: &classifier,
                 masked: &masked,
             };
-            let bricks = ClassifiedBricks::new(&source, self.macrocells(), slot_budget);
-            let lit = LitBricks::new(bricks.len(), lit_budget);
+            // One budget for both caches: the lit bricks in use first,
+            // the classified ones in what they leave (see `LitBricks`).
+            let budget = Budget::new(self.cache_budget);
+            let bricks = ClassifiedBricks::sharing(&source, self.macrocells(), budget.clone());
+            let lit = LitBricks::sharing(bricks.len(), budget, size_of::<Classified>());
             *guard = Some(FastState {
                 classifier,
                 bricks,

@@ -21,6 +21,12 @@
 //! the first ones a frame asked for, and a budget smaller than all the
 //! bricks still fills each brick once a frame when the bricks in use fit.
 //!
+//! Several caches may draw on one [`Budget`] (the classified and the lit
+//! bricks do). A cache whose `get` is given a way to make room (`shed`:
+//! the lit bricks drop classified ones, which can be made again) frees
+//! bytes that way before it falls back on a scratch buffer, so it has the
+//! first claim on the budget and the other cache keeps what is left.
+//!
 //! The policy is by frame rather than least-recently-used because a frame
 //! visits bricks in an order (tiles, front to back) that repeats from
 //! frame to frame: LRU would evict every brick just before its next use
@@ -34,7 +40,7 @@
 
 use std::ops::Deref;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::sync::{Arc, Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// How many entries the clock hand looks at for a buffer to take before
 /// giving up and filling a temporary one.
@@ -60,12 +66,49 @@ impl<T> Deref for CacheRef<'_, T> {
     }
 }
 
+/// Bytes that one or more caches allocate their buffers from.
+#[derive(Debug)]
+pub(crate) struct Budget {
+    limit: usize,
+    /// Bytes of the buffers allocated, by every cache drawing on it.
+    used: AtomicUsize,
+}
+
+impl Budget {
+    /// At most `limit` bytes.
+    pub fn new(limit: usize) -> Arc<Self> {
+        Arc::new(Budget {
+            limit,
+            used: AtomicUsize::new(0),
+        })
+    }
+
+    /// The most bytes.
+    pub fn limit(&self) -> usize {
+        self.limit
+    }
+
+    /// Counts `size` more bytes if there is room for them.
+    fn take(&self, size: usize) -> bool {
+        self.used
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |b| {
+                (b.checked_add(size)? <= self.limit).then_some(b + size)
+            })
+            .is_ok()
+    }
+
+    /// Gives back `size` bytes.
+    fn give(&self, size: usize) {
+        self.used.fetch_sub(size, Ordering::AcqRel);
+    }
+}
+
 /// Per-brick buffers of type `T` under a budget of bytes.
 pub(crate) struct BrickCache<T> {
     entries: Vec<Entry<T>>,
-    /// Bytes of the buffers allocated (each `size_of::<T>()`).
+    /// Bytes of this cache's buffers (each `size_of::<T>()`).
     bytes: AtomicUsize,
-    budget: usize,
+    budget: Arc<Budget>,
     /// Where the next sweep for a buffer to take starts.
     hand: AtomicUsize,
     /// Whether a buffer filled for frame `f` is still valid in frame `now`.
@@ -91,12 +134,12 @@ impl<T> BrickCache<T> {
     /// buffer's place in the pool.
     pub const BYTES_PER_ENTRY: usize = size_of::<Entry<T>>() + size_of::<Box<T>>();
 
-    /// A cache of `count` entries holding at most `budget` bytes of
-    /// buffers. `valid` and `evictable` give the policy (see the module
-    /// docs); frames are numbered from 1.
+    /// A cache of `count` entries whose buffers take at most what `budget`
+    /// has room for. `valid` and `evictable` give the policy (see the
+    /// module docs); frames are numbered from 1.
     pub fn new(
         count: usize,
-        budget: usize,
+        budget: Arc<Budget>,
         valid: fn(u64, u64) -> bool,
         evictable: fn(u64, u64) -> bool,
     ) -> Self {
@@ -108,13 +151,13 @@ impl<T> BrickCache<T> {
                 })
                 .collect(),
             bytes: AtomicUsize::new(0),
-            budget,
             hand: AtomicUsize::new(0),
             valid,
             evictable,
             pool: Mutex::new(Vec::with_capacity(
-                count.min(budget / size_of::<T>().max(1)),
+                count.min(budget.limit / size_of::<T>().max(1)),
             )),
+            budget,
             fills: AtomicUsize::new(0),
         }
     }
@@ -170,11 +213,43 @@ impl<T> BrickCache<T> {
     /// Counts one more buffer if the budget has room for it.
     fn reserve_bytes(&self) -> bool {
         let size = size_of::<T>();
-        self.bytes
-            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |b| {
-                (b + size <= self.budget).then_some(b + size)
+        let room = self.budget.take(size);
+        if room {
+            self.bytes.fetch_add(size, Ordering::AcqRel);
+        }
+        room
+    }
+
+    /// Drops one buffer that no one is reading (one given back, else any
+    /// entry's), its bytes back to the budget for another cache drawing
+    /// on it; says whether it found one. The hand goes round the entries
+    /// once at most: a cache that holds a buffer gives one up unless every
+    /// holder is being read.
+    pub fn shed(&self) -> bool {
+        if self.bytes() == 0 {
+            return false;
+        }
+        let pooled = self.pool.lock().unwrap_or_else(|e| e.into_inner()).pop();
+        let dropped = pooled.is_some() || {
+            let count = self.entries.len();
+            (0..count).any(|_| {
+                let m = self.hand.fetch_add(1, Ordering::Relaxed) % count;
+                let entry = &self.entries[m];
+                entry.buffer.try_write().is_ok_and(|mut buffer| {
+                    let taken = buffer.take();
+                    if taken.is_some() {
+                        entry.frame.store(0, Ordering::Release);
+                    }
+                    taken.is_some()
+                })
             })
-            .is_ok()
+        };
+        if dropped {
+            let size = size_of::<T>();
+            self.bytes.fetch_sub(size, Ordering::AcqRel);
+            self.budget.give(size);
+        }
+        dropped
     }
 
     /// Bytes of buffer memory allocated.
@@ -188,7 +263,8 @@ impl<T> BrickCache<T> {
     /// the budget has no room for it, the buffer in `scratch` (made there
     /// the first time: a caller reuses one for many bricks), filled for
     /// this use only. `blank` makes a buffer to fill (its contents are
-    /// overwritten).
+    /// overwritten); `shed` makes room in the budget when it has none
+    /// (another cache's [`Self::shed`]), saying whether it did.
     pub fn get<'a>(
         &'a self,
         n: usize,
@@ -196,6 +272,7 @@ impl<T> BrickCache<T> {
         blank: impl Fn() -> Box<T>,
         fill: impl FnOnce(&mut T),
         scratch: &'a mut Option<Box<T>>,
+        shed: impl Fn() -> bool,
     ) -> CacheRef<'a, T> {
         let entry = &self.entries[n];
         {
@@ -211,7 +288,7 @@ impl<T> BrickCache<T> {
         if !valid {
             self.fills.fetch_add(1, Ordering::Relaxed);
             if buffer.is_none() {
-                *buffer = self.reserve(n, now, &blank);
+                *buffer = self.reserve(n, now, &blank, shed);
             }
             match buffer.as_deref_mut() {
                 Some(b) => fill(b),
@@ -234,13 +311,25 @@ impl<T> BrickCache<T> {
     }
 
     /// A buffer for entry `n`: one given back, else a new one if the
-    /// budget allows, else one taken from an evictable entry, else `None`.
-    fn reserve(&self, n: usize, now: u64, blank: &impl Fn() -> Box<T>) -> Option<Box<T>> {
+    /// budget allows (after `shed` made room, while it can), else one
+    /// taken from an evictable entry, else `None`.
+    fn reserve(
+        &self,
+        n: usize,
+        now: u64,
+        blank: &impl Fn() -> Box<T>,
+        shed: impl Fn() -> bool,
+    ) -> Option<Box<T>> {
         if let Some(buffer) = self.pool.lock().unwrap_or_else(|e| e.into_inner()).pop() {
             return Some(buffer);
         }
-        if self.reserve_bytes() {
-            return Some(blank());
+        loop {
+            if self.reserve_bytes() {
+                return Some(blank());
+            }
+            if !shed() {
+                break;
+            }
         }
         let count = self.entries.len();
         for _ in 0..SWEEP.min(count) {
@@ -291,7 +380,7 @@ mod tests {
     fn per_frame(count: usize, buffers: usize) -> BrickCache<[u64; 16]> {
         BrickCache::new(
             count,
-            buffers * size_of::<[u64; 16]>(),
+            Budget::new(buffers * size_of::<[u64; 16]>()),
             |f, now| f == now,
             |f, now| f < now,
         )
@@ -314,6 +403,7 @@ mod tests {
                             b.fill(100 * now + n as u64)
                         },
                         &mut scratch,
+                        || false,
                     )[7];
                     assert_eq!(v, 100 * now + n as u64);
                 }
@@ -347,6 +437,7 @@ mod tests {
                                     b.fill(1000 * now + n as u64)
                                 },
                                 &mut scratch,
+                                || false,
                             )[15];
                             assert_eq!(v, 1000 * now + n as u64);
                         }
@@ -365,7 +456,7 @@ mod tests {
         // frame and this one, as the classified bricks are.
         let cache: BrickCache<[u64; 16]> = BrickCache::new(
             6,
-            2 * size_of::<[u64; 16]>(),
+            Budget::new(2 * size_of::<[u64; 16]>()),
             |_, _| true,
             |f, now| f + 1 < now,
         );
@@ -381,6 +472,7 @@ mod tests {
                     b.fill(n as u64)
                 },
                 &mut scratch,
+                || false,
             );
             assert_eq!(b[0], n as u64);
             drop(b);

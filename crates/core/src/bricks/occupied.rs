@@ -37,13 +37,14 @@
 //! All of this depends on the volume and the classifier only: the light,
 //! which follows the camera, is applied per frame by [`crate::cpu::lit_bricks`].
 
-use crate::bricks::cache::{BrickCache, CacheRef};
+use crate::bricks::cache::{BrickCache, Budget, CacheRef};
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot, slot_coords};
 use crate::kernels::gradient::Differences;
 use crate::transfer::classifier::Classifier;
 use crate::volume::{Sample, Volume};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Bytes one occupied brick takes beside its slots, for the memory bound
 /// ([`crate::memory`]): its entries in every per-brick list of
@@ -143,7 +144,15 @@ impl ClassifiedBricks {
     /// Finds the occupied bricks of `source`'s volume (`macrocells` are its
     /// value ranges) and classifies them, keeping at most `budget` bytes of
     /// classified slots (see the module docs).
+    #[cfg(test)]
     pub fn new(source: &Source, macrocells: &Macrocells, budget: usize) -> Self {
+        Self::sharing(source, macrocells, Budget::new(budget))
+    }
+
+    /// [`Self::new`], the classified slots drawing on `budget`, which
+    /// other caches may share (the lit bricks, which take precedence:
+    /// see [`Self::shed`]).
+    pub(crate) fn sharing(source: &Source, macrocells: &Macrocells, budget: Arc<Budget>) -> Self {
         crate::with_samples!(source.volume.samples(), |data| Self::classify(
             source, data, macrocells, budget
         ))
@@ -154,7 +163,7 @@ impl ClassifiedBricks {
         source: &Source,
         data: &[T],
         macrocells: &Macrocells,
-        budget: usize,
+        budget: Arc<Budget>,
     ) -> Self {
         let Source {
             volume,
@@ -197,8 +206,8 @@ impl ClassifiedBricks {
 
         // Every occupied brick's cells, from its slots' opacities; and, if
         // the budget holds them all, its slots, classified now and kept.
+        let eager = occupied.len().saturating_mul(size_of::<Classified>()) <= budget.limit();
         let voxels = BrickCache::new(occupied.len(), budget, |_, _| true, |f, now| f + 1 < now);
-        let eager = occupied.len() * size_of::<Classified>() <= budget;
         let (cells, occupied_cells): (Vec<_>, Vec<_>) = (0..occupied.len())
             .into_par_iter()
             .map(|n| {
@@ -258,7 +267,16 @@ impl ClassifiedBricks {
                 slots.needed = needed_slots(&self.cells[n]);
             },
             scratch,
+            || false,
         )
+    }
+
+    /// Drops one brick's classified slots, if one is cached and no one is
+    /// reading it, giving its bytes back to the budget (for the lit bricks,
+    /// which need them more: a brick is classified again from the volume
+    /// when needed); says whether it did.
+    pub fn shed(&self) -> bool {
+        self.voxels.shed()
     }
 
     /// How many times a brick was classified on demand since the bricks

@@ -16,7 +16,7 @@
 //! the result is `f32` RGBA per slot, ready for the ray caster to load
 //! without conversion.
 
-use crate::bricks::cache::{BrickCache, CacheRef};
+use crate::bricks::cache::{BrickCache, Budget, CacheRef};
 use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, Source, UNIT, Voxel};
 use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
@@ -24,6 +24,7 @@ use crate::transfer::classifier::Classifier;
 use crate::transfer::function::PiecewiseLinear;
 use crate::transfer::labels::colour_value;
 use crate::volume::Sample;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use wide::bytemuck::cast;
 use wide::{f32x4, i16x8, i32x4, i32x8};
@@ -54,12 +55,20 @@ pub(crate) const SLOT_BYTES_PER_OCCUPIED_BRICK: usize = size_of::<[[f32; 4]; SLO
 /// gives its buffer back to the cache's pool for the next brick. The
 /// budget then has to hold the bricks of the tiles in flight, not every
 /// brick of the frame: a faint transfer function over a dense 512³ CT at
-/// 1024² lights 87 499 bricks a frame (1.0 GB of lit voxels, more than
-/// the default budget's 0.67 GiB), but a few rows of tiles need about
-/// 10 000 at a time. Before, the first bricks a frame lit kept their
-/// buffers to its end and every brick after them was lit again for each
-/// tile that listed it (2 to 4), as it still is when even the bricks in
-/// use do not fit.
+/// 1024² lights 244 000 bricks a frame (2.8 GB of lit voxels), of which
+/// the tiles in flight on two threads hold about 11 000 (128 MiB) at a
+/// time. Before, the first bricks a frame lit kept their buffers to its
+/// end and every brick after them was lit again for each tile that listed
+/// it (677 000 bricks lit a frame there), as it still is when even the
+/// bricks in use do not fit.
+///
+/// **One budget.** The lit bricks share their budget with the classified
+/// ones ([`ClassifiedBricks`]): a lit brick that finds no room drops a
+/// classified brick to make it ([`ClassifiedBricks::shed`]), since a
+/// brick classified again costs once a frame at most, and a brick lit
+/// again costs once per tile. The classified bricks keep what the bricks
+/// in use leave (there, 896 MiB of the default 1 GiB rather than the third
+/// they had when the budget was split).
 pub struct LitBricks {
     cache: BrickCache<[[f32; 4]; SLOTS]>,
     /// The frame being rendered: bricks lit for another are stale.
@@ -71,10 +80,12 @@ pub struct LitBricks {
 }
 
 impl LitBricks {
-    /// The lit bricks of `bricks` occupied bricks, at most `budget` bytes
-    /// of lit voxels.
-    pub fn new(bricks: usize, budget: usize) -> Self {
-        let fits = bricks.saturating_mul(SLOT_BYTES_PER_OCCUPIED_BRICK) <= budget;
+    /// The lit bricks of `bricks` occupied bricks, their lit voxels
+    /// drawing on `budget`, which a cache of `beside` bytes a brick shares
+    /// (the classified bricks).
+    pub(crate) fn sharing(bricks: usize, budget: Arc<Budget>, beside: usize) -> Self {
+        let per_brick = SLOT_BYTES_PER_OCCUPIED_BRICK + beside;
+        let fits = bricks.saturating_mul(per_brick) <= budget.limit();
         LitBricks {
             cache: BrickCache::new(bricks, budget, |f, now| f == now, |f, now| f < now),
             frame: 0,
@@ -129,6 +140,10 @@ impl LitBricks {
             || Box::new([[0.0; 4]; SLOTS]),
             |out| lighting.shade(n, out),
             scratch,
+            // The lit bricks in use come first: a classified brick is made
+            // again from the volume once a frame at most, a lit brick that
+            // finds no room would be lit once per tile.
+            || lighting.bricks.shed(),
         )
     }
 
