@@ -9,6 +9,7 @@
 //! commands and their settings; `view/browser.rs` opens the browser.
 
 mod browser;
+mod levels;
 mod reproduce;
 
 use crate::error::CliError;
@@ -31,7 +32,13 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let tf_text = look.tf_file().map(read_tf_file).transpose()?;
     let mut settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
     let mut named = named_transfer_function(look, tf_text.as_deref())?;
-    let mut input = load(&args.input, look.log)?;
+    // A chunked file is opened from its metadata, and only the level the
+    // first drafts show is read (`view/levels.rs`).
+    let pyramid = levels::open(args, &settings)?;
+    let mut input = match &pyramid {
+        Some(p) => p.start_input(args)?,
+        None => load(&args.input, look.log)?,
+    };
     // A transfer function chosen from the volume (`--tf auto`, `--labels`)
     // is the page's starting one, and its commands name it in full.
     from_volume(
@@ -63,12 +70,17 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         ))
     })?;
     let volume = &input.volume;
-    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
-    let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory);
+    let grid = match &pyramid {
+        // The frames' memory is checked against the level each renders.
+        Some(p) => p.coarsest_grid(),
+        None => (volume.dims(), volume.spacing(), volume.sample_type()),
+    };
+    let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory)
+        .with_level(levels::level_word(args, pyramid.as_ref()));
     reproduce
         .reproduce(&state)
         .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
-    let hello = Start {
+    let mut hello = Start {
         name: &input.name,
         volume,
         log: look.log,
@@ -76,7 +88,11 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         settings: &settings,
     }
     .hello();
+    if let Some(p) = &pyramid {
+        p.describe(&mut hello);
+    }
     let pool = thread_pool(args.view.threads)?;
+    let labels = input.volume.is_labels();
     let viewer = Viewer {
         volume: Arc::new(input.volume),
         non_finite,
@@ -86,6 +102,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         reproduce: Arc::new(reproduce),
         pool: Arc::new(pool),
         max_sessions: MAX_TABS,
+        levels: pyramid.map(|p| p.into_levels(labels)),
     };
 
     let addr = SocketAddr::new(args.bind, args.port);

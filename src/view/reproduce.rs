@@ -83,6 +83,7 @@ impl CliReproduce {
         reading.opt("--format", inp.format.clone());
         reading.opt("--frame", inp.frame.map(|f| f.to_string()));
         reading.opt("--array", inp.array.clone());
+        reading.opt("--channel", inp.channel.map(|c| c.to_string()));
         reading.opt("--max-memory", inp.max_memory.map(|m| m.to_string()));
 
         let mut always = Words::default();
@@ -159,6 +160,16 @@ impl CliReproduce {
             non_finite,
             max_memory,
         }
+    }
+
+    /// The same, its commands reading the level `level` names (`auto` or
+    /// a number), if any: a multiscale volume's.
+    pub fn with_level(mut self, level: Option<String>) -> Self {
+        if let Some(level) = level {
+            self.reading.push("--level".into());
+            self.reading.push(level);
+        }
+        self
     }
 
     /// The arguments of the `volray render` command of `state` (after

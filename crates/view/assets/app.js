@@ -5,7 +5,9 @@
 // Hooks for automation: the frame is #frame; document.body.dataset.frames
 // counts the frames shown; document.body.dataset.state is "still" once the
 // full-quality frame of the current state is shown ("moving" before,
-// "error" when the current state was refused).
+// "error" when the current state was refused); for a multiscale volume
+// document.body.dataset.level is the level the frame shown renders (0 the
+// finest) and dataset.pieces the pieces it was rendered in.
 "use strict";
 
 const token = new URLSearchParams(location.search).get("token") || "";
@@ -177,7 +179,20 @@ function showRate(header) {
   const kind = header.quality === "draft" ? "draft" : "full";
   $("status").textContent =
     `${header.width}×${header.height} ${kind} · render ${header.render_ms.toFixed(1)} ms` +
-    ` · ${shownTimes.length} frames/s`;
+    ` · ${shownTimes.length} frames/s` + levelText(header.level);
+  if (header.level) {
+    body.dataset.level = String(header.level.index);
+    body.dataset.pieces = String(header.level.pieces);
+  }
+}
+
+// "level 2 of 5 (256³)", and the pieces of a level rendered piece by piece.
+function levelText(level) {
+  if (!level) return "";
+  const [x, y, z] = level.dims;
+  const dims = x === y && y === z ? `${x}³` : `${x}×${y}×${z}`;
+  const pieces = level.pieces > 1 ? `, ${level.pieces} pieces` : "";
+  return ` · level ${level.index} of ${level.count} (${dims}${pieces})`;
 }
 
 // ------------------------------------------------------------ the start
@@ -187,8 +202,9 @@ function start(message) {
   state = structuredClone(message.start);
   const [nx, ny, nz] = message.dims;
   const [lo, hi] = message.range;
+  const levels = message.levels ? ` · ${message.levels.length} levels` : "";
   $("volume").textContent =
-    `${message.name} · ${nx}×${ny}×${nz} · values ${fmt(lo)} to ${fmt(hi)}` +
+    `${message.name} · ${nx}×${ny}×${nz}${levels} · values ${fmt(lo)} to ${fmt(hi)}` +
     (message.log ? " (log10)" : "");
   frame.width = state.width;
   frame.height = state.height;

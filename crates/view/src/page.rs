@@ -33,5 +33,6 @@ mod tests {
             assert!(!text.contains("http://") && !text.contains("https://"));
         }
         assert!(APP_JS.contains("dataset.frames") && APP_JS.contains("\"still\""));
+        assert!(APP_JS.contains("dataset.level") && APP_JS.contains("header.level"));
     }
 }
