@@ -47,6 +47,11 @@ pub fn from_volume(
     input: &mut crate::input::Input,
 ) -> Result<RenderSettings, CliError> {
     let mut settings = settings.clone();
+    crate::settings::file_window(
+        &args.view.look,
+        &mut settings.transfer_function,
+        input.file.as_ref().map(|(_, info)| info),
+    );
     crate::settings::from_volume(
         &args.view.look,
         &mut settings.transfer_function,

@@ -153,6 +153,29 @@ pub fn from_volume(
     volray_options::from_volume(&look(look_args), transfer_function, volume, name).map_err(refused)
 }
 
+/// The file's own display window (an OME-Zarr image's `omero` window of
+/// the channel read) as the default `--range`: the transfer function's
+/// domain where the flags leave it to the volume (no `--range`, no `--tf`
+/// file or preset with a domain; not `--labels`, and not `--log`, whose
+/// domain is taken before the file is read). `--tf auto`, the default,
+/// then chooses within the window, as it does within a `--range`. What
+/// napari-ome-zarr and vizarr show as the contrast limits; the colour
+/// hint is not taken.
+pub fn file_window(
+    look_args: &LookArgs,
+    transfer_function: &mut TransferFunction,
+    info: Option<&volray_io::FileInfo>,
+) {
+    let free = transfer_function.domain.is_none() && !look_args.labels && !look_args.log;
+    if let (true, Some(window)) = (
+        free,
+        info.and_then(|i| i.omero.as_ref())
+            .and_then(volray_io::OmeroChannel::window_range),
+    ) {
+        transfer_function.domain = Some(window);
+    }
+}
+
 /// The labels of `volume` (`name`), refused as `--labels` would be.
 pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, CliError> {
     volray_options::volume_labels(volume, name).map_err(refused)

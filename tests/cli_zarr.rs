@@ -9,7 +9,7 @@ mod common;
 use std::fs;
 use std::path::Path;
 
-use common::{stderr, stdout, volray};
+use common::{Picture, stderr, stdout, volray};
 use serde_json::{Value, json};
 
 /// One uint8 level of shape (z, y, x) at `dir`, values 0, 1, 2, ... in C order.
@@ -146,5 +146,57 @@ fn level_flags_are_refused_where_they_cannot_apply() {
             "0",
         ],
         "--level and --channel apply to Zarr/OME-Zarr images only, not to raw samples files",
+    );
+}
+
+/// Adds an `omero` block to the image's attributes: channel 0 shown in
+/// the window `start`..`end`.
+fn add_omero(root: &Path, start: f64, end: f64) {
+    let path = root.join("zarr.json");
+    let mut meta: Value = serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    meta["attributes"]["ome"]["omero"] = json!({"channels": [{
+        "label": "nuclei", "color": "00FF00", "active": true,
+        "window": {"start": start, "end": end, "min": 0, "max": 255},
+    }]});
+    fs::write(&path, meta.to_string()).unwrap();
+}
+
+#[test]
+fn an_omero_window_is_the_default_range_and_flags_override_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = dir.path().join("plain.ome.zarr");
+    let hinted = dir.path().join("hinted.ome.zarr");
+    write_image(&plain);
+    write_image(&hinted);
+    add_omero(&hinted, 10.0, 30.0);
+    let render = |image: &Path, name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", image.to_str().unwrap(), "--size", "24x24"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+        let run = volray(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        // The pixels: the PNG's text chunks name the file.
+        Picture::read(&out)
+    };
+    // The hint is the window a --range would give, not the value range.
+    let hinted_default = render(&hinted, "hinted.png", &[]);
+    assert_eq!(
+        hinted_default,
+        render(&plain, "ranged.png", &["--range", "10,30"])
+    );
+    assert_ne!(hinted_default, render(&plain, "plain.png", &[]));
+    // A flag that fixes the domain wins; others take the window.
+    assert_eq!(
+        render(&hinted, "hinted-ranged.png", &["--range", "0,47"]),
+        render(&plain, "plain-ranged.png", &["--range", "0,47"])
+    );
+    assert_eq!(
+        render(&hinted, "hinted-viridis.png", &["--colormap", "viridis"]),
+        render(
+            &plain,
+            "plain-viridis.png",
+            &["--colormap", "viridis", "--range", "10,30"]
+        )
     );
 }

@@ -175,6 +175,15 @@ pub struct OmeroChannel {
     pub window: Option<(f64, f64, Option<f64>, Option<f64>)>,
 }
 
+impl OmeroChannel {
+    /// The display window `start`..`end`, where it is a range (finite,
+    /// `start < end`): what a viewer of the image maps to black..full.
+    pub fn window_range(&self) -> Option<(f64, f64)> {
+        let (start, end, _, _) = self.window?;
+        (start.is_finite() && end.is_finite() && start < end).then_some((start, end))
+    }
+}
+
 /// One resolution level of a multiscale image, for `volray info`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LevelInfo {
