@@ -507,3 +507,21 @@ fn a_bind_beyond_loopback_warns_and_a_bad_start_is_refused() {
     let out = common::volray(&["view", "blobs:16", "--blend", "mip", "--opacity", "0,1"]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[tokio::test(flavor = "current_thread")]
+async fn a_pyramids_page_says_which_level_its_still_shows() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("b.ome.zarr");
+    let path = path.to_str().unwrap();
+    let out = common::volray(&["convert", "blobs:96", "-o", path]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    // 64² stills need the 96³ level; the 32² drafts, the 48³.
+    let Some((_viewer, b)) = open(&[path, "--size", "64"]).await else {
+        return;
+    };
+    assert_eq!(b.eval("return document.body.dataset.level;").await, "0");
+    let status = b.text("status").await;
+    assert!(status.contains("level 0 of 2 (96³)"), "{status}");
+    assert!(b.text("volume").await.contains("96×96×96 · 2 levels"));
+    b.close().await;
+}
