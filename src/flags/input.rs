@@ -58,8 +58,9 @@ pub struct InputArgs {
     pub array: Option<String>,
 
     /// Zarr/OME-Zarr: which resolution level of a multiscale image, 0 the
-    /// finest (`volray info` lists them), or `auto` (render): the
-    /// coarsest level whose voxels are no larger than a pixel [default: 0].
+    /// finest (`volray info` lists them), or `auto` (render, view): the
+    /// coarsest level whose voxels are no larger than a pixel [default: 0;
+    /// auto in view].
     #[arg(long, value_name = "N|auto", value_parser = parse_level)]
     pub level: Option<LevelChoice>,
 
