@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use volray_core::{Image, NonFinite, RenderSettings};
 use volray_distributed::streamed::{StreamError, StreamTimes, Streamed};
 use volray_io::{MapPolicy, format_bytes};
-use volray_lazy::{Chunked, Plan as LazyPlan};
+use volray_lazy::{Chunked, Found, LookError, Plan as LazyPlan};
 use volray_options::level::LevelChoice;
 
 /// How INPUT is rendered.
@@ -33,6 +33,8 @@ pub enum Plan {
 pub struct StreamedInput {
     pub name: String,
     pub streamed: Streamed,
+    /// The labels or histogram found in the level, once.
+    found: Found,
     /// What the note after a frame says: the level, and why in pieces.
     level: usize,
     whole: u128,
@@ -104,6 +106,7 @@ pub fn plan(
         } => Ok(Plan::Streamed(Box::new(StreamedInput {
             name: spec.to_string(),
             streamed: streamed.with_labels(view.look.labels),
+            found: Found::default(),
             level,
             whole: need,
             max_memory,
@@ -127,7 +130,8 @@ fn display(spec: &str) -> String {
 
 impl StreamedInput {
     /// `settings` with what the flags leave to the volume (`--labels`,
-    /// `--tf auto`), found piece by piece.
+    /// `--tf auto`), found piece by piece (volray-lazy's [`Found`], which
+    /// the Python module shares).
     pub fn settings_from_volume(
         &mut self,
         view: &ViewArgs,
@@ -135,30 +139,14 @@ impl StreamedInput {
     ) -> Result<RenderSettings, CliError> {
         let look = crate::settings::look(&view.look);
         let name = self.name.clone();
-        if view.look.labels {
-            let found = self
-                .streamed
-                .labels(&settings, volray_core::transfer::labels::MAX_LABELS)
-                .map_err(|e| self.failure(view, e))?;
-            let found =
-                volray_options::labels_found(found, &name).map_err(crate::settings::refused)?;
-            crate::settings::label_transfer_function(
-                &view.look,
-                &mut settings.transfer_function,
-                &found,
-                &name,
-            )?;
-            return Ok(settings);
+        let found = self
+            .found
+            .apply(&mut self.streamed, &look, &mut settings, &name);
+        match found {
+            Ok(()) => Ok(settings),
+            Err(LookError::Stream(e)) => Err(self.failure(view, e)),
+            Err(LookError::Refused(e)) => Err(crate::settings::refused(e)),
         }
-        if look.auto_tf()
-            && let Some(histogram) = self
-                .streamed
-                .histogram(&settings, volray_core::transfer::auto::BINS)
-                .map_err(|e| self.failure(view, e))?
-        {
-            volray_options::apply_auto(&look, &mut settings.transfer_function, &histogram);
-        }
-        Ok(settings)
     }
 
     /// One frame.

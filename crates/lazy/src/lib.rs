@@ -13,7 +13,13 @@
 //! 3. [`Chunked::plan`]: [`Plan::Whole`] when the level's frame fits the
 //!    memory limit (read it with `volray_io::read` at that level: the same
 //!    pixels as any file), else [`Plan::Pieces`], a
-//!    [`Streamed`] render that reads at most [`PIECE_BUDGET`] at a time.
+//!    [`Streamed`] render that reads at most [`PIECE_BUDGET`] at a time;
+//! 4. for [`Plan::Pieces`], [`Found::apply`]: what the look leaves to the
+//!    volume (`--labels`' list, `--tf auto`'s histogram), found piece by
+//!    piece once and kept for the frames after.
+//!
+//! [`Chunked::stoppable`] makes a frame in pieces stop at its next piece
+//! once a flag is set (Ctrl-C in Python, a newer view in the viewer).
 //!
 //! ```
 //! use volray_core::{RenderSettings, NonFinite, Volume};
@@ -46,12 +52,18 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use volray_core::camera::CameraError;
 use volray_core::glam::DVec3;
-use volray_core::{MemoryBound, NonFinite, RenderSettings, VolumeSource};
-use volray_distributed::streamed::Streamed;
-use volray_io::{FileInfo, IoError, Lazy, LevelInfo, ReadOptions};
+use volray_core::sampling::grid::GridFrame;
+use volray_core::transfer::{auto, labels::MAX_LABELS};
+use volray_core::{
+    Histogram, MemoryBound, NonFinite, RenderSettings, SampleType, Volume, VolumeSource,
+};
+use volray_distributed::streamed::{StreamError, Streamed};
+use volray_io::{FileInfo, IoError, Lazy, LevelInfo, ReadOptions, VolumeFormat};
+use volray_options::{LookOptions, OptionError};
 
 /// The most one piece's frame may take (volray-core's bound: the piece
 /// read, the renderer's structures for a dense piece, its frame), however
@@ -130,6 +142,32 @@ impl Chunked {
         &self.path
     }
 
+    /// The file's format.
+    pub fn format(&self) -> VolumeFormat {
+        self.lazy.format
+    }
+
+    /// The same file opened again at level `level` (the same time point
+    /// and channel), from its metadata; `self` stays open.
+    pub fn open_level(&self, level: usize) -> Result<Chunked, IoError> {
+        let opts = ReadOptions {
+            level: Some(level),
+            ..self.opts.clone()
+        };
+        Chunked::open(&self.path, &opts)?
+            .ok_or_else(|| IoError::invalid(&self.path, "the store changed while it was open"))
+    }
+
+    /// The same level, its boxes refused with [`STOPPED`] once `stop` is
+    /// set: a [`Streamed`] frame of it stops before its next piece, the
+    /// pieces already read kept. `Streamed` has no stop flag of its own,
+    /// and a piece is the unit it reads.
+    pub fn stoppable(mut self, stop: Arc<AtomicBool>) -> Chunked {
+        let inner = Arc::clone(&self.lazy.source);
+        self.lazy.source = Arc::new(Stoppable { inner, stop });
+        self
+    }
+
     /// The level open, its source and metadata.
     pub fn into_lazy(self) -> Lazy {
         self.lazy
@@ -205,5 +243,128 @@ impl Chunked {
             need,
             streamed: Box::new(streamed),
         }
+    }
+}
+
+/// The error of a box read once the stop flag of [`Chunked::stoppable`]
+/// is set (a [`StreamError::Read`]).
+pub const STOPPED: &str = "stopped";
+
+/// A source whose reads fail with [`STOPPED`] once `stop` is set.
+struct Stoppable {
+    inner: Arc<dyn VolumeSource>,
+    stop: Arc<AtomicBool>,
+}
+
+impl VolumeSource for Stoppable {
+    fn grid(&self) -> GridFrame {
+        self.inner.grid()
+    }
+
+    fn sample_type(&self) -> SampleType {
+        self.inner.sample_type()
+    }
+
+    fn is_labels(&self) -> bool {
+        self.inner.is_labels()
+    }
+
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        if self.stop.load(Ordering::Relaxed) {
+            return Err(STOPPED.to_string());
+        }
+        self.inner.read_box(lo, hi)
+    }
+
+    fn voxel_bytes(&self) -> usize {
+        self.inner.voxel_bytes()
+    }
+}
+
+/// Why the look of a frame in pieces could not be completed.
+#[derive(Debug)]
+pub enum LookError {
+    /// A piece could not be read, or the pieces do not fit.
+    Stream(StreamError),
+    /// The options refuse what was found (`--labels` on a volume of more
+    /// than [`MAX_LABELS`] values, `--tf auto` with labels, ...).
+    Refused(OptionError),
+}
+
+/// What the look of a frame leaves to the volume, found piece by piece
+/// over a [`Streamed`] level and kept for the frames after: the distinct
+/// labels (`--labels`) or the histogram `--tf auto` chooses from. Both
+/// are the whole level's, the same as one process finds in the level read
+/// whole (volray-distributed's `Streamed::labels` and
+/// `Streamed::histogram`); keep one per `Streamed`.
+#[derive(Debug, Default, Clone)]
+pub struct Found {
+    labels: Option<Vec<i64>>,
+    histogram: Option<Option<Histogram>>,
+}
+
+impl Found {
+    /// The level's histogram in [`auto::BINS`] bins over its finite
+    /// values, found once (every piece read); `None` for a level with no
+    /// finite value. The pieces are those of frames of `settings`.
+    pub fn histogram(
+        &mut self,
+        streamed: &mut Streamed,
+        settings: &RenderSettings,
+    ) -> Result<Option<&Histogram>, StreamError> {
+        if self.histogram.is_none() {
+            self.histogram = Some(streamed.histogram(settings, auto::BINS)?);
+        }
+        Ok(self.histogram.as_ref().and_then(Option::as_ref))
+    }
+
+    /// The level's distinct labels, sorted, found once; refused (naming
+    /// the volume `name`) where it holds more than [`MAX_LABELS`].
+    pub fn labels(
+        &mut self,
+        streamed: &mut Streamed,
+        settings: &RenderSettings,
+        name: &str,
+    ) -> Result<&[i64], LookError> {
+        if self.labels.is_none() {
+            let found = streamed
+                .labels(settings, MAX_LABELS)
+                .map_err(LookError::Stream)?;
+            let found = volray_options::labels_found(found, name).map_err(LookError::Refused)?;
+            self.labels = Some(found);
+        }
+        Ok(self.labels.as_deref().unwrap_or_default())
+    }
+
+    /// `settings` completed as `look` leaves to the volume `name`, as
+    /// volray-options' `from_volume` completes them for a volume in
+    /// memory: the label transfer function from the labels found
+    /// (`look.labels`), or the automatic one from the histogram
+    /// (`look.auto_tf()`).
+    pub fn apply(
+        &mut self,
+        streamed: &mut Streamed,
+        look: &LookOptions,
+        settings: &mut RenderSettings,
+        name: &str,
+    ) -> Result<(), LookError> {
+        if look.labels {
+            let found = self.labels(streamed, settings, name)?;
+            return volray_options::label_transfer_function(
+                look,
+                &mut settings.transfer_function,
+                found,
+                name,
+            )
+            .map_err(LookError::Refused);
+        }
+        if look.auto_tf()
+            && let Some(histogram) = self
+                .histogram(streamed, settings)
+                .map_err(LookError::Stream)?
+        {
+            volray_options::apply_auto(look, &mut settings.transfer_function, histogram);
+        }
+        Ok(())
     }
 }
