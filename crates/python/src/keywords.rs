@@ -69,6 +69,7 @@ pub const VOLUME: &[&str] = &[
     "log",
     "nonfinite",
     "max_memory",
+    "level",
 ];
 
 /// Keyword arguments, each taken once.

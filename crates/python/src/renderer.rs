@@ -5,25 +5,41 @@
 //! pending signals every 20 ms of the wait (a finished frame returns at
 //! once); on KeyboardInterrupt it stops the frame (volray-core's
 //! `render_stoppable`: the work left is skipped) and raises.
+//!
+//! A lazy volume (`volume.rs`: a chunked file read from its metadata)
+//! takes volray-lazy's road, as `volray render` does (`src/streamed.rs`):
+//! each frame picks its level (`level="auto"`: the coarsest whose voxels
+//! are no larger than a pixel's footprint; else the level asked for, or
+//! the volume's), then reads that level whole when its frame fits
+//! `max_memory` (prepared as any volume, kept while frames need that
+//! level: the same pixels as `read(path, level=N)` rendered) or renders
+//! it piece by piece (volray-distributed's `Streamed`, kept likewise, the
+//! labels and `tf="auto"` histogram found piece by piece once). A frame
+//! in pieces stops at its next piece on Ctrl-C: `Streamed` has no stop
+//! flag within a piece, so the piece being rendered finishes first.
 
 use crate::array::{self, ArrayBytes, Order};
-use crate::errors::{option_error, render_error, settings_error, value_error};
+use crate::errors::{io_error, option_error, render_error, settings_error, value_error};
 use crate::frame::Frame;
 use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
-use crate::volume::Volume;
+use crate::volume::{LazyFile, Volume};
+use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use volray_core::transfer::auto;
 use volray_core::{
-    DEFAULT_CACHE_BUDGET, Histogram, MemoryBound, NonFinite, RenderSettings,
-    Renderer as CoreRenderer,
+    DEFAULT_CACHE_BUDGET, Histogram, Image, MemoryBound, NonFinite, RenderError, RenderSettings,
+    Renderer as CoreRenderer, Volume as CoreVolume,
 };
-use volray_io::format_bytes;
-use volray_options::LookOptions;
+use volray_distributed::streamed::{StreamError, Streamed};
+use volray_io::{MapPolicy, ReadOptions, format_bytes};
+use volray_lazy::{Chunked, Found, LookError, Plan};
+use volray_options::level::LevelChoice;
+use volray_options::{CameraOptions, LookOptions, Options};
 
 /// How often the calling thread looks for Ctrl-C while a frame renders.
 const SIGNAL_POLL: Duration = Duration::from_millis(20);
@@ -36,10 +52,73 @@ const SIGNAL_POLL: Duration = Duration::from_millis(20);
 #[pyclass(frozen, module = "volray")]
 pub struct Renderer {
     recipe: Recipe,
-    /// The volume as last prepared. Frames take a reference and render
-    /// from it; a frame that finds the samples changed prepares them
-    /// again and puts its result here.
-    prepared: Mutex<Arc<Prepared>>,
+    road: Road,
+}
+
+/// How frames reach the samples.
+enum Road {
+    /// The samples in memory (an array, a volume read whole), prepared
+    /// once: the volume as last prepared. Frames take a reference and
+    /// render from it; a frame that finds the samples changed prepares
+    /// them again and puts its result here.
+    Memory(Mutex<Arc<Prepared>>),
+    /// A lazy volume: the level and the way each frame needs.
+    Lazy(Box<LazyRoad>),
+}
+
+/// A lazy volume's frames (see the module documentation).
+struct LazyRoad {
+    volume: Py<Volume>,
+    choice: LevelChoice,
+    /// Set on Ctrl-C: the pieces' reads fail from then on
+    /// (`Chunked::stoppable`), so a frame in pieces stops at its next one.
+    stop: Arc<AtomicBool>,
+    /// Locked only while detached from Python (never while waiting for
+    /// the GIL), so frames of one renderer from several threads queue.
+    state: Mutex<LazyState>,
+}
+
+#[derive(Default)]
+struct LazyState {
+    /// The level open now (stoppable by `stop`).
+    chunked: Option<Chunked>,
+    way: Way,
+    /// The settings of the last frame, which `value_range` splits by.
+    settings: Option<RenderSettings>,
+}
+
+/// How the level of the last frame is rendered, kept for the next.
+#[derive(Default)]
+enum Way {
+    #[default]
+    None,
+    /// Read whole and prepared as any volume.
+    Whole {
+        level: usize,
+        prepared: Arc<Prepared>,
+    },
+    /// Rendered piece by piece; what the look left to the volume, found
+    /// once.
+    Pieces {
+        level: usize,
+        streamed: Box<Streamed>,
+        found: Found,
+    },
+}
+
+impl Way {
+    fn level(&self) -> Option<usize> {
+        match self {
+            Way::None => None,
+            Way::Whole { level, .. } | Way::Pieces { level, .. } => Some(*level),
+        }
+    }
+}
+
+/// What a lazy frame renders after its way is settled.
+enum Next {
+    Whole(Arc<Prepared>),
+    Pieces,
 }
 
 /// The volume and the volume-level options: what a renderer is prepared
@@ -90,7 +169,7 @@ impl Recipe {
     fn watched(&self, py: Python<'_>) -> PyResult<Option<ArrayBytes>> {
         match &self.source {
             Source::Volume(v) if v.get().frozen => Ok(None),
-            Source::Volume(v) => ArrayBytes::new(v.get().data.bind(py), None).map(Some),
+            Source::Volume(v) => ArrayBytes::new(v.get().array(py)?, None).map(Some),
             Source::Array { object, .. } => array::watched(object.bind(py)).map(Some),
         }
     }
@@ -113,8 +192,7 @@ impl Recipe {
     /// caches' budget. Samples read in place are checked against the
     /// digest after each frame (`ArrayBytes::verify`).
     fn prepare(&self, py: Python<'_>, digest: Option<u64>) -> PyResult<Prepared> {
-        let name = &self.name;
-        let mut core = match &self.source {
+        let core = match &self.source {
             Source::Volume(v) => v.get().core_expecting(py, digest)?,
             Source::Array {
                 object,
@@ -126,11 +204,22 @@ impl Recipe {
                 let volume = Volume::from_array(object, *spacing, *origin, *order, false)?;
                 // Checked after each frame only where the frame reads the
                 // caller's memory; a copy is the renderer's alone.
-                let kept = ArrayBytes::new(volume.data.bind(py), None)?;
+                let kept = ArrayBytes::new(volume.array(py)?, None)?;
                 let in_place = digest.is_some() && array::watched(object)?.same_bytes(&kept);
                 volume.core_expecting(py, digest.filter(|_| in_place))?
             }
         };
+        self.prepare_core(py, core, digest)
+    }
+
+    /// [`Recipe::prepare`] of the samples `core`.
+    fn prepare_core(
+        &self,
+        py: Python<'_>,
+        mut core: CoreVolume,
+        digest: Option<u64>,
+    ) -> PyResult<Prepared> {
+        let name = &self.name;
         if let Some(s) = self.spacing {
             core = core
                 .with_spacing(s.into())
@@ -181,6 +270,7 @@ impl Renderer {
         let spacing = k.take::<[f64; 3]>("spacing", "three numbers (dx, dy, dz)")?;
         let origin = k.take::<[f64; 3]>("origin", "three numbers (x, y, z)")?;
         let labels_given = k.take::<bool>("labels", "True or False")?;
+        let level = level_choice(k)?;
         let (source, spacing, origin, vol_labels, name, nan_is_empty) =
             match volume.cast::<Volume>() {
                 Ok(v) => {
@@ -230,32 +320,77 @@ impl Renderer {
             max_memory,
             name,
         };
+        let lazy = match &recipe.source {
+            Source::Volume(v) if v.get().lazy.is_some() => Some(v.clone_ref(py)),
+            _ => None,
+        };
+        if let Some(volume) = lazy {
+            let own = volume.get().level().unwrap_or(0);
+            let choice = level.unwrap_or(LevelChoice::Index(own));
+            if let LevelChoice::Index(n) = choice {
+                let levels = volume
+                    .get()
+                    .lazy
+                    .as_ref()
+                    .map_or(1, |l| l.chunked.levels().len());
+                if n >= levels {
+                    return Err(value_error(format!(
+                        "{}: level {n} is not among the file's {levels} levels (0 to {})",
+                        recipe.name,
+                        levels - 1
+                    )));
+                }
+            }
+            return Ok(Renderer {
+                recipe,
+                road: Road::Lazy(Box::new(LazyRoad {
+                    volume,
+                    choice,
+                    stop: Arc::new(AtomicBool::new(false)),
+                    state: Mutex::new(LazyState::default()),
+                })),
+            });
+        }
+        if level.is_some() {
+            return Err(value_error(format!(
+                "level: {} is in memory: level picks a level of a volume read lazily from a chunked file (volray.read of a Zarr or OME-Zarr image)",
+                recipe.name
+            )));
+        }
         let digest = recipe.digest(py, None)?;
         let prepared = recipe.prepare(py, digest)?;
         Ok(Renderer {
             recipe,
-            prepared: Mutex::new(Arc::new(prepared)),
+            road: Road::Memory(Mutex::new(Arc::new(prepared))),
         })
     }
 
     /// The volume prepared from the samples as they are now: the last
     /// one, or (the samples changed since) a new one.
-    fn current(&self, py: Python<'_>, pool: Option<&rayon::ThreadPool>) -> PyResult<Arc<Prepared>> {
+    fn current(
+        &self,
+        py: Python<'_>,
+        memory: &Mutex<Arc<Prepared>>,
+        pool: Option<&rayon::ThreadPool>,
+    ) -> PyResult<Arc<Prepared>> {
         // The lock is held only to clone or replace the `Arc`, never
         // across a call that waits for the GIL or another thread.
-        let last = Arc::clone(&self.prepared.lock().unwrap_or_else(|e| e.into_inner()));
+        let last = Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner()));
         let digest = self.recipe.digest(py, pool)?;
         if digest == last.digest {
             return Ok(last);
         }
         let fresh = Arc::new(self.recipe.prepare(py, digest)?);
-        *self.prepared.lock().unwrap_or_else(|e| e.into_inner()) = Arc::clone(&fresh);
+        *memory.lock().unwrap_or_else(|e| e.into_inner()) = Arc::clone(&fresh);
         Ok(fresh)
     }
 
-    /// One frame with the frame keywords of `k`; `fresh`: the renderer
-    /// was prepared just now, so its samples need no second digest.
-    fn frame(&self, py: Python<'_>, k: &Keywords<'_>, fresh: bool) -> PyResult<Frame> {
+    /// The options and settings of a frame with the frame keywords of
+    /// `k`, and its pool of workers (`threads=`).
+    fn settings_of(
+        &self,
+        k: &Keywords<'_>,
+    ) -> PyResult<(Options, RenderSettings, Option<rayon::ThreadPool>)> {
         let look = LookOptions {
             labels: self.recipe.labels,
             log: self.recipe.log,
@@ -263,13 +398,36 @@ impl Renderer {
         };
         let options = keywords::options(k, look)?;
         let threads = keywords::threads(k)?;
-        let mut settings =
+        let settings =
             volray_options::settings(&options).map_err(|e| settings_error(e, &options.camera))?;
         let pool = threads.map(pool).transpose()?;
-        let prepared = match fresh {
-            true => Arc::clone(&self.prepared.lock().unwrap_or_else(|e| e.into_inner())),
-            false => self.current(py, pool.as_ref())?,
+        Ok((options, settings, pool))
+    }
+
+    /// One frame with the frame keywords of `k`; `fresh`: the renderer
+    /// was prepared just now, so its samples need no second digest.
+    fn frame(&self, py: Python<'_>, k: &Keywords<'_>, fresh: bool) -> PyResult<Frame> {
+        let (options, settings, pool) = self.settings_of(k)?;
+        let memory = match &self.road {
+            Road::Memory(memory) => memory,
+            Road::Lazy(lazy) => return self.lazy_frame(py, lazy, &options, settings, pool),
         };
+        let prepared = match fresh {
+            true => Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner())),
+            false => self.current(py, memory, pool.as_ref())?,
+        };
+        self.render_prepared(py, &prepared, &options, settings, pool.as_ref())
+    }
+
+    /// A frame of a prepared volume, with what the options leave to it.
+    fn render_prepared(
+        &self,
+        py: Python<'_>,
+        prepared: &Prepared,
+        options: &Options,
+        mut settings: RenderSettings,
+        pool: Option<&rayon::ThreadPool>,
+    ) -> PyResult<Frame> {
         let name = &self.recipe.name;
         // What the options leave to the volume, as volray-options'
         // from_volume does, from what was found once.
@@ -292,39 +450,9 @@ impl Renderer {
         let stop = AtomicBool::new(false);
         let inner = &prepared.inner;
         let settings = &settings;
-        let mut interrupt = None;
-        let hook = InterruptHook::take();
-        let rendered = py.detach(|| {
-            std::thread::scope(|s| {
-                let (done, finished) = mpsc::channel();
-                let (pool, stop) = (&pool, &stop);
-                s.spawn(move || {
-                    let report = |pixels| hook.report(pixels, stop);
-                    let frame = || inner.render_stoppable(settings, &report, stop);
-                    // The global pool (one worker per core) unless threads= is given.
-                    let image = match pool {
-                        Some(pool) => pool.install(frame),
-                        None => frame(),
-                    };
-                    // The receiver waits for this; it cannot be gone.
-                    let _ = done.send(image);
-                });
-                loop {
-                    match finished.recv_timeout(SIGNAL_POLL) {
-                        Ok(image) => break image,
-                        Err(RecvTimeoutError::Timeout) => {
-                            if interrupt.is_none()
-                                && let Err(e) = Python::attach(|py| py.check_signals())
-                            {
-                                interrupt = Some(e);
-                                stop.store(true, Ordering::Relaxed);
-                            }
-                        }
-                        Err(RecvTimeoutError::Disconnected) => {
-                            panic!("the render thread ended without a frame")
-                        }
-                    }
-                }
+        let (rendered, interrupt) = py.detach(|| {
+            interruptible(pool, &stop, |report| {
+                inner.render_stoppable(settings, report, &stop)
             })
         });
         if let Some(e) = interrupt {
@@ -332,6 +460,218 @@ impl Renderer {
         }
         let image = rendered.map_err(|e| render_error(e, &options.camera, name))?;
         Ok(Frame { image })
+    }
+
+    /// A frame of a lazy volume: its level, then the level whole or in
+    /// pieces, as its plan says.
+    fn lazy_frame(
+        &self,
+        py: Python<'_>,
+        lazy: &LazyRoad,
+        options: &Options,
+        mut settings: RenderSettings,
+        pool: Option<rayon::ThreadPool>,
+    ) -> PyResult<Frame> {
+        let level = self.level_for(lazy, &settings, &options.camera)?;
+        let pool = pool.as_ref();
+        let name = &self.recipe.name;
+        let settings_ref = &mut settings;
+        let next = py.detach(|| -> PyResult<(Next, Option<Image>)> {
+            let mut state = lazy.state.lock().unwrap_or_else(|e| e.into_inner());
+            self.settle(lazy, &mut state, level, settings_ref)?;
+            state.settings = Some(settings_ref.clone());
+            if let Way::Whole { prepared, .. } = &state.way {
+                return Ok((Next::Whole(Arc::clone(prepared)), None));
+            }
+            let Way::Pieces {
+                streamed, found, ..
+            } = &mut state.way
+            else {
+                unreachable!("settled above")
+            };
+            lazy.stop.store(false, Ordering::SeqCst);
+            let settings = &mut *settings_ref;
+            let (rendered, interrupt) = interruptible(pool, &lazy.stop, |report| {
+                found
+                    .apply(streamed, &options.look, settings, name)
+                    .and_then(|()| streamed.render(settings, report).map_err(LookError::Stream))
+            });
+            if let Some(e) = interrupt {
+                return Err(e);
+            }
+            let (image, _times) = rendered.map_err(|e| match e {
+                LookError::Stream(e) => stream_error(e, &options.camera, name),
+                LookError::Refused(e) => option_error(e),
+            })?;
+            Ok((Next::Pieces, Some(image)))
+        })?;
+        match next {
+            (Next::Whole(prepared), _) => {
+                self.render_prepared(py, &prepared, options, settings, pool)
+            }
+            (Next::Pieces, image) => Ok(Frame {
+                image: image.expect("a frame in pieces returns its image"),
+            }),
+        }
+    }
+
+    /// The level a frame of `settings` needs: `level="auto"`'s choice
+    /// for the view, or the level asked for.
+    fn level_for(
+        &self,
+        lazy: &LazyRoad,
+        settings: &RenderSettings,
+        camera: &CameraOptions,
+    ) -> PyResult<usize> {
+        match lazy.choice {
+            LevelChoice::Index(n) => Ok(n),
+            LevelChoice::Auto => lazy_file(lazy)
+                .chunked
+                .auto_level(settings)
+                .map_err(|e| render_error(RenderError::from(e), camera, &self.recipe.name)),
+        }
+    }
+
+    /// Makes `state` ready for a frame of `settings` at `level`: the level
+    /// open, and read whole (prepared) or set to be rendered in pieces,
+    /// as volray-lazy's plan says for `max_memory`. What the last frame
+    /// kept is kept where the plan is the same. Called detached from
+    /// Python, the state locked.
+    fn settle(
+        &self,
+        lazy: &LazyRoad,
+        state: &mut LazyState,
+        level: usize,
+        settings: &RenderSettings,
+    ) -> PyResult<()> {
+        let file = lazy_file(lazy);
+        let name = &self.recipe.name;
+        if state.chunked.as_ref().map(Chunked::level) != Some(level) {
+            state.way = Way::None;
+            state.chunked = None;
+            let chunked = file.chunked.open_level(level).map_err(io_error)?;
+            state.chunked = Some(chunked.stoppable(Arc::clone(&lazy.stop)));
+        }
+        let Some(chunked) = &state.chunked else {
+            unreachable!("opened above")
+        };
+        let own = file.chunked.level();
+        let overridden =
+            self.recipe.spacing.is_some() || self.recipe.origin.is_some() || file.spacing_given;
+        let refuse_override = |how: &str| {
+            value_error(format!(
+                "{name}: spacing and origin given apply to level {own} read whole, not to level {level} {how}: leave them out (the file's own are used)"
+            ))
+        };
+        let plan = chunked.plan(settings, self.recipe.nonfinite, self.recipe.max_memory, 0);
+        match plan {
+            Plan::Whole { level, .. } => {
+                if overridden && level != own {
+                    return Err(refuse_override("read whole"));
+                }
+                if !matches!(state.way, Way::Whole { level: l, .. } if l == level) {
+                    // The last level's samples go before the next is read.
+                    state.way = Way::None;
+                    let prepared =
+                        Python::attach(|py| self.prepare_level(py, lazy, file, chunked))?;
+                    state.way = Way::Whole {
+                        level,
+                        prepared: Arc::new(prepared),
+                    };
+                }
+            }
+            Plan::Pieces {
+                level,
+                need,
+                streamed,
+            } => {
+                if overridden {
+                    return Err(refuse_override("in pieces"));
+                }
+                if self.recipe.log {
+                    return Err(value_error(format!(
+                        "{name}: level {level} may take up to {} to render whole, more than max_memory {}, and log=True is not yet taken piece by piece: raise max_memory, or pick a coarser level",
+                        format_bytes(need),
+                        format_bytes(u128::from(self.recipe.max_memory))
+                    )));
+                }
+                if !matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
+                    state.way = Way::Pieces {
+                        level,
+                        streamed: Box::new(streamed.with_labels(self.recipe.labels)),
+                        found: Found::default(),
+                    };
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The level `chunked` read whole and prepared: the volume's own
+    /// samples where `data` read them already, else read from the file.
+    fn prepare_level(
+        &self,
+        py: Python<'_>,
+        lazy: &LazyRoad,
+        file: &LazyFile,
+        chunked: &Chunked,
+    ) -> PyResult<Prepared> {
+        let volume = lazy.volume.get();
+        let own = chunked.level() == file.chunked.level();
+        if own && volume.loaded(py).is_some() {
+            return self.recipe.prepare_core(py, volume.core(py)?, None);
+        }
+        let opts = ReadOptions {
+            max_memory: self.recipe.max_memory,
+            map: MapPolicy::Never,
+            ..chunked.read_options()
+        };
+        let path = chunked.path();
+        let read = py
+            .detach(|| volray_io::read(path, &opts))
+            .map_err(io_error)?;
+        let mut core = read.volume;
+        if own && file.spacing_given {
+            core = core
+                .with_spacing(volume.spacing.into())
+                .map_err(|e| value_error(format!("spacing: {e}")))?;
+        }
+        if volume.labels {
+            core = core.as_labels();
+        }
+        self.recipe.prepare_core(py, core, None)
+    }
+
+    /// A lazy volume's value range: of the level of the last frame (of a
+    /// default frame before the first), read whole or found piece by
+    /// piece (every piece read once).
+    fn lazy_value_range(&self, py: Python<'_>, lazy: &LazyRoad) -> PyResult<(f32, f32)> {
+        let (options, default, _) = self.settings_of(&Keywords::new(None, &[], "value_range")?)?;
+        let name = &self.recipe.name;
+        py.detach(|| {
+            let mut state = lazy.state.lock().unwrap_or_else(|e| e.into_inner());
+            let settings = match state.settings.clone() {
+                Some(settings) => settings,
+                None => {
+                    let level = self.level_for(lazy, &default, &options.camera)?;
+                    self.settle(lazy, &mut state, level, &default)?;
+                    state.settings = Some(default.clone());
+                    default
+                }
+            };
+            match &mut state.way {
+                Way::None => unreachable!("settled by the frame before, or above"),
+                Way::Whole { prepared, .. } => Ok(prepared.inner.value_range()),
+                Way::Pieces {
+                    streamed, found, ..
+                } => {
+                    let histogram = found
+                        .histogram(streamed, &settings)
+                        .map_err(|e| stream_error(e, &options.camera, name))?;
+                    Ok(histogram.map_or((0.0, 0.0), |h| (h.min, h.max)))
+                }
+            }
+        })
     }
 
     /// Refuses a frame that may take more than `max_memory` even with no
@@ -391,7 +731,9 @@ fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
 #[pymethods]
 impl Renderer {
     /// `Renderer(volume, *, spacing=None, origin=None, order="xyz",
-    /// labels=None, log=False, nonfinite="refuse", max_memory=None)`.
+    /// labels=None, log=False, nonfinite="refuse", max_memory=None,
+    /// level=None)`: `level` ("auto" or a number) picks the level of a
+    /// lazy volume's file each frame renders.
     #[new]
     #[pyo3(signature = (volume, **kwargs))]
     fn new(
@@ -414,14 +756,146 @@ impl Renderer {
     /// samples as they are now.
     #[getter]
     fn value_range(&self, py: Python<'_>) -> PyResult<(f32, f32)> {
-        Ok(self.current(py, None)?.inner.value_range())
+        match &self.road {
+            Road::Memory(memory) => Ok(self.current(py, memory, None)?.inner.value_range()),
+            Road::Lazy(lazy) => self.lazy_value_range(py, lazy),
+        }
     }
 
-    fn __repr__(&self) -> String {
-        let prepared = Arc::clone(&self.prepared.lock().unwrap_or_else(|e| e.into_inner()));
-        let [x, y, z] = prepared.inner.volume().dims();
-        format!("Renderer({}: {x}x{y}x{z})", self.recipe.name)
+    /// The level the last frame rendered (of a lazy volume's file: with
+    /// `level="auto"`, the one its view needed); `None` before the first
+    /// frame, and for a volume in memory.
+    #[getter]
+    fn level(&self, py: Python<'_>) -> Option<usize> {
+        let Road::Lazy(lazy) = &self.road else {
+            return None;
+        };
+        py.detach(|| {
+            lazy.state
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .way
+                .level()
+        })
     }
+
+    /// How many pieces the last frame was cut into: 1 where the level was
+    /// read whole (always, for a volume in memory); more where it would
+    /// not fit `max_memory` whole and was rendered piece by piece, read
+    /// from its file; `None` before a lazy volume's first frame.
+    #[getter]
+    fn pieces(&self, py: Python<'_>) -> Option<usize> {
+        let Road::Lazy(lazy) = &self.road else {
+            return Some(1);
+        };
+        py.detach(
+            || match &lazy.state.lock().unwrap_or_else(|e| e.into_inner()).way {
+                Way::None => None,
+                Way::Whole { .. } => Some(1),
+                Way::Pieces { streamed, .. } => Some(streamed.pieces()),
+            },
+        )
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let name = &self.recipe.name;
+        match &self.road {
+            Road::Memory(memory) => {
+                let prepared = Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner()));
+                let [x, y, z] = prepared.inner.volume().dims();
+                format!("Renderer({name}: {x}x{y}x{z})")
+            }
+            Road::Lazy(lazy) => {
+                let (x, y, z) = lazy.volume.get().dims(py);
+                let level = match lazy.choice {
+                    LevelChoice::Auto => "auto".to_string(),
+                    LevelChoice::Index(n) => n.to_string(),
+                };
+                format!("Renderer({name}: {x}x{y}x{z}, lazy, level {level})")
+            }
+        }
+    }
+}
+
+/// Runs `work` (a frame, given the progress callback) on a worker thread,
+/// on `pool` or the global pool, while the calling thread (detached from
+/// Python) asks Python for pending signals every [`SIGNAL_POLL`] of the
+/// wait; on KeyboardInterrupt it sets `stop` and waits for the work to
+/// end. The work's result, and the interrupt if one came.
+fn interruptible<T: Send>(
+    pool: Option<&rayon::ThreadPool>,
+    stop: &AtomicBool,
+    work: impl FnOnce(&(dyn Fn(usize) + Sync)) -> T + Send,
+) -> (T, Option<PyErr>) {
+    let hook = InterruptHook::take();
+    let mut interrupt = None;
+    let out = std::thread::scope(|s| {
+        let (done, finished) = mpsc::channel();
+        let hook = &hook;
+        s.spawn(move || {
+            let report = |pixels| hook.report(pixels, stop);
+            let frame = || work(&report);
+            // The global pool (one worker per core) unless threads= is given.
+            let out = match pool {
+                Some(pool) => pool.install(frame),
+                None => frame(),
+            };
+            // The receiver waits for this; it cannot be gone.
+            let _ = done.send(out);
+        });
+        loop {
+            match finished.recv_timeout(SIGNAL_POLL) {
+                Ok(out) => break out,
+                Err(RecvTimeoutError::Timeout) => {
+                    if interrupt.is_none()
+                        && let Err(e) = Python::attach(|py| py.check_signals())
+                    {
+                        interrupt = Some(e);
+                        stop.store(true, Ordering::SeqCst);
+                    }
+                }
+                Err(RecvTimeoutError::Disconnected) => {
+                    panic!("the render thread ended without a frame")
+                }
+            }
+        }
+    });
+    (out, interrupt)
+}
+
+/// A lazy volume's file (a lazy road's volume is lazy).
+fn lazy_file(lazy: &LazyRoad) -> &LazyFile {
+    match &lazy.volume.get().lazy {
+        Some(file) => file,
+        None => unreachable!("a lazy road's volume is lazy"),
+    }
+}
+
+/// A frame in pieces that failed, as the Python exception.
+fn stream_error(e: StreamError, camera: &CameraOptions, name: &str) -> PyErr {
+    match e {
+        StreamError::Read(message) => PyOSError::new_err(message),
+        StreamError::TooLarge(message) => value_error(format!(
+            "{name}: {message}: raise max_memory, or pick a coarser level"
+        )),
+        StreamError::Render(e) => render_error(e, camera, name),
+    }
+}
+
+/// `level=`: `"auto"` or a level number, if given.
+fn level_choice(k: &Keywords<'_>) -> PyResult<Option<LevelChoice>> {
+    let Some(level) = k.get("level") else {
+        return Ok(None);
+    };
+    if let Ok(s) = level.cast::<PyString>() {
+        let text = s.to_cow()?;
+        return text
+            .parse::<LevelChoice>()
+            .map(Some)
+            .map_err(|e| value_error(format!("level: {e}")));
+    }
+    keywords::extract::<usize>(level, "level", "'auto' or a level number (0 the finest)")
+        .map(|n| Some(LevelChoice::Index(n)))
 }
 
 /// `render(volume, **options) -> Frame`: one frame of `volume` (a numpy

@@ -1,14 +1,29 @@
 //! `Volume` (a numpy array with its spacing, origin and what its file
 //! said) and `read` (any file volray reads, or a built-in source).
+//!
+//! A file stored in chunks (Zarr, OME-Zarr, and whatever else
+//! volray-lazy's `Chunked::open` opens box by box) is read lazily: `read`
+//! opens it from its metadata and reads no sample; `Volume.data` reads
+//! the level whole on first use (checked against `max_memory` first) and
+//! keeps it; `render` and `Renderer` read the level a frame needs, whole
+//! or piece by piece (`renderer.rs`).
 
 use crate::array::{self, Order};
 use crate::errors::{io_error, value_error};
 use numpy::{PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyList, PyString};
 use std::path::PathBuf;
 use volray_core::{Histogram, SampleType, Volume as CoreVolume};
-use volray_io::{DType, Endian, FileInfo, MapPolicy, RawOptions, ReadOptions, VolumeFormat};
+use volray_io::{
+    DType, Endian, FileInfo, MapPolicy, RawOptions, ReadOptions, VolumeFormat, format_bytes,
+};
+use volray_lazy::Chunked;
+
+/// The most chunk files a level's `bytes_stored` is counted over (as
+/// `volray info` counts them): about 4 µs a file.
+const COUNTED_FILES: usize = 100_000;
 
 /// A volume: `data`, a numpy array `a[x, y, z]` (x fastest in memory),
 /// and where its voxels lie, `spacing` and `origin` in `(x, y, z)`.
@@ -20,10 +35,18 @@ use volray_io::{DType, Endian, FileInfo, MapPolicy, RawOptions, ReadOptions, Vol
 /// holds then (it digests the samples before each frame); do not change
 /// it while a frame of it renders (the GIL is released meanwhile: the
 /// frame is refused with `OSError`). A volume `read` gives is read-only.
+///
+/// A volume `read` from a chunked file (Zarr, OME-Zarr) is lazy
+/// (`lazy` is True): its dims, spacing, levels and info come from the
+/// metadata, no sample is read until `data` is asked for (then the level
+/// is read whole, if it fits `max_memory`, and kept), and `render` /
+/// `Renderer` read only the level a frame needs, piece by piece where it
+/// would not fit whole.
 #[pyclass(frozen, module = "volray")]
 pub struct Volume {
-    /// The samples, C-contiguous `(nz, ny, nx)`.
-    pub data: Py<PyUntypedArray>,
+    /// The samples, C-contiguous `(nz, ny, nx)`: set at once, or (a lazy
+    /// volume) on first use.
+    data: PyOnceLock<Py<PyUntypedArray>>,
     pub sample: SampleType,
     pub spacing: [f64; 3],
     pub origin: [f64; 3],
@@ -34,6 +57,18 @@ pub struct Volume {
     /// cannot change, so a renderer need not digest them each frame.
     pub frozen: bool,
     pub file: Option<(VolumeFormat, FileInfo)>,
+    /// Where a lazy volume's samples stay until they are asked for.
+    pub lazy: Option<LazyFile>,
+}
+
+/// A level of a chunked file, opened from its metadata.
+pub struct LazyFile {
+    pub chunked: Chunked,
+    /// `read`'s `max_memory`: what reading the level whole may take.
+    pub max_memory: u64,
+    /// Whether `read` was given a spacing (which holds for this level
+    /// only).
+    pub spacing_given: bool,
 }
 
 impl Volume {
@@ -48,7 +83,7 @@ impl Volume {
     ) -> PyResult<Self> {
         let (array, sample) = array::normalise(data, order, "volume")?;
         let volume = Volume {
-            data: array.unbind(),
+            data: PyOnceLock::new(),
             sample,
             spacing: spacing.unwrap_or([1.0; 3]),
             origin: origin.unwrap_or([0.0; 3]),
@@ -56,10 +91,76 @@ impl Volume {
             name: "volume".into(),
             frozen: false,
             file: None,
+            lazy: None,
         };
+        let _ = volume.data.set(data.py(), array.unbind());
         // Sides, spacing and origin checked now, not at the first frame.
         volume.core(data.py())?;
         Ok(volume)
+    }
+
+    /// The samples, C-contiguous `(nz, ny, nx)`: a lazy volume's level
+    /// read whole now if it was not yet.
+    pub fn array<'py>(&self, py: Python<'py>) -> PyResult<&Bound<'py, PyUntypedArray>> {
+        let data = self.data.get_or_try_init(py, || self.read_whole(py))?;
+        Ok(data.bind(py))
+    }
+
+    /// The samples if they are in memory (always, but for a lazy volume
+    /// whose `data` was not asked for).
+    pub fn loaded<'py>(&self, py: Python<'py>) -> Option<&Bound<'py, PyUntypedArray>> {
+        self.data.get(py).map(|d| d.bind(py))
+    }
+
+    /// A lazy volume's level, read whole: refused before a byte is read
+    /// where it would take more than `read`'s `max_memory`.
+    fn read_whole(&self, py: Python<'_>) -> PyResult<Py<PyUntypedArray>> {
+        let Some(lazy) = &self.lazy else {
+            unreachable!("a volume not read lazily has its samples from the start")
+        };
+        let chunked = &lazy.chunked;
+        let [x, y, z] = chunked.source().grid().dims;
+        let bytes =
+            [x, y, z].iter().map(|&n| n as u128).product::<u128>() * self.sample.bytes() as u128;
+        if bytes > u128::from(lazy.max_memory) {
+            let level = chunked.level();
+            let fits = (chunked.levels().iter())
+                .position(|l| u128::from(l.bytes_in_memory) <= u128::from(lazy.max_memory));
+            let coarser = match fits {
+                Some(n) if n > level => {
+                    format!("read a coarser level (volray.read(path, level={n})), ")
+                }
+                _ => String::new(),
+            };
+            return Err(value_error(format!(
+                "{}: level {level} ({x}x{y}x{z} {}) takes {} in memory, more than max_memory {}: {coarser}raise max_memory, or render the volume without reading .data (render and Renderer read what a frame needs, piece by piece)",
+                self.name,
+                self.sample.name(),
+                format_bytes(bytes),
+                format_bytes(u128::from(lazy.max_memory)),
+            )));
+        }
+        let opts = ReadOptions {
+            max_memory: lazy.max_memory,
+            map: MapPolicy::Never,
+            ..chunked.read_options()
+        };
+        let path = chunked.path();
+        let loaded = py
+            .detach(|| volray_io::read(path, &opts))
+            .map_err(io_error)?;
+        let volume = loaded.volume;
+        if volume.dims() != [x, y, z] || volume.sample_type() != self.sample {
+            let [a, b, c] = volume.dims();
+            return Err(PyErr::new::<pyo3::exceptions::PyOSError, _>(format!(
+                "{}: the store changed since it was opened: level {} was {x}x{y}x{z} {}, now {a}x{b}x{c} {}: read it again",
+                self.name,
+                chunked.level(),
+                self.sample.name(),
+                volume.sample_type().name()
+            )));
+        }
+        Ok(array::to_numpy(py, volume, false)?.unbind())
     }
 
     /// The volume as volray-core's, over the same samples (no copy).
@@ -71,7 +172,7 @@ impl Volume {
     /// `expected` (checked after each frame) where one is given.
     pub fn core_expecting(&self, py: Python<'_>, expected: Option<u64>) -> PyResult<CoreVolume> {
         let volume = array::volume(
-            self.data.bind(py),
+            self.array(py)?,
             self.sample,
             self.spacing,
             self.origin,
@@ -113,17 +214,39 @@ impl Volume {
         Volume::from_array(data, spacing, origin, Order::parse(order)?, labels)
     }
 
-    /// The samples, `a[x, y, z]`: a view of them, not a copy.
+    /// The samples, `a[x, y, z]`: a view of them, not a copy. A lazy
+    /// volume reads its level whole the first time (`ValueError` if it
+    /// would take more than `read`'s `max_memory`) and keeps it.
     #[getter]
     fn data<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        array::xyz(self.data.bind(py))
+        array::xyz(self.array(py)?)
     }
 
     /// Points along x, y and z.
     #[getter]
-    fn dims(&self, py: Python<'_>) -> (usize, usize, usize) {
-        let shape = self.data.bind(py).shape().to_vec();
+    pub fn dims(&self, py: Python<'_>) -> (usize, usize, usize) {
+        if let Some(lazy) = &self.lazy {
+            let [x, y, z] = lazy.chunked.source().grid().dims;
+            return (x, y, z);
+        }
+        let shape = self.loaded(py).map(|d| d.shape().to_vec());
+        let shape = shape.unwrap_or_else(|| vec![0; 3]);
         (shape[2], shape[1], shape[0])
+    }
+
+    /// Whether the volume is read lazily from a chunked file: no sample
+    /// read until `data` is asked for, and `render` / `Renderer` read only
+    /// what a frame needs (a `level`, whole or piece by piece).
+    #[getter]
+    fn lazy(&self) -> bool {
+        self.lazy.is_some()
+    }
+
+    /// Which of its file's `levels` this volume is (0 the finest); `None`
+    /// for an array or a built-in source.
+    #[getter]
+    pub fn level(&self) -> Option<usize> {
+        self.file.as_ref().map(|(_, info)| info.level)
     }
 
     #[getter]
@@ -151,7 +274,8 @@ impl Volume {
     /// volume is one level of, finest first, each a dict: `path`, `dims`
     /// (x, y, z), `spacing`, `origin`, `chunk_shape` and `shard_shape`
     /// (in the array's axis order), `codecs`, `bytes_stored` (its chunk
-    /// files) and `bytes_in_memory` (one time point and channel); empty
+    /// files, counted when asked for; `None` for a level of more than
+    /// 100 000 files) and `bytes_in_memory` (one time point and channel); empty
     /// for a file with one level, an array or a built-in source.
     /// `volray.read(path, level=N)` reads level N.
     #[getter]
@@ -167,7 +291,12 @@ impl Volume {
                 d.set_item("chunk_shape", l.chunk_shape.clone())?;
                 d.set_item("shard_shape", l.shard_shape.clone())?;
                 d.set_item("codecs", &l.codecs)?;
-                d.set_item("bytes_stored", l.bytes_stored)?;
+                // Counted when asked for (opening a level does not walk
+                // its chunk files), as `volray info` counts them.
+                let stored = l
+                    .bytes_stored
+                    .or_else(|| py.detach(|| l.count_bytes_stored(COUNTED_FILES)));
+                d.set_item("bytes_stored", stored)?;
                 d.set_item("bytes_in_memory", l.bytes_in_memory)?;
                 levels.append(d)?;
             }
@@ -192,14 +321,18 @@ impl Volume {
         d.set_item("sample_type", self.sample.name())?;
         d.set_item("spacing", self.spacing)?;
         d.set_item("origin", self.origin)?;
-        let volume = self.core(py)?;
-        let histogram = py.detach(|| Histogram::of(&volume, 256));
+        d.set_item("lazy", self.lazy.is_some())?;
         let values = PyDict::new(py);
-        if let Some(h) = histogram {
-            values.set_item("min", h.min)?;
-            values.set_item("max", h.max)?;
-            values.set_item("mean", h.mean)?;
-            values.set_item("non_finite", h.non_finite)?;
+        // A lazy volume's values are known once its samples are read.
+        if self.lazy.is_none() || self.loaded(py).is_some() {
+            let volume = self.core(py)?;
+            let histogram = py.detach(|| Histogram::of(&volume, 256));
+            if let Some(h) = histogram {
+                values.set_item("min", h.min)?;
+                values.set_item("max", h.max)?;
+                values.set_item("mean", h.mean)?;
+                values.set_item("non_finite", h.non_finite)?;
+            }
         }
         d.set_item("values", values)?;
         if let Some((_, i)) = &self.file {
@@ -223,12 +356,20 @@ impl Volume {
     fn __repr__(&self, py: Python<'_>) -> String {
         let (x, y, z) = self.dims(py);
         format!(
-            "Volume({}: {x}x{y}x{z} {}, spacing {:?}, origin {:?}{})",
+            "Volume({}: {x}x{y}x{z} {}, spacing {:?}, origin {:?}{}{})",
             self.name,
             self.sample.name(),
             self.spacing,
             self.origin,
-            if self.labels { ", labels" } else { "" }
+            if self.labels { ", labels" } else { "" },
+            match &self.lazy {
+                Some(l) => format!(
+                    ", level {} of {}, lazy",
+                    l.chunked.level(),
+                    l.chunked.levels().len()
+                ),
+                None => String::new(),
+            }
         )
     }
 }
@@ -242,6 +383,11 @@ impl Volume {
 /// and `channel` pick a level and a channel of an OME-Zarr image (the
 /// command line's `--level` and `--channel`; 0 by default), `frame` its
 /// time point. `dims`, `dtype` and `endian` describe a raw file.
+///
+/// A chunked file (Zarr, OME-Zarr) is read lazily: the volume comes from
+/// the metadata alone, `volume.data` reads the level when first asked
+/// for, and `render(volume, level="auto")` picks the level each view
+/// needs (`level="auto"` here cannot know the view, and is refused).
 #[pyfunction]
 #[pyo3(signature = (path, *, format=None, frame=None, array=None, level=None, channel=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
 #[allow(clippy::too_many_arguments)]
@@ -251,7 +397,7 @@ pub fn read(
     format: Option<&str>,
     frame: Option<usize>,
     array: Option<String>,
-    level: Option<usize>,
+    level: Option<&Bound<'_, PyAny>>,
     channel: Option<usize>,
     dims: Option<[usize; 3]>,
     dtype: Option<&str>,
@@ -261,6 +407,7 @@ pub fn read(
 ) -> PyResult<Volume> {
     let spec = path.to_string_lossy().to_string();
     let max_memory = max_memory.unwrap_or_else(volray_io::default_max_memory);
+    let level = read_level(&spec, level)?;
     let (volume, file) = if volray_data::is_source_spec(&spec) {
         if level.is_some() || channel.is_some() {
             return Err(value_error(format!(
@@ -307,6 +454,12 @@ pub fn read(
             // The samples move into a numpy array, which owns its memory.
             map: MapPolicy::Never,
         };
+        let chunked = py
+            .detach(|| Chunked::open(&path, &opts))
+            .map_err(io_error)?;
+        if let Some(chunked) = chunked {
+            return Ok(lazy_volume(chunked, spec, spacing, max_memory));
+        }
         let loaded = py
             .detach(|| volray_io::read(&path, &opts))
             .map_err(io_error)?;
@@ -319,8 +472,8 @@ pub fn read(
     // Read-only: a renderer of the volume need not digest the samples
     // before each frame (docs/python.md); `.copy()` gives a writeable one.
     let data = array::to_numpy(py, volume, false)?;
-    Ok(Volume {
-        data: data.unbind(),
+    let volume = Volume {
+        data: PyOnceLock::new(),
         sample,
         spacing,
         origin,
@@ -328,5 +481,48 @@ pub fn read(
         name: spec,
         frozen: true,
         file,
-    })
+        lazy: None,
+    };
+    let _ = volume.data.set(py, data.unbind());
+    Ok(volume)
+}
+
+/// `read`'s `level=`: a level number, or `None`.
+fn read_level(spec: &str, level: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    let Some(level) = level else { return Ok(None) };
+    if let Ok(s) = level.cast::<PyString>()
+        && s.to_cow()? == "auto"
+    {
+        return Err(value_error(format!(
+            "{spec}: level='auto' picks the level a view needs, which read() cannot know: read the file (lazily, no sample is read) and give level='auto' to render() or Renderer(): volray.render(volray.read(path), level='auto')"
+        )));
+    }
+    crate::keywords::extract::<usize>(level, "level", "a level number (0 the finest)").map(Some)
+}
+
+/// The volume of a chunked file's level, from its metadata: no sample
+/// read.
+fn lazy_volume(
+    chunked: Chunked,
+    name: String,
+    spacing: Option<[f64; 3]>,
+    max_memory: u64,
+) -> Volume {
+    let source = chunked.source();
+    let grid = source.grid();
+    Volume {
+        data: PyOnceLock::new(),
+        sample: source.sample_type(),
+        spacing: spacing.unwrap_or(grid.spacing.to_array()),
+        origin: grid.origin.to_array(),
+        labels: source.is_labels(),
+        name,
+        frozen: true,
+        file: Some((chunked.format(), chunked.info().clone())),
+        lazy: Some(LazyFile {
+            chunked,
+            max_memory,
+            spacing_given: spacing.is_some(),
+        }),
+    }
 }

@@ -18,6 +18,12 @@ without a copy; other types become float32. Arrays volray returns
 :class:`Renderer` renders an array as it is at each frame: change it in
 place between frames, not while one renders.
 
+A chunked file (Zarr, OME-Zarr) is read lazily: ``volray.read`` reads its
+metadata only (``Volume.lazy``), ``Volume.data`` reads the level when
+first asked for, and ``volray.render(volume, level="auto")`` reads the
+level each view needs, piece by piece where it would not fit
+``max_memory`` whole.
+
 Every keyword of :func:`render` is the ``volray render`` flag of the same
 name (``look_at`` is ``--look-at``; ``shading=False`` is ``--no-shading``)
 with the same default and the same pixels. Bad input raises ``ValueError``

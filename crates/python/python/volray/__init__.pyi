@@ -17,6 +17,7 @@ Plane = Union[Tuple[float, float, float, float, float, float], Tuple[Vec3, Vec3]
 ArrayLike = Union[npt.NDArray[Any], Sequence[Any]]
 Path = Union[str, PathLike]
 Blend = Literal["composite", "mip", "maximum", "minip", "minimum", "average", "iso"]
+Level = Union[int, Literal["auto"]]
 
 class TransferFunction:
     def __init__(
@@ -62,6 +63,14 @@ class Camera:
     perspective: Optional[float]
 
 class Volume:
+    """Samples with their spacing and origin. A volume ``read`` from a
+    chunked file (Zarr, OME-Zarr) is lazy: ``dims``, ``spacing``,
+    ``origin``, ``sample_type``, ``labels``, ``levels`` and ``info`` come
+    from the metadata; ``data`` reads the level whole on first use
+    (``ValueError`` over ``max_memory``) and keeps it; ``render`` and
+    ``Renderer`` read only the level a frame needs, piece by piece where
+    it would not fit whole."""
+
     def __init__(
         self,
         data: ArrayLike,
@@ -87,6 +96,12 @@ class Volume:
     def info(self) -> Dict[str, Any]: ...
     @property
     def levels(self) -> List[Dict[str, Any]]: ...
+    @property
+    def lazy(self) -> bool:
+        """True for a volume read lazily from a chunked file."""
+    @property
+    def level(self) -> Optional[int]:
+        """Which of its file's levels this volume is (None for an array)."""
 
 class Frame:
     @property
@@ -110,6 +125,7 @@ class Renderer:
         log: bool = False,
         nonfinite: Literal["refuse", "transparent"] = "refuse",
         max_memory: Optional[int] = None,
+        level: Optional[Level] = None,
     ) -> None: ...
     def render(
         self,
@@ -152,6 +168,12 @@ class Renderer:
     ) -> Frame: ...
     @property
     def value_range(self) -> Pair: ...
+    @property
+    def level(self) -> Optional[int]:
+        """The level of a lazy volume's file the last frame rendered."""
+    @property
+    def pieces(self) -> Optional[int]:
+        """The pieces the last frame was cut into (1: read whole)."""
 
 def render(
     volume: Union[Volume, ArrayLike],
@@ -163,6 +185,7 @@ def render(
     log: bool = False,
     nonfinite: Literal["refuse", "transparent"] = "refuse",
     max_memory: Optional[int] = None,
+    level: Optional[Level] = None,
     size: Union[int, Tuple[int, int]] = 480,
     view: Optional[Vec3] = None,
     look_at: Optional[Vec3] = None,
@@ -213,7 +236,9 @@ def read(
     endian: Optional[Literal["little", "big"]] = None,
     spacing: Optional[Vec3] = None,
     max_memory: Optional[int] = None,
-) -> Volume: ...
+) -> Volume:
+    """The volume in ``path``; a chunked file (Zarr, OME-Zarr) lazily,
+    from its metadata (see :class:`Volume`)."""
 
 def hydrogen(
     n: int, l: int, m: int, grid: int = 50, extent: Optional[float] = None, real: bool = False
