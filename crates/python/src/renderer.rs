@@ -642,25 +642,36 @@ impl Renderer {
         self.recipe.prepare_core(py, core, None)
     }
 
-    /// A lazy volume's value range: of the level of the last frame (of a
-    /// default frame before the first), read whole or found piece by
-    /// piece (every piece read once).
+    /// A lazy volume's value range: of the level of the last frame; before
+    /// the first (or after one that failed), of the level asked for (the
+    /// volume's own with `level="auto"`, which needs a view). Read whole,
+    /// or found piece by piece (every piece read once).
     fn lazy_value_range(&self, py: Python<'_>, lazy: &LazyRoad) -> PyResult<(f32, f32)> {
         let (options, default, _) = self.settings_of(&Keywords::new(None, &[], "value_range")?)?;
         let name = &self.recipe.name;
         py.detach(|| {
             let mut state = lazy.state.lock().unwrap_or_else(|e| e.into_inner());
-            let settings = match state.settings.clone() {
-                Some(settings) => settings,
-                None => {
-                    let level = self.level_for(lazy, &default, &options.camera)?;
-                    self.settle(lazy, &mut state, level, &default)?;
-                    state.settings = Some(default.clone());
-                    default
+            let settings = match (&state.way, state.settings.clone()) {
+                (Way::Whole { .. } | Way::Pieces { .. }, Some(settings)) => settings,
+                _ => {
+                    // A small frame: the range does not depend on it, and
+                    // the pieces need fit no picture.
+                    let settings = RenderSettings {
+                        width: 16,
+                        height: 16,
+                        ..default
+                    };
+                    let level = match lazy.choice {
+                        LevelChoice::Index(n) => n,
+                        LevelChoice::Auto => lazy_file(lazy).chunked.level(),
+                    };
+                    self.settle(lazy, &mut state, level, &settings)?;
+                    state.settings = Some(settings.clone());
+                    settings
                 }
             };
             match &mut state.way {
-                Way::None => unreachable!("settled by the frame before, or above"),
+                Way::None => unreachable!("settled by a frame before, or above"),
                 Way::Whole { prepared, .. } => Ok(prepared.inner.value_range()),
                 Way::Pieces {
                     streamed, found, ..

@@ -173,6 +173,21 @@ def test_a_frame_over_max_memory_is_rendered_in_pieces_within_1_255_of_the_whole
     assert np.array_equal(b[:, :, :3], expected[:, :, :3])
 
 
+def test_value_range_before_any_frame_is_the_level_asked_for_whole_or_in_pieces(store):
+    path, pyramid = store
+    full = (float(pyramid[0].min()), float(pyramid[0].max()))
+    coarse = (float(pyramid[2].min()), float(pyramid[2].max()))
+    assert coarse != full
+    for max_memory in (None, 100_000):
+        assert volray.Renderer(volray.read(path), max_memory=max_memory).value_range == pytest.approx(full)
+        assert volray.Renderer(volray.read(path), level=2, max_memory=max_memory).value_range == pytest.approx(coarse)
+        # level="auto" needs a view: the volume's own level until a frame.
+        auto = volray.Renderer(volray.read(path, level=2), level="auto", max_memory=max_memory)
+        assert auto.value_range == pytest.approx(coarse)
+    tight = volray.Renderer(volray.read(path), max_memory=100_000)
+    assert tight.value_range == pytest.approx(full) and tight.pieces > 1
+
+
 def test_labels_in_pieces_are_found_as_in_the_whole(zarr_modules, tmp_path):
     path = tmp_path / "labels.ome.zarr"
     n = 48
