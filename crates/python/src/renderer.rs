@@ -458,7 +458,9 @@ impl Renderer {
         if let Some(e) = interrupt {
             return Err(e);
         }
-        let image = rendered.map_err(|e| render_error(e, &options.camera, name))?;
+        let image = rendered
+            .map_err(|panic| internal_error(name, &panic))?
+            .map_err(|e| render_error(e, &options.camera, name))?;
         Ok(Frame { image })
     }
 
@@ -496,10 +498,15 @@ impl Renderer {
                     .apply(streamed, &options.look, settings, name)
                     .and_then(|()| streamed.render(settings, report).map_err(LookError::Stream))
             });
+            let rendered = rendered.map_err(|panic| {
+                // What the pieces knew may be half updated: start afresh.
+                state.way = Way::None;
+                internal_error(name, &panic)
+            });
             if let Some(e) = interrupt {
                 return Err(e);
             }
-            let (image, _times) = rendered.map_err(|e| match e {
+            let (image, _times) = rendered?.map_err(|e| match e {
                 LookError::Stream(e) => stream_error(e, &options.camera, name),
                 LookError::Refused(e) => option_error(e),
             })?;
@@ -832,12 +839,13 @@ impl Renderer {
 /// on `pool` or the global pool, while the calling thread (detached from
 /// Python) asks Python for pending signals every [`SIGNAL_POLL`] of the
 /// wait; on KeyboardInterrupt it sets `stop` and waits for the work to
-/// end. The work's result, and the interrupt if one came.
+/// end. The work's result (or the message of its panic), and the
+/// interrupt if one came.
 fn interruptible<T: Send>(
     pool: Option<&rayon::ThreadPool>,
     stop: &AtomicBool,
     work: impl FnOnce(&(dyn Fn(usize) + Sync)) -> T + Send,
-) -> (T, Option<PyErr>) {
+) -> (Result<T, String>, Option<PyErr>) {
     let hook = InterruptHook::take();
     let mut interrupt = None;
     let out = std::thread::scope(|s| {
@@ -847,10 +855,16 @@ fn interruptible<T: Send>(
             let report = |pixels| hook.report(pixels, stop);
             let frame = || work(&report);
             // The global pool (one worker per core) unless threads= is given.
-            let out = match pool {
+            let run = || match pool {
                 Some(pool) => pool.install(frame),
                 None => frame(),
             };
+            // A panic (a bug) becomes an exception, not an abort of Python.
+            let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).map_err(|p| {
+                (p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .or_else(|| p.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic".to_string())
+            });
             // The receiver waits for this; it cannot be gone.
             let _ = done.send(out);
         });
@@ -872,6 +886,13 @@ fn interruptible<T: Send>(
         }
     });
     (out, interrupt)
+}
+
+/// A frame that panicked (a bug in volray), as `RuntimeError`.
+fn internal_error(name: &str, panic: &str) -> PyErr {
+    pyo3::exceptions::PyRuntimeError::new_err(format!(
+        "{name}: the frame failed inside volray (a bug, please report it): {panic}"
+    ))
 }
 
 /// A lazy volume's file (a lazy road's volume is lazy).
