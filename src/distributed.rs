@@ -86,7 +86,7 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     let name = source.name.clone();
     let fail = |e| failure(&args.view, &name, e);
     let mut d = Distributed::read(&mpi, &source, mode).map_err(fail)?;
-    let settings = from_volume(&d, &args.view, &name, settings)?;
+    let settings = from_volume(&d, &args.view, (&name, source.window), settings)?;
     let (image, _) = d.render(&settings).map_err(fail)?;
     if let Some(image) = image {
         render::write_still(args, kind, &image)?;
@@ -113,7 +113,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
     let (d, per_frame, walls) = {
         let start = mpi.time();
         let mut d = Distributed::read(&mpi, &source, mode).map_err(fail)?;
-        let base = from_volume(&d, &args.view, &name, base.clone())?;
+        let base = from_volume(&d, &args.view, (&name, source.window), base.clone())?;
         let read_wall = mpi.time() - start;
         let mut per_frame: Vec<Vec<RankTimes>> = Vec::new();
         let mut walls = Vec::new();
@@ -176,14 +176,16 @@ fn initialize() -> Result<Mpi, CliError> {
 /// takes it ([`crate::render::from_volume`]): with `--labels`, the label
 /// transfer function of the labels every rank found, joined; otherwise
 /// `--tf auto` (the default) chosen from the whole volume's histogram,
-/// summed over the ranks' owned voxels.
+/// summed over the ranks' owned voxels, within the file's display window
+/// where it gives one.
 fn from_volume(
     d: &Distributed<'_, Mpi>,
     view: &ViewArgs,
-    name: &str,
+    (name, window): (&str, Option<(f64, f64)>),
     mut settings: RenderSettings,
 ) -> Result<RenderSettings, CliError> {
     let fail = |e| failure(view, name, e);
+    crate::settings::file_window(&view.look, &mut settings.transfer_function, window);
     let look = crate::settings::look(&view.look);
     if view.look.labels {
         let found = d
@@ -238,6 +240,8 @@ struct CliSource {
     log_floor: Option<f32>,
     /// A built-in source's spec: each rank generates its box.
     generate: Option<String>,
+    /// The file's display window (OME-Zarr `omero`), the default `--range`.
+    window: Option<(f64, f64)>,
     /// `--log` and `--labels` as given.
     log: bool,
     labels: bool,
@@ -359,6 +363,7 @@ impl CliSource {
             chunked: None,
             log_floor: None,
             generate: None,
+            window: None,
             log: view.look.log,
             labels: view.look.labels,
             max_memory,
@@ -383,6 +388,7 @@ impl CliSource {
             if all.iter().all(|m| m.first() == Some(&1)) {
                 let lazy = opened.ok().flatten().expect("agreed");
                 source.grid = lazy.source.grid();
+                source.window = lazy.info.display_window();
                 let stored = lazy.source.sample_type();
                 source.chunked = Some(lazy.source);
                 let fits = source.check_piece(mpi, Route::Chunked { stored });

@@ -50,7 +50,10 @@ pub fn from_volume(
     crate::settings::file_window(
         &args.view.look,
         &mut settings.transfer_function,
-        input.file.as_ref().map(|(_, info)| info),
+        input
+            .file
+            .as_ref()
+            .and_then(|(_, info)| info.display_window()),
     );
     crate::settings::from_volume(
         &args.view.look,

@@ -164,14 +164,10 @@ pub fn from_volume(
 pub fn file_window(
     look_args: &LookArgs,
     transfer_function: &mut TransferFunction,
-    info: Option<&volray_io::FileInfo>,
+    window: Option<(f64, f64)>,
 ) {
     let free = transfer_function.domain.is_none() && !look_args.labels && !look_args.log;
-    if let (true, Some(window)) = (
-        free,
-        info.and_then(|i| i.omero.as_ref())
-            .and_then(volray_io::OmeroChannel::window_range),
-    ) {
+    if let (true, Some(window)) = (free, window) {
         transfer_function.domain = Some(window);
     }
 }

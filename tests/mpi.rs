@@ -325,6 +325,21 @@ fn each_rank_reads_the_chunks_of_its_own_box_of_an_ome_zarr_image() {
     // The 129³ fractal written by volray convert: 64³ chunks, zstd.
     let store = dir.path().join("f129.ome.zarr");
     single(&["convert", "fractal:129", "-o", store.to_str().unwrap()]);
+    // An omero window over the upper half of its values: the default
+    // range of every rank as of one process.
+    let info = single(&["info", store.to_str().unwrap(), "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let (lo, hi) = (
+        info["values"]["min"].as_f64().unwrap(),
+        info["values"]["max"].as_f64().unwrap(),
+    );
+    let meta_path = store.join("zarr.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&meta_path).unwrap()).unwrap();
+    meta["attributes"]["ome"]["omero"] = serde_json::json!({"channels": [{
+        "window": {"start": (lo + hi) / 2.0, "end": hi, "min": lo, "max": hi}
+    }]});
+    std::fs::write(&meta_path, meta.to_string()).unwrap();
     let args = [
         store.to_str().unwrap(),
         "--size",

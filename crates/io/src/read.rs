@@ -175,6 +175,14 @@ pub struct OmeroChannel {
     pub window: Option<(f64, f64, Option<f64>, Option<f64>)>,
 }
 
+impl FileInfo {
+    /// The display window the file gives its values (an OME-Zarr image's
+    /// `omero` window of the channel read), where it is a range.
+    pub fn display_window(&self) -> Option<(f64, f64)> {
+        self.omero.as_ref()?.window_range()
+    }
+}
+
 impl OmeroChannel {
     /// The display window `start`..`end`, where it is a range (finite,
     /// `start < end`): what a viewer of the image maps to black..full.
