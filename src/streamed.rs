@@ -35,6 +35,8 @@ pub struct StreamedInput {
     pub streamed: Streamed,
     /// The labels or histogram found in the level, once.
     found: Found,
+    /// The file's display window (OME-Zarr `omero`), the default `--range`.
+    window: Option<(f64, f64)>,
     /// What the note after a frame says: the level, and why in pieces.
     level: usize,
     whole: u128,
@@ -107,6 +109,7 @@ pub fn plan(
             name: spec.to_string(),
             streamed: streamed.with_labels(view.look.labels),
             found: Found::default(),
+            window: chunked.info().display_window(),
             level,
             whole: need,
             max_memory,
@@ -139,6 +142,7 @@ impl StreamedInput {
     ) -> Result<RenderSettings, CliError> {
         let look = crate::settings::look(&view.look);
         let name = self.name.clone();
+        crate::settings::file_window(&view.look, &mut settings.transfer_function, self.window);
         let found = self
             .found
             .apply(&mut self.streamed, &look, &mut settings, &name);

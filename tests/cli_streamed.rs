@@ -263,3 +263,43 @@ fn info_reads_the_metadata_of_a_large_level_and_the_values_of_a_smaller_one() {
     assert!(hi["max"].as_f64() <= lo["max"].as_f64(), "{hi} {lo}");
     assert!(hi["max"].as_f64().unwrap() < lo["max"].as_f64().unwrap());
 }
+
+#[test]
+fn an_omero_window_is_the_default_range_in_pieces_as_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let meta_path = image.join("zarr.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&meta_path).unwrap()).unwrap();
+    meta["attributes"]["ome"]["omero"] = json!({"channels": [{
+        "window": {"start": 8000, "end": 24000, "min": 0, "max": 65535}
+    }]});
+    fs::write(&meta_path, meta.to_string()).unwrap();
+    let path = image.to_str().unwrap();
+    let look = ["--colormap", "viridis", "--size", "40x36", "--level", "0"];
+    let out = |name: &str| dir.path().join(name);
+    let said = render(
+        &[&[path, "--max-memory", "100K"], &look[..]].concat(),
+        &out("p.png"),
+    );
+    assert!(said.contains("pieces"), "{said}");
+    render(
+        &[&[path, "--range", "8000,24000"], &look[..]].concat(),
+        &out("w.png"),
+    );
+    render(
+        &[path].iter().chain(&look).copied().collect::<Vec<_>>(),
+        &out("d.png"),
+    );
+    render(
+        &[&[path, "--range", "0,32000"], &look[..]].concat(),
+        &out("o.png"),
+    );
+    let pieces = Picture::read(&out("p.png"));
+    let ranged = Picture::read(&out("w.png"));
+    assert!(pieces.max_diff(&ranged) <= 1);
+    assert!(Picture::read(&out("d.png")).max_diff(&ranged) <= 1);
+    // A window the picture shows: another range is another picture.
+    assert!(pieces.max_diff(&Picture::read(&out("o.png"))) > 16);
+}
