@@ -637,6 +637,7 @@ impl<'v> Renderer<'v> {
         times.cast = t3 - t2;
         times.bricks = state.bricks.len();
         times.lit = lighting.count();
+        state.lit.end_frame(times.lit);
         times.classified = state.bricks.classified_count() - classified_before;
         times.cached_bytes = state.bricks.slot_bytes() + state.lit.bytes();
         times

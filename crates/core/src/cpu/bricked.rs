@@ -418,6 +418,7 @@ impl<'a> Rays<'a> {
         // Where a brick the lit-brick cache has no room for is lit.
         let mut scratch = None;
         let mut live = states.iter().filter(|s| !s.done).count();
+        let mut reached = 0;
         for &n in list {
             // Once every ray of the tile has terminated, the bricks behind
             // are hidden: neither lit nor classified. (A dense CT seen at
@@ -426,6 +427,7 @@ impl<'a> Rays<'a> {
             if live == 0 {
                 break;
             }
+            reached += 1;
             // The brick's box, computed per tile rather than kept per
             // frame (64 bytes an occupied brick): a few operations for the
             // tile's 256 rays.
@@ -441,10 +443,10 @@ impl<'a> Rays<'a> {
                 steppings,
             );
         }
-        // The tile is done with every brick of its list, reached or not:
-        // the lit-brick cache gives a brick's buffer back after its last
-        // tile (see `LitBricks`).
-        for &n in list {
+        // The tile is done with the bricks it reached: the lit-brick cache
+        // gives a brick's buffer back after its last tile (see
+        // `LitBricks`: the bricks behind are not counted down).
+        for &n in &list[..reached] {
             scene.lit.done(n as usize);
         }
     }
