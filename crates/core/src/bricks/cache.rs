@@ -270,44 +270,53 @@ impl<T> BrickCache<T> {
         n: usize,
         now: u64,
         blank: impl Fn() -> Box<T>,
-        fill: impl FnOnce(&mut T),
+        mut fill: impl FnMut(&mut T),
         scratch: &'a mut Option<Box<T>>,
         shed: impl Fn() -> bool,
     ) -> CacheRef<'a, T> {
         let entry = &self.entries[n];
-        {
-            let buffer = entry.buffer.read().unwrap_or_else(|e| e.into_inner());
-            if buffer.is_some() && (self.valid)(entry.frame.load(Ordering::Acquire), now) {
-                entry.frame.fetch_max(now, Ordering::AcqRel);
-                return CacheRef::Cached(buffer);
-            }
-        }
-        let mut buffer = entry.buffer.write().unwrap_or_else(|e| e.into_inner());
-        // Another thread may have filled it meanwhile.
-        let valid = buffer.is_some() && (self.valid)(entry.frame.load(Ordering::Acquire), now);
-        if !valid {
-            self.fills.fetch_add(1, Ordering::Relaxed);
-            if buffer.is_none() {
-                *buffer = self.reserve(n, now, &blank, shed);
-            }
-            match buffer.as_deref_mut() {
-                Some(b) => fill(b),
-                None => {
-                    // No room: the scratch buffer, used once.
-                    drop(buffer);
-                    let scratch = scratch.get_or_insert_with(blank);
-                    fill(scratch);
-                    return CacheRef::Scratch(scratch);
+        // Rarely more than once: see the end of the loop.
+        loop {
+            {
+                let buffer = entry.buffer.read().unwrap_or_else(|e| e.into_inner());
+                if buffer.is_some() && (self.valid)(entry.frame.load(Ordering::Acquire), now) {
+                    entry.frame.fetch_max(now, Ordering::AcqRel);
+                    return CacheRef::Cached(buffer);
                 }
             }
+            let mut buffer = entry.buffer.write().unwrap_or_else(|e| e.into_inner());
+            // Another thread may have filled it meanwhile.
+            let valid = buffer.is_some() && (self.valid)(entry.frame.load(Ordering::Acquire), now);
+            if !valid {
+                self.fills.fetch_add(1, Ordering::Relaxed);
+                if buffer.is_none() {
+                    *buffer = self.reserve(n, now, &blank, &shed);
+                }
+                match buffer.as_deref_mut() {
+                    Some(b) => fill(b),
+                    None => {
+                        // No room: the scratch buffer, used once.
+                        drop(buffer);
+                        let scratch = scratch.get_or_insert_with(&blank);
+                        fill(scratch);
+                        return CacheRef::Scratch(scratch);
+                    }
+                }
+            }
+            entry.frame.fetch_max(now, Ordering::AcqRel);
+            // Read under a shared lock, so that other threads can read it
+            // too: a buffer used in frame `now` is not taken for another
+            // brick in it.
+            drop(buffer);
+            let buffer = entry.buffer.read().unwrap_or_else(|e| e.into_inner());
+            if buffer.is_some() {
+                return CacheRef::Cached(buffer);
+            }
+            // Between the two locks another cache drawing on the budget
+            // shed this buffer to make room (`shed` takes any buffer no
+            // one holds a lock on; std's RwLock cannot turn a write lock
+            // into a read lock): fill the brick again.
         }
-        entry.frame.fetch_max(now, Ordering::AcqRel);
-        // Read under a shared lock, so that other threads can read it too:
-        // a buffer used in frame `now` is neither taken nor refilled in it.
-        drop(buffer);
-        let buffer = entry.buffer.read().unwrap_or_else(|e| e.into_inner());
-        debug_assert!(buffer.is_some(), "a buffer used in this frame stays");
-        CacheRef::Cached(buffer)
     }
 
     /// A buffer for entry `n`: one given back, else a new one if the
@@ -448,6 +457,44 @@ mod tests {
         }
         // Bricks without a buffer are filled on every request.
         assert!(fills.load(Ordering::Relaxed) > 5 * 10);
+    }
+
+    #[test]
+    fn a_buffer_shed_while_its_brick_is_filled_is_filled_again_not_read_empty() {
+        // The lit bricks shed classified ones from another thread at any
+        // moment, even between a fill's write lock and its read lock: the
+        // reader must see its brick's values, never a missing buffer.
+        let cache = per_frame(4, 4);
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        // Stops the shedding thread however the reads end (a failed
+        // assertion too, or the scope would wait for it forever).
+        struct Stop<'a>(&'a std::sync::atomic::AtomicBool);
+        impl Drop for Stop<'_> {
+            fn drop(&mut self) {
+                self.0.store(true, Ordering::Relaxed);
+            }
+        }
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                while !stop.load(Ordering::Relaxed) {
+                    cache.shed();
+                }
+            });
+            let _stop = Stop(&stop);
+            for now in 1..=20_000u64 {
+                let n = (now % 4) as usize;
+                let mut scratch = None;
+                let v = cache.get(
+                    n,
+                    now,
+                    || Box::new([0; 16]),
+                    |b| b.fill(10 * now + n as u64),
+                    &mut scratch,
+                    || false,
+                )[3];
+                assert_eq!(v, 10 * now + n as u64);
+            }
+        });
     }
 
     #[test]
