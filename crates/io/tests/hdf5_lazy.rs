@@ -15,51 +15,23 @@
 //! from PyPI, which `.ci/run` installs); without them these tests fail
 //! under `CI=true` and are skipped elsewhere.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use volray_core::{Volume, VolumeSource};
 use volray_io::{IoError, Lazy, ReadOptions, VolumeFormat, open_lazy, read};
 
-/// The workspace's `target/pyenv` python.
-fn python() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/pyenv/bin/python")
-}
-
 /// The directory the writers filled, or `None` (with the reason printed)
 /// where they are missing outside CI.
 fn files() -> Option<&'static Path> {
     static DIR: OnceLock<Option<tempfile::TempDir>> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let has = Command::new(python())
-            .args(["-c", "import h5py, netCDF4, h5netcdf, numpy"])
-            .status()
-            .is_ok_and(|s| s.success());
-        if !has {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "target/pyenv lacks h5py, netCDF4 or h5netcdf: target/pyenv/bin/pip install h5py netCDF4 h5netcdf (as .ci/run does)"
-            );
-            eprintln!("skipped: target/pyenv lacks h5py, netCDF4 or h5netcdf");
-            return None;
-        }
-        let dir = tempfile::tempdir().unwrap();
-        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hdf5_lazy/write_files.py");
-        let out = Command::new(python())
-            .arg(&script)
-            .arg(dir.path())
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "write_files.py failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        Some(dir)
-    })
-    .as_ref()
-    .map(|d| d.path())
+    common::written_by_python(
+        &DIR,
+        &["h5py", "netCDF4", "h5netcdf", "numpy"],
+        "tests/hdf5_lazy/write_files.py",
+    )
 }
 
 fn opts(frame: Option<usize>, max_memory: u64) -> ReadOptions {

@@ -10,52 +10,24 @@
 //! which `.ci/run` installs); without them these tests fail under
 //! `CI=true` and are skipped elsewhere.
 
+mod common;
+
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use volray_core::glam::DVec3;
 use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, open_lazy, read};
 
-/// The workspace's `target/pyenv` python.
-fn python() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/pyenv/bin/python")
-}
-
 /// The directory the writers filled, or `None` (with the reason printed)
 /// where they are missing outside CI.
 fn stores() -> Option<&'static Path> {
     static DIR: OnceLock<Option<tempfile::TempDir>> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let has = Command::new(python())
-            .args(["-c", "import zarr, ome_zarr, numcodecs, numpy"])
-            .status()
-            .is_ok_and(|s| s.success());
-        if !has {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "target/pyenv lacks zarr-python or ome-zarr: target/pyenv/bin/pip install zarr ome-zarr (as .ci/run does)"
-            );
-            eprintln!("skipped: target/pyenv lacks zarr or ome-zarr (pip install zarr ome-zarr)");
-            return None;
-        }
-        let dir = tempfile::tempdir().unwrap();
-        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/zarr/write_stores.py");
-        let out = Command::new(python())
-            .arg(&script)
-            .arg(dir.path())
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "write_stores.py failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        Some(dir)
-    })
-    .as_ref()
-    .map(|d| d.path())
+    common::written_by_python(
+        &DIR,
+        &["zarr", "ome_zarr", "numcodecs", "numpy"],
+        "tests/zarr/write_stores.py",
+    )
 }
 
 fn opts(level: Option<usize>, frame: Option<usize>, channel: Option<usize>) -> ReadOptions {

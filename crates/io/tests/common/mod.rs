@@ -487,3 +487,45 @@ pub fn mutations_never_panic(files: &[PathBuf], target: &str, seed: u64) {
         }
     }
 }
+
+/// The files an independent writer made: `script` (relative to this
+/// crate) run once per test binary by the workspace's `target/pyenv`
+/// python into a temporary directory kept in `cell`. `None`, with the
+/// reason printed, where that python lacks one of `modules`; under
+/// `CI=true` that fails instead (`.ci/run` installs them).
+pub fn written_by_python(
+    cell: &'static std::sync::OnceLock<Option<tempfile::TempDir>>,
+    modules: &[&str],
+    script: &str,
+) -> Option<&'static Path> {
+    let python = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/pyenv/bin/python");
+    cell.get_or_init(|| {
+        let has = std::process::Command::new(&python)
+            .args(["-c", &format!("import {}", modules.join(", "))])
+            .status()
+            .is_ok_and(|s| s.success());
+        if !has {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "target/pyenv lacks one of {modules:?}: target/pyenv/bin/pip install them (as .ci/run does)"
+            );
+            eprintln!("skipped: target/pyenv lacks one of {modules:?}");
+            return None;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let out = std::process::Command::new(&python)
+            .args(["-W", "ignore"])
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join(script))
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{script} failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        Some(dir)
+    })
+    .as_ref()
+    .map(|d| d.path())
+}
