@@ -153,23 +153,14 @@ pub fn from_volume(
     volray_options::from_volume(&look(look_args), transfer_function, volume, name).map_err(refused)
 }
 
-/// The file's own display window (an OME-Zarr image's `omero` window of
-/// the channel read) as the default `--range`: the transfer function's
-/// domain where the flags leave it to the volume (no `--range`, no `--tf`
-/// file or preset with a domain; not `--labels`, and not `--log`, whose
-/// domain is taken before the file is read). `--tf auto`, the default,
-/// then chooses within the window, as it does within a `--range`. What
-/// napari-ome-zarr and vizarr show as the contrast limits; the colour
-/// hint is not taken.
+/// The file's own display window (OME-Zarr `omero`) as the default
+/// `--range` (volray-options' [`file_window`](volray_options::file_window)).
 pub fn file_window(
     look_args: &LookArgs,
     transfer_function: &mut TransferFunction,
     window: Option<(f64, f64)>,
 ) {
-    let free = transfer_function.domain.is_none() && !look_args.labels && !look_args.log;
-    if let (true, Some(window)) = (free, window) {
-        transfer_function.domain = Some(window);
-    }
+    volray_options::file_window(&look(look_args), transfer_function, window);
 }
 
 /// The labels of `volume` (`name`), refused as `--labels` would be.

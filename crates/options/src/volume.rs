@@ -10,6 +10,37 @@ use crate::options::{LookOptions, Tf};
 use volray_core::transfer::{auto, labels};
 use volray_core::{Histogram, TransferFunction, Volume};
 
+/// The file's own display window (an OME-Zarr image's `omero` window of
+/// the channel read) as the default range: the transfer function's domain
+/// where `look` leaves it to the volume (no range, no transfer function
+/// or preset with a domain of its own; not labels, and not log, whose
+/// domain is taken before the file is read). The automatic transfer
+/// function then chooses within the window, as within a range. What
+/// napari-ome-zarr and vizarr show as the contrast limits. Call it before
+/// [`from_volume`].
+///
+/// ```
+/// use volray_core::TransferFunction;
+/// use volray_options::{LookOptions, file_window};
+///
+/// let mut tf = TransferFunction::default();
+/// file_window(&LookOptions::default(), &mut tf, Some((100.0, 900.0)));
+/// assert_eq!(tf.domain, Some((100.0, 900.0)));
+/// // A range given wins: its domain is set before.
+/// let mut tf = TransferFunction { domain: Some((0.0, 50.0)), ..TransferFunction::default() };
+/// file_window(&LookOptions::default(), &mut tf, Some((100.0, 900.0)));
+/// assert_eq!(tf.domain, Some((0.0, 50.0)));
+/// ```
+pub fn file_window(
+    look: &LookOptions,
+    transfer_function: &mut TransferFunction,
+    window: Option<(f64, f64)>,
+) {
+    if transfer_function.domain.is_none() && !look.labels && !look.log {
+        transfer_function.domain = window;
+    }
+}
+
 /// Puts into `transfer_function` (and `volume`) what `look` leaves to the
 /// volume `name` (for messages): labels or the automatic choice.
 pub fn from_volume(

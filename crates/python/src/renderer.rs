@@ -135,6 +135,9 @@ struct Recipe {
     nonfinite: NonFinite,
     max_memory: u64,
     name: String,
+    /// The file's display window (an OME-Zarr `omero` window), the
+    /// default `range`.
+    window: Option<(f64, f64)>,
 }
 
 /// Where the samples come from.
@@ -310,6 +313,10 @@ impl Renderer {
         let max_memory = k
             .take::<u64>("max_memory", "a number of bytes")?
             .unwrap_or_else(volray_io::default_max_memory);
+        let window = match &source {
+            Source::Volume(v) => v.get().display_window(),
+            Source::Array { .. } => None,
+        };
         let recipe = Recipe {
             source,
             spacing,
@@ -319,6 +326,7 @@ impl Renderer {
             nonfinite,
             max_memory,
             name,
+            window,
         };
         let lazy = match &recipe.source {
             Source::Volume(v) if v.get().lazy.is_some() => Some(v.clone_ref(py)),
@@ -398,8 +406,13 @@ impl Renderer {
         };
         let options = keywords::options(k, look)?;
         let threads = keywords::threads(k)?;
-        let settings =
+        let mut settings =
             volray_options::settings(&options).map_err(|e| settings_error(e, &options.camera))?;
+        volray_options::file_window(
+            &options.look,
+            &mut settings.transfer_function,
+            self.recipe.window,
+        );
         let pool = threads.map(pool).transpose()?;
         Ok((options, settings, pool))
     }

@@ -186,6 +186,12 @@ impl Volume {
         })
     }
 
+    /// The display window its file gives (an OME-Zarr `omero` window),
+    /// which renders take as their default `range`.
+    pub fn display_window(&self) -> Option<(f64, f64)> {
+        self.file.as_ref()?.1.display_window()
+    }
+
     /// Whether the file marks its NaN values as space it does not cover
     /// (always rendered as empty space).
     pub fn nan_is_empty(&self) -> bool {

@@ -291,3 +291,35 @@ def test_ctrl_c_stops_a_frame_in_pieces_at_its_next_piece(store):
     assert 0 < reported <= SIZE * SIZE, reported
     # The renderer renders on afterwards, the same picture.
     assert np.array_equal(np.asarray(renderer.render(**arguments)), reference)
+
+
+def test_an_omero_window_is_the_default_range_whole_and_in_pieces(zarr_modules, store, cli_image):
+    path, _ = store
+    zarr = zarr_modules[0]
+    group = zarr.open_group(str(path), mode="r+")
+    ome = dict(group.attrs["ome"])
+    ome["omero"] = {
+        "channels": [
+            {
+                "window": {"start": 300.0, "end": 900.0, "min": 0.0, "max": 1200.0},
+                "color": "00FF00",
+                "label": "ball",
+                "active": True,
+            }
+        ]
+    }
+    group.attrs["ome"] = ome
+    args = dict(size=SIZE, azimuth=30, elevation=20, colormap="viridis")
+    hinted = rgb(volray.render(volray.read(path), **args))
+    # The window is the range a script would give, as the command line takes it.
+    assert np.array_equal(hinted, rgb(volray.render(volray.read(path), range=(300, 900), **args)))
+    expected = cli_image(path, "--size", SIZE, "--azimuth", 30, "--elevation", 20, "--colormap", "viridis")
+    assert np.array_equal(hinted, expected[:, :, :3])
+    # A range given wins; another range is another picture.
+    wide = rgb(volray.render(volray.read(path), range=(0, 1200), **args))
+    assert np.abs(hinted - wide).max() > 16
+    # In pieces too.
+    renderer = volray.Renderer(volray.read(path), max_memory=PIECES)
+    pieces = rgb(renderer.render(**args))
+    assert renderer.pieces > 1
+    assert np.abs(pieces - hinted).max() <= 1
