@@ -94,13 +94,17 @@ pub fn plan(
     let mode: NonFinite = view.sampling.nonfinite.into();
     // A 16-bit PNG quantises the frame first: 8 bytes a pixel (memory.rs).
     let png = 8 * settings.width as u128 * settings.height as u128;
-    match chunked.plan(settings, mode, max_memory, png) {
+    let plan = if view.look.log {
+        // The log of the level, found piece by piece after a pass over it
+        // for its smallest positive value.
+        chunked
+            .plan_log(settings, mode, max_memory, png)
+            .map_err(|e| CliError::input(format!("--log: {spec}: {e}")))?
+    } else {
+        chunked.plan(settings, mode, max_memory, png)
+    };
+    match plan {
         LazyPlan::Whole { level, .. } => Ok(Plan::Whole { level: Some(level) }),
-        LazyPlan::Pieces { level, need, .. } if view.look.log => Err(CliError::input(format!(
-            "{spec}: level {level} may take up to {} to render whole, more than --max-memory {}, and --log is not yet taken piece by piece: raise --max-memory, or pick a coarser --level",
-            format_bytes(need),
-            format_bytes(u128::from(max_memory))
-        ))),
         LazyPlan::Pieces {
             level,
             need,

@@ -156,6 +156,18 @@ fn a_level_over_max_memory_renders_piece_by_piece_as_it_would_whole() {
         let diff = Picture::read(&pieces).max_diff(&Picture::read(&whole));
         assert!(diff <= 1, "{extra:?}: {diff}");
     }
+    // --log: the level's smallest positive value found first, then each
+    // piece on the whole's log scale (a third of the budget: 300 kB cannot
+    // hold the level's f32 log whole).
+    for extra in [&["--log"][..], &["--log", "--tf", "auto"][..]] {
+        let args = [&[path, "--size", "40x36"], extra].concat();
+        render(&args, &whole);
+        let limited = [&args[..], &["--max-memory", "300K"]].concat();
+        let said = render(&limited, &pieces);
+        assert!(said.contains("in pieces"), "{extra:?}: {said}");
+        let diff = Picture::read(&pieces).max_diff(&Picture::read(&whole));
+        assert!(diff <= 1, "{extra:?}: {diff}");
+    }
 }
 
 #[test]

@@ -50,6 +50,10 @@
 //! }
 //! ```
 
+mod log;
+
+pub use log::Log10Source;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -243,6 +247,46 @@ impl Chunked {
             need,
             streamed: Box::new(streamed),
         }
+    }
+
+    /// [`plan`](Self::plan) for the log10 of the level's values (`--log`).
+    /// Read whole, the level's samples and their `f32` log are both held
+    /// while it converts; in pieces, each piece is read through
+    /// [`Log10Source`] (after a pass over the level for its smallest
+    /// positive value), which holds a piece's samples, their `f32` copy
+    /// and their log at once: at most 2.5 times the `f32` piece the
+    /// pieces' bound counts, so the pieces get a third of the budget.
+    pub fn plan_log(
+        &self,
+        settings: &RenderSettings,
+        non_finite: NonFinite,
+        max_memory: u64,
+        extra: u128,
+    ) -> Result<Plan, String> {
+        let level = self.level();
+        let grid = self.source().grid();
+        let voxels: u128 = grid.dims.iter().map(|&n| n as u128).product();
+        let log = MemoryBound::new(
+            grid.dims,
+            grid.spacing,
+            SampleType::F32,
+            settings,
+            non_finite,
+            0,
+        );
+        let stored = voxels * self.source().voxel_bytes() as u128;
+        let need = log.total() + stored + extra;
+        if need <= u128::from(max_memory) {
+            return Ok(Plan::Whole { level, need });
+        }
+        let budget = max_memory.min(PIECE_BUDGET);
+        let source = Log10Source::over(Arc::clone(self.source()), budget)?;
+        let streamed = Streamed::new(Arc::new(source), non_finite, budget / 3);
+        Ok(Plan::Pieces {
+            level,
+            need,
+            streamed: Box::new(streamed),
+        })
     }
 }
 
