@@ -1,13 +1,15 @@
 //! Fuzzes the HDF5 reader (pure Rust, hdf5-pure).
-//! The first byte chooses `--frame` (bits 0-2) and the dataset (bits 4-7,
-//! one of the names the seed files hold, or none that exists).
+//! The first byte chooses `--frame` (bits 0-2), a lazy read of a box of
+//! half the dataset (bit 3: the chunk index, the chunks a box touches,
+//! contiguous rows; `open_lazy`) rather than the whole, and the dataset
+//! (bits 4-7, one of the names the seed files hold, or none that exists).
 #![no_main]
 
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
-use volray_fuzz::{Harness, frame_choice, read_path, split_control};
-use volray_io::VolumeFormat;
+use volray_fuzz::{Harness, frame_choice, read_lazy_half, read_path, split_control};
+use volray_io::{ReadOptions, VolumeFormat};
 
 static HARNESS: OnceLock<Harness> = OnceLock::new();
 
@@ -36,5 +38,15 @@ fuzz_target!(|data: &[u8]| {
     let path = harness.put("input.h5", file);
     let dataset = DATASETS[usize::from(control >> 4)];
     let target = path.with_file_name(format!("input.h5:{dataset}"));
-    read_path(&target, VolumeFormat::Hdf5, frame_choice(control), None);
+    if control & 8 != 0 {
+        let opts = ReadOptions {
+            format: Some(VolumeFormat::Hdf5),
+            frame: frame_choice(control),
+            max_memory: 64 << 20,
+            ..ReadOptions::default()
+        };
+        read_lazy_half(&target, &opts);
+    } else {
+        read_path(&target, VolumeFormat::Hdf5, frame_choice(control), None);
+    }
 });

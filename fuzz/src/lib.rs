@@ -117,7 +117,7 @@ pub fn read_with(path: &Path, opts: &ReadOptions) {
     }
 }
 
-/// Opens `path` lazily, as a source of boxes (a chunked store: Zarr),
+/// Opens `path` lazily, as a source of boxes (a chunked store: Zarr, HDF5),
 /// and reads the box of the first half of each axis (at least 2 voxels),
 /// so that the readers of part of a chunk or shard are fuzzed too; a
 /// refusal (of the store, or of the box) must be one line naming the file.
