@@ -249,13 +249,9 @@ impl Chunked {
         }
     }
 
-    /// [`plan`](Self::plan) for the log10 of the level's values (`--log`).
-    /// Read whole, the level's samples and their `f32` log are both held
-    /// while it converts; in pieces, each piece is read through
-    /// [`Log10Source`] (after a pass over the level for its smallest
-    /// positive value), which holds a piece's samples, their `f32` copy
-    /// and their log at once: at most 2.5 times the `f32` piece the
-    /// pieces' bound counts, so the pieces get a third of the budget.
+    /// [`plan`](Self::plan) for the log10 of the level's values (`--log`):
+    /// whole when [`whole_log_bytes`](Self::whole_log_bytes) plus `extra`
+    /// fits, else [`log_pieces`](Self::log_pieces).
     pub fn plan_log(
         &self,
         settings: &RenderSettings,
@@ -264,6 +260,20 @@ impl Chunked {
         extra: u128,
     ) -> Result<Plan, String> {
         let level = self.level();
+        let need = self.whole_log_bytes(settings, non_finite) + extra;
+        if need <= u128::from(max_memory) {
+            return Ok(Plan::Whole { level, need });
+        }
+        Ok(Plan::Pieces {
+            level,
+            need,
+            streamed: Box::new(self.log_pieces(non_finite, max_memory)?),
+        })
+    }
+
+    /// [`whole_bytes`](Self::whole_bytes) for the log10 of the level read
+    /// whole: its `f32` log, and its samples beside it while it converts.
+    pub fn whole_log_bytes(&self, settings: &RenderSettings, non_finite: NonFinite) -> u128 {
         let grid = self.source().grid();
         let voxels: u128 = grid.dims.iter().map(|&n| n as u128).product();
         let log = MemoryBound::new(
@@ -274,19 +284,19 @@ impl Chunked {
             non_finite,
             0,
         );
-        let stored = voxels * self.source().voxel_bytes() as u128;
-        let need = log.total() + stored + extra;
-        if need <= u128::from(max_memory) {
-            return Ok(Plan::Whole { level, need });
-        }
+        log.total() + voxels * self.source().voxel_bytes() as u128
+    }
+
+    /// The level's log10 rendered in pieces: a pass over the level for
+    /// its smallest positive value (in slabs of at most min(`max_memory`,
+    /// [`PIECE_BUDGET`])), then each piece read through [`Log10Source`],
+    /// which holds a piece's samples, their `f32` copy and their log at
+    /// once: at most 2.5 times the `f32` piece the pieces' bound counts,
+    /// so the pieces get a third of the budget.
+    pub fn log_pieces(&self, non_finite: NonFinite, max_memory: u64) -> Result<Streamed, String> {
         let budget = max_memory.min(PIECE_BUDGET);
         let source = Log10Source::over(Arc::clone(self.source()), budget)?;
-        let streamed = Streamed::new(Arc::new(source), non_finite, budget / 3);
-        Ok(Plan::Pieces {
-            level,
-            need,
-            streamed: Box::new(streamed),
-        })
+        Ok(Streamed::new(Arc::new(source), non_finite, budget / 3))
     }
 }
 

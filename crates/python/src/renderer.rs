@@ -583,7 +583,31 @@ impl Renderer {
                 "{name}: spacing and origin given apply to level {own} read whole, not to level {level} {how}: leave them out (the file's own are used)"
             ))
         };
-        let plan = chunked.plan(settings, self.recipe.nonfinite, self.recipe.max_memory, 0);
+        let (mode, max_memory) = (self.recipe.nonfinite, self.recipe.max_memory);
+        let plan = if self.recipe.log {
+            // The log scale's pass over the level is made once, when its
+            // pieces are first needed.
+            let level = chunked.level();
+            let need = chunked.whole_log_bytes(settings, mode);
+            if need <= u128::from(max_memory) {
+                Plan::Whole { level, need }
+            } else if matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
+                return Ok(());
+            } else {
+                if overridden {
+                    return Err(refuse_override("in pieces"));
+                }
+                let streamed = (chunked.log_pieces(mode, max_memory))
+                    .map_err(|e| value_error(format!("log=True: {name}: {e}")))?;
+                Plan::Pieces {
+                    level,
+                    need,
+                    streamed: Box::new(streamed),
+                }
+            }
+        } else {
+            chunked.plan(settings, mode, max_memory, 0)
+        };
         match plan {
             Plan::Whole { level, .. } => {
                 if overridden && level != own {
@@ -601,19 +625,10 @@ impl Renderer {
                 }
             }
             Plan::Pieces {
-                level,
-                need,
-                streamed,
+                level, streamed, ..
             } => {
                 if overridden {
                     return Err(refuse_override("in pieces"));
-                }
-                if self.recipe.log {
-                    return Err(value_error(format!(
-                        "{name}: level {level} may take up to {} to render whole, more than max_memory {}, and log=True is not yet taken piece by piece: raise max_memory, or pick a coarser level",
-                        format_bytes(need),
-                        format_bytes(u128::from(self.recipe.max_memory))
-                    )));
                 }
                 if !matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
                     state.way = Way::Pieces {

@@ -267,13 +267,19 @@ def test_level_is_refused_for_a_volume_in_memory_and_out_of_range(store):
         volray.Renderer(volray.read(path), level="coarse")
 
 
-def test_log_in_pieces_is_refused_and_whole_is_taken(store):
+def test_log_is_taken_whole_and_in_pieces_on_the_whole_levels_scale(store, cli_image):
     path, _ = store
-    with pytest.raises(ValueError, match="log=True is not yet taken piece by piece"):
-        volray.render(volray.read(path), log=True, max_memory=PIECES, size=SIZE)
     frame = volray.render(volray.read(path), log=True, size=SIZE)
     expected = volray.render(in_memory(volray.read(path)), log=True, size=SIZE)
     assert np.array_equal(np.asarray(frame), np.asarray(expected))
+    # 1.5 MB cannot hold the level's f32 log beside its samples: in pieces,
+    # after a pass for the level's smallest positive value.
+    renderer = volray.Renderer(volray.read(path), log=True, max_memory=1_500_000)
+    pieces = rgb(renderer.render(size=SIZE))
+    assert renderer.pieces > 1
+    assert np.abs(pieces - rgb(frame)).max() <= 1
+    cli = cli_image(path, "--log", "--size", SIZE, "--max-memory", "1500000")
+    assert np.array_equal(pieces, cli[:, :, :3])
 
 
 def test_ctrl_c_stops_a_frame_in_pieces_at_its_next_piece(store):
