@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{stderr, volray};
+use common::{pyenv_with, stderr, volray};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use volray_core::Volume;
@@ -89,19 +89,9 @@ fn a_converted_volume_reads_back_as_the_volume_read() {
 /// at `a[x, y, z]`, and NRRD's spacing and origin.
 #[test]
 fn numpy_and_pynrrd_read_what_convert_wrote() {
-    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
-    let has = Command::new(&python)
-        .args(["-c", "import numpy, nrrd"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "target/pyenv with numpy and pynrrd is needed (.ci/run makes it)"
-        );
-        eprintln!("skipped: target/pyenv has no numpy and pynrrd (.ci/run makes it)");
+    let Some(python) = pyenv_with(&["numpy", "nrrd"]) else {
         return;
-    }
+    };
     for name in ["flipped.nii", "u16.nii"] {
         python_reads(&python, &fixture("nifti", name));
     }
@@ -343,21 +333,9 @@ fn zarr_flags_with_a_file_output_and_a_foreign_directory_are_refused() {
 /// metadata validated against NGFF 0.5 and 0.4.
 #[test]
 fn zarr_python_and_ome_zarr_read_what_convert_wrote() {
-    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
-    let has = Command::new(&python)
-        .args(["-c", "import numpy, zarr, ome_zarr, ome_zarr_models"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "target/pyenv with zarr, ome-zarr and ome-zarr-models is needed (.ci/run makes it)"
-        );
-        eprintln!(
-            "skipped: target/pyenv has no zarr, ome-zarr or ome-zarr-models (.ci/run installs them)"
-        );
+    let Some(python) = pyenv_with(&["numpy", "zarr", "ome_zarr", "ome_zarr_models"]) else {
         return;
-    }
+    };
     let dir = tempfile::tempdir().unwrap();
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/convert/check_ome_zarr.py");
     let py = |args: &[&std::ffi::OsStr]| {

@@ -8,10 +8,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{Picture, stderr, volray};
+use common::{Picture, pyenv_with, render};
 
 /// Two blobs over a ramp, u16, a[x, y, z] of (48, 40, 36) in 16³ chunks
 /// (deflate and shuffle), as `vol.h5:/data` and as `vol.nc:/rho` (f32).
@@ -36,19 +35,7 @@ with netCDF4.Dataset(sys.argv[1] + "/vol.nc", "w", format="NETCDF4") as nc:
 /// The directory holding the files, or `None` where the writers are
 /// missing outside CI.
 fn files() -> Option<tempfile::TempDir> {
-    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
-    let has = Command::new(&python)
-        .args(["-c", "import h5py, netCDF4, numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "target/pyenv lacks h5py or netCDF4: target/pyenv/bin/pip install h5py netCDF4 (as .ci/run does)"
-        );
-        eprintln!("skipped: target/pyenv lacks h5py or netCDF4");
-        return None;
-    }
+    let python = pyenv_with(&["h5py", "netCDF4", "numpy"])?;
     let dir = tempfile::tempdir().unwrap();
     let out = Command::new(&python)
         .args(["-c", WRITE, dir.path().to_str().unwrap()])
@@ -60,14 +47,6 @@ fn files() -> Option<tempfile::TempDir> {
         String::from_utf8_lossy(&out.stderr)
     );
     Some(dir)
-}
-
-/// Renders `args` to `out`, asserting success; its stderr.
-fn render(args: &[&str], out: &Path) -> String {
-    let all = [&["render"], args, &["-o", out.to_str().unwrap()]].concat();
-    let result = volray(&all);
-    assert!(result.status.success(), "{all:?}: {}", stderr(&result));
-    stderr(&result)
 }
 
 const LOOK: [&str; 6] = ["--preset", "mr", "--range", "0,32000", "--size", "40x36"];

@@ -10,7 +10,7 @@ mod common;
 use std::fs;
 use std::path::Path;
 
-use common::{Picture, stderr, volray};
+use common::{Picture, render, stderr, volray};
 use serde_json::json;
 
 /// The image's finest level, (x, y, z).
@@ -113,14 +113,6 @@ fn write_image(root: &Path) {
         }]}},
     });
     fs::write(root.join("zarr.json"), meta.to_string()).unwrap();
-}
-
-/// Renders `args` to `out`, asserting success; its stderr.
-fn render(args: &[&str], out: &Path) -> String {
-    let all = [&["render"], args, &["-o", out.to_str().unwrap()]].concat();
-    let result = volray(&all);
-    assert!(result.status.success(), "{all:?}: {}", stderr(&result));
-    stderr(&result)
 }
 
 const LOOK: [&str; 6] = ["--preset", "mr", "--range", "0,32000", "--size", "40x36"];

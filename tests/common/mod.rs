@@ -2,7 +2,7 @@
 #![allow(dead_code)] // each test binary uses part of this
 
 use std::fs;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Runs `volray` with `args` and returns what it did.
@@ -19,6 +19,34 @@ pub fn stdout(out: &Output) -> String {
 
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The workspace's `target/pyenv` python (which `.ci/run` makes), if it
+/// imports every one of `modules`; else `None`, the reason printed, and
+/// under `CI=true` a failure rather than a skip.
+pub fn pyenv_with(modules: &[&str]) -> Option<PathBuf> {
+    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
+    let has = Command::new(&python)
+        .args(["-c", &format!("import {}", modules.join(", "))])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "target/pyenv lacks one of {modules:?}: .ci/run installs them"
+        );
+        eprintln!("skipped: target/pyenv lacks one of {modules:?} (.ci/run installs them)");
+        return None;
+    }
+    Some(python)
+}
+
+/// `volray render ARGS -o OUT`, asserting success; its stderr (the notes).
+pub fn render(args: &[&str], out: &Path) -> String {
+    let all = [&["render"], args, &["-o", out.to_str().unwrap()]].concat();
+    let result = volray(&all);
+    assert!(result.status.success(), "{all:?}: {}", stderr(&result));
+    stderr(&result)
 }
 
 /// An 8-bit RGB picture read back from a PNG volray wrote.
