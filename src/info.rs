@@ -263,10 +263,8 @@ fn describe_image(name: &str, image: &FlatImage, as_json: bool) {
 }
 
 /// The stored type, and the frames and arrays a file holds.
-/// The most chunk files `volray info` counts a level's stored bytes over:
-/// walking them takes about 4 µs a file here (262 144 shards of a 16384³
-/// level: 1 s), so a level of millions of chunks is left uncounted.
-const COUNTED_FILES: usize = 100_000;
+/// The most chunk files `volray info` counts a level's stored bytes over.
+const COUNTED_FILES: usize = volray_io::LevelInfo::COUNTED_FILES;
 
 /// `info` with each level's stored bytes counted, where it has no more
 /// than [`COUNTED_FILES`] files.

@@ -21,10 +21,6 @@ use volray_io::{
 };
 use volray_lazy::Chunked;
 
-/// The most chunk files a level's `bytes_stored` is counted over (as
-/// `volray info` counts them): about 4 µs a file.
-const COUNTED_FILES: usize = 100_000;
-
 /// A volume: `data`, a numpy array `a[x, y, z]` (x fastest in memory),
 /// and where its voxels lie, `spacing` and `origin` in `(x, y, z)`.
 ///
@@ -299,9 +295,9 @@ impl Volume {
                 d.set_item("codecs", &l.codecs)?;
                 // Counted when asked for (opening a level does not walk
                 // its chunk files), as `volray info` counts them.
-                let stored = l
-                    .bytes_stored
-                    .or_else(|| py.detach(|| l.count_bytes_stored(COUNTED_FILES)));
+                let stored = l.bytes_stored.or_else(|| {
+                    py.detach(|| l.count_bytes_stored(volray_io::LevelInfo::COUNTED_FILES))
+                });
                 d.set_item("bytes_stored", stored)?;
                 d.set_item("bytes_in_memory", l.bytes_in_memory)?;
                 levels.append(d)?;
