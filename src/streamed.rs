@@ -60,23 +60,10 @@ pub fn plan(
     let max_memory = args
         .max_memory
         .unwrap_or_else(volray_io::default_max_memory);
-    let path = PathBuf::from(spec);
-    let fixed = match requested {
-        Some(LevelChoice::Index(n)) => Some(n),
-        _ => None,
-    };
-    let numbered = InputArgs {
-        level: fixed.map(LevelChoice::Index),
-        ..args.clone()
-    };
-    let opts = input::read_options(&numbered, spec, &path, max_memory, MapPolicy::IfLarger)?;
-    let Some(mut chunked) = Chunked::open(&path, &opts)? else {
-        if requested == Some(LevelChoice::Auto) {
-            return Err(CliError::input(format!(
-                "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
-            )));
-        }
-        return Ok(Plan::Whole { level: fixed });
+    let Some(mut chunked) = open_chunked(args, spec, max_memory)? else {
+        return Ok(Plan::Whole {
+            level: fixed_level(args),
+        });
     };
     if requested == Some(LevelChoice::Auto) {
         let chosen = chunked
@@ -119,6 +106,38 @@ pub fn plan(
             max_memory,
         }))),
     }
+}
+
+/// The level `--level N` names; `None` for `auto` or none.
+pub fn fixed_level(args: &InputArgs) -> Option<usize> {
+    match args.level {
+        Some(LevelChoice::Index(n)) => Some(n),
+        _ => None,
+    }
+}
+
+/// Opens INPUT (`spec`) from its metadata where it is stored in chunks, at
+/// the level `--level N` names (0 for `auto`, which the caller resolves);
+/// `None` for a file read whole or mapped. `--level auto` on such a file
+/// is refused: it has one level.
+pub fn open_chunked(
+    args: &InputArgs,
+    spec: &str,
+    max_memory: u64,
+) -> Result<Option<Chunked>, CliError> {
+    let path = PathBuf::from(spec);
+    let numbered = InputArgs {
+        level: fixed_level(args).map(LevelChoice::Index),
+        ..args.clone()
+    };
+    let opts = input::read_options(&numbered, spec, &path, max_memory, MapPolicy::IfLarger)?;
+    let chunked = Chunked::open(&path, &opts)?;
+    if chunked.is_none() && args.level == Some(LevelChoice::Auto) {
+        return Err(CliError::input(format!(
+            "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
+        )));
+    }
+    Ok(chunked)
 }
 
 /// The input flags reading INPUT whole at `level` (`--level auto`

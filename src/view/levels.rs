@@ -13,14 +13,13 @@
 //! yet).
 
 use crate::error::CliError;
-use crate::flags::{InputArgs, ViewerArgs};
+use crate::flags::ViewerArgs;
 use crate::input::{self, Input};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use volray_core::glam::DVec3;
 use volray_core::{NonFinite, RenderSettings, SampleType};
-use volray_io::{MapPolicy, ReadOptions, format_bytes};
-use volray_lazy::Chunked;
+use volray_io::format_bytes;
 use volray_options::level::LevelChoice;
 use volray_view::{DRAFT_SHARE, Hello, Pyramid, draft_side};
 
@@ -52,34 +51,14 @@ pub fn open(args: &ViewerArgs, settings: &RenderSettings) -> Result<Option<Opene
         return Ok(None);
     }
     let max_memory = inp.max_memory.unwrap_or_else(volray_io::default_max_memory);
-    let path = PathBuf::from(spec);
-    let fixed = match inp.level {
-        Some(LevelChoice::Index(n)) => Some(n),
-        _ => None,
-    };
-    let numbered = InputArgs {
-        level: fixed.map(LevelChoice::Index),
-        ..inp.clone()
-    };
-    let opts = input::read_options(&numbered, spec, &path, max_memory, MapPolicy::IfLarger)?;
-    let Some(chunked) = Chunked::open(&path, &opts)? else {
-        if auto {
-            return Err(CliError::input(format!(
-                "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
-            )));
-        }
+    let fixed = crate::streamed::fixed_level(inp);
+    let Some(chunked) = crate::streamed::open_chunked(inp, spec, max_memory)? else {
         return Ok(None);
     };
     let count = chunked.levels().len();
     let mut sources = Vec::with_capacity(count);
     for level in 0..count {
-        let opts = ReadOptions {
-            level: Some(level),
-            ..opts.clone()
-        };
-        let opened = Chunked::open(&path, &opts)?
-            .ok_or_else(|| CliError::io(format!("{spec}: the store changed while it was open")))?;
-        sources.push(Arc::clone(opened.source()));
+        sources.push(Arc::clone(chunked.open_level(level)?.source()));
     }
     let pyramid =
         Pyramid::new(sources, fixed).map_err(|e| CliError::input(format!("{spec}: {e}")))?;

@@ -200,12 +200,7 @@ impl Chunked {
         if level == self.level() {
             return Ok(self);
         }
-        let opts = ReadOptions {
-            level: Some(level),
-            ..self.opts
-        };
-        Chunked::open(&self.path, &opts)?
-            .ok_or_else(|| IoError::invalid(&self.path, "the store changed while it was open"))
+        self.open_level(level)
     }
 
     /// The most bytes a frame of `settings` may take with the level read
