@@ -18,6 +18,7 @@ pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
 pub(crate) mod hdf5;
+pub(crate) mod hdf5_axes;
 pub(crate) mod hdf5_lazy;
 pub(crate) mod metaimage;
 pub(crate) mod minc;
