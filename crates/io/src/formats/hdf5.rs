@@ -31,6 +31,7 @@
 use std::path::{Path, PathBuf};
 
 use hdf5_pure::{AttrValue, Dataset, Group};
+use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
 use super::hdf5_axes::{Placement, Role, axis_order};
@@ -82,6 +83,26 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         Found::Minc(file_path) => return super::minc::read(&file_path, opts),
         Found::Dataset(o) => *o,
     };
+    let steps = [
+        DVec3::X * o.spacing.x,
+        DVec3::Y * o.spacing.y,
+        DVec3::Z * o.spacing.z,
+    ];
+    read_opened(o, None, steps, VolumeFormat::Hdf5, opts)
+}
+
+/// Reads the volume of a dataset opened and placed (by [`open`], or a
+/// NetCDF-4 variable's by `netcdf4.rs`): each stored value through `real`
+/// where given (the volume then kept as `f32`), the grid's steps along x,
+/// y, z `steps` (negative along a decreasing coordinate: flipped by
+/// `grid_to_volume`).
+pub(crate) fn read_opened(
+    o: Opened,
+    real: Option<&dyn Fn(f64) -> f64>,
+    steps: [DVec3; 3],
+    format: VolumeFormat,
+    opts: &ReadOptions,
+) -> Result<Loaded, IoError> {
     let Opened {
         file_path,
         h5,
@@ -92,8 +113,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         placement,
         dims,
         mut info,
-        spacing,
         origin,
+        ..
     } = o;
     let what =
         |reason: String| IoError::invalid(&file_path, format!("HDF5 dataset \"{name}\": {reason}"));
@@ -104,26 +125,24 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         placement.first_fixed(),
         sample.size,
     );
+    let kept = if real.is_some() {
+        SampleType::F32
+    } else {
+        sample.stored
+    };
     let voxels = slabs.check(
         &file_path,
         &format!("dataset shape {shape:?}"),
         h5.len,
-        sample.stored,
+        kept,
         opts.max_memory,
     )?;
-    let data = read_as_stored!(sample.stored, |T| read_volume::<T>(
-        &slabs, &placement, voxels
-    ))
-    .map_err(what)?;
-    let steps = [
-        DVec3::X * spacing.x,
-        DVec3::Y * spacing.y,
-        DVec3::Z * spacing.z,
-    ];
+    let data = read_as_stored!(kept, |T| read_volume::<T>(&slabs, &placement, voxels, real))
+        .map_err(what)?;
     let volume = grid_to_volume(&file_path, dims, data, steps, origin, &mut info)?;
     Ok(Loaded {
         volume,
-        format: VolumeFormat::Hdf5,
+        format,
         info,
     })
 }
@@ -262,6 +281,7 @@ fn read_volume<T: Stored>(
     slabs: &Slabs,
     placement: &Placement,
     voxels: usize,
+    real: Option<&dyn Fn(f64) -> f64>,
 ) -> Result<Vec<T>, String> {
     let mut data = vec![T::default(); voxels];
     // The first row read: the frame's, for a series read a row at a time.
@@ -269,6 +289,7 @@ fn read_volume<T: Stored>(
     let start = placement.first_fixed().unwrap_or(0) * row;
     slabs.read(|first, part| {
         placement.place(start + first, part, |at, v| {
+            let v = real.map_or(v, |f| f(v));
             // Exact for the integer types kept; `as f32` for the rest.
             data[at] = T::from_f64(f64::from(v as f32));
         });

@@ -268,7 +268,7 @@ fn axistags(json: &str) -> Option<Vec<String>> {
 /// The dimension names of a netCDF-C variable at `name`: its
 /// `_Netcdf4Coordinates` dimension ids, each looked up among the
 /// datasets with `_Netcdf4Dimid` in its group and the groups above.
-fn netcdf_dimensions(file: &File, name: &str, ids: &AttrValue) -> Option<Vec<String>> {
+pub(crate) fn netcdf_dimensions(file: &File, name: &str, ids: &AttrValue) -> Option<Vec<String>> {
     let ids = crate::shared::hdf5::numbers(ids)?;
     let mut groups: Vec<&str> = Vec::new();
     let mut path = name.trim_end_matches('/');

@@ -43,7 +43,7 @@ use std::collections::HashMap;
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use hdf5_pure::{ChunkIndex, Datatype, DatatypeByteOrder, FloatingPointLayout, Layout};
 use volray_core::sampling::grid::GridFrame;
@@ -218,6 +218,8 @@ pub(crate) struct H5Source {
     /// Bytes of one sample in the file.
     sample_size: usize,
     stored: SampleType,
+    /// What each stored value becomes, where it is not itself.
+    real: Option<RealValue>,
     grid: GridFrame,
     storage: Storage,
     max_memory: u64,
@@ -237,6 +239,21 @@ pub(crate) fn open(
     if o.dims.iter().any(|&n| n < 2) {
         return Ok(None);
     }
+    from_opened(o, None, opts).map(Some)
+}
+
+/// Maps a stored sample to the value kept (CF's `scale_factor`,
+/// `add_offset` and fill values, for a NetCDF-4 variable).
+pub(crate) type RealValue = Arc<dyn Fn(f64) -> f64 + Send + Sync>;
+
+/// The source of boxes of a dataset opened and placed (`hdf5.rs`'s
+/// [`Opened`], or a NetCDF-4 variable's, `netcdf4.rs`), each stored value
+/// through `real` where given (the volume then kept as `f32`).
+pub(crate) fn from_opened(
+    o: Opened,
+    real: Option<RealValue>,
+    opts: &ReadOptions,
+) -> Result<(H5Source, FileInfo), IoError> {
     let Opened {
         file_path,
         h5,
@@ -349,7 +366,12 @@ pub(crate) fn open(
         ),
     });
     let file = File::open(&file_path).map_err(|e| IoError::os(&file_path, "open", e))?;
-    Ok(Some((
+    let stored = if real.is_some() {
+        SampleType::F32
+    } else {
+        sample.stored
+    };
+    Ok((
         H5Source {
             path: file_path,
             name,
@@ -359,7 +381,8 @@ pub(crate) fn open(
             placement,
             element,
             sample_size: sample.size,
-            stored: sample.stored,
+            stored,
+            real,
             grid: GridFrame {
                 dims,
                 origin,
@@ -369,7 +392,7 @@ pub(crate) fn open(
             max_memory: opts.max_memory,
         },
         info,
-    )))
+    ))
 }
 
 /// The chunks of a chunked dataset (see the module docs), or the row
@@ -573,7 +596,11 @@ impl H5Source {
             hi: dhi,
         };
         // The value as the eager reader keeps it, at its place in the box.
-        let mut put = |at: usize, v: f64| out[at] = T::from_f64(f64::from(v as f32));
+        let real = self.real.as_deref();
+        let mut put = |at: usize, v: f64| {
+            let v = real.map_or(v, |f| f(v));
+            out[at] = T::from_f64(f64::from(v as f32));
+        };
         match (&self.storage, self.element) {
             (Storage::Contiguous { address }, Some(e)) => {
                 self.contiguous(*address, e, &w, &mut put)?
