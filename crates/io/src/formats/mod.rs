@@ -23,6 +23,7 @@ pub(crate) mod hdf5_lazy;
 pub(crate) mod metaimage;
 pub(crate) mod minc;
 pub(crate) mod mrc;
+pub(crate) mod netcdf4;
 pub(crate) mod nifti;
 pub(crate) mod npy;
 pub(crate) mod nrrd;
