@@ -267,7 +267,8 @@ fn axistags(json: &str) -> Option<Vec<String>> {
 
 /// The dimension names of a netCDF-C variable at `name`: its
 /// `_Netcdf4Coordinates` dimension ids, each looked up among the
-/// datasets with `_Netcdf4Dimid` in its group and the groups above.
+/// dimension scales (`CLASS` "DIMENSION_SCALE") with `_Netcdf4Dimid` in
+/// its group and the groups above.
 pub(crate) fn netcdf_dimensions(file: &File, name: &str, ids: &AttrValue) -> Option<Vec<String>> {
     let ids = crate::shared::hdf5::numbers(ids)?;
     let mut groups: Vec<&str> = Vec::new();
@@ -287,6 +288,10 @@ pub(crate) fn netcdf_dimensions(file: &File, name: &str, ids: &AttrValue) -> Opt
         {
             let Ok(d) = group.dataset(&ds) else { continue };
             let Ok(attrs) = d.attrs() else { continue };
+            // A scale: h5netcdf gives its variables a _Netcdf4Dimid too.
+            if attrs.get("CLASS").and_then(text).as_deref() != Some("DIMENSION_SCALE") {
+                continue;
+            }
             if let Some(id) = attrs
                 .get("_Netcdf4Dimid")
                 .and_then(crate::shared::hdf5::numbers)

@@ -489,4 +489,31 @@ mod tests {
         let err = read(&fixture("cf_tzyx.nc"), &opts(None, Some("nothing"))).unwrap_err();
         assert!(err.to_string().contains("rho(time, z, y, x)"), "{err}");
     }
+
+    #[test]
+    fn netcdf_dimension_names_orient_the_hdf5_route_too() {
+        // h5netcdf gives the variable a _Netcdf4Dimid of its own: only the
+        // scales name dimensions.
+        let path = fixture("h5netcdf_zyx.nc");
+        let l = read(&path, &opts(None, None)).unwrap();
+        check("w (CF)", &l.volume, ramp);
+        let on_hdf5 = |spec: &str| {
+            let p = PathBuf::from(format!("{}{spec}", path.display()));
+            crate::formats::hdf5::read(&p, &ReadOptions::default()).unwrap()
+        };
+        let l = on_hdf5(":/w");
+        check("w (HDF5)", &l.volume, ramp);
+        assert!(
+            l.info
+                .header
+                .iter()
+                .any(|(k, v)| k == "axis order" && v.contains("a[z, y, x] from dimension scales")),
+            "{:?}",
+            l.info.header
+        );
+        let tzyx = fixture("cf_tzyx.nc");
+        let p = PathBuf::from(format!("{}:/rho", tzyx.display()));
+        let l = crate::formats::hdf5::read(&p, &opts(Some(1), None)).unwrap();
+        check("rho (HDF5)", &l.volume, |x, y, z| ramp(x, y, z) + 1000.0);
+    }
 }
