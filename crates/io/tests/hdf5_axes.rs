@@ -111,14 +111,25 @@ fn attached_h5py_dimension_scales_are_not_followed_and_say_so() {
 }
 
 #[test]
-fn names_other_than_axis_letters_keep_the_default_order_with_a_note() {
+fn netcdf_style_names_go_by_the_cf_rule() {
+    // DIMENSION_LABELS depth, lat, lon: a[z, y, x].
+    let l = load("cf_names", &ReadOptions::default());
+    assert_ramp("cf_names", &l.volume, 0);
+    assert_eq!(
+        header_value(&l, "axis order"),
+        "a[z, y, x] from attribute DIMENSION_LABELS read by the CF conventions (depth is z (its name), lat is y (its name), lon is x (its name))"
+    );
+}
+
+#[test]
+fn names_neither_axis_letters_nor_cf_names_keep_the_default_order_with_a_note() {
     let l = load("other_names", &ReadOptions::default());
     assert_ramp("other_names", &l.volume, 0);
     assert!(
         l.info
             .notes
             .iter()
-            .any(|n| n.contains("lon, lat, depth") && n.contains("not x, y, z")),
+            .any(|n| n.contains("i, j, k") && n.contains("not x, y, z, t, c, nor CF names")),
         "{:?}",
         l.info.notes
     );
@@ -152,6 +163,7 @@ fn every_box_read_box_by_box_equals_the_eager_read() {
         ("ilastik", 2, "chunks of shape"),
         ("tczyx", 4, "row windows"),
         ("yxz", 1, "contiguous"),
+        ("cf_names", 1, "contiguous"),
     ] {
         for f in 0..frames {
             let opts = frame(f);

@@ -204,7 +204,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let shape = h5::shape(&dataset).map_err(what)?;
     let attrs = sorted_attrs(dataset.attrs());
     let order = if (2..=5).contains(&shape.len()) {
-        axis_order(&h5.file, &name, &attrs, &dataset, shape.len())
+        axis_order(&h5.file, &name, &attrs, &dataset, &shape)
             .map_err(|e| format!("shape {shape:?}: {e}"))
     } else {
         Err(format!(

@@ -28,8 +28,11 @@
 //! variable-length strings and arrays of them, UTF-8 or ASCII, are read.
 //!
 //! Names `x`, `y`, `z`, `t`, `c` (any case; also `time`, `channel`) name
-//! the axes directly. A dataset whose names include others keeps the
-//! default order, with a note. Without names, the default: `a[x, y]` (an
+//! the axes directly. Other names go by the CF conventions' rule for
+//! dimension names (`shared/cf.rs`, NetCDF's: `lon`, `lat`, `depth`,
+//! `level`, `time`...; the names it does not know spatial from the last
+//! backwards) where that rule names one spatial axis at least; a dataset
+//! whose names it cannot read keeps the default order, with a note. Without names, the default: `a[x, y]` (an
 //! image), `a[x, y, z]`, `a[t, x, y, z]`, the first axis being x; existing
 //! files read as they always have.
 //!
@@ -37,8 +40,11 @@
 //! C order over those axes as the dataset holds them, so for `a[t, c, z,
 //! y, x]` frame `t·C + c` is time point `t` of channel `c`.
 
+use std::path::Path;
+
 use hdf5_pure::{AttrValue, Dataset, File};
 
+use crate::shared::cf;
 use crate::shared::hdf5::text;
 
 /// What one dataset axis holds.
@@ -128,8 +134,9 @@ pub(crate) fn axis_order(
     name: &str,
     attrs: &[(String, AttrValue)],
     dataset: &Dataset,
-    rank: usize,
+    shape: &[usize],
 ) -> Result<AxisOrder, String> {
+    let rank = shape.len();
     let attr = |n: &str| attrs.iter().find(|(k, _)| k == n).map(|(_, v)| v);
     let mut found: Vec<(String, Vec<String>)> = Vec::new();
     if let Some(v) = attr("axes") {
@@ -168,8 +175,15 @@ pub(crate) fn axis_order(
         }
         let roles: Option<Vec<Role>> = names.iter().map(|n| Role::of(n)).collect();
         let Some(roles) = roles else {
+            if let Some((roles, why)) = cf_roles(&names, shape) {
+                return Ok(AxisOrder {
+                    roles,
+                    source: format!("{source} read by the CF conventions ({why})"),
+                    ignored: (!ignored.is_empty()).then(|| ignored.join("; ")),
+                });
+            }
             ignored.push(format!(
-                "{source} names axes {} that are not x, y, z, t, c",
+                "{source} names axes {} that are not x, y, z, t, c, nor CF names",
                 names.join(", ")
             ));
             continue;
@@ -207,6 +221,42 @@ pub(crate) fn axis_order(
         roles,
         ignored: (!ignored.is_empty()).then(|| ignored.join("; ")),
     })
+}
+
+/// The roles CF's rule for dimension names (`shared/cf.rs`: `lon`,
+/// `latitude`, `depth`, `level`, `time`, ...) gives axes named `names`,
+/// the unnamed ones spatial from the last backwards, and why; `None`
+/// where it names no spatial axis itself or finds no order (two names for
+/// x, two long axes beside x, y, z).
+fn cf_roles(names: &[String], shape: &[usize]) -> Option<(Vec<Role>, String)> {
+    let var = cf::Variable {
+        name: String::new(),
+        dims: names.to_vec(),
+        shape: shape.iter().map(|&n| n as u64).collect(),
+        attrs: Vec::new(),
+        type_name: String::new(),
+        integer: false,
+    };
+    let layout = cf::layout(Path::new(""), &var, std::slice::from_ref(&var), None).ok()?;
+    let by_place = layout
+        .reasons
+        .iter()
+        .filter(|r| r.ends_with("(its place)"))
+        .count();
+    if by_place >= 3 {
+        return None;
+    }
+    let roles = (0..names.len())
+        .map(|d| match layout.spatial.iter().position(|&s| s == d) {
+            Some(0) => Role::X,
+            Some(1) => Role::Y,
+            Some(_) => Role::Z,
+            None if Some(d) == layout.frame_dim => Role::Time,
+            // One sample long: held at 0.
+            None => Role::Channel,
+        })
+        .collect();
+    Some((roles, layout.reasons.join(", ")))
 }
 
 /// Each role at most once; x and y present.
