@@ -10,7 +10,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use common::{assert_frame_out_of_range, check_voxels, frame, ramp, refuse};
+use common::{assert_frame_out_of_range, check_voxels, frame, header_value, ramp, refuse};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
 use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
@@ -45,13 +45,18 @@ fn ome_physical_sizes_give_the_spacing_in_their_unit() {
     assert_eq!(l.volume.origin(), DVec3::ZERO);
     assert_eq!(l.info.length_unit.as_deref(), Some("\u{b5}m"));
     assert_eq!(l.info.frames, 1);
+    assert_eq!(
+        header_value(&l, "OME Pixels"),
+        "DimensionOrder XYCZT, SizeZ 3, SizeC 1, SizeT 1"
+    );
 }
 
 #[test]
 fn sizes_in_different_units_are_converted_to_micrometres() {
     // PhysicalSizeX 500 nm, Y 0.25 (the default µm), Z 0.002 mm.
     let l = load("ome_zcyx.ome.tif", &ReadOptions::default());
-    assert_close(l.volume.spacing(), DVec3::new(0.5, 0.25, 2.0));
+    // By exact powers of ten: 500 nm is 0.5 µm exactly.
+    assert_eq!(l.volume.spacing(), DVec3::new(0.5, 0.25, 2.0));
     assert_eq!(l.info.length_unit.as_deref(), Some("\u{b5}m"));
     assert!(
         l.info

@@ -175,6 +175,13 @@ impl Ome {
 
     /// The spacing and its unit (see the module docs), with a note.
     pub(super) fn geometry(&self, path: &Path, info: &mut FileInfo) -> Result<DVec3, IoError> {
+        info.header.push((
+            "OME Pixels".into(),
+            format!(
+                "DimensionOrder {}, SizeZ {}, SizeC {}, SizeT {}",
+                self.dimension_order, self.shape.slices, self.shape.channels, self.shape.times
+            ),
+        ));
         let mut spacing = DVec3::ONE;
         let lengths: Vec<(usize, f64, &str)> = self
             .sizes
@@ -208,7 +215,7 @@ impl Ome {
                     ),
                 )
             })?;
-            spacing[a] = v * from / to;
+            spacing[a] = convert(v, from, to);
         }
         let written: Vec<String> = self
             .sizes
@@ -264,6 +271,20 @@ fn metres(unit: &str) -> Option<f64> {
         "in" => 0.0254,
         _ => return None,
     })
+}
+
+/// `v` in a unit of `from` metres, in units of `to` metres: by an exact
+/// power of ten where the ratio is one (500 nm is 0.5 µm exactly).
+fn convert(v: f64, from: f64, to: f64) -> f64 {
+    let (up, down) = (from / to, to / from);
+    let whole = |r: f64| r >= 1.0 && (r.round() - r).abs() <= 1e-9 * r;
+    if whole(down) {
+        v / down.round()
+    } else if whole(up) {
+        v * up.round()
+    } else {
+        v * up
+    }
 }
 
 /// An element's name without its namespace prefix.
