@@ -14,9 +14,10 @@
 //!   from its file address, inflated (to exactly its decoded size, no
 //!   more), unshuffled, and its part of the box copied out. Scratch: one
 //!   chunk, stored and decoded.
-//! - **contiguous**: each row of z the box covers is read from the file at
-//!   its offset (a row of the box's y rows at once where that is not much
-//!   more than the box needs).
+//! - **contiguous**: each row of the dataset's last axis (z, without axis
+//!   names) the box covers is read from the file at its offset (a row of
+//!   the box's rows along the axis before it at once where that is not
+//!   much more than the box needs).
 //! - anything else (compact data, no data written, chunks missing from the
 //!   index so that the fill value stands in for them, other filters: fletcher32,
 //!   szip, lzf, scale-offset, n-bit; non-IEEE or bit-packed types):
@@ -341,7 +342,7 @@ pub(crate) fn from_opened(
     };
     info.notes.push(match &storage {
         Storage::Contiguous { .. } => {
-            "read box by box: each row of z a box covers, from its place in the contiguous data"
+            "read box by box: each row of the last axis a box covers, from its place in the contiguous data"
                 .to_string()
         }
         Storage::Chunks(c) => format!(
