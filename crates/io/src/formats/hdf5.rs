@@ -1,8 +1,13 @@
 //! HDF5 datasets (`file.h5:/group/dataset`), read in pure Rust through
 //! `hdf5-pure` (`shared/hdf5.rs`): no system library, in every build.
 //!
-//! Axis convention, the same as volray's `.npy` reader: a 3-D dataset of
-//! shape `(n0, n1, n2)` (C order, the last index varying fastest in the
+//! Axis order: a dataset that names its axes (an `axes` attribute such as
+//! `"zyx"` or `"tczyx"`, ilastik's `axistags`, h5py's `DIMENSION_LABELS`,
+//! netCDF-C's dimension scales) is read in the order its names say, its
+//! time and channel axes numbering the volumes (`--frame`); see
+//! `hdf5_axes.rs`, which both this reader and the box-by-box one use.
+//! Without names, the convention of volray's `.npy` reader: a 3-D dataset
+//! of shape `(n0, n1, n2)` (C order, the last index varying fastest in the
 //! file) is indexed `a[x, y, z]`, so the volume has dims `[n0, n1, n2]`
 //! and is transposed on reading. A 4-D dataset is a series `a[t, x, y, z]`
 //! and `--frame t` picks one volume (0 by default); only that volume is read.
@@ -10,8 +15,8 @@
 //! what it holds ([`IoError::FlatImage`]).
 //!
 //! Geometry from the dataset's attributes, each one value per dataset
-//! axis in dataset order (so axis 0 is x), or a single value for all
-//! axes; a 4-D dataset may give 4 values, the first (time) is dropped:
+//! axis in dataset order (those of time and channel dropped), one per
+//! spatial axis in dataset order, or a single value for all axes:
 //! - `spacing` and `origin` (unit from a string attribute `unit` or
 //!   `units`, if any);
 //! - `element_size_um` (the Fiji/ilastik convention), in micrometres.
@@ -26,8 +31,10 @@
 use std::path::{Path, PathBuf};
 
 use hdf5_pure::{AttrValue, Dataset, Group};
+use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
+use super::hdf5_axes::{Placement, Role, axis_order};
 use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
@@ -54,12 +61,8 @@ pub(crate) struct Opened {
     pub dataset: Dataset,
     pub sample: h5::NumericType,
     pub shape: Vec<usize>,
-    /// Volumes along the first axis of a 4-D dataset (1 otherwise), and
-    /// the one read.
-    pub frames: usize,
-    pub frame: usize,
-    /// A 4-D dataset (a series a[t, x, y, z]).
-    pub series: bool,
+    /// Which dataset axis is x, y, z, and the volume read (the frame).
+    pub placement: Placement,
     /// Samples along x, y, z (a 2-D image: z is 1).
     pub dims: [usize; 3],
     pub info: FileInfo,
@@ -80,6 +83,26 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         Found::Minc(file_path) => return super::minc::read(&file_path, opts),
         Found::Dataset(o) => *o,
     };
+    let steps = [
+        DVec3::X * o.spacing.x,
+        DVec3::Y * o.spacing.y,
+        DVec3::Z * o.spacing.z,
+    ];
+    read_opened(o, None, steps, VolumeFormat::Hdf5, opts)
+}
+
+/// Reads the volume of a dataset opened and placed (by [`open`], or a
+/// NetCDF-4 variable's by `netcdf4.rs`): each stored value through `real`
+/// where given (the volume then kept as `f32`), the grid's steps along x,
+/// y, z `steps` (negative along a decreasing coordinate: flipped by
+/// `grid_to_volume`).
+pub(crate) fn read_opened(
+    o: Opened,
+    real: Option<&dyn Fn(f64) -> f64>,
+    steps: [DVec3; 3],
+    format: VolumeFormat,
+    opts: &ReadOptions,
+) -> Result<Loaded, IoError> {
     let Opened {
         file_path,
         h5,
@@ -87,41 +110,39 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         dataset,
         sample,
         shape,
-        frames,
-        frame,
-        series,
+        placement,
         dims,
         mut info,
-        spacing,
         origin,
+        ..
     } = o;
     let what =
         |reason: String| IoError::invalid(&file_path, format!("HDF5 dataset \"{name}\": {reason}"));
     let slabs = Slabs::new(
         &dataset,
         &shape,
-        frames,
-        series.then_some(frame),
+        placement.frames,
+        placement.first_fixed(),
         sample.size,
     );
+    let kept = if real.is_some() {
+        SampleType::F32
+    } else {
+        sample.stored
+    };
     let voxels = slabs.check(
         &file_path,
         &format!("dataset shape {shape:?}"),
         h5.len,
-        sample.stored,
+        kept,
         opts.max_memory,
     )?;
-    let data =
-        read_as_stored!(sample.stored, |T| read_volume::<T>(&slabs, dims, voxels)).map_err(what)?;
-    let steps = [
-        DVec3::X * spacing.x,
-        DVec3::Y * spacing.y,
-        DVec3::Z * spacing.z,
-    ];
+    let data = read_as_stored!(kept, |T| read_volume::<T>(&slabs, &placement, voxels, real))
+        .map_err(what)?;
     let volume = grid_to_volume(&file_path, dims, data, steps, origin, &mut info)?;
     Ok(Loaded {
         volume,
-        format: VolumeFormat::Hdf5,
+        format,
         info,
     })
 }
@@ -181,44 +202,64 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
 
     let sample = numeric_type(&dataset).map_err(what)?;
     let shape = h5::shape(&dataset).map_err(what)?;
-    let (frames, dims) = match shape.as_slice() {
-        // A 2-D image a[x, y]: read, and described rather than rendered.
-        &[n0, n1] => (1, [n0, n1, 1]),
-        &[n0, n1, n2] => (1, [n0, n1, n2]),
-        &[t, n0, n1, n2] => (t, [n0, n1, n2]),
-        other => {
-            return Err(what(format!(
-                "shape {other:?} has {} dimension(s): volray reads 3-D datasets a[x, y, z] and 4-D series a[t, x, y, z]",
-                other.len()
-            )));
-        }
-    };
+    let attrs = sorted_attrs(dataset.attrs());
+    let order = if (2..=5).contains(&shape.len()) {
+        axis_order(&h5.file, &name, &attrs, &dataset, &shape)
+            .map_err(|e| format!("shape {shape:?}: {e}"))
+    } else {
+        Err(format!(
+            "shape {shape:?} has {} dimension(s): volray reads 3-D datasets a[x, y, z], 4-D series a[t, x, y, z], and datasets of up to 5 named axes (an axes attribute such as \"tczyx\")",
+            shape.len()
+        ))
+    }
+    .map_err(what)?;
     let frame = opts.frame.unwrap_or(0);
-    if frame >= frames {
-        return Err(IoError::frame_out_of_range(
+    let placement = Placement::new(&shape, &order.roles, frame).map_err(|frames| {
+        IoError::frame_out_of_range(
             &file_path,
             frame,
             format!(
-                "HDF5 dataset \"{name}\" holds {frames} volume(s) along its first axis, numbered from 0"
+                "HDF5 dataset \"{name}\" holds {frames} volume(s) along {}, numbered from 0",
+                if order.is_default() {
+                    "its first axis".to_string()
+                } else {
+                    format!("its time/channel axes ({})", order.shown())
+                }
             ),
-        ));
-    }
-    let series = frames > 1 || shape.len() == 4;
+        )
+    })?;
+    let (frames, dims) = (placement.frames, placement.dims);
 
-    let attrs = sorted_attrs(dataset.attrs());
     let mut info = FileInfo::new(sample.name.clone());
     info.frames = frames;
     info.frame = frame;
     info.header = header_fields(&dataset, &name, &shape, &sample.name, &attrs);
-    info.notes.push(format!(
-        "C-order dataset of shape {shape:?} read as a[{}x, y, z] (the first axis is x; the file's fastest axis is z), transposed to x fastest",
-        if series { "t, " } else { "" }
+    info.header.push((
+        "axis order".into(),
+        format!("{} from {}", order.shown(), order.source),
     ));
-    if frames > 1 {
-        info.notes
-            .push(format!("volume {frame} of {frames} read (first axis: t)"));
+    info.notes.push(if order.is_default() {
+        format!(
+            "C-order dataset of shape {shape:?} read as {} (the first axis is x; the file's fastest axis is z), transposed to x fastest; axis order from {}",
+            order.shown(),
+            order.source
+        )
+    } else {
+        format!(
+            "C-order dataset of shape {shape:?} read as {}, axis order from {}, transposed to x fastest",
+            order.shown(),
+            order.source
+        )
+    });
+    if let Some(why) = &order.ignored {
+        info.notes.push(format!("axis names not used: {why}"));
     }
-    let (spacing, origin) = geometry(&attrs, series, &mut info).map_err(what)?;
+    if frames > 1 {
+        info.notes.push(format!(
+            "volume {frame} of {frames} read (time/channel axes in C order, as the dataset holds them)"
+        ));
+    }
+    let (spacing, origin) = geometry(&attrs, &order.roles, &mut info).map_err(what)?;
     Ok(Found::Dataset(Box::new(Opened {
         file_path,
         h5,
@@ -226,9 +267,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         dataset,
         sample,
         shape,
-        frames,
-        frame,
-        series,
+        placement,
         dims,
         info,
         spacing,
@@ -236,25 +275,24 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     })))
 }
 
-/// Reads one volume into an x-fastest buffer: the dataset's first axis
-/// is x, its last (fastest in the file) z.
+/// Reads one volume into an x-fastest buffer, each sample placed as the
+/// dataset's axis order says (`hdf5_axes.rs`).
 fn read_volume<T: Stored>(
     slabs: &Slabs,
-    dims: [usize; 3],
+    placement: &Placement,
     voxels: usize,
+    real: Option<&dyn Fn(f64) -> f64>,
 ) -> Result<Vec<T>, String> {
-    let [n0, n1, n2] = dims;
     let mut data = vec![T::default(); voxels];
-    // Sample (x, y, z) at C-order index x·n1·n2 + y·n2 + z goes to
-    // x + n0·(y + n1·z).
+    // The first row read: the frame's, for a series read a row at a time.
+    let row: usize = placement.shape[1..].iter().product();
+    let start = placement.first_fixed().unwrap_or(0) * row;
     slabs.read(|first, part| {
-        for (i, &v) in part.iter().enumerate() {
-            let at = first + i;
-            let (x, yz) = (at / (n1 * n2), at % (n1 * n2));
-            let (y, z) = (yz / n2, yz % n2);
+        placement.place(start + first, part, |at, v| {
+            let v = real.map_or(v, |f| f(v));
             // Exact for the integer types kept; `as f32` for the rest.
-            data[x + n0 * (y + n1 * z)] = T::from_f64(f64::from(v as f32));
-        }
+            data[at] = T::from_f64(f64::from(v as f32));
+        });
     })?;
     Ok(data)
 }
@@ -262,7 +300,7 @@ fn read_volume<T: Stored>(
 /// Spacing and origin from the dataset's attributes (see the module docs).
 fn geometry(
     attrs: &[(String, AttrValue)],
-    series: bool,
+    roles: &[Role],
     info: &mut FileInfo,
 ) -> Result<(DVec3, DVec3), String> {
     let attr = |name: &str| attrs.iter().find(|(n, _)| n == name).map(|(_, v)| v);
@@ -272,12 +310,12 @@ fn geometry(
     let mut spacing = DVec3::ONE;
     let mut origin = DVec3::ZERO;
     let mut sources = Vec::new();
-    if let Some(s) = vector_attr(attr("element_size_um"), "element_size_um", series)? {
+    if let Some(s) = vector_attr(attr("element_size_um"), "element_size_um", roles, 1.0)? {
         spacing = s;
         sources.push("element_size_um");
         info.length_unit = Some("um".into());
     }
-    if let Some(s) = vector_attr(attr("spacing"), "spacing", series)? {
+    if let Some(s) = vector_attr(attr("spacing"), "spacing", roles, 1.0)? {
         spacing = s;
         sources.push("spacing");
         info.length_unit = unit.clone();
@@ -288,7 +326,7 @@ fn geometry(
             spacing.x, spacing.y, spacing.z
         ));
     }
-    if let Some(o) = vector_attr(attr("origin"), "origin", series)? {
+    if let Some(o) = vector_attr(attr("origin"), "origin", roles, 0.0)? {
         origin = o;
         sources.push("origin");
         if info.length_unit.is_none() {
@@ -318,29 +356,55 @@ fn geometry(
     Ok((spacing, origin))
 }
 
-/// A numeric attribute of one value per axis (or one for all axes; a
-/// series may give a leading time value, dropped), if present.
+/// A numeric attribute, if present: one value per dataset axis (those of
+/// time and channel dropped), one per spatial axis in the dataset's order,
+/// or one for all axes. A dataset of the default order `a[x, y]` may give
+/// x, y, z. An axis given no value (z of an image) gets `unset`.
 fn vector_attr(
     value: Option<&AttrValue>,
     name: &str,
-    series: bool,
+    roles: &[Role],
+    unset: f64,
 ) -> Result<Option<DVec3>, String> {
     let Some(value) = value else {
         return Ok(None);
     };
     let values = numbers(value).ok_or_else(|| format!("attribute \"{name}\" is not numeric"))?;
-    let v: &[f64] = match values.len() {
+    let spatial: Vec<Role> = roles
+        .iter()
+        .copied()
+        .filter(|r| !matches!(r, Role::Time | Role::Channel))
+        .collect();
+    let per_axis: Vec<(Role, f64)> = match values.len() {
         1 => return finite(name, DVec3::splat(values[0])).map(Some),
-        3 => &values,
-        4 if series => &values[1..],
+        n if n == roles.len() => roles.iter().copied().zip(values).collect(),
+        n if n == spatial.len() => spatial.iter().copied().zip(values).collect(),
+        3 if roles == [Role::X, Role::Y] => [Role::X, Role::Y, Role::Z]
+            .into_iter()
+            .zip(values)
+            .collect(),
         n => {
             return Err(format!(
-                "attribute \"{name}\" has {n} values, needs 3 (one per axis){}",
-                if series { " or 4" } else { "" }
+                "attribute \"{name}\" has {n} values, needs {} (one per axis){}",
+                spatial.len(),
+                if roles.len() != spatial.len() {
+                    format!(" or {}", roles.len())
+                } else {
+                    String::new()
+                }
             ));
         }
     };
-    finite(name, DVec3::new(v[0], v[1], v[2])).map(Some)
+    let mut v = DVec3::splat(unset);
+    for (role, x) in per_axis {
+        match role {
+            Role::X => v.x = x,
+            Role::Y => v.y = x,
+            Role::Z => v.z = x,
+            Role::Time | Role::Channel => {}
+        }
+    }
+    finite(name, v).map(Some)
 }
 
 fn finite(name: &str, v: DVec3) -> Result<DVec3, String> {

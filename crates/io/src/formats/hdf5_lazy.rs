@@ -14,21 +14,25 @@
 //!   from its file address, inflated (to exactly its decoded size, no
 //!   more), unshuffled, and its part of the box copied out. Scratch: one
 //!   chunk, stored and decoded.
-//! - **contiguous**: each row of z the box covers is read from the file at
-//!   its offset (a row of the box's y rows at once where that is not much
-//!   more than the box needs).
+//! - **contiguous**: each row of the dataset's last axis (z, without axis
+//!   names) the box covers is read from the file at its offset (a row of
+//!   the box's rows along the axis before it at once where that is not
+//!   much more than the box needs).
 //! - anything else (compact data, no data written, chunks missing from the
 //!   index so that the fill value stands in for them, other filters: fletcher32,
 //!   szip, lzf, scale-offset, n-bit; non-IEEE or bit-packed types):
 //!   through `hdf5-pure`'s row windows (`read_f64_rows`), which decode only
-//!   the chunks the rows of the box's x range touch: the rows the box's x
-//!   range covers, whole in y and z, a window of at most about a million
-//!   samples at a time (a volume of a 4-D series is one row, read whole).
+//!   the chunks the rows of the box's range along the dataset's first axis
+//!   touch: those rows, whole along the other axes, a window of at most
+//!   about a million samples at a time (where the first axis is time or
+//!   channel, the frame's one row, read whole).
 //!
 //! Values are those of the eager reader exactly: the sample as a `f64`
 //! (as `hdf5-pure` decodes it), rounded to `f32`, kept in the volume's
-//! type; the dataset's axes are a[x, y, z] or a[t, x, y, z], transposed to
-//! x fastest.
+//! type; each sample placed as the dataset's axis order says
+//! (`hdf5_axes.rs`: named axes, or a[x, y, z] and a[t, x, y, z]), x
+//! fastest. A box of the volume is a box of the dataset over its x, y and
+//! z axes, one index wide along time and channel.
 //!
 //! Before anything is read, the shape is checked against the file's
 //! length (no more than deflate's 1032:1 of it), each chunk's address and
@@ -40,13 +44,14 @@ use std::collections::HashMap;
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use hdf5_pure::{ChunkIndex, Datatype, DatatypeByteOrder, FloatingPointLayout, Layout};
 use volray_core::sampling::grid::GridFrame;
 use volray_core::{SampleType, Volume, VolumeSource, check_box};
 
 use super::hdf5::{Found, Opened};
+use super::hdf5_axes::{Placement, each_index};
 use crate::dtype::{Stored, read_as_stored};
 use crate::shared::compress::{Compression, inflate_exact};
 use crate::shared::hdf5::{self as h5, check_stored, slab_rows, slab_samples};
@@ -206,14 +211,16 @@ pub(crate) struct H5Source {
     name: String,
     file: Mutex<File>,
     file_len: u64,
-    /// The dataset's shape: (x, y, z) or (t, x, y, z).
+    /// The dataset's shape.
     shape: Vec<usize>,
-    /// The volume read of a series (0 for a 3-D dataset).
-    frame: usize,
+    /// Which dataset axis is x, y, z, and the volume (frame) read.
+    placement: Placement,
     element: Option<Element>,
     /// Bytes of one sample in the file.
     sample_size: usize,
     stored: SampleType,
+    /// What each stored value becomes, where it is not itself.
+    real: Option<RealValue>,
     grid: GridFrame,
     storage: Storage,
     max_memory: u64,
@@ -233,6 +240,21 @@ pub(crate) fn open(
     if o.dims.iter().any(|&n| n < 2) {
         return Ok(None);
     }
+    from_opened(o, None, opts).map(Some)
+}
+
+/// Maps a stored sample to the value kept (CF's `scale_factor`,
+/// `add_offset` and fill values, for a NetCDF-4 variable).
+pub(crate) type RealValue = Arc<dyn Fn(f64) -> f64 + Send + Sync>;
+
+/// The source of boxes of a dataset opened and placed (`hdf5.rs`'s
+/// [`Opened`], or a NetCDF-4 variable's, `netcdf4.rs`), each stored value
+/// through `real` where given (the volume then kept as `f32`).
+pub(crate) fn from_opened(
+    o: Opened,
+    real: Option<RealValue>,
+    opts: &ReadOptions,
+) -> Result<(H5Source, FileInfo), IoError> {
     let Opened {
         file_path,
         h5,
@@ -240,7 +262,7 @@ pub(crate) fn open(
         dataset,
         sample,
         shape,
-        frame,
+        placement,
         dims,
         mut info,
         spacing,
@@ -320,7 +342,7 @@ pub(crate) fn open(
     };
     info.notes.push(match &storage {
         Storage::Contiguous { .. } => {
-            "read box by box: each row of z a box covers, from its place in the contiguous data"
+            "read box by box: each row of the last axis a box covers, from its place in the contiguous data"
                 .to_string()
         }
         Storage::Chunks(c) => format!(
@@ -345,17 +367,23 @@ pub(crate) fn open(
         ),
     });
     let file = File::open(&file_path).map_err(|e| IoError::os(&file_path, "open", e))?;
-    Ok(Some((
+    let stored = if real.is_some() {
+        SampleType::F32
+    } else {
+        sample.stored
+    };
+    Ok((
         H5Source {
             path: file_path,
             name,
             file: Mutex::new(file),
             file_len: h5.len,
             shape,
-            frame,
+            placement,
             element,
             sample_size: sample.size,
-            stored: sample.stored,
+            stored,
+            real,
             grid: GridFrame {
                 dims,
                 origin,
@@ -365,7 +393,7 @@ pub(crate) fn open(
             max_memory: opts.max_memory,
         },
         info,
-    )))
+    ))
 }
 
 /// The chunks of a chunked dataset (see the module docs), or the row
@@ -514,16 +542,17 @@ impl H5Source {
     /// Bytes held beside the box while it is read.
     fn scratch(&self) -> u128 {
         let n = self.shape.len();
-        let volume = &self.shape[n - 3..];
         match &self.storage {
-            Storage::Contiguous { .. } => (volume[1] * volume[2] * self.sample_size) as u128,
+            Storage::Contiguous { .. } => {
+                (self.shape[n - 2] * self.shape[n - 1] * self.sample_size) as u128
+            }
             Storage::Chunks(c) => 2 * c.bytes as u128 + 4096,
             Storage::Rows { .. } => {
-                let row = (volume[1] * volume[2]) as u128;
-                let rows = if n == 4 {
-                    volume[0] as u128
+                let row = self.shape[1..].iter().product::<usize>() as u128;
+                let rows = if self.placement.first_fixed().is_some() {
+                    1
                 } else {
-                    slab_rows(volume[1] * volume[2], 1, slab_samples()) as u128
+                    slab_rows(row as usize, 1, slab_samples()) as u128
                 };
                 rows * row * (8 + self.sample_size as u128)
             }
@@ -559,20 +588,26 @@ impl H5Source {
 
     /// The box's samples, x fastest.
     fn samples<T: Stored>(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Vec<T>, IoError> {
-        let [nx, ny, nz] = std::array::from_fn(|a| hi[a] - lo[a]);
-        let mut out = vec![T::default(); nx * ny * nz];
-        // Sample (x, y, z) of the whole goes to (x - lo) + nx·((y - lo) +
-        // ny·(z - lo)) of the box; the value as the eager reader keeps it.
-        let mut put = |x: usize, y: usize, z: usize, v: f64| {
-            out[(x - lo[0]) + nx * ((y - lo[1]) + ny * (z - lo[2]))] =
-                T::from_f64(f64::from(v as f32));
+        let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+        let mut out = vec![T::default(); dims.iter().product()];
+        let (dlo, dhi) = self.placement.dataset_box(lo, hi);
+        let w = Window {
+            strides: self.placement.strides(dims),
+            lo: dlo,
+            hi: dhi,
+        };
+        // The value as the eager reader keeps it, at its place in the box.
+        let real = self.real.as_deref();
+        let mut put = |at: usize, v: f64| {
+            let v = real.map_or(v, |f| f(v));
+            out[at] = T::from_f64(f64::from(v as f32));
         };
         match (&self.storage, self.element) {
             (Storage::Contiguous { address }, Some(e)) => {
-                self.contiguous(*address, e, lo, hi, &mut put)?
+                self.contiguous(*address, e, &w, &mut put)?
             }
-            (Storage::Chunks(c), Some(e)) => self.chunks(c, e, lo, hi, &mut put)?,
-            _ => self.rows(lo, hi, &mut put)?,
+            (Storage::Chunks(c), Some(e)) => self.chunks(c, e, &w, &mut put)?,
+            _ => self.rows(&w, &mut put)?,
         }
         Ok(out)
     }
@@ -604,97 +639,83 @@ impl H5Source {
         &self,
         address: u64,
         e: Element,
-        lo: [usize; 3],
-        hi: [usize; 3],
-        put: &mut impl FnMut(usize, usize, usize, f64),
+        w: &Window,
+        put: &mut impl FnMut(usize, f64),
     ) -> Result<(), IoError> {
         let n = self.shape.len();
-        let [n0, n1, n2] = [self.shape[n - 3], self.shape[n - 2], self.shape[n - 1]];
+        let (a1, a2) = (n - 2, n - 1);
+        let ds = c_strides(&self.shape);
         let s = e.size;
-        let (ny, nz) = (hi[1] - lo[1], hi[2] - lo[2]);
-        // From (x, lo_y, lo_z) to (x, hi_y - 1, hi_z - 1): one read per x.
-        let span = ((ny - 1) * n2 + nz) * s;
+        let (ny, nz) = (w.hi[a1] - w.lo[a1], w.hi[a2] - w.lo[a2]);
+        // From (.., lo, lo) to (.., hi - 1, hi - 1) of the last two axes:
+        // one read per index of the others.
+        let span = ((ny - 1) * self.shape[a2] + nz) * s;
         let whole_span = span <= ny * nz * s + SPAN_SLACK;
         let mut buf = vec![0u8; if whole_span { span } else { nz * s }];
-        let first = |x: usize, y: usize| -> u64 {
-            let at = ((self.frame * n0 + x) * n1 + y) * n2 + lo[2];
-            address + (at * s) as u64
-        };
-        for x in lo[0]..hi[0] {
+        each_index(&w.lo[..a1], &w.hi[..a1], |outer| {
+            let flat: usize = outer.iter().zip(&ds).map(|(&i, &d)| i * d).sum();
+            let first = |y: usize| address + ((flat + y * ds[a1] + w.lo[a2]) * s) as u64;
+            let at_outer: usize = (0..a1).map(|a| (outer[a] - w.lo[a]) * w.strides[a]).sum();
             if whole_span {
-                self.read_at(first(x, lo[1]), &mut buf)?;
+                self.read_at(first(w.lo[a1]), &mut buf)?;
             }
-            for y in lo[1]..hi[1] {
+            for y in w.lo[a1]..w.hi[a1] {
                 let line = if whole_span {
-                    &buf[(y - lo[1]) * n2 * s..][..nz * s]
+                    &buf[(y - w.lo[a1]) * self.shape[a2] * s..][..nz * s]
                 } else {
-                    self.read_at(first(x, y), &mut buf)?;
+                    self.read_at(first(y), &mut buf)?;
                     &buf[..]
                 };
-                for (k, b) in line.chunks_exact(s).enumerate() {
-                    put(x, y, lo[2] + k, (e.value)(b));
+                let mut at = at_outer + (y - w.lo[a1]) * w.strides[a1];
+                for b in line.chunks_exact(s) {
+                    put(at, (e.value)(b));
+                    at += w.strides[a2];
                 }
             }
-        }
-        Ok(())
+            Ok(())
+        })
     }
 
     fn chunks(
         &self,
         c: &Chunks,
         e: Element,
-        lo: [usize; 3],
-        hi: [usize; 3],
-        put: &mut impl FnMut(usize, usize, usize, f64),
+        w: &Window,
+        put: &mut impl FnMut(usize, f64),
     ) -> Result<(), IoError> {
         let n = self.shape.len();
-        let lead = n - 3;
+        let last = n - 1;
         let k = &c.shape;
         // The chunk's own C-order strides, in samples.
-        let mut stride = vec![1usize; n];
-        for a in (0..n - 1).rev() {
-            stride[a] = stride[a + 1] * k[a + 1];
-        }
-        let range = |a: usize| lo[a] / k[lead + a]..=(hi[a] - 1) / k[lead + a];
+        let cs = c_strides(k);
+        let grid_lo: Vec<usize> = (0..n).map(|a| w.lo[a] / k[a]).collect();
+        let grid_hi: Vec<usize> = (0..n).map(|a| (w.hi[a] - 1) / k[a] + 1).collect();
         let mut stored = Vec::new();
-        for cx in range(0) {
-            for cy in range(1) {
-                for cz in range(2) {
-                    let mut at = vec![cx, cy, cz];
-                    if lead == 1 {
-                        at.insert(0, self.frame / k[0]);
-                    }
-                    let Some(chunk) = c.index.get(&at) else {
-                        return Err(self.fail(format!(
-                            "the chunk at {at:?} on the chunk grid is missing from its index"
-                        )));
-                    };
-                    let data = self.decode(c, chunk, &at, &mut stored)?;
-                    let base = if lead == 1 {
-                        (self.frame % k[0]) * stride[0]
-                    } else {
-                        0
-                    };
-                    let origin = [cx * k[lead], cy * k[lead + 1], cz * k[lead + 2]];
-                    let from: [usize; 3] = std::array::from_fn(|a| lo[a].max(origin[a]));
-                    let to: [usize; 3] =
-                        std::array::from_fn(|a| hi[a].min(origin[a] + k[lead + a]));
-                    for x in from[0]..to[0] {
-                        for y in from[1]..to[1] {
-                            let row = base
-                                + (x - origin[0]) * stride[lead]
-                                + (y - origin[1]) * stride[lead + 1];
-                            let first = (row + from[2] - origin[2]) * e.size;
-                            let last = (row + to[2] - origin[2]) * e.size;
-                            for (i, b) in data[first..last].chunks_exact(e.size).enumerate() {
-                                put(x, y, from[2] + i, (e.value)(b));
-                            }
-                        }
-                    }
+        each_index(&grid_lo, &grid_hi, |at| {
+            let Some(chunk) = c.index.get(at) else {
+                return Err(self.fail(format!(
+                    "the chunk at {at:?} on the chunk grid is missing from its index"
+                )));
+            };
+            let data = self.decode(c, chunk, at, &mut stored)?;
+            let origin: Vec<usize> = (0..n).map(|a| at[a] * k[a]).collect();
+            let from: Vec<usize> = (0..n).map(|a| w.lo[a].max(origin[a])).collect();
+            let to: Vec<usize> = (0..n).map(|a| w.hi[a].min(origin[a] + k[a])).collect();
+            each_index(&from[..last], &to[..last], |idx| {
+                let row: usize = (0..last).map(|a| (idx[a] - origin[a]) * cs[a]).sum();
+                let first = (row + from[last] - origin[last]) * e.size;
+                let end = (row + to[last] - origin[last]) * e.size;
+                let mut put_at: usize = (0..last)
+                    .map(|a| (idx[a] - w.lo[a]) * w.strides[a])
+                    .sum::<usize>()
+                    + (from[last] - w.lo[last]) * w.strides[last];
+                for b in data[first..end].chunks_exact(e.size) {
+                    put(put_at, (e.value)(b));
+                    put_at += w.strides[last];
                 }
-            }
-        }
-        Ok(())
+                Ok(())
+            })
+        })
     }
 
     /// Reads and decodes one chunk: its stored bytes into `stored`, the
@@ -742,58 +763,68 @@ impl H5Source {
     }
 
     /// Through `hdf5-pure`'s row windows (see the module docs).
-    fn rows(
-        &self,
-        lo: [usize; 3],
-        hi: [usize; 3],
-        put: &mut impl FnMut(usize, usize, usize, f64),
-    ) -> Result<(), IoError> {
+    fn rows(&self, w: &Window, put: &mut impl FnMut(usize, f64)) -> Result<(), IoError> {
         let n = self.shape.len();
-        let [n0, n1, n2] = [self.shape[n - 3], self.shape[n - 2], self.shape[n - 1]];
+        let last = n - 1;
+        let ds = c_strides(&self.shape);
+        let row = ds[0];
         let h5 = h5::open(&self.path)?;
         let dataset = h5
             .file
             .dataset(&self.name)
             .map_err(|e| self.fail(format!("cannot open: {e}")))?;
-        let read = |first: usize, count: usize, expected: usize| -> Result<Vec<f64>, IoError> {
+        let read = |first: usize, count: usize| -> Result<Vec<f64>, IoError> {
             let values = dataset
                 .read_f64_rows(first as u64, count as u64)
                 .map_err(|e| self.fail(format!("cannot read: {e}")))?;
-            if values.len() != expected {
+            if values.len() != count * row {
                 return Err(self.fail(format!(
-                    "cannot read: rows {first}..{} gave {} values, expected {expected}",
+                    "cannot read: rows {first}..{} gave {} values, expected {}",
                     first + count,
-                    values.len()
+                    values.len(),
+                    count * row
                 )));
             }
             Ok(values)
         };
-        let row = n1 * n2;
-        let mut copy = |values: &[f64], x0: usize, x1: usize| {
-            for x in x0..x1 {
-                for y in lo[1]..hi[1] {
-                    let line = &values[(x - x0) * row + y * n2..][..n2];
-                    for (k, &v) in line[lo[2]..hi[2]].iter().enumerate() {
-                        put(x, y, lo[2] + k, v);
-                    }
-                }
-            }
-        };
-        if n == 4 {
-            let values = read(self.frame, 1, n0 * row)?;
-            copy(&values[lo[0] * row..], lo[0], hi[0]);
-            return Ok(());
-        }
         let window = slab_rows(row, 1, slab_samples());
-        let mut first = lo[0];
-        while first < hi[0] {
-            let end = (first + window).min(hi[0]);
-            let values = read(first, end - first, (end - first) * row)?;
-            copy(&values, first, end);
+        let mut first = w.lo[0];
+        while first < w.hi[0] {
+            let end = (first + window).min(w.hi[0]);
+            let values = read(first, end - first)?;
+            let (mut lo, mut hi) = (w.lo.clone(), w.hi.clone());
+            (lo[0], hi[0]) = (first, end);
+            each_index(&lo[..last], &hi[..last], |idx| {
+                let at: usize = (0..last).map(|a| idx[a] * ds[a]).sum::<usize>() - first * ds[0];
+                let mut put_at: usize = (0..last).map(|a| (idx[a] - w.lo[a]) * w.strides[a]).sum();
+                for &v in &values[at + w.lo[last]..at + w.hi[last]] {
+                    put(put_at, v);
+                    put_at += w.strides[last];
+                }
+                Ok::<(), IoError>(())
+            })?;
             first = end;
         }
         Ok(())
     }
+}
+
+/// A box of the dataset (per axis `lo..hi`), and the strides, per
+/// dataset axis, at which its samples go into the volume's box (x
+/// fastest; 0 along time and channel).
+struct Window {
+    lo: Vec<usize>,
+    hi: Vec<usize>,
+    strides: Vec<usize>,
+}
+
+/// The C-order strides, in samples, of an array of `shape`.
+fn c_strides(shape: &[usize]) -> Vec<usize> {
+    let mut stride = vec![1usize; shape.len()];
+    for a in (0..shape.len().saturating_sub(1)).rev() {
+        stride[a] = stride[a + 1] * shape[a + 1];
+    }
+    stride
 }
 
 /// Undoes HDF5's shuffle filter: the first bytes of every element, then

@@ -200,10 +200,10 @@ pub(crate) fn check_stored(
     Ok(values)
 }
 
-/// How one volume of a dataset is read: the volume is the last three
-/// axes of its shape; a 3-D dataset is read in slabs of rows of its first
-/// axis (whole chunks at a time), a volume of a series (a 4-D dataset,
-/// `frame` chosen) as its one row of the first axis, whole.
+/// How one volume of a dataset is read: in slabs of rows of its first
+/// axis (whole chunks at a time), or, where the first axis is not one of
+/// the volume's (a series `a[t, ...]`, `frame` chosen), as its one row of
+/// the first axis, whole.
 pub(crate) struct Slabs<'d> {
     dataset: &'d Dataset,
     shape: &'d [usize],
@@ -217,9 +217,9 @@ pub(crate) struct Slabs<'d> {
 }
 
 impl<'d> Slabs<'d> {
-    /// The reading of a dataset of `shape` (3 or 4 axes; the first of 4
-    /// holds `frames` volumes, of which `frame` is read) and samples of
-    /// `sample_size` bytes.
+    /// The reading of a dataset of `shape` holding `frames` volumes, and
+    /// samples of `sample_size` bytes: row `frame` of the first axis, or
+    /// (`None`) all its rows.
     pub(crate) fn new(
         dataset: &'d Dataset,
         shape: &'d [usize],
@@ -227,9 +227,8 @@ impl<'d> Slabs<'d> {
         frame: Option<usize>,
         sample_size: usize,
     ) -> Self {
-        let volume = &shape[shape.len().saturating_sub(3)..];
-        let rows = volume.first().copied().unwrap_or(1);
-        let row = volume
+        let rows = shape.first().copied().unwrap_or(1);
+        let row = shape
             .iter()
             .skip(1)
             .fold(1usize, |a, &n| a.saturating_mul(n));
@@ -278,16 +277,17 @@ impl<'d> Slabs<'d> {
     /// The samples held at once.
     pub(crate) fn scratch(&self) -> usize {
         match self.frame {
-            Some(_) => self.rows.saturating_mul(self.row),
+            Some(_) => self.row,
             None => self.row.saturating_mul(self.slab.min(self.rows)),
         }
     }
 
     /// Reads the volume, handing each slab to `take` with the C-order
-    /// index of its first sample within the volume.
+    /// index of its first sample among those read (from the first row
+    /// read: row `frame`, or row 0).
     pub(crate) fn read(&self, mut take: impl FnMut(usize, &[f64])) -> Result<(), String> {
         if let Some(frame) = self.frame {
-            take(0, &self.rows_of(frame, 1, self.rows * self.row)?);
+            take(0, &self.rows_of(frame, 1, self.row)?);
             return Ok(());
         }
         let mut first = 0;

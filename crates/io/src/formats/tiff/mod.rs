@@ -21,10 +21,18 @@
 //! - a linear value calibration `cf=0` with `c0=`, `c1=` (ImageJ stores
 //!   signed 16-bit data as unsigned with `c0=-32768`): applied, with a note.
 //!
-//! Without ImageJ metadata the spacing is 1 (the resolution tags of a
-//! plain TIFF describe print size, not voxel size) and the origin is 0.
+//! OME-TIFF (an `ImageDescription` holding OME-XML, as tifffile's
+//! `ome=True`, Bio-Formats and OMERO write it; `ome.rs`) gives the pages'
+//! order (`DimensionOrder` with `SizeZ`, `SizeC`, `SizeT`: each (time
+//! point, channel) pair one volume, numbered `t·SizeC + c` as for ImageJ)
+//! and the spacing from `PhysicalSizeX`/`Y`/`Z` and their units, converted
+//! to one unit. ImageJ metadata, where present, is read first, as before.
+//!
+//! Without either the spacing is 1 (the resolution tags of a plain TIFF
+//! describe print size, not voxel size) and the origin is 0.
 
 mod imagej;
+mod ome;
 mod page;
 
 use std::io::BufReader;
@@ -34,7 +42,8 @@ use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
 use volray_core::glam::DVec3;
 
-use self::imagej::{ImageJ, calibration, imagej_geometry, stack_shape};
+use self::imagej::{ImageJ, Shape, calibration, imagej_geometry, stack_shape};
+use self::ome::{Ome, is_ome};
 use self::page::{
     Sample, compression_name, find_ascii, find_f64, header_fields, page_info, tiff_error,
 };
@@ -152,7 +161,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         .as_deref()
         .filter(|d| d.starts_with("ImageJ="))
         .map(ImageJ::parse);
-    let shape = stack_shape(path, imagej.as_ref(), pages.len())?;
+    let ome = match description.as_deref() {
+        Some(d) if imagej.is_none() && is_ome(d) => Some(Ome::parse(path, d)?),
+        _ => None,
+    };
+    let shape = match &ome {
+        Some(o) => ome_shape(path, o, &mut pages, &mut info)?,
+        None => stack_shape(path, imagej.as_ref(), pages.len())?,
+    };
     info.frames = shape.channels * shape.times;
     let frame = opts.frame.unwrap_or(0);
     if frame >= info.frames {
@@ -168,11 +184,21 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.frame = frame;
     let (t, c) = (frame / shape.channels, frame % shape.channels);
     if info.frames > 1 {
-        info.notes.push(format!(
-            "volume {frame} of {} read: time point {t}, channel {c} (ImageJ page order: channel fastest, then slice, then time)",
-            info.frames
-        ));
+        info.notes.push(match &ome {
+            Some(o) => format!(
+                "volume {frame} of {} read: time point {t}, channel {c} (frames numbered t x SizeC + c; pages in OME DimensionOrder {})",
+                info.frames, o.dimension_order
+            ),
+            None => format!(
+                "volume {frame} of {} read: time point {t}, channel {c} (ImageJ page order: channel fastest, then slice, then time)",
+                info.frames
+            ),
+        });
     }
+    let page_of = |z: usize| match &ome {
+        Some(o) => o.page(z, c, t),
+        None => (t * shape.slices + z) * shape.channels + c,
+    };
     // One page per volume is a 2-D image: read, and described rather
     // than rendered (`grid_to_volume`).
 
@@ -205,7 +231,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let data = read_as_stored!(sample.stored(), |T| {
         let mut data: Vec<T> = Vec::with_capacity(voxels);
         for z in 0..shape.slices {
-            let page = &pages[(t * shape.slices + z) * shape.channels + c];
+            let page = &pages[page_of(z)];
             let what = format!("page {}", page.ifd);
             decoder
                 .seek_to_image(page.ifd)
@@ -235,6 +261,9 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         None => data,
     };
     info.notes.extend(calibration_note);
+    if let Some(o) = &ome {
+        spacing = o.geometry(path, &mut info)?;
+    }
     match &imagej {
         Some(ij) => {
             imagej_geometry(
@@ -245,6 +274,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
                 &mut info,
             );
         }
+        None if ome.is_some() => {}
         None => {
             if x_resolution.is_some() || y_resolution.is_some() {
                 info.notes.push(
@@ -266,6 +296,39 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         info,
     })
 }
+/// The stack's shape from OME-XML, checked against the full-resolution
+/// `pages`: the first image's planes, the pages of other images (a file of
+/// several series) dropped with a note.
+fn ome_shape(
+    path: &Path,
+    ome: &Ome,
+    pages: &mut Vec<page::Page>,
+    info: &mut FileInfo,
+) -> Result<Shape, IoError> {
+    let planes = ome.planes();
+    if planes > pages.len() || (planes < pages.len() && ome.images < 2) {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "OME-XML says SizeZ={} SizeC={} SizeT={} ({planes} planes) but the file has {} full-resolution page(s)",
+                ome.shape.slices,
+                ome.shape.channels,
+                ome.shape.times,
+                pages.len()
+            ),
+        ));
+    }
+    if planes < pages.len() {
+        info.notes.push(format!(
+            "OME-XML describes {} images: the first read ({planes} of {} pages)",
+            ome.images,
+            pages.len()
+        ));
+        pages.truncate(planes);
+    }
+    Ok(ome.shape)
+}
+
 /// Refuses a stack whose `voxels` samples would decode to more bytes than
 /// a `file_len`-byte file can plausibly hold (see [`MAX_INFLATION`]).
 fn check_budget(

@@ -1,0 +1,137 @@
+//! OME-TIFF stacks written by tifffile with `ome=True`
+//! (`fixtures/make_tiff_fixtures.py`): the OME-XML's physical sizes and
+//! units, and its DimensionOrder, SizeZ/SizeC/SizeT saying which pages
+//! are the z slices of which channel and time point.
+//!
+//! Every volume is (x, y, z) = (5, 4, 3) holding `v = x + 10y + 100z`
+//! (tifffile's `a[z, y, x]`), plus `1000·frame`, frame `t·SizeC + c`.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{assert_frame_out_of_range, check_voxels, frame, header_value, ramp, refuse};
+use volray_core::Volume;
+use volray_core::glam::DVec3;
+use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
+
+fn fixture(name: &str) -> PathBuf {
+    common::fixture("tiff", name)
+}
+
+fn load(name: &str, opts: &ReadOptions) -> Loaded {
+    let l = read(&fixture(name), opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(l.format, VolumeFormat::Tiff);
+    l
+}
+
+fn assert_ramp(what: &str, volume: &Volume, frame: usize) {
+    check_voxels(what, volume, [5, 4, 3], |x, y, z| {
+        (ramp(x, y, z) + 1000 * frame as i64) as f32
+    });
+}
+
+fn assert_close(got: DVec3, want: DVec3) {
+    assert!((got - want).abs().max_element() < 1e-12, "{got} != {want}");
+}
+
+#[test]
+fn ome_physical_sizes_give_the_spacing_in_their_unit() {
+    let l = load("ome_zyx.ome.tif", &ReadOptions::default());
+    assert_ramp("ome_zyx", &l.volume, 0);
+    // Page 0, row 0, column 1 holds 1: at volume (1, 0, 0).
+    assert_eq!(l.volume.get(1, 0, 0), 1.0);
+    assert_close(l.volume.spacing(), DVec3::new(0.5, 0.25, 2.0));
+    assert_eq!(l.volume.origin(), DVec3::ZERO);
+    assert_eq!(l.info.length_unit.as_deref(), Some("\u{b5}m"));
+    assert_eq!(l.info.frames, 1);
+    assert_eq!(
+        header_value(&l, "OME Pixels"),
+        "DimensionOrder XYCZT, SizeZ 3, SizeC 1, SizeT 1"
+    );
+}
+
+#[test]
+fn sizes_in_different_units_are_converted_to_micrometres() {
+    // PhysicalSizeX 500 nm, Y 0.25 (the default µm), Z 0.002 mm.
+    let l = load("ome_zcyx.ome.tif", &ReadOptions::default());
+    // By exact powers of ten: 500 nm is 0.5 µm exactly.
+    assert_eq!(l.volume.spacing(), DVec3::new(0.5, 0.25, 2.0));
+    assert_eq!(l.info.length_unit.as_deref(), Some("\u{b5}m"));
+    assert!(
+        l.info
+            .notes
+            .iter()
+            .any(|n| n.contains("converted to \u{b5}m")),
+        "{:?}",
+        l.info.notes
+    );
+    // One unit throughout: kept as written.
+    let l = load("ome_tzyx.ome.tif", &ReadOptions::default());
+    assert_close(l.volume.spacing(), DVec3::new(0.1, 0.1, 0.3));
+    assert_eq!(l.info.length_unit.as_deref(), Some("mm"));
+}
+
+#[test]
+fn channels_and_time_points_are_frames_whatever_the_dimension_order() {
+    // XYCZT (channel fastest), XYZCT (z fastest), and time points.
+    for (name, frames) in [
+        ("ome_zcyx.ome.tif", 2),
+        ("ome_czyx.ome.tif", 2),
+        ("ome_tzyx.ome.tif", 2),
+    ] {
+        for f in 0..frames {
+            let l = load(name, &frame(f));
+            let want = if name.starts_with("ome_tzyx") {
+                2 * f
+            } else {
+                f
+            };
+            assert_ramp(name, &l.volume, want);
+            assert_eq!((l.info.frames, l.info.frame), (frames, f), "{name}");
+        }
+        let err = read(&fixture(name), &frame(frames)).unwrap_err();
+        assert_frame_out_of_range(&err, frames, "the stack holds 2 volume(s)");
+    }
+}
+
+#[test]
+fn ome_xml_that_does_not_fit_the_pages_is_refused_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read(fixture("ome_zcyx.ome.tif")).unwrap();
+    // More planes than pages (same length, so the TIFF stays whole).
+    let lying = common::replace(&good, "SizeZ=\"3\"", "SizeZ=\"9\"");
+    refuse(
+        dir.path(),
+        "lying.ome.tif",
+        &lying,
+        "OME-XML says SizeZ=9 SizeC=2 SizeT=1 (18 planes) but the file has 6 full-resolution page(s)",
+    );
+    let order = common::replace(&good, "XYCZT", "XYCZZ");
+    refuse(
+        dir.path(),
+        "order.ome.tif",
+        &order,
+        "OME-XML: Pixels DimensionOrder=\"XYCZZ\" is not XY followed by Z, C and T",
+    );
+    let size = common::replace(&good, "PhysicalSizeX=\"500.0\"", "PhysicalSizeX=\"-50.00\"");
+    refuse(
+        dir.path(),
+        "size.ome.tif",
+        &size,
+        "OME-XML: Pixels PhysicalSizeX=\"-50.00\" is not a positive length",
+    );
+    let unit = common::replace(
+        &good,
+        "PhysicalSizeXUnit=\"nm\"",
+        "PhysicalSizeXUnit=\"zz\"",
+    );
+    refuse(
+        dir.path(),
+        "unit.ome.tif",
+        &unit,
+        "\"zz\" is not a length unit",
+    );
+    let xml = common::replace(&good, "<Pixels ", "<Pixels<");
+    refuse(dir.path(), "xml.ome.tif", &xml, "OME-XML");
+}
