@@ -34,6 +34,7 @@
 //! ([`prescan`]), and before the volume is allocated every file's pixel
 //! data is checked to be able to hold what its header declares.
 
+mod codecs;
 mod header;
 mod pixels;
 mod prescan;
