@@ -17,7 +17,7 @@ mod common;
 use std::fs;
 use std::path::PathBuf;
 
-use common::{Lcg, mutate, read_or_refuse, refused};
+use common::{Lcg, assert_note, mutate, read_or_refuse, refused};
 use volray_core::glam::DVec3;
 use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
 
@@ -324,4 +324,36 @@ fn compressed_volumes_over_max_memory_are_refused_before_decoding() {
         ..ReadOptions::default()
     };
     assert!(read(&fixture("jpeg_split.dcm"), &room).is_ok());
+}
+
+#[test]
+fn rounded_positions_are_read_at_the_mean_gap_with_a_note() {
+    // z = 10.0, 11.2, 12.3, 13.5, 14.6, 15.8 (1.15 mm steps rounded to
+    // one decimal): gaps 1.1 and 1.2 mm, mean 1.16 mm.
+    let l = load("rounded");
+    let v = &l.volume;
+    assert_eq!(v.dims(), [X, Y, 6]);
+    assert!((v.spacing() - DVec3::new(0.6, 0.8, 1.16)).length() < 1e-12);
+    assert_eq!(v.origin(), DVec3::new(-10.0, 20.0, 10.0));
+    for k in 0..6 {
+        for j in 0..Y {
+            for i in 0..X {
+                assert_eq!(v.get(i, j, k), (i + 10 * j + 100 * k) as f32);
+            }
+        }
+    }
+    assert_note(
+        &l,
+        "slice gaps vary from 1.1 to 1.2 mm, at most 0.06 mm off their mean 1.16 mm, within the tolerance of 0.1116 mm (1 % of the mean gap plus 0.1 mm for positions written to 1 decimal(s)): read at the mean gap",
+    );
+}
+
+#[test]
+fn a_gap_beyond_the_tolerance_is_refused_naming_it() {
+    // z = 0, 2, 4, 5.94, 7.94, 9.94: the gap 4 -> 5.94 is 3 % short.
+    let msg = refused(&fixture("uneven"), &ReadOptions::default());
+    assert!(
+        msg.contains("slice gaps are uneven: 1.94 mm (between mr2.dcm and mr3.dcm) to 2 mm (between mr0.dcm and mr1.dcm), mean 1.988 mm; the gap of 1.94 mm between mr2.dcm and mr3.dcm is 0.048 mm off the mean, beyond the tolerance of 0.02988 mm (1 % of the mean gap plus 0.01 mm for positions written to 2 decimal(s))"),
+        "{msg}"
+    );
 }

@@ -8,8 +8,12 @@
 //! the order of (SeriesNumber, SeriesInstanceUID). The slices are sorted
 //! along their normal by ImagePositionPatient ([`stack`]); they must share
 //! Rows, Columns, sample layout, orientation and PixelSpacing, and be
-//! equally spaced (gaps within 1 % of their mean; smaller variations are
-//! noted). Slices without any position are ordered by InstanceNumber and
+//! equally spaced: every gap within 1 % of the mean gap plus what rounding
+//! the positions to the decimals they are written with can do (gaps of 1.1
+//! and 1.2 mm from positions written to 0.1 mm are one 1.16 mm spacing);
+//! such a stack is read at the mean gap with a note, and beyond the
+//! tolerance it is refused naming the farthest gap ([`stack`] compares
+//! this with ITK's rule). Slices without any position are ordered by InstanceNumber and
 //! spaced by SpacingBetweenSlices or SliceThickness (or 1 mm), with a note.
 //!
 //! A multi-frame file: frame positions come from the per-frame functional

@@ -317,6 +317,7 @@ mod tests {
     fn ct_values_are_kept_in_the_narrowest_integer_type() {
         let plane = |slope: f64, intercept: f64| Plane {
             position: None,
+            position_decimals: None,
             orientation: None,
             pixel_spacing: None,
             slope,
@@ -353,6 +354,7 @@ mod tests {
             .collect();
         let plane = Plane {
             position: None,
+            position_decimals: None,
             orientation: None,
             pixel_spacing: None,
             slope: 2.0,
