@@ -157,16 +157,35 @@ fn multi_frame_files_with_one_or_several_fragments_per_frame() {
 }
 
 #[test]
-fn twelve_bit_dct_jpeg_and_jpeg_ls_are_refused_by_name() {
+fn twelve_bit_dct_jpeg_is_refused_by_name() {
     let msg = refused(&fixture("jpeg_extended"), &ReadOptions::default());
     assert!(
         msg.contains("cannot decode the pixel data (JPEG Extended, 1.2.840.10008.1.2.4.51): frame 0 is 12-bit DCT JPEG (SOF1 marker FFC1), which volray's JPEG decoder (jpeg-decoder) does not read"),
         "{msg}"
     );
-    for name in ["jpegls", "jpegls_near", "jpegls_frames.dcm"] {
-        let msg = refused(&fixture(name), &ReadOptions::default());
-        assert!(msg.contains("(JPEG-LS "), "{msg}");
-        assert!(msg.contains("volray has no JPEG-LS decoder"), "{msg}");
+}
+
+#[test]
+fn jpeg_ls_series_equal_the_written_values_or_charls_decoding() {
+    let l = load("jpegls");
+    check(&l, |i, j, k| stored("s16", i, j, k), 0.0);
+    assert!(
+        l.info
+            .stored_type
+            .contains("JPEG-LS Lossless, 1.2.840.10008.1.2.4.80")
+    );
+    let l = load("jpegls_frames.dcm");
+    check(&l, |i, j, k| stored("u12", i, j, k), 0.0);
+    let l = load("jpegls_u8");
+    check(&l, |i, j, k| stored("u8", i, j, k), 0.0);
+    // Near-lossless (NEAR 2): exactly CharLS's decoding (through pyjpegls).
+    let l = load("jpegls_near");
+    check(&l, pydicom_decoded("jpegls_near"), 0.0);
+    // Flat patches (run mode), edges, noise and extremes (escape codes),
+    // lossless and NEAR 3.
+    for name in ["jpegls_textured", "jpegls_textured_near", "jpegls_noise_u8"] {
+        let l = load(name);
+        check(&l, pydicom_decoded(name), 0.0);
     }
 }
 
@@ -218,12 +237,15 @@ fn refused_series(name: &str, edit: impl Fn(&[u8]) -> Vec<u8>) -> String {
     refused(dir.path(), &ReadOptions::default())
 }
 
-const CODEC_SERIES: [&str; 5] = [
+const CODEC_SERIES: [&str; 8] = [
     "jpeg_baseline",
     "jpeg_lossless",
     "jpeg_sv1_8bit",
     "j2k_lossless",
     "j2k_lossy",
+    "jpegls",
+    "jpegls_near",
+    "jpegls_textured",
 ];
 
 #[test]

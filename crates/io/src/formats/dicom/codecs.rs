@@ -1,16 +1,18 @@
 //! Encapsulated pixel data in JPEG (baseline, extended 8-bit, lossless
-//! process 14 and SV1) and JPEG 2000, decoded frame by frame.
+//! process 14 and SV1), JPEG-LS (lossless and near-lossless) and JPEG 2000
+//! (lossless and lossy), decoded frame by frame.
 //!
 //! The frames are split out of the fragments here (PS3.5 A.4, [`split`]),
-//! each frame's codestream header is read ([`jpeg_header`],
-//! [`j2k_header`]) and checked against the image header (Rows, Columns,
+//! each frame's codestream header is read ([`jpeg_header`] for JPEG and
+//! JPEG-LS, [`j2k_header`]) and checked against the image header (Rows, Columns,
 //! one sample, at most BitsAllocated bits) before the decoder runs, and
 //! the decoded samples go into a buffer sized from the image header, which
 //! the caller has checked against `--max-memory` before allocating it.
 //!
-//! The decoders are the crates `dicom-pixeldata`'s own adapters use —
-//! `jpeg-decoder` (pure Rust) and `jpeg2k` on `openjp2` (a pure-Rust port of
-//! OpenJPEG) — called directly rather than through the adapters, which
+//! The JPEG and JPEG 2000 decoders are the crates `dicom-pixeldata`'s own
+//! adapters use — `jpeg-decoder` (pure Rust) and `jpeg2k` on `openjp2` (a
+//! pure-Rust port of OpenJPEG) — called directly rather than through the
+//! adapters, which
 //! cannot split a frame spread over several fragments without a Basic
 //! Offset Table, and index out of bounds (a panic) when a stream decodes
 //! to more samples than the header declares. Both decoders can still panic
@@ -19,13 +21,16 @@
 //! wrapped in [`catch_unwind`], so a corrupt codestream is a one-line
 //! error naming the file and frame, never a crash.
 //!
+//! JPEG-LS is decoded by volray's own [`jpegls`] (dicom-pixeldata's adapter
+//! needs the C++ CharLS, built with CMake).
+//!
 //! Not decoded: 12-bit DCT JPEG (JPEG Extended, process 4: `jpeg-decoder`
-//! reads 8-bit DCT only) and JPEG-LS (only C++ decoders exist, CharLS):
-//! both are refused by name.
+//! reads 8-bit DCT only), refused by name.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use super::header::ImageFormat;
+use super::jpegls;
 
 /// The codec family of a transfer syntax decoded here.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -303,9 +308,18 @@ pub(super) fn decode_frames(
                 push(samples, format, out);
             }
             Codec::JpegLs => {
-                return Err(
-                    "volray has no JPEG-LS decoder (no pure-Rust one exists): convert the series first, e.g. with gdcmconv --raw or dcmdjpls".into(),
-                );
+                let h = jpeg_header(&stream).map_err(|e| format!("frame {f}: {e}"))?;
+                check_header(&h, format, f, "JPEG-LS")?;
+                if h.process != 0xF7 {
+                    return Err(format!(
+                        "frame {f} holds a JPEG (SOF marker FF{:02X}), not a JPEG-LS stream (SOF55, FFF7)",
+                        h.process
+                    ));
+                }
+                let samples = guarded(f, "JPEG-LS", || {
+                    jpegls::decode(&stream, pixels).map(Samples::U16)
+                })?;
+                push(samples, format, out);
             }
         }
         if out.len() - start != pixels * format.sample_bytes() {

@@ -33,17 +33,19 @@
 //! row index along the column direction, slices along the normal.
 //!
 //! Compressed pixel data: JPEG (baseline, 8-bit extended, lossless and
-//! SV1) and JPEG 2000 (lossless and lossy) are decoded frame by frame in
-//! [`codecs`] (jpeg-decoder, openjp2: pure Rust), each frame's codestream
-//! header checked against the image header first; RLE Lossless by
-//! `dicom-pixeldata`. 12-bit DCT JPEG, JPEG-LS and other syntaxes (HTJ2K,
-//! MPEG, JPEG XL) are refused with their name. Before anything
+//! SV1), JPEG-LS (lossless, near-lossless) and JPEG 2000 (lossless, lossy)
+//! are decoded frame by frame in [`codecs`] (jpeg-decoder, volray's own
+//! [`jpegls`], openjp2: all pure Rust), each frame's codestream header
+//! checked against the image header first; RLE Lossless by
+//! `dicom-pixeldata`. 12-bit DCT JPEG and other syntaxes (HTJ2K, MPEG,
+//! JPEG XL) are refused with their name. Before anything
 //! is parsed, every element length is checked against the file
 //! ([`prescan`]), and before the volume is allocated every file's pixel
 //! data is checked to be able to hold what its header declares.
 
 mod codecs;
 mod header;
+mod jpegls;
 mod pixels;
 mod prescan;
 mod stack;
