@@ -64,6 +64,7 @@ for t in $targets; do
         add dicom 00 "$fix"/dicom/*.dcm "$fix"/dicom/*/*.dcm "$fix"/dicom/ct/IM*
         add dicom 08 "$fix"/dicom/single.dcm "$fix"/dicom/enhanced_ct.dcm
         add dicom 02 "$fix"/dicom/enhanced_4d.dcm
+        add dicom 08 "$fix"/dicom/jpeg_split.dcm "$fix"/dicom/j2k_split.dcm "$fix"/dicom/jpegls_frames.dcm
         ;;
     tiff)
         add tiff 00 "$fix"/tiff/*.tif

@@ -218,10 +218,11 @@ fn rle_and_big_endian_series() {
 }
 
 #[test]
-fn undecodable_transfer_syntax_is_named() {
+fn corrupt_codestream_is_named_with_its_transfer_syntax() {
+    // The fragment is SOC, SIZ and 20 zero bytes: a cut SIZ segment.
     let msg = refused(&fixture("j2k"), &ReadOptions::default());
     assert!(
-        msg.contains("cannot decode the pixel data (JPEG 2000 Lossless, 1.2.840.10008.1.2.4.90)"),
+        msg.contains("cannot decode the pixel data (JPEG 2000 Lossless, 1.2.840.10008.1.2.4.90): frame 0: the JPEG 2000 codestream ends inside its SIZ marker segment"),
         "{msg}"
     );
 }

@@ -110,6 +110,10 @@ impl ImageFormat {
 pub(super) struct Plane {
     /// ImagePositionPatient: the centre of the first pixel, in mm.
     pub position: Option<DVec3>,
+    /// The most decimals written in any of ImagePositionPatient's values
+    /// ("11.25" has 2): the positions' rounding. `None` without a
+    /// position, or with an exponent.
+    pub position_decimals: Option<u32>,
     /// ImageOrientationPatient: the directions of increasing column and row index.
     pub orientation: Option<[DVec3; 2]>,
     /// PixelSpacing: (between rows, between columns), in mm.
@@ -362,11 +366,16 @@ fn planes(obj: &DefaultDicomObject, header: &mut FileHeader) -> Result<(), Strin
                     .flatten()
                     .find_map(|g| g.get(seq)?.items()?.first())
             };
-            let position = group(tags::PLANE_POSITION_SEQUENCE)
+            let position_group = group(tags::PLANE_POSITION_SEQUENCE);
+            let position = position_group
                 .map(|g| vector(g, IPP))
                 .transpose()?
                 .flatten()
                 .or(top.position);
+            let position_decimals = match position_group {
+                Some(g) if g.get(IPP.0).is_some() => decimals(g, IPP),
+                _ => top.position_decimals,
+            };
             let orientation = group(tags::PLANE_ORIENTATION_SEQUENCE)
                 .map(orientation)
                 .transpose()?
@@ -383,6 +392,7 @@ fn planes(obj: &DefaultDicomObject, header: &mut FileHeader) -> Result<(), Strin
             };
             header.planes.push(Plane {
                 position,
+                position_decimals,
                 orientation,
                 pixel_spacing,
                 slope,
@@ -472,6 +482,7 @@ fn top_plane(obj: &InMemDicomObject) -> Result<Plane, String> {
     let (slope, intercept) = rescale(obj)?;
     Ok(Plane {
         position: vector(obj, IPP)?,
+        position_decimals: decimals(obj, IPP),
         orientation: orientation(obj)?,
         pixel_spacing: pixel_spacing(obj)?,
         slope,
@@ -543,6 +554,22 @@ fn pixel_spacing(obj: &InMemDicomObject) -> Result<Option<[f64; 2]>, String> {
         ));
     }
     Ok(Some([v[0], v[1]]))
+}
+
+/// The most digits after the decimal point in any of `attr`'s decimal
+/// strings (PS3.5 6.2, DS); `None` if absent or written with an exponent.
+fn decimals(obj: &InMemDicomObject, attr: Attr) -> Option<u32> {
+    let text = obj.get(attr.0)?.to_str().ok()?;
+    let mut most = None;
+    for value in text.split('\\') {
+        let value = value.trim_matches(['\0', ' ']);
+        if value.is_empty() || value.contains(['e', 'E']) {
+            return None;
+        }
+        let d = value.split_once('.').map_or(0, |(_, f)| f.len() as u32);
+        most = most.max(Some(d));
+    }
+    most
 }
 
 fn vector(obj: &InMemDicomObject, attr: Attr) -> Result<Option<DVec3>, String> {

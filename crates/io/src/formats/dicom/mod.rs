@@ -8,9 +8,14 @@
 //! the order of (SeriesNumber, SeriesInstanceUID). The slices are sorted
 //! along their normal by ImagePositionPatient ([`stack`]); they must share
 //! Rows, Columns, sample layout, orientation and PixelSpacing, and be
-//! equally spaced (gaps within 1 % of their mean; smaller variations are
-//! noted). Slices without any position are ordered by InstanceNumber and
-//! spaced by SpacingBetweenSlices or SliceThickness (or 1 mm), with a note.
+//! equally spaced: every gap within 1 % of the mean gap plus what rounding
+//! the positions to the decimals they are written with can do (gaps of 1.1
+//! and 1.2 mm from positions written to 0.1 mm are one 1.16 mm spacing);
+//! such a stack is read at the mean gap with a note, and beyond the
+//! tolerance it is refused naming the farthest gap ([`stack`] compares
+//! this with ITK's rule). Slices without any position are ordered by
+//! InstanceNumber and spaced by SpacingBetweenSlices or SliceThickness (or
+//! 1 mm), with a note.
 //!
 //! A multi-frame file: frame positions come from the per-frame functional
 //! groups (enhanced images), from GridFrameOffsetVector (RT dose), or from
@@ -27,14 +32,20 @@
 //! [`grid_to_volume`]: column index along the row direction,
 //! row index along the column direction, slices along the normal.
 //!
-//! Compressed pixel data is decoded by `dicom-pixeldata` (RLE and JPEG
-//! baseline, extended and lossless in this build); other transfer syntaxes
-//! (JPEG 2000, JPEG-LS, ...) are refused with their name. Before anything
+//! Compressed pixel data: JPEG (baseline, 8-bit extended, lossless and
+//! SV1), JPEG-LS (lossless, near-lossless) and JPEG 2000 (lossless, lossy)
+//! are decoded frame by frame in [`codecs`] (jpeg-decoder, volray's own
+//! [`jpegls`], openjp2: all pure Rust), each frame's codestream header
+//! checked against the image header first; RLE Lossless by
+//! `dicom-pixeldata`. 12-bit DCT JPEG and other syntaxes (HTJ2K, MPEG,
+//! JPEG XL) are refused with their name. Before anything
 //! is parsed, every element length is checked against the file
 //! ([`prescan`]), and before the volume is allocated every file's pixel
 //! data is checked to be able to hold what its header declares.
 
+mod codecs;
 mod header;
+mod jpegls;
 mod pixels;
 mod prescan;
 mod stack;

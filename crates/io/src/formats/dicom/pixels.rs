@@ -14,6 +14,7 @@ use dicom_pixeldata::PixelDecoder;
 
 use volray_core::SampleType;
 
+use super::codecs::{self, Codec};
 use super::header::{ImageFormat, Plane};
 use crate::dtype::Stored;
 use crate::error::IoError;
@@ -62,16 +63,27 @@ pub(super) fn decode(
         return Ok(decoded);
     }
 
+    let syntax = obj.meta().transfer_syntax();
+    if let Some(codec) = Codec::of(syntax) {
+        return decode_encapsulated(path, obj, format, frames, codec).map(Frames::Int);
+    }
     let result = catch_unwind(AssertUnwindSafe(|| obj.decode_pixel_data()));
     let decoded = match result {
         Ok(Ok(d)) => d,
         Ok(Err(e)) => {
-            let ts = obj.meta().transfer_syntax();
+            // The error's sources say why ("Could not decode pixel data"
+            // alone does not).
+            let mut reason = e.to_string();
+            let mut source = std::error::Error::source(&e);
+            while let Some(s) = source {
+                reason = format!("{reason}: {s}");
+                source = s.source();
+            }
             return Err(IoError::invalid(
                 path,
                 format!(
-                    "cannot decode the pixel data ({}): {e}",
-                    transfer_syntax_name(ts)
+                    "cannot decode the pixel data ({}): {reason}",
+                    transfer_syntax_name(syntax)
                 ),
             ));
         }
@@ -105,6 +117,46 @@ pub(super) fn decode(
         return Err(short(path, have, samples, format, frames));
     }
     Ok(Frames::Int(bytes))
+}
+
+/// Decodes the JPEG or JPEG 2000 frames of `obj` ([`codecs`]) into a
+/// buffer of `frames` frames of `format`, sized from the header (which the
+/// caller checked against `--max-memory`) before anything is decoded.
+fn decode_encapsulated(
+    path: &Path,
+    obj: &DefaultDicomObject,
+    format: &ImageFormat,
+    frames: usize,
+    codec: Codec,
+) -> Result<Vec<u8>, IoError> {
+    let syntax = transfer_syntax_name(obj.meta().transfer_syntax());
+    let fail = |reason: String| {
+        IoError::invalid(
+            path,
+            format!("cannot decode the pixel data ({syntax}): {reason}"),
+        )
+    };
+    let value = obj
+        .get(tags::PIXEL_DATA)
+        .ok_or_else(|| fail("no PixelData (7FE0,0010)".into()))?
+        .value();
+    let (Some(offsets), Some(fragments)) = (value.offset_table(), value.fragments()) else {
+        return Err(fail(
+            "PixelData (7FE0,0010) is not encapsulated (no fragments), as the transfer syntax requires".into(),
+        ));
+    };
+    let split = codecs::split(codec, offsets, fragments, frames).map_err(fail)?;
+    let bytes = format
+        .rows
+        .checked_mul(format.columns)
+        .and_then(|n| n.checked_mul(frames))
+        .and_then(|n| n.checked_mul(format.sample_bytes()))
+        .ok_or_else(|| fail("the decoded size is too large to address".into()))?;
+    let mut out = Vec::new();
+    out.try_reserve_exact(bytes)
+        .map_err(|_| fail(format!("cannot allocate {bytes} bytes")))?;
+    codecs::decode_frames(codec, &split, format, &mut out).map_err(fail)?;
+    Ok(out)
 }
 
 fn short(path: &Path, have: usize, want: usize, format: &ImageFormat, frames: usize) -> IoError {
@@ -265,6 +317,7 @@ mod tests {
     fn ct_values_are_kept_in_the_narrowest_integer_type() {
         let plane = |slope: f64, intercept: f64| Plane {
             position: None,
+            position_decimals: None,
             orientation: None,
             pixel_spacing: None,
             slope,
@@ -301,6 +354,7 @@ mod tests {
             .collect();
         let plane = Plane {
             position: None,
+            position_decimals: None,
             orientation: None,
             pixel_spacing: None,
             slope: 2.0,

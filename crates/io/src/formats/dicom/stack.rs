@@ -15,8 +15,16 @@ use super::header::Plane;
 /// Positions closer than this (mm) along the normal are the same slice.
 const SAME_POSITION_MM: f64 = 1e-3;
 
-/// Gaps may differ from their mean by this fraction and still be equal
-/// spacing (DICOM positions are decimal strings of limited precision).
+/// Gaps may differ from their mean by this fraction of it, plus the
+/// rounding of the positions ([`gap_tolerance`]), and still be read as
+/// equal spacing at the mean gap, with a note.
+///
+/// ITK's ImageSeriesReader (itkImageSeriesReader.hxx, GenerateData) reads
+/// any series, taking the gap between the first two slices as the spacing
+/// and warning "Non uniform sampling or missing slices detected" when a gap
+/// differs from it by more than `SpacingWarningRelThreshold` (1e-4) of it;
+/// volray reads within this tolerance and refuses beyond it, where a slice
+/// is likely missing and one spacing would misplace slices.
 const GAP_TOLERANCE: f64 = 0.01;
 
 /// Gap differences above this fraction of the mean are reported in a note.
@@ -118,19 +126,39 @@ pub(super) fn stack(planes: &[Plane], name: &dyn Fn(usize) -> String) -> Result<
     let mean = (along[order[n - 1]] - along[order[0]]) / (n - 1) as f64;
     let (kmin, gmin) = extreme(&gaps, |a, b| a < b);
     let (kmax, gmax) = extreme(&gaps, |a, b| a > b);
-    let deviation = (gmax - mean).max(mean - gmin) / mean;
-    if deviation > GAP_TOLERANCE {
+    let decimals = planes.iter().filter_map(|p| p.position_decimals).max();
+    let (tolerance, stated) = gap_tolerance(mean, normal, decimals);
+    let deviation = (gmax - mean).max(mean - gmin);
+    let (kfar, gfar) = if gmax - mean >= mean - gmin {
+        (kmax, gmax)
+    } else {
+        (kmin, gmin)
+    };
+    if deviation > tolerance {
         return Err(format!(
-            "slice gaps are uneven: {gmin} mm (between {} and {}) to {gmax} mm (between {} and {}), mean {mean} mm; a slice may be missing, and volray needs equally spaced slices",
+            "slice gaps are uneven: {} mm (between {} and {}) to {} mm (between {} and {}), mean {} mm; the gap of {} mm between {} and {} is {} mm off the mean, beyond the tolerance of {} mm ({stated}): a slice may be missing, and volray needs equally spaced slices",
+            round(gmin),
             name(order[kmin]),
             name(order[kmin + 1]),
+            round(gmax),
             name(order[kmax]),
-            name(order[kmax + 1])
+            name(order[kmax + 1]),
+            round(mean),
+            round(gfar),
+            name(order[kfar]),
+            name(order[kfar + 1]),
+            round(deviation),
+            round(tolerance),
         ));
     }
-    if deviation > GAP_NOTE {
+    if deviation > GAP_NOTE * mean {
         notes.push(format!(
-            "slice gaps vary from {gmin} to {gmax} mm; their mean {mean} mm is used"
+            "slice gaps vary from {} to {} mm, at most {} mm off their mean {} mm, within the tolerance of {} mm ({stated}): read at the mean gap",
+            round(gmin),
+            round(gmax),
+            round(deviation),
+            round(mean),
+            round(tolerance)
         ));
     }
 
@@ -149,6 +177,34 @@ pub(super) fn stack(planes: &[Plane], name: &dyn Fn(usize) -> String) -> Result<
         order,
         notes,
     })
+}
+
+/// How far a gap may lie from the mean gap `mean` (mm) along unit
+/// `normal`: [`GAP_TOLERANCE`] of the mean, plus what rounding the
+/// positions to `decimals` decimals can do to a gap (each coordinate off by
+/// at most half a unit of the last decimal, so a gap by one unit times the
+/// normal's 1-norm); and that rule in words.
+fn gap_tolerance(mean: f64, normal: DVec3, decimals: Option<u32>) -> (f64, String) {
+    let percent = GAP_TOLERANCE * 100.0;
+    match decimals {
+        Some(d) if d <= 6 => {
+            let rounding = 10f64.powi(-(d as i32)) * normal.abs().element_sum();
+            (
+                GAP_TOLERANCE * mean + rounding,
+                format!(
+                    "{percent} % of the mean gap plus {} mm for positions written to {d} decimal(s)",
+                    round(rounding)
+                ),
+            )
+        }
+        _ => (GAP_TOLERANCE * mean, format!("{percent} % of the mean gap")),
+    }
+}
+
+/// `x` to 6 significant decimals, for messages (gaps computed from decimal
+/// strings carry binary noise: 1.2000000000000002).
+fn round(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
 }
 
 /// The index and value of the extreme element under `better`.
@@ -215,6 +271,7 @@ mod tests {
     fn plane(pos: DVec3, row: DVec3, col: DVec3) -> Plane {
         Plane {
             position: Some(pos),
+            position_decimals: None,
             orientation: Some([row, col]),
             pixel_spacing: Some([0.8, 0.6]),
             slope: 1.0,
@@ -289,6 +346,43 @@ mod tests {
         let err = stack(&spacing, &name).unwrap_err();
         assert!(err.contains("PixelSpacing 0.8\\0.7"), "{err}");
         assert!(stack(&z(&[0.0]), &name).unwrap_err().contains("at least 2"));
+    }
+
+    #[test]
+    fn rounded_positions_widen_the_gap_tolerance() {
+        // 1.15 mm steps written with one decimal: gaps 1.1 and 1.2 mm.
+        let zs = [10.0, 11.2, 12.3, 13.5, 14.6, 15.8];
+        let rounded = |decimals: Option<u32>| -> Vec<Plane> {
+            zs.iter()
+                .map(|&z| Plane {
+                    position_decimals: decimals,
+                    ..plane(DVec3::new(0.0, 0.0, z), DVec3::X, DVec3::Y)
+                })
+                .collect()
+        };
+        let s = stack(&rounded(Some(1)), &name).unwrap();
+        assert!((s.steps[2].z - 1.16).abs() < 1e-12);
+        assert!(
+            s.notes[0].contains("tolerance of 0.1116 mm"),
+            "{:?}",
+            s.notes
+        );
+        // Written with more decimals, the same gaps are uneven.
+        let err = stack(&rounded(Some(3)), &name).unwrap_err();
+        assert!(err.contains("beyond the tolerance of 0.0126 mm (1 % of the mean gap plus 0.001 mm for positions written to 3 decimal(s))"), "{err}");
+        let err = stack(&rounded(None), &name).unwrap_err();
+        assert!(
+            err.contains(
+                "is 0.06 mm off the mean, beyond the tolerance of 0.0116 mm (1 % of the mean gap)"
+            ),
+            "{err}"
+        );
+        // An oblique normal: rounding moves a gap by a unit per component.
+        let (_, stated) = gap_tolerance(1.0, DVec3::new(0.6, 0.0, 0.8), Some(2));
+        assert_eq!(
+            stated,
+            "1 % of the mean gap plus 0.014 mm for positions written to 2 decimal(s)"
+        );
     }
 
     #[test]
