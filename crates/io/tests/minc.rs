@@ -129,14 +129,14 @@ fn not_minc2_is_refused_clearly() {
     std::fs::copy(common::fixture("hdf5", "one.h5"), &plain).unwrap();
     let msg = common::refused(&plain, &ReadOptions::default());
     assert!(msg.contains("MINC2: no group /minc-2.0/image/0"), "{msg}");
-    // MINC1 is netCDF.
+    // MINC1 is NetCDF-3: a truncated header is NetCDF's refusal.
     let msg = common::refused_at(
         dir.path(),
         "old.mnc",
         b"CDF\x01\0\0\0\0",
         &ReadOptions::default(),
     );
-    assert!(msg.contains("MINC1 (netCDF)"), "{msg}");
+    assert!(msg.contains("NetCDF header (byte 8)"), "{msg}");
     let msg = common::refused_at(dir.path(), "junk.mnc", b"not hdf5", &ReadOptions::default());
     assert!(msg.contains("HDF5: cannot open"), "{msg}");
 }
