@@ -351,3 +351,28 @@ fn broken_fixtures_never_panic() {
         ],
     );
 }
+
+#[test]
+fn a_netcdf4_file_still_takes_the_hdf5_route() {
+    // Until the NetCDF-4 reader lands: HDF5's axis convention, a[x, y, z].
+    let path = fixture("netcdf", "netcdf4.nc");
+    let spec = std::path::PathBuf::from(format!("{}:/r", path.display()));
+    let forced = ReadOptions {
+        format: Some(VolumeFormat::Netcdf),
+        ..ReadOptions::default()
+    };
+    for (p, opts) in [
+        (&path, ReadOptions::default()),
+        (&spec, ReadOptions::default()),
+        (&path, forced),
+    ] {
+        let l = read(p, &opts).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        assert_eq!(l.format, VolumeFormat::Hdf5);
+        common::check_voxels("netcdf4", &l.volume, [2, 3, 4], |x, y, z| {
+            ramp(z, y, x, 0) as f32
+        });
+    }
+    // And is opened box by box, as HDF5 datasets are.
+    let lazy = volray_io::open_lazy(&path, &ReadOptions::default()).unwrap();
+    assert!(lazy.is_some_and(|l| l.format == VolumeFormat::Hdf5));
+}

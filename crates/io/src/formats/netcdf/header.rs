@@ -463,7 +463,7 @@ impl Parser<'_> {
             let ty = NcType::from_code(code, self.version)
                 .ok_or_else(|| self.fail(format!("attribute {name}: type code {code}")))?;
             let count = self.non_neg(&format!("attribute {name}: count"))?;
-            let bytes = count.checked_mul(ty.size()).unwrap_or(u64::MAX);
+            let bytes = count.saturating_mul(ty.size());
             let raw = self.bytes(bytes, &format!("attribute {name}: values"))?;
             self.skip_padding(bytes)?;
             let value = if ty == NcType::Char {

@@ -41,14 +41,7 @@ pub(crate) use header::{Header, NcType, Var, read_values};
 
 /// Reads the NetCDF file at `path`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let (mut file, _) = open_input(path)?;
-    let mut magic = [0u8; 4];
-    let got = file
-        .by_ref()
-        .take(4)
-        .read(&mut magic)
-        .map_err(|e| IoError::os(path, "read", e))?;
-    if got == 4 && &magic == b"\x89HDF" {
+    if is_hdf5(path) {
         // A NetCDF-4 file: HDF5. The lead wires netcdf4::read here at
         // merge; until then, the HDF5 route that `file.nc:/var` takes.
         return super::hdf5::read(path, opts);
@@ -58,6 +51,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         return super::minc1::read_parsed(path, opts, file, header);
     }
     read_cf(path, opts, file, header)
+}
+
+/// Whether the file at `path` starts with HDF5's signature (a NetCDF-4
+/// file); false where it cannot be read (the reader then says why).
+pub(crate) fn is_hdf5(path: &Path) -> bool {
+    let mut magic = [0u8; 8];
+    // Not opened unless a regular file: opening a FIFO blocks.
+    std::fs::metadata(path).is_ok_and(|m| m.is_file())
+        && std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut magic))
+            .is_ok()
+        && &magic == b"\x89HDF\r\n\x1a\n"
 }
 
 /// Opens and parses the NetCDF-3 file at `path`.
