@@ -24,6 +24,11 @@
 //!   record variable); only the frame read is read.
 //! - Which variable, which axes, spacing, origin, units and frames: CF
 //!   (`shared/cf.rs`).
+//! - Not done: the NetCDF default fill values (a variable without
+//!   `_FillValue` keeps every stored value, as xarray does; netCDF4-python
+//!   masks the type's default fill), the `_Unsigned` attribute of
+//!   NetCDF-3 bytes, and box-by-box (lazy) reads: a variable is read
+//!   whole, a frame at a time, within `--max-memory`.
 
 mod header;
 
