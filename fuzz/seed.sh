@@ -27,7 +27,7 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
@@ -85,7 +85,14 @@ for t in $targets; do
         ;;
     minc)
         add minc 00 "$fix"/minc/*.mnc
-        add minc 02 "$fix"/minc/series_u8.mnc
+        add minc 02 "$fix"/minc/series_u8.mnc "$fix"/minc/series_minc1.mnc
+        ;;
+    netcdf)
+        # Control: frame in bits 0-2, array in bits 4-6 (fuzz_targets/netcdf.rs).
+        add netcdf 00 "$fix"/netcdf/*.nc "$fix"/minc/*minc1.mnc
+        add netcdf 12 "$fix"/netcdf/classic.nc "$fix"/netcdf/data64.nc
+        add netcdf 22 "$fix"/netcdf/offset64.nc
+        add netcdf 02 "$fix"/netcdf/packed.nc
         ;;
     # Only the committed seeds (make_zarr_seeds.py): a store is two files
     # packed into one input (fuzz_targets/zarr.rs).

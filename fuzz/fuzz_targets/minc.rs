@@ -1,4 +1,5 @@
-//! Fuzzes the MINC2 reader (HDF5 in libminc's layout, through hdf5-pure).
+//! Fuzzes the MINC reader: MINC2 (HDF5 in libminc's layout, through
+//! hdf5-pure) and, for inputs starting with `CDF`, MINC1 (NetCDF-3).
 //! The first byte chooses `--frame` (bits 0-2).
 #![no_main]
 

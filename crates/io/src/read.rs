@@ -393,6 +393,12 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
         });
     }
     if let Some(format) = VolumeFormat::from_path(path) {
+        // A NetCDF-4 `.nc` is HDF5: read (and opened box by box) as HDF5,
+        // as before NetCDF-3 had its row. The lead wires netcdf4::read here
+        // at merge.
+        if format == VolumeFormat::Netcdf && crate::formats::netcdf::is_hdf5(path) {
+            return Ok(VolumeFormat::Hdf5);
+        }
         return Ok(format);
     }
     if opts.raw.is_some() {

@@ -129,14 +129,79 @@ fn not_minc2_is_refused_clearly() {
     std::fs::copy(common::fixture("hdf5", "one.h5"), &plain).unwrap();
     let msg = common::refused(&plain, &ReadOptions::default());
     assert!(msg.contains("MINC2: no group /minc-2.0/image/0"), "{msg}");
-    // MINC1 is netCDF.
+    // MINC1 is NetCDF-3: a truncated header is NetCDF's refusal.
     let msg = common::refused_at(
         dir.path(),
         "old.mnc",
         b"CDF\x01\0\0\0\0",
         &ReadOptions::default(),
     );
-    assert!(msg.contains("MINC1 (netCDF)"), "{msg}");
+    assert!(msg.contains("NetCDF header (byte 8)"), "{msg}");
     let msg = common::refused_at(dir.path(), "junk.mnc", b"not hdf5", &ReadOptions::default());
     assert!(msg.contains("HDF5: cannot open"), "{msg}");
+}
+
+// ---- MINC1: NetCDF-3 in libminc's layout (make_minc1_fixtures.py,
+// written by netCDF4-python and checked with nibabel's Minc1Image) ----
+
+#[test]
+fn minc1_reads_as_its_minc2_twin() {
+    // The same image, geometry and scaling as ramp_i16.mnc, whose values
+    // and affine are nibabel's (above).
+    let l = load("ramp_minc1.mnc", &ReadOptions::default());
+    let twin = load("ramp_i16.mnc", &ReadOptions::default());
+    assert_eq!(l.volume, twin.volume);
+    assert_eq!(l.volume.origin(), DVec3::new(-3.0, 4.0, 4.0));
+    assert_eq!(l.info.stored_type, "int16 (big-endian)");
+    assert_eq!(common::header_value(&l, "format"), "MINC1 (NetCDF-3)");
+    assert_eq!(l.info.length_unit.as_deref(), Some("mm"));
+    assert_note(&l, "valid_range");
+    assert_note(&l, "per slice of zspace");
+    assert_note(&l, "index axis 1 -> -y");
+}
+
+#[test]
+fn minc1_unsigned_bytes_in_a_time_series_with_rotated_axes() {
+    for t in 0..2 {
+        let l = load("series_minc1.mnc", &frame(t));
+        assert_eq!((l.info.frames, l.info.frame), (2, t));
+        assert_eq!(l.info.stored_type, "uint8 (big-endian)");
+        // nibabel: raw (above 127: the signtype is "unsigned") scaled from
+        // 0..255 onto image-min..image-max of (time, zspace).
+        check_voxels("series_minc1", &l.volume, [5, 4, 3], |x, y, z| {
+            let raw = (x + 2 * y + 6 * z + 50 * t + 100) as f64;
+            let (lo, hi) = (-(t as f64) - z as f64, 10.0 + (t + z) as f64);
+            (raw * (hi - lo) / 255.0 + lo) as f32
+        });
+        // x and y rotated 30° about z: kept in the grid's own axes.
+        assert_eq!(l.volume.spacing(), DVec3::new(1.0, 2.0, 3.0));
+        assert_note(&l, "rotated away from world x, y, z");
+        assert_note(&l, "per slice of time,zspace");
+    }
+    let path = common::fixture("minc", "series_minc1.mnc");
+    let err = common::error_about(&path, &frame(2), &path);
+    assert_frame_out_of_range(&err, 2, "the MINC1 image holds 2 volume(s) along \"time\"");
+}
+
+#[test]
+fn minc1_under_a_netcdf_name_or_none_is_read_as_minc() {
+    let dir = tempfile::tempdir().unwrap();
+    let want = load("ramp_minc1.mnc", &ReadOptions::default()).volume;
+    for name in ["scan.nc", "scan"] {
+        let p = dir.path().join(name);
+        std::fs::copy(common::fixture("minc", "ramp_minc1.mnc"), &p).unwrap();
+        let l = read(&p, &ReadOptions::default()).unwrap();
+        assert_eq!(l.format, VolumeFormat::Minc, "{name}");
+        assert_eq!(l.volume, want, "{name}");
+    }
+}
+
+#[test]
+fn broken_minc1_files_are_refused_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read(common::fixture("minc", "ramp_minc1.mnc")).unwrap();
+    let bad = common::replace(&good, "signed__", "sined___");
+    common::refuse(dir.path(), "sign.mnc", &bad, "signtype \"sined___\"");
+    let files = ["ramp_minc1.mnc", "series_minc1.mnc"].map(|n| common::fixture("minc", n));
+    common::byte_flips_never_panic(&files, 0x6d31, &[ReadOptions::default(), frame(1)]);
 }

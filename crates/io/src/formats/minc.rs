@@ -19,7 +19,8 @@
 //!   Float images are real values already.
 //!
 //! The file's fastest axis is volray's x, so the samples need no
-//! transposing. MINC1 files (netCDF) are refused with a hint.
+//! transposing. A `.mnc` file whose magic is NetCDF's (`CDF`) is MINC1,
+//! read by `formats/minc1.rs` with this module's geometry and scaling.
 
 use std::path::Path;
 
@@ -28,6 +29,7 @@ use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
 use crate::error::IoError;
+use crate::shared::cf::Value;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::hdf5::{
     self as h5, Slabs, numbers, numeric_type, read_small, shown, sorted_attrs, text,
@@ -43,10 +45,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         use std::io::Read;
         let mut magic = [0u8; 3];
         if f.read_exact(&mut magic).is_ok() && &magic == b"CDF" {
-            return Err(fail(
-                "this is a MINC1 (netCDF) file: volray reads MINC2; convert it with `mincconvert -2`"
-                    .into(),
-            ));
+            // MINC1: NetCDF-3 underneath.
+            return super::minc1::read(path, opts);
         }
     }
     let h5 = h5::open(path)?;
@@ -64,23 +64,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let attr = |name: &str| attrs.iter().find(|(n, _)| n == name).map(|(_, v)| v);
     let order = dimorder(attr("dimorder"), shape.len()).map_err(what)?;
 
-    // The spatial axes: the last three; a fourth, leading, is frames.
-    let (frames, spatial) = match (shape.as_slice(), order.as_slice()) {
-        ([_, _, _], [_, _, _]) => (1, 0),
-        ([t, _, _, _], [first, ..]) if !first.ends_with("space") => (*t, 1),
-        _ => {
-            return Err(what(format!(
-                "dimorder \"{}\" over shape {shape:?}: volray reads three spatial dimensions (xspace, yspace, zspace), after an optional leading one such as time",
-                order.join(",")
-            )));
-        }
-    };
+    let (frames, spatial) = spatial_split(&order, &shape).map_err(what)?;
     let names = &order[spatial..];
-    if let Some(bad) = names.iter().find(|n| !n.ends_with("space")) {
-        return Err(what(format!(
-            "dimension \"{bad}\" is not spatial: volray reads xspace, yspace and zspace (after an optional leading time)"
-        )));
-    }
     let frame = opts.frame.unwrap_or(0);
     if frame >= frames {
         return Err(IoError::frame_out_of_range(
@@ -120,7 +105,19 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.header
         .extend(attrs.iter().map(|(k, v)| (format!("@{k}"), shown(v))));
 
-    let (steps, origin) = geometry(&h5.file.root(), names, &mut info).map_err(fail)?;
+    let root = h5.file.root();
+    let attrs_of = |name: &str| -> Vec<(String, Value)> {
+        root.dataset(&format!("minc-2.0/dimensions/{name}"))
+            .map(|d| {
+                sorted_attrs(d.attrs())
+                    .into_iter()
+                    .filter_map(|(k, v)| neutral(&v).map(|v| (k, v)))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let (steps, origin) =
+        geometry(names, &attrs_of, "/minc-2.0/dimensions", &mut info).map_err(fail)?;
     let scaling = if sample.name.starts_with("float") {
         info.notes
             .push("float image: real values as stored (no image-min/image-max scaling)".into());
@@ -168,6 +165,29 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     })
 }
 
+/// Where the spatial dimensions of an image of dimensions `order` and
+/// `shape` begin, and how many frames the dimension before them holds:
+/// the last three are xspace, yspace and zspace in some order; a fourth,
+/// leading, (time) holds frames.
+pub(crate) fn spatial_split(order: &[String], shape: &[usize]) -> Result<(usize, usize), String> {
+    let (frames, spatial) = match (shape, order) {
+        ([_, _, _], [_, _, _]) => (1, 0),
+        ([t, _, _, _], [first, ..]) if !first.ends_with("space") => (*t, 1),
+        _ => {
+            return Err(format!(
+                "dimorder \"{}\" over shape {shape:?}: volray reads three spatial dimensions (xspace, yspace, zspace), after an optional leading one such as time",
+                order.join(",")
+            ));
+        }
+    };
+    if let Some(bad) = order[spatial..].iter().find(|n| !n.ends_with("space")) {
+        return Err(format!(
+            "dimension \"{bad}\" is not spatial: volray reads xspace, yspace and zspace (after an optional leading time)"
+        ));
+    }
+    Ok((frames, spatial))
+}
+
 /// The axis names of `dimorder` (`"zspace,yspace,xspace"`), one per axis
 /// of a `rank`-axis dataset.
 fn dimorder(value: Option<&AttrValue>, rank: usize) -> Result<Vec<String>, String> {
@@ -184,9 +204,10 @@ fn dimorder(value: Option<&AttrValue>, rank: usize) -> Result<Vec<String>, Strin
 
 /// The step vector of each spatial axis (in file order, slowest first)
 /// and the world position of index 0, from the dimension datasets.
-fn geometry(
-    root: &Group,
+pub(crate) fn geometry(
     names: &[String],
+    attrs_of: &dyn Fn(&str) -> Vec<(String, Value)>,
+    source: &str,
     info: &mut FileInfo,
 ) -> Result<([DVec3; 3], DVec3), String> {
     let mut steps = [DVec3::ZERO; 3];
@@ -203,11 +224,16 @@ fn geometry(
                 ));
             }
         };
-        let attrs = root
-            .dataset(&format!("minc-2.0/dimensions/{name}"))
-            .map(|d| sorted_attrs(d.attrs()))
-            .unwrap_or_default();
+        let attrs = attrs_of(name);
         let attr = |key: &str| attrs.iter().find(|(n, _)| n == key).map(|(_, v)| v);
+        let numbers = |v: &Value| match v {
+            Value::Numbers(n) => Some(n.clone()),
+            Value::Text(_) => None,
+        };
+        let text = |v: &Value| match v {
+            Value::Text(t) => Some(t.trim_end_matches(['\0', ' ']).to_string()),
+            Value::Numbers(_) => None,
+        };
         let number = |key: &str, default: f64| -> Result<f64, String> {
             match attr(key).map(numbers) {
                 None => Ok(default),
@@ -248,14 +274,22 @@ fn geometry(
         ));
     }
     info.notes.push(format!(
-        "geometry from /minc-2.0/dimensions: {}; world = Σ cosines · (start + step · index), nibabel's affine",
+        "geometry from {source}: {}; world = Σ cosines · (start + step · index), nibabel's affine",
         described.join("; ")
     ));
     Ok((steps, origin))
 }
 
-/// The map from stored to real values of an integer image.
-struct Scaling {
+/// An HDF5 attribute as a format-neutral value (text, else numbers).
+fn neutral(v: &AttrValue) -> Option<Value> {
+    text(v)
+        .map(Value::Text)
+        .or_else(|| numbers(v).map(Value::Numbers))
+}
+
+/// The map from stored to real values of an integer image, MINC1's and
+/// MINC2's (nibabel's `_normalize`).
+pub(crate) struct Scaling {
     /// Stored values are clipped to `[lo, hi]`, the valid range.
     lo: f64,
     hi: f64,
@@ -285,17 +319,7 @@ impl Scaling {
             );
             return Ok(None);
         };
-        let (type_lo, type_hi) = type_range(image)?;
-        let (lo, hi) = match valid_range.map(numbers) {
-            None => (type_lo, type_hi),
-            Some(Some(v)) if v.len() == 2 && v[0] < v[1] => (v[0], v[1]),
-            Some(_) => return Err("attribute \"valid_range\" is not two increasing numbers".into()),
-        };
-        if lo < type_lo || hi > type_hi {
-            return Err(format!(
-                "valid_range [{lo}, {hi}] is outside the stored type's range [{type_lo}, {type_hi}]"
-            ));
-        }
+        let (lo, hi) = valid_range_of(valid_range.map(numbers), type_range(image)?)?;
         let scale_order = |ds: &Dataset| -> Result<Vec<String>, String> {
             let rank = h5::shape(ds)?.len();
             match sorted_attrs(ds.attrs())
@@ -307,19 +331,36 @@ impl Scaling {
             }
         };
         let (min_order, max_order) = (scale_order(&min_ds)?, scale_order(&max_ds)?);
-        if min_order != max_order {
-            return Err("image-min and image-max have different dimensions".into());
-        }
-        let k = min_order.len();
-        if k > 2 || min_order != order[..k.min(order.len())] {
-            return Err(format!(
-                "image-min/image-max over \"{}\": volray reads scaling over the image's first one or two dimensions",
-                min_order.join(",")
-            ));
-        }
-        let slices: usize = shape[..k].iter().product();
+        let slices = scale_slices(&min_order, &max_order, order, shape)?;
         let min = read_small(&min_ds, slices).map_err(|e| format!("image-min {e}"))?;
         let max = read_small(&max_ds, slices).map_err(|e| format!("image-max {e}"))?;
+        Scaling::new(
+            (lo, hi),
+            min,
+            max,
+            shape,
+            &min_order,
+            valid_range.is_some(),
+            info,
+        )
+        .map(Some)
+    }
+
+    /// The scaling from valid range `[lo, hi]` onto image-min and
+    /// image-max (`min`, `max`, one per slice of the image's first
+    /// dimensions `min_order`); `valid_given`: whether the range is the
+    /// file's `valid_range` rather than the type's.
+    pub(crate) fn new(
+        (lo, hi): (f64, f64),
+        min: Vec<f64>,
+        max: Vec<f64>,
+        shape: &[usize],
+        min_order: &[String],
+        valid_given: bool,
+        info: &mut FileInfo,
+    ) -> Result<Scaling, String> {
+        let k = min_order.len();
+        let slices: usize = shape[..k].iter().product();
         if min.len() != slices || max.len() != slices {
             return Err(format!(
                 "image-min/image-max hold {} and {} values for {slices} slices",
@@ -330,29 +371,71 @@ impl Scaling {
         let per = shape[k..].iter().product();
         info.notes.push(format!(
             "real values: stored values clipped to [{lo}, {hi}] ({}) mapped onto [image-min, image-max] {}",
-            if valid_range.is_some() { "valid_range" } else { "the type's range" },
+            if valid_given { "valid_range" } else { "the type's range" },
             if k == 0 {
                 format!("[{}, {}]", min[0], max[0])
             } else {
                 format!("per slice of {}", min_order.join(","))
             }
         ));
-        Ok(Some(Scaling {
+        Ok(Scaling {
             lo,
             hi,
             min,
             max,
             per,
-        }))
+        })
     }
 
     /// The real value of stored value `v` at C-order index `at`.
-    fn real(&self, at: usize, v: f64) -> f64 {
+    pub(crate) fn real(&self, at: usize, v: f64) -> f64 {
         let s = at / self.per;
         let (min, max) = (self.min[s], self.max[s]);
         let slope = (max - min) / (self.hi - self.lo);
         v.clamp(self.lo, self.hi) * slope + (min - self.lo * slope)
     }
+}
+
+/// The valid range: the image's `valid_range` attribute (`given`: absent,
+/// or its numbers if numeric), else its integer type's range, within
+/// which it must lie (nibabel's `_get_valid_range`).
+pub(crate) fn valid_range_of(
+    given: Option<Option<Vec<f64>>>,
+    (type_lo, type_hi): (f64, f64),
+) -> Result<(f64, f64), String> {
+    let (lo, hi) = match given {
+        None => (type_lo, type_hi),
+        Some(Some(v)) if v.len() == 2 && v[0] < v[1] => (v[0], v[1]),
+        Some(_) => return Err("attribute \"valid_range\" is not two increasing numbers".into()),
+    };
+    if lo < type_lo || hi > type_hi {
+        return Err(format!(
+            "valid_range [{lo}, {hi}] is outside the stored type's range [{type_lo}, {type_hi}]"
+        ));
+    }
+    Ok((lo, hi))
+}
+
+/// Checks that image-min and image-max lie over the same first one or two
+/// dimensions of the image (`order`, of `shape`); returns how many
+/// values each holds, one per slice.
+pub(crate) fn scale_slices(
+    min_order: &[String],
+    max_order: &[String],
+    order: &[String],
+    shape: &[usize],
+) -> Result<usize, String> {
+    if min_order != max_order {
+        return Err("image-min and image-max have different dimensions".into());
+    }
+    let k = min_order.len();
+    if k > 2 || k > order.len() || min_order != &order[..k] {
+        return Err(format!(
+            "image-min/image-max over \"{}\": volray reads scaling over the image's first one or two dimensions",
+            min_order.join(",")
+        ));
+    }
+    Ok(shape[..k].iter().product())
 }
 
 /// The range of the image's integer type.

@@ -22,7 +22,9 @@ pub(crate) mod hdf5_axes;
 pub(crate) mod hdf5_lazy;
 pub(crate) mod metaimage;
 pub(crate) mod minc;
+pub(crate) mod minc1;
 pub(crate) mod mrc;
+pub(crate) mod netcdf;
 pub(crate) mod netcdf4;
 pub(crate) mod nifti;
 pub(crate) mod npy;
@@ -76,6 +78,10 @@ pub enum VolumeFormat {
     Minc,
     /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
     Zarr,
+    /// NetCDF-3 (`.nc`, `.cdf`, `.nc3`): classic, 64-bit offset and
+    /// 64-bit data, with the CF conventions; a NetCDF-4 file (HDF5) is
+    /// read as HDF5, a MINC1 file as MINC.
+    Netcdf,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -379,6 +385,20 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: true,
         read: zarr::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Netcdf,
+        name: "netcdf",
+        description: "NetCDF",
+        extensions: &["nc", "cdf", "nc3", "netcdf"],
+        name_stems: &[],
+        known_as: ".nc/.cdf",
+        // CDF-1, CDF-2, CDF-5; NetCDF-4 is HDF5 (the HDF5 row's magic).
+        magic: Magic::strong(&[(0, b"CDF\x01"), (0, b"CDF\x02"), (0, b"CDF\x05")]),
+        frames: true,
+        arrays: true,
+        levels: false,
+        read: netcdf::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -627,13 +647,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 15);
+        assert_eq!(VolumeFormat::ALL.len(), 16);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

@@ -163,16 +163,6 @@ impl Layout {
         s.sort_unstable_by(|a, b| b.cmp(a));
         s
     }
-
-    /// The index of every dimension in the slab read: the frame on the
-    /// frame dimension, 0 elsewhere (spatial dimensions are whole).
-    pub(crate) fn fixed_index(&self, dim: usize) -> usize {
-        if Some(dim) == self.frame_dim {
-            self.frame
-        } else {
-            0
-        }
-    }
 }
 
 /// The relative tolerance on evenly spaced coordinates: every value within
@@ -627,10 +617,10 @@ impl Packing {
         let fail =
             |what: &str| IoError::invalid(path, format!("variable {}: attribute {what}", var.name));
         let one = |name: &str| -> Result<Option<f64>, IoError> {
-            match var.attr(name) {
-                None => Ok(None),
-                Some(Value::Numbers(v)) if v.len() == 1 => Ok(Some(v[0])),
-                Some(_) => Err(fail(&format!("{name} is not one number"))),
+            match (var.attr(name), var.numbers(name)) {
+                (None, _) => Ok(None),
+                (_, Some([v])) => Ok(Some(*v)),
+                _ => Err(fail(&format!("{name} is not one number"))),
             }
         };
         let scale = one("scale_factor")?.unwrap_or(1.0);
