@@ -318,7 +318,8 @@ fn check_options(path: &Path, format: VolumeFormat, opts: &ReadOptions) -> Resul
     }
     // An HDF5 dataset is one level, level 0: `render` names it when it
     // reads whole what it opened box by box (`open_lazy`).
-    let one_level = format == VolumeFormat::Hdf5 && opts.level == Some(0);
+    let one_level =
+        matches!(format, VolumeFormat::Hdf5 | VolumeFormat::Netcdf) && opts.level == Some(0);
     if ((opts.level.is_some() && !one_level) || opts.channel.is_some()) && !spec.levels {
         return Err(IoError::LevelNotApplicable {
             path: path.to_path_buf(),
@@ -369,6 +370,15 @@ pub fn open_lazy(path: &Path, opts: &ReadOptions) -> Result<Option<Lazy>, IoErro
                 info,
             },
         )),
+        // A NetCDF-4 variable (HDF5 underneath) with its CF geometry and
+        // packing; a NetCDF-3 variable is read whole.
+        VolumeFormat::Netcdf if crate::formats::netcdf::is_netcdf4(path) => Ok(
+            crate::formats::netcdf4::open_lazy(path, opts)?.map(|(source, info)| Lazy {
+                source: Arc::new(source),
+                format,
+                info,
+            }),
+        ),
         _ => Ok(None),
     }
 }
@@ -378,8 +388,15 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
     if let Some(format) = opts.format {
         return Ok(format);
     }
-    if split_hdf5_path(path).is_some() {
-        return Ok(VolumeFormat::Hdf5);
+    if let Some((file, _)) = split_hdf5_path(path) {
+        // `file.nc:/var` names a NetCDF-4 variable: read with its CF
+        // geometry (formats/netcdf4.rs); any other `file:/dataset` is HDF5.
+        let netcdf = VolumeFormat::from_path(&file) == Some(VolumeFormat::Netcdf);
+        return Ok(if netcdf {
+            VolumeFormat::Netcdf
+        } else {
+            VolumeFormat::Hdf5
+        });
     }
     if path.is_dir() {
         // Zarr groups and arrays by their metadata files; any other
@@ -393,12 +410,6 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
         });
     }
     if let Some(format) = VolumeFormat::from_path(path) {
-        // A NetCDF-4 `.nc` is HDF5: read (and opened box by box) as HDF5,
-        // as before NetCDF-3 had its row. The lead wires netcdf4::read here
-        // at merge.
-        if format == VolumeFormat::Netcdf && crate::formats::netcdf::is_hdf5(path) {
-            return Ok(VolumeFormat::Hdf5);
-        }
         return Ok(format);
     }
     if opts.raw.is_some() {

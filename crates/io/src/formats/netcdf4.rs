@@ -31,10 +31,6 @@
 //! (`None`: it is read whole, within `--max-memory`), as a box source's
 //! grid steps forward along every axis.
 
-// Reached through the format table once the lead wires the NetCDF row's
-// HDF5-magic files here (read, open_lazy); until then only its tests.
-#![cfg_attr(not(test), allow(dead_code))]
-
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -88,8 +84,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     } = open(path, opts)?;
     let real = |v: f64| packing.real(v);
     let real: Option<&dyn Fn(f64) -> f64> = (!packing.is_identity()).then_some(&real);
-    // The lead's Netcdf row of the format table: its VolumeFormat.
-    read_opened(opened, real, steps, VolumeFormat::Hdf5, opts)
+    read_opened(opened, real, steps, VolumeFormat::Netcdf, opts)
 }
 
 /// Opens the variable `path` names as a source of boxes; `None` where it

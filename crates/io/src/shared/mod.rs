@@ -19,9 +19,6 @@
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
 //! | `cf.rs` | the CF conventions, format neutral: axes, coordinate variables, packing, fill values | NetCDF-3, MINC1, NetCDF-4 |
 
-// Until the NetCDF-3 reader (branch netcdf) that uses all of it is merged:
-// branch hdf5-axes uses most of it (formats/netcdf4.rs). Drop at merge.
-#[allow(dead_code)]
 pub(crate) mod cf;
 pub(crate) mod compress;
 pub(crate) mod geometry;

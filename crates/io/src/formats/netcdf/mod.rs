@@ -46,16 +46,24 @@ pub(crate) use header::{Header, NcType, Var, read_values};
 
 /// Reads the NetCDF file at `path`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    if is_hdf5(path) {
-        // A NetCDF-4 file: HDF5. The lead wires netcdf4::read here at
-        // merge; until then, the HDF5 route that `file.nc:/var` takes.
-        return super::hdf5::read(path, opts);
+    if is_netcdf4(path) {
+        // A NetCDF-4 file: HDF5 underneath, read with the same CF rules.
+        return super::netcdf4::read(path, opts);
     }
     let (file, header) = open(path)?;
     if super::minc1::is_minc1(&header) {
         return super::minc1::read_parsed(path, opts, file, header);
     }
     read_cf(path, opts, file, header)
+}
+
+/// Whether `path` is a NetCDF-4 file (HDF5 underneath), or names a
+/// variable in one (`file.nc:/var`).
+pub(crate) fn is_netcdf4(path: &Path) -> bool {
+    match crate::split_hdf5_path(path) {
+        Some((file, _)) => is_hdf5(&file),
+        None => is_hdf5(path),
+    }
 }
 
 /// Whether the file at `path` starts with HDF5's signature (a NetCDF-4
