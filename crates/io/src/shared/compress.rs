@@ -19,6 +19,20 @@ use crate::error::IoError;
 /// bytes is lying, and every reader refuses it before allocating.
 pub const MAX_DEFLATE_RATIO: u64 = 1032;
 
+/// The most bytes one byte of a bzip2 stream can decode to. A block holds
+/// at most 900,000 bytes after the first run-length stage (libbzip2's
+/// `nblockMAX` for `-9`), and that stage turns at most 5 bytes (4 equal
+/// bytes and a count, which decoders take up to 255) into 259, so a block
+/// decodes to at most 46,620,000 bytes; a block costs more than 21 bytes
+/// (48-bit magic, 32-bit CRC, 1 + 24 bits, a symbol map of at least 32
+/// bits, 18 bits of group and selector counts, a selector, two coding
+/// tables of at least 8 bits, an end-of-block symbol: 173 bits). So no
+/// stream decodes to more than 46,620,000 / 20 < 2,400,000 bytes per byte.
+/// That bound refuses only absurd headers: bzip2 data is read
+/// incrementally, the output growing only as data decodes and reading
+/// stopped one byte past the declared size (payload/decode.rs).
+pub const MAX_BZIP2_RATIO: u64 = 2_400_000;
+
 /// The compressed encodings readers meet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Compression {
