@@ -23,6 +23,7 @@ pub(crate) mod metaimage;
 pub(crate) mod minc;
 pub(crate) mod mrc;
 pub(crate) mod nifti;
+pub(crate) mod not_read;
 pub(crate) mod npy;
 pub(crate) mod nrrd;
 pub(crate) mod raw;
