@@ -112,6 +112,7 @@ fn naming_flags(e: &IoError) -> String {
         | IoError::Volume { .. }
         | IoError::Npy { .. }
         | IoError::Invalid { .. }
+        | IoError::NotRead { .. }
         | IoError::FlatImage { .. }
         | IoError::ImageSize { .. } => e.to_string(),
     }

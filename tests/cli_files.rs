@@ -427,3 +427,41 @@ fn a_skewed_map_of_part_of_a_cell_renders_with_empty_space_around_its_box() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(fs::metadata(&png).unwrap().len() > 0);
 }
+
+#[test]
+fn info_names_a_format_it_does_not_read_and_the_tool_that_converts_it() {
+    // Fixtures: crates/io/tests/fixtures/make_not_read_fixtures.py.
+    let dir = "crates/io/tests/fixtures/not_read";
+    let out_dir = tempfile::tempdir().unwrap();
+    let png = out_dir.path().join("never.png");
+    let png = png.to_str().unwrap();
+    for (file, expect) in [
+        (
+            "T1.PAR",
+            "Philips PAR/REC is not read by volray; convert it to NIfTI with nibabel's parrec2nii",
+        ),
+        (
+            "tinypet.v",
+            "ECAT 7 is not read by volray; convert it to NIfTI with nibabel",
+        ),
+        (
+            "scaled+tlrc.HEAD",
+            "AFNI BRIK/HEAD is not read by volray; convert it to NIfTI with AFNI's 3dAFNItoNIFTI",
+        ),
+        (
+            "grid.vdb",
+            "OpenVDB is not read by volray; copy the grid to a dense array",
+        ),
+        ("n5", "N5 is not read by volray; convert it to Zarr"),
+    ] {
+        let path = format!("{dir}/{file}");
+        for args in [vec!["info", &path], vec!["render", &path, "-o", png]] {
+            let out = volray(&args);
+            assert_eq!(out.status.code(), Some(1), "{path}: {}", stderr(&out));
+            let err = stderr(&out);
+            assert_eq!(err.lines().count(), 1, "{err}");
+            assert!(err.contains(&format!("{path}: {expect}")), "{err}");
+            assert!(!err.contains("DICOM"), "{err}");
+        }
+    }
+}

@@ -104,6 +104,16 @@ pub enum IoError {
     )]
     UnknownFormat { path: PathBuf },
 
+    /// A format volray recognises (by content) but does not read, e.g.
+    /// `scan.PAR: Philips PAR/REC is not read by volray; convert it to ...`:
+    /// `hint` names a tool that converts it to a format volray reads.
+    #[error("{}: {format} is not read by volray; {hint}", path.display())]
+    NotRead {
+        path: PathBuf,
+        format: &'static str,
+        hint: &'static str,
+    },
+
     /// A raw layout ([`ReadOptions::raw`]) given for a file whose format
     /// carries its own layout.
     #[error("{}: raw layout options do not apply to {format} files", path.display())]
@@ -219,6 +229,7 @@ impl IoError {
             | IoError::Npy { .. }
             | IoError::Invalid { .. }
             | IoError::UnknownFormat { .. }
+            | IoError::NotRead { .. }
             | IoError::RawOptionsNotApplicable { .. }
             | IoError::FrameNotApplicable { .. }
             | IoError::LevelNotApplicable { .. }
@@ -247,6 +258,7 @@ impl IoError {
             | IoError::Npy { path, .. }
             | IoError::Invalid { path, .. }
             | IoError::UnknownFormat { path }
+            | IoError::NotRead { path, .. }
             | IoError::RawOptionsNotApplicable { path, .. }
             | IoError::FrameNotApplicable { path, .. }
             | IoError::LevelNotApplicable { path, .. }

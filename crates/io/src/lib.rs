@@ -32,11 +32,11 @@
 //! |---|---|---|
 //! | raw | `formats/raw.rs` | layout from [`RawOptions`] |
 //! | NumPy `.npy` | `formats/npy/` | `a[x, y, z]`; C order transposed |
-//! | NRRD `.nrrd`, `.nhdr` | `formats/nrrd/` | raw, gzip, ascii, hex; detached and multi-file data; space directions; 4-D frames |
+//! | NRRD `.nrrd`, `.nhdr` | `formats/nrrd/` | raw, gzip, bzip2, ascii, hex; detached and multi-file data; space directions; 4-D frames |
 //! | MetaImage `.mha`, `.mhd` | `formats/metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
 //! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
 //! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
-//! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib; Direction; pieces |
+//! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib, LZ4, LZMA; Direction; pieces |
 //! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
 //! | TIFF stacks `.tif` | `formats/tiff/` | pages are z; ImageJ spacing; hyperstack frames; OME-XML page order, physical sizes and units |
 //! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`); axes named by `axes`, `axistags`, `DIMENSION_LABELS`, dimension scales (`hdf5_axes.rs`), else `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
@@ -52,6 +52,9 @@
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is
 //! read and refused as a volume with [`IoError::FlatImage`], which
 //! carries what was read ([`FlatImage`]) for a caller that describes it.
+//! Formats recognised but not read (PAR/REC, ECAT 7, AFNI, OpenVDB, N5:
+//! `formats/not_read.rs`) are refused with [`IoError::NotRead`], which
+//! names the format and a tool that converts it.
 //!
 //! What the readers share is under `shared/` (its module docs list each
 //! piece and who uses it): [`grid_to_volume`] (`shared/geometry.rs`) maps
@@ -60,7 +63,8 @@
 //! `shared/text_header.rs` reads the lines and field values of NRRD and
 //! MetaImage headers, and `shared/payload/` their data (skips,
 //! encodings, multi-file lists) within the file's bounds;
-//! [`inflate_exact`] (`shared/compress.rs`) inflates to a declared size;
+//! [`inflate_exact`] (`shared/compress.rs`) decodes gzip, zlib, LZ4 and
+//! xz to a declared size;
 //! [`check_volume_size`] (`shared/limits.rs`) checks a header's dimensions
 //! for overflow and against [`ReadOptions::max_memory`];
 //! `shared/text_reader.rs` streams numbers out of text formats and text

@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use volray_core::{Volume, VolumeSource};
 
-use crate::formats::VolumeFormat;
+use crate::formats::{VolumeFormat, not_read};
 use crate::shared::geometry::Reorientation;
 use crate::shared::input::open_input;
 use crate::shared::limits::default_max_memory;
@@ -399,15 +399,19 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
         });
     }
     if path.is_dir() {
-        // Zarr groups and arrays by their metadata files; any other
-        // directory is a DICOM series (or a `.zarr` missing its metadata).
+        // Zarr groups and arrays by their metadata files; N5 refused by
+        // name; a directory inside a Zarr store or holding stores named
+        // as such; any other directory is a DICOM series (or a `.zarr`
+        // missing its metadata).
         let zarr = crate::formats::zarr::is_zarr_dir(path)
             || VolumeFormat::from_path(path) == Some(VolumeFormat::Zarr);
-        return Ok(if zarr {
-            VolumeFormat::Zarr
-        } else {
-            VolumeFormat::Dicom
-        });
+        if zarr {
+            return Ok(VolumeFormat::Zarr);
+        }
+        if let Some(refusal) = not_read::refuse_dir(path).or_else(|| stores_near(path)) {
+            return Err(refusal);
+        }
+        return Ok(VolumeFormat::Dicom);
     }
     if let Some(format) = VolumeFormat::from_path(path) {
         return Ok(format);
@@ -420,9 +424,53 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
     file.take(1024)
         .read_to_end(&mut head)
         .map_err(|e| IoError::os(path, "read", e))?;
+    // Formats recognised but not read are named before the readers'
+    // weaker signatures are tried.
+    if let Some(refusal) = not_read::refuse_file(path, &head) {
+        return Err(refusal);
+    }
     VolumeFormat::sniff(&head).ok_or_else(|| IoError::UnknownFormat {
         path: path.to_path_buf(),
     })
+}
+
+/// Most directory entries looked at for Zarr or N5 stores inside a
+/// directory that is neither (a DICOM series holds files, not stores).
+const STORES_LOOKED_AT: usize = 4096;
+
+/// Why the directory `dir` (neither Zarr nor N5 itself) is no DICOM
+/// series: it lies inside a Zarr or N5 store, or holds such stores.
+fn stores_near(dir: &Path) -> Option<IoError> {
+    let is_store =
+        |d: &Path| crate::formats::zarr::is_zarr_dir(d) || not_read::refuse_dir(d).is_some();
+    if let Some(store) = dir.ancestors().skip(1).take(32).find(|a| is_store(a)) {
+        return Some(IoError::invalid(
+            dir,
+            format!(
+                "this directory lies inside the store {}: pass the store (or one of its arrays), not a directory of its chunks",
+                store.display()
+            ),
+        ));
+    }
+    let mut stores: Vec<String> = std::fs::read_dir(dir)
+        .ok()?
+        .take(STORES_LOOKED_AT)
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.is_dir() && is_store(p))
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    if stores.is_empty() {
+        return None;
+    }
+    stores.sort();
+    Some(IoError::invalid(
+        dir,
+        format!(
+            "this directory holds Zarr or N5 stores, not a DICOM series: pass one of them ({})",
+            stores.join(", ")
+        ),
+    ))
 }
 
 #[cfg(test)]

@@ -72,7 +72,7 @@ fn check_cells(name: &str, l: &Loaded, points: &Grid) {
     );
 }
 
-const VARIANTS: [(&str, &str); 11] = [
+const VARIANTS: [(&str, &str); 18] = [
     ("vti_ascii.vti", "little"),
     ("vti_binary.vti", "little"),
     ("vti_binary_u32.vti", "little"),
@@ -84,6 +84,13 @@ const VARIANTS: [(&str, &str); 11] = [
     ("vti_appended_base64_zlib_u32.vti", "little"),
     ("vti_appended_raw_be.vti", "big"),
     ("vti_binary_be_zlib.vti", "big"),
+    ("vti_binary_lz4.vti", "little"),
+    ("vti_binary_lz4_u32.vti", "little"),
+    ("vti_appended_raw_lz4.vti", "little"),
+    ("vti_appended_base64_lzma_u32.vti", "little"),
+    ("vti_binary_lzma.vti", "little"),
+    ("vti_appended_raw_lzma_u32.vti", "little"),
+    ("vti_binary_be_lzma.vti", "big"),
 ];
 
 #[test]
@@ -228,14 +235,13 @@ fn direction_matrix_and_extent_offsets() {
 }
 
 #[test]
-fn lz4_is_refused_clearly() {
-    let err = read_with("vti_lz4.vti", None).unwrap_err();
-    assert!(!err.is_io_failure());
-    assert!(
-        err.to_string()
-            .contains("compressor=\"vtkLZ4DataCompressor\""),
-        "{err}"
+fn lz4_with_vtks_default_block_size() {
+    let l = load("vti_lz4.vti", None);
+    assert_eq!(
+        header_value(&l, "VTKFile compressor"),
+        "vtkLZ4DataCompressor"
     );
+    check_ramp("vti_lz4.vti", &l);
 }
 
 // ---- broken files ----
@@ -407,6 +413,118 @@ fn malformed_files() {
     assert!(msg.contains("holds more than the 60 values"), "{msg}");
 }
 
+/// `bytes` with header word `index` of the appended array at `offset` set
+/// to `value` (`word` bytes, little-endian), in a raw appended file.
+fn set_word(bytes: &[u8], offset: usize, word: usize, index: usize, value: u64) -> Vec<u8> {
+    let tag = b"<AppendedData encoding=\"raw\">";
+    let at = bytes.windows(tag.len()).position(|w| w == tag).unwrap();
+    let start = at + bytes[at..].iter().position(|&b| b == b'_').unwrap() + 1;
+    let mut out = bytes.to_vec();
+    let from = start + offset + index * word;
+    out[from..from + word].copy_from_slice(&value.to_le_bytes()[..word]);
+    out
+}
+
+/// The extent of every fixture with z running 0 to `z`.
+fn with_z_extent(bytes: &[u8], z: usize) -> Vec<u8> {
+    let b = replace(
+        bytes,
+        "WholeExtent=\"0 3 0 2 0 4\"",
+        &format!("WholeExtent=\"0 3 0 2 0 {z}\""),
+    );
+    replace(
+        &b,
+        "Piece Extent=\"0 3 0 2 0 4\"",
+        &format!("Piece Extent=\"0 3 0 2 0 {z}\""),
+    )
+}
+
+/// LZ4 and xz blocks whose header lies about their sizes, or whose bytes
+/// are cut or garbled: one line naming the array and block, and nothing
+/// allocated for a size only the header claims.
+#[test]
+fn lying_truncated_and_corrupt_lz4_and_lzma_blocks() {
+    // "ramp" is one block of 240 bytes (block size 256) at offset 0.
+    for (file, word, codec) in [
+        ("vti_appended_raw_lz4.vti", 8, "LZ4 block"),
+        ("vti_appended_raw_lzma_u32.vti", 4, "xz stream"),
+    ] {
+        let b = fixture_text(file);
+        // The extent and the header claim 288 bytes; the block holds 240.
+        let more = set_word(&with_z_extent(&b, 5), 0, word, 2, 288);
+        let more = set_word(&more, 0, word, 1, 288);
+        let msg = error_for(&more);
+        assert!(
+            msg.contains(&format!(
+                "DataArray \"ramp\" block 0: {codec} decodes to 240 bytes, but the header declares 288"
+            )),
+            "{file}: {msg}"
+        );
+        // They claim 192 bytes; the block holds 240.
+        let less = set_word(&with_z_extent(&b, 3), 0, word, 2, 192);
+        let msg = error_for(&less);
+        assert!(
+            msg.contains(&format!(
+                "DataArray \"ramp\" block 0: {codec} decodes past the 192 bytes the header declares"
+            )),
+            "{file}: {msg}"
+        );
+        // A compressed size larger than the data that follows.
+        let msg = error_for(&set_word(&b, 0, word, 3, 1 << 30));
+        assert!(
+            msg.contains("\"ramp\": compressed block 0 (1073741824 bytes) runs past the end"),
+            "{file}: {msg}"
+        );
+        // A compressed size cut short: the block ends early.
+        let msg = error_for(&set_word(&b, 0, word, 3, 40));
+        assert!(
+            msg.contains("DataArray \"ramp\" block 0: "),
+            "{file}: {msg}"
+        );
+        // The block's bytes garbled (the data follows the 4 header words):
+        // xz checks its CRC; LZ4 blocks carry no checksum, so garbled
+        // literals decode (the byte flips below still must not panic).
+        if codec == "LZ4 block" {
+            continue;
+        }
+        let mut garbled = b.clone();
+        let tag = b"<AppendedData encoding=\"raw\">";
+        let at = b.windows(tag.len()).position(|w| w == tag).unwrap();
+        let start = at + b[at..].iter().position(|&c| c == b'_').unwrap() + 1 + 4 * word;
+        for x in &mut garbled[start + 8..start + 24] {
+            *x ^= 0x5a;
+        }
+        let msg = error_for(&garbled);
+        assert!(
+            msg.contains("DataArray \"ramp\" block 0: corrupt xz stream"),
+            "{file}: {msg}"
+        );
+    }
+
+    // An LZ4 header claiming far more than its bytes can decode to (255:1)
+    // is refused before decoding, whatever the memory limit.
+    let b = with_z_extent(&fixture_text("vti_appended_raw_lz4.vti"), 99_999);
+    let b = set_word(&b, 0, 8, 0, 1);
+    let b = set_word(&b, 0, 8, 1, 4_800_000);
+    let b = set_word(&b, 0, 8, 2, 4_800_000);
+    let unlimited = ReadOptions {
+        max_memory: u64::MAX,
+        ..ReadOptions::default()
+    };
+    let msg = refused_file("bad.vti", &b, &unlimited);
+    assert!(msg.contains("cannot inflate to the 4800000"), "{msg}");
+    // xz has no useful ratio: the claim is refused once the stream ends,
+    // its output having grown only to what it holds.
+    let b = with_z_extent(&fixture_text("vti_appended_raw_lzma_u32.vti"), 99_999);
+    let b = set_word(&b, 0, 4, 1, 4_800_000);
+    let b = set_word(&b, 0, 4, 2, 4_800_000);
+    let msg = refused_file("bad.vti", &b, &unlimited);
+    assert!(
+        msg.contains("xz stream decodes to 240 bytes, but the header declares 4800000"),
+        "{msg}"
+    );
+}
+
 /// Deterministic byte flips and truncations of a few fixtures, each read
 /// for its point and its cell array: a volume or a one-line message,
 /// never a panic.
@@ -418,6 +536,8 @@ fn no_panic_on_truncation_or_corruption() {
         "vti_appended_base64_zlib_u32.vti",
         "vti_binary.vti",
         "vti_pieces.vti",
+        "vti_appended_raw_lz4.vti",
+        "vti_binary_lzma.vti",
     ]
     .map(fixture);
     common::byte_flips_never_panic(

@@ -27,6 +27,7 @@ pub(crate) mod mrc;
 pub(crate) mod netcdf;
 pub(crate) mod netcdf4;
 pub(crate) mod nifti;
+pub(crate) mod not_read;
 pub(crate) mod npy;
 pub(crate) mod nrrd;
 pub(crate) mod raw;

@@ -4,8 +4,9 @@
 //! after the header, and detached `.nhdr` headers whose `data file` names
 //! one file, a `LIST` of files, or a numbered `%d` series.
 //!
-//! Read: every sample type but `block`; encodings `raw`, `gzip`, `ascii`
-//! (`text`, `txt`) and `hex` (`bzip2` is refused with a clear message);
+//! Read: every sample type but `block`; encodings `raw`, `gzip`, `bzip2`
+//! (`bz2`; decoded by the `bzip2` crate's pure-Rust libbz2-rs-sys), `ascii`
+//! (`text`, `txt`) and `hex`;
 //! `endian`, `line skip`, `byte skip` (including -1: data at the end of a
 //! raw file); 3-D files, and 4-D files whose one non-spatial axis (a
 //! `space directions` entry of `none`, or a `list`, `vector`, `time`, ...
@@ -142,7 +143,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         inflated_skip: 0,
     };
     let skip = match byte_skip {
-        n if n >= 0 && matches!(encoding, Encoding::Gzip | Encoding::Zlib) => {
+        n if n >= 0 && encoding.is_compressed() => {
             layout.inflated_skip = n as u64;
             Skip::Forward(0)
         }
@@ -258,11 +259,9 @@ fn parse_encoding(path: &Path, name: &str) -> Result<Encoding, IoError> {
         "gz" | "gzip" => Ok(Encoding::Gzip),
         "txt" | "text" | "ascii" => Ok(Encoding::Text),
         "hex" => Ok(Encoding::Hex),
-        "bz2" | "bzip2" => Err(Field::nrrd(path, "encoding").error(format!(
-            "{name} is not supported: save the file with raw or gzip encoding (e.g. `unu save -e gzip`)"
-        ))),
+        "bz2" | "bzip2" => Ok(Encoding::Bzip2),
         _ => Err(Field::nrrd(path, "encoding").error(format!(
-            "unknown encoding \"{name}\" (known: raw, gzip, ascii, hex)"
+            "unknown encoding \"{name}\" (known: raw, gzip, bzip2, ascii, hex)"
         ))),
     }
 }

@@ -1,11 +1,14 @@
 //! The block-header framing of VTK XML binary data (vtkXMLWriter): a byte
-//! count, or for zlib-compressed data the block count, block size, last
-//! block size and compressed block sizes, in `header_type` words of the
-//! file's byte order; raw (appended) or base64 (inline or appended), with
-//! the header and data base64-encoded separately or as one stream.
+//! count, or for compressed data (zlib, LZ4 or LZMA, vtkXMLWriter's
+//! `WriteCompressionHeader`) the block count, block size, last block size
+//! and compressed block sizes, in `header_type` words of the file's byte
+//! order; raw (appended) or base64 (inline or appended), with the header
+//! and data base64-encoded separately or as one stream. Each block is one
+//! zlib stream, raw LZ4 block or xz stream (`shared/compress.rs`).
 //!
 //! Every declared size is checked against the bytes that hold it, and each
-//! compressed block against deflate's largest ratio, before allocating.
+//! compressed block against its codec's largest ratio (zlib, LZ4), before
+//! allocating; xz blocks grow only as they decode.
 
 use std::path::Path;
 
@@ -15,7 +18,7 @@ use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
 
 use crate::dtype::Endian;
 use crate::error::IoError;
-use crate::shared::compress::{Compression, inflate_exact};
+use crate::shared::compress::{Compression, Decompressor};
 
 /// How a file frames its binary data (`VTKFile` attributes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -24,13 +27,10 @@ pub(super) struct BlockFormat {
     pub endian: Endian,
     /// Bytes per header word (`header_type` UInt32 or UInt64).
     pub word: usize,
-    /// `compressor="vtkZLibDataCompressor"`.
-    pub compressed: bool,
+    /// `compressor="vtkZLibDataCompressor"`, `"vtkLZ4DataCompressor"` or
+    /// `"vtkLZMADataCompressor"`; `None` when uncompressed.
+    pub compressed: Option<Compression>,
 }
-
-/// Deflate's largest compression ratio (RFC 1951: a 258-byte match costs
-/// at least two bits), bounding what a compressed block can inflate to.
-use crate::shared::compress::MAX_DEFLATE_RATIO;
 
 /// Base64 as VTK writes it, read leniently about padding and trailing bits.
 const BASE64: GeneralPurpose = GeneralPurpose::new(
@@ -60,7 +60,7 @@ struct Blocks {
 }
 
 /// The block layout in `header` (3 + n words), checked against the
-/// expected size and against deflate's ratio.
+/// expected size and against the codec's ratio.
 fn blocks(
     path: &Path,
     header: &[u8],
@@ -89,7 +89,8 @@ fn blocks(
     let sum = compressed
         .iter()
         .fold(0u64, |a, &c| a.saturating_add(c as u64));
-    if (expected as u64) > sum.saturating_mul(MAX_DEFLATE_RATIO) {
+    let ratio = s.compressed.and_then(Compression::max_ratio);
+    if ratio.is_some_and(|r| (expected as u64) > sum.saturating_mul(r)) {
         return Err(IoError::invalid(
             path,
             format!(
@@ -106,23 +107,25 @@ fn blocks(
     Ok(Blocks { sizes, compressed })
 }
 
-/// Inflates the blocks laid out in `b` from `data`.
+/// Decodes the blocks laid out in `b` from `data` with `kind`.
 fn inflate_blocks(
     path: &Path,
     data: &[u8],
     b: &Blocks,
+    kind: Compression,
     expected: usize,
     name: &str,
 ) -> Result<Vec<u8>, IoError> {
-    // The output grows as blocks inflate; each block's declared size is
-    // bounded by deflate's ratio before inflate_exact allocates it.
+    // The output grows as blocks decode; each block's declared size is
+    // bounded by the codec's ratio before it is allocated (an xz block's
+    // output grows as it decodes).
     let mut out = Vec::with_capacity(expected.min(1 << 20));
+    let mut decompressor = Decompressor::new(kind);
     let mut at = 0usize;
     for (i, (&size, &c)) in b.sizes.iter().zip(&b.compressed).enumerate() {
-        if size as u64
-            > (c as u64)
-                .saturating_mul(MAX_DEFLATE_RATIO)
-                .saturating_add(64)
+        if kind
+            .max_ratio()
+            .is_some_and(|r| size as u64 > (c as u64).saturating_mul(r).saturating_add(64))
         {
             return Err(IoError::invalid(
                 path,
@@ -134,10 +137,9 @@ fn inflate_blocks(
         let chunk = data.get(at..at.saturating_add(c)).ok_or_else(|| {
             IoError::invalid(path, format!("DataArray \"{name}\": compressed block {i} ({c} bytes) runs past the end of the data"))
         })?;
-        out.extend(inflate_exact(
+        out.extend(decompressor.decode_exact(
             path,
             chunk,
-            Compression::Zlib,
             size,
             &format!("DataArray \"{name}\" block {i}"),
         )?);
@@ -161,7 +163,7 @@ pub(super) fn raw_block(
         )
     };
     let w = s.word;
-    if !s.compressed {
+    let Some(kind) = s.compressed else {
         let header = region.get(..w).ok_or_else(|| short("header"))?;
         let n = word(header, s, 0);
         if n != expected as u64 {
@@ -171,7 +173,7 @@ pub(super) fn raw_block(
             .get(w..w + expected)
             .map(<[u8]>::to_vec)
             .ok_or_else(|| short("data"));
-    }
+    };
     let head = region
         .get(..3 * w)
         .ok_or_else(|| short("compression header"))?;
@@ -181,7 +183,7 @@ pub(super) fn raw_block(
     }
     let hlen = (3 + n as usize) * w;
     let b = blocks(path, &region[..hlen], s, expected, name)?;
-    inflate_blocks(path, &region[hlen..], &b, expected, name)
+    inflate_blocks(path, &region[hlen..], &b, kind, expected, name)
 }
 
 fn size_mismatch(path: &Path, name: &str, declared: u64, expected: usize) -> IoError {
@@ -229,7 +231,7 @@ pub(super) fn base64_block(
     let w = s.word;
     // The header's length: one word, or 3 + n words when compressed (the
     // first 3 words are 4·w characters in either encoding).
-    let header_len = if s.compressed {
+    let header_len = if s.compressed.is_some() {
         let first = b64(path, text.get(..4 * w).ok_or_else(short)?, name)?;
         let n = word(&first, s, 0);
         if n > (text.len() / w) as u64 {
@@ -247,7 +249,7 @@ pub(super) fn base64_block(
             return Err(short());
         }
         let rest = &text[seg..];
-        if !s.compressed {
+        let Some(kind) = s.compressed else {
             let n = word(&header, s, 0);
             if n != expected as u64 {
                 return Err(size_mismatch(path, name, n, expected));
@@ -259,12 +261,12 @@ pub(super) fn base64_block(
             };
             let data = b64(path, rest.get(..chars).ok_or_else(short)?, name)?;
             return data.get(..expected).map(<[u8]>::to_vec).ok_or_else(short);
-        }
+        };
         let b = blocks(path, &header, s, expected, name)?;
         let sum: usize = b.compressed.iter().sum();
         let chars = if inline { rest.len() } else { b64_len(sum) };
         let data = b64(path, rest.get(..chars).ok_or_else(short)?, name)?;
-        return inflate_blocks(path, &data, &b, expected, name);
+        return inflate_blocks(path, &data, &b, kind, expected, name);
     }
     // One stream: decode the header first, then as much as it declares.
     let header = b64(
@@ -273,7 +275,7 @@ pub(super) fn base64_block(
         name,
     )?;
     let header = header.get(..header_len).ok_or_else(short)?;
-    let payload = if s.compressed {
+    let payload = if s.compressed.is_some() {
         blocks(path, header, s, expected, name)?
             .compressed
             .iter()
@@ -290,11 +292,12 @@ pub(super) fn base64_block(
     let data = all
         .get(header_len..header_len + payload)
         .ok_or_else(short)?;
-    if s.compressed {
-        let b = blocks(path, header, s, expected, name)?;
-        inflate_blocks(path, data, &b, expected, name)
-    } else {
-        Ok(data.to_vec())
+    match s.compressed {
+        Some(kind) => {
+            let b = blocks(path, header, s, expected, name)?;
+            inflate_blocks(path, data, &b, kind, expected, name)
+        }
+        None => Ok(data.to_vec()),
     }
 }
 
@@ -302,7 +305,7 @@ pub(super) fn base64_block(
 mod tests {
     use super::*;
 
-    fn format(word: usize, compressed: bool) -> BlockFormat {
+    fn format(word: usize, compressed: Option<Compression>) -> BlockFormat {
         BlockFormat {
             endian: Endian::Little,
             word,
@@ -315,7 +318,7 @@ mod tests {
         let data: Vec<u8> = (0..10).collect();
         let p = Path::new("f.vti");
         for word in [4usize, 8] {
-            let s = format(word, false);
+            let s = format(word, None);
             let mut header = 10u64.to_le_bytes()[..word].to_vec();
             // Separately encoded.
             let text = [BASE64.encode(&header), BASE64.encode(&data)].concat();
@@ -362,7 +365,7 @@ mod tests {
         for c in &chunks {
             header.extend((c.len() as u32).to_le_bytes());
         }
-        let s = format(4, true);
+        let s = format(4, Some(Compression::Zlib));
         let mut raw = header.clone();
         raw.extend(chunks.concat());
         assert_eq!(raw_block(p, &raw, &s, 700, "a").unwrap(), data);

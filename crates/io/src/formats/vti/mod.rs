@@ -6,18 +6,21 @@
 //! `"binary"` (base64 in the element) or `"appended"` (at `offset` after
 //! the `_` of `<AppendedData encoding="raw|base64">`). Binary and appended
 //! data start with a block header of `header_type` words (UInt32 or
-//! UInt64, in the file's `byte_order`): the byte count, or with
-//! `compressor="vtkZLibDataCompressor"` the block count, block size, last
-//! block size and each block's compressed size (vtkXMLWriter). VTK
-//! base64-encodes a compressed array's header and data separately, an
-//! uncompressed one as one stream; both are accepted either way.
+//! UInt64, in the file's `byte_order`): the byte count, or with a
+//! `compressor` (`vtkZLibDataCompressor`, `vtkLZ4DataCompressor`,
+//! `vtkLZMADataCompressor`) the block count, block size, last block size
+//! and each block's compressed size (vtkXMLWriter); each block is one zlib
+//! stream, raw LZ4 block or xz stream. VTK base64-encodes a compressed
+//! array's header and data separately, an uncompressed one as one stream;
+//! both are accepted either way.
 //!
 //! The XML part is read in `structure` (quick-xml, up to `<AppendedData>`,
 //! whose raw bytes are not XML), the binary framing in `blocks`; this file
 //! picks the array, decodes it in every piece, assembles the pieces and
 //! sets the geometry. Every size a header declares is checked against the
-//! bytes that hold it before anything is allocated, and a compressed size
-//! against deflate's largest ratio. Array choice and cell data:
+//! bytes that hold it and against `--max-memory` before anything is
+//! allocated, and a compressed size against its codec's largest ratio
+//! (zlib, LZ4). Array choice and cell data:
 //! [`crate::shared::vtk_arrays`].
 
 mod blocks;

@@ -13,6 +13,7 @@ use super::blocks::BlockFormat;
 use crate::FileInfo;
 use crate::dtype::{DType, Endian};
 use crate::error::IoError;
+use crate::shared::compress::Compression;
 use crate::shared::vtk_arrays::{ArrayEntry, Association};
 
 /// Where an array's values are.
@@ -153,7 +154,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8], info: &mut FileInfo) -> Result<St
         blocks: BlockFormat {
             endian: Endian::Little,
             word: 4,
-            compressed: false,
+            compressed: None,
         },
         whole: [0; 6],
         origin: DVec3::ZERO,
@@ -346,13 +347,15 @@ fn root(
         }
     };
     s.blocks.compressed = match get(attrs, "compressor") {
-        None | Some("") => false,
-        Some("vtkZLibDataCompressor") => true,
+        None | Some("") => None,
+        Some("vtkZLibDataCompressor") => Some(Compression::Zlib),
+        Some("vtkLZ4DataCompressor") => Some(Compression::Lz4Block),
+        Some("vtkLZMADataCompressor") => Some(Compression::Xz),
         Some(other) => {
             return Err(IoError::invalid(
                 path,
                 format!(
-                    "VTKFile compressor=\"{other}\": volray reads uncompressed and vtkZLibDataCompressor data only (re-save with zlib or no compression)"
+                    "VTKFile compressor=\"{other}\": volray reads uncompressed, vtkZLibDataCompressor, vtkLZ4DataCompressor and vtkLZMADataCompressor data (re-save with one of them)"
                 ),
             ));
         }

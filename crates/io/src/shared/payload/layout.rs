@@ -15,6 +15,9 @@ pub(crate) enum Encoding {
     /// zlib (RFC 1950), or gzip where the stream starts with gzip's magic
     /// (MetaIO inflates with `inflateInit2(.., 47)`, which accepts both).
     Zlib,
+    /// bzip2, possibly several concatenated streams (NRRD `encoding: bzip2`,
+    /// written by teem with libbz2's `BZ2_bzWrite`).
+    Bzip2,
     /// Decimal numbers separated by whitespace or commas.
     Text,
     /// Two hexadecimal digits per byte, whitespace between them ignored.
@@ -22,8 +25,8 @@ pub(crate) enum Encoding {
 }
 
 impl Encoding {
-    pub(super) fn is_compressed(self) -> bool {
-        matches!(self, Encoding::Gzip | Encoding::Zlib)
+    pub(crate) fn is_compressed(self) -> bool {
+        matches!(self, Encoding::Gzip | Encoding::Zlib | Encoding::Bzip2)
     }
 }
 

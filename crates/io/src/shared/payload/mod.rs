@@ -1,6 +1,6 @@
 //! The samples behind a text header (NRRD, MetaImage): one or more data
 //! regions (the rest of the header's own file, or separate data files),
-//! each raw, gzip- or zlib-compressed, decimal text or hexadecimal, turned
+//! each raw, gzip-, zlib- or bzip2-compressed, decimal text or hexadecimal, turned
 //! into `f32` with one frame of a multi-volume file kept.
 //!
 //! A header is trusted only as far as the files bear it out:
@@ -8,7 +8,7 @@
 //! bytes follow, [`check_region`] compares that with what the header
 //! declares before anything is allocated, and [`read_regions`] reads no
 //! byte past a region. Compressed streams cannot be sized from the file,
-//! so their declared size is bounded by deflate's largest ratio and the
+//! so their declared size is bounded by the codec's largest ratio and the
 //! output grows only as data actually inflates; a stream that inflates to
 //! less or more than declared is refused.
 //!

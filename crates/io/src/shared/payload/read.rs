@@ -4,6 +4,7 @@
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
+use bzip2::read::MultiBzDecoder;
 use flate2::read::{MultiGzDecoder, ZlibDecoder};
 use volray_core::Samples;
 
@@ -54,6 +55,7 @@ fn mappable(
         Encoding::Raw => None,
         Encoding::Gzip => Some("gzip-compressed"),
         Encoding::Zlib => Some("zlib-compressed"),
+        Encoding::Bzip2 => Some("bzip2-compressed"),
         Encoding::Text => Some("text"),
         Encoding::Hex => Some("hex"),
     };
@@ -171,6 +173,10 @@ fn read_region<T: Stored>(
                 ("zlib", Box::new(ZlibDecoder::new(buffered)))
             };
             read_inflated(path, name, &mut decoder, samples, layout, sink)
+        }
+        Encoding::Bzip2 => {
+            let mut decoder = MultiBzDecoder::new(BufReader::new(bounded));
+            read_inflated(path, "bzip2", &mut decoder, samples, layout, sink)
         }
         Encoding::Text => read_text(path, BufReader::new(bounded), samples, sink),
         Encoding::Hex => read_hex(path, &mut BufReader::new(bounded), samples, layout, sink),

@@ -12,7 +12,7 @@ use crate::shared::input::open_input;
 
 /// Deflate's largest compression ratio (RFC 1951: a 258-byte match costs
 /// at least two bits, so 1032 output bytes per input byte at most).
-use crate::shared::compress::MAX_DEFLATE_RATIO;
+use crate::shared::compress::{MAX_BZIP2_RATIO, MAX_DEFLATE_RATIO};
 
 /// How far into a file the data starts, after the base position and any
 /// skipped lines.
@@ -227,6 +227,19 @@ pub(crate) fn check_region(
                         "the header declares {needed} bytes of data, but {} compressed bytes cannot inflate to more than {} (deflate's limit is {MAX_DEFLATE_RATIO}:1)",
                         region.len,
                         region.len.saturating_mul(MAX_DEFLATE_RATIO)
+                    ),
+                ));
+            }
+        }
+        Encoding::Bzip2 => {
+            let needed = bytes.saturating_add(layout.inflated_skip);
+            if needed > region.len.saturating_mul(MAX_BZIP2_RATIO) {
+                return Err(IoError::invalid(
+                    path,
+                    format!(
+                        "the header declares {needed} bytes of data, but {} bzip2-compressed bytes cannot decode to more than {}",
+                        region.len,
+                        region.len.saturating_mul(MAX_BZIP2_RATIO)
                     ),
                 ));
             }
