@@ -17,6 +17,7 @@
 pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
+pub(crate) mod fits;
 pub(crate) mod hdf5;
 pub(crate) mod hdf5_lazy;
 pub(crate) mod metaimage;
@@ -74,6 +75,9 @@ pub enum VolumeFormat {
     Minc,
     /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
     Zarr,
+    /// FITS images (`.fits`, `.fit`, `.fts`, `.fits.gz`): the primary HDU
+    /// and IMAGE extensions.
+    Fits,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -377,6 +381,20 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: true,
         read: zarr::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Fits,
+        name: "fits",
+        description: "FITS image",
+        extensions: &["fits", "fit", "fts", "fits.gz", "fit.gz", "fts.gz"],
+        name_stems: &[],
+        known_as: ".fits/.fits.gz",
+        // FITS Standard 4.0 §4.4.1.1: SIMPLE, value T in column 30.
+        magic: Magic::strong(&[(0, b"SIMPLE  =                    T")]),
+        frames: true,
+        arrays: true,
+        levels: false,
+        read: fits::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -625,13 +643,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .fits/.fits.gz"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, fits"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 15);
+        assert_eq!(VolumeFormat::ALL.len(), 16);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
