@@ -45,6 +45,7 @@
 //! | VASP CHGCAR/CHG | `formats/chgcar/` | divided by the cell volume; periodic plane added; spin blocks as frames; known by content too |
 //! | MINC2 `.mnc` | `formats/minc.rs` | on the HDF5 layer; dimorder, steps, starts, direction cosines; image-min/max scaling as nibabel |
 //! | Zarr v2/v3, OME-Zarr 0.4/0.5 (a directory) | `formats/zarr/` | through `zarrs` (blosc, zstd, gzip, sharding, fill values); known by `zarr.json`/`.zarray`/`.zgroup`; levels ([`ReadOptions::level`]), time points, channels ([`ReadOptions::channel`]) |
+//! | FITS `.fits`, `.fits.gz` | `formats/fits/` | own parser; BITPIX 8 … −64, BSCALE/BZERO, BLANK as NaN; linear WCS (world spacing when the axes share a unit, else pixel coordinates); image HDUs and a 4th axis as frames, `--array EXTNAME` |
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is
