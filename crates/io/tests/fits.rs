@@ -460,3 +460,44 @@ fn broken_copies_never_panic() {
     // Every 5th header byte of the first block replaced, and truncations.
     common::header_edits_never_panic(&fixtures[..2], 0, b"0 9-'=E\xff", |_| 2880);
 }
+
+#[test]
+fn a_rotated_pc_matrix_keeps_the_grid_in_its_own_axes() {
+    let l = load("rotated_mm.fits", &ReadOptions::default());
+    check_voxels("rotated", &l.volume, DIMS, |i, j, k| {
+        ramp(i, j, k) as f32 + 0.25
+    });
+    // astropy.wcs: pixel (1, 0, 0) at (√3, 1, 0), |step| 2 mm; origin 0.
+    assert_eq!(l.volume.spacing(), DVec3::splat(2.0));
+    assert_eq!(l.volume.origin(), DVec3::ZERO);
+    assert_note(&l, "rotated away from world x, y, z");
+}
+
+#[test]
+fn a_sheared_cd_matrix_is_resampled_over_its_box() {
+    let l = load("sheared_mm.fits", &ReadOptions::default());
+    assert!(l.info.nan_is_empty);
+    assert_note(&l, "resampled trilinearly");
+    // astropy.wcs: steps (1, 0, 0), (0.5, 1, 0), (0, 0, 1) mm from 0.
+    let to_grid =
+        volray_core::glam::DMat3::from_cols(DVec3::X, DVec3::new(0.5, 1.0, 0.0), DVec3::Z)
+            .inverse();
+    let inside = common::check_resampled(&l.volume, to_grid, [7.0, 5.0, 4.0], 1e-3, |g| {
+        g.x + 10.0 * g.y + 100.0 * g.z + 0.25
+    });
+    assert!(inside > 100, "{inside}");
+}
+
+#[test]
+fn unscaled_bytes_are_mapped_from_the_file() {
+    let opts = ReadOptions {
+        map: volray_io::MapPolicy::Always,
+        ..ReadOptions::default()
+    };
+    let l = load("u8.fits", &opts);
+    assert_note(&l, "mapped from the file");
+    assert_eq!(l.volume, load("u8.fits", &ReadOptions::default()).volume);
+    // Big-endian 16-bit samples cannot be: read into memory.
+    let l = load("i16.fits", &opts);
+    assert!(!common::has_note(&l, "mapped from the file"));
+}
