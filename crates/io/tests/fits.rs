@@ -431,6 +431,18 @@ fn truncated_data_and_headers_without_end_are_refused() {
         &no_naxis,
         "no NAXIS3 card (NAXIS = 3)",
     );
+    // THUMB, the 2-D image read when nothing else is left, declares no data.
+    let gcount = common::replace(
+        &fixture_bytes("multi.fits")[..3 * 2880],
+        "GCOUNT  =                    1",
+        "GCOUNT  =                    0",
+    );
+    common::refuse(
+        dir.path(),
+        "gcount.fits",
+        &gcount,
+        "HDU 1 (EXTNAME 'THUMB'): the image needs 96 bytes, but its header declares 0 bytes of data (PCOUNT 0, GCOUNT 0)",
+    );
     let bad_cdelt = common::replace(
         &fixture_bytes("wcs_mm.fits"),
         "CDELT1  =                  0.5",

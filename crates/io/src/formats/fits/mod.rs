@@ -303,6 +303,16 @@ fn read_chosen(
     let count = dims[0] * dims[1] * dims[2];
     let size = hdu.bitpix.unsigned_abs() as u64 / 8;
     let frame_bytes = count as u64 * size;
+    // An IMAGE extension's PCOUNT and GCOUNT (0 and 1) could say less.
+    let needed = u128::from(frame_bytes) * (frame_in_hdu as u128 + 1);
+    if needed > hdu.data_bytes {
+        return Err(bad(format!(
+            "the image needs {needed} bytes, but its header declares {} bytes of data (PCOUNT {}, GCOUNT {})",
+            hdu.data_bytes,
+            hdu.header.text("PCOUNT"),
+            hdu.header.text("GCOUNT")
+        )));
+    }
     let offset = hdu.data_start + frame_bytes * frame_in_hdu as u64;
     let dtype = data::dtype(hdu.bitpix);
     let mappable = if src.is_gzip() {
