@@ -27,7 +27,7 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf fits"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
@@ -97,6 +97,11 @@ for t in $targets; do
     # Only the committed seeds (make_zarr_seeds.py): a store is two files
     # packed into one input (fuzz_targets/zarr.rs).
     zarr) ;;
+    fits)
+        add fits 00 "$fix"/fits/*.fits "$fix"/fits/*.fits.gz
+        add fits 03 "$fix"/fits/multi.fits
+        add fits 22 "$fix"/fits/multi.fits
+        ;;
     *) echo "seed.sh: unknown target $t" >&2; exit 1 ;;
     esac
     [ -d "$here/seeds/$t" ] && [ "$t" != raw ] && add "$t" none "$here"/seeds/"$t"/*

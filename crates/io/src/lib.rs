@@ -47,6 +47,7 @@
 //! | Zarr v2/v3, OME-Zarr 0.4/0.5 (a directory) | `formats/zarr/` | through `zarrs` (blosc, zstd, gzip, sharding, fill values); known by `zarr.json`/`.zarray`/`.zgroup`; levels ([`ReadOptions::level`]), time points, channels ([`ReadOptions::channel`]) |
 //! | NetCDF-3 `.nc`, `.cdf` (CDF-1, CDF-2, CDF-5) | `formats/netcdf/` | own bounds-checked parser; record dimension; CF conventions (`shared/cf.rs`): axes, coordinate variables, units, packing, fill values; `--frame` (time), `--array` (variable) |
 //! | MINC1 `.mnc` (NetCDF-3) | `formats/minc1.rs` | on the NetCDF-3 layer with MINC2's geometry and scaling; signtype |
+//! | FITS `.fits`, `.fits.gz` | `formats/fits/` | own parser; BITPIX 8 … −64, BSCALE/BZERO, BLANK as NaN; linear WCS (world spacing when the axes share a unit, else pixel coordinates); image HDUs and a 4th axis as frames, `--array EXTNAME` |
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is

@@ -29,11 +29,13 @@ pub struct ReadOptions {
     /// `--frame`): the 4th dimension of NIfTI, NRRD, MetaImage and HDF5,
     /// the orbital of a cube file, the frame set of a TIFF stack, the
     /// density block of a CHGCAR (0 total, 1 magnetisation), the series of
-    /// a DICOM directory.
+    /// a DICOM directory, the 3-D images of a FITS file (and the steps of
+    /// their 4th axis) in file order.
     pub frame: Option<usize>,
     /// Which named array of a file holding several (the CLI's `--array`):
     /// VTK point or cell data arrays; the image of an OME-Zarr plate
-    /// (`A/1/0`: row, column, field) or collection (`0`, a series).
+    /// (`A/1/0`: row, column, field) or collection (`0`, a series); the
+    /// HDU of a FITS file, by EXTNAME or number.
     pub array: Option<String>,
     /// Which resolution level of a multiscale image (the CLI's `--level`),
     /// 0 the finest: the `datasets` of an OME-Zarr image.

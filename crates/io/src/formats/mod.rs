@@ -17,6 +17,7 @@
 pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
+pub(crate) mod fits;
 pub(crate) mod hdf5;
 pub(crate) mod hdf5_axes;
 pub(crate) mod hdf5_lazy;
@@ -80,9 +81,12 @@ pub enum VolumeFormat {
     /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
     Zarr,
     /// NetCDF-3 (`.nc`, `.cdf`, `.nc3`): classic, 64-bit offset and
-    /// 64-bit data, with the CF conventions; a NetCDF-4 file (HDF5) is
-    /// read as HDF5, a MINC1 file as MINC.
+    /// 64-bit data, and NetCDF-4 (HDF5 underneath, `formats/netcdf4.rs`),
+    /// with the CF conventions; a MINC1 file as MINC.
     Netcdf,
+    /// FITS images (`.fits`, `.fit`, `.fts`, `.fits.gz`): the primary HDU
+    /// and IMAGE extensions.
+    Fits,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -399,6 +403,18 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         arrays: true,
         levels: false,
         read: netcdf::read,
+        format: VolumeFormat::Fits,
+        name: "fits",
+        description: "FITS image",
+        extensions: &["fits", "fit", "fts", "fits.gz", "fit.gz", "fts.gz"],
+        name_stems: &[],
+        known_as: ".fits/.fits.gz",
+        // FITS Standard 4.0 §4.4.1.1: SIMPLE, value T in column 30.
+        magic: Magic::strong(&[(0, b"SIMPLE  =                    T")]),
+        frames: true,
+        arrays: true,
+        levels: false,
+        read: fits::read,
     },
 ];
 
@@ -648,13 +664,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 16);
+        assert_eq!(VolumeFormat::ALL.len(), 17);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
