@@ -20,6 +20,7 @@ pub(crate) mod dicom;
 pub(crate) mod hdf5;
 pub(crate) mod hdf5_lazy;
 pub(crate) mod metaimage;
+pub(crate) mod mgh;
 pub(crate) mod minc;
 pub(crate) mod mrc;
 pub(crate) mod nifti;
@@ -74,6 +75,8 @@ pub enum VolumeFormat {
     Minc,
     /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
     Zarr,
+    /// FreeSurfer MGH (`.mgh`) and gzip-compressed MGH (`.mgz`).
+    Mgh,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -131,6 +134,10 @@ pub(crate) struct Magic {
     /// A test of the first 1024 bytes as text (lossy UTF-8), for text
     /// headers; the formats' tests must not both accept a file.
     pub text: Option<fn(&str) -> bool>,
+    /// A test of the first bytes as binary fields, for headers without a
+    /// magic string (MGH's version word, Analyze's `sizeof_hdr`): tried
+    /// after every format's `weak` signatures, before the `text` tests.
+    pub binary: Option<fn(&[u8]) -> bool>,
 }
 
 impl Magic {
@@ -139,6 +146,7 @@ impl Magic {
         strong: &[],
         weak: &[],
         text: None,
+        binary: None,
     };
 
     const fn strong(signatures: Signatures) -> Magic {
@@ -377,6 +385,24 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: true,
         read: zarr::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Mgh,
+        name: "mgh",
+        description: "FreeSurfer MGH/MGZ",
+        extensions: &["mgh", "mgz", "mgh.gz"],
+        name_stems: &[],
+        known_as: ".mgh/.mgz",
+        // Version 1, big-endian, then plausible dimensions and type; an
+        // .mgz is sniffed after inflating its first bytes (`sniff`).
+        magic: Magic {
+            binary: Some(mgh::sniff),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: mgh::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -474,6 +500,18 @@ impl VolumeFormat {
     /// number (`head` should hold at least the first 1024 bytes, or the
     /// whole file if shorter).
     pub fn sniff(head: &[u8]) -> Option<Self> {
+        // A gzip file (.nii.gz, .mgz) is known by what it inflates to; a
+        // gzip file that shows nothing is still taken for a .nii.gz.
+        if head.starts_with(b"\x1f\x8b") {
+            if let Some(format) = Self::sniff_plain(&inflate_head(head)) {
+                return Some(format);
+            }
+        }
+        Self::sniff_plain(head)
+    }
+
+    /// [`VolumeFormat::sniff`] of bytes that are not inflated first.
+    fn sniff_plain(head: &[u8]) -> Option<Self> {
         let shows = |signatures: Signatures| {
             signatures
                 .iter()
@@ -482,7 +520,12 @@ impl VolumeFormat {
         let by_bytes = FORMATS
             .iter()
             .find(|spec| shows(spec.magic.strong))
-            .or_else(|| FORMATS.iter().find(|spec| shows(spec.magic.weak)));
+            .or_else(|| FORMATS.iter().find(|spec| shows(spec.magic.weak)))
+            .or_else(|| {
+                FORMATS
+                    .iter()
+                    .find(|spec| spec.magic.binary.is_some_and(|test| test(head)))
+            });
         let spec = by_bytes.or_else(|| {
             let text = String::from_utf8_lossy(&head[..head.len().min(1024)]);
             FORMATS
@@ -491,6 +534,24 @@ impl VolumeFormat {
         })?;
         Some(spec.format)
     }
+}
+
+/// The first bytes (at most 1024) that the gzip stream starting `head`
+/// inflates to, as far as `head` goes; empty if it is no gzip stream.
+fn inflate_head(head: &[u8]) -> Vec<u8> {
+    use std::io::Read;
+    let mut out = Vec::with_capacity(1024);
+    let mut decoder = flate2::read::MultiGzDecoder::new(head).take(1024);
+    let mut buf = [0u8; 256];
+    // A stream cut short by `head`'s end fails after yielding what it
+    // could: keep that.
+    while let Ok(n) = decoder.read(&mut buf) {
+        if n == 0 {
+            break;
+        }
+        out.extend_from_slice(&buf[..n]);
+    }
+    out
 }
 
 impl fmt::Display for VolumeFormat {
@@ -625,13 +686,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .mgh/.mgz"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, mgh"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 15);
+        assert_eq!(VolumeFormat::ALL.len(), 16);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
