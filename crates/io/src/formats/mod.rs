@@ -77,6 +77,9 @@ pub enum VolumeFormat {
     Zarr,
     /// FreeSurfer MGH (`.mgh`) and gzip-compressed MGH (`.mgz`).
     Mgh,
+    /// Analyze 7.5 `.hdr`/`.img` pairs (no NIfTI magic), read by the
+    /// NIfTI reader.
+    Analyze,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -403,6 +406,23 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: mgh::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Analyze,
+        name: "analyze",
+        description: "Analyze 7.5",
+        // `.hdr` is NIfTI's pair too: the content decides.
+        extensions: &[],
+        name_stems: &[],
+        known_as: ".hdr/.img (Analyze 7.5)",
+        magic: Magic {
+            binary: Some(nifti::sniff_analyze),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: nifti::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -686,13 +706,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .mgh/.mgz"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .mgh/.mgz, .hdr/.img (Analyze 7.5)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, mgh"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, mgh, analyze"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 16);
+        assert_eq!(VolumeFormat::ALL.len(), 17);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

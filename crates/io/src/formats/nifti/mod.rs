@@ -1,4 +1,13 @@
-//! NIfTI-1 and NIfTI-2 volumes: `.nii`, `.nii.gz` and `.hdr`/`.img` pairs.
+//! NIfTI-1 and NIfTI-2 volumes: `.nii`, `.nii.gz` and `.hdr`/`.img` pairs;
+//! and Analyze 7.5 pairs, NIfTI-1's ancestor.
+//!
+//! Analyze 7.5 (a 348-byte `.hdr` without NIfTI's magic, as nibabel's
+//! AnalyzeImage and SPM write it) is read here as a sub-case of the NIfTI-1
+//! pair, which shares its layout up to the transforms; it has its own row
+//! ([`VolumeFormat::Analyze`]) so that it is named in messages and
+//! `volray info`. It carries voxel sizes but no orientation: nibabel's
+//! affine for it is used (`geometry.rs`), with SPM's `originator` when set,
+//! and `funused1`/`funused2` as SPM's scale and offset.
 //!
 //! [`read`] runs in the order of the file: `source.rs` opens it (plain or
 //! gzip, and the `.img` beside a `.hdr`), `header.rs` parses the 348-byte
@@ -40,6 +49,7 @@ use std::path::Path;
 
 use self::data::{Layout, dim_text, scaling, too_big};
 use self::geometry::{geometry, length_unit};
+pub(crate) use self::header::sniff_analyze;
 use self::header::{detect_version, parse_header};
 use self::source::{Source, image_path};
 use crate::dtype::{Stored, read_as_stored};
@@ -55,8 +65,24 @@ use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 /// Samples decoded per read: bounds the scratch buffer beside the output.
 const CHUNK_SAMPLES: usize = 1 << 16;
 
-/// Reads the NIfTI file at `path` (see the module documentation).
+/// Reads the NIfTI or Analyze 7.5 file at `path` (see the module
+/// documentation). Messages about an Analyze header name Analyze 7.5.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let mut analyze = false;
+    read_as(path, opts, &mut analyze).map_err(|e| match e {
+        IoError::Invalid { path, reason } if analyze => IoError::Invalid {
+            path,
+            reason: reason
+                .replace("NIfTI field", "Analyze 7.5 field")
+                .replace("NIfTI header", "Analyze 7.5 header")
+                .replace("NIfTI magic says", "an Analyze 7.5 header says"),
+        },
+        other => other,
+    })
+}
+
+/// [`read`], setting `analyze` once the header shows an Analyze 7.5 one.
+fn read_as(path: &Path, opts: &ReadOptions, analyze: &mut bool) -> Result<Loaded, IoError> {
     let (mut source, file_len) = Source::open(path)?;
     let header_source_gz = source.is_gzip();
 
@@ -73,6 +99,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         .fill(path, &mut bytes[4..], 4, len as u64)
         .map_err(|e| short_header(path, e))?;
     let header = parse_header(path, &bytes, version, endian)?;
+    *analyze = header.analyze.is_some();
 
     let layout = Layout::of(path, &header, opts.frame)?;
     let mut info = FileInfo::new(format!("{} ({}-endian)", layout.type_name, endian));
@@ -86,7 +113,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.length_unit = length_unit(header.xyzt_units).map(str::to_string);
     info.notes.push(format!(
         "{} header, {} ({}-endian{})",
-        version.name(),
+        if header.analyze.is_some() {
+            "Analyze 7.5 (no NIfTI magic)"
+        } else {
+            version.name()
+        },
         if header.single_file {
             "data in the same file"
         } else {
@@ -288,7 +319,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
     Ok(Loaded {
         volume,
-        format: VolumeFormat::Nifti,
+        format: if header.analyze.is_some() {
+            VolumeFormat::Analyze
+        } else {
+            VolumeFormat::Nifti
+        },
         info,
     })
 }
