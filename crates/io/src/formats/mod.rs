@@ -522,10 +522,10 @@ impl VolumeFormat {
     pub fn sniff(head: &[u8]) -> Option<Self> {
         // A gzip file (.nii.gz, .mgz) is known by what it inflates to; a
         // gzip file that shows nothing is still taken for a .nii.gz.
-        if head.starts_with(b"\x1f\x8b") {
-            if let Some(format) = Self::sniff_plain(&inflate_head(head)) {
-                return Some(format);
-            }
+        if head.starts_with(b"\x1f\x8b")
+            && let Some(format) = Self::sniff_plain(&inflate_head(head))
+        {
+            return Some(format);
         }
         Self::sniff_plain(head)
     }
