@@ -179,3 +179,28 @@ fn lying_truncated_and_huge_headers_are_refused_naming_analyze() {
         "{msg}"
     );
 }
+
+/// Deterministic byte flips and truncations of the headers (with their
+/// .img beside them), read with and without a frame: never a panic.
+#[test]
+fn no_panic_on_truncation_or_corruption() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = common::Lcg(0x2545_f491_4f6c_dd1d);
+    for name in ["u8", "i16_be", "spm_origin"] {
+        let hdr = std::fs::read(fixture(&format!("{name}.hdr"))).unwrap();
+        std::fs::copy(fixture(&format!("{name}.img")), dir.path().join("x.img")).unwrap();
+        let path = dir.path().join("x.hdr");
+        for _ in 0..200 {
+            let bytes = common::mutate(&hdr, &mut rng, 3);
+            std::fs::write(&path, &bytes).unwrap();
+            for opts in [ReadOptions::default(), common::frame(1)] {
+                // Refusals may be about the .img (what it holds).
+                if let Err(e) = read(&path, &opts) {
+                    let msg = e.to_string();
+                    assert!(!e.is_io_failure() && !msg.contains('\n'), "{msg}");
+                    assert!(msg.starts_with(&dir.path().display().to_string()), "{msg}");
+                }
+            }
+        }
+    }
+}

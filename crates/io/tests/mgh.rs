@@ -238,3 +238,16 @@ fn a_gzip_bomb_is_refused_before_inflating() {
     let l = read(&path, &ReadOptions::default()).unwrap();
     assert_eq!(l.volume.dims(), [256, 256, 256]);
 }
+
+/// Deterministic byte flips and truncations of the MGH and MGZ fixtures,
+/// each read with and without a frame: a volume or a one-line message,
+/// never a panic.
+#[test]
+fn no_panic_on_truncation_or_corruption() {
+    let fixtures = ["i16.mgh", "f32.mgz", "u8.mgz", "no_ras.mgh"].map(fixture);
+    common::byte_flips_never_panic(
+        &fixtures,
+        0x9e37_79b9_7f4a_7c15,
+        &[ReadOptions::default(), frame(1)],
+    );
+}
