@@ -27,7 +27,7 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf fits"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
@@ -47,6 +47,13 @@ for t in $targets; do
         add nifti 00 "$fix"/nifti/*.nii "$fix"/nifti/*.nii.gz
         add nifti 08 "$fix"/nifti/pair.hdr
         add nifti 02 "$fix"/nifti/frames4d.nii.gz "$fix"/nifti/nifti2_frames4d.nii
+        add nifti 02 "$fix"/nifti/vector5d.nii "$fix"/nifti/vector5d_t2.nii.gz
+        add nifti 08 "$fix"/analyze/*.hdr
+        ;;
+    mgh)
+        add mgh 00 "$fix"/mgh/*.mgh
+        add mgh 08 "$fix"/mgh/*.mgz
+        add mgh 09 "$fix"/mgh/f32.mgz "$fix"/mgh/u8.mgz
         ;;
     vtk)
         add vtk 00 "$fix"/vtk/*.vtk

@@ -1,4 +1,5 @@
-//! Fuzzes the reader of NIfTI-1/2 (`.nii`, gzip or not, and `.hdr` with the fixture `pair.img` beside it).
+//! Fuzzes the reader of NIfTI-1/2 (`.nii`, gzip or not, and `.hdr` with the fixture `pair.img` beside it),
+//! which also reads 5-D files and Analyze 7.5 headers (a `.hdr` without the magic; seeded from fixtures/analyze).
 //! The first byte chooses `--frame` (bits 0-2) and `.hdr` (bit 3).
 #![no_main]
 

@@ -34,7 +34,7 @@
 //! | NumPy `.npy` | `formats/npy/` | `a[x, y, z]`; C order transposed |
 //! | NRRD `.nrrd`, `.nhdr` | `formats/nrrd/` | raw, gzip, bzip2, ascii, hex; detached and multi-file data; space directions; 4-D frames |
 //! | MetaImage `.mha`, `.mhd` | `formats/metaimage/` | raw, zlib; TransformMatrix; 4-D frames |
-//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames |
+//! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames; 5-D components as frames; sheared sform resampled, NaN outside ([`FileInfo::nan_is_empty`]) |
 //! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib, LZ4, LZMA; Direction; pieces |
 //! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
@@ -48,6 +48,8 @@
 //! | NetCDF-3 `.nc`, `.cdf` (CDF-1, CDF-2, CDF-5) | `formats/netcdf/` | own bounds-checked parser; record dimension; CF conventions (`shared/cf.rs`): axes, coordinate variables, units, packing, fill values; `--frame` (time), `--array` (variable) |
 //! | MINC1 `.mnc` (NetCDF-3) | `formats/minc1.rs` | on the NetCDF-3 layer with MINC2's geometry and scaling; signtype |
 //! | FITS `.fits`, `.fits.gz` | `formats/fits/` | own parser; BITPIX 8 … −64, BSCALE/BZERO, BLANK as NaN; linear WCS (world spacing when the axes share a unit, else pixel coordinates); image HDUs and a 4th axis as frames, `--array EXTNAME` |
+//! | FreeSurfer MGH `.mgh`, `.mgz` | `formats/mgh/` | big-endian; nibabel's get_affine (Mdc, delta, Pxyz_c); frames; gzip streamed; known by content too |
+//! | Analyze 7.5 `.hdr`/`.img` | `formats/nifti/` | a NIfTI-1 pair without magic; nibabel's affine (x flipped, centre or SPM originator); known by content |
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is

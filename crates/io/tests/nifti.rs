@@ -241,6 +241,114 @@ fn four_d_files_pick_a_frame() {
 }
 
 #[test]
+fn five_d_vector_components_are_frames_in_the_files_order() {
+    // (4, 3, 5, 1, 3): three components, one time point.
+    let l = load("vector5d.nii");
+    assert_eq!((l.info.frames, l.info.frame), (3, 0));
+    assert_eq!(header_value(&l, "dim"), "5 4 3 5 1 3 1 1");
+    assert!(
+        has_note(
+            &l,
+            "5-D: 3 components (dim[5], intent_code 1007 = vector) x 1 time point (dim[4]); --frame picks one: frame = t + 1*c"
+        ),
+        "{:?}",
+        l.info.notes
+    );
+    for c in 0..3 {
+        let l = load_with("vector5d.nii", &frame(c));
+        check_world("vector5d", &l, &ALIGNED, |i, j, k| {
+            (ramp(i, j, k) + 10000 * c as i64) as f32
+        });
+    }
+    let err = read(&fixture("vector5d.nii"), &frame(3)).unwrap_err();
+    assert_frame_out_of_range(
+        &err,
+        3,
+        "the file holds 3 volumes (3 components (dim[5]) x 1 time point (dim[4]); frame = t + 1*c)",
+    );
+    // (4, 3, 5, 2, 3), gzip: frame t + 2c holds time point t of component c.
+    for f in 0..6 {
+        let (t, c) = (f % 2, f / 2);
+        let l = load_with("vector5d_t2.nii.gz", &frame(f));
+        assert_eq!((l.info.frames, l.info.frame), (6, f));
+        check_world("vector5d_t2", &l, &ALIGNED, |i, j, k| {
+            (ramp(i, j, k) + 1000 * t as i64 + 10000 * c as i64) as f32
+        });
+        assert!(
+            has_note(&l, &format!("this is frame {f}: t {t}, component {c}")),
+            "{:?}",
+            l.info.notes
+        );
+    }
+}
+
+#[test]
+fn sheared_sform_is_resampled_onto_an_orthogonal_grid() {
+    // The file holds 3x - 2y + 0.5z + 7 at each voxel's world position;
+    // trilinear resampling reproduces a linear function exactly inside the
+    // grid's box, and the box's corners outside it are NaN.
+    let sheared: Affine = [
+        [1.0, 0.5, 0.0, -2.0],
+        [0.0, 1.5, 0.3, 1.0],
+        [0.2, 0.0, 2.0, 4.0],
+    ];
+    let linear = |w: DVec3| 3.0 * w.x - 2.0 * w.y + 0.5 * w.z + 7.0;
+    let l = load("sheared.nii");
+    assert!(l.info.nan_is_empty);
+    assert!(has_note(&l, "the sform is sheared"), "{:?}", l.info.notes);
+    assert!(has_note(&l, "resampled trilinearly"), "{:?}", l.info.notes);
+    // About the shortest step, |(1, 0, 0.2)|, fitted to each axis's extent
+    // (3 + 1 = 4 along x: 4 steps of 1; 3 + 1.2 along y; 0.6 + 8 along z).
+    let s = l.volume.spacing();
+    assert!((s - DVec3::new(1.0, 1.05, 1.075)).length() < 1e-6, "{s}");
+    assert_eq!(l.volume.dims(), [5, 5, 9]);
+    let grid = Grid::from_affine(SHAPE, &sheared);
+    let to_grid =
+        volray_core::glam::DMat3::from_cols(grid.steps[0], grid.steps[1], grid.steps[2]).inverse();
+    // The bounding box of the sheared box: its lowest corner is the origin.
+    let lo = DVec3::new(-2.0, 1.0, 4.0);
+    assert!(
+        (l.volume.origin() - lo).length() < 1e-6,
+        "{}",
+        l.volume.origin()
+    );
+    let [nx, ny, nz] = l.volume.dims();
+    let (mut inside, mut outside) = (0, 0);
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let w = l.volume.world_position(x, y, z);
+                let g = to_grid * (w - grid.origin);
+                let v = l.volume.get(x, y, z);
+                let eps = 1e-9;
+                if (0..3).all(|a| g[a] >= eps && g[a] <= (SHAPE[a] - 1) as f64 - eps) {
+                    assert!(
+                        (f64::from(v) - linear(w)).abs() < 1e-3,
+                        "({x}, {y}, {z}): {v} vs {}",
+                        linear(w)
+                    );
+                    inside += 1;
+                } else if (0..3).any(|a| g[a] < -1e-6 || g[a] > (SHAPE[a] - 1) as f64 + 1e-6) {
+                    assert!(v.is_nan(), "({x}, {y}, {z}) outside the box holds {v}");
+                    outside += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        inside > 20 && outside > 20,
+        "{inside} inside, {outside} outside"
+    );
+    // A limit below the resampled grid refuses it, naming the sform.
+    let opts = ReadOptions {
+        max_memory: 1000,
+        ..ReadOptions::default()
+    };
+    let err = read(&fixture("sheared.nii"), &opts).unwrap_err();
+    assert!(err.to_string().contains("NIfTI sform (sheared)"), "{err}");
+}
+
+#[test]
 fn nifti2_files() {
     let l = load("nifti2_i32.nii");
     check_world("nifti2_i32.nii", &l, &ALIGNED, |i, j, k| {
@@ -388,13 +496,26 @@ fn bad_header_fields() {
     assert!(msg.contains("Analyze 7.5"), "{msg}");
 
     let mut b = f32_nii();
-    put_i16(&mut b, 40, 5);
-    put_i16(&mut b, 50, 2);
+    put_i16(&mut b, 40, 6);
+    put_i16(&mut b, 52, 2);
     let msg = error_for("d.nii", &b);
     assert!(
-        msg.contains("\"dim[5]\" is 2") && msg.contains("5-D"),
+        msg.contains("\"dim[6]\" is 2") && msg.contains("6-D"),
         "{msg}"
     );
+    // A 5-D header whose components the file does not hold.
+    let mut b = f32_nii();
+    put_i16(&mut b, 40, 5);
+    put_i16(&mut b, 50, 2);
+    let msg = error_for("d5.nii", &b);
+    assert!(
+        msg.contains("file is 592 bytes") && msg.contains("implies 832"),
+        "{msg}"
+    );
+    put_i16(&mut b, 48, 30000);
+    put_i16(&mut b, 50, 30000);
+    let msg = error_for("d5.nii", &b);
+    assert!(msg.contains("implies 216000000352"), "{msg}");
 
     // dim[0] 2: the first slice, a 2-D image (tests/flat.rs), described
     // but not a volume; dim[0] 1 is no image at all.

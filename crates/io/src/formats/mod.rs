@@ -22,6 +22,7 @@ pub(crate) mod hdf5;
 pub(crate) mod hdf5_axes;
 pub(crate) mod hdf5_lazy;
 pub(crate) mod metaimage;
+pub(crate) mod mgh;
 pub(crate) mod minc;
 pub(crate) mod minc1;
 pub(crate) mod mrc;
@@ -87,6 +88,11 @@ pub enum VolumeFormat {
     /// FITS images (`.fits`, `.fit`, `.fts`, `.fits.gz`): the primary HDU
     /// and IMAGE extensions.
     Fits,
+    /// FreeSurfer MGH (`.mgh`) and gzip-compressed MGH (`.mgz`).
+    Mgh,
+    /// Analyze 7.5 `.hdr`/`.img` pairs (no NIfTI magic), read by the
+    /// NIfTI reader.
+    Analyze,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -144,6 +150,10 @@ pub(crate) struct Magic {
     /// A test of the first 1024 bytes as text (lossy UTF-8), for text
     /// headers; the formats' tests must not both accept a file.
     pub text: Option<fn(&str) -> bool>,
+    /// A test of the first bytes as binary fields, for headers without a
+    /// magic string (MGH's version word, Analyze's `sizeof_hdr`): tried
+    /// after every format's `weak` signatures, before the `text` tests.
+    pub binary: Option<fn(&[u8]) -> bool>,
 }
 
 impl Magic {
@@ -152,6 +162,7 @@ impl Magic {
         strong: &[],
         weak: &[],
         text: None,
+        binary: None,
     };
 
     const fn strong(signatures: Signatures) -> Magic {
@@ -403,6 +414,8 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         arrays: true,
         levels: false,
         read: netcdf::read,
+    },
+    FormatSpec {
         format: VolumeFormat::Fits,
         name: "fits",
         description: "FITS image",
@@ -415,6 +428,41 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         arrays: true,
         levels: false,
         read: fits::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Mgh,
+        name: "mgh",
+        description: "FreeSurfer MGH/MGZ",
+        extensions: &["mgh", "mgz", "mgh.gz"],
+        name_stems: &[],
+        known_as: ".mgh/.mgz",
+        // Version 1, big-endian, then plausible dimensions and type; an
+        // .mgz is sniffed after inflating its first bytes (`sniff`).
+        magic: Magic {
+            binary: Some(mgh::sniff),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: mgh::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Analyze,
+        name: "analyze",
+        description: "Analyze 7.5",
+        // `.hdr` is NIfTI's pair too: the content decides.
+        extensions: &[],
+        name_stems: &[],
+        known_as: ".hdr/.img (Analyze 7.5)",
+        magic: Magic {
+            binary: Some(nifti::sniff_analyze),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: nifti::read,
     },
 ];
 
@@ -513,6 +561,18 @@ impl VolumeFormat {
     /// number (`head` should hold at least the first 1024 bytes, or the
     /// whole file if shorter).
     pub fn sniff(head: &[u8]) -> Option<Self> {
+        // A gzip file (.nii.gz, .mgz) is known by what it inflates to; a
+        // gzip file that shows nothing is still taken for a .nii.gz.
+        if head.starts_with(b"\x1f\x8b")
+            && let Some(format) = Self::sniff_plain(&inflate_head(head))
+        {
+            return Some(format);
+        }
+        Self::sniff_plain(head)
+    }
+
+    /// [`VolumeFormat::sniff`] of bytes that are not inflated first.
+    fn sniff_plain(head: &[u8]) -> Option<Self> {
         let shows = |signatures: Signatures| {
             signatures
                 .iter()
@@ -521,7 +581,12 @@ impl VolumeFormat {
         let by_bytes = FORMATS
             .iter()
             .find(|spec| shows(spec.magic.strong))
-            .or_else(|| FORMATS.iter().find(|spec| shows(spec.magic.weak)));
+            .or_else(|| FORMATS.iter().find(|spec| shows(spec.magic.weak)))
+            .or_else(|| {
+                FORMATS
+                    .iter()
+                    .find(|spec| spec.magic.binary.is_some_and(|test| test(head)))
+            });
         let spec = by_bytes.or_else(|| {
             let text = String::from_utf8_lossy(&head[..head.len().min(1024)]);
             FORMATS
@@ -530,6 +595,24 @@ impl VolumeFormat {
         })?;
         Some(spec.format)
     }
+}
+
+/// The first bytes (at most 1024) that the gzip stream starting `head`
+/// inflates to, as far as `head` goes; empty if it is no gzip stream.
+fn inflate_head(head: &[u8]) -> Vec<u8> {
+    use std::io::Read;
+    let mut out = Vec::with_capacity(1024);
+    let mut decoder = flate2::read::MultiGzDecoder::new(head).take(1024);
+    let mut buf = [0u8; 256];
+    // A stream cut short by `head`'s end fails after yielding what it
+    // could: keep that.
+    while let Ok(n) = decoder.read(&mut buf) {
+        if n == 0 {
+            break;
+        }
+        out.extend_from_slice(&buf[..n]);
+    }
+    out
 }
 
 impl fmt::Display for VolumeFormat {
@@ -664,13 +747,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 17);
+        assert_eq!(VolumeFormat::ALL.len(), 19);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

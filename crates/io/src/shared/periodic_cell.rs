@@ -150,6 +150,39 @@ pub(crate) fn resample_box(
     Ok((volume, note))
 }
 
+/// Resamples a sheared grid that is no crystal (a NIfTI sform that is
+/// not a rotation times a scale) over its own box, as [`resample_box`]
+/// does: NaN outside the parallelepiped from its first point to its last.
+pub(crate) fn resample_sheared(
+    dims: [usize; 3],
+    data: &[f32],
+    steps: [DVec3; 3],
+    origin: DVec3,
+    names: [&str; 3],
+    unit: &str,
+    max_memory: u64,
+) -> Result<(Volume, String), ResampleError> {
+    if dims.iter().any(|&n| n < 2) {
+        return Err(ResampleError::Cell(format!(
+            "{} x {} x {} points span no box: every axis needs at least 2",
+            dims[0], dims[1], dims[2]
+        )));
+    }
+    let grid = Grid::new(dims, data, steps, origin);
+    let (volume, described) = grid.resample(Extent::Box, max_memory)?;
+    let [a, b, c] = names;
+    let note = format!(
+        "{}: the grid's box of {} x {} x {} points ({a} x {b} x {c}), a parallelepiped, was resampled trilinearly onto {} covering the box; the {} samples outside the box are NaN (empty space, no data)",
+        not_orthogonal(steps, names),
+        dims[0],
+        dims[1],
+        dims[2],
+        described.in_unit(unit),
+        volume.len() - described.inside,
+    );
+    Ok((volume, note))
+}
+
 /// "the grid axes are not orthogonal (angle(b, c) ..., ... degrees)", the
 /// axes named `names`.
 fn not_orthogonal(steps: [DVec3; 3], names: [&str; 3]) -> String {

@@ -51,7 +51,12 @@ pub(super) struct Layout {
     pub(super) count: usize,
     pub(super) dtype: DType,
     pub(super) type_name: &'static str,
+    /// Volumes in all: `times · components`.
     pub(super) frames: usize,
+    /// `dim[4]` (time points) and `dim[5]` (components: vector or
+    /// channel data) where the header uses them, else 1.
+    pub(super) times: usize,
+    pub(super) components: usize,
     pub(super) frame: usize,
     pub(super) frame_bytes: u64,
     pub(super) vox_offset: u64,
@@ -96,11 +101,11 @@ impl Layout {
                 ));
             }
         }
-        if let Some(a) = (5..=ndim).find(|&a| dim[a] > 1) {
+        if let Some(a) = (6..=ndim).find(|&a| dim[a] > 1) {
             return Err(IoError::invalid(
                 path,
                 format!(
-                    "NIfTI field \"dim[{a}]\" is {}: {ndim}-D data (beyond a 4th dimension of volumes) is not supported",
+                    "NIfTI field \"dim[{a}]\" is {}: {ndim}-D data (beyond a 5th dimension of components) is not supported",
                     dim[a]
                 ),
             ));
@@ -124,21 +129,35 @@ impl Layout {
                 ),
             ));
         }
-        let frames = if ndim >= 4 {
+        // Volumes lie one after another in the file's order, time (dim[4])
+        // fastest, then components (dim[5]): frame t + T·c is one block.
+        let times = if ndim >= 4 {
             to_usize(4).unwrap_or(usize::MAX)
         } else {
             1
         };
+        let components = if ndim >= 5 {
+            to_usize(5).unwrap_or(usize::MAX)
+        } else {
+            1
+        };
+        let frames = times
+            .checked_mul(components)
+            .ok_or_else(|| too_big(path, header))?;
         let frame_index = frame.unwrap_or(0);
         if frame_index >= frames {
-            return Err(IoError::frame_out_of_range(
-                path,
-                frame_index,
+            let held = if components > 1 {
+                format!(
+                    "the file holds {frames} volumes ({components} components (dim[5]) x {times} time point{} (dim[4]); frame = t + {times}*c), numbered from 0",
+                    if times == 1 { "" } else { "s" }
+                )
+            } else {
                 format!(
                     "the file holds {frames} volume{} (dim[4]), numbered from 0",
                     if frames == 1 { "" } else { "s" }
-                ),
-            ));
+                )
+            };
+            return Err(IoError::frame_out_of_range(path, frame_index, held));
         }
         let count = dims[0]
             .checked_mul(dims[1])
@@ -160,6 +179,8 @@ impl Layout {
             dtype,
             type_name,
             frames,
+            times,
+            components,
             frame: frame_index,
             frame_bytes,
             vox_offset: v as u64,

@@ -16,6 +16,9 @@ pub(super) fn geometry(
     h: &Header,
     info: &mut FileInfo,
 ) -> Result<([DVec3; 3], DVec3), IoError> {
+    if let Some(originator) = h.analyze {
+        return analyze_geometry(path, h, originator, info);
+    }
     if h.sform_code > 0 {
         let steps = [0, 1, 2].map(|a| DVec3::new(h.srow[0][a], h.srow[1][a], h.srow[2][a]));
         let origin = DVec3::new(h.srow[0][3], h.srow[1][3], h.srow[2][3]);
@@ -69,6 +72,76 @@ pub(super) fn geometry(
         ],
         DVec3::ZERO,
     ))
+}
+
+/// An Analyze 7.5 grid, which carries voxel sizes but no orientation:
+/// nibabel's affine for it (`AnalyzeHeader.get_base_affine`, i.e.
+/// `shape_zoom_affine` with `x_flip`; SPM's `get_origin_affine`):
+///
+/// ```text
+/// steps  = diag(-pixdim[1], pixdim[2], pixdim[3])       (x flipped: radiological)
+/// origin = -steps · c,  c = originator - 1  if SPM's originator is set and
+///                          within (-dim, 2·dim) on every axis,
+///                       c = (dim - 1) / 2   else (the centre voxel)
+/// ```
+fn analyze_geometry(
+    path: &Path,
+    h: &Header,
+    originator: [i64; 3],
+    info: &mut FileInfo,
+) -> Result<([DVec3; 3], DVec3), IoError> {
+    for a in 1..=3 {
+        let p = h.pixdim[a];
+        if !(p.is_finite() && p != 0.0) {
+            return Err(IoError::invalid(
+                path,
+                format!(
+                    "NIfTI field \"pixdim[{a}]\" is {p}: voxel sizes must be finite and non-zero"
+                ),
+            ));
+        }
+    }
+    let zooms = [-h.pixdim[1], h.pixdim[2], h.pixdim[3]];
+    let dims = [1, 2, 3].map(|a| {
+        if a as i64 <= h.dim[0] {
+            h.dim[a] as f64
+        } else {
+            1.0
+        }
+    });
+    let spm = originator.iter().any(|&o| o != 0)
+        && (0..3)
+            .all(|a| (originator[a] as f64) > -dims[a] && (originator[a] as f64) < 2.0 * dims[a]);
+    let centre = if spm {
+        originator.map(|o| o as f64 - 1.0)
+    } else {
+        dims.map(|n| (n - 1.0) / 2.0)
+    };
+    info.notes.push(format!(
+        "Analyze 7.5 carries no orientation: taken as nibabel does, x flipped (radiological), {}",
+        if spm {
+            format!(
+                "origin at voxel ({}, {}, {}) from SPM's originator {} {} {} (counted from 1)",
+                centre[0], centre[1], centre[2], originator[0], originator[1], originator[2]
+            )
+        } else {
+            format!(
+                "origin at the centre voxel ({}, {}, {})",
+                centre[0], centre[1], centre[2]
+            )
+        }
+    ));
+    let steps = [
+        DVec3::X * zooms[0],
+        DVec3::Y * zooms[1],
+        DVec3::Z * zooms[2],
+    ];
+    let origin = -DVec3::new(
+        zooms[0] * centre[0],
+        zooms[1] * centre[1],
+        zooms[2] * centre[2],
+    );
+    Ok((steps, origin))
 }
 
 /// `|pixdim[1..=3]|`, which must be finite and non-zero.

@@ -157,6 +157,106 @@ const NIFTI2_FIELDS: &[Field] = &[
     Field("unused_str", 525, Kind::Text, 15),
 ];
 
+/// The Analyze 7.5 header (Mayo's `dbh.h`, `struct dsr`), in file order:
+/// the same 348 bytes, without NIfTI's magic and transforms. `originator`
+/// is read as SPM does, five int16 (the voxel at the origin, from 1).
+const ANALYZE_FIELDS: &[Field] = &[
+    Field("sizeof_hdr", 0, Kind::I32, 1),
+    Field("data_type", 4, Kind::Text, 10),
+    Field("db_name", 14, Kind::Text, 18),
+    Field("extents", 32, Kind::I32, 1),
+    Field("session_error", 36, Kind::I16, 1),
+    Field("regular", 38, Kind::Text, 1),
+    Field("hkey_un0", 39, Kind::U8, 1),
+    Field("dim", 40, Kind::I16, 8),
+    Field("vox_units", 56, Kind::Text, 4),
+    Field("cal_units", 60, Kind::Text, 8),
+    Field("unused1", 68, Kind::I16, 1),
+    Field("datatype", 70, Kind::I16, 1),
+    Field("bitpix", 72, Kind::I16, 1),
+    Field("dim_un0", 74, Kind::I16, 1),
+    Field("pixdim", 76, Kind::F32, 8),
+    Field("vox_offset", 108, Kind::F32, 1),
+    Field("funused1", 112, Kind::F32, 1),
+    Field("funused2", 116, Kind::F32, 1),
+    Field("funused3", 120, Kind::F32, 1),
+    Field("cal_max", 124, Kind::F32, 1),
+    Field("cal_min", 128, Kind::F32, 1),
+    Field("compressed", 132, Kind::F32, 1),
+    Field("verified", 136, Kind::F32, 1),
+    Field("glmax", 140, Kind::I32, 1),
+    Field("glmin", 144, Kind::I32, 1),
+    Field("descrip", 148, Kind::Text, 80),
+    Field("aux_file", 228, Kind::Text, 24),
+    Field("orient", 252, Kind::U8, 1),
+    Field("originator", 253, Kind::I16, 5),
+    Field("generated", 263, Kind::Text, 10),
+    Field("scannum", 273, Kind::Text, 10),
+    Field("patient_id", 283, Kind::Text, 10),
+    Field("exp_date", 293, Kind::Text, 10),
+    Field("exp_time", 303, Kind::Text, 10),
+    Field("hist_un0", 313, Kind::Text, 3),
+    Field("views", 316, Kind::I32, 1),
+    Field("vols_added", 320, Kind::I32, 1),
+    Field("start_field", 324, Kind::I32, 1),
+    Field("field_skip", 328, Kind::I32, 1),
+    Field("omax", 332, Kind::I32, 1),
+    Field("omin", 336, Kind::I32, 1),
+    Field("smax", 340, Kind::I32, 1),
+    Field("smin", 344, Kind::I32, 1),
+];
+
+/// Whether `head` starts with an Analyze 7.5 header: `sizeof_hdr` 348 in
+/// either byte order, no NIfTI magic at byte 344 and `dim[0]` 1 to 7 in
+/// the same order.
+pub(crate) fn sniff_analyze(head: &[u8]) -> bool {
+    let Some(h) = head.get(..348) else {
+        return false;
+    };
+    let first4 = [h[0], h[1], h[2], h[3]];
+    let magic = &h[344..348];
+    if magic == b"n+1\0" || magic == b"ni1\0" {
+        return false;
+    }
+    [Endian::Little, Endian::Big].into_iter().any(|endian| {
+        let (size, ndim) = match endian {
+            Endian::Little => (
+                i32::from_le_bytes(first4),
+                i16::from_le_bytes([h[40], h[41]]),
+            ),
+            Endian::Big => (
+                i32::from_be_bytes(first4),
+                i16::from_be_bytes([h[40], h[41]]),
+            ),
+        };
+        size == 348 && (1..=7).contains(&ndim)
+    })
+}
+
+/// Decodes `bytes` along the field table `table`.
+fn decode(bytes: &[u8], table: &[Field], endian: Endian) -> Vec<(&'static str, Value)> {
+    let mut fields = Vec::with_capacity(table.len());
+    for &Field(name, offset, kind, count) in table {
+        let raw = &bytes[offset..offset + kind.size() * count];
+        let value = match kind {
+            Kind::Text => Value::Text(text(raw)),
+            Kind::U8 => Value::Ints(raw.iter().map(|&b| i64::from(b)).collect()),
+            Kind::I16 | Kind::I32 | Kind::I64 => Value::Ints(
+                raw.chunks_exact(kind.size())
+                    .map(|c| int(c, endian))
+                    .collect(),
+            ),
+            Kind::F32 | Kind::F64 => Value::Floats(
+                raw.chunks_exact(kind.size())
+                    .map(|c| float(c, endian))
+                    .collect(),
+            ),
+        };
+        fields.push((name, value));
+    }
+    fields
+}
+
 /// A decoded header field.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Value {
@@ -182,6 +282,11 @@ impl Value {
 pub(super) struct Header {
     /// `n+1`/`n+2` (data in the same file) or `ni1`/`ni2` (a `.hdr`/`.img` pair).
     pub(super) single_file: bool,
+    /// An Analyze 7.5 header (no NIfTI magic): its first three
+    /// `originator` int16, SPM's origin voxel counted from 1 (0 0 0 if
+    /// unset). `fields` then holds the Analyze fields, the transforms
+    /// are unset and `scl_slope`/`scl_inter` are SPM's `funused1`/`funused2`.
+    pub(super) analyze: Option<[i64; 3]>,
     pub(super) dim: [i64; 8],
     pub(super) datatype: i64,
     pub(super) bitpix: i64,
@@ -245,25 +350,7 @@ pub(super) fn parse_header(
     endian: Endian,
 ) -> Result<Header, IoError> {
     debug_assert_eq!(bytes.len(), version.header_len());
-    let mut fields = Vec::with_capacity(version.fields().len());
-    for &Field(name, offset, kind, count) in version.fields() {
-        let raw = &bytes[offset..offset + kind.size() * count];
-        let value = match kind {
-            Kind::Text => Value::Text(text(raw)),
-            Kind::U8 => Value::Ints(raw.iter().map(|&b| i64::from(b)).collect()),
-            Kind::I16 | Kind::I32 | Kind::I64 => Value::Ints(
-                raw.chunks_exact(kind.size())
-                    .map(|c| int(c, endian))
-                    .collect(),
-            ),
-            Kind::F32 | Kind::F64 => Value::Floats(
-                raw.chunks_exact(kind.size())
-                    .map(|c| float(c, endian))
-                    .collect(),
-            ),
-        };
-        fields.push((name, value));
-    }
+    let fields = decode(bytes, version.fields(), endian);
     let find = |name: &str| fields.iter().find(|(n, _)| *n == name).map(|(_, v)| v);
     let ints = |name: &str| match find(name) {
         Some(Value::Ints(v)) => v.clone(),
@@ -290,6 +377,7 @@ pub(super) fn parse_header(
     };
     let mut header = Header {
         single_file: true,
+        analyze: None,
         dim,
         datatype: ints("datatype")[0],
         bitpix: ints("bitpix")[0],
@@ -316,10 +404,15 @@ pub(super) fn parse_header(
     } else if stored == pair {
         header.single_file = false;
     } else if version == Version::Nifti1 && magic.is_empty() {
-        return Err(IoError::invalid(
-            path,
-            "NIfTI field \"magic\" is empty: this is an Analyze 7.5 header, which volray does not read (convert it to NIfTI)",
-        ));
+        // Analyze 7.5: the same layout up to the transforms; always a
+        // .hdr/.img pair, no orientation, SPM's origin in `originator`.
+        header.single_file = false;
+        header.fields = decode(bytes, ANALYZE_FIELDS, endian);
+        header.xyzt_units = 0;
+        header.qform_code = 0;
+        header.sform_code = 0;
+        let originator = [253, 255, 257].map(|at| int(&bytes[at..at + 2], endian));
+        header.analyze = Some(originator);
     } else {
         return Err(IoError::invalid(
             path,
@@ -375,6 +468,16 @@ fn float(c: &[u8], endian: Endian) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn analyze_table_tiles_its_header() {
+        let mut end = 0;
+        for &Field(name, offset, kind, count) in ANALYZE_FIELDS {
+            assert_eq!(offset, end, "{name}");
+            end = offset + kind.size() * count;
+        }
+        assert_eq!(end, 348);
+    }
 
     #[test]
     fn field_tables_tile_the_headers() {

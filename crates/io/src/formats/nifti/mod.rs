@@ -1,4 +1,13 @@
-//! NIfTI-1 and NIfTI-2 volumes: `.nii`, `.nii.gz` and `.hdr`/`.img` pairs.
+//! NIfTI-1 and NIfTI-2 volumes: `.nii`, `.nii.gz` and `.hdr`/`.img` pairs;
+//! and Analyze 7.5 pairs, NIfTI-1's ancestor.
+//!
+//! Analyze 7.5 (a 348-byte `.hdr` without NIfTI's magic, as nibabel's
+//! AnalyzeImage and SPM write it) is read here as a sub-case of the NIfTI-1
+//! pair, which shares its layout up to the transforms; it has its own row
+//! ([`VolumeFormat::Analyze`]) so that it is named in messages and
+//! `volray info`. It carries voxel sizes but no orientation: nibabel's
+//! affine for it is used (`geometry.rs`), with SPM's `originator` when set,
+//! and `funused1`/`funused2` as SPM's scale and offset.
 //!
 //! [`read`] runs in the order of the file: `source.rs` opens it (plain or
 //! gzip, and the `.img` beside a `.hdr`), `header.rs` parses the 348-byte
@@ -16,11 +25,20 @@
 //!   (`srow_x/y/z`) if `sform_code > 0`, else from the qform quaternion if
 //!   `qform_code > 0` (nifti1.h "method 2"), else from `pixdim` alone
 //!   ("method 1", origin at 0); they go through [`grid_to_volume`];
+//! - a sheared sform (columns not orthogonal: not a rotation times a
+//!   scale), which nibabel and ITK read as it is, is resampled trilinearly
+//!   onto an axis-aligned grid covering the file's box, NaN outside it
+//!   ([`FileInfo::nan_is_empty`]), as skewed CCP4 maps are
+//!   (`shared/periodic_cell.rs`), within `max_memory`;
 //! - `xyzt_units` names the length unit (m, mm, µm), which is reported, not
 //!   converted;
-//! - a 4-D file holds `dim[4]` volumes and `--frame` picks one; 5-D and
-//!   higher data (any `dim[5..]` above 1) are refused, as are complex, RGB,
-//!   bit and 128-bit float samples.
+//! - a 4-D file holds `dim[4]` volumes and `--frame` picks one; a 5-D
+//!   file (vector or channel data, `dim[5]` components, nibabel's shape
+//!   `(x, y, z, t, c)`) holds `dim[4]·dim[5]` volumes numbered in the
+//!   file's own order, time fastest: frame `t + dim[4]·c` is one
+//!   contiguous block (a later channel axis maps component `c` to
+//!   channel `c`); 6-D and higher data (any `dim[6..]` above 1) are
+//!   refused, as are complex, RGB, bit and 128-bit float samples.
 
 mod data;
 mod geometry;
@@ -31,6 +49,7 @@ use std::path::Path;
 
 use self::data::{Layout, dim_text, scaling, too_big};
 use self::geometry::{geometry, length_unit};
+pub(crate) use self::header::sniff_analyze;
 use self::header::{detect_version, parse_header};
 use self::source::{Source, image_path};
 use crate::dtype::{Stored, read_as_stored};
@@ -39,14 +58,31 @@ use crate::shared::compress::MAX_DEFLATE_RATIO;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::limits::{F32_BYTES, check_frame_dims};
 use crate::shared::mapped::{self, Plan};
+use crate::shared::periodic_cell;
 use crate::shared::rescale::rescale;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 /// Samples decoded per read: bounds the scratch buffer beside the output.
 const CHUNK_SAMPLES: usize = 1 << 16;
 
-/// Reads the NIfTI file at `path` (see the module documentation).
+/// Reads the NIfTI or Analyze 7.5 file at `path` (see the module
+/// documentation). Messages about an Analyze header name Analyze 7.5.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
+    let mut analyze = false;
+    read_as(path, opts, &mut analyze).map_err(|e| match e {
+        IoError::Invalid { path, reason } if analyze => IoError::Invalid {
+            path,
+            reason: reason
+                .replace("NIfTI field", "Analyze 7.5 field")
+                .replace("NIfTI header", "Analyze 7.5 header")
+                .replace("NIfTI magic says", "an Analyze 7.5 header says"),
+        },
+        other => other,
+    })
+}
+
+/// [`read`], setting `analyze` once the header shows an Analyze 7.5 one.
+fn read_as(path: &Path, opts: &ReadOptions, analyze: &mut bool) -> Result<Loaded, IoError> {
     let (mut source, file_len) = Source::open(path)?;
     let header_source_gz = source.is_gzip();
 
@@ -63,6 +99,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         .fill(path, &mut bytes[4..], 4, len as u64)
         .map_err(|e| short_header(path, e))?;
     let header = parse_header(path, &bytes, version, endian)?;
+    *analyze = header.analyze.is_some();
 
     let layout = Layout::of(path, &header, opts.frame)?;
     let mut info = FileInfo::new(format!("{} ({}-endian)", layout.type_name, endian));
@@ -76,7 +113,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     info.length_unit = length_unit(header.xyzt_units).map(str::to_string);
     info.notes.push(format!(
         "{} header, {} ({}-endian{})",
-        version.name(),
+        if header.analyze.is_some() {
+            "Analyze 7.5 (no NIfTI magic)"
+        } else {
+            version.name()
+        },
         if header.single_file {
             "data in the same file"
         } else {
@@ -85,7 +126,17 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         endian,
         if header_source_gz { ", gzip" } else { "" }
     ));
-    if layout.frames > 1 && opts.frame.is_none() {
+    if layout.components > 1 {
+        let (t, c) = (layout.times, layout.components);
+        info.notes.push(format!(
+            "5-D: {c} components (dim[5]{}) x {t} time point{} (dim[4]); --frame picks one: frame = t + {t}*c, the file's own order (this is frame {}: t {}, component {})",
+            intent_name(&header),
+            if t == 1 { "" } else { "s" },
+            layout.frame,
+            layout.frame % t,
+            layout.frame / t
+        ));
+    } else if layout.frames > 1 && opts.frame.is_none() {
         info.notes.push(format!(
             "the file holds {} volumes (dim[4]); volume 0 was read",
             layout.frames
@@ -188,7 +239,13 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let scale = scaling(&header, &mut info);
     let stored = layout.dtype.stored();
     let held = stored.bytes() as u64 + if scale.is_some() { F32_BYTES } else { 0 };
-    let mappable = if data_source.is_gzip() {
+    // Where the grid lies, known before any sample is read: a sheared
+    // sform is resampled in memory, so it cannot be mapped.
+    let (steps, origin) = geometry(path, &header, &mut info)?;
+    let sheared = periodic_cell::is_skewed(steps);
+    let mappable = if sheared {
+        Err("the sheared grid is resampled in memory".to_string())
+    } else if data_source.is_gzip() {
         Err("gzip-compressed data: store it as .nii".to_string())
     } else if scale.is_some() {
         Err("scl_slope scales the values as they are read".to_string())
@@ -235,16 +292,54 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         Some((slope, inter)) => rescale(data, slope, inter),
         None => data,
     };
-    let (steps, origin) = geometry(path, &header, &mut info)?;
-    let volume = grid_to_volume(path, layout.dims, data, steps, origin, &mut info)?;
+    let volume = if sheared && layout.dims.iter().all(|&n| n >= 2) {
+        // nibabel and ITK take a sheared sform as it is: resampled onto an
+        // axis-aligned grid over the file's own box, NaN outside it.
+        let unit = info.length_unit.clone().unwrap_or_default();
+        let (volume, note) = periodic_cell::resample_sheared(
+            layout.dims,
+            &data.to_f32_vec(),
+            steps,
+            origin,
+            ["i", "j", "k"],
+            &unit,
+            opts.max_memory,
+        )
+        .map_err(|e| e.at(path, "NIfTI sform (sheared)"))?;
+        info.notes.push(format!(
+            "the sform is sheared (not a rotation times a scale); {note}"
+        ));
+        info.nan_is_empty = true;
+        volume
+    } else {
+        grid_to_volume(path, layout.dims, data, steps, origin, &mut info)?
+    };
     if plan == Plan::Map {
         info.notes.push(mapped::mapped_note(&volume));
     }
     Ok(Loaded {
         volume,
-        format: VolumeFormat::Nifti,
+        format: if header.analyze.is_some() {
+            VolumeFormat::Analyze
+        } else {
+            VolumeFormat::Nifti
+        },
         info,
     })
+}
+
+/// ", intent_code N (name)" for a header that names its intent, else "".
+fn intent_name(header: &header::Header) -> String {
+    let code = header.ints("intent_code").first().copied().unwrap_or(0);
+    match code {
+        0 => String::new(),
+        1007 => ", intent_code 1007 = vector".to_string(),
+        2001 => ", intent_code 2001 = RGB vector".to_string(),
+        2002 => ", intent_code 2002 = RGBA vector".to_string(),
+        1005 => ", intent_code 1005 = symmetric matrix".to_string(),
+        1004 => ", intent_code 1004 = general matrix".to_string(),
+        _ => format!(", intent_code {code}"),
+    }
 }
 
 /// A header cut short reads as a bad file, whatever the source.
