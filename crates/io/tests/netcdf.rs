@@ -353,8 +353,9 @@ fn broken_fixtures_never_panic() {
 }
 
 #[test]
-fn a_netcdf4_file_still_takes_the_hdf5_route() {
-    // Until the NetCDF-4 reader lands: HDF5's axis convention, a[x, y, z].
+fn a_netcdf4_file_is_read_by_the_netcdf4_reader_and_opened_box_by_box() {
+    // HDF5 underneath: the file, `file.nc:/var` and `--format netcdf` all
+    // go to formats/netcdf4.rs, the right way round (x the last dimension).
     let path = fixture("netcdf", "netcdf4.nc");
     let spec = std::path::PathBuf::from(format!("{}:/r", path.display()));
     let forced = ReadOptions {
@@ -367,12 +368,21 @@ fn a_netcdf4_file_still_takes_the_hdf5_route() {
         (&path, forced),
     ] {
         let l = read(p, &opts).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-        assert_eq!(l.format, VolumeFormat::Hdf5);
-        common::check_voxels("netcdf4", &l.volume, [2, 3, 4], |x, y, z| {
-            ramp(z, y, x, 0) as f32
+        assert_eq!(l.format, VolumeFormat::Netcdf, "{}", p.display());
+        common::check_voxels("netcdf4", &l.volume, [4, 3, 2], |x, y, z| {
+            ramp(x, y, z, 0) as f32
         });
     }
-    // And is opened box by box, as HDF5 datasets are.
+    // `--format hdf5` names the bare dataset, its axes from the scales.
+    let bare = ReadOptions {
+        format: Some(VolumeFormat::Hdf5),
+        ..ReadOptions::default()
+    };
+    let l = read(&spec, &bare).unwrap();
+    assert_eq!(l.format, VolumeFormat::Hdf5);
+    common::check_voxels("netcdf4 as hdf5", &l.volume, [4, 3, 2], |x, y, z| {
+        ramp(x, y, z, 0) as f32
+    });
     let lazy = volray_io::open_lazy(&path, &ReadOptions::default()).unwrap();
-    assert!(lazy.is_some_and(|l| l.format == VolumeFormat::Hdf5));
+    assert!(lazy.is_some_and(|l| l.format == VolumeFormat::Netcdf));
 }
