@@ -132,7 +132,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             );
             if h.non_finite > 0 && info.is_some_and(|i| i.nan_is_empty) {
                 outln!(
-                    "           {} NaN: space the file does not cover, rendered as empty",
+                    "           {} NaN: no value (outside the file's grid, or fill or blank values; see the notes), rendered as empty",
                     h.non_finite
                 );
             } else if h.non_finite > 0 {

@@ -416,7 +416,7 @@ fn a_skewed_map_of_part_of_a_cell_renders_with_empty_space_around_its_box() {
     assert!(out.status.success(), "{}", stderr(&out));
     let text = stdout(&out);
     for expect in [
-        "NaN: space the file does not cover, rendered as empty",
+        "NaN: no value (outside the file's grid, or fill or blank values; see the notes), rendered as empty",
         "not periodic, so only its own box is resampled",
     ] {
         assert!(text.contains(expect), "missing {expect:?} in\n{text}");

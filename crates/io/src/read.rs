@@ -143,9 +143,11 @@ pub struct FileInfo {
     /// collection's images), if any, and the one read.
     pub arrays: Vec<String>,
     pub array: Option<String>,
-    /// The volume's NaN values are space the file does not cover (the
-    /// box of a skewed CCP4 map resampled onto an axis-aligned grid):
-    /// to be rendered as empty space, not refused.
+    /// The volume's NaN values hold no value: space the file does not
+    /// cover (the box of a skewed CCP4 map or sheared NIfTI grid
+    /// resampled onto an axis-aligned grid), or samples the file marks
+    /// undefined (FITS BLANK, CF fill values): to be rendered as empty
+    /// space, not refused.
     pub nan_is_empty: bool,
     /// The volume was mapped in the file's own axis order, which is not
     /// x, y, z along world +x, +y, +z (only under
