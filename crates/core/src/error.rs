@@ -30,6 +30,36 @@ pub enum RenderError {
     /// ([`Renderer::render_stoppable`](crate::Renderer::render_stoppable)).
     #[error("the frame was stopped before it was finished")]
     Stopped,
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+/// Why several volumes cannot be rendered together ([`crate::scene`]).
+/// Layers are counted from 0, the first volume being layer 0.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SceneError {
+    #[error("a scene needs at least one volume")]
+    Empty,
+    #[error(
+        "volume {layer} (box {} .. {}) does not meet the first volume's box ({} .. {}): check its origin and spacing",
+        bounds.0, bounds.1, first.0, first.1
+    )]
+    Disjoint {
+        layer: usize,
+        bounds: (DVec3, DVec3),
+        first: (DVec3, DVec3),
+    },
+    #[error("{looks} looks for {layers} volumes: give one per volume")]
+    Looks { layers: usize, looks: usize },
+    #[error("volume {layer}: opacity {value} must be in [0, 1]")]
+    Opacity { layer: usize, value: f32 },
+    #[error("volume {layer}: {error}")]
+    Layer {
+        layer: usize,
+        error: Box<RenderError>,
+    },
+    #[error("a scene of several volumes is rendered whole, not as a piece of a distributed frame")]
+    Piece,
 }
 
 /// A render setting out of its range: which one, its value and the bound.

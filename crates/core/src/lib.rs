@@ -90,6 +90,7 @@ mod progress;
 mod reference;
 mod renderer;
 pub mod sampling;
+pub mod scene;
 mod settings;
 pub mod transfer;
 mod volume;
@@ -97,7 +98,7 @@ mod volume;
 pub use camera::{
     Camera, CameraError, CameraPoint, Fit, Orbit, OrthographicView, Projection, View,
 };
-pub use error::{ImageSide, Reflection, RenderError, SettingError};
+pub use error::{ImageSide, Reflection, RenderError, SceneError, SettingError};
 pub use frame::Frame;
 pub use glam;
 pub use histogram::Histogram;

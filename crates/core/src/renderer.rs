@@ -48,7 +48,7 @@ use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use std::borrow::Cow;
 use std::sync::atomic::AtomicBool;
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Mutex, MutexGuard, OnceLock};
 use std::time::{Duration, Instant};
 
 /// A volume ready to render. Its value range is found once; the fast
@@ -96,12 +96,12 @@ fn verify(volume: &Volume) -> Result<(), RenderError> {
 pub const DEFAULT_CACHE_BUDGET: usize = 1 << 30;
 
 /// The fast path's state kept between frames.
-struct FastState {
+pub(crate) struct FastState {
     /// What `bricks` were classified with.
-    classifier: Classifier,
-    bricks: ClassifiedBricks,
+    pub classifier: Classifier,
+    pub bricks: ClassifiedBricks,
     /// The frame's lit bricks, buffers reused from frame to frame.
-    lit: LitBricks,
+    pub lit: LitBricks,
 }
 
 /// Where a fast frame's time went.
@@ -303,6 +303,32 @@ impl<'v> Renderer<'v> {
         Ok((partial, times))
     }
 
+    /// [`Self::render_partial`] with a [`Progress`] (a scene's layers
+    /// rendered apart share their caller's), its samples verified.
+    pub(crate) fn render_partial_with(
+        &self,
+        settings: &RenderSettings,
+        progress: &Progress,
+    ) -> Result<PartialImage, RenderError> {
+        let frame = self.prepare(settings)?;
+        let partial = match settings.method {
+            Method::Fast => {
+                let mut partial = self.blank(settings, Vec::new());
+                self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
+                partial
+            }
+            Method::Reference => self.render_reference(settings, &frame, progress),
+        };
+        self.verify()?;
+        Ok(partial)
+    }
+
+    /// Whether the volume's samples were what they are meant to be while
+    /// they were read (see [`verify`]).
+    pub(crate) fn verify(&self) -> Result<(), RenderError> {
+        verify(&self.volume)
+    }
+
     /// The finished frame of `partial` (rendered with `settings`): over the
     /// background, projected values through the colour map.
     pub fn finish(&self, settings: &RenderSettings, partial: PartialImage) -> Image {
@@ -326,7 +352,7 @@ impl<'v> Renderer<'v> {
     /// path is finished by the casters, each ray over the background as
     /// its last step ([`Finish::Over`]), with no second pass over the
     /// pixels; the others are finished from their partial image.
-    fn render_frame(
+    pub(crate) fn render_frame(
         &self,
         settings: &RenderSettings,
         image: &mut Image,
@@ -399,7 +425,7 @@ impl<'v> Renderer<'v> {
     }
 
     /// The volume's min/max bricks, found on the first frame that needs them.
-    fn macrocells(&self) -> &Macrocells {
+    pub(crate) fn macrocells(&self) -> &Macrocells {
         self.macrocells
             .get_or_init(|| Macrocells::new(&self.volume))
     }
@@ -434,7 +460,7 @@ impl<'v> Renderer<'v> {
     /// perspective views too (as a headlight at infinity): one light
     /// geometry for the whole frame, so that pre-classification can light
     /// the voxels once.
-    fn light(settings: &RenderSettings, view: &View) -> LightGeometry {
+    pub(crate) fn light(settings: &RenderSettings, view: &View) -> LightGeometry {
         let to_viewer = (-view.direction()).as_vec3();
         match settings.light_direction {
             Some(l) => LightGeometry::new(l.as_vec3(), to_viewer),
@@ -549,8 +575,7 @@ impl<'v> Renderer<'v> {
     ) -> FrameTimes {
         let start = Instant::now();
         let classifier = self.classifier(settings);
-        let voxels = (self.packed_voxels)
-            .get_or_init(|| post_cast::packed_voxels(&self.volume, &gradients(&self.volume)));
+        let voxels = self.packed_voxels();
         let scene = post_cast::Scene {
             voxels,
             macrocells: self.macrocells(),
@@ -567,25 +592,15 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// The bricked ray caster: classify (only when the classifier changed),
-    /// light the occupied bricks, bin them into tiles, cast the rays.
-    fn render_bricks(
-        &self,
-        settings: &RenderSettings,
-        frame: &Frame,
-        pixels: &mut [PartialPixel],
-        finish: Finish,
-        progress: &Progress,
-    ) -> FrameTimes {
-        let mut times = FrameTimes::default();
-        let classifier = self.classifier(settings);
+    /// The bricked fast path's state for `classifier`, locked for a frame:
+    /// the occupied bricks classified by it (classified again only when
+    /// it differs from the last frame's) and the lit bricks' buffers.
+    pub(crate) fn fast_state(&self, classifier: Classifier) -> MutexGuard<'_, Option<FastState>> {
         let mut guard = self.fast.lock().unwrap_or_else(|e| e.into_inner());
-        let t0 = Instant::now();
-        let mask = self.non_finite.as_ref();
-        let masked = |v: usize| mask.is_some_and(|m| m.contains(v));
         if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
             // Drop the old bricks before building the new ones.
             *guard = None;
+            let masked = self.masked();
             let source = Source {
                 volume: &self.volume,
                 classifier: &classifier,
@@ -602,6 +617,37 @@ impl<'v> Renderer<'v> {
                 lit,
             });
         }
+        guard
+    }
+
+    /// Whether voxel `v` is a non-finite one rendered as empty space.
+    pub(crate) fn masked(&self) -> impl Fn(usize) -> bool + Sync + '_ {
+        let mask = self.non_finite.as_ref();
+        move |v: usize| mask.is_some_and(|m| m.contains(v))
+    }
+
+    /// Every voxel's gradient and value packed ([`post_cast::packed_voxels`]),
+    /// made on the first frame that needs them and kept.
+    pub(crate) fn packed_voxels(&self) -> &[wide::f32x4] {
+        (self.packed_voxels)
+            .get_or_init(|| post_cast::packed_voxels(&self.volume, &gradients(&self.volume)))
+    }
+
+    /// The bricked ray caster: classify (only when the classifier changed),
+    /// light the occupied bricks, bin them into tiles, cast the rays.
+    fn render_bricks(
+        &self,
+        settings: &RenderSettings,
+        frame: &Frame,
+        pixels: &mut [PartialPixel],
+        finish: Finish,
+        progress: &Progress,
+    ) -> FrameTimes {
+        let mut times = FrameTimes::default();
+        let classifier = self.classifier(settings);
+        let t0 = Instant::now();
+        let mut guard = self.fast_state(classifier);
+        let masked = self.masked();
         let state = guard.as_mut().expect("the state was just made");
         let t1 = Instant::now();
         let bins = TileBins::new(&state.bricks, &frame.sampling, &frame.view);

@@ -16,6 +16,7 @@ pub mod blend;
 pub mod composite;
 pub mod gradient;
 pub mod lanes;
+pub mod mix;
 pub mod phong;
 pub mod projection;
 pub mod trilinear;

@@ -83,7 +83,7 @@
 
 mod cast;
 mod scene;
-mod skipping;
+pub(crate) mod skipping;
 #[cfg(test)]
 mod tests;
 

@@ -1,0 +1,1 @@
+//! The scene's paths against each other and against closed forms.
