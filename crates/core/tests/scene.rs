@@ -119,12 +119,20 @@ fn two_and_three_volumes_match_the_reference_in_both_mixes_and_classifications()
                 looks: looks.clone(),
                 mix,
             };
-            assert_fast_matches(&scene, &three, &format!("3 volumes {mix:?} {classification:?}"));
+            assert_fast_matches(
+                &scene,
+                &three,
+                &format!("3 volumes {mix:?} {classification:?}"),
+            );
             let two = SceneSettings {
                 looks: looks[..2].to_vec(),
                 ..three
             };
-            assert_fast_matches(&scene2, &two, &format!("2 volumes {mix:?} {classification:?}"));
+            assert_fast_matches(
+                &scene2,
+                &two,
+                &format!("2 volumes {mix:?} {classification:?}"),
+            );
         }
     }
 }
@@ -141,8 +149,11 @@ fn an_overlay_on_another_grid_and_spacing_matches_the_reference_in_both_projecti
         DVec3::new(12.0, 10.0, 8.0),
         7.0,
     );
-    let scene = Scene::new(vec![Renderer::new(&base).unwrap(), Renderer::new(&fine).unwrap()])
-        .unwrap();
+    let scene = Scene::new(vec![
+        Renderer::new(&base).unwrap(),
+        Renderer::new(&fine).unwrap(),
+    ])
+    .unwrap();
     for projection in [
         Projection::Orthographic,
         Projection::Perspective { fov_degrees: 40.0 },
@@ -163,7 +174,9 @@ fn an_overlay_on_another_grid_and_spacing_matches_the_reference_in_both_projecti
                     look(&settings, sparse_tf()),
                     look(
                         &settings,
-                        tf(r#"{"opacity": [[0, 0], [0.2, 0], [1, 0.8]], "color": [[0, 1, 0.8, 0]]}"#),
+                        tf(
+                            r#"{"opacity": [[0, 0], [0.2, 0], [1, 0.8]], "color": [[0, 1, 0.8, 0]]}"#,
+                        ),
                     ),
                 ],
                 settings,
@@ -181,9 +194,20 @@ fn an_overlay_on_another_grid_and_spacing_matches_the_reference_in_both_projecti
 #[test]
 fn every_blend_mode_and_a_crop_match_the_reference() {
     let a = waves([20, 22, 18], DVec3::ONE, DVec3::ZERO, 0.0);
-    let b = ball([20, 22, 18], 1.0, DVec3::ZERO, DVec3::new(9.0, 11.0, 9.0), 8.0);
+    let b = ball(
+        [20, 22, 18],
+        1.0,
+        DVec3::ZERO,
+        DVec3::new(9.0, 11.0, 9.0),
+        8.0,
+    );
     let scene = Scene::new(vec![Renderer::new(&a).unwrap(), Renderer::new(&b).unwrap()]).unwrap();
-    for blend in [Blend::Composite, Blend::Maximum, Blend::Minimum, Blend::Average] {
+    for blend in [
+        Blend::Composite,
+        Blend::Maximum,
+        Blend::Minimum,
+        Blend::Average,
+    ] {
         let settings = RenderSettings {
             blend,
             crop: Some((DVec3::new(2.0, 3.0, 1.0), DVec3::new(17.0, 19.5, 14.0))),
@@ -259,9 +283,16 @@ fn the_ball_in_front_hides_the_other_volumes_ball_from_either_side() {
             let magenta = |p: &[f32; 4]| p[0] > 0.01;
             let pixels = image.pixels();
             if front == [1.0, 0.0, 1.0] {
-                assert!(pixels.iter().filter(|p| green(p)).count() > 50, "{method:?}");
+                assert!(
+                    pixels.iter().filter(|p| green(p)).count() > 50,
+                    "{method:?}"
+                );
             } else {
-                assert_eq!(pixels.iter().filter(|p| magenta(p)).count(), 0, "{method:?}");
+                assert_eq!(
+                    pixels.iter().filter(|p| magenta(p)).count(),
+                    0,
+                    "{method:?}"
+                );
             }
         }
     }
@@ -269,7 +300,12 @@ fn the_ball_in_front_hides_the_other_volumes_ball_from_either_side() {
 
 #[test]
 fn a_scene_of_one_volume_renders_exactly_as_its_renderer() {
-    let v = waves([21, 17, 19], DVec3::new(1.0, 0.8, 1.1), DVec3::new(-3.0, 2.0, 0.5), 0.4);
+    let v = waves(
+        [21, 17, 19],
+        DVec3::new(1.0, 0.8, 1.1),
+        DVec3::new(-3.0, 2.0, 0.5),
+        0.4,
+    );
     let renderer = Renderer::new(&v).unwrap();
     for blend in [Blend::Composite, Blend::Maximum] {
         for classification in [Classification::Pre, Classification::Post] {
@@ -286,7 +322,11 @@ fn a_scene_of_one_volume_renders_exactly_as_its_renderer() {
                 settings,
                 mix: Mix::Composite,
             };
-            assert_eq!(render(&scene, &request), alone, "{blend:?} {classification:?}");
+            assert_eq!(
+                render(&scene, &request),
+                alone,
+                "{blend:?} {classification:?}"
+            );
         }
     }
 }
@@ -359,7 +399,10 @@ fn the_additive_mix_sums_the_channels_colours() {
     let mut both = 0;
     for (i, p) in image.pixels().iter().enumerate() {
         let (r, g) = (ra.pixels()[i], gb.pixels()[i]);
-        assert!((p[0] - r[0]).abs() < 1e-6 && (p[1] - g[1]).abs() < 1e-6, "{p:?}");
+        assert!(
+            (p[0] - r[0]).abs() < 1e-6 && (p[1] - g[1]).abs() < 1e-6,
+            "{p:?}"
+        );
         assert!((p[3] - (1.0 - (1.0 - r[3]) * (1.0 - g[3]))).abs() < 1e-6);
         both += (r[0] > 0.2 && g[1] > 0.2) as usize;
     }
@@ -391,8 +434,11 @@ fn a_label_overlay_shows_each_label_in_its_table_colour_over_a_translucent_scan(
         ..RenderSettings::default()
     };
     let table = transfer_function(&[0, 3, 7], &LabelStyle::default()).unwrap();
-    let scene =
-        Scene::new(vec![Renderer::new(&scan).unwrap(), Renderer::new(&labels).unwrap()]).unwrap();
+    let scene = Scene::new(vec![
+        Renderer::new(&scan).unwrap(),
+        Renderer::new(&labels).unwrap(),
+    ])
+    .unwrap();
     for method in [Method::Fast, Method::Reference] {
         let settings = RenderSettings {
             method,
@@ -472,12 +518,27 @@ fn the_image_is_the_same_on_one_and_on_several_threads() {
 #[test]
 fn refused_scenes_name_the_volume_and_the_problem() {
     let a = ball([10, 10, 10], 1.0, DVec3::ZERO, DVec3::splat(4.5), 3.0);
-    let far = ball([10, 10, 10], 1.0, DVec3::splat(50.0), DVec3::splat(54.5), 3.0);
-    let err = Scene::new(vec![Renderer::new(&a).unwrap(), Renderer::new(&far).unwrap()])
-        .err()
-        .unwrap();
-    assert!(matches!(err, SceneError::Disjoint { layer: 1, .. }), "{err}");
-    assert!(err.to_string().contains("does not meet the first volume"), "{err}");
+    let far = ball(
+        [10, 10, 10],
+        1.0,
+        DVec3::splat(50.0),
+        DVec3::splat(54.5),
+        3.0,
+    );
+    let err = Scene::new(vec![
+        Renderer::new(&a).unwrap(),
+        Renderer::new(&far).unwrap(),
+    ])
+    .err()
+    .unwrap();
+    assert!(
+        matches!(err, SceneError::Disjoint { layer: 1, .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string().contains("does not meet the first volume"),
+        "{err}"
+    );
     assert_eq!(Scene::new(vec![]).err(), Some(SceneError::Empty));
 
     let scene = Scene::new(vec![Renderer::new(&a).unwrap(), Renderer::new(&a).unwrap()]).unwrap();
@@ -519,6 +580,8 @@ fn refused_scenes_name_the_volume_and_the_problem() {
         mix: Mix::Composite,
     };
     let err = scene.render(&request).unwrap_err();
-    assert!(err.to_string().starts_with("volume 1: opacity ramp"), "{err}");
+    assert!(
+        err.to_string().starts_with("volume 1: opacity ramp"),
+        "{err}"
+    );
 }
-

@@ -91,19 +91,39 @@ impl TileBins {
     /// Bins the occupied bricks of `bricks` for `view`, leaving out those
     /// whose samples `sampling` cuts away.
     pub fn new(bricks: &ClassifiedBricks, sampling: &Sampling, view: &View) -> Self {
+        Self::of_boxes(
+            bricks.len(),
+            |n| bricks.brick(n),
+            |n| bricks.occupied_box(n),
+            sampling,
+            view,
+        )
+    }
+
+    /// Bins `count` bricks, brick `n` being brick `brick(n)` of the grid
+    /// and its samples lying in the index-space box `cells(n)` (within
+    /// the brick's), for `view`, leaving out those whose samples
+    /// `sampling` cuts away; the lists hold the numbers `n`.
+    pub fn of_boxes(
+        count: usize,
+        brick: impl Fn(usize) -> [usize; 3],
+        cells: impl Fn(usize) -> ([usize; 3], [usize; 3]),
+        sampling: &Sampling,
+        view: &View,
+    ) -> Self {
         let grid = &sampling.grid;
         let tiles_x = view.width().div_ceil(TILE);
         let tiles_y = view.height().div_ceil(TILE);
         let mut order: Vec<(f64, u32)> = match view {
             View::Orthographic(v) => {
                 let direction = v.direction / grid.spacing;
-                (bricks.bricks().enumerate())
-                    .map(|(n, b)| (site(b).dot(direction), n as u32))
+                (0..count)
+                    .map(|n| (site(brick(n)).dot(direction), n as u32))
                     .collect()
             }
-            View::Perspective(v) => (bricks.bricks().enumerate())
-                .map(|(n, b)| {
-                    let world = grid.origin + site(b) * grid.spacing;
+            View::Perspective(v) => (0..count)
+                .map(|n| {
+                    let world = grid.origin + site(brick(n)) * grid.spacing;
                     (world.distance_squared(v.eye), n as u32)
                 })
                 .collect(),
@@ -125,7 +145,7 @@ impl TileBins {
         let rects: Vec<Option<[u16; 4]>> = order
             .iter()
             .map(|&(_, n)| {
-                let cells = bricks.occupied_box(n as usize);
+                let cells = cells(n as usize);
                 if clipping.is_active() && !kept(cells) {
                     return None;
                 }

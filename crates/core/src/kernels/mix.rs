@@ -88,7 +88,10 @@ mod tests {
     fn the_mix_is_the_weighted_colour_of_independent_absorbers() {
         // Red at 0.5 and blue at 0.25: opacity 1 − 0.5·0.75 = 0.625; colour
         // (0.5·red + 0.25·blue)/0.75 = (2/3, 0, 1/3).
-        let m = mix_reference([DVec4::new(1.0, 0.0, 0.0, 0.5), DVec4::new(0.0, 0.0, 1.0, 0.25)]);
+        let m = mix_reference([
+            DVec4::new(1.0, 0.0, 0.0, 0.5),
+            DVec4::new(0.0, 0.0, 1.0, 0.25),
+        ]);
         let want = DVec4::new(2.0 / 3.0, 0.0, 1.0 / 3.0, 0.625);
         assert!((m - want).abs().max_element() < 1e-15, "{m:?}");
         let mut f = Mixer::NEW;
@@ -99,7 +102,10 @@ mod tests {
             assert!((f64::from(*g) - w).abs() < 1e-6, "{got:?}");
         }
         // An opaque sample makes the mix opaque, whatever the others.
-        let m = mix_reference([DVec4::new(0.0, 1.0, 0.0, 1.0), DVec4::new(1.0, 0.0, 0.0, 0.4)]);
+        let m = mix_reference([
+            DVec4::new(0.0, 1.0, 0.0, 1.0),
+            DVec4::new(1.0, 0.0, 0.0, 0.4),
+        ]);
         assert_eq!(m.w, 1.0);
     }
 }

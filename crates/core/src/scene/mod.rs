@@ -226,9 +226,8 @@ impl<'v> Scene<'v> {
             }
         }
         let first = first.bounds();
-        let bounds = (layers.iter().map(|l| l.volume().bounds())).fold(first, |(lo, hi), b| {
-            (lo.min(b.0), hi.max(b.1))
-        });
+        let bounds = (layers.iter().map(|l| l.volume().bounds()))
+            .fold(first, |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
         Ok(Scene { layers, bounds })
     }
 
@@ -358,8 +357,10 @@ impl<'v> Scene<'v> {
         }
         // One march through every volume shown.
         let frame = self.frame(shared)?;
-        let layers: Vec<(&Renderer, &RenderSettings)> =
-            shown.iter().map(|&i| (&self.layers[i], &settings[i])).collect();
+        let layers: Vec<(&Renderer, &RenderSettings)> = shown
+            .iter()
+            .map(|&i| (&self.layers[i], &settings[i]))
+            .collect();
         let partial = match shared.method {
             Method::Reference => reference::render(&layers, &frame, shared, progress),
             Method::Fast => fast::render(&layers, &frame, shared, progress),

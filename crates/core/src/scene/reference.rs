@@ -47,9 +47,9 @@ impl Layer<'_> {
         let dims = self.grid.dims;
         let index = clamp_to_grid((p - self.grid.origin) / self.grid.spacing, dims).to_array();
         Some(match &self.samples {
-            Samples::Pre(shaded) => trilinear::reference(index, dims, DVec4::ZERO, |i| {
-                shaded.voxels[i].as_dvec4()
-            }),
+            Samples::Pre(shaded) => {
+                trilinear::reference(index, dims, DVec4::ZERO, |i| shaded.voxels[i].as_dvec4())
+            }
             Samples::Post(post) => post.sample(index),
         })
     }

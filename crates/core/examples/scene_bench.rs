@@ -1,0 +1,174 @@
+//! How much a scene of two and three channels costs against one channel
+//! alone: channels of one 256³ grid (Gaussian blobs, different in each
+//! channel, empty space between them), rendered at 512², each frame turned
+//! a further half degree. Prints the median frame time of each case and
+//! its ratio to the one channel's, all measured in one run, alternating
+//! the cases frame by frame.
+//!
+//! `cargo run --release -p volray-core --example scene_bench [-- N FRAMES]`
+//! (N: grid side, default 256; FRAMES: timed frames per case, default 7).
+
+use std::time::Instant;
+use volray_core::camera::Camera;
+use volray_core::glam::DVec3;
+use volray_core::scene::{Look, Mix, Scene, SceneSettings};
+use volray_core::{
+    Classification, PiecewiseLinear, RenderSettings, Renderer, TransferFunction, Volume,
+};
+
+/// Gaussian blobs on an `n`³ grid over the unit cube, from a seed.
+fn channel(n: usize, seed: u64) -> Volume {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let blobs: Vec<(DVec3, f64)> = (0..12)
+        .map(|_| {
+            (
+                DVec3::new(next(), next(), next()) * 0.8 + 0.1,
+                0.04 + 0.06 * next(),
+            )
+        })
+        .collect();
+    let h = 1.0 / (n - 1) as f64;
+    Volume::from_fn([n; 3], DVec3::splat(h), DVec3::ZERO, move |p| {
+        blobs
+            .iter()
+            .map(|(c, w)| (-(p - *c).length_squared() / (w * w)).exp())
+            .sum::<f64>() as f32
+    })
+    .unwrap()
+}
+
+/// One case: renders frame `n`.
+type Frame<'a> = Box<dyn Fn(usize) + 'a>;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
+    let n = args.first().copied().unwrap_or(256);
+    let frames = args.get(1).copied().unwrap_or(7);
+    let volumes: Vec<Volume> = (0..3).map(|c| channel(n, c + 1)).collect();
+    let colours = [[1.0, 0.0, 1.0], [0.0, 1.0, 0.0], [0.0, 1.0, 1.0]];
+    let tf = |rgb: [f32; 3]| TransferFunction {
+        domain: Some((0.0, 1.0)),
+        opacity: Some(
+            PiecewiseLinear::new("opacity", vec![(0.0, [0.0]), (0.15, [0.0]), (1.0, [0.6])])
+                .unwrap(),
+        ),
+        color: Some(PiecewiseLinear::constant(rgb)),
+    };
+    for classification in [Classification::Pre, Classification::Post] {
+        let settings = |frame: usize| RenderSettings {
+            width: 512,
+            height: 512,
+            step: 0.5,
+            classification,
+            camera: Camera {
+                azimuth: 30.0 + 0.5 * frame as f64,
+                elevation: 20.0,
+                ..Camera::default()
+            },
+            transfer_function: tf(colours[0]),
+            ..RenderSettings::default()
+        };
+        let one = Renderer::new(&volumes[0]).unwrap();
+        let scene = |k: usize| {
+            Scene::new(
+                volumes[..k]
+                    .iter()
+                    .map(|v| Renderer::new(v).unwrap())
+                    .collect(),
+            )
+            .unwrap()
+        };
+        // Each case its own scene: a scene keeps the classification of its
+        // last frame, which another look would redo every frame.
+        let (two, two_clear, three) = (scene(2), scene(2), scene(3));
+        let request = |k: usize, frame: usize, mix: Mix| {
+            let s = settings(frame);
+            SceneSettings {
+                looks: (0..k)
+                    .map(|c| Look {
+                        transfer_function: tf(colours[c]),
+                        ..Look::of(&s)
+                    })
+                    .collect(),
+                settings: s,
+                mix,
+            }
+        };
+        let only = std::env::var("SCENE_BENCH_ONLY").ok();
+        let clear = |f: usize| {
+            let mut r = request(2, f, Mix::Composite);
+            r.looks[1].visible = true;
+            r.looks[1].transfer_function.opacity = Some(PiecewiseLinear::constant([0.0]));
+            r
+        };
+        let cases: [(&str, Frame); 6] = [
+            (
+                "1 channel (its renderer)",
+                Box::new(|f| drop(one.render(&settings(f)).unwrap())),
+            ),
+            (
+                "2 channels, 2nd clear",
+                Box::new(|f| drop(two_clear.render(&clear(f)).unwrap())),
+            ),
+            (
+                "2 channels, composite",
+                Box::new(|f| drop(two.render(&request(2, f, Mix::Composite)).unwrap())),
+            ),
+            (
+                "2 channels, additive",
+                Box::new(|f| drop(two.render(&request(2, f, Mix::Additive)).unwrap())),
+            ),
+            (
+                "3 channels, composite",
+                Box::new(|f| drop(three.render(&request(3, f, Mix::Composite)).unwrap())),
+            ),
+            (
+                "3 channels, additive",
+                Box::new(|f| drop(three.render(&request(3, f, Mix::Additive)).unwrap())),
+            ),
+        ];
+        let cases: Vec<_> = (cases.into_iter())
+            .filter(|(name, _)| only.as_deref().is_none_or(|o| name.contains(o)))
+            .collect();
+        // A warm-up frame each: classification, lit bricks, packed voxels.
+        for (_, case) in &cases {
+            case(0);
+        }
+        let mut times = vec![Vec::new(); cases.len()];
+        for frame in 1..=frames {
+            for (i, (_, case)) in cases.iter().enumerate() {
+                let t = Instant::now();
+                case(frame);
+                times[i].push(t.elapsed().as_secs_f64());
+            }
+        }
+        let medians: Vec<f64> = times.into_iter().map(median).collect();
+        println!(
+            "{n}³ channels at 512², step 0.5, {classification:?}-classified, {} threads, {frames} frames:",
+            rayon::current_num_threads()
+        );
+        for ((name, _), m) in cases.iter().zip(&medians) {
+            println!(
+                "  {name:<26} {:>8.1} ms  {:>5.2}×",
+                m * 1e3,
+                m / medians[0] /* the first case shown */
+            );
+        }
+    }
+}
