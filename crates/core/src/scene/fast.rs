@@ -2,17 +2,27 @@
 //! (`reference.rs`), in `f32`, front to back, with early ray termination,
 //! skipping what is transparent in each volume.
 //!
-//! **Chunks.** Each ray takes its samples in chunks, from [`FIRST_CHUNK`]
-//! samples where it enters a volume's occupied bricks, doubling to
-//! [`CHUNK`] (a ray that meets an opaque surface stops within a few
-//! samples, and wastes at most the rest of its chunk). For a
-//! chunk, each volume fills its samples of it (colour and opacity, zero
-//! outside its box and where it is transparent), walking the bricks the
-//! chunk crosses in its own grid; then the chunk's samples are mixed
-//! ([`Mixer`]) and composited, and the ray stops once less than 1/1024 of
-//! the light gets through. A chunk in which no volume has an opaque sample
-//! is passed over whole. So each volume's inner loop runs over one brick
-//! of its own at a time, as on the single-volume paths.
+//! **Where a ray looks.** Each volume's bricks that may add something
+//! (pre-classified: its occupied bricks; post-classified: those whose value
+//! range is not transparent) are binned into the image's 16² tiles, front
+//! to back, as for the single-volume caster ([`TileBins`]). A tile no
+//! volume lists is empty. Each ray of a tile reads each volume's list in
+//! order, finding its range of samples in each listed brick (the order in
+//! which the ray meets them), and takes the nearest range of any volume
+//! joined with every range that overlaps it: samples outside these ranges
+//! are transparent in every volume, so empty space is skipped only where
+//! every volume is empty. A ray stopped by a surface reads no further.
+//!
+//! **Chunks.** Within a range the ray takes its samples in chunks, from
+//! [`FIRST_CHUNK`] samples, doubling to [`CHUNK`] (a ray that meets an
+//! opaque surface stops within a few samples, and wastes at most the rest
+//! of its chunk). For a chunk, each volume with a brick in the range fills
+//! its samples (colour and opacity; zero outside its box and where it is
+//! transparent), brick by brick of its own grid, so its inner loop runs
+//! over one brick at a time as on the single-volume paths; then the
+//! chunk's samples are mixed ([`Mixer`]) and composited, and the ray stops
+//! once less than 1/1024 of the light gets through. A tile holds each
+//! pre-classified brick it reads, lit, until its rays are done ([`Held`]).
 //!
 //! **A volume's samples** are those of its single-volume fast path:
 //! - pre-classified (the paper's): its occupied bricks, classified once
@@ -27,7 +37,7 @@
 //!
 //! Positions are `f32`, counted from the ray's first sample in each
 //! volume's index space, so a far eye costs no precision. Each pixel is
-//! computed from its own ray alone, whatever thread runs it (rows in
+//! computed from its own ray alone, whatever thread runs it (tiles in
 //! parallel): the image is bit-identical for any thread count.
 
 use super::SceneFrame;
@@ -55,9 +65,8 @@ use std::ops::Range;
 use std::sync::MutexGuard;
 use wide::f32x4;
 
-/// Samples a ray takes at a time: each volume fills a chunk, then the
-/// chunk is mixed and composited. A terminated ray has wasted at most
-/// this many samples of each volume.
+/// The most samples a ray takes at a time: each volume fills a chunk,
+/// then the chunk is mixed and composited.
 pub(crate) const CHUNK: usize = 32;
 
 /// The first chunk of a ray's range in some volume's bricks.
