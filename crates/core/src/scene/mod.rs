@@ -68,16 +68,13 @@
 //!     },
 //!     ..Look::of(&settings)
 //! };
-//! let request = SceneSettings {
-//!     settings,
-//!     looks: vec![coloured([1.0, 0.0, 1.0]), coloured([0.0, 1.0, 0.0])],
-//!     mix: Mix::Composite,
-//! };
+//! let looks = vec![coloured([1.0, 0.0, 1.0]), coloured([0.0, 1.0, 0.0])];
+//! let request = SceneSettings { settings, looks, mix: Mix::Composite };
 //! let image = scene.render(&request).unwrap();
-//! // Seen along −x, +y is to the left: the second ball is green, the first magenta.
+//! // Seen along −x, +y is to the right: the first ball magenta, the second green.
 //! let (left, right) = (image.get(11, 24), image.get(36, 24));
-//! assert!(left[1] > 0.3 && left[0] < 0.05, "{left:?}");
-//! assert!(right[0] > 0.3 && right[1] < 0.05, "{right:?}");
+//! assert!(left[0] > 0.3 && left[1] < 0.05, "{left:?}");
+//! assert!(right[1] > 0.3 && right[0] < 0.05, "{right:?}");
 //! ```
 
 mod fast;
