@@ -14,6 +14,11 @@ pub fn option_of(e: &RenderError, camera: &CameraOptions) -> Option<Opt> {
     let opt = match e {
         RenderError::NonFinite { .. } => Opt::NonFinite,
         RenderError::SamplesChanged(_) | RenderError::Stopped => return None,
+        // A scene's volume: its own error's option.
+        RenderError::Scene(volray_core::SceneError::Layer { error, .. }) => {
+            return option_of(error, camera);
+        }
+        RenderError::Scene(_) => return None,
         RenderError::Camera(c) => match c {
             CameraError::NoDirection(_) if camera.view.is_some() => Opt::View,
             CameraError::NoDirection(_) => Opt::LookAt,
