@@ -123,18 +123,18 @@ enum Next {
 
 /// The volume and the volume-level options: what a renderer is prepared
 /// from, again whenever the samples change.
-struct Recipe {
+pub(crate) struct Recipe {
     source: Source,
     /// Spacing and origin given with a `Volume` (an array's are in its
     /// `Source`).
     spacing: Option<[f64; 3]>,
     origin: Option<[f64; 3]>,
     /// What the volume-level options fixed.
-    labels: bool,
+    pub labels: bool,
     log: bool,
-    nonfinite: NonFinite,
-    max_memory: u64,
-    name: String,
+    pub nonfinite: NonFinite,
+    pub max_memory: u64,
+    pub name: String,
     /// The file's display window (an OME-Zarr `omero` window), the
     /// default `range`.
     window: Option<(f64, f64)>,
@@ -156,14 +156,19 @@ enum Source {
 }
 
 /// What is found once per volume's samples.
-struct Prepared {
-    inner: CoreRenderer<'static>,
-    /// The labels present (with `labels=True`), or the histogram the
-    /// automatic transfer function is chosen from (else).
-    found_labels: Option<Vec<i64>>,
-    histogram: Option<Histogram>,
+pub(crate) struct Prepared {
+    pub inner: CoreRenderer<'static>,
+    pub known: Known,
     /// The digest of the samples this was prepared from, where watched.
-    digest: Option<u64>,
+    pub digest: Option<u64>,
+}
+
+/// What the options may leave to the volume, found once: the labels
+/// present (with `labels=True`), or the histogram the automatic transfer
+/// function is chosen from (else).
+pub(crate) struct Known {
+    pub labels: Option<Vec<i64>>,
+    pub histogram: Option<Histogram>,
 }
 
 impl Recipe {
@@ -180,7 +185,11 @@ impl Recipe {
     /// The digest of the samples as they are now (on `pool`, or the
     /// global pool; the GIL released while hashing); `None` if they are
     /// read-only.
-    fn digest(&self, py: Python<'_>, pool: Option<&rayon::ThreadPool>) -> PyResult<Option<u64>> {
+    pub(crate) fn digest(
+        &self,
+        py: Python<'_>,
+        pool: Option<&rayon::ThreadPool>,
+    ) -> PyResult<Option<u64>> {
         let Some(watched) = self.watched(py)? else {
             return Ok(None);
         };
@@ -194,7 +203,7 @@ impl Recipe {
     /// value range, labels or histogram, non-finite values, the brick
     /// caches' budget. Samples read in place are checked against the
     /// digest after each frame (`ArrayBytes::verify`).
-    fn prepare(&self, py: Python<'_>, digest: Option<u64>) -> PyResult<Prepared> {
+    pub(crate) fn prepare(&self, py: Python<'_>, digest: Option<u64>) -> PyResult<Prepared> {
         let core = match &self.source {
             Source::Volume(v) => v.get().core_expecting(py, digest)?,
             Source::Array {
@@ -255,17 +264,19 @@ impl Recipe {
         };
         Ok(Prepared {
             inner,
-            found_labels,
-            histogram,
+            known: Known {
+                labels: found_labels,
+                histogram,
+            },
             digest,
         })
     }
 }
 
-impl Renderer {
-    /// The renderer of `volume` (an array or a `Volume`) with the
-    /// volume-level keywords of `k`.
-    fn build(py: Python<'_>, volume: &Bound<'_, PyAny>, k: &Keywords<'_>) -> PyResult<Self> {
+impl Recipe {
+    /// The recipe of `volume` (an array or a `Volume`) with the
+    /// volume-level keywords of `k` (but `level`).
+    pub(crate) fn build(volume: &Bound<'_, PyAny>, k: &Keywords<'_>) -> PyResult<Self> {
         let order = match k.take::<String>("order", "'zyx' or 'xyz'")? {
             Some(o) => Order::parse(&o)?,
             None => Order::Xyz,
@@ -273,7 +284,6 @@ impl Renderer {
         let spacing = k.take::<[f64; 3]>("spacing", "three numbers (dx, dy, dz)")?;
         let origin = k.take::<[f64; 3]>("origin", "three numbers (x, y, z)")?;
         let labels_given = k.take::<bool>("labels", "True or False")?;
-        let level = level_choice(k)?;
         let (source, spacing, origin, vol_labels, name, nan_is_empty) =
             match volume.cast::<Volume>() {
                 Ok(v) => {
@@ -317,7 +327,7 @@ impl Renderer {
             Source::Volume(v) => v.get().display_window(),
             Source::Array { .. } => None,
         };
-        let recipe = Recipe {
+        Ok(Recipe {
             source,
             spacing,
             origin,
@@ -327,7 +337,88 @@ impl Renderer {
             max_memory,
             name,
             window,
-        };
+        })
+    }
+
+    /// The options and settings of a frame of this volume with the frame
+    /// keywords of `k` (its file's display window the default range).
+    pub(crate) fn settings_of(&self, k: &Keywords<'_>) -> PyResult<(Options, RenderSettings)> {
+        let options = keywords::options(k, self.look())?;
+        let mut settings =
+            volray_options::settings(&options).map_err(|e| settings_error(e, &options.camera))?;
+        volray_options::file_window(&options.look, &mut settings.transfer_function, self.window);
+        Ok((options, settings))
+    }
+
+    /// The look options the recipe fixes (labels, log).
+    pub(crate) fn look(&self) -> LookOptions {
+        LookOptions {
+            labels: self.labels,
+            log: self.log,
+            ..LookOptions::default()
+        }
+    }
+
+    /// Puts into `settings` what `options` leave to the volume, as
+    /// volray-options' from_volume does, from what `prepared` found
+    /// once: the labels' transfer function, or the automatic one.
+    pub(crate) fn leave_to_volume(
+        &self,
+        known: &Known,
+        options: &Options,
+        settings: &mut RenderSettings,
+    ) -> PyResult<()> {
+        match (&known.labels, &known.histogram) {
+            (Some(found), _) => volray_options::label_transfer_function(
+                &options.look,
+                &mut settings.transfer_function,
+                found,
+                &self.name,
+            )
+            .map_err(option_error),
+            (None, Some(histogram)) if options.look.auto_tf() => {
+                volray_options::apply_auto(
+                    &options.look,
+                    &mut settings.transfer_function,
+                    histogram,
+                );
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Refuses a frame that may take more than `max_memory` even with no
+    /// brick cache (the command line's rule, `src/memory.rs`).
+    pub(crate) fn check_memory(
+        &self,
+        inner: &CoreRenderer<'_>,
+        settings: &RenderSettings,
+    ) -> PyResult<()> {
+        let need = need(inner, settings, self.nonfinite);
+        let volume = inner.volume();
+        let limit = u128::from(self.max_memory);
+        if need > limit {
+            let [nx, ny, nz] = volume.dims();
+            return Err(value_error(format!(
+                "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels may take up to {}, more than max_memory {} (raise it, or use a smaller grid)",
+                self.name,
+                settings.width,
+                settings.height,
+                format_bytes(need),
+                format_bytes(limit),
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Renderer {
+    /// The renderer of `volume` (an array or a `Volume`) with the
+    /// volume-level keywords of `k`.
+    fn build(py: Python<'_>, volume: &Bound<'_, PyAny>, k: &Keywords<'_>) -> PyResult<Self> {
+        let level = level_choice(k)?;
+        let recipe = Recipe::build(volume, k)?;
         let lazy = match &recipe.source {
             Source::Volume(v) if v.get().lazy.is_some() => Some(v.clone_ref(py)),
             _ => None,
@@ -399,21 +490,8 @@ impl Renderer {
         &self,
         k: &Keywords<'_>,
     ) -> PyResult<(Options, RenderSettings, Option<rayon::ThreadPool>)> {
-        let look = LookOptions {
-            labels: self.recipe.labels,
-            log: self.recipe.log,
-            ..LookOptions::default()
-        };
-        let options = keywords::options(k, look)?;
-        let threads = keywords::threads(k)?;
-        let mut settings =
-            volray_options::settings(&options).map_err(|e| settings_error(e, &options.camera))?;
-        volray_options::file_window(
-            &options.look,
-            &mut settings.transfer_function,
-            self.recipe.window,
-        );
-        let pool = threads.map(pool).transpose()?;
+        let (options, settings) = self.recipe.settings_of(k)?;
+        let pool = keywords::threads(k)?.map(pool).transpose()?;
         Ok((options, settings, pool))
     }
 
@@ -442,24 +520,8 @@ impl Renderer {
         pool: Option<&rayon::ThreadPool>,
     ) -> PyResult<Frame> {
         let name = &self.recipe.name;
-        // What the options leave to the volume, as volray-options'
-        // from_volume does, from what was found once.
-        match (&prepared.found_labels, &prepared.histogram) {
-            (Some(found), _) => volray_options::label_transfer_function(
-                &options.look,
-                &mut settings.transfer_function,
-                found,
-                name,
-            )
-            .map_err(option_error)?,
-            (None, Some(histogram)) if options.look.auto_tf() => volray_options::apply_auto(
-                &options.look,
-                &mut settings.transfer_function,
-                histogram,
-            ),
-            _ => {}
-        }
-        self.check_memory(&prepared.inner, &settings)?;
+        (self.recipe).leave_to_volume(&prepared.known, options, &mut settings)?;
+        self.recipe.check_memory(&prepared.inner, &settings)?;
         let stop = AtomicBool::new(false);
         let inner = &prepared.inner;
         let settings = &settings;
@@ -719,31 +781,15 @@ impl Renderer {
             }
         })
     }
-
-    /// Refuses a frame that may take more than `max_memory` even with no
-    /// brick cache (the command line's rule, `src/memory.rs`).
-    fn check_memory(&self, inner: &CoreRenderer<'_>, settings: &RenderSettings) -> PyResult<()> {
-        let need = need(inner, settings, self.recipe.nonfinite);
-        let volume = inner.volume();
-        let limit = u128::from(self.recipe.max_memory);
-        if need > limit {
-            let [nx, ny, nz] = volume.dims();
-            return Err(value_error(format!(
-                "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels may take up to {}, more than max_memory {} (raise it, or use a smaller grid)",
-                self.recipe.name,
-                settings.width,
-                settings.height,
-                format_bytes(need),
-                format_bytes(limit),
-            )));
-        }
-        Ok(())
-    }
 }
 
 /// What rendering a frame of `settings` may take beyond the samples
 /// (a numpy array's are the caller's) with no brick cache.
-fn need(renderer: &CoreRenderer<'_>, settings: &RenderSettings, mode: NonFinite) -> u128 {
+pub(crate) fn need(
+    renderer: &CoreRenderer<'_>,
+    settings: &RenderSettings,
+    mode: NonFinite,
+) -> u128 {
     let volume = renderer.volume();
     let bound = MemoryBound::new(
         volume.dims(),
@@ -767,7 +813,7 @@ fn cache_budget(renderer: &CoreRenderer<'_>, mode: NonFinite, max_memory: u64) -
 }
 
 /// A pool of `threads` workers.
-fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
+pub(crate) fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
     let builder = rayon::ThreadPoolBuilder::new().num_threads(threads);
     builder.build().map_err(|e| {
         pyo3::exceptions::PyOSError::new_err(format!("cannot start worker threads: {e}"))
@@ -869,7 +915,7 @@ impl Renderer {
 /// wait; on KeyboardInterrupt it sets `stop` and waits for the work to
 /// end. The work's result (or the message of its panic), and the
 /// interrupt if one came.
-fn interruptible<T: Send>(
+pub(crate) fn interruptible<T: Send>(
     pool: Option<&rayon::ThreadPool>,
     stop: &AtomicBool,
     work: impl FnOnce(&(dyn Fn(usize) + Sync)) -> T + Send,
@@ -917,7 +963,7 @@ fn interruptible<T: Send>(
 }
 
 /// A frame that panicked (a bug in volray), as `RuntimeError`.
-fn internal_error(name: &str, panic: &str) -> PyErr {
+pub(crate) fn internal_error(name: &str, panic: &str) -> PyErr {
     pyo3::exceptions::PyRuntimeError::new_err(format!(
         "{name}: the frame failed inside volray (a bug, please report it): {panic}"
     ))
@@ -968,6 +1014,9 @@ pub fn render(
     volume: &Bound<'_, PyAny>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Frame> {
+    if crate::scene::is_scene(volume, kwargs)? {
+        return crate::scene::render(py, volume, kwargs);
+    }
     let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME], "render")?;
     Renderer::build(py, volume, &k)?.frame(py, &k, true)
 }
