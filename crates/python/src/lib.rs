@@ -19,7 +19,8 @@
 //! `volume.rs` (`Volume`, `read`), `keywords.rs` (keyword arguments to
 //! options), `renderer.rs` (`Renderer`, `render`, Ctrl-C), `frame.rs`
 //! (`Frame`), `transfer.rs` (`TransferFunction`, `Camera`), `generate.rs`
-//! (`hydrogen`, `fractal`), `errors.rs` (library errors as Python
+//! (`hydrogen`, `fractal`), `scene.rs` (`Scene`, `render` of several
+//! volumes), `errors.rs` (library errors as Python
 //! exceptions, options named as Python spells them).
 
 use pyo3::prelude::*;
@@ -31,6 +32,7 @@ mod frame;
 mod generate;
 mod keywords;
 mod renderer;
+mod scene;
 mod transfer;
 mod volume;
 
@@ -38,6 +40,7 @@ mod volume;
 fn _volray(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<volume::Volume>()?;
     m.add_class::<renderer::Renderer>()?;
+    m.add_class::<scene::Scene>()?;
     m.add_class::<frame::Frame>()?;
     m.add_class::<transfer::TransferFunction>()?;
     m.add_class::<transfer::Camera>()?;

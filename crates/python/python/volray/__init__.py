@@ -24,6 +24,14 @@ first asked for, and ``volray.render(volume, level="auto")`` reads the
 level each view needs, piece by piece where it would not fit
 ``max_memory`` whole.
 
+Several volumes in one picture: ``volray.render([a, b], looks=[{...},
+{...}], mix="composite")`` renders them in one ray march, each occluding
+the others where it lies in front; each look is a dict of the per-volume
+keywords (``tf``, ``colormap``, ``range``, ``labels``, ...) with
+``color``, ``opacity_scale`` and ``visible``. ``channel_axis=`` splits a
+4-D array into channels, coloured magenta, green, cyan, yellow, ...
+:class:`Scene` keeps the volumes prepared across frames.
+
 Every keyword of :func:`render` is the ``volray render`` flag of the same
 name (``look_at`` is ``--look-at``; ``shading=False`` is ``--no-shading``)
 with the same default and the same pixels. Bad input raises ``ValueError``
@@ -37,6 +45,7 @@ from ._volray import (
     Camera,
     Frame,
     Renderer,
+    Scene,
     TransferFunction,
     Volume,
     __version__,
@@ -52,6 +61,7 @@ __all__ = [
     "Camera",
     "Frame",
     "Renderer",
+    "Scene",
     "TransferFunction",
     "Volume",
     "__version__",
