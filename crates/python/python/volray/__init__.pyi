@@ -1,7 +1,19 @@
 """Type stubs for volray (see the package's docstring for the conventions)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union
+from typing import (
+    Any,
+    Dict,
+    List,
+    Literal,
+    Mapping,
+    Optional,
+    Sequence,
+    Tuple,
+    TypedDict,
+    Union,
+    overload,
+)
 
 import numpy as np
 import numpy.typing as npt
@@ -175,6 +187,173 @@ class Renderer:
     def pieces(self) -> Optional[int]:
         """The pieces the last frame was cut into (1: read whole)."""
 
+Mix = Literal["composite", "additive"]
+Color = Union[str, float, Tuple[float, float, float]]
+
+class Look(TypedDict, total=False):
+    """One volume's look in a scene: the per-volume keywords of
+    :func:`render` (volume keywords are fixed once a :class:`Scene` is
+    made), with ``color`` (a name, ``'#rrggbb'`` or ``(r, g, b)``: that
+    colour throughout), ``opacity_scale`` (its opacity times this, in
+    [0, 1]) and ``visible``."""
+
+    spacing: Vec3
+    origin: Vec3
+    order: Literal["xyz", "zyx"]
+    labels: bool
+    log: bool
+    nonfinite: Literal["refuse", "transparent"]
+    opacity: Pair
+    tf: Union[Literal["auto"], TransferFunction, Mapping[str, Any], Path]
+    preset: str
+    colormap: str
+    range: Pair
+    iso: float
+    iso_thickness: float
+    gradient_opacity: Pair
+    label_opacity: Union[Mapping[int, float], Sequence[Tuple[int, float]]]
+    show_labels: Sequence[int]
+    color: Color
+    opacity_scale: float
+    visible: bool
+
+Volumes = Union[Sequence[Union[Volume, npt.NDArray[Any]]], npt.NDArray[Any]]
+
+class Scene:
+    """Several volumes rendered together in one ray march (each occludes
+    the others where it lies in front), each kept prepared across frames
+    as a :class:`Renderer` keeps one. ``channel_axis`` splits a 4-D array
+    into channels coloured magenta, green, cyan, yellow, red, blue,
+    orange, white (then again)."""
+
+    def __init__(
+        self,
+        volumes: Volumes,
+        *,
+        looks: Optional[Sequence[Mapping[str, Any]]] = None,
+        mix: Mix = "composite",
+        channel_axis: Optional[int] = None,
+        spacing: Optional[Vec3] = None,
+        origin: Optional[Vec3] = None,
+        order: Literal["xyz", "zyx"] = "xyz",
+        labels: Optional[bool] = None,
+        log: bool = False,
+        nonfinite: Literal["refuse", "transparent"] = "refuse",
+        max_memory: Optional[int] = None,
+    ) -> None: ...
+    def render(
+        self,
+        *,
+        size: Union[int, Tuple[int, int]] = 480,
+        view: Optional[Vec3] = None,
+        look_at: Optional[Vec3] = None,
+        up: Vec3 = (0, 0, 1),
+        perspective: Optional[float] = None,
+        azimuth: float = 0,
+        elevation: float = 0,
+        zoom: float = 1,
+        clip: Optional[Union[Plane, Sequence[Plane]]] = None,
+        crop: Optional[Tuple[float, float, float, float, float, float]] = None,
+        camera: Optional[Camera] = None,
+        step: float = 1,
+        jitter: bool = False,
+        reference: bool = False,
+        opacity: Optional[Pair] = None,
+        tf: Union[None, Literal["auto"], TransferFunction, Mapping[str, Any], Path] = None,
+        preset: Optional[str] = None,
+        colormap: Optional[str] = None,
+        range: Optional[Pair] = None,
+        blend: Blend = "composite",
+        iso: Optional[float] = None,
+        iso_thickness: Optional[float] = None,
+        gradient_opacity: Optional[Pair] = None,
+        post_classification: bool = False,
+        shading: bool = True,
+        ambient: Rgb = 0.1,
+        diffuse: Rgb = 0.7,
+        specular: Rgb = 0.2,
+        shininess: float = 10,
+        light: Optional[Vec3] = None,
+        light_color: Rgb = 1,
+        background: Rgb = 0,
+        label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
+        show_labels: Optional[Sequence[int]] = None,
+        threads: Optional[int] = None,
+        color: Optional[Color] = None,
+        opacity_scale: Optional[float] = None,
+        visible: Optional[bool] = None,
+    ) -> Frame:
+        """One frame; the per-volume keywords given here apply to every
+        volume whose look does not give them."""
+    @property
+    def looks(self) -> List[Dict[str, Any]]:
+        """Copies of the looks, one per volume."""
+    @looks.setter
+    def looks(self, looks: Sequence[Mapping[str, Any]]) -> None: ...
+    @property
+    def mix(self) -> Mix: ...
+    @mix.setter
+    def mix(self, mix: Mix) -> None: ...
+    def __len__(self) -> int: ...
+
+@overload
+def render(
+    volume: Volumes,
+    *,
+    looks: Optional[Sequence[Mapping[str, Any]]] = None,
+    mix: Mix = "composite",
+    channel_axis: Optional[int] = None,
+    spacing: Optional[Vec3] = None,
+    origin: Optional[Vec3] = None,
+    order: Literal["xyz", "zyx"] = "xyz",
+    labels: Optional[bool] = None,
+    log: bool = False,
+    nonfinite: Literal["refuse", "transparent"] = "refuse",
+    max_memory: Optional[int] = None,
+    size: Union[int, Tuple[int, int]] = 480,
+    view: Optional[Vec3] = None,
+    look_at: Optional[Vec3] = None,
+    up: Vec3 = (0, 0, 1),
+    perspective: Optional[float] = None,
+    azimuth: float = 0,
+    elevation: float = 0,
+    zoom: float = 1,
+    clip: Optional[Union[Plane, Sequence[Plane]]] = None,
+    crop: Optional[Tuple[float, float, float, float, float, float]] = None,
+    camera: Optional[Camera] = None,
+    step: float = 1,
+    jitter: bool = False,
+    reference: bool = False,
+    opacity: Optional[Pair] = None,
+    tf: Union[None, Literal["auto"], TransferFunction, Mapping[str, Any], Path] = None,
+    preset: Optional[str] = None,
+    colormap: Optional[str] = None,
+    range: Optional[Pair] = None,
+    blend: Blend = "composite",
+    iso: Optional[float] = None,
+    iso_thickness: Optional[float] = None,
+    gradient_opacity: Optional[Pair] = None,
+    post_classification: bool = False,
+    shading: bool = True,
+    ambient: Rgb = 0.1,
+    diffuse: Rgb = 0.7,
+    specular: Rgb = 0.2,
+    shininess: float = 10,
+    light: Optional[Vec3] = None,
+    light_color: Rgb = 1,
+    background: Rgb = 0,
+    label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
+    show_labels: Optional[Sequence[int]] = None,
+    threads: Optional[int] = None,
+    color: Optional[Color] = None,
+    opacity_scale: Optional[float] = None,
+    visible: Optional[bool] = None,
+) -> Frame:
+    """Several volumes in one picture (a list or tuple of volumes, or a
+    4-D array with ``channel_axis``): the shared keywords, each volume's
+    look from ``looks`` (see :class:`Look`)."""
+
+@overload
 def render(
     volume: Union[Volume, ArrayLike],
     *,
