@@ -43,7 +43,7 @@
 
 use crate::bricks::cache::CacheRef;
 use crate::bricks::occupied::ClassifiedBricks;
-use crate::bricks::{BRICK, SIDE, SLOTS, cell, slot};
+use crate::bricks::{BRICK, BrickGrid, SIDE, SLOTS, cell, slot};
 use crate::camera::View;
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::{TILE, TileBins};
@@ -69,7 +69,7 @@ const PARALLEL_SLACK: f32 = 1e-4;
 
 /// The box of an occupied brick's occupied cells, in index space.
 #[derive(Debug, Clone, Copy)]
-struct CellBox {
+pub(crate) struct CellBox {
     /// The brick's first voxel.
     origin: f32x4,
     /// The box relative to `origin`.
@@ -200,11 +200,74 @@ impl Steppings for [Stepping] {
     }
 }
 
-/// Everything a ray reads.
-struct Scene<'a> {
+/// What a tile's rays read in the bricks of its list: one volume's lit
+/// bricks ([`One`]), or several volumes' on one grid
+/// ([`crate::scene`]'s channels, `Channels` in `scene/channels.rs`). The
+/// caster is the same code for both (monomorphised), so one volume's
+/// frames are exactly what they were before there were several.
+pub(crate) trait BrickSource: Sync {
+    /// A brick's voxels, lit for the frame, as [`Self::march`] reads them.
+    type Lit<'l>
+    where
+        Self: 'l;
+    /// Where bricks are lit when the lit-brick caches have no room.
+    type Scratch: Default;
+    /// The box of list entry `n`'s occupied cells.
+    fn cell_box(&self, n: usize) -> CellBox;
+    /// List entry `n`'s voxels, lit now unless they are.
+    fn light<'l>(&'l self, n: usize, scratch: &'l mut Self::Scratch) -> Self::Lit<'l>;
+    /// Composites `segment`'s samples in list entry `n` into `acc`;
+    /// returns whether the ray has terminated.
+    fn march<'l>(
+        &'l self,
+        acc: &mut FrontToBack,
+        lit: &Self::Lit<'l>,
+        n: usize,
+        segment: &Segment,
+    ) -> bool;
+    /// A tile is done with list entry `n`.
+    fn done(&self, n: usize);
+}
+
+/// One volume's occupied bricks, lit into `lit` by `lighting`.
+struct One<'a> {
     bricks: &'a ClassifiedBricks,
     lit: &'a LitBricks,
     lighting: &'a Lighting<'a>,
+}
+
+impl BrickSource for One<'_> {
+    type Lit<'l>
+        = CacheRef<'l, [[f32; 4]; SLOTS]>
+    where
+        Self: 'l;
+    type Scratch = Option<Box<[[f32; 4]; SLOTS]>>;
+
+    #[inline]
+    fn cell_box(&self, n: usize) -> CellBox {
+        cell_box(self.bricks, n)
+    }
+
+    #[inline]
+    fn light<'l>(&'l self, n: usize, scratch: &'l mut Self::Scratch) -> Self::Lit<'l> {
+        self.lit.get(n, self.lighting, scratch)
+    }
+
+    #[inline]
+    fn march<'l>(
+        &'l self,
+        acc: &mut FrontToBack,
+        lit: &Self::Lit<'l>,
+        n: usize,
+        segment: &Segment,
+    ) -> bool {
+        march(acc, lit, &self.bricks.cells[n], segment)
+    }
+
+    #[inline]
+    fn done(&self, n: usize) {
+        self.lit.done(n)
+    }
 }
 
 /// Renders the occupied bricks of `bricks`, lit into `lit` by `lighting`
@@ -225,13 +288,28 @@ pub fn render(
     finish: Finish,
     progress: &Progress,
 ) {
-    let width = view.width();
-    assert_eq!(pixels.len(), width * view.height());
-    let scene = Scene {
+    let one = One {
         bricks,
         lit,
         lighting,
     };
+    render_source(&one, bins, sampling, view, pixels, finish, progress);
+}
+
+/// Renders the bricks of `source`, binned into `bins` (whose lists hold
+/// the source's entries), through `view` with samples where `sampling`
+/// says, into `pixels`, as [`render`] does.
+pub(crate) fn render_source<S: BrickSource>(
+    source: &S,
+    bins: &TileBins,
+    sampling: &Sampling,
+    view: &View,
+    pixels: &mut [PartialPixel],
+    finish: Finish,
+    progress: &Progress,
+) {
+    let width = view.width();
+    assert_eq!(pixels.len(), width * view.height());
     let rays = Rays::new(sampling, view);
     // Each tile's rows, as slices of the image rows: the tiles are then
     // independent pieces of work, small enough to balance the threads.
@@ -248,7 +326,7 @@ pub fn render(
             return;
         }
         let (tx, ty) = (t % bins.tiles_x, t / bins.tiles_x);
-        rays.tile(&scene, bins.list(tx, ty), (tx, ty), finish, &mut rows);
+        rays.tile(source, bins.list(tx, ty), (tx, ty), finish, &mut rows);
         progress.done(rows.iter().map(|r| r.len()).sum());
     });
 }
@@ -263,14 +341,19 @@ fn to_lanes(v: DVec3) -> f32x4 {
 }
 
 fn cell_box(bricks: &ClassifiedBricks, n: usize) -> CellBox {
-    let b = bricks.brick(n);
-    let origin = lanes(bricks.grid.origin(b));
-    let (lo, hi) = bricks.occupied_box(n);
-    CellBox {
-        origin,
-        lo: lanes(lo) - origin,
-        hi: lanes(hi) - origin,
-        boundary: bricks.grid.touches_boundary(b),
+    CellBox::new(&bricks.grid, bricks.brick(n), bricks.occupied_box(n))
+}
+
+impl CellBox {
+    /// The index-space box `cells` of occupied cells in brick `b` of `grid`.
+    pub(crate) fn new(grid: &BrickGrid, b: [usize; 3], (lo, hi): ([usize; 3], [usize; 3])) -> Self {
+        let origin = lanes(grid.origin(b));
+        CellBox {
+            origin,
+            lo: lanes(lo) - origin,
+            hi: lanes(hi) - origin,
+            boundary: grid.touches_boundary(b),
+        }
     }
 }
 
@@ -319,9 +402,9 @@ impl<'a> Rays<'a> {
 
     /// Renders tile (`tx`, `ty`), whose bricks are `list`, into `rows`
     /// (its rows of pixels, top to bottom), as `finish` says.
-    fn tile(
+    fn tile<B: BrickSource>(
         &self,
-        scene: &Scene,
+        scene: &B,
         list: &[u32],
         (tx, ty): (usize, usize),
         finish: Finish,
@@ -407,16 +490,16 @@ impl<'a> Rays<'a> {
     /// next brick is touched: the brick's voxels are loaded into the cache
     /// once for all the tile's rays. Each ray still takes its bricks front
     /// to back, so its arithmetic is that of a ray cast on its own.
-    fn cast<S: Steppings + ?Sized>(
+    fn cast<B: BrickSource, S: Steppings + ?Sized>(
         &self,
-        scene: &Scene,
+        scene: &B,
         list: &[u32],
         pixel: &impl Fn(usize) -> (usize, usize),
         states: &mut [RayState],
         steppings: &S,
     ) {
         // Where a brick the lit-brick cache has no room for is lit.
-        let mut scratch = None;
+        let mut scratch = B::Scratch::default();
         let mut live = states.iter().filter(|s| !s.done).count();
         let mut reached = 0;
         for &n in list {
@@ -431,23 +514,14 @@ impl<'a> Rays<'a> {
             // The brick's box, computed per tile rather than kept per
             // frame (64 bytes an occupied brick): a few operations for the
             // tile's 256 rays.
-            let b = &cell_box(scene.bricks, n as usize);
-            let cells = &scene.bricks.cells[n as usize];
-            let scratch = &mut scratch;
-            live -= self.cross(
-                b,
-                move || scene.lit.get(n as usize, scene.lighting, scratch),
-                cells,
-                pixel,
-                states,
-                steppings,
-            );
+            let b = &scene.cell_box(n as usize);
+            live -= self.cross(b, scene, n as usize, &mut scratch, pixel, states, steppings);
         }
         // The tile is done with the bricks it reached: the lit-brick cache
         // gives a brick's buffer back after its last tile (see
         // `LitBricks`: the bricks behind are not counted down).
         for &n in &list[..reached] {
-            scene.lit.done(n as usize);
+            scene.done(n as usize);
         }
     }
 
@@ -457,17 +531,19 @@ impl<'a> Rays<'a> {
     /// the brick (a brick that no live ray samples is never lit). Returns
     /// how many rays ended here.
     #[inline(always)]
-    fn cross<'l, S: Steppings + ?Sized>(
+    #[allow(clippy::too_many_arguments)]
+    fn cross<'l, B: BrickSource, S: Steppings + ?Sized>(
         &self,
         b: &CellBox,
-        light: impl FnOnce() -> CacheRef<'l, [[f32; 4]; SLOTS]>,
-        cells: &[u64; 8],
+        scene: &'l B,
+        n: usize,
+        scratch: &'l mut B::Scratch,
         pixel: &impl Fn(usize) -> (usize, usize),
         states: &mut [RayState],
         steppings: &S,
     ) -> usize {
-        let mut light = Some(light);
-        let mut lit = None;
+        let mut scratch = Some(scratch);
+        let mut lit: Option<B::Lit<'l>> = None;
         let mut ended = 0;
         for (i, state) in states.iter_mut().enumerate() {
             if state.done {
@@ -506,9 +582,10 @@ impl<'a> Rays<'a> {
                 first,
                 last,
             };
-            let lit: &[[f32; 4]; SLOTS] =
-                lit.get_or_insert_with(|| light.take().expect("lit once")());
-            state.done = march(&mut state.acc, lit, cells, &segment);
+            let lit = lit.get_or_insert_with(|| {
+                scene.light(n, scratch.take().expect("a brick is lit once a tile"))
+            });
+            state.done = scene.march(&mut state.acc, lit, n, &segment);
             ended += usize::from(state.done);
         }
         ended
@@ -516,17 +593,17 @@ impl<'a> Rays<'a> {
 }
 
 /// Where one ray crosses one brick's box of occupied cells.
-struct Segment {
+pub(crate) struct Segment {
     /// The ray's `t = 0` point and its step, relative to the brick's first
     /// voxel (lane 3 unused).
-    origin: f32x4,
-    delta: f32x4,
+    pub origin: f32x4,
+    pub delta: f32x4,
     /// The box, relative to the brick's first voxel.
-    lo: f32x4,
-    hi: f32x4,
+    pub lo: f32x4,
+    pub hi: f32x4,
     /// Its samples.
-    first: i32,
-    last: i32,
+    pub first: i32,
+    pub last: i32,
 }
 
 /// Composites the samples of `segment` into `acc` from the brick's `lit`

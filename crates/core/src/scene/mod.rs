@@ -77,6 +77,7 @@
 //! assert!(right[1] > 0.3 && right[0] < 0.05, "{right:?}");
 //! ```
 
+mod channels;
 mod fast;
 mod reference;
 #[cfg(test)]
@@ -92,7 +93,7 @@ use crate::renderer::Renderer;
 use crate::sampling::Sampling;
 use crate::sampling::clipping::{ClipPlane, Clipping};
 use crate::sampling::grid::GridFrame;
-use crate::settings::{MAX_SAMPLES_PER_RAY, Method, RenderSettings};
+use crate::settings::{Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
 use crate::transfer::function::{PiecewiseLinear, TransferFunction};
 use crate::transfer::iso::IsoSurface;
 use crate::{SettingError, Volume};
@@ -360,6 +361,11 @@ impl<'v> Scene<'v> {
             .collect();
         let partial = match shared.method {
             Method::Reference => reference::render(&layers, &frame, shared, progress),
+            Method::Fast
+                if shared.classification == Classification::Pre && channels::one_grid(&layers) =>
+            {
+                channels::render(&layers, &frame, progress)
+            }
             Method::Fast => fast::render(&layers, &frame, shared, progress),
         };
         for (layer, _) in &layers {
