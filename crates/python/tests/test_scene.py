@@ -121,7 +121,9 @@ def test_opacity_scale_and_visible():
     a, b = ball((23, 16, 16)), ball((9, 16, 16))
     common = dict(tf=OPAQUE, shading=False, size=48)
     looks = [{"color": "magenta"}, {"color": "green"}]
-    hidden = centre(volray.render([a, b], looks=[{**looks[0], "visible": False}, looks[1]], **common))
+    hidden = centre(
+        volray.render([a, b], looks=[{**looks[0], "visible": False}, looks[1]], **common)
+    )
     assert hidden[1] > 0.99 and hidden[0] < 0.01
     faded = centre(
         volray.render([a, b], looks=[{**looks[0], "opacity_scale": 0.05}, looks[1]], **common)
@@ -228,7 +230,7 @@ def test_bad_input_raises_one_clear_exception():
         volray.render([a, b], looks=[{}, {"color": "mauve"}])
     with pytest.raises(ValueError, match="volume 0: color conflicts with colormap"):
         volray.render([a, b], looks=[{"color": "red", "colormap": "inferno"}, {}])
-    with pytest.raises(ValueError, match=r"volume 1: opacity_scale: 2 must be a number in \[0, 1\]"):
+    with pytest.raises(ValueError, match=r"volume 1: opacity_scale: 2 must be a number in \[0, 1"):
         volray.render([a, b], looks=[{}, {"opacity_scale": 2}])
     with pytest.raises(ValueError, match="mix: unknown mix 'sum'"):
         volray.render([a, b], mix="sum")
@@ -240,3 +242,24 @@ def test_bad_input_raises_one_clear_exception():
         volray.render([a, nan])
     # A look may say what the volume's own keywords are.
     volray.render([a, nan], looks=[{}, {"nonfinite": "transparent"}], size=16)
+
+
+@pytest.mark.parametrize("mix", ["composite", "additive"])
+def test_ctrl_c_stops_a_scene_frame(mix):
+    from volray import _volray
+
+    rng = np.random.default_rng(7)
+    a, b = rng.random((40, 40, 40), np.float32), rng.random((40, 40, 40), np.float32)
+    scene = volray.Scene([a, b], looks=[{"color": "magenta"}, {"color": "green"}], mix=mix)
+    # One worker, held after its first report until the interrupt is seen.
+    arguments = dict(size=64, step=0.25, opacity=(0, 0.02), threads=1)
+    _volray._interrupt_next_frame()
+    with pytest.raises(KeyboardInterrupt):
+        scene.render(**arguments)
+    reported = _volray._hooked_frame_pixels()
+    assert 0 < reported < 64 * 64, reported
+    # The scene renders on afterwards, as a fresh one does.
+    fresh = volray.Scene([a.copy(), b.copy()], looks=scene.looks, mix=mix)
+    assert np.array_equal(
+        np.asarray(scene.render(**arguments)), np.asarray(fresh.render(**arguments))
+    )
