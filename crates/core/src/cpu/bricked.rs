@@ -612,7 +612,7 @@ pub(crate) struct Segment {
 // whatever its callers become (inlined, the compiler's choices around it
 // moved its cost by several per cent from one change to the next).
 #[inline(never)]
-fn march(
+pub(crate) fn march(
     acc: &mut FrontToBack,
     lit: &[[f32; 4]; SLOTS],
     cells: &[u64; 8],

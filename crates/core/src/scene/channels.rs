@@ -10,7 +10,8 @@
 //! has its lit voxels ([`crate::cpu::lit_bricks`], each volume's own
 //! cache); a sample takes, from each volume whose cell is occupied, its
 //! trilinear colour and opacity, mixes them ([`Mixer`]) and composites
-//! the mix. A volume transparent in a cell adds exactly nothing there
+//! the mix (the sample of a volume alone there as it is: the mix of one
+//! sample is itself, up to rounding). A volume transparent in a cell adds exactly nothing there
 //! (its eight corners have opacity 0), as on the single-volume path.
 //!
 //! The geometry of the rays (parallel or from the eye, crops, clip
@@ -21,7 +22,7 @@ use super::SceneFrame;
 use crate::bricks::cache::CacheRef;
 use crate::bricks::occupied::{ClassifiedBricks, Source};
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot};
-use crate::cpu::bricked::{BrickSource, CellBox, Segment, render_source};
+use crate::cpu::bricked::{self, BrickSource, CellBox, Segment, render_source};
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::TileBins;
 use crate::kernels::composite::{Finish, FrontToBack};
@@ -145,8 +146,11 @@ impl BrickSource for Channels<'_> {
         // The voxels read straight, not through each lock's guard.
         static NOTHING: ([[f32; 4]; SLOTS], [u64; CELLS / 64]) =
             ([[0.0; 4]; SLOTS], [0; CELLS / 64]);
-        if lit.len() > DIRECT {
-            return march(acc, lit, segment);
+        match lit.len() {
+            // One volume occupied here: the single-volume caster's march.
+            1 => return bricked::march(acc, &lit[0].0, lit[0].1, segment),
+            n if n > DIRECT => return march(acc, lit, segment),
+            _ => {}
         }
         let mut direct = [(&NOTHING.0, &NOTHING.1); DIRECT];
         for (d, (voxels, cells)) in direct.iter_mut().zip(lit) {
@@ -188,20 +192,36 @@ fn march<L: Deref<Target = [[f32; 4]; SLOTS]>>(
         let [i, j, l, _] = c.to_array().map(|x| x as usize & (BRICK - 1));
         let bit = cell(i, j, l);
         let [fx, fy, fz, _] = (here - f32x4::from_i32x4(c)).to_array();
-        let mut mixer = Mixer::NEW;
+        // One volume's sample is composited as it is; several are mixed.
+        let (mut mixer, mut only, mut count) = (Mixer::NEW, f32x4::ZERO, 0);
         for (lit, cells) in volumes {
             if cells[bit / 64] >> (bit % 64) & 1 == 0 {
                 continue;
             }
             let voxels = corners(|s| f32x4::new(lit[s]), slot(i, j, l), SIDE, SIDE * SIDE);
-            mixer.add(interpolate(voxels, [fx, fy, fz]));
-        }
-        if let Some(sample) = mixer.sample() {
-            ray.add(sample);
-            if ray.is_opaque() {
-                terminated = true;
-                break;
+            let sample = interpolate(voxels, [fx, fy, fz]);
+            count += 1;
+            if count == 1 {
+                only = sample;
+            } else {
+                if count == 2 {
+                    mixer.add(only);
+                }
+                mixer.add(sample);
             }
+        }
+        let sample = match count {
+            0 => continue,
+            1 => only,
+            _ => match mixer.sample() {
+                Some(sample) => sample,
+                None => continue,
+            },
+        };
+        ray.add(sample);
+        if ray.is_opaque() {
+            terminated = true;
+            break;
         }
     }
     *acc = ray;
