@@ -204,7 +204,12 @@ impl Scene {
         };
         let n = volumes.len();
         let looks = check_looks(py, looks, n)?;
-        let mix = parse_mix(mix)?;
+        // Channels add up by default, as napari and the command line show them.
+        let default = match channel_axis {
+            Some(_) => Mix::Additive,
+            None => Mix::Composite,
+        };
+        let mix = parse_mix(mix, default)?;
         let mut layers = Vec::with_capacity(n);
         for (i, (volume, palette)) in volumes.iter().zip(palette).enumerate() {
             // The shared volume keywords, then its look's.
@@ -539,10 +544,10 @@ fn check_looks(
         .collect()
 }
 
-/// `mix=`: `'composite'` (the default) or `'additive'`.
-fn parse_mix(value: Option<&Bound<'_, PyAny>>) -> PyResult<Mix> {
+/// `mix=`: `'composite'` or `'additive'` (`default` when not given).
+fn parse_mix(value: Option<&Bound<'_, PyAny>>, default: Mix) -> PyResult<Mix> {
     let Some(value) = value.filter(|v| !v.is_none()) else {
-        return Ok(Mix::Composite);
+        return Ok(default);
     };
     let name: String = extract(value, "mix", "'composite' or 'additive'")?;
     match name.as_str() {
@@ -617,7 +622,7 @@ fn hex(digits: &str) -> Option<[f32; 3]> {
 
 #[pymethods]
 impl Scene {
-    /// `Scene(volumes, *, looks=None, mix="composite", channel_axis=None,
+    /// `Scene(volumes, *, looks=None, mix=None, channel_axis=None,
     /// spacing=None, origin=None, order="xyz", labels=None, log=False,
     /// nonfinite="refuse", max_memory=None)`: the volumes prepared once.
     #[new]
@@ -684,7 +689,7 @@ impl Scene {
 
     #[setter]
     fn set_mix(&self, mix: &Bound<'_, PyAny>) -> PyResult<()> {
-        let mix = parse_mix(Some(mix))?;
+        let mix = parse_mix(Some(mix), Mix::Composite)?;
         *self.mix.lock().unwrap_or_else(|e| e.into_inner()) = mix;
         Ok(())
     }

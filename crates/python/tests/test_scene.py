@@ -163,12 +163,16 @@ def test_a_label_volume_over_a_scan():
 def test_channel_axis_splits_channels_in_the_palette_colours():
     stack = np.stack([ball((16, 8, 16)), ball((16, 24, 16)), ball((16, 16, 8))])
     split = volray.render(stack, channel_axis=0, size=40)
+    # Channels add up unless told otherwise.
     listed = volray.render(
         list(stack),
         looks=[{"color": "magenta"}, {"color": "green"}, {"color": "cyan"}],
+        mix="additive",
         size=40,
     )
     assert np.array_equal(np.asarray(split), np.asarray(listed))
+    composite = volray.render(stack, channel_axis=0, mix="composite", size=40)
+    assert not np.array_equal(np.asarray(composite), np.asarray(split))
     # The axis may be any, negative too; a look's colour wins.
     moved = np.moveaxis(stack, 0, -1)
     again = volray.render(

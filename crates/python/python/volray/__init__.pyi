@@ -224,14 +224,15 @@ class Scene:
     the others where it lies in front), each kept prepared across frames
     as a :class:`Renderer` keeps one. ``channel_axis`` splits a 4-D array
     into channels coloured magenta, green, cyan, yellow, red, blue,
-    orange, white (then again)."""
+    orange, white (then again). ``mix`` is ``"composite"`` by default,
+    ``"additive"`` for channels."""
 
     def __init__(
         self,
         volumes: Volumes,
         *,
         looks: Optional[Sequence[Mapping[str, Any]]] = None,
-        mix: Mix = "composite",
+        mix: Optional[Mix] = None,
         channel_axis: Optional[int] = None,
         spacing: Optional[Vec3] = None,
         origin: Optional[Vec3] = None,
@@ -301,7 +302,7 @@ def render(
     volume: Volumes,
     *,
     looks: Optional[Sequence[Mapping[str, Any]]] = None,
-    mix: Mix = "composite",
+    mix: Optional[Mix] = None,
     channel_axis: Optional[int] = None,
     spacing: Optional[Vec3] = None,
     origin: Optional[Vec3] = None,
