@@ -58,8 +58,8 @@ pub enum SceneError {
         layer: usize,
         error: Box<RenderError>,
     },
-    #[error("a scene of several volumes is rendered whole, not as a piece of a distributed frame")]
-    Piece,
+    #[error("a scene of pieces: {0}")]
+    Piece(&'static str),
 }
 
 /// A render setting out of its range: which one, its value and the bound.

@@ -10,11 +10,12 @@ mod common;
 use common::{colorful, on_the_reference, sparse_tf, tf};
 use volray_core::camera::{Camera, Projection};
 use volray_core::glam::DVec3;
+use volray_core::sampling::grid::GridFrame;
 use volray_core::scene::{Look, Mix, Scene, SceneSettings};
 use volray_core::transfer::labels::{LabelStyle, PALETTE, transfer_function};
 use volray_core::{
-    Blend, Classification, Image, Method, PiecewiseLinear, RenderError, RenderSettings, Renderer,
-    SceneError, TransferFunction, Volume,
+    Blend, Classification, Image, Method, PartialImage, Piece, PiecewiseLinear, RenderError,
+    RenderSettings, Renderer, SceneError, TransferFunction, Volume,
 };
 
 /// A ball of density `1 − r/radius` about `centre` (world units) on
@@ -582,6 +583,160 @@ fn refused_scenes_name_the_volume_and_the_problem() {
     let err = scene.render(&request).unwrap_err();
     assert!(
         err.to_string().starts_with("volume 1: opacity ramp"),
+        "{err}"
+    );
+}
+
+/// The piece of `volume` owning voxels `owned`, held with its ghosts.
+fn piece_of(volume: &Volume, owned: ([usize; 3], [usize; 3])) -> (Volume, Piece) {
+    let (lo, hi) = Piece::held(owned, volume.dims());
+    let renderer = Renderer::new(volume).unwrap();
+    let piece = Piece {
+        whole: GridFrame {
+            dims: volume.dims(),
+            origin: volume.origin(),
+            spacing: volume.spacing(),
+        },
+        offset: lo,
+        owned,
+        value_range: renderer.value_range(),
+        max_gradient: renderer.max_gradient(),
+    };
+    (volume.sub_box(lo, hi), piece)
+}
+
+#[test]
+fn pieces_of_a_scene_composited_front_to_back_give_the_whole_scenes_frame() {
+    // Two channels of one grid, cut into three slabs along x as the ranks
+    // of a distributed frame hold them; each slab a scene of its two
+    // pieces.
+    let (dims, spacing, origin) = (
+        [33, 27, 25],
+        DVec3::new(1.0, 1.1, 0.9),
+        DVec3::new(-2.0, 1.0, 0.5),
+    );
+    let channels = [
+        waves(dims, spacing, origin, 0.0),
+        waves(dims, spacing, origin, 1.9),
+    ];
+    let whole = Scene::new(channels.iter().map(|v| Renderer::new(v).unwrap()).collect()).unwrap();
+    let cuts = [(0, 12), (12, 21), (21, dims[0])];
+    let slabs: Vec<Vec<(Volume, Piece)>> = (cuts.iter())
+        .map(|&(a, b)| {
+            (channels.iter())
+                .map(|v| piece_of(v, ([a, 0, 0], [b, dims[1], dims[2]])))
+                .collect()
+        })
+        .collect();
+    let scenes: Vec<Scene> = (slabs.iter())
+        .map(|pieces| {
+            Scene::new(
+                pieces
+                    .iter()
+                    .map(|(v, _)| Renderer::new(v).unwrap())
+                    .collect(),
+            )
+            .unwrap()
+        })
+        .collect();
+    let cameras = [
+        Camera::default(),
+        Camera {
+            azimuth: 30.0,
+            elevation: -25.0,
+            ..Camera::default()
+        },
+        Camera {
+            projection: Projection::Perspective { fov_degrees: 35.0 },
+            azimuth: -25.0,
+            elevation: 10.0,
+            ..Camera::default()
+        },
+    ];
+    for camera in cameras {
+        for classification in [Classification::Pre, Classification::Post] {
+            for method in [Method::Fast, Method::Reference] {
+                let settings = RenderSettings {
+                    width: 48,
+                    height: 40,
+                    camera,
+                    classification,
+                    method,
+                    opacity_ramp: (0.0, 0.2),
+                    background: [0.1, 0.2, 0.3],
+                    ..RenderSettings::default()
+                };
+                let looks = vec![
+                    coloured(&settings, [1.0, 0.0, 1.0]),
+                    look(&settings, colorful()),
+                ];
+                let request = SceneSettings {
+                    settings: settings.clone(),
+                    looks: looks.clone(),
+                    mix: Mix::Composite,
+                };
+                let frame = render(&whole, &request);
+                // Each slab's partial image; the eye is on the +x side.
+                let mut parts: Vec<PartialImage> = (scenes.iter().zip(&slabs))
+                    .map(|(scene, pieces)| {
+                        let looks = (looks.iter().zip(pieces))
+                            .map(|(l, (_, piece))| Look {
+                                piece: Some(piece.clone()),
+                                ..l.clone()
+                            })
+                            .collect();
+                        let request = SceneSettings {
+                            looks,
+                            ..request.clone()
+                        };
+                        scene.render_partial(&request, &|_| {}).unwrap()
+                    })
+                    .collect();
+                let mut front = parts.pop().unwrap();
+                while let Some(behind) = parts.pop() {
+                    front.combine(&behind);
+                }
+                let combined = front.finish(settings.background, |_| unreachable!());
+                let diff = combined.max_abs_diff(&frame).unwrap();
+                let bound = if method == Method::Reference {
+                    1e-5
+                } else {
+                    2.0 / 1024.0
+                };
+                let what = format!("{camera:?} {classification:?} {method:?}");
+                assert!(diff <= bound, "{what}: {diff}");
+                assert!(
+                    frame.pixels().iter().filter(|p| p[3] > 0.5).count() > 100,
+                    "{what}"
+                );
+            }
+        }
+    }
+    // What does not combine front to back is refused.
+    let settings = RenderSettings::default();
+    let (_, piece) = &slabs[0][0];
+    let with_piece = Look {
+        piece: Some(piece.clone()),
+        ..Look::of(&settings)
+    };
+    let request = SceneSettings {
+        looks: vec![with_piece.clone(), with_piece.clone()],
+        settings,
+        mix: Mix::Additive,
+    };
+    let err = scenes[0].render(&request).unwrap_err();
+    assert!(
+        err.to_string().contains("only in the composite mix"),
+        "{err}"
+    );
+    let request = SceneSettings {
+        looks: vec![with_piece, Look::of(&request.settings)],
+        mix: Mix::Composite,
+        ..request
+    };
+    let err = scenes[0].render(&request).unwrap_err();
+    assert!(
+        err.to_string().contains("every volume is a piece, or none"),
         "{err}"
     );
 }

@@ -87,7 +87,8 @@ use crate::camera::View;
 use crate::error::{RenderError, SceneError};
 use crate::image::Image;
 use crate::kernels::composite::{EMPTY, PartialPixel, over_background};
-use crate::partial::PartialPixels;
+use crate::partial::{PartialImage, PartialPixels};
+use crate::piece::Piece;
 use crate::progress::Progress;
 use crate::renderer::Renderer;
 use crate::sampling::Sampling;
@@ -132,6 +133,14 @@ pub struct Look {
     pub opacity: f32,
     /// `false`: not drawn (a hidden layer keeps its caches).
     pub visible: bool,
+    /// The volume is this piece of a larger one, as one rank of a
+    /// distributed frame holds it ([`crate::piece`]): its whole volume's
+    /// grid, the box it owns, the whole volume's value range. The volumes
+    /// of a scene of pieces are pieces of one grid, split alike (the
+    /// channels of one stack); their partial images
+    /// ([`Scene::render_partial`]) combine front to back into the whole
+    /// scene's frame.
+    pub piece: Option<Piece>,
 }
 
 impl Look {
@@ -146,6 +155,7 @@ impl Look {
             gradient_opacity_max: settings.gradient_opacity_max,
             opacity: 1.0,
             visible: true,
+            piece: settings.piece.clone(),
         }
     }
 
@@ -180,6 +190,7 @@ impl Look {
             iso: self.iso,
             gradient_opacity: self.gradient_opacity,
             gradient_opacity_max: self.gradient_opacity_max,
+            piece: self.piece.clone(),
             ..shared.clone()
         }
     }
@@ -271,13 +282,74 @@ impl<'v> Scene<'v> {
         Ok(image)
     }
 
+    /// The box the camera frames in a frame of `request`: every volume's,
+    /// or the whole grid's of a scene of pieces, whose pieces are checked
+    /// to split one grid alike (the volumes' pieces: `shared.piece` is
+    /// for one volume, refused here).
+    fn framed(&self, request: &SceneSettings) -> Result<(DVec3, DVec3), SceneError> {
+        let pieces: Vec<Option<&Piece>> = request.looks.iter().map(|l| l.piece.as_ref()).collect();
+        if request.settings.piece.is_some() {
+            return Err(SceneError::Piece(
+                "a scene's pieces are given per volume (Look::piece), not in the shared settings",
+            ));
+        }
+        if pieces.iter().any(Option::is_some) && pieces.iter().any(Option::is_none) {
+            return Err(SceneError::Piece("either every volume is a piece, or none"));
+        }
+        let Some(first) = pieces[0] else {
+            return Ok(self.bounds);
+        };
+        let alike = |p: &Option<&Piece>| {
+            p.is_some_and(|p| {
+                p.whole == first.whole && p.offset == first.offset && p.owned == first.owned
+            })
+        };
+        if !pieces.iter().all(alike) {
+            return Err(SceneError::Piece(
+                "the volumes' pieces must be the same box of one grid",
+            ));
+        }
+        if request.mix == Mix::Additive || request.settings.blend.is_projection() {
+            return Err(SceneError::Piece(
+                "pieces of a scene combine front to back only in the composite mix",
+            ));
+        }
+        Ok(first.whole.bounds())
+    }
+
+    /// One frame of the composite mix as a partial image: premultiplied
+    /// colour and transmittance, without the background. With every
+    /// volume a piece of its whole ([`Look::piece`]), the partial images
+    /// of the pieces, combined front to back
+    /// ([`PartialImage::combine`]) and finished over the background
+    /// ([`PartialImage::finish`]), give the whole scene's frame, as for
+    /// one volume (see [`crate::piece`]). The additive mix and the
+    /// projections, which do not combine front to back, are refused.
+    pub fn render_partial(
+        &self,
+        request: &SceneSettings,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<PartialImage, RenderError> {
+        if request.mix == Mix::Additive || request.settings.blend.is_projection() {
+            return Err(
+                SceneError::Piece("a scene's partial image is of the composite mix only").into(),
+            );
+        }
+        let settings = self.layer_settings(request)?;
+        let progress = Progress::new(progress);
+        if self.layers.len() == 1 {
+            return self.layers[0].render_partial_with(&settings[0], &progress);
+        }
+        let shown: Vec<usize> = (0..self.layers.len())
+            .filter(|&i| request.looks[i].shown())
+            .collect();
+        self.composite(&settings, &shown, request, &progress)
+    }
+
     /// Each layer's settings in a frame of `request`, checked.
     fn layer_settings(&self, request: &SceneSettings) -> Result<Vec<RenderSettings>, RenderError> {
         let shared = &request.settings;
         shared.validate()?;
-        if shared.piece.is_some() {
-            return Err(SceneError::Piece.into());
-        }
         if request.looks.len() != self.layers.len() {
             return Err(SceneError::Looks {
                 layers: self.layers.len(),
@@ -285,6 +357,7 @@ impl<'v> Scene<'v> {
             }
             .into());
         }
+        let bounds = self.framed(request)?;
         let world_step = shared.step * self.voxel_size();
         let samples = (self.bounds.1 - self.bounds.0).length() / world_step;
         if samples > MAX_SAMPLES_PER_RAY {
@@ -305,11 +378,17 @@ impl<'v> Scene<'v> {
                     .into());
                 }
                 let step = world_step / layer.volume().spacing().min_element();
-                let settings = look.apply(shared, step, self.bounds);
-                settings.validate().map_err(|e| SceneError::Layer {
-                    layer: i,
-                    error: Box::new(e.into()),
-                })?;
+                let settings = look.apply(shared, step, bounds);
+                let volume = layer.volume();
+                (settings.validate())
+                    .and_then(|()| match &settings.piece {
+                        Some(piece) => piece.validate(volume.dims(), volume.spacing()),
+                        None => Ok(()),
+                    })
+                    .map_err(|e| SceneError::Layer {
+                        layer: i,
+                        error: Box::new(e.into()),
+                    })?;
                 Ok(settings)
             })
             .collect()
@@ -354,7 +433,25 @@ impl<'v> Scene<'v> {
             return Ok(Image::from_pixels(width, height, pixels).expect("the frame's size"));
         }
         // One march through every volume shown.
-        let frame = self.frame(shared)?;
+        let partial = self.composite(&settings, &shown, request, progress)?;
+        Ok(partial.finish(background, |_| unreachable!("a composited frame")))
+    }
+
+    /// The volumes `shown` (their settings `settings`) marched as one, in
+    /// the composite mix: a partial image.
+    fn composite(
+        &self,
+        settings: &[RenderSettings],
+        shown: &[usize],
+        request: &SceneSettings,
+        progress: &Progress,
+    ) -> Result<PartialImage, RenderError> {
+        let shared = &request.settings;
+        let (width, height) = (shared.width, shared.height);
+        if shown.is_empty() {
+            return Ok(PartialImage::composite(width, height));
+        }
+        let frame = self.frame(shared, &settings[shown[0]], self.layers[shown[0]].volume())?;
         let layers: Vec<(&Renderer, &RenderSettings)> = shown
             .iter()
             .map(|&i| (&self.layers[i], &settings[i]))
@@ -371,14 +468,27 @@ impl<'v> Scene<'v> {
         for (layer, _) in &layers {
             layer.verify()?;
         }
-        Ok(partial.finish(background, |_| unreachable!("a composited frame")))
+        Ok(partial)
     }
 
-    /// The frame's view and samples: the camera framing every volume,
-    /// rays through their box, samples `step` times the smallest spacing apart.
-    fn frame(&self, shared: &RenderSettings) -> Result<SceneFrame, RenderError> {
-        let bounds = shared.camera.framed_bounds(self.bounds);
-        let view = View::frame(&shared.camera, bounds, shared.width, shared.height)?;
+    /// The frame's view and samples: the camera framing every volume (or
+    /// the whole grid of a scene of pieces), rays through their box (the
+    /// whole grid's, taking the samples the pieces own), samples `step`
+    /// times the smallest spacing apart. `first` and its settings
+    /// `layer`: a volume shown, whose piece, if it is one, stands for
+    /// every volume's.
+    fn frame(
+        &self,
+        shared: &RenderSettings,
+        layer: &RenderSettings,
+        first: &Volume,
+    ) -> Result<SceneFrame, RenderError> {
+        let view = View::frame(
+            &shared.camera,
+            layer.camera.framed_bounds(self.bounds),
+            shared.width,
+            shared.height,
+        )?;
         let (lo, hi) = self.bounds;
         let clipping = Clipping {
             crop: shared.crop,
@@ -389,19 +499,34 @@ impl<'v> Scene<'v> {
                 })
                 .collect(),
         };
-        let sampling = Sampling {
+        let (grid, ownership) = match &layer.piece {
+            // The piece's own grid, its rays bounded by the whole's.
+            Some(piece) => (
+                GridFrame {
+                    dims: first.dims(),
+                    origin: first.origin(),
+                    spacing: first.spacing(),
+                },
+                Some(piece.ownership()),
+            ),
             // The box of every volume as a grid of 2³ points: rays are
             // sampled in it, each volume mapping the world to its own grid.
-            grid: GridFrame {
-                dims: [2; 3],
-                origin: lo,
-                spacing: hi - lo,
-            },
+            None => (
+                GridFrame {
+                    dims: [2; 3],
+                    origin: lo,
+                    spacing: hi - lo,
+                },
+                None,
+            ),
+        };
+        let sampling = Sampling {
+            grid,
             step: shared.step * self.voxel_size(),
             clipping,
             jitter: shared.jitter,
             from_eye: matches!(view, View::Perspective(_)),
-            ownership: None,
+            ownership,
         };
         Ok(SceneFrame { view, sampling })
     }
