@@ -251,12 +251,14 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
     /// The whole volume's largest gradient magnitude: the largest over
     /// every rank's owned voxels (not its ghosts, whose outermost layer
     /// has one-sided differences), found the first time a frame needs it.
-    fn max_gradient(&mut self) -> Result<f32, FrameError> {
+    /// This rank's piece is `held` (the volume its renderer holds,
+    /// wherever that renderer is now: its own, or a scene's).
+    fn max_gradient_of(&mut self, held: Option<&Volume>) -> Result<f32, FrameError> {
         if let Some(g) = self.max_gradient {
             return Ok(g);
         }
-        let local = self.held.renderer.as_ref().map_or(0.0, |r| {
-            owned_max_gradient(r.volume(), self.held.offset, self.held.piece_owned)
+        let local = held.map_or(0.0, |v| {
+            owned_max_gradient(v, self.held.offset, self.held.piece_owned)
         });
         self.held.max_gradient = local;
         let all = agree(self.transport, Ok(local.to_le_bytes().to_vec()))?;
@@ -273,21 +275,57 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
         settings: &RenderSettings,
     ) -> Result<RenderSettings, FrameError> {
         let needs_gradient = settings.iso.is_some() || settings.gradient_opacity.is_some();
+        Ok(RenderSettings {
+            piece: Some(self.piece(needs_gradient)?),
+            ..settings.clone()
+        })
+    }
+
+    /// This rank's piece of the whole volume, with the whole volume's
+    /// largest gradient if `needs_gradient` (agreed across the ranks the
+    /// first time: every rank must ask alike).
+    pub fn piece(&mut self, needs_gradient: bool) -> Result<Piece, FrameError> {
+        let renderer = self.held.renderer.take();
+        let piece = self.piece_of(needs_gradient, renderer.as_ref().map(Renderer::volume));
+        self.held.renderer = renderer;
+        piece
+    }
+
+    /// [`Self::piece`], this rank's piece being `held` (the volume its
+    /// renderer holds, wherever that renderer is now: a scene's).
+    pub(crate) fn piece_of(
+        &mut self,
+        needs_gradient: bool,
+        held: Option<&Volume>,
+    ) -> Result<Piece, FrameError> {
         let max_gradient = if needs_gradient {
-            self.max_gradient()?
+            self.max_gradient_of(held)?
         } else {
             0.0
         };
-        Ok(RenderSettings {
-            piece: Some(Piece {
-                whole: self.grid,
-                offset: self.held.offset,
-                owned: self.held.piece_owned,
-                value_range: self.value_range,
-                max_gradient,
-            }),
-            ..settings.clone()
+        Ok(Piece {
+            whole: self.grid,
+            offset: self.held.offset,
+            owned: self.held.piece_owned,
+            value_range: self.value_range,
+            max_gradient,
         })
+    }
+
+    /// Takes this rank's renderer (none if its box is empty), for a
+    /// scene of several volumes' pieces ([`crate::scene`]).
+    pub(crate) fn take_renderer(&mut self) -> Option<Renderer<'static>> {
+        self.held.renderer.take()
+    }
+
+    /// The transport and this rank's compositing plan.
+    pub(crate) fn plan(&self) -> (&'t T, &Plan) {
+        (self.transport, &self.plan)
+    }
+
+    /// The times of reading and agreeing.
+    pub(crate) fn read_times(&self) -> RankTimes {
+        self.held.times
     }
 
     /// Renders one frame of `settings` across the ranks: the finished

@@ -18,6 +18,10 @@
 //! 4. [`transport`]: the messages, over MPI (feature `mpi`, module `mpi`) or
 //!    between threads of one process ([`transport::Local`]).
 //!
+//! Several volumes of one grid (channels) go through the same steps
+//! together: [`scene`] reads each rank's box of each and renders them as
+//! one scene of pieces.
+//!
 //! ```
 //! use volray_core::glam::DVec3;
 //! use volray_core::{RenderSettings, Volume};
@@ -45,6 +49,7 @@ pub mod frame;
 pub mod kd;
 #[cfg(feature = "mpi")]
 pub mod mpi;
+pub mod scene;
 pub mod schedule;
 pub mod streamed;
 pub mod transport;

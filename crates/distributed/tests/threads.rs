@@ -192,3 +192,63 @@ fn ranks_join_their_labels_into_the_whole_volumes() {
         );
     }
 }
+
+#[test]
+fn two_channels_across_one_to_five_ranks_give_the_single_process_scene_within_a_level() {
+    use volray_core::PiecewiseLinear;
+    use volray_core::scene::{Look, Mix, Scene, SceneSettings};
+    use volray_distributed::scene::DistributedScene;
+    // Two channels of one grid: the common blobs, and waves on its grid.
+    let a = volume();
+    let b = Volume::from_fn(a.dims(), a.spacing(), a.origin(), |p| {
+        (0.5 + 0.4 * (p.x * 0.4).sin() * (p.y * 0.3 + p.z * 0.2).cos()) as f32
+    })
+    .unwrap();
+    let single = Scene::new(vec![Renderer::new(&a).unwrap(), Renderer::new(&b).unwrap()]).unwrap();
+    for (name, settings) in cases()
+        .into_iter()
+        .filter(|(_, s)| !s.blend.is_projection())
+    {
+        let looks = vec![
+            Look::of(&settings),
+            Look {
+                transfer_function: volray_core::TransferFunction {
+                    opacity: Some(
+                        PiecewiseLinear::new("opacity", vec![(0.6, [0.0]), (1.0, [0.5])]).unwrap(),
+                    ),
+                    color: Some(PiecewiseLinear::constant([0.0, 1.0, 0.2])),
+                    domain: None,
+                },
+                iso: None,
+                gradient_opacity: None,
+                ..Look::of(&settings)
+            },
+        ];
+        let request = SceneSettings {
+            settings: settings.clone(),
+            looks,
+            mix: Mix::Composite,
+        };
+        let want = single.render(&request).unwrap();
+        for ranks in [1, 2, 3, 5] {
+            let frames: Vec<Option<Image>> = std::thread::scope(|s| {
+                let handles: Vec<_> = (Local::group(ranks).into_iter())
+                    .map(|t| {
+                        let (a, b, request) = (&a, &b, &request);
+                        s.spawn(move || {
+                            let sources: [&dyn volray_distributed::frame::Source; 2] = [a, b];
+                            let mut d =
+                                DistributedScene::read(&t, &sources, Default::default()).unwrap();
+                            d.render(request).unwrap().0
+                        })
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().unwrap()).collect()
+            });
+            assert!(frames[1..].iter().all(Option::is_none));
+            let frame = frames[0].as_ref().expect("rank 0's frame");
+            let diff = frame.max_abs_diff(&want).unwrap();
+            assert!(diff <= 1.0 / 255.0, "{name}, {ranks} ranks: {diff}");
+        }
+    }
+}
