@@ -42,12 +42,12 @@ pub enum SceneError {
     Empty,
     #[error(
         "volume {layer} (box {} .. {}) does not meet the first volume's box ({} .. {}): check its origin and spacing",
-        bounds.0, bounds.1, first.0, first.1
+        boxes[0].0, boxes[0].1, boxes[1].0, boxes[1].1
     )]
     Disjoint {
         layer: usize,
-        bounds: (DVec3, DVec3),
-        first: (DVec3, DVec3),
+        /// Its box and the first volume's (boxed: errors stay small).
+        boxes: Box<[(DVec3, DVec3); 2]>,
     },
     #[error("{looks} looks for {layers} volumes: give one per volume")]
     Looks { layers: usize, looks: usize },

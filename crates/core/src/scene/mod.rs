@@ -229,8 +229,7 @@ impl<'v> Scene<'v> {
             if !overlaps(layer.volume(), first) {
                 return Err(SceneError::Disjoint {
                     layer: i,
-                    bounds: layer.volume().bounds(),
-                    first: first.bounds(),
+                    boxes: Box::new([layer.volume().bounds(), first.bounds()]),
                 });
             }
         }
