@@ -156,7 +156,11 @@ impl BrickSource for Channels<'_> {
         for (d, (voxels, cells)) in direct.iter_mut().zip(lit) {
             *d = (&**voxels, *cells);
         }
-        march(acc, &direct[..lit.len()], segment)
+        match lit.len() {
+            2 => march_n(acc, &[direct[0], direct[1]], segment),
+            3 => march_n(acc, &[direct[0], direct[1], direct[2]], segment),
+            n => march(acc, &direct[..n], segment),
+        }
     }
 
     fn done(&self, u: usize) {
@@ -175,6 +179,28 @@ impl BrickSource for Channels<'_> {
 /// whether the ray has terminated.
 #[inline(never)]
 fn march<L: Deref<Target = [[f32; 4]; SLOTS]>>(
+    acc: &mut FrontToBack,
+    volumes: &[(L, &[u64; CELLS / 64])],
+    segment: &Segment,
+) -> bool {
+    march_body(acc, volumes, segment)
+}
+
+/// [`march`] for exactly `N` volumes, the loop over them unrolled: two
+/// channels of the bench's 256³ specimen took 1.79 times one channel's
+/// frame, against 1.86 through the slice (`examples/scene_bench.rs`,
+/// one run each).
+#[inline(never)]
+fn march_n<const N: usize>(
+    acc: &mut FrontToBack,
+    volumes: &[(&[[f32; 4]; SLOTS], &[u64; CELLS / 64]); N],
+    segment: &Segment,
+) -> bool {
+    march_body(acc, volumes, segment)
+}
+
+#[inline(always)]
+fn march_body<L: Deref<Target = [[f32; 4]; SLOTS]>>(
     acc: &mut FrontToBack,
     volumes: &[(L, &[u64; CELLS / 64])],
     segment: &Segment,
