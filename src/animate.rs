@@ -16,9 +16,12 @@
 //!   where the data do. The volumes are read one at a time, twice (first
 //!   for their ranges and bounds, then to render), so a long series never
 //!   has to fit in memory.
+//! - **Time points** (`--frames`) are a series of one file's frames
+//!   (`--frame 0, 1, ...`: a 4-D NIfTI's volumes, an OME-Zarr image's
+//!   `t`, NetCDF time), read and rendered as a series of files is.
 
 use crate::error::CliError;
-use crate::flags::RenderArgs;
+use crate::flags::{InputArgs, RenderArgs};
 use crate::session::{load, progress_bar, render_failure, renderer_for};
 use crate::streamed::Plan;
 use rayon::ThreadPool;
@@ -84,6 +87,74 @@ pub fn series(
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
+    let inputs: Vec<InputArgs> = (specs.iter())
+        .map(|spec| InputArgs {
+            input: Some(spec.clone()),
+            ..args.input.clone()
+        })
+        .collect();
+    series_of(args, &inputs, base, pool)
+}
+
+/// `--frames`: the time points of INPUT (its frames, as `--frame` counts
+/// them), one frame each, as a series of inputs is rendered.
+pub fn time_points(
+    args: &RenderArgs,
+    kind: crate::render::OutputKind,
+    base: &RenderSettings,
+    pool: &ThreadPool,
+) -> Result<(), CliError> {
+    let spec = args.input.input.as_deref().unwrap_or(crate::input::DEMO);
+    let refuse = |why: String| Err(CliError::input(format!("--frames: {spec}: {why}")));
+    if volray_data::is_source_spec(spec) {
+        return refuse("a built-in source has one time point: give a file holding several".into());
+    }
+    if args.input.frame.is_some() {
+        return Err(CliError::input(
+            "--frames renders the time points of INPUT; --frame picks one: give one of them",
+        ));
+    }
+    // The count, from the first time point's file information.
+    let count = match &load(&args.input, false)?.file {
+        Some((_, info)) => info.frames,
+        None => 1,
+    };
+    if count < 2 {
+        return refuse("it holds one time point (volray info says what it holds)".into());
+    }
+    let range = args.scene.frames.expect("--frames given");
+    let end = range.end.unwrap_or(count);
+    if range.start >= count || end > count {
+        let given = match range.end {
+            Some(e) => format!("{}:{e}", range.start),
+            None => format!("{}:", range.start),
+        };
+        return Err(CliError::input(format!(
+            "--frames {given}: {spec} holds {count} time points, numbered from 0"
+        )));
+    }
+    crate::overwrite::refuse_overwriting_inputs(
+        &crate::render::output_files(args, kind, end - range.start),
+        &[spec.to_string()],
+        &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
+    )?;
+    let inputs: Vec<InputArgs> = (range.start..end)
+        .map(|t| InputArgs {
+            frame: Some(t),
+            ..args.input.clone()
+        })
+        .collect();
+    series_of(args, &inputs, base, pool)
+}
+
+/// One frame per volume `inputs` name, in order: one transfer function
+/// and one framing for all.
+fn series_of(
+    args: &RenderArgs,
+    inputs: &[InputArgs],
+    base: &RenderSettings,
+    pool: &ThreadPool,
+) -> Result<(), CliError> {
     // Pass 1: the value range and bounds of all the volumes together, and
     // the first volume's histogram, should the transfer function be chosen
     // from it.
@@ -91,8 +162,8 @@ pub fn series(
     let mut extent = Extent::default();
     let mut first = None;
     let mut labels = std::collections::BTreeSet::new();
-    for spec in specs {
-        let input = load_one(args, spec)?;
+    for one in inputs {
+        let input = load(one, args.view.look.log)?;
         if first.is_none() && look.auto_tf() {
             first = volray_core::Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
         }
@@ -110,7 +181,7 @@ pub fn series(
     if look.labels {
         // The labels of every volume, so that a label has one colour.
         let found: Vec<i64> = labels.into_iter().collect();
-        let names = format!("{} volumes", specs.len());
+        let names = format!("{} volumes", inputs.len());
         crate::settings::label_transfer_function(
             look,
             &mut settings.transfer_function,
@@ -124,9 +195,9 @@ pub fn series(
     }
 
     // Pass 2: render each.
-    let mut writer = Writer::new(args, &settings, specs.len())?;
-    for spec in specs {
-        let mut input = load_one(args, spec)?;
+    let mut writer = Writer::new(args, &settings, inputs.len())?;
+    for one in inputs {
+        let mut input = load(one, args.view.look.log)?;
         input.volume.set_labels(look.labels);
         let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
         let renderer = renderer_for(&args.view, &settings, &input)?;
@@ -134,13 +205,6 @@ pub fn series(
         writer.push(&image.map_err(fail)?)?;
     }
     writer.finish()
-}
-
-/// The volume `spec` names, read with the options of INPUT.
-fn load_one(args: &RenderArgs, spec: &str) -> Result<crate::input::Input, CliError> {
-    let mut input = args.input.clone();
-    input.input = Some(spec.to_string());
-    load(&input, args.view.look.log)
 }
 
 /// The value range, the bounds and (for gradient opacity) the largest
@@ -190,15 +254,30 @@ impl Extent {
 }
 
 /// The animation being written, with its progress bar.
-struct Writer {
+pub struct Writer {
     animation: Animation,
-    bar: indicatif::ProgressBar,
+    pub bar: indicatif::ProgressBar,
 }
 
 impl Writer {
     /// Starts the animation `args` asks for: `frames` frames of the size
     /// in `settings`.
     fn new(args: &RenderArgs, settings: &RenderSettings, frames: usize) -> Result<Self, CliError> {
+        Self::with_pixels(
+            args,
+            settings,
+            frames,
+            frames * settings.width * settings.height,
+        )
+    }
+
+    /// [`Writer::new`], its progress bar counting `pixels` in all.
+    pub fn with_pixels(
+        args: &RenderArgs,
+        settings: &RenderSettings,
+        frames: usize,
+        pixels: usize,
+    ) -> Result<Self, CliError> {
         let animation = Animation::create(
             &args.out.output,
             settings.width,
@@ -206,7 +285,7 @@ impl Writer {
             frames,
             args.animation.fps.unwrap_or(DEFAULT_FPS),
         )?;
-        let bar = progress_bar((frames * settings.width * settings.height) as u64);
+        let bar = progress_bar(pixels as u64);
         Ok(Writer { animation, bar })
     }
 
@@ -219,11 +298,11 @@ impl Writer {
         pool.install(|| renderer.render_with_progress(settings, &|n| self.bar.inc(n as u64)))
     }
 
-    fn push(&mut self, image: &Image) -> Result<(), CliError> {
+    pub fn push(&mut self, image: &Image) -> Result<(), CliError> {
         Ok(self.animation.push(image)?)
     }
 
-    fn finish(self) -> Result<(), CliError> {
+    pub fn finish(self) -> Result<(), CliError> {
         self.bar.finish_and_clear();
         self.animation.finish()?;
         Ok(())

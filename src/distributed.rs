@@ -51,6 +51,11 @@ pub fn launched() -> bool {
 
 /// `volray render` under `mpirun`: one still image, written by rank 0.
 pub fn render(args: &RenderArgs) -> Result<(), CliError> {
+    if args.scene.is_scene() || args.scene.frames.is_some() {
+        return Err(CliError::input(
+            "under mpirun, render writes one still image of one volume: --channels, --overlay and --frames are rendered by one process",
+        ));
+    }
     if args.animation.turntable.is_some() || !args.animation.series.is_empty() {
         return Err(CliError::input(
             "under mpirun, render writes one still image: --turntable and series are rendered by one process",

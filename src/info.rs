@@ -99,7 +99,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     outln!("input:     {}", input.name);
     outln!("format:    {format}");
     if let Some(i) = info {
-        print_stored(i);
+        print_stored(i, &input.name);
     }
     outln!("dims:      {nx} x {ny} x {nz} ({points} points)");
     outln!(
@@ -244,7 +244,7 @@ fn describe_image(name: &str, image: &FlatImage, as_json: bool) {
         .unwrap_or_default();
     outln!("input:     {name}");
     outln!("format:    {}", image.format.description());
-    print_stored(i);
+    print_stored(i, name);
     outln!(
         "dims:      {nx} x {ny} x {nz} ({} points: an image, not a volume)",
         image.values.len()
@@ -286,12 +286,22 @@ fn stored(l: &volray_io::LevelInfo) -> String {
     )
 }
 
-fn print_stored(i: &FileInfo) {
+fn print_stored(i: &FileInfo, name: &str) {
     outln!("stored as: {}", i.stored_type);
     if i.frames > 1 {
         outln!(
             "frame:     {} of {} (--frame picks another)",
             i.frame,
+            i.frames
+        );
+    }
+    let channels = channels(i);
+    if channels > 1 {
+        outln!("channels:  {channels} (render them together: volray render {name} --channels all)");
+    }
+    if i.frames > 1 {
+        outln!(
+            "           (its {} frames as an animation: volray render {name} --frames all -o OUT.gif)",
             i.frames
         );
     }
@@ -348,6 +358,18 @@ fn print_stored(i: &FileInfo) {
     }
 }
 
+/// How many channels `--channels` finds in the file: an OME-Zarr image's
+/// `c` axis (its frames are time points), else its frames.
+fn channels(i: &FileInfo) -> usize {
+    if i.levels.is_empty() {
+        return i.frames;
+    }
+    (i.header.iter())
+        .find(|(k, _)| k == "channels")
+        .and_then(|(_, v)| v.parse().ok())
+        .unwrap_or(1)
+}
+
 /// The header as written and the notes of how the file was read.
 fn print_header_and_notes(i: &FileInfo) {
     if !i.header.is_empty() {
@@ -368,6 +390,7 @@ fn print_header_and_notes(i: &FileInfo) {
 fn add_file_json(out: &mut Value, i: &FileInfo) {
     out["stored_type"] = json!(i.stored_type);
     out["frames"] = json!(i.frames);
+    out["channels"] = json!(channels(i));
     out["frame"] = json!(i.frame);
     out["arrays"] = json!(i.arrays);
     out["array"] = json!(i.array);

@@ -8,9 +8,10 @@
 //!   sampling, output, animation) and one per subcommand; `flags/mod.rs`
 //!   parses the command line and lists them all;
 //! - one module per subcommand: `render.rs` (one still image, and the
-//!   checks before any work) with `animate.rs` (turntables and series),
-//!   `bench.rs` (with `bench/peers.rs` and `bench/vtk.rs`), `info.rs`,
-//!   `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
+//!   checks before any work) with `animate.rs` (turntables, series and
+//!   `--frames`) and `scene.rs` (several volumes in one picture:
+//!   `--channels`, `--overlay`), `bench.rs` (with `bench/peers.rs` and
+//!   `bench/vtk.rs`), `info.rs`, `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
 //!   writes with), `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
 //!   `view/reproduce.rs`: the page's state as a `volray render` command);
 //! - what they share: `input.rs` (reading INPUT), `settings.rs` (the flags
@@ -44,6 +45,7 @@ mod memory;
 mod overwrite;
 mod paper;
 mod render;
+mod scene;
 mod session;
 mod settings;
 mod streamed;

@@ -1,5 +1,7 @@
 //! `volray render`: INPUT → Volume → Renderer → Image → PNG or OpenEXR;
-//! with `--turntable` or several inputs, an animation (`animate.rs`).
+//! with `--turntable`, `--frames` or several inputs, an animation
+//! (`animate.rs`); with `--channels` or `--overlay`, several volumes in
+//! one picture (`scene.rs`).
 
 use crate::animate;
 use crate::error::CliError;
@@ -13,12 +15,16 @@ use volray_core::RenderSettings;
 use volray_io::{Animation, AnimationKind, BitDepth};
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    refuse_scene_flags_alone(args)?;
+    if args.scene.is_scene() {
+        return crate::scene::run(args);
+    }
     let specs = specs(args);
     let animation = animation_reason(args)?;
     let kind = output_kind(&args.out.output, args.out.bit_depth, animation)?;
     if args.animation.fps.is_some() && animation.is_none() {
         return Err(CliError::input(
-            "--fps applies to animations: give --turntable FRAMES or several inputs",
+            "--fps applies to animations: give --turntable FRAMES, --frames or several inputs",
         ));
     }
     let settings = settings(&args.view)?;
@@ -32,6 +38,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(frames)) => {
             animate::turntable(args, &settings, &pool, frames as usize)
+        }
+        (OutputKind::Animation, None) if args.scene.frames.is_some() => {
+            animate::time_points(args, kind, &settings, &pool)
         }
         (OutputKind::Animation, None) => animate::series(args, &specs, &settings, &pool),
         (kind, _) => still(args, &settings, &pool, kind),
@@ -130,10 +139,44 @@ fn specs(args: &RenderArgs) -> Vec<String> {
         .collect()
 }
 
+/// The flags of several volumes that mean nothing without `--channels`
+/// or `--overlay`, and `--frames` with what it cannot take, refused.
+fn refuse_scene_flags_alone(args: &RenderArgs) -> Result<(), CliError> {
+    let scene = &args.scene;
+    if !scene.is_scene() {
+        if scene.channel_colors.is_some() {
+            return Err(CliError::input(
+                "--channel-colors colours the channels of --channels: give --channels",
+            ));
+        }
+        if scene.mix.is_some() {
+            return Err(CliError::input(
+                "--mix mixes several volumes: give --channels or --overlay",
+            ));
+        }
+    }
+    if scene.frames.is_some() {
+        if args.animation.turntable.is_some() {
+            return Err(CliError::input(
+                "--frames animates the time points of INPUT: give --frames or --turntable, not both",
+            ));
+        }
+        if !args.animation.series.is_empty() {
+            return Err(CliError::input(
+                "--frames animates the time points of one input: give one input with it",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Why the output is an animation (the flag that asks for one), or
 /// `None` for a single frame. A turntable of a series is refused: which
 /// frame would turn how far is not obvious.
 fn animation_reason(args: &RenderArgs) -> Result<Option<&'static str>, CliError> {
+    if args.scene.frames.is_some() {
+        return Ok(Some("--frames"));
+    }
     match (args.animation.turntable, args.animation.series.is_empty()) {
         (Some(_), false) => Err(CliError::input(
             "--turntable renders one volume: give one input, or several inputs without --turntable",

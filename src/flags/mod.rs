@@ -9,7 +9,8 @@
 //!   `look.rs` (classification, shading, blending) and `sampling.rs`
 //!   (the step, jitter, the path, non-finite values), and `--threads`;
 //! - `output.rs` and `animation.rs`: render's output file, and its
-//!   turntables and series;
+//!   turntables and series; `scene.rs`: several volumes in one picture
+//!   (`--channels`, `--overlay`) and a file's time points (`--frames`);
 //! - `render.rs`, `bench.rs`, `info.rs`, `convert.rs`, `generate.rs`, `paper.rs`,
 //!   `viewer.rs` (`volray view`): each subcommand's arguments (`bench.rs`
 //!   also says which groups `--peers` refuses);
@@ -28,6 +29,7 @@ mod paper;
 mod parse;
 mod render;
 mod sampling;
+mod scene;
 mod view;
 mod viewer;
 
@@ -39,9 +41,10 @@ pub use info::InfoArgs;
 pub use input::InputArgs;
 pub use look::{BlendMode, LookArgs};
 pub use paper::{PaperArgs, PaperItem};
-pub use parse::one_line_error;
+pub use parse::{one_line_error, parse_opacity, parse_range};
 pub use render::RenderArgs;
 pub use sampling::SamplingArgs;
+pub use scene::{Channels, MixMode, PALETTE};
 pub use view::ViewArgs;
 pub use viewer::ViewerArgs;
 

@@ -3,6 +3,7 @@
 use super::animation::AnimationArgs;
 use super::input::InputArgs;
 use super::output::OutputArgs;
+use super::scene::SceneArgs;
 use super::view::ViewArgs;
 use clap::Args;
 
@@ -17,6 +18,9 @@ pub struct RenderArgs {
 
     #[command(flatten)]
     pub animation: AnimationArgs,
+
+    #[command(flatten)]
+    pub scene: SceneArgs,
 
     #[command(flatten)]
     pub view: ViewArgs,
