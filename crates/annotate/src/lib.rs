@@ -1,0 +1,39 @@
+//! # volray-annotate: what makes a frame a figure
+//!
+//! Annotations drawn into a rendered frame ([`volray_core::Image`]), for
+//! pictures that go into papers and talks:
+//!
+//! - [`text`]: text from one embedded open font (DejaVu Sans), rasterised
+//!   from its outlines at any size, blended over the frame;
+//! - [`colorbar`]: the transfer function's colour bar over its value
+//!   window, with its opacity, and ticks labelled in the data's units
+//!   (log-spaced for `--log`); a legend for label volumes;
+//! - [`scalebar`]: a round length in world units, as many pixels long as
+//!   the view's pixel size says;
+//! - [`ticks`]: round tick values and short labels.
+//!
+//! ```
+//! use volray_annotate::colorbar::{ColorBar, Side};
+//! use volray_annotate::scalebar::ScaleBar;
+//! use volray_core::Image;
+//!
+//! let mut frame = Image::new(480, 480, [0.0, 0.0, 0.0, 1.0]);
+//! let grey = |v: f64| [(v / 100.0) as f32; 3];
+//! let bar = ColorBar {
+//!     window: (0.0, 100.0),
+//!     log: false,
+//!     colour: &grey,
+//!     opacity: &|v| (v / 100.0) as f32,
+//!     unit: Some("HU"),
+//!     side: Side::Right,
+//! };
+//! let drawn = bar.draw(&mut frame, [1.0; 3]);
+//! assert_eq!(drawn.ticks.len(), 6); // 0, 20, ..., 100
+//! let scale = ScaleBar { pixel_size: 0.5, length: None, unit: Some("mm"), approximate: false };
+//! assert_eq!(scale.draw(&mut frame, [1.0; 3]).length, 50.0); // about a fifth of 240 mm
+//! ```
+
+pub mod colorbar;
+pub mod scalebar;
+pub mod text;
+pub mod ticks;
