@@ -51,7 +51,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         .map(|spec| OverlaySpec::parse(spec))
         .collect::<Result<Vec<_>, _>>()?;
     let tf_texts = (overlays.iter())
-        .map(|o| o.tf.as_deref().map(read_overlay_tf).transpose())
+        .map(|o| {
+            o.tf.as_deref()
+                .map(|tf| read_overlay_tf(&o.spec, tf))
+                .transpose()
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let first_spec = args.input.input.as_deref().unwrap_or(input::DEMO);
     let inputs: Vec<String> = std::iter::once(first_spec.to_string())
@@ -400,7 +404,10 @@ impl OverlaySpec {
             channel: None,
             max_memory: args.input.max_memory,
         };
-        let mut input = load(&input_args, false)?;
+        let mut input = load(&input_args, false).map_err(|e| CliError {
+            message: format!("--overlay: {}", e.message),
+            ..e
+        })?;
         let shared = crate::settings::options(&args.view, None)?;
         let look = LookOptions {
             opacity: self.opacity,
@@ -473,10 +480,13 @@ fn option_tokens(rest: &str) -> Option<Vec<(String, Option<String>)>> {
     Some(options)
 }
 
-/// Reads an overlay's `tf=` file, refused as `--tf` is.
-fn read_overlay_tf(path: &str) -> Result<String, CliError> {
+/// Reads the `tf=` file of the overlay `spec`, refused as `--tf` is.
+fn read_overlay_tf(spec: &str, path: &str) -> Result<String, CliError> {
     crate::settings::read_tf_file(&PathBuf::from(path)).map_err(|e| CliError {
-        message: e.message.replacen("--tf ", "tf=", 1),
+        message: format!(
+            "--overlay {spec}: {}",
+            e.message.replacen("--tf ", "tf=", 1)
+        ),
         ..e
     })
 }

@@ -237,6 +237,52 @@ fn an_overlay_of_labels_draws_its_label_in_the_table_colour_over_a_faint_volume(
     }
 }
 
+/// An OME-Zarr image (v2, uncompressed) of `channels` along its `c` axis.
+fn ome_zarr(dir: &Path, name: &str, channels: &[Vec<f32>]) -> String {
+    let root = dir.join(name);
+    let level = root.join("0");
+    std::fs::create_dir_all(&level).unwrap();
+    std::fs::write(root.join(".zgroup"), r#"{"zarr_format": 2}"#).unwrap();
+    let axes = r#"[{"name": "c", "type": "channel"}, {"name": "z", "type": "space"}, {"name": "y", "type": "space"}, {"name": "x", "type": "space"}]"#;
+    let attrs = format!(
+        r#"{{"multiscales": [{{"version": "0.4", "axes": {axes}, "datasets": [{{"path": "0", "coordinateTransformations": [{{"type": "scale", "scale": [1, 1, 1, 1]}}]}}]}}]}}"#
+    );
+    std::fs::write(root.join(".zattrs"), attrs).unwrap();
+    let array = format!(
+        r#"{{"zarr_format": 2, "shape": [{c}, {N}, {N}, {N}], "chunks": [1, {N}, {N}, {N}], "dtype": "<f4", "compressor": null, "fill_value": 0, "order": "C", "filters": null}}"#,
+        c = channels.len()
+    );
+    std::fs::write(level.join(".zarray"), array).unwrap();
+    for (c, data) in channels.iter().enumerate() {
+        let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        std::fs::write(level.join(format!("{c}.0.0.0")), bytes).unwrap();
+    }
+    root.to_str().unwrap().to_string()
+}
+
+#[test]
+fn channels_of_an_ome_zarr_image_are_its_c_axis() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = ome_zarr(dir.path(), "cells.zarr", &[ball(6.0), ball(17.0)]);
+    let p = render(
+        dir.path(),
+        "zarr.png",
+        &[&image, "--channels", "all", "--no-shading"],
+    );
+    let (left, right) = (p.at(11, 24), p.at(36, 24));
+    assert!(
+        left[0] > 60 && left[0].abs_diff(left[2]) <= 2 && left[1] <= 2,
+        "{left:?}"
+    );
+    assert!(right[1] > 60 && right[0] <= 2 && right[2] <= 2, "{right:?}");
+    let run = volray(&["info", &image]);
+    let text = stdout(&run);
+    assert!(
+        text.contains("channels:  2 (render them together"),
+        "{text}"
+    );
+}
+
 /// The numbered PNGs `name_%03d.png` in `dir`, in order.
 fn numbered(dir: &Path, stem: &str) -> Vec<PathBuf> {
     let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
