@@ -10,7 +10,9 @@
 //!   (log-spaced for `--log`); a legend for label volumes;
 //! - [`scalebar`]: a round length in world units, as many pixels long as
 //!   the view's pixel size says;
-//! - [`ticks`]: round tick values and short labels.
+//! - [`ticks`]: round tick values and short labels;
+//! - [`figure`]: the annotations a front end asks for, drawn for what was
+//!   rendered (one function for the command line, Python and the viewer).
 //!
 //! ```
 //! use volray_annotate::colorbar::{ColorBar, Side};
@@ -34,6 +36,7 @@
 //! ```
 
 pub mod colorbar;
+pub mod figure;
 pub mod scalebar;
 pub mod text;
 pub mod ticks;

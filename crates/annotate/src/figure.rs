@@ -1,0 +1,199 @@
+//! A frame made a figure: the annotations a front end asks for
+//! ([`Annotations`]: colour bar, scale bar, title, panel label) drawn
+//! for what was rendered ([`Subject`]: the view, the transfer function's
+//! colours and opacity over its window, the units), in an ink that reads
+//! on the frame's background. The command line, Python and the viewer
+//! draw through this one function.
+
+use crate::colorbar::{ColorBar, Side, legend};
+use crate::scalebar::ScaleBar;
+use crate::text::Font;
+use volray_core::camera::View;
+use volray_core::glam::DVec3;
+use volray_core::{Blend, Image};
+
+/// What to draw.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Annotations {
+    /// The colour bar (a legend for a label volume), on this side.
+    pub colorbar: Option<Side>,
+    /// A scale bar: `Some(None)` of a round length, `Some(Some(l))` of
+    /// length `l` in world units.
+    pub scale_bar: Option<Option<f64>>,
+    /// Text over the frame, centred.
+    pub title: Option<String>,
+    /// Text in the top left corner (a panel's letter).
+    pub label: Option<String>,
+}
+
+impl Annotations {
+    /// Whether anything is drawn.
+    pub fn any(&self) -> bool {
+        self.colorbar.is_some()
+            || self.scale_bar.is_some()
+            || self.title.is_some()
+            || self.label.is_some()
+    }
+}
+
+/// What was rendered, as the annotations need it.
+pub struct Subject<'a> {
+    pub view: &'a View,
+    /// The volume's box in the world (a perspective scale bar holds at
+    /// its centre's depth).
+    pub bounds: (DVec3, DVec3),
+    /// The values the transfer function spans, in the data's units.
+    pub window: (f64, f64),
+    /// The data were rendered as log10 (`--log`): the bar's ticks are
+    /// decades of the data's own values.
+    pub log: bool,
+    /// Colour and opacity (per unit voxel distance) of a value in the
+    /// data's units.
+    pub colour: &'a dyn Fn(f64) -> [f32; 3],
+    pub opacity: &'a dyn Fn(f64) -> f32,
+    /// A label volume's labels and colours: a legend instead of a bar.
+    pub labels: Option<Vec<(String, [f32; 3])>>,
+    /// The projection blend mode, if one: the bar then shows the colour
+    /// map without opacity.
+    pub blend: Blend,
+    /// The unit of the values (`HU`) and of lengths (`mm`), if known.
+    pub value_unit: Option<&'a str>,
+    pub length_unit: Option<&'a str>,
+    /// The frame's background colour.
+    pub background: [f32; 3],
+}
+
+/// The ink that reads on `background`: white on dark, black on light
+/// (by its luminance, Rec. 709).
+pub fn ink(background: [f32; 3]) -> [f32; 3] {
+    let [r, g, b] = background;
+    if 0.2126 * r + 0.7152 * g + 0.0722 * b > 0.5 {
+        [0.0; 3]
+    } else {
+        [1.0; 3]
+    }
+}
+
+/// The world size of one pixel where the scale bar holds, and whether it
+/// holds only there (perspective: at the depth of the box's centre).
+pub fn pixel_size(view: &View, bounds: (DVec3, DVec3)) -> (f64, bool) {
+    match view {
+        View::Orthographic(v) => (v.pixel_size, false),
+        View::Perspective(v) => {
+            let centre = (bounds.0 + bounds.1) / 2.0;
+            let depth = (centre - v.eye).dot(v.direction).max(f64::MIN_POSITIVE);
+            (depth * v.pixel_size, true)
+        }
+    }
+}
+
+/// Draws `what` for `subject` into `image`.
+pub fn annotate(image: &mut Image, what: &Annotations, subject: &Subject) {
+    let ink = ink(subject.background);
+    if let Some(side) = what.colorbar {
+        match &subject.labels {
+            Some(entries) if !entries.is_empty() => legend(image, entries, side, ink),
+            _ => {
+                let projection = subject.blend != Blend::Composite;
+                let opaque = |_: f64| 1.0;
+                let bar = ColorBar {
+                    window: subject.window,
+                    log: subject.log && subject.window.0 > 0.0,
+                    colour: subject.colour,
+                    opacity: if projection { &opaque } else { subject.opacity },
+                    unit: subject.value_unit,
+                    side,
+                };
+                bar.draw(image, ink);
+            }
+        }
+    }
+    if let Some(length) = what.scale_bar {
+        let (size, approximate) = pixel_size(subject.view, subject.bounds);
+        ScaleBar {
+            pixel_size: size,
+            length,
+            unit: subject.length_unit,
+            approximate,
+        }
+        .draw(image, ink);
+    }
+    let font = Font::embedded();
+    let side = image.width().min(image.height()) as f32;
+    if let Some(title) = &what.title {
+        let size = (side / 22.0).max(11.0);
+        let (w, ascent, _) = font.measure(title, size);
+        let x = (image.width() as f32 - w) / 2.0;
+        font.draw(image, title, size, (x.max(2.0), ascent + side / 40.0), ink);
+    }
+    if let Some(label) = &what.label {
+        let size = (side / 16.0).max(12.0);
+        let (_, ascent, _) = font.measure(label, size);
+        let margin = side / 40.0;
+        font.draw(image, label, size, (margin, ascent + margin), ink);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use volray_core::camera::Camera;
+
+    #[test]
+    fn the_ink_reads_on_the_background() {
+        assert_eq!(ink([0.0; 3]), [1.0; 3]);
+        assert_eq!(ink([1.0; 3]), [0.0; 3]);
+        assert_eq!(ink([0.1, 0.2, 0.5]), [1.0; 3]);
+    }
+
+    #[test]
+    fn a_perspective_pixel_is_measured_at_the_boxs_centre() {
+        let bounds = (DVec3::ZERO, DVec3::splat(10.0));
+        let camera = Camera {
+            view_point: Some(DVec3::new(45.0, 5.0, 5.0)),
+            projection: volray_core::Projection::Perspective { fov_degrees: 30.0 },
+            ..Camera::default()
+        };
+        let view = View::frame(&camera, bounds, 200, 200).unwrap();
+        let (size, approximate) = pixel_size(&view, bounds);
+        let View::Perspective(v) = &view else {
+            unreachable!()
+        };
+        assert!(approximate);
+        assert!((size - 40.0 * v.pixel_size).abs() < 1e-9, "{size}");
+        let view = View::frame(&Camera::default(), bounds, 200, 200).unwrap();
+        assert!(!pixel_size(&view, bounds).1);
+    }
+
+    #[test]
+    fn nothing_asked_draws_nothing() {
+        let view = View::frame(&Camera::default(), (DVec3::ZERO, DVec3::ONE), 64, 64).unwrap();
+        let mut image = Image::new(64, 64, [0.2, 0.2, 0.2, 1.0]);
+        let before = image.clone();
+        let grey = |v: f64| [v as f32; 3];
+        let subject = Subject {
+            view: &view,
+            bounds: (DVec3::ZERO, DVec3::ONE),
+            window: (0.0, 1.0),
+            log: false,
+            colour: &grey,
+            opacity: &|_| 1.0,
+            labels: None,
+            blend: Blend::Composite,
+            value_unit: None,
+            length_unit: None,
+            background: [0.2; 3],
+        };
+        annotate(&mut image, &Annotations::default(), &subject);
+        assert_eq!(image, before);
+        let all = Annotations {
+            colorbar: Some(Side::Right),
+            scale_bar: Some(None),
+            title: Some("A title".into()),
+            label: Some("a".into()),
+        };
+        assert!(all.any());
+        annotate(&mut image, &all, &subject);
+        assert_ne!(image, before);
+    }
+}
