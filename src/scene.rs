@@ -215,8 +215,12 @@ fn channels(
     }
     let log = args.view.look.log;
     let first = load(input_args, log)?;
-    let zarr = matches!(&first.file, Some((VolumeFormat::Zarr, _)));
-    let info = &first.file.as_ref().expect("a file was read").1;
+    let Some((format, info)) = &first.file else {
+        return Err(CliError::input(format!(
+            "--channels: {spec} is not a file holding several channels"
+        )));
+    };
+    let zarr = *format == VolumeFormat::Zarr;
     let count = if zarr {
         (info.header.iter())
             .find(|(k, _)| k == "channels")
