@@ -36,6 +36,7 @@ mod convert;
 #[cfg(feature = "mpi")]
 mod distributed;
 mod error;
+mod figure;
 mod flags;
 mod generate;
 mod info;

@@ -35,6 +35,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
     )?;
     let pool = thread_pool(args.view.threads)?;
+    if kind == OutputKind::Animation {
+        crate::figure::refuse(&args.figure, "animations")?;
+    }
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(frames)) => {
             animate::turntable(args, &settings, &pool, frames as usize)
@@ -82,6 +85,7 @@ fn still(
 ) -> Result<(), CliError> {
     let input_args = match crate::streamed::plan(&args.input, &args.view, settings)? {
         Plan::Streamed(mut streamed) => {
+            crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
             let settings = &streamed.settings_from_volume(&args.view, settings.clone())?;
             let bar = progress_bar((settings.width * settings.height) as u64);
             let (image, times) =
@@ -97,10 +101,11 @@ fn still(
     let settings = &from_volume(args, settings, &mut input)?;
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
-    let image = pool
+    let mut image = pool
         .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
         .map_err(|e| render_failure(&args.view, &input.name, e))?;
     bar.finish_and_clear();
+    crate::figure::draw(args, kind, settings, &renderer, &input, &mut image)?;
 
     write_still(args, kind, &image)
 }

@@ -40,6 +40,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
     let animation = args.animation.turntable.map(|_| "--turntable");
     let kind = output_kind(&args.out.output, args.out.bit_depth, animation)?;
+    if kind == OutputKind::Animation {
+        crate::figure::refuse(&args.figure, "animations")?;
+    }
     if args.animation.fps.is_some() && animation.is_none() {
         return Err(CliError::input(
             "--fps applies to animations: give --turntable FRAMES",
@@ -148,8 +151,14 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         }
         (kind, _) => {
             let bar = progress_bar(per_frame as u64);
-            let image = frame(settings.clone(), &bar)?;
+            let mut image = frame(settings.clone(), &bar)?;
             bar.finish_and_clear();
+            // The first volume's colour bar, in the view that frames
+            // every volume.
+            let mut first = layers[0].settings.clone();
+            first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
+            let renderer = &scene.layers()[0];
+            crate::figure::draw(args, kind, &first, renderer, &layers[0].input, &mut image)?;
             write_still(args, kind, &image)
         }
     }

@@ -11,6 +11,8 @@
 //! - `output.rs` and `animation.rs`: render's output file, and its
 //!   turntables and series; `scene.rs`: several volumes in one picture
 //!   (`--channels`, `--overlay`) and a file's time points (`--frames`);
+//!   `figure.rs`: annotations drawn into a still (`--colorbar`,
+//!   `--scale-bar`, `--title`, `--label`);
 //! - `render.rs`, `bench.rs`, `info.rs`, `convert.rs`, `generate.rs`, `paper.rs`,
 //!   `viewer.rs` (`volray view`): each subcommand's arguments (`bench.rs`
 //!   also says which groups `--peers` refuses);
@@ -20,6 +22,7 @@ mod animation;
 mod bench;
 mod camera;
 mod convert;
+mod figure;
 mod generate;
 mod info;
 mod input;
@@ -36,6 +39,7 @@ mod viewer;
 pub use bench::BenchArgs;
 pub use camera::CameraArgs;
 pub use convert::ConvertArgs;
+pub use figure::{ColorBarSide, FigureArgs, ScaleLength};
 pub use generate::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 pub use info::InfoArgs;
 pub use input::InputArgs;

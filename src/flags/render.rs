@@ -1,6 +1,7 @@
 //! `volray render`'s flags, each group in its own module.
 
 use super::animation::AnimationArgs;
+use super::figure::FigureArgs;
 use super::input::InputArgs;
 use super::output::OutputArgs;
 use super::scene::SceneArgs;
@@ -21,6 +22,9 @@ pub struct RenderArgs {
 
     #[command(flatten)]
     pub scene: SceneArgs,
+
+    #[command(flatten)]
+    pub figure: FigureArgs,
 
     #[command(flatten)]
     pub view: ViewArgs,

@@ -72,7 +72,7 @@ impl ScaleBar<'_> {
                 blend(image, x as i64, (y + thick) as i64 - t as i64, ink, 1.0);
             }
         }
-        let mut text = label(length, 0.0);
+        let mut text = label(length, length);
         if let Some(unit) = self.unit {
             text = format!("{text} {unit}");
         }
