@@ -274,7 +274,7 @@ fn channels(
         }
         Some(given) => given.0.clone(),
         None => (0..indices.len())
-            .map(|i| crate::flags::PALETTE[i % crate::flags::PALETTE.len()].1)
+            .map(volray_options::colors::channel_colour)
             .collect(),
     };
     let mut first = Some(first);

@@ -84,27 +84,6 @@ pub struct Frames {
     pub end: Option<usize>,
 }
 
-/// The default channel colours, in order: the fluorescence palette.
-pub const PALETTE: [(&str, [f32; 3]); 8] = [
-    ("magenta", [1.0, 0.0, 1.0]),
-    ("green", [0.0, 1.0, 0.0]),
-    ("cyan", [0.0, 1.0, 1.0]),
-    ("yellow", [1.0, 1.0, 0.0]),
-    ("red", [1.0, 0.0, 0.0]),
-    ("blue", [0.0, 0.0, 1.0]),
-    ("orange", [1.0, 0.5, 0.0]),
-    ("white", [1.0, 1.0, 1.0]),
-];
-
-/// Colour names taken beside the palette's.
-const MORE_COLORS: [(&str, [f32; 3]); 5] = [
-    ("grey", [0.5, 0.5, 0.5]),
-    ("gray", [0.5, 0.5, 0.5]),
-    ("purple", [0.5, 0.0, 1.0]),
-    ("pink", [1.0, 0.4, 0.7]),
-    ("black", [0.0, 0.0, 0.0]),
-];
-
 fn parse_channels(s: &str) -> Result<Channels, String> {
     let s = s.trim();
     if s == "all" {
@@ -142,17 +121,10 @@ pub fn parse_color(s: &str) -> Result<[f32; 3], String> {
             _ => Err(format!("'{s}' is not a colour #rrggbb")),
         };
     }
-    let lower = s.to_ascii_lowercase();
-    (PALETTE.iter().chain(&MORE_COLORS))
-        .find(|(name, _)| *name == lower)
-        .map(|&(_, rgb)| rgb)
-        .ok_or_else(|| {
-            let names: Vec<&str> = (PALETTE.iter().chain(&MORE_COLORS))
-                .map(|(n, _)| *n)
-                .filter(|n| *n != "gray")
-                .collect();
-            format!("unknown colour '{s}' ({}, or #rrggbb)", names.join(", "))
-        })
+    volray_options::colors::named(s).ok_or_else(|| {
+        let names = volray_options::colors::names();
+        format!("unknown colour '{s}' ({}, or #rrggbb)", names.join(", "))
+    })
 }
 
 fn parse_colors(s: &str) -> Result<ChannelColors, String> {

@@ -28,6 +28,7 @@
 //! ```
 
 mod blame;
+pub mod colors;
 mod error;
 pub mod level;
 mod option;

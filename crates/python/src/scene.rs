@@ -30,6 +30,7 @@ use volray_core::scene::{Look, Mix, Scene as CoreScene, SceneSettings};
 use volray_core::{PiecewiseLinear, RenderSettings};
 use volray_io::format_bytes;
 use volray_options::Options;
+use volray_options::colors::{channel_colour, named};
 
 /// The per-volume keywords that decide how a volume is prepared (fixed
 /// when a `Scene` is made).
@@ -56,25 +57,6 @@ pub const LAYER_EXTRA: &[&str] = &["color", "opacity_scale", "visible"];
 pub const SCENE: &[&str] = &["looks", "mix", "channel_axis"];
 
 const MAX_MEMORY: &[&str] = &["max_memory"];
-
-/// The colours of `channel_axis`'s channels, in order (then again).
-pub const PALETTE: [(&str, [f32; 3]); 8] = [
-    ("magenta", [1.0, 0.0, 1.0]),
-    ("green", [0.0, 1.0, 0.0]),
-    ("cyan", [0.0, 1.0, 1.0]),
-    ("yellow", [1.0, 1.0, 0.0]),
-    ("red", [1.0, 0.0, 0.0]),
-    ("blue", [0.0, 0.0, 1.0]),
-    ("orange", [1.0, 0.5, 0.0]),
-    ("white", [1.0, 1.0, 1.0]),
-];
-
-/// Colour names `color=` takes besides the palette's.
-const MORE_COLORS: [(&str, [f32; 3]); 3] = [
-    ("black", [0.0, 0.0, 0.0]),
-    ("gray", [0.5, 0.5, 0.5]),
-    ("grey", [0.5, 0.5, 0.5]),
-];
 
 /// Several volumes rendered together, each kept prepared across frames
 /// (see the module documentation).
@@ -190,7 +172,7 @@ impl Scene {
             Some(axis) => {
                 let axis = extract::<isize>(axis, "channel_axis", "an axis number")?;
                 let channels = channels(py, volumes, axis)?;
-                let colours = (0..channels.len()).map(|c| Some(PALETTE[c % PALETTE.len()].1));
+                let colours = (0..channels.len()).map(|c| Some(channel_colour(c)));
                 (channels, colours.collect())
             }
             None => {
@@ -572,15 +554,13 @@ fn parse_color(value: &Bound<'_, PyAny>) -> PyResult<[f32; 3]> {
     if let Ok(s) = value.cast::<PyString>() {
         let text = s.to_cow()?;
         let lower = text.trim().to_ascii_lowercase();
-        if let Some((_, rgb)) = (PALETTE.iter().chain(&MORE_COLORS)).find(|(n, _)| *n == lower) {
-            return Ok(*rgb);
+        if let Some(rgb) = named(&lower) {
+            return Ok(rgb);
         }
         if let Some(rgb) = lower.strip_prefix('#').and_then(hex) {
             return Ok(rgb);
         }
-        let names: Vec<&str> = (PALETTE.iter().chain(&MORE_COLORS))
-            .map(|(n, _)| *n)
-            .collect();
+        let names = volray_options::colors::names();
         return Err(value_error(format!(
             "color: unknown colour '{text}': expected '#rrggbb', (r, g, b) or one of {}",
             names.join(", ")
