@@ -27,7 +27,7 @@
 //! function from them.
 
 use crate::error::CliError;
-use crate::flags::{BenchArgs, InputArgs, RenderArgs, ViewArgs};
+use crate::flags::{BenchArgs, Channels, InputArgs, MixMode, RenderArgs, ViewArgs};
 use crate::input::{self, Input};
 use crate::render::{self, OutputKind};
 use crate::session::render_failure;
@@ -36,10 +36,12 @@ use std::time::Duration;
 use volray_core::SampleType;
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
-use volray_core::{Camera, NonFinite, RenderSettings, Volume};
+use volray_core::scene::{Look, Mix, SceneSettings};
+use volray_core::{Camera, Image, NonFinite, RenderSettings, Volume};
 use volray_distributed::frame::{Distributed, FrameError, RankTimes, Source, agree};
 use volray_distributed::kd::Decomposition;
 use volray_distributed::mpi::Mpi;
+use volray_distributed::scene::DistributedScene;
 use volray_distributed::transport::Transport;
 use volray_io::{MapPolicy, Reorientation, format_bytes};
 
@@ -51,10 +53,16 @@ pub fn launched() -> bool {
 
 /// `volray render` under `mpirun`: one still image, written by rank 0.
 pub fn render(args: &RenderArgs) -> Result<(), CliError> {
-    if args.scene.is_scene() || args.scene.frames.is_some() {
+    if !args.scene.overlay.is_empty() || args.scene.frames.is_some() {
         return Err(CliError::input(
-            "under mpirun, render writes one still image of one volume: --channels, --overlay and --frames are rendered by one process",
+            "under mpirun, render writes one still image of one grid: --overlay (volumes on other grids) and --frames are rendered by one process",
         ));
+    }
+    if args.figure.any() {
+        return Err(CliError::input(format!(
+            "{}: under mpirun, render writes the bare frame: annotations are drawn by one process",
+            args.figure.first_flag()
+        )));
     }
     if args.animation.turntable.is_some() || !args.animation.series.is_empty() {
         return Err(CliError::input(
@@ -86,6 +94,13 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     };
     agree(&mpi, checked.map(|_| Vec::new()).map_err(|e| e.to_string()))
         .map_err(|e| failure(&args.view, "", e))?;
+    if let Some(which) = &args.scene.channels {
+        let image = channels(args, which, &mpi, settings)?;
+        if let Some(image) = image {
+            render::write_still(args, kind, &image)?;
+        }
+        return Ok(());
+    }
     let source = CliSource::open(&mpi, &args.input, &args.view, &settings)?;
     let mode = source.non_finite;
     let name = source.name.clone();
@@ -97,6 +112,190 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
         render::write_still(args, kind, &image)?;
     }
     Ok(())
+}
+
+/// `--channels` under `mpirun`: every channel split alike among the ranks
+/// (the channels of one file share its grid), each rank reading its box
+/// of each. The composite mix renders each rank's boxes as one scene of
+/// pieces (volray-distributed's `DistributedScene`) and composites the
+/// ranks' partial images; the additive mix renders each channel across
+/// the ranks on its own and sums the colours on rank 0. Each channel's
+/// look is one process's: its colour, its own value window (agreed by the
+/// ranks), the opacity the look flags give or, by default, the one `--tf
+/// auto` chooses from its own histogram (summed over the ranks). The
+/// frame on rank 0.
+fn channels(
+    args: &RenderArgs,
+    which: &Channels,
+    mpi: &Mpi,
+    settings: RenderSettings,
+) -> Result<Option<Image>, CliError> {
+    let view = &args.view;
+    let look = &view.look;
+    if look.labels || look.preset.is_some() || look.colormap.is_some() {
+        return Err(CliError::input(
+            "--channels colours each channel: --labels, --preset and --colormap do not apply",
+        ));
+    }
+    let spec = args
+        .input
+        .input
+        .as_deref()
+        .unwrap_or(input::DEMO)
+        .to_string();
+    let picked = args.input.frame.is_some() || args.input.channel.is_some();
+    if volray_data::is_source_spec(&spec) || picked {
+        return Err(CliError::input(format!(
+            "--channels: give a file holding several channels, without --frame or --channel ({spec})"
+        )));
+    }
+    // How many channels, and which reader option picks one: rank 0 asks
+    // the file (its metadata for a chunked store), every rank learns it.
+    let probe = if mpi.rank() == 0 {
+        channel_count(&args.input, &spec)
+    } else {
+        Ok((0, false))
+    };
+    let told = probe.map(|(n, zarr)| {
+        let mut bytes = (n as u32).to_le_bytes().to_vec();
+        bytes.push(u8::from(zarr));
+        bytes
+    });
+    let all = agree(mpi, told.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
+    let word = |b: &[u8]| u32::from_le_bytes(b[..4].try_into().expect("four bytes")) as usize;
+    let (count, zarr) = (word(&all[0]), all[0][4] == 1);
+    if count < 2 {
+        return Err(CliError::input(format!(
+            "--channels: {spec} holds one volume, no channels to render together"
+        )));
+    }
+    let indices: Vec<usize> = match which {
+        Channels::All => (0..count).collect(),
+        Channels::Some(list) => list.clone(),
+    };
+    if let Some(bad) = indices.iter().find(|&&i| i >= count) {
+        return Err(CliError::input(format!(
+            "--channels {bad}: {spec} holds {count} channels, numbered from 0"
+        )));
+    }
+    let colors: Vec<[f32; 3]> = match &args.scene.channel_colors {
+        Some(given) if given.0.len() != indices.len() => {
+            return Err(CliError::input(format!(
+                "--channel-colors: {} colour(s) for {} channels: give one per channel",
+                given.0.len(),
+                indices.len()
+            )));
+        }
+        Some(given) => given.0.clone(),
+        None => (0..indices.len())
+            .map(volray_options::colors::channel_colour)
+            .collect(),
+    };
+    let sources = (indices.iter())
+        .map(|&i| {
+            let mut one = args.input.clone();
+            if zarr {
+                one.channel = Some(i);
+            } else {
+                one.frame = Some(i);
+            }
+            CliSource::open(mpi, &one, view, &settings)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mode = sources[0].non_finite;
+    let fail = |e| failure(view, &spec, e);
+    let projection = settings.blend.is_projection();
+    let additive = match args.scene.mix {
+        Some(MixMode::Composite) => false,
+        Some(MixMode::Additive) | None => true,
+    };
+    if projection {
+        return Err(CliError::input(
+            "--channels under mpirun: the projections (--blend mip, ...) are rendered by one process",
+        ));
+    }
+    // Each channel's settings: its colour; the opacity chosen from its
+    // histogram where the look flags leave it.
+    let channel_settings = |d: &Distributed<'_, Mpi>, i: usize, source: &CliSource| {
+        let mut s = settings.clone();
+        s.transfer_function.color = Some(volray_core::PiecewiseLinear::constant(colors[i]));
+        let name = format!("{spec} (channel {})", indices[i]);
+        from_volume(d, view, (&name, source.window), s)
+    };
+    if additive {
+        // Each channel across the ranks on its own, over black; rank 0
+        // sums the colours and puts the background behind what lets it
+        // through.
+        let mut sum: Option<Vec<[f32; 4]>> = None;
+        for (i, source) in sources.iter().enumerate() {
+            let mut d = Distributed::read(mpi, source, mode).map_err(fail)?;
+            let mut s = channel_settings(&d, i, source)?;
+            s.background = [0.0; 3];
+            let (image, _) = d.render(&s).map_err(fail)?;
+            if let Some(image) = image {
+                let acc =
+                    sum.get_or_insert_with(|| vec![[0.0, 0.0, 0.0, 1.0]; image.pixels().len()]);
+                for (a, p) in acc.iter_mut().zip(image.pixels()) {
+                    // The image's alpha is 1 − T: T multiplies.
+                    *a = [a[0] + p[0], a[1] + p[1], a[2] + p[2], a[3] * (1.0 - p[3])];
+                }
+            }
+        }
+        let bg = settings.background;
+        return Ok(sum.map(|acc| {
+            let pixels = (acc.into_iter())
+                .map(|[r, g, b, t]| {
+                    [
+                        (r + t * bg[0]).min(1.0),
+                        (g + t * bg[1]).min(1.0),
+                        (b + t * bg[2]).min(1.0),
+                        1.0 - t,
+                    ]
+                })
+                .collect();
+            Image::from_pixels(settings.width, settings.height, pixels).expect("the frame's size")
+        }));
+    }
+    // Each channel read, and its look from its statistics (agreed across
+    // the ranks), before the scene takes its renderer.
+    let mut volumes = Vec::with_capacity(sources.len());
+    let mut looks = Vec::with_capacity(sources.len());
+    for (i, source) in sources.iter().enumerate() {
+        let d = Distributed::read(mpi, source, mode).map_err(fail)?;
+        looks.push(Look::of(&channel_settings(&d, i, source)?));
+        volumes.push(d);
+    }
+    let mut d = DistributedScene::of(volumes).map_err(fail)?;
+    let request = SceneSettings {
+        settings: settings.clone(),
+        looks,
+        mix: Mix::Composite,
+    };
+    let (image, _) = d.render(&request).map_err(fail)?;
+    Ok(image)
+}
+
+/// INPUT's channels, as rank 0 finds them: how many, and whether they
+/// are an OME-Zarr image's `c` axis (else the file's frames).
+fn channel_count(args: &InputArgs, spec: &str) -> Result<(usize, bool), CliError> {
+    let path = std::path::PathBuf::from(spec);
+    let max_memory = args
+        .max_memory
+        .unwrap_or_else(volray_io::default_max_memory);
+    let opts = input::read_options(args, spec, &path, max_memory, MapPolicy::IfLarger)?;
+    if let Some(lazy) = volray_io::open_lazy(&path, &opts)? {
+        let zarr = lazy.format == volray_io::VolumeFormat::Zarr;
+        if zarr {
+            let count = (lazy.info.header.iter())
+                .find(|(k, _)| k == "channels")
+                .and_then(|(_, v)| v.parse::<usize>().ok())
+                .unwrap_or(1);
+            return Ok((count, true));
+        }
+        return Ok((lazy.info.frames, false));
+    }
+    let input = input::load_with(args, MapPolicy::AlwaysInFileOrder)?;
+    Ok((input.file.map_or(1, |(_, info)| info.frames), false))
 }
 
 /// `volray bench` under `mpirun`: per-rank times of each stage, medians

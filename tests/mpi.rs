@@ -700,3 +700,93 @@ fn a_rank_over_max_memory_is_refused_before_it_allocates() {
         assert!(!peaks.is_empty(), "{name}: {stderr}");
     }
 }
+
+/// A 4-D NIfTI (`.nii`, float32, unit spacing) of `frames` volumes of
+/// `n`³, written byte by byte.
+fn nifti_4d(dir: &Path, n: usize, frames: &[Vec<f32>]) -> PathBuf {
+    let mut bytes = vec![0u8; 352];
+    let put_i16 =
+        |b: &mut Vec<u8>, at: usize, v: i16| b[at..at + 2].copy_from_slice(&v.to_le_bytes());
+    let put_f32 =
+        |b: &mut Vec<u8>, at: usize, v: f32| b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+    bytes[0..4].copy_from_slice(&348i32.to_le_bytes());
+    let dims = [
+        4,
+        n as i16,
+        n as i16,
+        n as i16,
+        frames.len() as i16,
+        1,
+        1,
+        1,
+    ];
+    for (i, d) in dims.iter().enumerate() {
+        put_i16(&mut bytes, 40 + 2 * i, *d);
+    }
+    put_i16(&mut bytes, 70, 16); // float32
+    put_i16(&mut bytes, 72, 32);
+    for (i, p) in [1.0, 1.0, 1.0, 1.0, 1.0].iter().enumerate() {
+        put_f32(&mut bytes, 76 + 4 * i, *p);
+    }
+    put_f32(&mut bytes, 108, 352.0); // vox_offset
+    put_f32(&mut bytes, 112, 1.0); // scl_slope
+    bytes[344..348].copy_from_slice(b"n+1\0");
+    for f in frames {
+        bytes.extend(f.iter().flat_map(|v| v.to_le_bytes()));
+    }
+    let path = dir.join("channels.nii");
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+#[test]
+fn channels_render_across_ranks_as_in_one_process_in_both_mixes() {
+    if mpirun().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // Two channels of one 28³ grid: balls at two places, overlapping.
+    let n = 28;
+    let ball = |c: [f32; 3], r: f32| -> Vec<f32> {
+        (0..n * n * n)
+            .map(|i| {
+                let p = [(i % n) as f32, ((i / n) % n) as f32, (i / (n * n)) as f32];
+                let d = (0..3).map(|a| (p[a] - c[a]).powi(2)).sum::<f32>().sqrt();
+                (1.0 - d / r).max(0.0)
+            })
+            .collect()
+    };
+    let file = nifti_4d(
+        dir.path(),
+        n,
+        &[ball([13.0, 10.0, 13.0], 9.0), ball([14.0, 17.0, 14.0], 8.0)],
+    );
+    let file = file.to_str().unwrap();
+    for mix in ["composite", "additive"] {
+        let args = [
+            file,
+            "--channels",
+            "all",
+            "--mix",
+            mix,
+            "--size",
+            "48",
+            "--azimuth",
+            "30",
+            "--elevation",
+            "20",
+            "--opacity",
+            "0,0.3",
+        ];
+        ranks_match_one_process(dir.path(), &format!("channels, {mix}"), &args, &[2, 3]);
+    }
+    // Overlays (other grids) are refused under mpirun, in one line.
+    let out = dir.path().join("o.png");
+    let run = ranks(
+        2,
+        &with_output(&[file, "--overlay", file], out.to_str().unwrap()),
+    );
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--overlay"));
+    assert!(!out.exists());
+}

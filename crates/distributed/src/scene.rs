@@ -38,6 +38,27 @@ pub enum SceneFrameError {
     Mix,
 }
 
+/// Refuses volumes on different grids, before anything is read.
+fn check_grids<T: Transport + ?Sized>(
+    transport: &T,
+    grids: &[volray_core::sampling::grid::GridFrame],
+) -> Result<(), FrameError> {
+    for (layer, grid) in grids.iter().enumerate() {
+        if *grid != grids[0] {
+            return Err(FrameError::Rank {
+                rank: transport.rank(),
+                message: SceneFrameError::Grids {
+                    layer,
+                    dims: grid.dims,
+                    first: grids[0].dims,
+                }
+                .to_string(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// One rank's part of a distributed scene: its piece of each volume.
 pub struct DistributedScene<'t, T: Transport + ?Sized> {
     volumes: Vec<Distributed<'t, T>>,
@@ -54,24 +75,21 @@ impl<'t, T: Transport + ?Sized> DistributedScene<'t, T> {
         sources: &[&dyn Source],
         non_finite: NonFinite,
     ) -> Result<Self, FrameError> {
-        let first = sources.first().map(|s| s.grid());
-        for (layer, source) in sources.iter().enumerate() {
-            let (grid, first) = (source.grid(), first.expect("a source"));
-            if grid != first {
-                return Err(FrameError::Rank {
-                    rank: transport.rank(),
-                    message: SceneFrameError::Grids {
-                        layer,
-                        dims: grid.dims,
-                        first: first.dims,
-                    }
-                    .to_string(),
-                });
-            }
-        }
-        let mut volumes: Vec<Distributed<T>> = (sources.iter())
+        let grids: Vec<_> = sources.iter().map(|s| s.grid()).collect();
+        check_grids(transport, &grids)?;
+        let volumes: Vec<Distributed<T>> = (sources.iter())
             .map(|s| Distributed::read(transport, *s, non_finite))
             .collect::<Result<_, _>>()?;
+        Self::of(volumes)
+    }
+
+    /// The scene of `volumes`, each read by [`Distributed::read`] (and
+    /// asked what it needs of the ranks, a histogram, say, before it is
+    /// handed here: its renderer then belongs to the scene).
+    pub fn of(mut volumes: Vec<Distributed<'t, T>>) -> Result<Self, FrameError> {
+        let first = volumes.first().expect("a volume");
+        let grids: Vec<_> = volumes.iter().map(Distributed::grid).collect();
+        check_grids(first.plan().0, &grids)?;
         let renderers: Vec<Renderer<'static>> = volumes
             .iter_mut()
             .filter_map(|d| d.take_renderer())
