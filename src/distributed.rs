@@ -164,33 +164,7 @@ fn channels(
     let all = agree(mpi, told.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
     let word = |b: &[u8]| u32::from_le_bytes(b[..4].try_into().expect("four bytes")) as usize;
     let (count, zarr) = (word(&all[0]), all[0][4] == 1);
-    if count < 2 {
-        return Err(CliError::input(format!(
-            "--channels: {spec} holds one volume, no channels to render together"
-        )));
-    }
-    let indices: Vec<usize> = match which {
-        Channels::All => (0..count).collect(),
-        Channels::Some(list) => list.clone(),
-    };
-    if let Some(bad) = indices.iter().find(|&&i| i >= count) {
-        return Err(CliError::input(format!(
-            "--channels {bad}: {spec} holds {count} channels, numbered from 0"
-        )));
-    }
-    let colors: Vec<[f32; 3]> = match &args.scene.channel_colors {
-        Some(given) if given.0.len() != indices.len() => {
-            return Err(CliError::input(format!(
-                "--channel-colors: {} colour(s) for {} channels: give one per channel",
-                given.0.len(),
-                indices.len()
-            )));
-        }
-        Some(given) => given.0.clone(),
-        None => (0..indices.len())
-            .map(volray_options::colors::channel_colour)
-            .collect(),
-    };
+    let (indices, colors) = crate::scene::picked_channels(args, which, &spec, count)?;
     let sources = (indices.iter())
         .map(|&i| {
             let mut one = args.input.clone();
@@ -284,18 +258,13 @@ fn channel_count(args: &InputArgs, spec: &str) -> Result<(usize, bool), CliError
         .unwrap_or_else(volray_io::default_max_memory);
     let opts = input::read_options(args, spec, &path, max_memory, MapPolicy::IfLarger)?;
     if let Some(lazy) = volray_io::open_lazy(&path, &opts)? {
-        let zarr = lazy.format == volray_io::VolumeFormat::Zarr;
-        if zarr {
-            let count = (lazy.info.header.iter())
-                .find(|(k, _)| k == "channels")
-                .and_then(|(_, v)| v.parse::<usize>().ok())
-                .unwrap_or(1);
-            return Ok((count, true));
-        }
-        return Ok((lazy.info.frames, false));
+        let count = crate::scene::channel_count(lazy.format, &lazy.info);
+        return Ok((count, lazy.format == volray_io::VolumeFormat::Zarr));
     }
     let input = input::load_with(args, MapPolicy::AlwaysInFileOrder)?;
-    Ok((input.file.map_or(1, |(_, info)| info.frames), false))
+    Ok(input.file.map_or((1, false), |(format, info)| {
+        (crate::scene::channel_count(format, &info), false)
+    }))
 }
 
 /// `volray bench` under `mpirun`: per-rank times of each stage, medians

@@ -22,7 +22,7 @@ use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
 use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
 use volray_core::{PiecewiseLinear, RenderError, RenderSettings, SceneError};
-use volray_io::VolumeFormat;
+use volray_io::{FileInfo, VolumeFormat};
 use volray_options::{LookOptions, Naming, Opt, Options, Tf};
 
 /// The overlay options, as the refusal of an unknown one lists them.
@@ -230,14 +230,7 @@ fn channels(
         )));
     };
     let zarr = *format == VolumeFormat::Zarr;
-    let count = if zarr {
-        (info.header.iter())
-            .find(|(k, _)| k == "channels")
-            .and_then(|(_, v)| v.parse::<usize>().ok())
-            .unwrap_or(1)
-    } else {
-        info.frames
-    };
+    let count = channel_count(*format, info);
     // Which reader option picks a channel: OME-Zarr's `c` (its `t` stays
     // --frame's), else the file's frames.
     let (picked, flag) = if zarr {
@@ -250,33 +243,7 @@ fn channels(
             "--channels picks the channels of {spec}; {flag} picks one: give one of them"
         )));
     }
-    if count < 2 {
-        return Err(CliError::input(format!(
-            "--channels: {spec} holds one volume, no channels to render together (volray info {spec} says what it holds)"
-        )));
-    }
-    let indices: Vec<usize> = match which {
-        Channels::All => (0..count).collect(),
-        Channels::Some(list) => list.clone(),
-    };
-    if let Some(bad) = indices.iter().find(|&&i| i >= count) {
-        return Err(CliError::input(format!(
-            "--channels {bad}: {spec} holds {count} channels, numbered from 0"
-        )));
-    }
-    let colors = match &args.scene.channel_colors {
-        Some(given) if given.0.len() != indices.len() => {
-            return Err(CliError::input(format!(
-                "--channel-colors: {} colour(s) for {} channels: give one per channel",
-                given.0.len(),
-                indices.len()
-            )));
-        }
-        Some(given) => given.0.clone(),
-        None => (0..indices.len())
-            .map(volray_options::colors::channel_colour)
-            .collect(),
-    };
+    let (indices, colors) = picked_channels(args, which, spec, count)?;
     let mut first = Some(first);
     let mut layers = Vec::with_capacity(indices.len());
     for (&index, &rgb) in indices.iter().zip(&colors) {
@@ -305,6 +272,59 @@ fn channels(
         layers.push(Layer { input, settings });
     }
     Ok(layers)
+}
+
+/// How many channels a file holds, as its reader says: an OME-Zarr
+/// image's `c` axis (the `channels` header entry), else its frames.
+pub fn channel_count(format: VolumeFormat, info: &FileInfo) -> usize {
+    if format == VolumeFormat::Zarr {
+        (info.header.iter())
+            .find(|(k, _)| k == "channels")
+            .and_then(|(_, v)| v.parse::<usize>().ok())
+            .unwrap_or(1)
+    } else {
+        info.frames
+    }
+}
+
+/// The channels `which` of the `count` that `spec` holds, and their
+/// colours (`--channel-colors`, else the palette): refused in one line
+/// where there are none to render together, one is out of range, or the
+/// colours do not match them.
+pub fn picked_channels(
+    args: &RenderArgs,
+    which: &Channels,
+    spec: &str,
+    count: usize,
+) -> Result<(Vec<usize>, Vec<[f32; 3]>), CliError> {
+    if count < 2 {
+        return Err(CliError::input(format!(
+            "--channels: {spec} holds one volume, no channels to render together (volray info {spec} says what it holds)"
+        )));
+    }
+    let indices: Vec<usize> = match which {
+        Channels::All => (0..count).collect(),
+        Channels::Some(list) => list.clone(),
+    };
+    if let Some(bad) = indices.iter().find(|&&i| i >= count) {
+        return Err(CliError::input(format!(
+            "--channels {bad}: {spec} holds {count} channels, numbered from 0"
+        )));
+    }
+    let colors = match &args.scene.channel_colors {
+        Some(given) if given.0.len() != indices.len() => {
+            return Err(CliError::input(format!(
+                "--channel-colors: {} colour(s) for {} channels: give one per channel",
+                given.0.len(),
+                indices.len()
+            )));
+        }
+        Some(given) => given.0.clone(),
+        None => (0..indices.len())
+            .map(volray_options::colors::channel_colour)
+            .collect(),
+    };
+    Ok((indices, colors))
 }
 
 /// A channel's colour transfer function: its colour at every value where
