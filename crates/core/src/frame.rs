@@ -23,11 +23,7 @@ impl Frame {
     /// Checks `settings` and frames their camera and samples on `volume`.
     pub fn new(settings: &RenderSettings, volume: &Volume) -> Result<Self, RenderError> {
         settings.validate()?;
-        let grid = GridFrame {
-            dims: volume.dims(),
-            origin: volume.origin(),
-            spacing: volume.spacing(),
-        };
+        let grid = GridFrame::of(volume);
         // A piece is framed, and sampled, as the whole volume it is part of.
         let whole = match &settings.piece {
             Some(piece) => {

@@ -592,11 +592,7 @@ fn piece_of(volume: &Volume, owned: ([usize; 3], [usize; 3])) -> (Volume, Piece)
     let (lo, hi) = Piece::held(owned, volume.dims());
     let renderer = Renderer::new(volume).unwrap();
     let piece = Piece {
-        whole: GridFrame {
-            dims: volume.dims(),
-            origin: volume.origin(),
-            spacing: volume.spacing(),
-        },
+        whole: GridFrame::of(volume),
         offset: lo,
         owned,
         value_range: renderer.value_range(),

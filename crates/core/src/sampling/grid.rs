@@ -31,6 +31,15 @@ pub struct GridFrame {
 }
 
 impl GridFrame {
+    /// The grid of `volume`'s voxels.
+    pub fn of(volume: &crate::volume::Volume) -> Self {
+        GridFrame {
+            dims: volume.dims(),
+            origin: volume.origin(),
+            spacing: volume.spacing(),
+        }
+    }
+
     /// The world size of the grid's box, `(n − 1)·spacing` on each axis.
     pub fn extent(&self) -> DVec3 {
         let n = |a: usize| (self.dims[a] - 1) as f64;

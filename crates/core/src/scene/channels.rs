@@ -276,11 +276,7 @@ pub(super) fn render(
     let grid = BrickGrid::new(volume.dims());
     // The frame's samples in the volumes' grid (the box is the same).
     let sampling = Sampling {
-        grid: GridFrame {
-            dims: volume.dims(),
-            origin: volume.origin(),
-            spacing: volume.spacing(),
-        },
+        grid: GridFrame::of(volume),
         ..frame.sampling.clone()
     };
     let mut states: Vec<MutexGuard<Option<FastState>>> = (layers.iter())

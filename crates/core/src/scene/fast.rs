@@ -582,11 +582,7 @@ pub(super) fn render(
             let (renderer, settings) = layers[i];
             let volume = renderer.volume();
             let grid = BrickGrid::new(volume.dims());
-            let layer_frame = GridFrame {
-                dims: volume.dims(),
-                origin: volume.origin(),
-                spacing: volume.spacing(),
-            };
+            let layer_frame = GridFrame::of(volume);
             // The frame's samples, in this volume's grid, for binning.
             let own = Sampling {
                 grid: layer_frame,

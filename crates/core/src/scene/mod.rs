@@ -500,14 +500,7 @@ impl<'v> Scene<'v> {
         };
         let (grid, ownership) = match &layer.piece {
             // The piece's own grid, its rays bounded by the whole's.
-            Some(piece) => (
-                GridFrame {
-                    dims: first.dims(),
-                    origin: first.origin(),
-                    spacing: first.spacing(),
-                },
-                Some(piece.ownership()),
-            ),
+            Some(piece) => (GridFrame::of(first), Some(piece.ownership())),
             // The box of every volume as a grid of 2³ points: rays are
             // sampled in it, each volume mapping the world to its own grid.
             None => (

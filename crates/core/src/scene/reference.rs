@@ -80,11 +80,7 @@ pub(super) fn render(
                 }
             };
             Layer {
-                grid: GridFrame {
-                    dims: volume.dims(),
-                    origin: volume.origin(),
-                    spacing: volume.spacing(),
-                },
+                grid: GridFrame::of(volume),
                 samples,
             }
         })
