@@ -164,7 +164,8 @@ fn channels(
     let all = agree(mpi, told.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
     let word = |b: &[u8]| u32::from_le_bytes(b[..4].try_into().expect("four bytes")) as usize;
     let (count, zarr) = (word(&all[0]), all[0][4] == 1);
-    let (indices, colors) = crate::scene::picked_channels(args, which, &spec, count)?;
+    let (indices, colors) =
+        crate::scene::picked_channels(args.scene.channel_colors.as_ref(), which, &spec, count)?;
     let sources = (indices.iter())
         .map(|&i| {
             let mut one = args.input.clone();

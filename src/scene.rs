@@ -14,7 +14,7 @@
 
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::{Channels, InputArgs, MixMode, RenderArgs, ViewArgs};
+use crate::flags::{ChannelColors, Channels, InputArgs, MixMode, RenderArgs, SceneArgs, ViewArgs};
 use crate::input::{self, Input};
 use crate::render::{OutputKind, output_kind, write_still};
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
@@ -26,14 +26,36 @@ use volray_io::{FileInfo, VolumeFormat};
 use volray_options::{LookOptions, Naming, Opt, Options, Tf};
 
 /// The overlay options, as the refusal of an unknown one lists them.
-const OVERLAY_OPTIONS: &str =
-    "labels, colormap=NAME, preset=NAME, range=LO,HI, opacity=P,Q, tf=FILE.json, frame=N";
+const OVERLAY_OPTIONS: &str = "labels, colormap=NAME, preset=NAME, range=LO,HI, opacity=P,Q, tf=FILE.json, frame=N, channel=N, hidden";
 
-/// One volume of the picture: what was read, and its settings alone
-/// (whose look becomes its [`Look`]).
-struct Layer {
-    input: Input,
-    settings: RenderSettings,
+/// One volume of the picture: what was read, its settings alone (whose
+/// look becomes its [`Look`]), and where it came from.
+pub struct Layer {
+    pub input: Input,
+    pub settings: RenderSettings,
+    pub source: LayerSource,
+}
+
+impl Layer {
+    /// Its look in the picture: shown unless an overlay's `hidden`.
+    pub fn look(&self) -> Look {
+        Look {
+            visible: !matches!(&self.source, LayerSource::Overlay(o) if o.hidden),
+            ..Look::of(&self.settings)
+        }
+    }
+}
+
+/// Where a volume of the picture came from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LayerSource {
+    /// INPUT, alone.
+    Input,
+    /// A channel of INPUT: its number, and whether OME-Zarr's `c` picks
+    /// it (`--channel`) rather than the file's frames (`--frame`).
+    Channel { index: usize, zarr: bool },
+    /// An `--overlay`.
+    Overlay(OverlaySpec),
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
@@ -50,16 +72,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let settings = crate::settings::settings(&args.view)?;
     crate::render::check_output(&args.out.output)?;
-    let overlays = (args.scene.overlay.iter())
-        .map(|spec| OverlaySpec::parse(spec))
-        .collect::<Result<Vec<_>, _>>()?;
-    let tf_texts = (overlays.iter())
-        .map(|o| {
-            o.tf.as_deref()
-                .map(|tf| read_overlay_tf(&o.spec, tf))
-                .transpose()
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let overlays = overlay_specs(&args.scene)?;
     let first_spec = args.input.input.as_deref().unwrap_or(input::DEMO);
     let inputs: Vec<String> = std::iter::once(first_spec.to_string())
         .chain(overlays.iter().map(|o| o.file.clone()))
@@ -92,26 +105,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         }
         Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
     };
-    let mut layers = match &args.scene.channels {
-        Some(which) => channels(args, &input_args, which, &settings)?,
-        None => {
-            let mut input = load(&input_args, args.view.look.log)?;
-            let settings = crate::render::from_volume(args, &settings, &mut input)?;
-            vec![Layer { input, settings }]
-        }
-    };
-    for (overlay, tf_text) in overlays.iter().zip(&tf_texts) {
-        let layer = overlay.load(args, tf_text.as_deref())?;
-        let first = &layers[0].input;
-        if !overlaps(&layer.input.volume, &first.volume) {
-            let ((a, b), (c, d)) = (layer.input.volume.bounds(), first.volume.bounds());
-            return Err(CliError::input(format!(
-                "--overlay {}: its box ({a} .. {b}) does not meet the box of {} ({c} .. {d}): check its origin and spacing",
-                overlay.spec, first.name
-            )));
-        }
-        layers.push(layer);
-    }
+    let layers = read_layers(&input_args, &args.view, &args.scene, &overlays, &settings)?;
 
     let names: Vec<&str> = layers.iter().map(|l| l.input.name.as_str()).collect();
     let renderers = (layers.iter())
@@ -119,7 +113,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         .collect::<Result<Vec<_>, _>>()?;
     let fail = |e: RenderError| scene_failure(&args.view, &names, e);
     let scene = Scene::new(renderers).map_err(|e| fail(RenderError::Scene(e)))?;
-    let looks: Vec<Look> = layers.iter().map(|l| Look::of(&l.settings)).collect();
+    let looks: Vec<Look> = layers.iter().map(Layer::look).collect();
     let mix = match args.scene.mix {
         Some(MixMode::Composite) => Mix::Composite,
         Some(MixMode::Additive) => Mix::Additive,
@@ -162,6 +156,68 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             write_still(args, kind, &image)
         }
     }
+}
+
+/// The `--overlay` specs, parsed.
+pub fn overlay_specs(scene: &SceneArgs) -> Result<Vec<OverlaySpec>, CliError> {
+    (scene.overlay.iter())
+        .map(|spec| OverlaySpec::parse(spec))
+        .collect()
+}
+
+/// The volumes of the picture, each read whole with its look: INPUT (read
+/// as `input_args` say) or its `--channels`, then each overlay, refused
+/// where an overlay does not meet the first volume.
+pub fn read_layers(
+    input_args: &InputArgs,
+    view: &ViewArgs,
+    scene: &SceneArgs,
+    overlays: &[OverlaySpec],
+    settings: &RenderSettings,
+) -> Result<Vec<Layer>, CliError> {
+    let tf_texts = (overlays.iter())
+        .map(|o| {
+            o.tf.as_deref()
+                .map(|tf| read_overlay_tf(&o.spec, tf))
+                .transpose()
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut layers = match &scene.channels {
+        Some(which) => channels(input_args, view, scene, which, settings)?,
+        None => {
+            let mut input = load(input_args, view.look.log)?;
+            let mut settings = settings.clone();
+            crate::settings::file_window(
+                &view.look,
+                &mut settings.transfer_function,
+                (input.file.as_ref()).and_then(|(_, info)| info.display_window()),
+            );
+            crate::settings::from_volume(
+                &view.look,
+                &mut settings.transfer_function,
+                &mut input.volume,
+                &input.name,
+            )?;
+            vec![Layer {
+                input,
+                settings,
+                source: LayerSource::Input,
+            }]
+        }
+    };
+    for (overlay, tf_text) in overlays.iter().zip(&tf_texts) {
+        let layer = overlay.load(view, input_args.max_memory, tf_text.as_deref())?;
+        let first = &layers[0].input;
+        if !overlaps(&layer.input.volume, &first.volume) {
+            let ((a, b), (c, d)) = (layer.input.volume.bounds(), first.volume.bounds());
+            return Err(CliError::input(format!(
+                "--overlay {}: its box ({a} .. {b}) does not meet the box of {} ({c} .. {d}): check its origin and spacing",
+                overlay.spec, first.name
+            )));
+        }
+        layers.push(layer);
+    }
+    Ok(layers)
 }
 
 /// The refusals of what several volumes in one picture do not take.
@@ -211,8 +267,9 @@ fn scene_failure(view: &ViewArgs, names: &[&str], e: RenderError) -> CliError {
 /// The channels `which` of INPUT (read as `input_args` say), each with
 /// its look.
 fn channels(
-    args: &RenderArgs,
     input_args: &InputArgs,
+    view: &ViewArgs,
+    scene: &SceneArgs,
     which: &Channels,
     settings: &RenderSettings,
 ) -> Result<Vec<Layer>, CliError> {
@@ -222,7 +279,7 @@ fn channels(
             "--channels: {spec} is a built-in source, one volume: give a file holding several channels"
         )));
     }
-    let log = args.view.look.log;
+    let log = view.look.log;
     let first = load(input_args, log)?;
     let Some((format, info)) = &first.file else {
         return Err(CliError::input(format!(
@@ -243,7 +300,7 @@ fn channels(
             "--channels picks the channels of {spec}; {flag} picks one: give one of them"
         )));
     }
-    let (indices, colors) = picked_channels(args, which, spec, count)?;
+    let (indices, colors) = picked_channels(scene.channel_colors.as_ref(), which, spec, count)?;
     let mut first = Some(first);
     let mut layers = Vec::with_capacity(indices.len());
     for (&index, &rgb) in indices.iter().zip(&colors) {
@@ -264,12 +321,16 @@ fn channels(
         let tf = &mut settings.transfer_function;
         tf.color = Some(channel_color(rgb, settings.blend.is_projection()));
         crate::settings::file_window(
-            &args.view.look,
+            &view.look,
             tf,
             input.file.as_ref().and_then(|(_, i)| i.display_window()),
         );
-        crate::settings::from_volume(&args.view.look, tf, &mut input.volume, &input.name)?;
-        layers.push(Layer { input, settings });
+        crate::settings::from_volume(&view.look, tf, &mut input.volume, &input.name)?;
+        layers.push(Layer {
+            input,
+            settings,
+            source: LayerSource::Channel { index, zarr },
+        });
     }
     Ok(layers)
 }
@@ -292,7 +353,7 @@ pub fn channel_count(format: VolumeFormat, info: &FileInfo) -> usize {
 /// where there are none to render together, one is out of range, or the
 /// colours do not match them.
 pub fn picked_channels(
-    args: &RenderArgs,
+    channel_colors: Option<&ChannelColors>,
     which: &Channels,
     spec: &str,
     count: usize,
@@ -311,7 +372,7 @@ pub fn picked_channels(
             "--channels {bad}: {spec} holds {count} channels, numbered from 0"
         )));
     }
-    let colors = match &args.scene.channel_colors {
+    let colors = match channel_colors {
         Some(given) if given.0.len() != indices.len() => {
             return Err(CliError::input(format!(
                 "--channel-colors: {} colour(s) for {} channels: give one per channel",
@@ -341,17 +402,21 @@ fn channel_color(rgb: [f32; 3], projection: bool) -> PiecewiseLinear<3> {
 
 /// An `--overlay FILE[:OPTIONS]`.
 #[derive(Debug, Clone, Default, PartialEq)]
-struct OverlaySpec {
+pub struct OverlaySpec {
     /// As given, for messages.
-    spec: String,
-    file: String,
-    labels: bool,
-    colormap: Option<String>,
-    preset: Option<String>,
-    range: Option<(f64, f64)>,
-    opacity: Option<(f32, f32)>,
-    tf: Option<String>,
-    frame: Option<usize>,
+    pub spec: String,
+    pub file: String,
+    pub labels: bool,
+    pub colormap: Option<String>,
+    pub preset: Option<String>,
+    pub range: Option<(f64, f64)>,
+    pub opacity: Option<(f32, f32)>,
+    pub tf: Option<String>,
+    pub frame: Option<usize>,
+    /// OME-Zarr's `c` (as `--channel`).
+    pub channel: Option<usize>,
+    /// Placed and framed, not drawn (`Look::visible`).
+    pub hidden: bool,
 }
 
 impl OverlaySpec {
@@ -379,11 +444,15 @@ impl OverlaySpec {
                     parsed.labels = true;
                     continue;
                 }
-                ("labels", Some(_)) => {
-                    return Err(refuse("labels takes no value".to_string()));
+                ("hidden", None) => {
+                    parsed.hidden = true;
+                    continue;
+                }
+                ("labels" | "hidden", Some(_)) => {
+                    return Err(refuse(format!("{name} takes no value")));
                 }
                 (_, Some(v)) => v.as_str(),
-                _ => unreachable!("only labels is a bare word"),
+                _ => unreachable!("only labels and hidden are bare words"),
             };
             let bad = |e: String| refuse(format!("{name}={value}: {e}"));
             match name.as_str() {
@@ -402,6 +471,14 @@ impl OverlaySpec {
                             .map_err(|_| bad("not a frame number (from 0)".to_string()))?,
                     )
                 }
+                "channel" => {
+                    parsed.channel = Some(
+                        value
+                            .trim()
+                            .parse()
+                            .map_err(|_| bad("not a channel number (from 0)".to_string()))?,
+                    )
+                }
                 _ => {
                     return Err(refuse(format!(
                         "unknown option \"{name}\" ({OVERLAY_OPTIONS})"
@@ -416,7 +493,12 @@ impl OverlaySpec {
     }
 
     /// The overlay read, with its look.
-    fn load(&self, args: &RenderArgs, tf_text: Option<&str>) -> Result<Layer, CliError> {
+    fn load(
+        &self,
+        view: &ViewArgs,
+        max_memory: Option<u64>,
+        tf_text: Option<&str>,
+    ) -> Result<Layer, CliError> {
         let refuse = |e: volray_options::OptionError| {
             CliError::input(format!(
                 "--overlay {}: {}",
@@ -434,14 +516,50 @@ impl OverlaySpec {
             frame: self.frame,
             array: None,
             level: None,
-            channel: None,
-            max_memory: args.input.max_memory,
+            channel: self.channel,
+            max_memory,
         };
         let mut input = load(&input_args, false).map_err(|e| CliError {
             message: format!("--overlay: {}", e.message),
             ..e
         })?;
-        let shared = crate::settings::options(&args.view, None)?;
+        let (look, mut settings) = self.settings(view, tf_text)?;
+        volray_options::file_window(
+            &look,
+            &mut settings.transfer_function,
+            input.file.as_ref().and_then(|(_, i)| i.display_window()),
+        );
+        volray_options::from_volume(
+            &look,
+            &mut settings.transfer_function,
+            &mut input.volume,
+            &input.name,
+        )
+        .map_err(refuse)?;
+        Ok(Layer {
+            input,
+            settings,
+            source: LayerSource::Overlay(self.clone()),
+        })
+    }
+
+    /// Its options' look (with the shared flags of `view`) and settings,
+    /// before anything is chosen from its volume.
+    pub fn settings(
+        &self,
+        view: &ViewArgs,
+        tf_text: Option<&str>,
+    ) -> Result<(LookOptions, RenderSettings), CliError> {
+        let refuse = |e: volray_options::OptionError| {
+            CliError::input(format!(
+                "--overlay {}: {}",
+                self.spec,
+                e.message(&OverlayNaming)
+            ))
+        };
+        // The shared flags without the first volume's `--tf` (whose text
+        // is not read here): the overlay's look is its own options'.
+        let shared = crate::settings::options(view, Some(""))?;
         let look = LookOptions {
             opacity: self.opacity,
             tf: self.tf.as_ref().map(|path| Tf::Json {
@@ -467,20 +585,8 @@ impl OverlaySpec {
             look: look.clone(),
             ..shared
         };
-        let mut settings = volray_options::settings(&options).map_err(refuse)?;
-        volray_options::file_window(
-            &look,
-            &mut settings.transfer_function,
-            input.file.as_ref().and_then(|(_, i)| i.display_window()),
-        );
-        volray_options::from_volume(
-            &look,
-            &mut settings.transfer_function,
-            &mut input.volume,
-            &input.name,
-        )
-        .map_err(refuse)?;
-        Ok(Layer { input, settings })
+        let settings = volray_options::settings(&options).map_err(refuse)?;
+        Ok((look, settings))
     }
 }
 
@@ -499,7 +605,7 @@ fn option_tokens(rest: &str) -> Option<Vec<(String, Option<String>)>> {
                 return None;
             }
             options.push((name.to_string(), Some(value.to_string())));
-        } else if token == "labels" {
+        } else if token == "labels" || token == "hidden" {
             options.push((token.to_string(), None));
         } else if token.parse::<f64>().is_ok()
             && let Some((_, Some(value))) = options.last_mut()

@@ -11,6 +11,7 @@
 mod browser;
 mod levels;
 mod reproduce;
+mod scene;
 
 use crate::error::CliError;
 use crate::flags::{BlendMode as BlendFlag, ViewerArgs};
@@ -28,6 +29,9 @@ use volray_view::{BlendMode, Reproduce, START_COLOURS, Start, ViewState, Viewer,
 const MAX_TABS: usize = 8;
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
+    if args.scene.is_scene() || args.scene.frames.is_some() {
+        return scene::run(args);
+    }
     let look = &args.view.look;
     let tf_text = look.tf_file().map(read_tf_file).transpose()?;
     let mut settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
@@ -86,6 +90,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         log: look.log,
         state: &state,
         settings: &settings,
+        others: Vec::new(),
+        time: None,
     }
     .hello();
     if let Some(p) = &pyramid {
@@ -103,8 +109,14 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         pool: Arc::new(pool),
         max_sessions: MAX_TABS,
         levels: pyramid.map(|p| p.into_levels(labels)),
+        others: Vec::new(),
+        time: None,
     };
+    serve(args, viewer)
+}
 
+/// Serves `viewer` as `args` say until Ctrl-C or SIGTERM.
+fn serve(args: &ViewerArgs, viewer: Viewer) -> Result<(), CliError> {
     let addr = SocketAddr::new(args.bind, args.port);
     let server = viewer.bind(addr).map_err(|e| CliError::io(e.to_string()))?;
     let url = server
@@ -162,5 +174,7 @@ pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
         window: None,
         opacity: None,
         colormap,
+        layers: Vec::new(),
+        time: None,
     }
 }

@@ -56,7 +56,30 @@ fn picture(bytes: &[u8], dir: &std::path::Path, name: &str) -> Picture {
 /// Runs the page's Command line (and writes its transfer-function file)
 /// in `dir` with this build's `volray`; the image it writes.
 fn run_command(command: &str, tf_file: Option<(&str, &str)>, dir: &std::path::Path) -> Picture {
-    if let Some((name, json)) = tf_file {
+    run_with_files(command, tf_file.into_iter().collect(), dir)
+}
+
+/// Runs the page's Command line with every file the last frame's header
+/// names (the `--tf` file and a scene's `--overlay` files); the image.
+async fn run_shown(b: &Browser, dir: &std::path::Path) -> Picture {
+    let header = b.eval("return window.volrayView.header();").await;
+    let mut files: Vec<(String, String)> = Vec::new();
+    if let Some([name, json]) = header["tf_file"].as_array().map(|f| [&f[0], &f[1]]) {
+        files.push((name.as_str().unwrap().into(), json.as_str().unwrap().into()));
+    }
+    for f in header["layer_tf_files"].as_array().into_iter().flatten() {
+        files.push((f[0].as_str().unwrap().into(), f[1].as_str().unwrap().into()));
+    }
+    let command = header["command"].as_str().unwrap();
+    let files = files
+        .iter()
+        .map(|(n, j)| (n.as_str(), j.as_str()))
+        .collect();
+    run_with_files(command, files, dir)
+}
+
+fn run_with_files(command: &str, files: Vec<(&str, &str)>, dir: &std::path::Path) -> Picture {
+    for (name, json) in files {
         std::fs::write(dir.join(name), json).unwrap();
     }
     let line = command
@@ -523,5 +546,140 @@ async fn a_pyramids_page_says_which_level_its_still_shows() {
     let status = b.text("status").await;
     assert!(status.contains("level 0 of 2 (96³)"), "{status}");
     assert!(b.text("volume").await.contains("96×96×96 · 2 levels"));
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn a_scenes_page_has_a_panel_per_volume_and_its_command_reproduces_each_edit() {
+    if !browser::available() {
+        return;
+    }
+    use common::nifti::{ball, frame, nifti};
+    let dir = tempfile::tempdir().unwrap();
+    // Two channels (a ball left, a ball right) and a label volume over
+    // both: a slab of label 1 through the middle.
+    let stack = nifti(dir.path(), "stack.nii", &[ball(6.0), ball(17.0)]);
+    let slab = frame(|_, _, z| if (10.0..14.0).contains(&z) { 1.0 } else { 0.0 });
+    let seg = nifti(dir.path(), "seg.nii", &[slab]);
+    let overlay = format!("{seg}:labels");
+    let Some((_viewer, b)) = open(&[
+        &stack,
+        "--channels",
+        "all",
+        "--overlay",
+        &overlay,
+        "--size",
+        "64",
+    ])
+    .await
+    else {
+        return;
+    };
+    let rows = b
+        .eval("return document.querySelectorAll('#volumes .volume').length;")
+        .await;
+    assert_eq!(rows, 3, "one row per volume");
+    let command = b.text("command").await;
+    for part in [
+        "--frame 0",
+        ":frame=1,range=",
+        "seg.nii:labels",
+        "--mix additive",
+    ] {
+        assert!(command.contains(part), "{part}: {command}");
+    }
+    let still = picture(&b.frame_bytes().await, dir.path(), "still.png");
+    assert_eq!(run_shown(&b, dir.path()).await, still, "the start");
+
+    // The second channel's panel: an opaque point in its editor.
+    b.eval("window.volrayView.select(1); return 0;").await;
+    let legend = b.text("tf-of").await;
+    assert!(legend.contains("channel 1"), "{legend}");
+    b.click_at("#tf", -40.0, -60.0).await;
+    b.wait_still().await;
+    let edited = picture(&b.frame_bytes().await, dir.path(), "edited.png");
+    assert_ne!(edited, still, "the edit did not change the image");
+    let state = b.eval("return window.volrayView.state();").await;
+    assert!(
+        state["opacity"].is_null(),
+        "the first channel's look is untouched"
+    );
+    assert!(state["layers"][0]["opacity"].is_array(), "{state}");
+    assert_eq!(run_shown(&b, dir.path()).await, edited, "the edit");
+
+    // One colour for it, and the label volume hidden.
+    b.eval("window.volrayView.setState({}); return 0;").await;
+    b.eval(
+        "const s = window.volrayView.state(); s.layers[0].colormap = '#ffaa00'; \
+         s.layers[1].visible = false; window.volrayView.setState({layers: s.layers}); return 0;",
+    )
+    .await;
+    b.wait_still().await;
+    let recoloured = picture(&b.frame_bytes().await, dir.path(), "recoloured.png");
+    assert_ne!(recoloured, edited);
+    let command = b.text("command").await;
+    assert!(command.contains("labels,hidden"), "{command}");
+    assert_eq!(
+        run_shown(&b, dir.path()).await,
+        recoloured,
+        "hidden and recoloured"
+    );
+
+    // A state for a volume the viewer does not show is refused in the page.
+    b.eval("window.volrayView.sendState({layers: []}); return 0;")
+        .await;
+    b.wait_for("document.body.dataset.state === 'error'").await;
+    let error = b.text("error").await;
+    assert!(
+        error.contains("describes 0 volume(s) beside the first"),
+        "{error}"
+    );
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn a_time_axis_has_a_slider_whose_time_point_is_the_commands_frame() {
+    if !browser::available() {
+        return;
+    }
+    use common::nifti::{ball, nifti};
+    let dir = tempfile::tempdir().unwrap();
+    let series = nifti(
+        dir.path(),
+        "series.nii",
+        &[ball(6.0), ball(12.0), ball(17.0)],
+    );
+    let Some((_viewer, b)) = open(&[&series, "--frames", "all", "--size", "64"]).await else {
+        return;
+    };
+    let hidden = b
+        .eval("return document.getElementById('time-box').hidden;")
+        .await;
+    assert_eq!(hidden, false, "the time slider shows");
+    let max = b.eval("return document.getElementById('time').max;").await;
+    assert_eq!(max, "2");
+    assert!(b.text("command").await.contains("--frame 0"));
+    let first = picture(&b.frame_bytes().await, dir.path(), "first.png");
+    b.eval("window.volrayView.setState({time: 2}); return 0;")
+        .await;
+    b.wait_still().await;
+    let last = picture(&b.frame_bytes().await, dir.path(), "last.png");
+    assert_ne!(last, first, "time point 2 is another picture");
+    let command = b.text("command").await;
+    assert!(command.contains("--frame 2"), "{command}");
+    assert_eq!(run_shown(&b, dir.path()).await, last);
+    // Back to the first time point: the first picture again.
+    b.eval("window.volrayView.setState({time: 0}); return 0;")
+        .await;
+    b.wait_still().await;
+    assert_eq!(
+        picture(&b.frame_bytes().await, dir.path(), "again.png"),
+        first
+    );
+    // A time point beyond the file's is refused in the page.
+    b.eval("window.volrayView.sendState({time: 3}); return 0;")
+        .await;
+    b.wait_for("document.body.dataset.state === 'error'").await;
+    assert!(b.text("error").await.contains("time point 3 is not served"));
     b.close().await;
 }

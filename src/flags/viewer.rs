@@ -1,9 +1,11 @@
 //! `volray view`'s flags: the input and every rendering option (the view
-//! it starts from, as `render` takes them), and where to serve: `--port`,
+//! it starts from, as `render` takes them; the volumes of a scene and a
+//! time axis, as `render` takes them), and where to serve: `--port`,
 //! `--bind`, `--no-browser`. (`view.rs` beside this file is the group of
 //! flags that render a frame, which `render` and `bench` share too.)
 
 use super::input::InputArgs;
+use super::scene::SceneArgs;
 use super::view::ViewArgs;
 use clap::Args;
 use std::net::IpAddr;
@@ -16,6 +18,12 @@ pub struct ViewerArgs {
 
     #[command(flatten)]
     pub view: ViewArgs,
+
+    /// Several volumes in one picture, each with its panel in the page
+    /// (`--channels`, `--overlay`), or a time axis with a slider
+    /// (`--frames`).
+    #[command(flatten)]
+    pub scene: SceneArgs,
 
     /// The port to serve on; 0 picks a free one.
     #[arg(long, value_name = "N", default_value_t = 0, help_heading = "Serving")]

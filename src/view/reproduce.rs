@@ -19,12 +19,21 @@ use crate::input;
 use crate::settings::settings_with_tf_text;
 use clap::Parser;
 use volray_core::glam::DVec3;
+use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, Phong, SampleType, TransferFunction};
-use volray_view::{BlendMode, Refusal, Reproduce, Reproduction, START_COLOURS, ViewState, WHITE};
+use volray_view::{
+    BlendMode, Refusal, Reproduce, Reproduction, START_COLOURS, SceneLooks, ViewState, WHITE,
+};
 
 /// The file the command writes and the transfer-function file it names.
 pub const OUTPUT: &str = "view.png";
 pub const TF_FILE: &str = "view-tf.json";
+
+/// The transfer-function file of a scene's volume `n` (from 1, the
+/// first's being [`TF_FILE`]).
+pub fn layer_tf_file(n: usize) -> String {
+    format!("view-tf-{n}.json")
+}
 
 /// The largest |log10| of a window end or isovalue written in the data's
 /// units under `--log` (10^308 is near the end of `f64`).
@@ -57,6 +66,39 @@ pub struct CliReproduce {
     grid: ([usize; 3], DVec3, SampleType),
     non_finite: NonFinite,
     max_memory: u64,
+    /// A scene's other volumes, as the command's `--overlay`s.
+    scene: Option<SceneWords>,
+    /// Whether the viewer serves a time axis: the state's time point is
+    /// the command's `--frame`.
+    time: bool,
+}
+
+/// A scene's volumes after the first as the command writes them: each
+/// an `--overlay` of its file with its look in full (`range=`, `tf=`),
+/// whatever its starting options, so that the command is the frame.
+pub struct SceneWords {
+    /// What picks the first volume's channel: `--frame K` or
+    /// `--channel K` (none for an input with overlays).
+    pub first: Vec<String>,
+    pub others: Vec<OtherWords>,
+    pub mix: Mix,
+}
+
+/// A scene's volume after the first.
+pub struct OtherWords {
+    /// Its file, and the options that pick and classify it: `frame=K`,
+    /// `channel=K`, `labels`.
+    pub file: String,
+    pub fixed: Vec<String>,
+    /// Its starting transfer function, its domain the window it starts
+    /// with (explicit: the value range where none was chosen).
+    pub start: TransferFunction,
+    /// Its starting opacity ramp.
+    pub ramp: (f32, f32),
+    /// A label volume keeps its label table's look (`start_look`), shown
+    /// or hidden.
+    pub labels: bool,
+    pub start_look: Look,
 }
 
 impl CliReproduce {
@@ -159,7 +201,22 @@ impl CliReproduce {
             grid,
             non_finite,
             max_memory,
+            scene: None,
+            time: false,
         }
+    }
+
+    /// The same, for a scene whose other volumes `scene` describes.
+    pub fn with_scene(mut self, scene: SceneWords) -> Self {
+        self.scene = Some(scene);
+        self
+    }
+
+    /// The same, for a viewer of a time axis: the state's time point is
+    /// the command's `--frame`.
+    pub fn with_time(mut self) -> Self {
+        self.time = true;
+        self
     }
 
     /// The same, its commands reading the level `level` names (`auto` or
@@ -174,7 +231,14 @@ impl CliReproduce {
 
     /// The arguments of the `volray render` command of `state` (after
     /// `volray`), and the transfer-function file's JSON if it names one.
+    #[cfg(test)]
     pub fn words(&self, state: &ViewState) -> Result<(Vec<String>, Option<String>), Refusal> {
+        self.scene_words(state)
+            .map(|(words, json, _)| (words, json))
+    }
+
+    /// [`Self::words`], with the files a scene's `--overlay`s name.
+    fn scene_words(&self, state: &ViewState) -> Result<SceneWordsOf, Refusal> {
         let mut w = Words::default();
         w.word("render");
         let dashed = self.input.starts_with('-');
@@ -182,6 +246,25 @@ impl CliReproduce {
             w.word(&self.input);
         }
         w.0.extend(self.reading.iter().cloned());
+        match (self.time, state.time) {
+            (true, Some(t)) => w.opt("--frame", Some(t.to_string())),
+            (true, None) => return Err(Refusal("the state names no time point".into())),
+            (false, Some(_)) => {
+                return Err(Refusal("this viewer serves no time axis".into()));
+            }
+            (false, None) => {}
+        }
+        let others = self.scene.as_ref().map_or(&[][..], |s| &s.others[..]);
+        if state.layers.len() != others.len() {
+            return Err(Refusal(format!(
+                "the state describes {} volume(s) beside the first; the viewer shows {}",
+                state.layers.len(),
+                others.len()
+            )));
+        }
+        if let Some(scene) = &self.scene {
+            w.0.extend(scene.first.iter().cloned());
+        }
         let (width, height) = (state.width, state.height);
         w.opt(
             "--size",
@@ -275,12 +358,98 @@ impl CliReproduce {
             "--background",
             (state.background != [0.0; 3]).then(|| rgb(state.background)),
         );
+        let mut files = Vec::new();
+        if let Some(scene) = &self.scene {
+            for (i, (layer, other)) in state.layers.iter().zip(&scene.others).enumerate() {
+                let mut options = other.fixed.clone();
+                if !other.labels {
+                    let (lo, hi) = match layer.window {
+                        Some([lo, hi]) => (lo, hi),
+                        None => other.start.domain.expect("an explicit starting window"),
+                    };
+                    options.push(format!("range={lo},{hi}"));
+                    let opacity: Option<Vec<[f32; 2]>> = match &layer.opacity {
+                        Some(points) => Some(points.clone()),
+                        None => (other.start.opacity.as_ref())
+                            .map(|f| f.points().iter().map(|&(t, [a])| [t, a]).collect()),
+                    };
+                    if opacity.is_none() {
+                        options.push(format!("opacity={},{}", other.ramp.0, other.ramp.1));
+                    }
+                    let colours = match layer.colormap.as_str() {
+                        START_COLOURS => other.start.color.as_ref().map(|f| f.points().to_vec()),
+                        WHITE => None,
+                        name => match volray_view::solid_colour(name) {
+                            Some(c) => Some(vec![(0.0, c), (1.0, c)]),
+                            None => {
+                                options.push(format!("colormap={name}"));
+                                None
+                            }
+                        },
+                    };
+                    let name = layer_tf_file(i + 2);
+                    options.push(format!("tf={name}"));
+                    files.push((name, tf_json(opacity.as_deref(), colours.as_deref())));
+                }
+                if !layer.visible {
+                    options.push("hidden".into());
+                }
+                w.opt(
+                    "--overlay",
+                    Some(format!("{}:{}", other.file, options.join(","))),
+                );
+            }
+            let mix = match scene.mix {
+                Mix::Composite => "composite",
+                Mix::Additive => "additive",
+            };
+            w.opt("--mix", Some(mix.to_string()));
+        }
         w.opt("-o", Some(OUTPUT.to_string()));
         if dashed {
             w.word("--");
             w.word(&self.input);
         }
-        Ok((w.0, json))
+        Ok((w.0, json, files))
+    }
+
+    /// The looks of a scene's other volumes as `render` makes them of the
+    /// command's words: `--overlay`s with their files' texts.
+    fn scene_looks(
+        &self,
+        args: &crate::flags::RenderArgs,
+        files: Vec<(String, String)>,
+    ) -> Result<Option<SceneLooks>, Refusal> {
+        let Some(scene) = &self.scene else {
+            return Ok(None);
+        };
+        let refuse = |e: CliError| Refusal(e.message);
+        let specs = crate::scene::overlay_specs(&args.scene).map_err(refuse)?;
+        let mut looks = Vec::with_capacity(specs.len());
+        for (spec, other) in specs.iter().zip(&scene.others) {
+            let look = if spec.labels {
+                other.start_look.clone()
+            } else {
+                let text = (files.iter())
+                    .find(|(name, _)| Some(name) == spec.tf.as_ref())
+                    .map(|(_, text)| text.as_str());
+                let (_, settings) = spec.settings(&args.view, text).map_err(refuse)?;
+                Look::of(&settings)
+            };
+            looks.push(Look {
+                visible: !spec.hidden,
+                ..look
+            });
+        }
+        let mix = match args.scene.mix {
+            Some(crate::flags::MixMode::Additive) => Mix::Additive,
+            _ => Mix::Composite,
+        };
+        Ok(Some(SceneLooks {
+            looks,
+            mix,
+            tf_files: files,
+        }))
     }
 
     /// `value` (as the renderer sees it) as the flags give it: with
@@ -300,7 +469,7 @@ impl CliReproduce {
 
 impl Reproduce for CliReproduce {
     fn reproduce(&self, state: &ViewState) -> Result<Reproduction, Refusal> {
-        let (words, json) = self.words(state)?;
+        let (words, json, files) = self.scene_words(state)?;
         let argv = std::iter::once("volray").chain(words.iter().map(String::as_str));
         let cli =
             Cli::try_parse_from(argv).map_err(|e| Refusal(crate::flags::one_line_error(&e)))?;
@@ -324,13 +493,19 @@ impl Reproduce for CliReproduce {
             .chain(words.iter().map(|w| shell_quote(w)))
             .collect::<Vec<_>>()
             .join(" ");
+        let scene = self.scene_looks(&args, files)?;
         Ok(Reproduction {
             settings,
             command,
             tf_file: json.map(|json| (TF_FILE.to_string(), json)),
+            scene,
         })
     }
 }
+
+/// A command's words, its `--tf` file's JSON, and its `--overlay`s'
+/// files: name and JSON.
+type SceneWordsOf = (Vec<String>, Option<String>, Vec<(String, String)>);
 
 /// Command-line words being written.
 #[derive(Default)]

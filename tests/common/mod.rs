@@ -1,6 +1,8 @@
 //! Running the `volray` binary from the integration tests.
 #![allow(dead_code)] // each test binary uses part of this
 
+pub mod nifti;
+
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

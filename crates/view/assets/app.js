@@ -7,7 +7,11 @@
 // full-quality frame of the current state is shown ("moving" before,
 // "error" when the current state was refused); for a multiscale volume
 // document.body.dataset.level is the level the frame shown renders (0 the
-// finest) and dataset.pieces the pieces it was rendered in.
+// finest) and dataset.pieces the pieces it was rendered in. A scene of
+// several volumes (volray view --channels, --overlay) lists them under
+// #volumes: state.layers[i - 1] is volume i's look (volume 0's is the
+// state's own window, opacity and colormap), volrayView.select(i) edits
+// it; a time axis (--frames) sets state.time from #time.
 "use strict";
 
 const token = new URLSearchParams(location.search).get("token") || "";
@@ -23,6 +27,7 @@ let lastViewSeq = 0;   // the last view request's
 let framesShown = 0;
 let shownTimes = [];   // when recent frames were shown, for the rate
 let stillTimer = 0;
+let selected = 0;      // the volume whose transfer function is edited
 
 // ---------------------------------------------------------------- socket
 
@@ -170,6 +175,22 @@ function showCommand(header) {
     $("tf-name").textContent = tf[0];
     $("tf-json").textContent = tf[1];
   }
+  // A scene's other volumes' files, each under its name.
+  const more = $("layer-tf-files");
+  more.replaceChildren();
+  for (const [name, json] of header.layer_tf_files || []) {
+    const title = document.createElement("div");
+    title.className = "row small muted";
+    title.append("with ");
+    const code = document.createElement("code");
+    code.textContent = name;
+    title.append(code, ":");
+    const pre = document.createElement("pre");
+    pre.className = "code layer-tf";
+    pre.dataset.name = name;
+    pre.textContent = json;
+    more.append(title, pre);
+  }
 }
 
 function showRate(header) {
@@ -209,13 +230,13 @@ function start(message) {
   frame.width = state.width;
   frame.height = state.height;
   $("left").style.width = `${Math.max(360, state.width + 2)}px`;
-  const select = $("colormap");
-  select.replaceChildren(...message.colormaps.map(([name]) => {
-    const option = document.createElement("option");
-    option.value = name;
-    option.textContent = name === "start" ? "as started" : name;
-    return option;
-  }));
+  showVolumes();
+  const time = message.time;
+  $("time-box").hidden = !time;
+  if (time) {
+    $("time").min = time[0];
+    $("time").max = time[1] - 1;
+  }
   $("save-width").value = state.width;
   $("save-height").value = state.height;
   showControls();
@@ -223,8 +244,98 @@ function start(message) {
   sendFull();
 }
 
+// The volume being edited: its look (window, opacity, colormap) in the
+// state, and what the server said of it (range, histogram, start).
+function look(i = selected) {
+  return i === 0 ? state : state.layers[i - 1];
+}
+
+function info(i = selected) {
+  if (i === 0) return hello;
+  const v = hello.volumes[i - 1];
+  const shared = hello.colormaps.filter(([name]) => name !== "start");
+  return {
+    ...v,
+    colormaps: v.start_colours ? [["start", v.start_colours], ...shared] : shared,
+  };
+}
+
+function volumeCount() {
+  return 1 + (hello.volumes ? hello.volumes.length : 0);
+}
+
+// One colour for the colour bar and the swatch: "#rrggbb" or a choice's.
+function coloursOf(i = selected) {
+  const name = look(i).colormap;
+  if (name.startsWith("#")) return [fromHex(name), fromHex(name)];
+  const maps = info(i).colormaps;
+  return (maps.find(([n]) => n === name) || maps[0])[1];
+}
+
+function showVolumes() {
+  const n = volumeCount();
+  $("volumes-box").hidden = n < 2;
+  const list = $("volumes");
+  list.replaceChildren();
+  for (let i = 0; i < n && n > 1; i++) {
+    const row = document.createElement("div");
+    row.className = "volume" + (i === selected ? " selected" : "");
+    row.dataset.index = String(i);
+    const shown = document.createElement("input");
+    shown.type = "checkbox";
+    shown.checked = i === 0 || state.layers[i - 1].visible;
+    shown.disabled = i === 0;
+    shown.title = i === 0 ? "the first volume frames the scene: lower its opacity to see through it" : "show or hide";
+    shown.addEventListener("change", () => {
+      state.layers[i - 1].visible = shown.checked;
+      sendFull();
+    });
+    const swatch = document.createElement("span");
+    swatch.className = "swatch";
+    const colours = coloursOf(i);
+    swatch.style.background = toCss(colours[colours.length - 1]);
+    const name = document.createElement("span");
+    name.className = "name";
+    name.textContent = (i === 0 ? hello.name : hello.volumes[i - 1].name);
+    name.addEventListener("click", () => selectVolume(i));
+    row.append(shown, swatch, name);
+    list.append(row);
+  }
+  const select = $("colormap");
+  select.replaceChildren(...info().colormaps.map(([name]) => {
+    const option = document.createElement("option");
+    option.value = name;
+    option.textContent = name === "start" ? "as started" : name;
+    return option;
+  }), new Option("one colour", "solid"));
+  $("tf-of").textContent = n > 1 ? `· ${selected === 0 ? hello.name : hello.volumes[selected - 1].name}` : "";
+  const labels = selected > 0 && hello.volumes[selected - 1].labels;
+  $("tf-box").classList.toggle("labels", labels);
+  $("tf-labels").hidden = !labels;
+  $("colormap").disabled = labels;
+  $("solid").disabled = labels;
+}
+
+function selectVolume(i) {
+  if (!state || i < 0 || i >= volumeCount()) return;
+  selected = i;
+  showVolumes();
+  showControls();
+  drawTf();
+}
+
+function isLabels() {
+  return selected > 0 && hello.volumes[selected - 1].labels;
+}
+
 function showControls() {
-  $("colormap").value = state.colormap;
+  const colours = look().colormap;
+  $("colormap").value = colours.startsWith("#") ? "solid" : colours;
+  if (colours.startsWith("#")) $("solid").value = colours;
+  if (state.time !== undefined && state.time !== null) {
+    $("time").value = state.time;
+    $("time-value").textContent = String(state.time);
+  }
   $("blend").value = state.blend;
   $("iso").value = state.iso ?? "";
   $("iso").disabled = state.blend !== "iso";
@@ -316,7 +427,13 @@ function onControl(id, event, apply, quality = "full") {
   });
 }
 
-onControl("colormap", "change", (el) => { state.colormap = el.value; });
+onControl("colormap", "change", (el) => {
+  look().colormap = el.value === "solid" ? $("solid").value : el.value;
+  showVolumes();
+});
+onControl("solid", "change", (el) => { look().colormap = el.value; showVolumes(); });
+onControl("time", "input", (el) => { state.time = Number(el.value); }, "draft");
+onControl("time", "change", (el) => { state.time = Number(el.value); });
 onControl("blend", "change", (el) => {
   state.blend = el.value;
   if (state.blend === "iso" && state.iso === null) {
@@ -337,8 +454,8 @@ onControl("background", "input", (el) => { state.background = fromHex(el.value);
 onControl("background", "change", (el) => { state.background = fromHex(el.value); });
 onControl("window-lo", "change", (el) => { setWindow(Number(el.value), windowOf()[1]); });
 onControl("window-hi", "change", (el) => { setWindow(windowOf()[0], Number(el.value)); });
-onControl("window-reset", "click", () => { state.window = null; });
-onControl("opacity-reset", "click", () => { state.opacity = null; });
+onControl("window-reset", "click", () => { look().window = null; });
+onControl("opacity-reset", "click", () => { look().opacity = null; });
 
 $("save").addEventListener("click", () => {
   if (!socket || !state) return;
@@ -352,11 +469,14 @@ $("copy").addEventListener("click", () => {
   if (!$("tf-file").hidden) {
     text = `cat > ${$("tf-name").textContent} <<'EOF'\n${$("tf-json").textContent}\nEOF\n${text}`;
   }
+  for (const pre of document.querySelectorAll("pre.layer-tf")) {
+    text = `cat > ${pre.dataset.name} <<'EOF'\n${pre.textContent}\nEOF\n${text}`;
+  }
   navigator.clipboard?.writeText(text);
 });
 
 function setWindow(lo, hi) {
-  if (Number.isFinite(lo) && Number.isFinite(hi) && lo < hi) state.window = [sig(lo, 6), sig(hi, 6)];
+  if (Number.isFinite(lo) && Number.isFinite(hi) && lo < hi) look().window = [sig(lo, 6), sig(hi, 6)];
 }
 
 // ---------------------------------------------- transfer-function editor
@@ -372,17 +492,18 @@ const BAR = 14;      // the colour bar's height
 const PAD = 6;       // room for the points at the edges
 
 function windowOf() {
-  return state.window ?? hello.start_window;
+  return look().window ?? info().start_window;
 }
 
 function opacityOf() {
-  if (state.opacity) return state.opacity;
-  if (hello.start_opacity) return hello.start_opacity;
-  return [[0, hello.opacity_ramp[0]], [1, hello.opacity_ramp[1]]];
+  const v = info();
+  if (look().opacity) return look().opacity;
+  if (v.start_opacity) return v.start_opacity;
+  return [[0, v.opacity_ramp[0]], [1, v.opacity_ramp[1]]];
 }
 
 function axis() {
-  const [lo, hi] = hello.range;
+  const [lo, hi] = info().range;
   const span = hi > lo ? hi - lo : 1;
   const w = tf.width - 2 * PAD;
   const h = tf.height - BAR - 2 * PAD;
@@ -406,7 +527,7 @@ function drawTf() {
   const { width, height } = tf;
   ctx.clearRect(0, 0, width, height);
   // Histogram, log counts.
-  const counts = hello.histogram;
+  const counts = info().histogram;
   const top = Math.log1p(Math.max(1, ...counts));
   ctx.fillStyle = "#cfcfcb";
   const bw = (width - 2 * PAD) / counts.length;
@@ -416,7 +537,7 @@ function drawTf() {
   });
   // The window and its colours.
   const [lo, hi] = windowOf();
-  const colours = (hello.colormaps.find(([n]) => n === state.colormap) || hello.colormaps[0])[1];
+  const colours = coloursOf();
   const x0 = ax.x(lo);
   const x1 = ax.x(hi);
   const gradient = ctx.createLinearGradient(x0, 0, x1, 0);
@@ -480,7 +601,7 @@ function nearestPoint(ax, x, y) {
 }
 
 tf.addEventListener("pointerdown", (e) => {
-  if (!state || e.button !== 0) return;
+  if (!state || e.button !== 0 || isLabels()) return;
   const ax = axis();
   const [x, y] = canvasXY(e);
   tf.setPointerCapture(e.pointerId);
@@ -502,7 +623,7 @@ tf.addEventListener("pointerdown", (e) => {
     index = points.findIndex(([pt]) => pt > t);
     if (index < 0) index = points.length;
     points.splice(index, 0, [round(t, 4), round(a, 4)]);
-    state.opacity = points;
+    look().opacity = points;
     drawTf();
     sendDraft();
   }
@@ -526,7 +647,7 @@ tf.addEventListener("pointermove", (e) => {
     const tMin = i > 0 ? points[i - 1][0] : 0;
     const tMax = i < points.length - 1 ? points[i + 1][0] : 1;
     points[i] = [round(clamp((ax.v(x) - lo) / (hi - lo), tMin, tMax), 4), round(clamp(ax.a(y), 0, 1), 4)];
-    state.opacity = points;
+    look().opacity = points;
   }
   showControls();
   drawTf();
@@ -543,13 +664,13 @@ tf.addEventListener("pointercancel", endTfDrag);
 
 function removePoint(e) {
   e.preventDefault();
-  if (!state || isProjection()) return;
+  if (!state || isProjection() || isLabels()) return;
   const [x, y] = canvasXY(e);
   const index = nearestPoint(axis(), x, y);
   const points = opacityOf().map((p) => p.slice());
   if (index < 0 || points.length <= 1) return;
   points.splice(index, 1);
-  state.opacity = points;
+  look().opacity = points;
   drawTf();
   sendFull();
 }
@@ -573,9 +694,11 @@ window.volrayView = {
   send: (text) => socket.send(text),
   state: () => structuredClone(state),
   header: () => lastHeader,
+  select: (i) => selectVolume(i),
   saved: () => lastSave,
   setState: (patch, quality = "full") => {
     Object.assign(state, patch);
+    showVolumes();
     showControls();
     drawTf();
     if (quality === "full") sendFull(); else send(quality);

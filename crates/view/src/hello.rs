@@ -2,7 +2,7 @@
 //! the [`Hello`] message, with the value histogram the window and the
 //! opacity editor are drawn over, and the colours of every colour choice.
 
-use crate::protocol::Hello;
+use crate::protocol::{Hello, VolumeHello};
 use crate::state::{START_COLOURS, ViewState, WHITE};
 use volray_core::transfer::colormap;
 use volray_core::{Histogram, RenderSettings, Volume};
@@ -23,24 +23,64 @@ pub struct Start<'a> {
     /// The starting state, and the settings it renders with.
     pub state: &'a ViewState,
     pub settings: &'a RenderSettings,
+    /// A scene's other volumes, in order: each one's name, volume and
+    /// starting settings (whose transfer function its panel starts from).
+    pub others: Vec<(&'a str, &'a Volume, &'a RenderSettings)>,
+    /// The time points served, `[first, end)` (`Hello::time`).
+    pub time: Option<[usize; 2]>,
+}
+
+/// What a panel draws over: the value histogram and its range, and the
+/// transfer function's starting window (its domain, else the range).
+fn histogram_of(volume: &Volume, settings: &RenderSettings) -> (Vec<u64>, [f32; 2], [f64; 2]) {
+    let histogram = Histogram::of(volume, HISTOGRAM_BINS);
+    let range = histogram.as_ref().map_or([0.0, 0.0], |h| [h.min, h.max]);
+    let start_window = (settings.transfer_function.domain)
+        .map_or([f64::from(range[0]), f64::from(range[1])], |(lo, hi)| {
+            [lo, hi]
+        });
+    (
+        histogram.map_or_else(Vec::new, |h| h.counts),
+        range,
+        start_window,
+    )
+}
+
+/// `eval` at [`COLOUR_SAMPLES`] evenly spaced `t`.
+fn sample(eval: &dyn Fn(f32) -> [f32; 3]) -> Vec<[f32; 3]> {
+    (0..COLOUR_SAMPLES)
+        .map(|i| eval(i as f32 / (COLOUR_SAMPLES - 1) as f32))
+        .collect()
+}
+
+/// The starting opacity points of `settings`' transfer function.
+fn start_opacity(settings: &RenderSettings) -> Option<Vec<[f32; 2]>> {
+    (settings.transfer_function.opacity.as_ref())
+        .map(|f| f.points().iter().map(|(t, [a])| [*t, *a]).collect())
+}
+
+/// A scene's volume after the first, as its panel is drawn.
+fn volume_hello(name: &str, volume: &Volume, settings: &RenderSettings) -> VolumeHello {
+    let (histogram, range, start_window) = histogram_of(volume, settings);
+    let (p, q) = settings.opacity_ramp;
+    VolumeHello {
+        name: name.to_string(),
+        dims: volume.dims(),
+        range,
+        histogram,
+        opacity_ramp: [p, q],
+        start_opacity: start_opacity(settings),
+        start_window,
+        start_colours: (settings.transfer_function.color.as_ref()).map(|c| sample(&|t| c.eval(t))),
+        labels: volume.is_labels(),
+    }
 }
 
 impl Start<'_> {
     /// The first message.
     pub fn hello(&self) -> Hello {
-        let histogram = Histogram::of(self.volume, HISTOGRAM_BINS);
-        let range = histogram.as_ref().map_or([0.0, 0.0], |h| [h.min, h.max]);
+        let (histogram, range, start_window) = histogram_of(self.volume, self.settings);
         let tf = &self.settings.transfer_function;
-        let start_window = tf
-            .domain
-            .map_or([f64::from(range[0]), f64::from(range[1])], |(lo, hi)| {
-                [lo, hi]
-            });
-        let sample = |eval: &dyn Fn(f32) -> [f32; 3]| -> Vec<[f32; 3]> {
-            (0..COLOUR_SAMPLES)
-                .map(|i| eval(i as f32 / (COLOUR_SAMPLES - 1) as f32))
-                .collect()
-        };
         let mut colormaps = Vec::new();
         if let Some(colour) = &tf.color {
             colormaps.push((START_COLOURS.to_string(), sample(&|t| colour.eval(t))));
@@ -57,16 +97,17 @@ impl Start<'_> {
             spacing: self.volume.spacing().to_array(),
             range,
             log: self.log,
-            histogram: histogram.map_or_else(Vec::new, |h| h.counts),
+            histogram,
             start: self.state.clone(),
             opacity_ramp: [p, q],
-            start_opacity: tf
-                .opacity
-                .as_ref()
-                .map(|f| f.points().iter().map(|(t, [a])| [*t, *a]).collect()),
+            start_opacity: start_opacity(self.settings),
             start_window,
             colormaps,
             levels: None,
+            volumes: (self.others.iter())
+                .map(|&(name, volume, settings)| volume_hello(name, volume, settings))
+                .collect(),
+            time: self.time,
         }
     }
 }
@@ -80,6 +121,9 @@ mod tests {
     #[test]
     fn hello_describes_the_volume_and_the_start() {
         let volume = Volume::new([2, 2, 2], (0..8).map(|i| i as f32).collect()).unwrap();
+        let labels = Volume::new([2, 2, 2], vec![0.0, 1.0, 1.0, 2.0, 0.0, 0.0, 0.0, 0.0])
+            .unwrap()
+            .as_labels();
         let settings = RenderSettings {
             transfer_function: TransferFunction::from_json(
                 r#"{"domain": [1, 5], "opacity": [[0, 0], [1, 0.5]], "color": [[0, 1, 0, 0], [1, 0, 0, 1]]}"#,
@@ -94,6 +138,8 @@ mod tests {
             log: false,
             state: &state,
             settings: &settings,
+            others: vec![("labels", &labels, &RenderSettings::default())],
+            time: None,
         }
         .hello();
         assert_eq!(hello.range, [0.0, 7.0]);
@@ -109,5 +155,12 @@ mod tests {
             ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
         );
         assert_eq!(hello.opacity_ramp, [0.0, 0.5]);
+        // A scene's second volume: its own histogram and range.
+        let second = &hello.volumes[0];
+        assert_eq!((second.name.as_str(), second.dims), ("labels", [2, 2, 2]));
+        assert_eq!(second.range, [0.0, 2.0]);
+        assert_eq!(second.histogram.iter().sum::<u64>(), 8);
+        assert!(second.labels && second.start_colours.is_none());
+        assert_eq!(second.start_window, [0.0, 2.0]);
     }
 }

@@ -52,13 +52,14 @@ mod token;
 
 pub use hello::Start;
 pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
-pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage};
+pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello};
 pub use pyramid::{CACHED_LEVELS, DRAFT_SHARE, Pyramid, PyramidError};
-pub use reproduce::{Refusal, Reproduce, Reproduction};
+pub use reproduce::{Refusal, Reproduce, Reproduction, SceneLooks};
 pub use server::{ServeError, Server, Stopper};
-pub use session::draft_side;
+pub use session::{ReadTimePoint, TimePoints, draft_side};
 pub use state::{
-    BlendMode, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState, WHITE, ZOOM_RANGE,
+    BlendMode, LayerState, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState, WHITE,
+    ZOOM_RANGE, solid_colour,
 };
 pub use stats::Snapshot;
 pub use token::{NoRandomness, Token};
@@ -93,6 +94,13 @@ pub struct Viewer {
     /// it is the first level the server holds, and the tabs render the
     /// pyramid's levels instead of it.
     pub levels: Option<(Pyramid, usize)>,
+    /// A scene's other volumes (`volray view --channels`, `--overlay`),
+    /// rendered with `volume` in one picture, each as the state's
+    /// `layers` and the caller's [`Reproduce`] say; not with `levels`.
+    pub others: Vec<Arc<Volume>>,
+    /// A time axis served one time point at a time (`volume` is the
+    /// starting one); not with `levels`.
+    pub time: Option<TimePoints>,
 }
 
 /// A viewer that could not start.
@@ -112,14 +120,25 @@ impl Viewer {
     /// Binds `addr` with a new access token; [`Server::run`] serves.
     pub fn bind(self, addr: SocketAddr) -> Result<Server, ViewError> {
         let token = Token::generate()?;
+        if self.levels.is_some() && (!self.others.is_empty() || self.time.is_some()) {
+            return Err(ViewError::Start(Refusal(
+                "a multiscale volume is served alone, without other volumes or a time axis".into(),
+            )));
+        }
         let start = self.reproduce.reproduce(&self.hello.start)?.settings;
-        let (costs, cache_budget) = ledger::Costs::fitting(
+        let (mut costs, cache_budget) = ledger::Costs::fitting(
             &self.volume,
             &start,
             self.non_finite,
             self.cache_budget,
             self.max_memory,
         );
+        // A scene's tab holds a renderer of each volume.
+        for other in &self.others {
+            let more = ledger::Costs::new(other, &start, self.non_finite, cache_budget);
+            costs.volume += more.volume;
+            costs.tab += more.tab;
+        }
         let ledger = ledger::Ledger::new(self.max_memory);
         let (held, levels, volume) = match self.levels {
             None => (
@@ -151,6 +170,8 @@ impl Viewer {
             ledger,
             costs,
             levels,
+            others: self.others,
+            time: self.time.map(Arc::new),
         };
         Ok(Server::bind(addr, token, hello, shared, held)?)
     }

@@ -143,6 +143,9 @@ pub struct FrameHeader {
     pub command: String,
     /// The transfer-function file it names: name and JSON.
     pub tf_file: Option<(String, String)>,
+    /// The files a scene's other volumes' `tf=` options name.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub layer_tf_files: Vec<(String, String)>,
     pub basis: Basis,
     /// The level of a multiscale volume the frame shows (absent for a
     /// volume of one level read whole).
@@ -206,6 +209,33 @@ pub struct Hello {
     /// level the first drafts show).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<Vec<[usize; 3]>>,
+    /// A scene's volumes after the first (whose are the fields above),
+    /// in their order: each one's panel.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub volumes: Vec<VolumeHello>,
+    /// The time points served, `[first, end)` as the file counts its
+    /// frames (`volray view --frames`): the time slider's range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<[usize; 2]>,
+}
+
+/// A scene's volume after the first, as its panel is drawn: the fields
+/// of [`Hello`] for the first volume.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VolumeHello {
+    pub name: String,
+    pub dims: [usize; 3],
+    pub range: [f32; 2],
+    pub histogram: Vec<u64>,
+    pub opacity_ramp: [f32; 2],
+    pub start_opacity: Option<Vec<[f32; 2]>>,
+    pub start_window: [f64; 2],
+    /// Its starting transfer function's colours at evenly spaced `t`
+    /// (the page's "start" choice for this volume), if it has some.
+    pub start_colours: Option<Vec<[f32; 3]>>,
+    /// A label volume: its colours and opacities are its label table's,
+    /// shown or hidden only.
+    pub labels: bool,
 }
 
 /// A message from the server as text.
@@ -309,6 +339,7 @@ mod tests {
             encode_ms: 0.5,
             command: "volray render".into(),
             tf_file: None,
+            layer_tf_files: Vec::new(),
             basis: Basis {
                 reference: [0.0; 3],
                 right: [0.0, 1.0, 0.0],

@@ -9,6 +9,7 @@
 
 use crate::state::ViewState;
 use volray_core::RenderSettings;
+use volray_core::scene::{Look, Mix};
 
 /// A state made ready to render, and how to render it again.
 #[derive(Debug, Clone, PartialEq)]
@@ -20,6 +21,20 @@ pub struct Reproduction {
     /// The transfer-function file the command names, if it names one:
     /// its name and its JSON text.
     pub tf_file: Option<(String, String)>,
+    /// A scene's other volumes (`ViewState::layers`): their looks, the
+    /// files their options name, and the mix; `None` for one volume.
+    pub scene: Option<SceneLooks>,
+}
+
+/// The looks of a scene's volumes after the first (whose look is
+/// [`Reproduction::settings`]'), as the command sets them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneLooks {
+    pub looks: Vec<Look>,
+    pub mix: Mix,
+    /// The transfer-function files the command's `--overlay` options
+    /// name: name and JSON.
+    pub tf_files: Vec<(String, String)>,
 }
 
 /// A state that cannot be rendered, in one line the page shows.

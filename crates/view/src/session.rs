@@ -31,6 +31,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use tokio::sync::mpsc;
 use volray_core::camera::View;
+use volray_core::scene::{Look, Scene, SceneSettings};
 use volray_core::{Image, NonFinite, RenderError, RenderSettings, Renderer, Volume};
 use volray_distributed::streamed::{StreamError, Streamed};
 
@@ -61,6 +62,26 @@ pub struct Shared {
     /// A multiscale volume served level by level (`pyramid.rs`): then
     /// the tabs render its levels, not `volume`.
     pub levels: Option<Arc<Levels>>,
+    /// A scene's other volumes, rendered with `volume` in one picture
+    /// (`volray_core::scene`); their renderers are counted in
+    /// `costs.tab`.
+    pub others: Vec<Arc<Volume>>,
+    /// A time axis served one time point at a time.
+    pub time: Option<Arc<TimePoints>>,
+}
+
+/// Reads one time point of a file as a volume, or says why not in one line.
+pub type ReadTimePoint = dyn Fn(usize) -> Result<Volume, String> + Send + Sync;
+
+/// The time points a viewer serves (`volray view --frames`): `volume` is
+/// the starting one; a tab asked for another reads it, holding it (its
+/// bytes reserved) until it is asked for the next.
+pub struct TimePoints {
+    /// `[first, end)`, as the file counts its frames.
+    pub range: [usize; 2],
+    /// The time point `volume` is.
+    pub start: usize,
+    pub read: Box<ReadTimePoint>,
 }
 
 /// A tab that could not be given a renderer.
@@ -90,6 +111,9 @@ enum FrameError {
     /// A level too large for any piece to fit what the limit has left.
     #[error("{0}")]
     Pieces(String),
+    /// A time point that could not be read, or is not served.
+    #[error("{0}")]
+    Time(String),
 }
 
 impl From<volray_core::camera::CameraError> for FrameError {
@@ -116,6 +140,8 @@ pub fn spawn(
     };
     let held = shared.ledger.reserve("another tab's renderer", tab_bytes)?;
     let levels = shared.levels.clone();
+    let others = shared.others.clone();
+    let time = shared.time.clone();
     let volume = Arc::clone(&shared.volume);
     let reproduce = Arc::clone(&shared.reproduce);
     let pool = Arc::clone(&shared.pool);
@@ -129,23 +155,36 @@ pub fn spawn(
         .spawn(move || {
             // Given back when the renderer is freed, after it.
             let (_open, _held) = (open, held);
+            let renderer = |volume| {
+                Renderer::with_non_finite(volume, non_finite)
+                    .map(|r| r.with_cache_budget(cache_budget))
+            };
             let source = match levels {
-                Some(levels) => Source::Levels(LevelTab {
+                Some(levels) => Ok(Source::Levels(LevelTab {
                     levels,
                     renderers: Vec::new(),
                     streamed: None,
+                })),
+                None if others.is_empty() => renderer(&volume).map(|r| Source::Whole {
+                    renderer: r,
+                    time: None,
                 }),
-                None => match Renderer::with_non_finite(&volume, non_finite) {
-                    Ok(r) => Source::Whole(r.with_cache_budget(cache_budget)),
-                    Err(e) => {
-                        let message = ServerMessage::Error {
-                            seq: None,
-                            message: e.to_string(),
-                        };
-                        let _ = out.blocking_send(Outgoing::Text(message.to_json()));
-                        return;
-                    }
-                },
+                None => (std::iter::once(&volume).chain(&others))
+                    .map(|v| renderer(v))
+                    .collect::<Result<Vec<_>, _>>()
+                    .and_then(|layers| Scene::new(layers).map_err(RenderError::Scene))
+                    .map(Source::Scene),
+            };
+            let source = match source {
+                Ok(source) => source,
+                Err(e) => {
+                    let message = ServerMessage::Error {
+                        seq: None,
+                        message: e.to_string(),
+                    };
+                    let _ = out.blocking_send(Outgoing::Text(message.to_json()));
+                    return;
+                }
             };
             let mut tab = Tab {
                 source,
@@ -154,6 +193,8 @@ pub fn spawn(
                 stats: &stats,
                 ledger: &ledger,
                 costs,
+                time: time.as_deref(),
+                volume: &volume,
             };
             while let Some(request) = mailbox.take() {
                 let frame = tab.frame(&request, mailbox.stop_flag());
@@ -191,11 +232,17 @@ pub fn spawn(
     Ok(())
 }
 
-/// What a tab renders: the volume, or a pyramid's levels.
+/// What a tab renders: the volume (or a time point of it, read for the
+/// tab and held with its bytes reserved), a scene of it and others, or a
+/// pyramid's levels.
 // One per tab, on its thread's stack: the sizes do not matter.
 #[allow(clippy::large_enum_variant)]
 enum Source<'a> {
-    Whole(Renderer<'a>),
+    Whole {
+        renderer: Renderer<'a>,
+        time: Option<(usize, Reservation)>,
+    },
+    Scene(Scene<'a>),
     Levels(LevelTab),
 }
 
@@ -207,6 +254,9 @@ struct Tab<'a> {
     stats: &'a Stats,
     ledger: &'a Arc<Ledger>,
     costs: Costs,
+    time: Option<&'a TimePoints>,
+    /// The starting time point's volume.
+    volume: &'a Volume,
 }
 
 /// A frame rendered, before it is encoded.
@@ -249,7 +299,27 @@ impl Tab<'_> {
             what: &what,
         };
         let drawn = match &mut self.source {
-            Source::Whole(renderer) => cx.whole(renderer, full, &settings)?,
+            Source::Whole { renderer, time } => {
+                if let Some(points) = self.time {
+                    at_time(points, self.volume, request.state.time, renderer, time, &cx)?;
+                }
+                cx.whole(renderer, full, &settings)?
+            }
+            Source::Scene(scene) => {
+                let Some(looks) = &reproduction.scene else {
+                    return Err(FrameError::Time(
+                        "the state has no looks for the scene's other volumes".into(),
+                    ));
+                };
+                let request = SceneSettings {
+                    settings: settings.clone(),
+                    looks: std::iter::once(Look::of(&settings))
+                        .chain(looks.looks.iter().cloned())
+                        .collect(),
+                    mix: looks.mix,
+                };
+                cx.scene(scene, full, &request)?
+            }
             Source::Levels(tab) => tab.draw(&cx, request.quality, full, &settings)?,
         };
         let Drawn {
@@ -276,6 +346,7 @@ impl Tab<'_> {
             encode_ms: rendered.elapsed().as_secs_f64() * 1e3,
             command: reproduction.command,
             tf_file: reproduction.tf_file,
+            layer_tf_files: reproduction.scene.map(|s| s.tf_files).unwrap_or_default(),
             basis,
             level,
         };
@@ -311,6 +382,41 @@ impl Context<'_> {
         let (bytes, message_bytes) = self.costs.frame(renderer.volume(), settings);
         let reserved = self.ledger.reserve(self.what, bytes)?;
         let image = self.render(renderer, settings)?;
+        Ok(Drawn {
+            image,
+            basis,
+            level: None,
+            reserved,
+            message_bytes,
+        })
+    }
+
+    /// A frame of the scene `request` asks for; its basis is that of the
+    /// full-size frame `full`, framing every volume.
+    fn scene(
+        &self,
+        scene: &Scene,
+        full: &RenderSettings,
+        request: &SceneSettings,
+    ) -> Result<Drawn, FrameError> {
+        let mut framed = full.clone();
+        framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
+        let basis = basis(&scene.layers()[0], &framed)?;
+        // Each volume's path and frame, as if each were rendered apart
+        // (the additive mix and the projections are): an upper bound.
+        let mut bytes = 0;
+        let mut message_bytes = 0;
+        for layer in scene.layers() {
+            let (b, m) = self.costs.frame(layer.volume(), &request.settings);
+            bytes += b;
+            message_bytes = m;
+        }
+        let reserved = self.ledger.reserve(self.what, bytes)?;
+        let image = {
+            let _rendering = self.stats.rendering();
+            self.pool
+                .install(|| scene.render_with_progress(request, &|_| {}, Some(self.stop)))?
+        };
         Ok(Drawn {
             image,
             basis,
@@ -497,6 +603,45 @@ impl LevelTab {
     }
 }
 
+/// Makes `renderer` render the time point `asked` (`None`: the starting
+/// one): a time point other than the starting one is read for this tab
+/// and held, its bytes reserved, until another is asked for.
+fn at_time<'a>(
+    points: &TimePoints,
+    start: &'a Volume,
+    asked: Option<usize>,
+    renderer: &mut Renderer<'a>,
+    held: &mut Option<(usize, Reservation)>,
+    cx: &Context,
+) -> Result<(), FrameError> {
+    let asked = asked.unwrap_or(points.start);
+    let [first, end] = points.range;
+    if !(first..end).contains(&asked) {
+        return Err(FrameError::Time(format!(
+            "time point {asked} is not served: {first} to {}",
+            end - 1
+        )));
+    }
+    let now = held.as_ref().map_or(points.start, |(t, _)| *t);
+    if now == asked {
+        return Ok(());
+    }
+    // Back to the starting time point, letting go of the one held before
+    // the next is read.
+    let budget = renderer.cache_budget();
+    let non_finite = cx.costs.non_finite();
+    *renderer = Renderer::with_non_finite(start, non_finite)?.with_cache_budget(budget);
+    *held = None;
+    if asked == points.start {
+        return Ok(());
+    }
+    let reserved = (cx.ledger).reserve(&format!("time point {asked}"), cx.costs.volume)?;
+    let volume = (points.read)(asked).map_err(FrameError::Time)?;
+    *renderer = Renderer::owning(volume, non_finite)?.with_cache_budget(budget);
+    *held = Some((asked, reserved));
+    Ok(())
+}
+
 /// A draft frame's side: half the full frame's, at least one pixel.
 pub fn draft_side(full: usize) -> usize {
     full.div_ceil(2)
@@ -570,6 +715,7 @@ mod tests {
                 settings,
                 command: format!("render --azimuth {}", state.azimuth),
                 tf_file: None,
+                scene: None,
             })
         }
     }
@@ -606,6 +752,8 @@ mod tests {
             ledger: Ledger::new(limit),
             costs,
             levels: None,
+            others: Vec::new(),
+            time: None,
         }
     }
 

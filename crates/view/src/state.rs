@@ -90,8 +90,41 @@ pub struct ViewState {
     pub window: Option<[f64; 2]>,
     /// Opacity points `[t, alpha]`, sorted by `t`; `None`: as at the start.
     pub opacity: Option<Vec<[f32; 2]>>,
-    /// A colour map's name, [`START_COLOURS`] or [`WHITE`].
+    /// A colour map's name, [`START_COLOURS`], [`WHITE`] or one colour
+    /// as `#rrggbb` ([`solid_colour`]).
     pub colormap: String,
+    /// The other volumes of a scene (`volray view --channels`,
+    /// `--overlay`), in their order after the first, whose look is the
+    /// fields above; empty for one volume.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub layers: Vec<LayerState>,
+    /// The time point shown, as the file counts its frames, where the
+    /// viewer serves a time axis (`volray view --frames`); `None`: the
+    /// one the viewer started with.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<usize>,
+}
+
+/// What a scene's volume after the first sets in its panel: shown or
+/// hidden, and its transfer function as [`ViewState`]'s fields for the
+/// first volume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerState {
+    pub visible: bool,
+    pub window: Option<[f64; 2]>,
+    pub opacity: Option<Vec<[f32; 2]>>,
+    pub colormap: String,
+}
+
+/// The colour of a colour choice written `#rrggbb`, components in [0, 1].
+pub fn solid_colour(name: &str) -> Option<[f32; 3]> {
+    let hex = name.strip_prefix('#')?;
+    if hex.len() != 6 || !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
+        return None;
+    }
+    let c = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).map(|v| f32::from(v) / 255.0);
+    Some([c(0).ok()?, c(2).ok()?, c(4).ok()?])
 }
 
 /// A state that cannot be rendered: which field, and why.
@@ -116,6 +149,10 @@ pub enum StateError {
     OpacityPoints { count: usize, max: usize },
     #[error("unknown colour map \"{0}\"")]
     Colormap(String),
+    /// A field of a scene's volume (numbered from 1, the first's being
+    /// the state's own fields).
+    #[error("volume {0}: {1}")]
+    Layer(usize, Box<StateError>),
 }
 
 impl ViewState {
@@ -157,24 +194,39 @@ impl ViewState {
         for c in self.background {
             within("background", f64::from(c), (0.0, 1.0))?;
         }
-        if let Some([lo, hi]) = self.window {
-            let bound = f64::from(f32::MAX);
-            within("window", lo, (-bound, bound))?;
-            within("window", hi, (-bound, bound))?;
-            if lo >= hi {
-                return Err(StateError::EmptyWindow { lo, hi });
-            }
-        }
-        if let Some(points) = &self.opacity {
-            check_opacity(points)?;
-        }
-        let known = [START_COLOURS, WHITE].contains(&self.colormap.as_str())
-            || colormap::NAMES.contains(&self.colormap.as_str());
-        if !known {
-            return Err(StateError::Colormap(self.colormap.clone()));
+        check_look(self.window, self.opacity.as_deref(), &self.colormap)?;
+        for (i, layer) in self.layers.iter().enumerate() {
+            check_look(layer.window, layer.opacity.as_deref(), &layer.colormap)
+                .map_err(|e| StateError::Layer(i + 2, Box::new(e)))?;
         }
         Ok(())
     }
+}
+
+/// A volume's window, opacity points and colours.
+fn check_look(
+    window: Option<[f64; 2]>,
+    opacity: Option<&[[f32; 2]]>,
+    colours: &str,
+) -> Result<(), StateError> {
+    if let Some([lo, hi]) = window {
+        let bound = f64::from(f32::MAX);
+        within("window", lo, (-bound, bound))?;
+        within("window", hi, (-bound, bound))?;
+        if lo >= hi {
+            return Err(StateError::EmptyWindow { lo, hi });
+        }
+    }
+    if let Some(points) = opacity {
+        check_opacity(points)?;
+    }
+    let known = [START_COLOURS, WHITE].contains(&colours)
+        || colormap::NAMES.contains(&colours)
+        || solid_colour(colours).is_some();
+    if !known {
+        return Err(StateError::Colormap(colours.to_string()));
+    }
+    Ok(())
 }
 
 /// `value` finite and in `[lo, hi]`.
@@ -240,6 +292,8 @@ pub(crate) mod tests {
             window: None,
             opacity: None,
             colormap: WHITE.into(),
+            layers: Vec::new(),
+            time: None,
         }
     }
 
@@ -253,6 +307,18 @@ pub(crate) mod tests {
         s.blend = BlendMode::Iso;
         s.iso = Some(0.25);
         assert_eq!(s.check(), Ok(()));
+        let json = serde_json::to_value(&s).unwrap();
+        // One volume's state says nothing of scenes or time.
+        assert!(json.get("layers").is_none() && json.get("time").is_none());
+        s.layers.push(LayerState {
+            visible: false,
+            window: Some([0.0, 1.0]),
+            opacity: Some(vec![[0.0, 0.5]]),
+            colormap: "#FF00ff".into(),
+        });
+        s.time = Some(3);
+        assert_eq!(s.check(), Ok(()));
+        assert_eq!(solid_colour("#FF00ff"), Some([1.0, 0.0, 1.0]));
         let json = serde_json::to_string(&s).unwrap();
         assert_eq!(serde_json::from_str::<ViewState>(&json).unwrap(), s);
     }
@@ -283,6 +349,21 @@ pub(crate) mod tests {
                 "sorted",
             ),
             (|s| s.colormap = "jet".into(), "unknown colour map \"jet\""),
+            (|s| s.colormap = "#ff00f".into(), "unknown colour map"),
+            (
+                |s| {
+                    let mut layer = LayerState {
+                        visible: true,
+                        window: None,
+                        opacity: None,
+                        colormap: "#00ff00".into(),
+                    };
+                    s.layers.push(layer.clone());
+                    layer.window = Some([1.0, 0.0]);
+                    s.layers.push(layer);
+                },
+                "volume 3: the value window [1, 0] must have lo < hi",
+            ),
         ];
         for (spoil, expect) in bad {
             let mut s = sample();

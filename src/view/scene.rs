@@ -1,0 +1,259 @@
+//! `volray view` of several volumes in one picture (`--channels`,
+//! `--overlay`) or of a file's time points (`--frames`).
+//!
+//! The volumes are read as `volray render` reads them (`crate::scene`),
+//! each whole; the page shows a panel per volume (shown or hidden, its
+//! colours, window and opacity) and the server renders them as one
+//! `volray_core::Scene`. The command each frame prints writes every
+//! volume after the first as an `--overlay` with its look in full
+//! (`range=`, `tf=view-tf-N.json`, `hidden`), the channels of INPUT
+//! included (`frame=K` or `channel=K`), with `--mix`: the frame the page
+//! shows is that command's.
+//!
+//! A time axis (`--frames A:B`) is served one time point at a time: the
+//! first is read before the server starts (its histogram and transfer
+//! function serve every time point, as a series' do), and each tab reads
+//! the one its slider asks for, as `--frame T`.
+
+use super::reproduce::{CliReproduce, OtherWords, SceneWords};
+use super::{MAX_TABS, serve, start_state};
+use crate::error::CliError;
+use crate::flags::{MixMode, ViewerArgs};
+use crate::input;
+use crate::scene::{Layer, LayerSource, overlay_specs, read_layers};
+use crate::session::{load, renderer_for, thread_pool};
+use crate::settings::{read_tf_file, settings_with_tf_text};
+use crate::streamed::Plan;
+use std::sync::Arc;
+use volray_core::scene::Mix;
+use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
+
+pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
+    refuse_unsupported(args)?;
+    let look = &args.view.look;
+    let tf_text = look.tf_file().map(read_tf_file).transpose()?;
+    let settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
+    let spec = args.input.input.as_deref().unwrap_or(input::DEMO);
+    let input_args = match crate::streamed::plan(&args.input, &args.view, &settings)? {
+        Plan::Streamed(streamed) => {
+            return Err(CliError::input(format!(
+                "{}: too large to read whole under --max-memory (it would be rendered in pieces from its chunks), which the viewer's --channels, --overlay and --frames do not support: give a coarser --level or raise --max-memory",
+                streamed.name
+            )));
+        }
+        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
+    };
+    let overlays = overlay_specs(&args.scene)?;
+
+    // A time axis: its first time point read now, the others as asked.
+    let mut time = None;
+    let mut first_args = input_args.clone();
+    if let Some(frames) = args.scene.frames {
+        first_args.frame = Some(frames.start);
+        let first = load(&first_args, look.log)?;
+        let count = first.file.as_ref().map_or(1, |(_, info)| info.frames);
+        let end = frames.end.unwrap_or(count);
+        if count < 2 || frames.start >= count || end > count {
+            return Err(CliError::input(format!(
+                "--frames {}:{end}: {spec} holds {count} time point(s), numbered from 0",
+                frames.start
+            )));
+        }
+        drop(first);
+        let (read_args, log, labels) = (input_args.clone(), look.log, look.labels);
+        time = Some(TimePoints {
+            range: [frames.start, end],
+            start: frames.start,
+            read: Box::new(move |t| {
+                let one = crate::flags::InputArgs {
+                    frame: Some(t),
+                    ..read_args.clone()
+                };
+                let mut input = load(&one, log).map_err(|e| e.message)?;
+                input.volume.set_labels(labels);
+                Ok(input.volume)
+            }),
+        });
+    }
+    let layers = read_layers(&first_args, &args.view, &args.scene, &overlays, &settings)?;
+    for layer in &layers {
+        // The checks `render` makes: memory, non-finite values, the view.
+        let renderer = renderer_for(&args.view, &layer.settings, &layer.input)?;
+        renderer
+            .prepare(&layer.settings)
+            .map_err(|e| crate::session::render_failure(&args.view, &layer.input.name, e))?;
+    }
+    let first = &layers[0];
+    let settings = first.settings.clone();
+    let cache_budget = crate::memory::cache_budget(&args.view, &settings, &first.input)?;
+    let non_finite = first.input.non_finite(args.view.sampling.nonfinite.into());
+
+    let mut state = start_state(args, &settings);
+    state.time = time.as_ref().map(|t| t.start);
+    state.layers = (layers[1..].iter())
+        .map(|l| LayerState {
+            visible: l.look().visible,
+            window: None,
+            opacity: None,
+            colormap: if l.settings.transfer_function.color.is_some() {
+                START_COLOURS.to_string()
+            } else {
+                WHITE.to_string()
+            },
+        })
+        .collect();
+    state.check().map_err(|e| {
+        CliError::input(format!(
+            "the starting view is beyond the viewer's bounds: {e}"
+        ))
+    })?;
+    let volume = &first.input.volume;
+    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
+    // The first volume's transfer function, as its command names it.
+    let named = settings.transfer_function.clone();
+    let mut reproduce = CliReproduce::new(args, named, grid, non_finite, first.input.max_memory);
+    if time.is_some() {
+        reproduce = reproduce.with_time();
+    }
+    if args.scene.is_scene() {
+        reproduce = reproduce.with_scene(scene_words(args, spec, &layers));
+    }
+    reproduce
+        .reproduce(&state)
+        .map_err(|e| CliError::input(format!("{}: {e}", first.input.name)))?;
+    let others: Vec<_> = (layers[1..].iter())
+        .map(|l| (l.input.name.as_str(), &l.input.volume, &l.settings))
+        .collect();
+    let hello = Start {
+        name: &first.input.name,
+        volume,
+        log: look.log,
+        state: &state,
+        settings: &settings,
+        others,
+        time: time.as_ref().map(|t| t.range),
+    }
+    .hello();
+    let pool = thread_pool(args.view.threads)?;
+    let max_memory = u128::from(first.input.max_memory);
+    let mut volumes = layers.into_iter().map(|l| Arc::new(l.input.volume));
+    let viewer = Viewer {
+        volume: volumes.next().expect("the first volume"),
+        non_finite,
+        cache_budget,
+        max_memory,
+        hello,
+        reproduce: Arc::new(reproduce),
+        pool: Arc::new(pool),
+        max_sessions: MAX_TABS,
+        levels: None,
+        others: volumes.collect(),
+        time,
+    };
+    serve(args, viewer)
+}
+
+/// What `render` refuses of several volumes in one picture, and what
+/// the viewer does not serve with them.
+fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
+    let scene = &args.scene;
+    let look = &args.view.look;
+    let flag = match (&scene.channels, scene.overlay.is_empty()) {
+        (Some(_), _) => "--channels",
+        (None, false) => "--overlay",
+        (None, true) => "--frames",
+    };
+    if scene.is_scene() && scene.frames.is_some() {
+        return Err(CliError::input(format!(
+            "{flag} and --frames cannot be combined: give one of them"
+        )));
+    }
+    if scene.frames.is_some() && (args.input.frame.is_some() || args.input.channel.is_some()) {
+        return Err(CliError::input(
+            "--frames serves a range of time points; --frame picks one: give one of them",
+        ));
+    }
+    if scene.channels.is_some() {
+        for (given, other) in [
+            (look.labels, "--labels"),
+            (look.preset.is_some(), "--preset"),
+            (look.colormap.is_some(), "--colormap"),
+        ] {
+            if given {
+                return Err(CliError::input(format!(
+                    "--channels colours each channel (--channel-colors): {other} does not apply to channels (give it to an --overlay instead)"
+                )));
+            }
+        }
+    }
+    if scene.is_scene() && look.log {
+        return Err(CliError::input(format!(
+            "{flag} with --log: the viewer writes each volume as an --overlay, which is not taken to log10: render the picture with volray render instead"
+        )));
+    }
+    if scene.is_scene() && (args.input.dims.is_some() || args.input.dtype.is_some()) {
+        return Err(CliError::input(format!(
+            "{flag}: a raw file (--dims, --dtype) holds one volume, and an overlay names a file with a header"
+        )));
+    }
+    Ok(())
+}
+
+/// The scene's volumes after the first as the commands write them.
+fn scene_words(args: &ViewerArgs, spec: &str, layers: &[Layer]) -> SceneWords {
+    let channel = |index: usize, zarr: bool| {
+        let flag = if zarr { "channel" } else { "frame" };
+        (flag, index)
+    };
+    let first = match layers[0].source {
+        LayerSource::Channel { index, zarr } => {
+            let (flag, index) = channel(index, zarr);
+            vec![format!("--{flag}"), index.to_string()]
+        }
+        _ => Vec::new(),
+    };
+    let others = (layers[1..].iter())
+        .map(|layer| {
+            let (file, fixed, labels) = match &layer.source {
+                LayerSource::Channel { index, zarr } => {
+                    let (flag, index) = channel(*index, *zarr);
+                    (spec.to_string(), vec![format!("{flag}={index}")], false)
+                }
+                LayerSource::Overlay(o) => {
+                    let mut fixed = Vec::new();
+                    if let Some(f) = o.frame {
+                        fixed.push(format!("frame={f}"));
+                    }
+                    if let Some(c) = o.channel {
+                        fixed.push(format!("channel={c}"));
+                    }
+                    if o.labels {
+                        fixed.push("labels".to_string());
+                    }
+                    (o.file.clone(), fixed, o.labels)
+                }
+                LayerSource::Input => unreachable!("only the first volume is INPUT"),
+            };
+            let mut start = layer.settings.transfer_function.clone();
+            if start.domain.is_none() {
+                let (lo, hi) = layer.input.volume.value_range().unwrap_or((0.0, 1.0));
+                start.domain = Some((f64::from(lo), f64::from(hi)));
+            }
+            OtherWords {
+                file,
+                fixed,
+                start,
+                ramp: layer.settings.opacity_ramp,
+                labels,
+                start_look: layer.look(),
+            }
+        })
+        .collect();
+    let mix = match args.scene.mix {
+        Some(MixMode::Composite) => Mix::Composite,
+        Some(MixMode::Additive) => Mix::Additive,
+        None if args.scene.channels.is_some() => Mix::Additive,
+        None => Mix::Composite,
+    };
+    SceneWords { first, others, mix }
+}
