@@ -182,10 +182,12 @@ pub fn read_layers(
                 .transpose()
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let mut budget = Budget::new(input_args.max_memory);
     let mut layers = match &scene.channels {
-        Some(which) => channels(input_args, view, scene, which, settings)?,
+        Some(which) => channels(input_args, view, scene, which, settings, &mut budget)?,
         None => {
             let mut input = load(input_args, view.look.log)?;
+            budget.add(&input.volume);
             let mut settings = settings.clone();
             crate::settings::file_window(
                 &view.look,
@@ -206,7 +208,10 @@ pub fn read_layers(
         }
     };
     for (overlay, tf_text) in overlays.iter().zip(&tf_texts) {
-        let layer = overlay.load(view, input_args.max_memory, tf_text.as_deref())?;
+        let mut layer = (overlay.load(view, budget.left(), tf_text.as_deref()))
+            .map_err(|e| budget.explain(e))?;
+        budget.add(&layer.input.volume);
+        layer.input.max_memory = budget.limit;
         let first = &layers[0].input;
         if !overlaps(&layer.input.volume, &first.volume) {
             let ((a, b), (c, d)) = (layer.input.volume.bounds(), first.volume.bounds());
@@ -218,6 +223,55 @@ pub fn read_layers(
         layers.push(layer);
     }
     Ok(layers)
+}
+
+/// `--max-memory` shared by the volumes of one picture: each is read
+/// under what the ones read before it left (a mapped volume's pages are
+/// the system's to drop, and hold nothing). Each volume's renderer is
+/// then checked against the whole limit on its own (`renderer_for`), not
+/// against what the others' hold: a gap, for volumes whose renderers'
+/// structures (brick caches, a cleaned copy) are large beside them.
+pub struct Budget {
+    limit: u64,
+    held: u64,
+}
+
+impl Budget {
+    fn new(max_memory: Option<u64>) -> Self {
+        Budget {
+            limit: max_memory.unwrap_or_else(volray_io::default_max_memory),
+            held: 0,
+        }
+    }
+
+    fn add(&mut self, volume: &volray_core::Volume) {
+        if !volume.samples().is_external() {
+            let [x, y, z] = volume.dims();
+            let bytes = (x * y * z * volume.sample_type().bytes()) as u64;
+            self.held = self.held.saturating_add(bytes);
+        }
+    }
+
+    /// The limit the next volume is read under.
+    fn left(&self) -> Option<u64> {
+        Some(self.limit.saturating_sub(self.held))
+    }
+
+    /// A refusal of the next volume, saying what the others hold.
+    fn explain(&self, e: CliError) -> CliError {
+        if self.held == 0 {
+            return e;
+        }
+        CliError {
+            message: format!(
+                "{} (the volumes read before it hold {} of --max-memory {})",
+                e.message,
+                volray_io::format_bytes(u128::from(self.held)),
+                volray_io::format_bytes(u128::from(self.limit))
+            ),
+            ..e
+        }
+    }
 }
 
 /// The refusals of what several volumes in one picture do not take.
@@ -272,6 +326,7 @@ fn channels(
     scene: &SceneArgs,
     which: &Channels,
     settings: &RenderSettings,
+    budget: &mut Budget,
 ) -> Result<Vec<Layer>, CliError> {
     let spec = input_args.input.as_deref().unwrap_or(input::DEMO);
     if volray_data::is_source_spec(spec) {
@@ -281,6 +336,7 @@ fn channels(
     }
     let log = view.look.log;
     let first = load(input_args, log)?;
+    budget.add(&first.volume);
     let Some((format, info)) = &first.file else {
         return Err(CliError::input(format!(
             "--channels: {spec} is not a file holding several channels"
@@ -313,7 +369,11 @@ fn channels(
                 } else {
                     one.frame = Some(index);
                 }
-                load(&one, log)?
+                one.max_memory = budget.left();
+                let mut input = load(&one, log).map_err(|e| budget.explain(e))?;
+                budget.add(&input.volume);
+                input.max_memory = budget.limit;
+                input
             }
         };
         input.name = format!("{spec} (channel {index})");

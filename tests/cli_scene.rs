@@ -218,6 +218,28 @@ fn a_hidden_overlay_frames_but_is_not_drawn_and_overlays_go_beside_a_tf_file() {
     assert!(text.contains("hidden takes no value"), "{text}");
 }
 
+#[test]
+fn the_volumes_of_one_picture_share_max_memory() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    // Compressed, so read whole (an uncompressed .nii is mapped, and its
+    // pages are the system's): 54 KiB a channel.
+    let plain = two_channels(dir.path());
+    let gz = dir.path().join("two.nii.gz");
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    e.write_all(&std::fs::read(&plain).unwrap()).unwrap();
+    std::fs::write(&gz, e.finish().unwrap()).unwrap();
+    let gz = gz.to_str().unwrap();
+    let args = |m: &'static str| [gz, "--channels", "all", "--max-memory", m];
+    // Each fits 100000 bytes alone, both do not.
+    render(dir.path(), "both.png", &args("150000"));
+    let text = refused(dir.path(), &args("100000"));
+    assert!(
+        text.contains("the volumes read before it hold 54 KiB of --max-memory 98 KiB"),
+        "{text}"
+    );
+}
+
 /// An OME-Zarr image (v2, uncompressed) of `channels` along its `c` axis.
 fn ome_zarr(dir: &Path, name: &str, channels: &[Vec<f32>]) -> String {
     let root = dir.join(name);
