@@ -456,3 +456,34 @@ fn bad_channels_and_overlays_are_refused_in_one_line_naming_the_option() {
     let e = refused(d, &[&file, "--frames", "all", "--turntable", "2"]);
     assert!(e.contains("--frames") && e.contains("--turntable"), "{e}");
 }
+
+#[test]
+fn the_viewer_refuses_what_it_cannot_serve_with_several_volumes_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = two_channels(dir.path());
+    for (args, expect) in [
+        (
+            vec!["--channels", "all", "--frames", "all"],
+            "--channels and --frames cannot be combined",
+        ),
+        (vec!["--channels", "all", "--log"], "--channels with --log"),
+        (vec!["--frames", "0:5"], "holds 2 time point(s)"),
+        (vec!["--frames", "all", "--frame", "1"], "--frame picks one"),
+        (
+            vec!["--channels", "all", "--preset", "ct-bone"],
+            "--preset does not apply",
+        ),
+    ] {
+        let all = [
+            &["view", file.as_str(), "--no-browser", "--port", "0"][..],
+            &args,
+        ]
+        .concat();
+        let run = volray(&all);
+        let text = stderr(&run);
+        assert_eq!(run.status.code(), Some(1), "{all:?}: {text}");
+        assert_eq!(text.lines().count(), 1, "one line: {text}");
+        assert!(text.contains(expect), "{all:?}: {text}");
+        assert!(stdout(&run).is_empty(), "no URL is printed: {all:?}");
+    }
+}
