@@ -4,9 +4,11 @@
 //! The page sends text messages, each a JSON object:
 //!
 //! - `{"type": "view", "seq": N, "quality": "draft"|"full", "state": {...}}`:
-//!   render this [`ViewState`]; `draft` while the user drags (half size,
-//!   JPEG), `full` once the interaction stops (full size, PNG). Only the
-//!   latest waiting request is rendered.
+//!   render this [`ViewState`]; `draft` while the user drags (JPEG, at
+//!   `"draft_scale"` of the full size, half by default: the page picks it
+//!   from the last drafts' times to hold its frame rate), `full` once the
+//!   interaction stops (full size, PNG). Only the latest waiting request
+//!   is rendered.
 //! - `{"type": "save", "seq": N, "state": {...}}`: render the state at
 //!   its size, as a PNG to download.
 //!
@@ -43,6 +45,8 @@ pub enum ClientMessage {
         seq: u64,
         quality: Quality,
         state: ViewState,
+        #[serde(default)]
+        draft_scale: Option<f64>,
     },
     Save {
         seq: u64,
@@ -57,7 +61,16 @@ pub struct Request {
     pub seq: u64,
     pub quality: Quality,
     pub state: ViewState,
+    /// A draft's size over the full size's, per side, in
+    /// [`DRAFT_SCALE_RANGE`].
+    pub draft_scale: f64,
 }
+
+/// The smallest and largest scale of a draft, per side.
+pub const DRAFT_SCALE_RANGE: (f64, f64) = (1.0 / 16.0, 1.0);
+
+/// A draft's scale when the page names none: half size.
+pub const DRAFT_SCALE: f64 = 0.5;
 
 /// A message refused: not JSON of a known shape, or out of bounds.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -68,6 +81,8 @@ pub enum MessageError {
     Malformed(String),
     #[error("\"quality\": \"save\" is asked for with a save message")]
     SaveQuality,
+    #[error("draft_scale {0} is outside 1/16 to 1")]
+    DraftScale(f64),
     #[error("{0}")]
     State(#[from] StateError),
 }
@@ -98,15 +113,25 @@ pub fn parse(text: &str) -> Result<Request, MessageError> {
             seq,
             quality,
             state,
-        } => Request {
-            seq,
-            quality,
-            state,
-        },
+            draft_scale,
+        } => {
+            let draft_scale = draft_scale.unwrap_or(DRAFT_SCALE);
+            let (lo, hi) = DRAFT_SCALE_RANGE;
+            if !(lo..=hi).contains(&draft_scale) {
+                return Err(MessageError::DraftScale(draft_scale));
+            }
+            Request {
+                seq,
+                quality,
+                state,
+                draft_scale,
+            }
+        }
         ClientMessage::Save { seq, state } => Request {
             seq,
             quality: Quality::Save,
             state,
+            draft_scale: DRAFT_SCALE,
         },
     };
     request.state.check()?;
@@ -276,6 +301,12 @@ mod tests {
         let save = serde_json::json!({"type": "save", "seq": 9, "state": sample()});
         let r = parse(&save.to_string()).unwrap();
         assert_eq!((r.seq, r.quality), (9, Quality::Save));
+        // A draft's scale: half by default, or as the page picks it.
+        assert_eq!(parse(&view("draft")).unwrap().draft_scale, DRAFT_SCALE);
+        let scaled = serde_json::json!({
+            "type": "view", "seq": 5, "quality": "draft", "state": sample(), "draft_scale": 0.25
+        });
+        assert_eq!(parse(&scaled.to_string()).unwrap().draft_scale, 0.25);
     }
 
     #[test]
@@ -318,6 +349,16 @@ mod tests {
                 "malformed",
             ),
             (&"x".repeat(MAX_MESSAGE_BYTES + 1), "too long"),
+            (
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": sample(), "draft_scale": 0.01})
+                    .to_string(),
+                "draft_scale 0.01 is outside 1/16 to 1",
+            ),
+            (
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": sample(), "draft_scale": 2})
+                    .to_string(),
+                "draft_scale 2 is outside",
+            ),
         ];
         for (text, expect) in cases {
             let err = parse(text).unwrap_err().to_string();

@@ -21,7 +21,8 @@ use crate::encode::{self, DRAFT_QUALITY};
 use crate::ledger::{Costs, Ledger, Overdrawn, Reservation};
 use crate::mailbox::Mailbox;
 use crate::protocol::{
-    Basis, FrameHeader, LevelShown, Quality, Request, ServerMessage, frame_message,
+    Basis, DRAFT_SCALE_RANGE, FrameHeader, LevelShown, Quality, Request, ServerMessage,
+    frame_message,
 };
 use crate::pyramid::{LevelError, Levels};
 use crate::reproduce::{Refusal, Reproduce};
@@ -195,8 +196,21 @@ pub fn spawn(
                 costs,
                 time: time.as_deref(),
                 volume: &volume,
+                last_still_ms: None,
             };
             while let Some(request) = mailbox.take() {
+                // A still slow to render: a quick frame of it first.
+                if let Some(quick) = tab.quick(&request)
+                    && let Ok((message, reservation)) = tab.frame(&quick, mailbox.stop_flag())
+                {
+                    stats.frame_rendered();
+                    if out
+                        .blocking_send(Outgoing::Frame(message, reservation))
+                        .is_err()
+                    {
+                        break;
+                    }
+                }
                 let frame = tab.frame(&request, mailbox.stop_flag());
                 mailbox.finished();
                 let outgoing = match frame {
@@ -257,7 +271,16 @@ struct Tab<'a> {
     time: Option<&'a TimePoints>,
     /// The starting time point's volume.
     volume: &'a Volume,
+    /// Milliseconds the last full-size frame took to render.
+    last_still_ms: Option<f64>,
 }
+
+/// A still that took longer than this to render is preceded by a quick
+/// frame ([`Tab::quick`]) the next time.
+pub const SLOW_STILL_MS: f64 = 300.0;
+
+/// What a quick frame aims to take.
+const QUICK_MS: f64 = 80.0;
 
 /// A frame rendered, before it is encoded.
 struct Drawn {
@@ -270,6 +293,13 @@ struct Drawn {
 }
 
 impl Tab<'_> {
+    /// A quick draft of the still `request` asks for, where the last still
+    /// took longer than [`SLOW_STILL_MS`]: its scale aims at [`QUICK_MS`]
+    /// (the time goes with the pixels, the square of the scale).
+    fn quick(&self, request: &Request) -> Option<Request> {
+        quick_request(self.last_still_ms, request)
+    }
+
     /// The frame `request` asks for, as a binary message, and the bytes
     /// reserved for the message until it is sent; stopped when `stop` is
     /// set.
@@ -282,8 +312,8 @@ impl Tab<'_> {
         let full = &reproduction.settings;
         let settings = match request.quality {
             Quality::Draft => RenderSettings {
-                width: draft_side(full.width),
-                height: draft_side(full.height),
+                width: scaled(full.width, request.draft_scale),
+                height: scaled(full.height, request.draft_scale),
                 ..full.clone()
             },
             Quality::Full | Quality::Save => full.clone(),
@@ -330,6 +360,9 @@ impl Tab<'_> {
             message_bytes,
         } = drawn;
         let rendered = Instant::now();
+        if request.quality == Quality::Full {
+            self.last_still_ms = Some((rendered - start).as_secs_f64() * 1e3);
+        }
         let mut rgb = Vec::new();
         let (mime, bytes) = match request.quality {
             Quality::Draft => ("image/jpeg", encode::jpeg(&image, DRAFT_QUALITY, &mut rgb)?),
@@ -642,6 +675,25 @@ fn at_time<'a>(
     Ok(())
 }
 
+/// [`Tab::quick`], for a tab whose last still took `last_still_ms`.
+fn quick_request(last_still_ms: Option<f64>, request: &Request) -> Option<Request> {
+    let last = last_still_ms?;
+    if request.quality != Quality::Full || last <= SLOW_STILL_MS {
+        return None;
+    }
+    let (lo, hi) = DRAFT_SCALE_RANGE;
+    Some(Request {
+        quality: Quality::Draft,
+        draft_scale: (QUICK_MS / last).sqrt().clamp(lo, hi),
+        ..request.clone()
+    })
+}
+
+/// A side of `full` pixels at `scale`, at least one pixel.
+fn scaled(full: usize, scale: f64) -> usize {
+    ((full as f64 * scale).round() as usize).max(1)
+}
+
 /// A draft frame's side: half the full frame's, at least one pixel.
 pub fn draft_side(full: usize) -> usize {
     full.div_ceil(2)
@@ -765,6 +817,7 @@ mod tests {
             seq,
             quality,
             state,
+            draft_scale: crate::protocol::DRAFT_SCALE,
         }
     }
 
@@ -795,6 +848,7 @@ mod tests {
                     seq,
                     quality,
                     state,
+                    draft_scale: crate::protocol::DRAFT_SCALE,
                 },
             );
         }
@@ -825,6 +879,7 @@ mod tests {
                 seq: 1000,
                 quality: Quality::Draft,
                 state: state.clone(),
+                draft_scale: crate::protocol::DRAFT_SCALE,
             },
         );
         let Some(Outgoing::Frame(message, _)) = rx.blocking_recv() else {
@@ -842,6 +897,7 @@ mod tests {
                 seq: 1001,
                 quality: Quality::Full,
                 state,
+                draft_scale: crate::protocol::DRAFT_SCALE,
             },
         );
         let Some(Outgoing::Text(text)) = rx.blocking_recv() else {
@@ -1250,5 +1306,27 @@ mod tests {
         assert_eq!(b.up, [0.0, 0.0, 1.0]);
         assert!((b.pixels_per_unit - 50.0).abs() < 1e-9);
         assert!(DVec3::from(b.reference).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_slow_still_is_preceded_by_a_quick_draft_scaled_to_its_time() {
+        let full = request(7, Quality::Full, 480, 0.0);
+        assert_eq!(quick_request(None, &full), None, "no still yet");
+        assert_eq!(quick_request(Some(SLOW_STILL_MS), &full), None, "not slow");
+        let draft = request(7, Quality::Draft, 480, 0.0);
+        assert_eq!(
+            quick_request(Some(2000.0), &draft),
+            None,
+            "drafts are quick"
+        );
+        // 4x QUICK_MS: half the side, a quarter of the pixels and time.
+        let quick = quick_request(Some(4.0 * QUICK_MS), &full).unwrap();
+        assert_eq!((quick.seq, quick.quality), (7, Quality::Draft));
+        assert!((quick.draft_scale - 0.5).abs() < 1e-12);
+        assert_eq!(quick.state, full.state);
+        // Never below 1/16 a side.
+        let slowest = quick_request(Some(1e9), &full).unwrap();
+        assert_eq!(slowest.draft_scale, DRAFT_SCALE_RANGE.0);
+        assert_eq!((scaled(480, 1.0 / 16.0), scaled(1, 1.0 / 16.0)), (30, 1));
     }
 }
