@@ -59,7 +59,9 @@ pub fn cache_budget(
         let [nx, ny, nz] = volume.dims();
         let what = format!(
             "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels",
-            input.name, view.camera.size.0, view.camera.size.1
+            input.name,
+            view.camera.size().0,
+            view.camera.size().1
         );
         // The oracle is dense: say so where the default path would fit.
         let fast = RenderSettings {

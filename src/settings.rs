@@ -64,7 +64,7 @@ pub fn options(view: &ViewArgs, tf_text: Option<&str>) -> Result<Options, CliErr
 /// The camera flags as options.
 pub fn camera(cam: &CameraArgs) -> CameraOptions {
     CameraOptions {
-        size: cam.size,
+        size: cam.size(),
         view: cam.view,
         look_at: cam.look_at,
         up: cam.up,

@@ -97,6 +97,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     if let Some(p) = &pyramid {
         p.describe(&mut hello);
     }
+    hello.fit = args.view.camera.size.is_none();
     let pool = thread_pool(args.view.threads)?;
     let labels = input.volume.is_labels();
     let viewer = Viewer {

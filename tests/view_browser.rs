@@ -683,3 +683,98 @@ async fn a_time_axis_has_a_slider_whose_time_point_is_the_commands_frame() {
     assert!(b.text("error").await.contains("time point 3 is not served"));
     b.close().await;
 }
+
+#[tokio::test(flavor = "current_thread")]
+async fn without_a_size_the_frame_fills_the_window_and_follows_it() {
+    // No --size: the page sizes the frame to its viewport.
+    let Some((_viewer, b)) = open(&["blobs:32"]).await else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let fits = r#"
+        const v = document.getElementById('viewport').getBoundingClientRect();
+        const f = document.getElementById('frame').getBoundingClientRect();
+        const s = window.volrayView.state();
+        const k = window.devicePixelRatio || 1;
+        return [s.width, s.height, Math.round(v.width * k), Math.round(v.height * k),
+                f.width * f.height, (window.innerWidth - (document.body.classList.contains('panel-hidden') ? 0 : document.getElementById('panel').offsetWidth))
+                  * (window.innerHeight - document.querySelector('header').offsetHeight)];
+    "#;
+    let sizes = |v: serde_json::Value| -> Vec<f64> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let first = sizes(b.eval(fits).await);
+    assert_eq!((first[0], first[1]), (first[2], first[3]), "{first:?}");
+    assert!(first[4] >= 0.85 * first[5], "the frame's area: {first:?}");
+    let still = picture(&b.frame_bytes().await, dir.path(), "still.png");
+    assert_eq!(
+        (still.width as f64, still.height as f64),
+        (first[0], first[1])
+    );
+    let command = b.text("command").await;
+    let size = format!("--size {}x{}", first[0], first[1]);
+    assert!(command.contains(&size), "{command}");
+    assert_eq!(
+        run_shown(&b, dir.path()).await,
+        still,
+        "the command's frame"
+    );
+
+    // Hiding the controls gives the frame their room.
+    b.client
+        .find(fantoccini::Locator::Id("panel-toggle"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    b.wait_for(&format!(
+        "window.volrayView.state().width > {} && document.body.dataset.state === 'still'",
+        first[0] + 300.0
+    ))
+    .await;
+    let wide = sizes(b.eval(fits).await);
+    assert_eq!((wide[0], wide[1]), (wide[2], wide[3]), "{wide:?}");
+    assert!(wide[4] >= 0.85 * wide[5], "{wide:?}");
+
+    // A smaller window: the frame follows.
+    b.client.set_window_size(800, 600).await.unwrap();
+    b.wait_for(&format!(
+        "window.volrayView.state().width < {} && document.body.dataset.state === 'still'",
+        wide[0] - 100.0
+    ))
+    .await;
+    let small = sizes(b.eval(fits).await);
+    assert_eq!((small[0], small[1]), (small[2], small[3]), "{small:?}");
+
+    // The views from each side: buttons and keys.
+    b.client
+        .find(fantoccini::Locator::Css("#toolbar [data-view='+z']"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(
+        command.contains("--azimuth 0") && command.contains("--elevation 90"),
+        "{command}"
+    );
+    let above = picture(&b.frame_bytes().await, dir.path(), "above.png");
+    b.eval("document.dispatchEvent(new KeyboardEvent('keydown', {key: '3'})); return 0;")
+        .await;
+    b.wait_for(
+        "window.volrayView.state().azimuth === 90 && window.volrayView.state().elevation === 0",
+    )
+    .await;
+    b.wait_still().await;
+    let side = picture(&b.frame_bytes().await, dir.path(), "side.png");
+    assert_ne!(side, above, "another view");
+    assert_eq!(run_shown(&b, dir.path()).await, side, "the command's frame");
+    b.close().await;
+}

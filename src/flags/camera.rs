@@ -14,12 +14,23 @@ use super::parse::{
 };
 use clap::Args;
 
+/// The image size without `--size`.
+pub const DEFAULT_SIZE: (usize, usize) = (480, 480);
+
+impl CameraArgs {
+    /// `--size`, else [`DEFAULT_SIZE`].
+    pub fn size(&self) -> (usize, usize) {
+        self.size.unwrap_or(DEFAULT_SIZE)
+    }
+}
+
 /// What the picture frames, and at what resolution.
 #[derive(Debug, Args)]
 pub struct CameraArgs {
-    /// Image size: W (square) or WxH, in pixels.
-    #[arg(long, value_name = "W|WxH", default_value = "480", value_parser = parse_size, allow_hyphen_values = true)]
-    pub size: (usize, usize),
+    /// Image size: W (square) or WxH, in pixels [default: 480; `volray
+    /// view`: the page's window].
+    #[arg(long, value_name = "W|WxH", value_parser = parse_size, allow_hyphen_values = true)]
+    pub size: Option<(usize, usize)>,
 
     /// View point, world coordinates [default: on the +x axis through the
     /// view reference, looking along −x, as in the paper's Fig. 1a].

@@ -124,7 +124,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let others: Vec<_> = (layers[1..].iter())
         .map(|l| (l.input.name.as_str(), &l.input.volume, &l.settings))
         .collect();
-    let hello = Start {
+    let mut hello = Start {
         name: &first.input.name,
         volume,
         log: look.log,
@@ -134,6 +134,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         time: time.as_ref().map(|t| t.range),
     }
     .hello();
+    hello.fit = args.view.camera.size.is_none();
     let pool = thread_pool(args.view.threads)?;
     let max_memory = u128::from(first.input.max_memory);
     let mut volumes = layers.into_iter().map(|l| Arc::new(l.input.volume));

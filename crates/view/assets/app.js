@@ -28,6 +28,12 @@ let framesShown = 0;
 let shownTimes = [];   // when recent frames were shown, for the rate
 let stillTimer = 0;
 let selected = 0;      // the volume whose transfer function is edited
+// A draft's size over the full frame's, per side: adapted from the last
+// drafts' render times to take about DRAFT_MS (the time goes with the
+// pixels, the square of the scale), so that a drag holds its frame rate
+// at any window size.
+let draftScale = 0.5;
+const DRAFT_MS = 30;
 
 // ---------------------------------------------------------------- socket
 
@@ -50,7 +56,9 @@ function send(quality) {
   seq += 1;
   lastViewSeq = seq;
   body.dataset.state = "moving";
-  socket.send(JSON.stringify({ type: "view", seq, quality, state }));
+  const message = { type: "view", seq, quality, state };
+  if (quality === "draft") message.draft_scale = round(draftScale, 4);
+  socket.send(JSON.stringify(message));
 }
 
 // While dragging: at most one draft per animation frame.
@@ -111,6 +119,7 @@ function onFrame(buffer) {
     if (old.startsWith("blob:")) URL.revokeObjectURL(old);
     basis = header.basis;
     lastHeader = header;
+    if (header.quality === "draft") adaptDraftScale(header);
     framesShown += 1;
     body.dataset.frames = String(framesShown);
     showCommand(header);
@@ -122,6 +131,14 @@ function onFrame(buffer) {
   }).catch(() => URL.revokeObjectURL(url));
 }
 let lastShownSeq = 0;
+
+function adaptDraftScale(header) {
+  const shown = header.width / state.width;
+  if (!(shown > 0) || !(header.render_ms >= 0)) return;
+  const wanted = clamp(shown * Math.sqrt(DRAFT_MS / Math.max(1, header.render_ms)), 1 / 16, 1);
+  // Halfway (in the logarithm) to the new scale: steady under noise.
+  draftScale = clamp(Math.sqrt(draftScale * wanted), 1 / 16, 1);
+}
 let basis = null;
 let lastHeader = null;
 let lastSave = null;
@@ -216,6 +233,65 @@ function levelText(level) {
   return ` · level ${level.index} of ${level.count} (${dims}${pieces})`;
 }
 
+// ---------------------------------------------------------- the window
+//
+// Started without --size (hello.fit), the frame is the viewport's size in
+// device pixels (at most 4096 a side) and follows it; a draft, smaller,
+// is shown at the same size on the screen.
+
+function dpr() {
+  return window.devicePixelRatio || 1;
+}
+
+function fitSize() {
+  const r = viewport.getBoundingClientRect();
+  let w = Math.max(1, Math.round(r.width * dpr()));
+  let h = Math.max(1, Math.round(r.height * dpr()));
+  const over = Math.max(w, h) / 4096;
+  if (over > 1) {
+    w = Math.max(1, Math.floor(w / over));
+    h = Math.max(1, Math.floor(h / over));
+  }
+  return [w, h];
+}
+
+// Sizes the state to the window; whether it changed.
+function fitToWindow() {
+  if (!hello || !hello.fit || !state) return false;
+  const [w, h] = fitSize();
+  if (w === state.width && h === state.height) return false;
+  state.width = w;
+  state.height = h;
+  $("save-width").value = w;
+  $("save-height").value = h;
+  return true;
+}
+
+// The frame's size on the screen: the state's, in CSS pixels.
+function sizeFrame() {
+  const k = hello && hello.fit ? dpr() : 1;
+  frame.style.width = `${state.width / k}px`;
+  frame.style.height = `${state.height / k}px`;
+}
+
+// Full-size pixels per CSS pixel of the frame as shown.
+function frameScale() {
+  const r = frame.getBoundingClientRect();
+  const shown = Math.min(r.width, r.height * (state.width / state.height));
+  return state.width / Math.max(1, shown);
+}
+
+let resizeTimer = 0;
+new ResizeObserver(() => {
+  clearTimeout(resizeTimer);
+  resizeTimer = setTimeout(() => {
+    if (fitToWindow()) {
+      sizeFrame();
+      sendFull();
+    }
+  }, 120);
+}).observe(document.getElementById("viewport"));
+
 // ------------------------------------------------------------ the start
 
 function start(message) {
@@ -227,9 +303,8 @@ function start(message) {
   $("volume").textContent =
     `${message.name} · ${nx}×${ny}×${nz}${levels} · values ${fmt(lo)} to ${fmt(hi)}` +
     (message.log ? " (log10)" : "");
-  frame.width = state.width;
-  frame.height = state.height;
-  $("left").style.width = `${Math.max(360, state.width + 2)}px`;
+  fitToWindow();
+  sizeFrame();
   showVolumes();
   const time = message.time;
   $("time-box").hidden = !time;
@@ -362,7 +437,7 @@ const viewport = $("viewport");
 let drag = null;
 
 viewport.addEventListener("pointerdown", (e) => {
-  if (!state || e.button !== 0) return;
+  if (!state || e.button !== 0 || e.target.closest("#toolbar")) return;
   viewport.setPointerCapture(e.pointerId);
   drag = {
     x: e.clientX, y: e.clientY, pan: e.shiftKey,
@@ -379,7 +454,7 @@ viewport.addEventListener("pointermove", (e) => {
   if (drag.pan) {
     if (!basis || !drag.lookAt) return;
     // Full-size pixels per screen pixel, then world units.
-    const scale = state.width / frame.clientWidth / basis.pixels_per_unit;
+    const scale = frameScale() / basis.pixels_per_unit;
     const move = [0, 1, 2].map((i) => (-dx * basis.right[i] + dy * basis.up[i]) * scale);
     state.look_at = drag.lookAt.map((v, i) => sig(v + move[i], 6));
     if (drag.viewPoint) state.view_point = drag.viewPoint.map((v, i) => sig(v + move[i], 6));
@@ -407,12 +482,55 @@ viewport.addEventListener("wheel", (e) => {
   fullSoon(200);
 }, { passive: false });
 
-viewport.addEventListener("dblclick", () => {
+viewport.addEventListener("dblclick", (e) => {
+  if (e.target.closest("#toolbar")) return;
+  setView("reset");
+});
+
+// The views from each side, isometric, and the start: the eye orbits the
+// up vector from the +x side (azimuth 90: from +y), then rises.
+const VIEWS = {
+  "+x": [0, 0], "-x": [180, 0], "+y": [90, 0], "-y": [-90, 0],
+  "+z": [0, 90], "-z": [0, -90], "iso": [45, 35.26],
+};
+
+function setView(name) {
   if (!state) return;
-  for (const key of ["azimuth", "elevation", "zoom", "look_at", "view_point"]) {
-    state[key] = structuredClone(hello.start[key]);
-  }
+  const keys = name === "reset"
+    ? ["azimuth", "elevation", "zoom", "look_at", "view_point"]
+    : ["look_at", "view_point"];
+  for (const key of keys) state[key] = structuredClone(hello.start[key]);
+  if (name !== "reset") [state.azimuth, state.elevation] = VIEWS[name];
   sendFull();
+}
+
+for (const button of document.querySelectorAll("#toolbar [data-view]")) {
+  button.addEventListener("click", () => setView(button.dataset.view));
+}
+$("fullscreen").addEventListener("click", toggleFullscreen);
+$("panel-toggle").addEventListener("click", togglePanel);
+
+function toggleFullscreen() {
+  const done = document.fullscreenElement
+    ? document.exitFullscreen()
+    : document.documentElement.requestFullscreen();
+  done?.catch?.(() => {});
+}
+
+function togglePanel() {
+  const hidden = body.classList.toggle("panel-hidden");
+  $("panel-toggle").setAttribute("aria-expanded", String(!hidden));
+}
+
+const KEYS = { "1": "+x", "2": "-x", "3": "+y", "4": "-y", "5": "+z", "6": "-z", "0": "iso", "r": "reset" };
+document.addEventListener("keydown", (e) => {
+  if (!state || e.ctrlKey || e.metaKey || e.altKey) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button")) return;
+  if (KEYS[e.key]) setView(KEYS[e.key]);
+  else if (e.key === "f") toggleFullscreen();
+  else if (e.key === "p") togglePanel();
+  else return;
+  e.preventDefault();
 });
 
 // ------------------------------------------------------------- controls
@@ -695,9 +813,12 @@ window.volrayView = {
   state: () => structuredClone(state),
   header: () => lastHeader,
   select: (i) => selectVolume(i),
+  view: (name) => setView(name),
+  draftScale: () => draftScale,
   saved: () => lastSave,
   setState: (patch, quality = "full") => {
     Object.assign(state, patch);
+    sizeFrame();
     showVolumes();
     showControls();
     drawTf();

@@ -104,6 +104,7 @@ impl Start<'_> {
             start_window,
             colormaps,
             levels: None,
+            fit: false,
             volumes: (self.others.iter())
                 .map(|&(name, volume, settings)| volume_hello(name, volume, settings))
                 .collect(),

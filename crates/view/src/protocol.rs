@@ -234,6 +234,10 @@ pub struct Hello {
     /// level the first drafts show).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<Vec<[usize; 3]>>,
+    /// Whether the page sizes the frame to its window (no size was given
+    /// at the start): the state's width and height follow the viewport
+    /// and its device pixel ratio.
+    pub fit: bool,
     /// A scene's volumes after the first (whose are the fields above),
     /// in their order: each one's panel.
     #[serde(skip_serializing_if = "Vec::is_empty")]
