@@ -177,5 +177,10 @@ pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
         colormap,
         layers: Vec::new(),
         time: None,
+        crop: args.view.camera.crop.map(|(lo, hi)| [lo, hi]),
+        clip: (args.view.camera.clip.iter())
+            .map(|&(point, normal)| [point, normal])
+            .collect(),
+        lighting: None,
     }
 }

@@ -778,3 +778,81 @@ async fn without_a_size_the_frame_fills_the_window_and_follows_it() {
     assert_eq!(run_shown(&b, dir.path()).await, side, "the command's frame");
     b.close().await;
 }
+
+#[tokio::test(flavor = "current_thread")]
+async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is_it() {
+    let Some((_viewer, b)) = open(&["blobs:32", "--size", "96"]).await else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let start = picture(&b.frame_bytes().await, dir.path(), "start.png");
+    let click = |id: &'static str| {
+        let b = &b;
+        async move {
+            b.client
+                .find(fantoccini::Locator::Id(id))
+                .await
+                .unwrap()
+                .click()
+                .await
+                .unwrap();
+        }
+    };
+    // Sets a control's value as a user would, and lets it tell the page.
+    let set = |id: &'static str, value: &'static str| {
+        let b = &b;
+        async move {
+            b.eval(&format!(
+                "const el = document.getElementById('{id}'); el.value = '{value}'; \
+                 el.dispatchEvent(new Event('change')); return 0;"
+            ))
+            .await;
+        }
+    };
+
+    // A crop box: its x from the middle of the box.
+    click("crop-on").await;
+    set("crop-x0", "0.5").await;
+    b.wait_still().await;
+    let cropped = picture(&b.frame_bytes().await, dir.path(), "cropped.png");
+    assert_ne!(cropped, start, "the crop changed nothing");
+    let command = b.text("command").await;
+    assert!(command.contains("--crop "), "{command}");
+    assert_eq!(run_shown(&b, dir.path()).await, cropped, "crop");
+    click("crop-on").await;
+
+    // A clip plane across z, keeping the low side.
+    set("clip-axis", "z").await;
+    click("clip-flip").await;
+    b.wait_still().await;
+    let state = b.eval("return window.volrayView.state();").await;
+    assert_eq!(state["crop"], serde_json::Value::Null, "the crop is off");
+    assert_eq!(
+        state["clip"][0][1],
+        serde_json::json!([0, 0, -1]),
+        "{state}"
+    );
+    let clipped = picture(&b.frame_bytes().await, dir.path(), "clipped.png");
+    assert_ne!(clipped, start);
+    assert_eq!(run_shown(&b, dir.path()).await, clipped, "clip");
+    set("clip-axis", "").await;
+
+    // The lighting: no ambient, a light from +y.
+    set("l-ambient", "0").await;
+    click("headlight").await;
+    set("l-azimuth", "90").await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(
+        command.contains("--ambient 0 ") && command.contains("--light "),
+        "{command}"
+    );
+    assert!(
+        !command.contains("--clip"),
+        "the clip plane is off: {command}"
+    );
+    let lit = picture(&b.frame_bytes().await, dir.path(), "lit.png");
+    assert_ne!(lit, start);
+    assert_eq!(run_shown(&b, dir.path()).await, lit, "lighting");
+    b.close().await;
+}

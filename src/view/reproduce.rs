@@ -45,16 +45,18 @@ pub struct CliReproduce {
     input: String,
     /// Its reading flags.
     reading: Vec<String>,
-    /// Flags that apply whatever the state: `--up`, `--clip`, `--crop`,
-    /// `--reference`, `--jitter`, `--nonfinite`, `--log`.
+    /// Flags that apply whatever the state: `--up`, `--reference`,
+    /// `--jitter`, `--nonfinite`, `--log`.
     always: Vec<String>,
     /// Flags that shape the opacity of compositing:
     /// `--gradient-opacity`, `--post-classification`.
     shaping: Vec<String>,
     /// `--iso-thickness`, with an isosurface.
     iso_thickness: Vec<String>,
-    /// The lighting flags, when lit.
+    /// The lighting flags, when lit and the state sets no lighting.
     lighting: Vec<String>,
+    /// `--light-color`, when lit.
+    light_color: Vec<String>,
     /// `--opacity P,Q` as given.
     ramp: Option<(f32, f32)>,
     /// The transfer function the flags named, its window in the data's
@@ -130,18 +132,6 @@ impl CliReproduce {
 
         let mut always = Words::default();
         always.opt("--up", (cam.up != [0.0, 0.0, 1.0]).then(|| v3(cam.up)));
-        for &(point, normal) in &cam.clip {
-            always.opt("--clip", Some(format!("{},{}", v3(point), v3(normal))));
-        }
-        always.opt(
-            "--crop",
-            cam.crop.map(|(lo, hi)| {
-                format!(
-                    "{},{},{},{},{},{}",
-                    lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
-                )
-            }),
-        );
         always.flag("--reference", sampling.reference);
         always.flag("--jitter", sampling.jitter);
         always.opt(
@@ -183,10 +173,12 @@ impl CliReproduce {
             (look.shininess != lit.shininess).then(|| look.shininess.to_string()),
         );
         lighting.opt("--light", look.light.map(v3));
-        lighting.opt(
+        let mut light_color = Words::default();
+        light_color.opt(
             "--light-color",
             (look.light_color != lit.light_color).then(|| rgb(look.light_color)),
         );
+        lighting.0.extend(light_color.0.iter().cloned());
 
         CliReproduce {
             input: inp.input.as_deref().unwrap_or(input::DEMO).to_string(),
@@ -195,6 +187,7 @@ impl CliReproduce {
             shaping: shaping.0,
             iso_thickness: iso_thickness.0,
             lighting: lighting.0,
+            light_color: light_color.0,
             ramp: look.opacity,
             start,
             log: look.log,
@@ -283,6 +276,18 @@ impl CliReproduce {
             "--step",
             (state.step != 1.0).then(|| state.step.to_string()),
         );
+        for [point, normal] in &state.clip {
+            w.opt("--clip", Some(format!("{},{}", v3(*point), v3(*normal))));
+        }
+        w.opt(
+            "--crop",
+            state.crop.map(|[lo, hi]| {
+                format!(
+                    "{},{},{},{},{},{}",
+                    lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+                )
+            }),
+        );
         w.0.extend(self.always.iter().cloned());
 
         let projection = state.blend.is_projection();
@@ -325,7 +330,14 @@ impl CliReproduce {
                 w.opt("--opacity", self.ramp.map(|(p, q)| format!("{p},{q}")));
             }
             w.0.extend(self.shaping.iter().cloned());
-            if state.shading {
+            if let (true, Some(l)) = (state.shading, &state.lighting) {
+                w.opt("--ambient", Some(l.ambient.to_string()));
+                w.opt("--diffuse", Some(l.diffuse.to_string()));
+                w.opt("--specular", Some(l.specular.to_string()));
+                w.opt("--shininess", Some(l.shininess.to_string()));
+                w.opt("--light", l.light.map(v3));
+                w.0.extend(self.light_color.iter().cloned());
+            } else if state.shading {
                 w.0.extend(self.lighting.iter().cloned());
             } else {
                 w.word("--no-shading");
@@ -748,6 +760,40 @@ mod tests {
         );
         assert!(out.command.contains("--no-shading") && !out.command.contains("--specular"));
         assert_eq!(out.settings.iso.unwrap().value, 0.25);
+    }
+
+    #[test]
+    fn crop_clip_and_lighting_from_the_page_are_the_commands() {
+        let (r, start) = reproduce(&["--crop", "-1,1,-1,1,-1,1", "--light-color", "1,0.9,0.8"]);
+        assert_eq!(start.crop, Some([[-1.0; 3], [1.0; 3]]), "the flags' crop");
+        let mut state = start.clone();
+        state.crop = Some([[-0.5, -1.0, -1.0], [1.0, 0.25, 1.0]]);
+        state.clip = vec![[[0.0, 0.0, 0.125], [0.0, 0.0, -1.0]]];
+        state.lighting = Some(volray_view::Lighting {
+            ambient: 0.25,
+            diffuse: 0.5,
+            specular: 0.75,
+            shininess: 40.0,
+            light: Some([1.0, 0.0, 0.0]),
+        });
+        let out = r.reproduce(&state).unwrap();
+        for part in [
+            "--clip 0,0,0.125,0,0,-1",
+            "--crop -0.5,1,-1,0.25,-1,1",
+            "--ambient 0.25 --diffuse 0.5 --specular 0.75 --shininess 40 --light 1,0,0 --light-color 1,0.9,0.8",
+        ] {
+            assert!(out.command.contains(part), "{part}: {}", out.command);
+        }
+        let (words, json) = r.words(&state).unwrap();
+        let s = render_settings(&words, json.as_deref());
+        assert_eq!(s, out.settings);
+        assert_eq!(s.phong.diffuse, [0.5; 3]);
+        assert_eq!(s.phong.shininess, 40.0);
+        assert_eq!(s.light_direction, Some(DVec3::X));
+        // No shading: no lighting words, whatever the state sets.
+        state.shading = false;
+        let out = r.reproduce(&state).unwrap();
+        assert!(!out.command.contains("--ambient") && !out.command.contains("--light"));
     }
 
     #[test]

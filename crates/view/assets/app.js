@@ -297,6 +297,11 @@ new ResizeObserver(() => {
 function start(message) {
   hello = message;
   state = structuredClone(message.start);
+  // What the server leaves out when empty.
+  state.clip = state.clip ?? [];
+  state.crop = state.crop ?? null;
+  state.lighting = state.lighting ?? null;
+  state.layers = state.layers ?? [];
   const [nx, ny, nz] = message.dims;
   const [lo, hi] = message.range;
   const levels = message.levels ? ` · ${message.levels.length} levels` : "";
@@ -422,9 +427,94 @@ function showControls() {
   $("fov").value = state.perspective ?? 30;
   $("fov").disabled = state.perspective === null;
   $("background").value = toHex(state.background);
+  showCuts();
   const [wlo, whi] = windowOf();
   $("window-lo").value = round(wlo, 6);
   $("window-hi").value = round(whi, 6);
+}
+
+// The crop box, a clip plane and the lighting: sliders over the box the
+// view frames (hello.bounds), in fractions of it.
+
+const AXES = ["x", "y", "z"];
+
+function boxAt(axis, t) {
+  const [lo, hi] = hello.bounds;
+  return sig(lo[axis] + t * (hi[axis] - lo[axis]), 6);
+}
+
+function fractionOf(axis, v) {
+  const [lo, hi] = hello.bounds;
+  return hi[axis] > lo[axis] ? clamp((v - lo[axis]) / (hi[axis] - lo[axis]), 0, 1) : 0;
+}
+
+function showCuts() {
+  $("crop-on").checked = !!state.crop;
+  AXES.forEach((name, axis) => {
+    for (const end of [0, 1]) {
+      const el = $(`crop-${name}${end}`);
+      el.disabled = !state.crop;
+      if (state.crop) el.value = fractionOf(axis, state.crop[end][axis]);
+    }
+  });
+  const plane = state.clip[0];
+  const axis = plane ? plane[1].findIndex((c) => c !== 0) : -1;
+  const aligned = plane && plane[1].filter((c) => c !== 0).length === 1;
+  $("clip-axis").value = aligned ? AXES[axis] : "";
+  $("clip-flip").checked = !!aligned && plane[1][axis] < 0;
+  $("clip-at").disabled = !aligned;
+  if (aligned) $("clip-at").value = fractionOf(axis, plane[0][axis]);
+  const l = state.lighting ?? hello.lighting;
+  for (const key of ["ambient", "diffuse", "specular", "shininess"]) $(`l-${key}`).value = l[key];
+  $("headlight").checked = !l.light;
+  if (l.light) {
+    const [x, y, z] = l.light;
+    const n = Math.hypot(x, y, z);
+    $("l-azimuth").value = Math.atan2(y, x) * 180 / Math.PI;
+    $("l-elevation").value = Math.asin(clamp(z / n, -1, 1)) * 180 / Math.PI;
+  }
+  $("l-azimuth").disabled = $("l-elevation").disabled = !l.light;
+}
+
+function readCrop() {
+  if (!$("crop-on").checked) return null;
+  const lo = [], hi = [];
+  AXES.forEach((name, axis) => {
+    let a = Number($(`crop-${name}0`).value);
+    let b = Number($(`crop-${name}1`).value);
+    if (b - a < 0.01) b = Math.min(1, a + 0.01), a = b - 0.01;
+    lo.push(boxAt(axis, a));
+    hi.push(boxAt(axis, b));
+  });
+  return [lo, hi];
+}
+
+function readClip() {
+  const name = $("clip-axis").value;
+  const rest = state.clip.slice(1);
+  if (!name) return rest;
+  const axis = AXES.indexOf(name);
+  const [lo, hi] = hello.bounds;
+  const point = [0, 1, 2].map((i) => sig((lo[i] + hi[i]) / 2, 6));
+  point[axis] = boxAt(axis, Number($("clip-at").value));
+  const normal = [0, 0, 0];
+  normal[axis] = $("clip-flip").checked ? -1 : 1;
+  return [[point, normal], ...rest];
+}
+
+function readLighting() {
+  const v = (id) => Number($(id).value);
+  let light = null;
+  if (!$("headlight").checked) {
+    const az = v("l-azimuth") * Math.PI / 180;
+    const el = v("l-elevation") * Math.PI / 180;
+    light = [Math.cos(el) * Math.cos(az), Math.cos(el) * Math.sin(az), Math.sin(el)].map((c) => round(c, 4));
+    if (light.every((c) => c === 0)) light = [1, 0, 0];
+  }
+  return {
+    ambient: v("l-ambient"), diffuse: v("l-diffuse"), specular: v("l-specular"),
+    shininess: v("l-shininess"), light,
+  };
 }
 
 function isProjection() {
@@ -574,6 +664,19 @@ onControl("window-lo", "change", (el) => { setWindow(Number(el.value), windowOf(
 onControl("window-hi", "change", (el) => { setWindow(windowOf()[0], Number(el.value)); });
 onControl("window-reset", "click", () => { look().window = null; });
 onControl("opacity-reset", "click", () => { look().opacity = null; });
+
+for (const id of ["crop-on", "crop-x0", "crop-x1", "crop-y0", "crop-y1", "crop-z0", "crop-z1"]) {
+  onControl(id, "input", () => { state.crop = readCrop(); }, "draft");
+  onControl(id, "change", () => { state.crop = readCrop(); });
+}
+for (const id of ["clip-axis", "clip-flip", "clip-at"]) {
+  onControl(id, "input", () => { state.clip = readClip(); }, "draft");
+  onControl(id, "change", () => { state.clip = readClip(); });
+}
+for (const id of ["l-ambient", "l-diffuse", "l-specular", "l-shininess", "headlight", "l-azimuth", "l-elevation"]) {
+  onControl(id, "input", () => { state.lighting = readLighting(); }, "draft");
+  onControl(id, "change", () => { state.lighting = readLighting(); });
+}
 
 $("save").addEventListener("click", () => {
   if (!socket || !state) return;

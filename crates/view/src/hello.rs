@@ -3,7 +3,7 @@
 //! opacity editor are drawn over, and the colours of every colour choice.
 
 use crate::protocol::{Hello, VolumeHello};
-use crate::state::{START_COLOURS, ViewState, WHITE};
+use crate::state::{Lighting, START_COLOURS, ViewState, WHITE};
 use volray_core::transfer::colormap;
 use volray_core::{Histogram, RenderSettings, Volume};
 
@@ -77,6 +77,29 @@ fn volume_hello(name: &str, volume: &Volume, settings: &RenderSettings) -> Volum
 }
 
 impl Start<'_> {
+    /// The box of every volume.
+    fn bounds(&self) -> [[f64; 3]; 2] {
+        let (mut lo, mut hi) = self.volume.bounds();
+        for (_, volume, _) in &self.others {
+            let (a, b) = volume.bounds();
+            (lo, hi) = (lo.min(a), hi.max(b));
+        }
+        [lo.to_array(), hi.to_array()]
+    }
+
+    /// The starting lighting, each term the mean of its r, g, b.
+    fn lighting(&self) -> Lighting {
+        let phong = &self.settings.phong;
+        let grey = |c: [f32; 3]| (c[0] + c[1] + c[2]) / 3.0;
+        Lighting {
+            ambient: grey(phong.ambient),
+            diffuse: grey(phong.diffuse),
+            specular: grey(phong.specular),
+            shininess: phong.shininess,
+            light: self.settings.light_direction.map(|d| d.to_array()),
+        }
+    }
+
     /// The first message.
     pub fn hello(&self) -> Hello {
         let (histogram, range, start_window) = histogram_of(self.volume, self.settings);
@@ -104,6 +127,8 @@ impl Start<'_> {
             start_window,
             colormaps,
             levels: None,
+            bounds: self.bounds(),
+            lighting: self.lighting(),
             fit: false,
             volumes: (self.others.iter())
                 .map(|&(name, volume, settings)| volume_hello(name, volume, settings))
@@ -162,6 +187,12 @@ mod tests {
         assert_eq!(second.range, [0.0, 2.0]);
         assert_eq!(second.histogram.iter().sum::<u64>(), 8);
         assert!(second.labels && second.start_colours.is_none());
+        // The box of both, and the default lighting.
+        assert_eq!(hello.bounds, [[0.0; 3], [1.0; 3]]);
+        assert_eq!(
+            (hello.lighting.diffuse, hello.lighting.light),
+            (settings.phong.diffuse[0], None)
+        );
         assert_eq!(second.start_window, [0.0, 2.0]);
     }
 }

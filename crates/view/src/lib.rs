@@ -58,8 +58,8 @@ pub use reproduce::{Refusal, Reproduce, Reproduction, SceneLooks};
 pub use server::{ServeError, Server, Stopper};
 pub use session::{ReadTimePoint, TimePoints, draft_side};
 pub use state::{
-    BlendMode, LayerState, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState, WHITE,
-    ZOOM_RANGE, solid_colour,
+    BlendMode, LayerState, Lighting, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState,
+    WHITE, ZOOM_RANGE, solid_colour,
 };
 pub use stats::Snapshot;
 pub use token::{NoRandomness, Token};

@@ -18,7 +18,7 @@
 //! frame: a 4-byte little-endian length, a JSON [`FrameHeader`] of that
 //! length, then the image file.
 
-use crate::state::{StateError, ViewState};
+use crate::state::{Lighting, StateError, ViewState};
 use serde::{Deserialize, Serialize};
 
 /// The largest message a page may send: a state with the most opacity
@@ -234,6 +234,12 @@ pub struct Hello {
     /// level the first drafts show).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<Vec<[usize; 3]>>,
+    /// The box the view frames, world corners `[lo, hi]` (every volume's,
+    /// for a scene): the crop and clip controls' ranges.
+    pub bounds: [[f64; 3]; 2],
+    /// The lighting the view starts with (each term the mean of its
+    /// r, g, b), for the lighting controls.
+    pub lighting: Lighting,
     /// Whether the page sizes the frame to its window (no size was given
     /// at the start): the state's width and height follow the viewport
     /// and its device pixel ratio.

@@ -27,6 +27,12 @@ pub const MAX_ANGLE: f64 = 1e6;
 /// The most points of the opacity function.
 pub const MAX_OPACITY_POINTS: usize = 256;
 
+/// The most clip planes.
+pub const MAX_CLIP_PLANES: usize = 6;
+
+/// The largest specular exponent the page may set.
+pub const MAX_SHININESS: f32 = 1000.0;
+
 /// The colours that are not a named colour map: the starting transfer
 /// function's own, and none (white material).
 pub const START_COLOURS: &str = "start";
@@ -103,6 +109,30 @@ pub struct ViewState {
     /// one the viewer started with.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time: Option<usize>,
+    /// The crop box's world corners `[lo, hi]` (`--crop`); `None`: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crop: Option<[[f64; 3]; 2]>,
+    /// Clip planes, each a world point and a normal towards the side kept
+    /// (`--clip`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clip: Vec<[[f64; 3]; 2]>,
+    /// Phong's terms and the light; `None`: as started.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lighting: Option<Lighting>,
+}
+
+/// What the page's lighting controls set: Phong's reflection terms as
+/// greys (`--ambient`, `--diffuse`, `--specular`), the exponent
+/// (`--shininess`) and the direction towards the light (`--light`;
+/// `None`: a headlight).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Lighting {
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub shininess: f32,
+    pub light: Option<[f64; 3]>,
 }
 
 /// What a scene's volume after the first sets in its panel: shown or
@@ -149,6 +179,12 @@ pub enum StateError {
     OpacityPoints { count: usize, max: usize },
     #[error("unknown colour map \"{0}\"")]
     Colormap(String),
+    #[error("the crop box's {axis} range [{lo}, {hi}] must have lo < hi")]
+    EmptyCrop { axis: char, lo: f64, hi: f64 },
+    #[error("{field} must not be zero")]
+    ZeroDirection { field: &'static str },
+    #[error("at most {MAX_CLIP_PLANES} clip planes, not {0}")]
+    ClipPlanes(usize),
     /// A field of a scene's volume (numbered from 1, the first's being
     /// the state's own fields).
     #[error("volume {0}: {1}")]
@@ -195,10 +231,65 @@ impl ViewState {
             within("background", f64::from(c), (0.0, 1.0))?;
         }
         check_look(self.window, self.opacity.as_deref(), &self.colormap)?;
+        if let Some([lo, hi]) = self.crop {
+            finite("crop", &[lo, hi].concat())?;
+            for (axis, name) in ['x', 'y', 'z'].into_iter().enumerate() {
+                if lo[axis] >= hi[axis] {
+                    return Err(StateError::EmptyCrop {
+                        axis: name,
+                        lo: lo[axis],
+                        hi: hi[axis],
+                    });
+                }
+            }
+        }
+        if self.clip.len() > MAX_CLIP_PLANES {
+            return Err(StateError::ClipPlanes(self.clip.len()));
+        }
+        for [point, normal] in &self.clip {
+            finite("clip", &[*point, *normal].concat())?;
+            nonzero("the clip plane's normal", normal)?;
+        }
+        if let Some(l) = &self.lighting {
+            for (field, v) in [
+                ("ambient", l.ambient),
+                ("diffuse", l.diffuse),
+                ("specular", l.specular),
+            ] {
+                within(field, f64::from(v), (0.0, 1.0))?;
+            }
+            within(
+                "shininess",
+                f64::from(l.shininess),
+                (1.0, f64::from(MAX_SHININESS)),
+            )?;
+            if let Some(light) = &l.light {
+                finite("light", light)?;
+                nonzero("the light's direction", light)?;
+            }
+        }
         for (i, layer) in self.layers.iter().enumerate() {
             check_look(layer.window, layer.opacity.as_deref(), &layer.colormap)
                 .map_err(|e| StateError::Layer(i + 2, Box::new(e)))?;
         }
+        Ok(())
+    }
+}
+
+/// Every number finite.
+fn finite(field: &'static str, values: &[f64]) -> Result<(), StateError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(StateError::NotFinite { field })
+    }
+}
+
+/// A direction, not zero.
+fn nonzero(field: &'static str, v: &[f64; 3]) -> Result<(), StateError> {
+    if v.iter().all(|c| *c == 0.0) {
+        Err(StateError::ZeroDirection { field })
+    } else {
         Ok(())
     }
 }
@@ -294,6 +385,9 @@ pub(crate) mod tests {
             colormap: WHITE.into(),
             layers: Vec::new(),
             time: None,
+            crop: None,
+            clip: Vec::new(),
+            lighting: None,
         }
     }
 
@@ -350,6 +444,46 @@ pub(crate) mod tests {
             ),
             (|s| s.colormap = "jet".into(), "unknown colour map \"jet\""),
             (|s| s.colormap = "#ff00f".into(), "unknown colour map"),
+            (
+                |s| s.crop = Some([[0.0, 0.0, 0.0], [1.0, -1.0, 1.0]]),
+                "the crop box's y range [0, -1] must have lo < hi",
+            ),
+            (
+                |s| s.crop = Some([[0.0, f64::NAN, 0.0], [1.0; 3]]),
+                "crop must be finite",
+            ),
+            (
+                |s| s.clip = vec![[[0.0; 3], [0.0; 3]]],
+                "the clip plane's normal must not be zero",
+            ),
+            (
+                |s| s.clip = vec![[[0.0; 3], [1.0, 0.0, 0.0]]; 7],
+                "at most 6 clip planes, not 7",
+            ),
+            (
+                |s| {
+                    s.lighting = Some(Lighting {
+                        ambient: 0.1,
+                        diffuse: 1.5,
+                        specular: 0.2,
+                        shininess: 10.0,
+                        light: None,
+                    })
+                },
+                "diffuse 1.5 is outside 0 to 1",
+            ),
+            (
+                |s| {
+                    s.lighting = Some(Lighting {
+                        ambient: 0.1,
+                        diffuse: 0.5,
+                        specular: 0.2,
+                        shininess: 10.0,
+                        light: Some([0.0; 3]),
+                    })
+                },
+                "the light's direction must not be zero",
+            ),
             (
                 |s| {
                     let mut layer = LayerState {
