@@ -856,3 +856,38 @@ async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is
     assert_eq!(run_shown(&b, dir.path()).await, lit, "lighting");
     b.close().await;
 }
+
+#[tokio::test(flavor = "current_thread")]
+async fn the_pointer_probes_the_world_point_and_value_under_it() {
+    // sphere:32: a field over the world box [−1, 1]³ (spacing 2/31),
+    // seen from +x; the centre ray runs along the x axis.
+    let Some((_viewer, b)) = open(&["sphere:32", "--size", "96"]).await else {
+        return;
+    };
+    b.hover("#frame", (0.0, 0.0)).await;
+    b.wait_for("document.getElementById('probe').textContent.includes('value')")
+        .await;
+    let text = b.text("probe").await;
+    // "(x, y, z) · voxel (i, j, k) · value v": on the x axis, in front.
+    let numbers: Vec<f64> = text
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let [x, y, z, i, j, k, value] = numbers[..] else {
+        panic!("{text}")
+    };
+    assert!(x > 0.0 && x <= 1.0, "in front of the centre: {text}");
+    assert!(y.abs() < 0.05 && z.abs() < 0.05, "on the axis: {text}");
+    let voxel = |w: f64| (w + 1.0) * 31.0 / 2.0;
+    assert!((voxel(x) - i).abs() < 0.06, "{text}");
+    assert!(
+        (voxel(y) - j).abs() < 0.06 && (voxel(z) - k).abs() < 0.06,
+        "{text}"
+    );
+    assert!(value > 0.0 && value <= 1.0, "{text}");
+    // Off the frame: the probe clears.
+    b.hover("#viewport", (-200.0, 0.0)).await;
+    b.wait_for("document.getElementById('probe').textContent === ''")
+        .await;
+    b.close().await;
+}

@@ -257,6 +257,20 @@ impl Browser {
         self.clicks(selector, (x, y), 1).await;
     }
 
+    /// Moves the pointer (no button) to `at` from the centre of the
+    /// element `selector`.
+    pub async fn hover(&self, selector: &str, at: (f64, f64)) {
+        let element = self.client.find(Locator::Css(selector)).await.unwrap();
+        let mouse = MouseActions::new("mouse".to_string()).then(PointerAction::MoveToElement {
+            element,
+            duration: None,
+            x: at.0,
+            y: at.1,
+        });
+        self.client.perform_actions(mouse).await.unwrap();
+        self.client.release_actions().await.unwrap();
+    }
+
     /// `n` clicks at `at` from the centre of the element `selector`.
     async fn clicks(&self, selector: &str, at: (f64, f64), n: usize) {
         let element = self.client.find(Locator::Css(selector)).await.unwrap();

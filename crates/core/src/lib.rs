@@ -86,6 +86,7 @@ mod memory;
 mod non_finite;
 mod partial;
 pub mod piece;
+pub mod probe;
 mod progress;
 mod reference;
 mod renderer;

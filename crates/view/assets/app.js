@@ -89,7 +89,9 @@ function fullSoon(ms) {
 }
 
 function onText(message) {
-  if (message.type === "hello") {
+  if (message.type === "probe") {
+    showProbe(message);
+  } else if (message.type === "hello") {
     start(message);
   } else if (message.type === "error") {
     showError(message.message);
@@ -538,7 +540,10 @@ viewport.addEventListener("pointerdown", (e) => {
 });
 
 viewport.addEventListener("pointermove", (e) => {
-  if (!drag) return;
+  if (!drag) {
+    probeAt(e);
+    return;
+  }
   const dx = e.clientX - drag.x;
   const dy = e.clientY - drag.y;
   if (drag.pan) {
@@ -554,6 +559,48 @@ viewport.addEventListener("pointermove", (e) => {
   }
   sendDraft();
 });
+
+// The probe: what the pixel under the pointer shows, asked at most every
+// PROBE_MS while the pointer moves over the frame (not while dragging).
+const PROBE_MS = 80;
+let probeTime = 0;
+let probeTimer = 0;
+
+function probeAt(e) {
+  if (!state || !socket || socket.readyState !== WebSocket.OPEN) return;
+  const r = frame.getBoundingClientRect();
+  const aspect = state.width / state.height;
+  const shownW = Math.min(r.width, r.height * aspect);
+  const shownH = shownW / aspect;
+  const left = r.left + (r.width - shownW) / 2;
+  const top = r.top + (r.height - shownH) / 2;
+  const x = ((e.clientX - left) / shownW) * state.width;
+  const y = ((e.clientY - top) / shownH) * state.height;
+  if (!(x >= 0 && y >= 0 && x < state.width && y < state.height)) {
+    $("probe").textContent = "";
+    return;
+  }
+  clearTimeout(probeTimer);
+  const wait = probeTime + PROBE_MS - performance.now();
+  if (wait > 0) {
+    probeTimer = setTimeout(() => probeAt(e), wait);
+    return;
+  }
+  probeTime = performance.now();
+  seq += 1;
+  socket.send(JSON.stringify({ type: "probe", seq, x, y, state }));
+}
+
+function showProbe(message) {
+  const box = $("probe");
+  if (!message.position) {
+    box.textContent = "nothing under the pointer";
+    return;
+  }
+  const [x, y, z] = message.position.map((v) => fmt(v));
+  const [i, j, k] = message.index.map((v) => round(v, 1));
+  box.textContent = `(${x}, ${y}, ${z}) · voxel (${i}, ${j}, ${k}) · value ${fmt(message.value)}`;
+}
 
 function endDrag(e) {
   if (!drag) return;
@@ -917,6 +964,10 @@ window.volrayView = {
   header: () => lastHeader,
   select: (i) => selectVolume(i),
   view: (name) => setView(name),
+  probe: (x, y) => {
+    seq += 1;
+    socket.send(JSON.stringify({ type: "probe", seq, x, y, state }));
+  },
   draftScale: () => draftScale,
   saved: () => lastSave,
   setState: (patch, quality = "full") => {

@@ -21,6 +21,7 @@ use std::sync::{Condvar, Mutex, MutexGuard};
 struct Slots<T> {
     latest: Option<T>,
     save: Option<T>,
+    probe: Option<T>,
     closed: bool,
     /// Requests replaced before they were taken.
     dropped: u64,
@@ -45,6 +46,8 @@ pub enum Slot {
     Latest,
     /// A save: likewise, in its own slot.
     Save,
+    /// A probe of a pixel: likewise; taken before the view (it is quick).
+    Probe,
 }
 
 impl<T> Default for Mailbox<T> {
@@ -53,6 +56,7 @@ impl<T> Default for Mailbox<T> {
             slots: Mutex::new(Slots {
                 latest: None,
                 save: None,
+                probe: None,
                 closed: false,
                 dropped: 0,
                 rendering: None,
@@ -85,6 +89,7 @@ impl<T> Mailbox<T> {
         let place = match slot {
             Slot::Latest => &mut slots.latest,
             Slot::Save => &mut slots.save,
+            Slot::Probe => &mut slots.probe,
         };
         if place.replace(request).is_some() {
             slots.dropped += 1;
@@ -93,7 +98,7 @@ impl<T> Mailbox<T> {
         self.ready.notify_one();
     }
 
-    /// Waits for a request (a save first) and takes it, clearing the stop
+    /// Waits for a request (a save first, then a probe) and takes it, clearing the stop
     /// flag for its frame; `None` once the mailbox is closed.
     pub fn take(&self) -> Option<T> {
         let mut slots = self.lock();
@@ -102,10 +107,9 @@ impl<T> Mailbox<T> {
             if slots.closed {
                 return None;
             }
-            let taken = match slots.save.take() {
-                Some(save) => Some((Slot::Save, save)),
-                None => slots.latest.take().map(|view| (Slot::Latest, view)),
-            };
+            let taken = (slots.save.take().map(|save| (Slot::Save, save)))
+                .or_else(|| slots.probe.take().map(|probe| (Slot::Probe, probe)))
+                .or_else(|| slots.latest.take().map(|view| (Slot::Latest, view)));
             if let Some((slot, request)) = taken {
                 slots.rendering = Some(slot);
                 self.stop.store(false, Ordering::Relaxed);
@@ -122,6 +126,7 @@ impl<T> Mailbox<T> {
         slots.closed = true;
         slots.latest = None;
         slots.save = None;
+        slots.probe = None;
         self.stop.store(true, Ordering::Relaxed);
         drop(slots);
         self.ready.notify_all();
@@ -153,7 +158,9 @@ impl<T> Mailbox<T> {
     #[cfg(test)]
     pub fn waiting(&self) -> usize {
         let slots = self.lock();
-        usize::from(slots.latest.is_some()) + usize::from(slots.save.is_some())
+        usize::from(slots.latest.is_some())
+            + usize::from(slots.save.is_some())
+            + usize::from(slots.probe.is_some())
     }
 }
 

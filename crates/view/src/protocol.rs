@@ -11,6 +11,9 @@
 //!   is rendered.
 //! - `{"type": "save", "seq": N, "state": {...}}`: render the state at
 //!   its size, as a PNG to download.
+//! - `{"type": "probe", "seq": N, "x": X, "y": Y, "state": {...}}`: what
+//!   the full-size frame's pixel at (X, Y) shows (`volray_core::probe`),
+//!   answered with a [`ServerMessage::Probe`]. Only the latest waits.
 //!
 //! The server answers with text messages (the [`Hello`] first, then
 //! [`ServerMessage::Error`] for a message it refused or a frame it could
@@ -52,6 +55,12 @@ pub enum ClientMessage {
         seq: u64,
         state: ViewState,
     },
+    Probe {
+        seq: u64,
+        x: f64,
+        y: f64,
+        state: ViewState,
+    },
 }
 
 /// A request the server can render: its sequence number, quality and
@@ -64,6 +73,9 @@ pub struct Request {
     /// A draft's size over the full size's, per side, in
     /// [`DRAFT_SCALE_RANGE`].
     pub draft_scale: f64,
+    /// A probe of the full-size frame's pixel (column, row), instead of
+    /// a frame.
+    pub probe: Option<[usize; 2]>,
 }
 
 /// The smallest and largest scale of a draft, per side.
@@ -83,6 +95,8 @@ pub enum MessageError {
     SaveQuality,
     #[error("draft_scale {0} is outside 1/16 to 1")]
     DraftScale(f64),
+    #[error("the probe's pixel ({x}, {y}) is outside the frame")]
+    ProbeOutside { x: f64, y: f64 },
     #[error("{0}")]
     State(#[from] StateError),
 }
@@ -125,6 +139,7 @@ pub fn parse(text: &str) -> Result<Request, MessageError> {
                 quality,
                 state,
                 draft_scale,
+                probe: None,
             }
         }
         ClientMessage::Save { seq, state } => Request {
@@ -132,7 +147,21 @@ pub fn parse(text: &str) -> Result<Request, MessageError> {
             quality: Quality::Save,
             state,
             draft_scale: DRAFT_SCALE,
+            probe: None,
         },
+        ClientMessage::Probe { seq, x, y, state } => {
+            let inside = |v: f64, n: usize| v.is_finite() && v >= 0.0 && v < n as f64;
+            if !inside(x, state.width) || !inside(y, state.height) {
+                return Err(MessageError::ProbeOutside { x, y });
+            }
+            Request {
+                seq,
+                quality: Quality::Full,
+                state,
+                draft_scale: DRAFT_SCALE,
+                probe: Some([x as usize, y as usize]),
+            }
+        }
     };
     request.state.check()?;
     Ok(request)
@@ -283,6 +312,14 @@ pub enum ServerMessage {
         seq: Option<u64>,
         message: String,
     },
+    /// What a probed pixel shows: its world point and the first volume's
+    /// value there, or nothing (`null`s).
+    Probe {
+        seq: u64,
+        position: Option<[f64; 3]>,
+        index: Option<[f64; 3]>,
+        value: Option<f32>,
+    },
 }
 
 impl ServerMessage {
@@ -317,6 +354,10 @@ mod tests {
             "type": "view", "seq": 5, "quality": "draft", "state": sample(), "draft_scale": 0.25
         });
         assert_eq!(parse(&scaled.to_string()).unwrap().draft_scale, 0.25);
+        // A probe of a pixel of the full-size frame.
+        let probe = serde_json::json!({"type": "probe", "seq": 6, "x": 12.5, "y": 479.9, "state": sample()});
+        let r = parse(&probe.to_string()).unwrap();
+        assert_eq!((r.seq, r.probe), (6, Some([12, 479])));
     }
 
     #[test]
@@ -368,6 +409,11 @@ mod tests {
                 &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": sample(), "draft_scale": 2})
                     .to_string(),
                 "draft_scale 2 is outside",
+            ),
+            (
+                &serde_json::json!({"type": "probe", "seq": 1, "x": 480, "y": 0, "state": sample()})
+                    .to_string(),
+                "the probe's pixel (480, 0) is outside the frame",
             ),
         ];
         for (text, expect) in cases {

@@ -320,6 +320,7 @@ fn receive(mailbox: &Mailbox<Request>, text: &str) -> Option<ServerMessage> {
     match protocol::parse(text) {
         Ok(request) => {
             let slot = match request.quality {
+                _ if request.probe.is_some() => Slot::Probe,
                 Quality::Save => Slot::Save,
                 Quality::Draft | Quality::Full => Slot::Latest,
             };

@@ -199,6 +199,14 @@ pub fn spawn(
                 last_still_ms: None,
             };
             while let Some(request) = mailbox.take() {
+                if request.probe.is_some() {
+                    let answer = tab.probe(&request);
+                    mailbox.finished();
+                    if out.blocking_send(Outgoing::Text(answer.to_json())).is_err() {
+                        break;
+                    }
+                    continue;
+                }
                 // A still slow to render: a quick frame of it first.
                 if let Some(quick) = tab.quick(&request)
                     && let Ok((message, reservation)) = tab.frame(&quick, mailbox.stop_flag())
@@ -298,6 +306,37 @@ impl Tab<'_> {
     /// (the time goes with the pixels, the square of the scale).
     fn quick(&self, request: &Request) -> Option<Request> {
         quick_request(self.last_still_ms, request)
+    }
+
+    /// What the pixel `request` probes shows, in the frame of its state
+    /// (at the time point this tab shows; the first volume of a scene;
+    /// nothing yet for a pyramid's levels).
+    fn probe(&mut self, request: &Request) -> ServerMessage {
+        let [col, row] = request.probe.unwrap_or_default();
+        let found = (|| -> Result<Option<volray_core::probe::Probe>, FrameError> {
+            let settings = self.reproduce.reproduce(&request.state)?.settings;
+            Ok(match &self.source {
+                Source::Whole { renderer, .. } => renderer.probe(&settings, col, row)?,
+                Source::Scene(scene) => {
+                    let mut framed = settings.clone();
+                    framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
+                    scene.layers()[0].probe(&framed, col, row)?
+                }
+                Source::Levels(_) => None,
+            })
+        })();
+        match found {
+            Ok(found) => ServerMessage::Probe {
+                seq: request.seq,
+                position: found.map(|p| p.position.to_array()),
+                index: found.map(|p| p.index.to_array()),
+                value: found.map(|p| p.value),
+            },
+            Err(e) => ServerMessage::Error {
+                seq: Some(request.seq),
+                message: e.to_string(),
+            },
+        }
     }
 
     /// The frame `request` asks for, as a binary message, and the bytes
@@ -687,6 +726,7 @@ fn quick_request(last_still_ms: Option<f64>, request: &Request) -> Option<Reques
         draft_scale: (QUICK_MS / last).sqrt().clamp(lo, hi),
         ..request.clone()
     })
+    .filter(|_| request.probe.is_none())
 }
 
 /// A side of `full` pixels at `scale`, at least one pixel.
@@ -818,6 +858,7 @@ mod tests {
             quality,
             state,
             draft_scale: crate::protocol::DRAFT_SCALE,
+            probe: None,
         }
     }
 
@@ -849,6 +890,7 @@ mod tests {
                     quality,
                     state,
                     draft_scale: crate::protocol::DRAFT_SCALE,
+                    probe: None,
                 },
             );
         }
@@ -880,6 +922,7 @@ mod tests {
                 quality: Quality::Draft,
                 state: state.clone(),
                 draft_scale: crate::protocol::DRAFT_SCALE,
+                probe: None,
             },
         );
         let Some(Outgoing::Frame(message, _)) = rx.blocking_recv() else {
@@ -898,6 +941,7 @@ mod tests {
                 quality: Quality::Full,
                 state,
                 draft_scale: crate::protocol::DRAFT_SCALE,
+                probe: None,
             },
         );
         let Some(Outgoing::Text(text)) = rx.blocking_recv() else {
@@ -1328,5 +1372,45 @@ mod tests {
         let slowest = quick_request(Some(1e9), &full).unwrap();
         assert_eq!(slowest.draft_scale, DRAFT_SCALE_RANGE.0);
         assert_eq!((scaled(480, 1.0 / 16.0), scaled(1, 1.0 / 16.0)), (30, 1));
+    }
+
+    #[test]
+    fn a_probe_is_answered_with_what_the_pixel_shows_and_a_frame_is_not_rendered() {
+        let shared = shared();
+        let mailbox = Arc::new(Mailbox::default());
+        let (tx, mut rx) = mpsc::channel(1);
+        spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+        let probe = |seq, col, row| {
+            let mut r = request(seq, Quality::Full, 33, 0.0);
+            r.probe = Some([col, row]);
+            r
+        };
+        mailbox.put(Slot::Probe, probe(1, 16, 16));
+        let Some(Outgoing::Text(text)) = rx.blocking_recv() else {
+            panic!("no answer")
+        };
+        let answer: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(
+            (answer["type"].as_str(), answer["seq"].as_u64()),
+            (Some("probe"), Some(1))
+        );
+        // The centre ray from +x meets the cone's values on the x axis.
+        let position = answer["position"].as_array().unwrap();
+        let x = position[0].as_f64().unwrap();
+        assert!(x > 0.0 && x < 1.0, "{answer}");
+        assert!(position[1].as_f64().unwrap().abs() < 1e-9, "{answer}");
+        let value = answer["value"].as_f64().unwrap();
+        assert!(
+            (value - (1.0 - x)).abs() < 0.05,
+            "the cone's value 1 - |p|: {answer}"
+        );
+        // The corner's ray meets only zeros: nothing.
+        mailbox.put(Slot::Probe, probe(2, 0, 0));
+        let Some(Outgoing::Text(text)) = rx.blocking_recv() else {
+            panic!("no answer")
+        };
+        let answer: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(answer["position"], serde_json::Value::Null, "{answer}");
+        assert_eq!(shared.stats.snapshot(&shared.ledger).frames, 0, "no frame");
     }
 }
