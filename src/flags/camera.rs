@@ -27,8 +27,8 @@ impl CameraArgs {
 /// What the picture frames, and at what resolution.
 #[derive(Debug, Args)]
 pub struct CameraArgs {
-    /// Image size: W (square) or WxH, in pixels [default: 480; `volray
-    /// view`: the page's window].
+    /// Image size: W (square) or WxH, in pixels (`volray view` without
+    /// it: the size of the page's window) [default: 480].
     #[arg(long, value_name = "W|WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<(usize, usize)>,
 

@@ -38,7 +38,10 @@ const DRAFT_MS = 30;
 // ---------------------------------------------------------------- socket
 
 function connect() {
-  const url = `ws://${location.host}/ws?token=${encodeURIComponent(token)}`;
+  // Relative to the page, so that the viewer works behind a proxy that
+  // serves it under a path (JupyterHub's, jupyter-server-proxy's).
+  const url = new URL(`ws?token=${encodeURIComponent(token)}`, location.href);
+  url.protocol = location.protocol === "https:" ? "wss:" : "ws:";
   socket = new WebSocket(url);
   socket.binaryType = "arraybuffer";
   socket.onmessage = (event) => {
