@@ -22,6 +22,7 @@
 
 use crate::error::CliError;
 use crate::flags::{InputArgs, RenderArgs};
+use crate::render::OutputKind;
 use crate::session::{load, progress_bar, render_failure, renderer_for};
 use crate::streamed::Plan;
 use rayon::ThreadPool;
@@ -45,6 +46,7 @@ pub fn turntable(
     let first = turntable_frame(base, 0, frames);
     let input_args = match crate::streamed::plan(&args.input, &args.view, &first)? {
         Plan::Streamed(mut streamed) => {
+            crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
             let base = &streamed.settings_from_volume(&args.view, base.clone())?;
             let mut writer = Writer::new(args, base, frames)?;
             for i in 0..frames {
@@ -62,8 +64,19 @@ pub fn turntable(
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
     for i in 0..frames {
-        let image = writer.render(pool, &renderer, &turntable_frame(base, i, frames));
-        writer.push(&image.map_err(fail)?)?;
+        let frame = turntable_frame(base, i, frames);
+        let mut image = writer.render(pool, &renderer, &frame).map_err(fail)?;
+        // Annotated in the frame's own view: the triad turns, the outline
+        // and a perspective scale bar follow it.
+        crate::figure::draw(
+            args,
+            OutputKind::Animation,
+            &frame,
+            &renderer,
+            &input,
+            &mut image,
+        )?;
+        writer.push(&image)?;
     }
     writer.finish()
 }
@@ -201,8 +214,22 @@ fn series_of(
         input.volume.set_labels(look.labels);
         let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
         let renderer = renderer_for(&args.view, &settings, &input)?;
-        let image = writer.render(pool, &renderer, &settings);
-        writer.push(&image.map_err(fail)?)?;
+        let mut image = writer.render(pool, &renderer, &settings).map_err(fail)?;
+        // One window and one view for every frame: the same colour bar and
+        // scale bar in each (a perspective one at the centre of the box
+        // framing them all); the outline of this frame's volume.
+        let framed = settings.camera.framed_bounds(input.volume.bounds());
+        crate::figure::draw_framed(
+            args,
+            OutputKind::Animation,
+            &settings,
+            &renderer,
+            &input,
+            &[input.volume.bounds()],
+            framed,
+            &mut image,
+        )?;
+        writer.push(&image)?;
     }
     writer.finish()
 }

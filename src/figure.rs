@@ -1,6 +1,8 @@
-//! `--colorbar`, `--scale-bar`, `--title`, `--label`: what a still was
-//! rendered with (the renderer's view and classifier, the labels, the
-//! units) handed to volray-annotate, which draws them into the image.
+//! `--colorbar`, `--scale-bar`, `--axes`, `--outline`, `--title`,
+//! `--label`: what a frame was rendered with (the renderer's view and
+//! classifier, the labels, the units, the names of the world's axes)
+//! handed to volray-annotate, which draws them into the image: a still,
+//! or each frame of a turntable or series (`animate.rs`).
 
 use crate::error::CliError;
 use crate::flags::{ColorBarSide, FigureArgs, RenderArgs, ScaleLength};
@@ -8,9 +10,11 @@ use crate::input::Input;
 use crate::render::OutputKind;
 use volray_annotate::colorbar::Side;
 use volray_annotate::figure::{Annotations, Subject, annotate};
+use volray_core::glam::DVec3;
 use volray_core::transfer::classifier::Classifier;
 use volray_core::transfer::labels::{MAX_LABELS, labels_of};
 use volray_core::{Blend, Image, RenderSettings, Renderer};
+use volray_io::VolumeFormat;
 
 /// The annotations the flags ask for.
 pub fn annotations(args: &FigureArgs) -> Annotations {
@@ -25,15 +29,50 @@ pub fn annotations(args: &FigureArgs) -> Annotations {
         }),
         title: args.title.clone(),
         label: args.label.clone(),
+        axes: args.axes,
+        outline: args.outline,
     }
 }
 
-/// Refuses annotations where they are not drawn yet: animations, and
-/// volumes rendered piece by piece from their chunks (`what`).
+/// The names of the world's +x, +y, +z where the file says what they
+/// are: a NIfTI, Analyze, MGH or MINC world is RAS+ (x towards the
+/// subject's right, y anterior, z superior), DICOM's LPS+, NRRD's its
+/// `space`; x, y, z otherwise, and for a grid rendered in its own axes
+/// because they are rotated away from the world's.
+pub fn axis_names(input: &Input) -> [&'static str; 3] {
+    const XYZ: [&str; 3] = ["x", "y", "z"];
+    let Some((format, info)) = &input.file else {
+        return XYZ;
+    };
+    if (info.notes.iter()).any(|n| n.contains("own axes")) {
+        return XYZ;
+    }
+    match format {
+        VolumeFormat::Nifti | VolumeFormat::Analyze | VolumeFormat::Mgh | VolumeFormat::Minc => {
+            ["R", "A", "S"]
+        }
+        VolumeFormat::Dicom => ["L", "P", "S"],
+        VolumeFormat::Nrrd => {
+            let space = (info.header.iter())
+                .find(|(k, _)| k == "space")
+                .map(|(_, v)| v.trim().to_ascii_lowercase());
+            match space.as_deref() {
+                Some("right-anterior-superior" | "ras") => ["R", "A", "S"],
+                Some("left-anterior-superior" | "las") => ["L", "A", "S"],
+                Some("left-posterior-superior" | "lps") => ["L", "P", "S"],
+                _ => XYZ,
+            }
+        }
+        _ => XYZ,
+    }
+}
+
+/// Refuses annotations where they are not drawn yet: volumes rendered
+/// piece by piece from their chunks (`what`).
 pub fn refuse(args: &FigureArgs, what: &str) -> Result<(), CliError> {
     if args.any() {
         return Err(CliError::input(format!(
-            "{}: annotations are drawn into still images of a volume read whole; not into {what} yet",
+            "{}: annotations are drawn into frames of a volume read whole; not into {what} yet",
             args.first_flag()
         )));
     }
@@ -49,6 +88,33 @@ pub fn draw(
     settings: &RenderSettings,
     renderer: &Renderer,
     input: &Input,
+    image: &mut Image,
+) -> Result<(), CliError> {
+    let bounds = renderer.volume().bounds();
+    draw_framed(
+        args,
+        kind,
+        settings,
+        renderer,
+        input,
+        &[bounds],
+        bounds,
+        image,
+    )
+}
+
+/// [`draw`], the outline drawing `boxes`, a perspective scale bar holding
+/// at the centre of `scale_box` (a series: the box framing every frame,
+/// so that the bar is the same in each).
+#[allow(clippy::too_many_arguments)]
+pub fn draw_framed(
+    args: &RenderArgs,
+    kind: OutputKind,
+    settings: &RenderSettings,
+    renderer: &Renderer,
+    input: &Input,
+    boxes: &[(DVec3, DVec3)],
+    scale_box: (DVec3, DVec3),
     image: &mut Image,
 ) -> Result<(), CliError> {
     if !args.figure.any() {
@@ -114,7 +180,7 @@ pub fn draw(
     let hounsfield = (args.view.look.preset.as_deref()).is_some_and(|p| p.starts_with("ct-"));
     let subject = Subject {
         view: &frame.view,
-        bounds: volume.bounds(),
+        bounds: scale_box,
         window,
         log,
         colour: &colour,
@@ -124,6 +190,8 @@ pub fn draw(
         value_unit: hounsfield.then_some("HU"),
         length_unit: length_unit.as_deref(),
         background: settings.background,
+        axis_names: axis_names(input),
+        boxes,
     };
     annotate(image, &annotations(&args.figure), &subject);
     Ok(())

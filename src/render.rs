@@ -35,9 +35,6 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
     )?;
     let pool = thread_pool(args.view.threads)?;
-    if kind == OutputKind::Animation {
-        crate::figure::refuse(&args.figure, "animations")?;
-    }
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(frames)) => {
             animate::turntable(args, &settings, &pool, frames as usize)

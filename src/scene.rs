@@ -62,9 +62,6 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
     let animation = args.animation.turntable.map(|_| "--turntable");
     let kind = output_kind(&args.out.output, args.out.bit_depth, animation)?;
-    if kind == OutputKind::Animation {
-        crate::figure::refuse(&args.figure, "animations")?;
-    }
     if args.animation.fps.is_some() && animation.is_none() {
         return Err(CliError::input(
             "--fps applies to animations: give --turntable FRAMES",
@@ -133,12 +130,35 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         pool.install(|| scene.render_with_progress(&request, &|n| bar.inc(n as u64), None))
             .map_err(fail)
     };
+    // The first volume's colour bar and scale bar, in the view that
+    // frames every volume (`camera`: the frame's), and the box of each
+    // volume for --outline.
+    let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
+    let annotate = |camera: volray_core::Camera, image: &mut volray_core::Image| {
+        let mut first = layers[0].settings.clone();
+        first.camera = camera;
+        first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
+        let renderer = &scene.layers()[0];
+        crate::figure::draw_framed(
+            args,
+            kind,
+            &first,
+            renderer,
+            &layers[0].input,
+            &boxes,
+            renderer.volume().bounds(),
+            image,
+        )
+    };
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(n)) => {
             let n = n as usize;
             let mut writer = animate::Writer::with_pixels(args, &settings, n, n * per_frame)?;
             for i in 0..n {
-                let image = frame(animate::turntable_frame(&settings, i, n), &writer.bar)?;
+                let turned = animate::turntable_frame(&settings, i, n);
+                let camera = turned.camera;
+                let mut image = frame(turned, &writer.bar)?;
+                annotate(camera, &mut image)?;
                 writer.push(&image)?;
             }
             writer.finish()
@@ -147,12 +167,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             let bar = progress_bar(per_frame as u64);
             let mut image = frame(settings.clone(), &bar)?;
             bar.finish_and_clear();
-            // The first volume's colour bar, in the view that frames
-            // every volume.
-            let mut first = layers[0].settings.clone();
-            first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
-            let renderer = &scene.layers()[0];
-            crate::figure::draw(args, kind, &first, renderer, &layers[0].input, &mut image)?;
+            annotate(layers[0].settings.camera, &mut image)?;
             write_still(args, kind, &image)
         }
     }

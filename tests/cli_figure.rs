@@ -1,10 +1,14 @@
-//! Figures from the command line: `--colorbar`, `--scale-bar`, `--title`
-//! and `--label` drawn into a still by volray-annotate (whose own tests
-//! hold the bar's colours at its ticks and the text to the font's
-//! rasterisation). Here: the annotations land where they belong and leave
-//! the rest of the picture as it was, the scale bar is its length over the
-//! view's pixel size, OpenEXR keeps the bare frame and says so, and what
-//! is not drawn yet is refused in one line.
+//! Figures from the command line: `--colorbar`, `--scale-bar`, `--axes`,
+//! `--outline`, `--title` and `--label` drawn into a still or each frame
+//! of an animation by volray-annotate (whose own tests hold the bar's
+//! colours at its ticks, the text to the font's rasterisation, the
+//! triad's directions). Here: the annotations land where they belong and
+//! leave the rest of the picture as it was, the scale bar is its length
+//! over the view's pixel size, the outline runs along the box's edges as
+//! the camera projects them, the triad points as the view turns the
+//! axes, turntables and series are annotated frame by frame, OpenEXR
+//! keeps the bare frame and says so, and what is not drawn yet is refused
+//! in one line.
 
 mod common;
 
@@ -12,6 +16,7 @@ use common::{Picture, stderr, volray};
 use std::path::Path;
 use volray_core::camera::{Camera, View};
 use volray_core::glam::DVec3;
+use volray_core::{Fit, Projection};
 
 /// Renders the built-in `sphere:32` (its box [−1, 1]³) at
 /// `size`², seen along −x, with `args`; the picture and stderr.
@@ -102,45 +107,28 @@ fn the_scale_bar_is_its_length_over_the_views_pixel_size() {
 }
 
 #[test]
-fn openexr_keeps_the_bare_frame_and_animations_are_refused() {
+fn openexr_keeps_the_bare_frame_and_bad_lengths_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("out.exr");
-    let run = volray(&[
-        "render",
-        "sphere:16",
-        "--size",
-        "32",
-        "--colorbar",
-        "-o",
-        exr.to_str().unwrap(),
-    ]);
-    assert!(run.status.success(), "{}", stderr(&run));
-    assert!(
-        stderr(&run).contains("keeps the bare frame"),
-        "{}",
-        stderr(&run)
-    );
-    let gif = dir.path().join("turn.gif");
-    let run = volray(&[
-        "render",
-        "sphere:16",
-        "--size",
-        "32",
-        "--turntable",
-        "3",
-        "--title",
-        "x",
-        "-o",
-        gif.to_str().unwrap(),
-    ]);
-    assert_eq!(run.status.code(), Some(1));
-    let message = stderr(&run);
-    assert_eq!(message.lines().count(), 1, "{message}");
-    assert!(
-        message.contains("--title") && message.contains("animations"),
-        "{message}"
-    );
-    assert!(!gif.exists());
+    for flag in ["--colorbar", "--axes", "--outline"] {
+        let run = volray(&[
+            "render",
+            "sphere:16",
+            "--size",
+            "32",
+            flag,
+            "-o",
+            exr.to_str().unwrap(),
+        ]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let message = stderr(&run);
+        assert!(
+            message.contains("keeps the bare frame") && message.starts_with(flag),
+            "{message}"
+        );
+        assert_eq!(message.lines().count(), 1, "{message}");
+    }
+    let gif = dir.path().join("out.gif");
     let run = volray(&[
         "render",
         "sphere:16",
@@ -154,4 +142,308 @@ fn openexr_keeps_the_bare_frame_and_animations_are_refused() {
         "{}",
         stderr(&run)
     );
+    assert!(!gif.exists());
+}
+
+/// The distance from `p` to the segment `a`–`b`.
+fn distance(p: (f64, f64), (a, b): ((f64, f64), (f64, f64))) -> f64 {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let t = (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+    (p.0 - a.0 - t * dx).hypot(p.1 - a.1 - t * dy)
+}
+
+/// The box's twelve edges as `view` projects them.
+fn edges(view: &View, (lo, hi): (DVec3, DVec3)) -> Vec<((f64, f64), (f64, f64))> {
+    let corner = |i: usize| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let mut out = Vec::new();
+    for i in 0..8 {
+        for bit in [1, 2, 4] {
+            if i & bit == 0 {
+                let (a, b) = (corner(i), corner(i | bit));
+                out.push((view.project(a).unwrap(), view.project(b).unwrap()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_outline_runs_along_the_boxs_edges_as_the_camera_projects_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = (DVec3::splat(-1.0), DVec3::ONE);
+    for (perspective, zoom) in [(None, "1"), (Some(35.0), "1"), (None, "1.6")] {
+        let mut args = vec!["--azimuth", "30", "--elevation", "20", "--zoom", zoom];
+        let fov = perspective.map(|f: f64| f.to_string());
+        if let Some(fov) = &fov {
+            args.extend(["--perspective", fov]);
+        }
+        let (bare, _) = render(dir.path(), "bare.png", 240, &args);
+        args.push("--outline");
+        let (fig, _) = render(dir.path(), "outline.png", 240, &args);
+        let camera = Camera {
+            azimuth: 30.0,
+            elevation: 20.0,
+            zoom: zoom.parse().unwrap(),
+            projection: perspective.map_or(Projection::Orthographic, |fov_degrees| {
+                Projection::Perspective { fov_degrees }
+            }),
+            fit: Fit::Box,
+            ..Camera::default()
+        };
+        let view = View::frame(&camera, bounds, 240, 240).unwrap();
+        let segments = edges(&view, bounds);
+        // Along each edge, the pixels carry the ink (white, at least half
+        // covered).
+        let mut on = 0;
+        for &(a, b) in &segments {
+            for f in 1..40 {
+                let f = f as f64 / 40.0;
+                let p = (a.0 + f * (b.0 - a.0), a.1 + f * (b.1 - a.1));
+                if p.0 < 0.0 || p.1 < 0.0 || p.0 >= 240.0 || p.1 >= 240.0 {
+                    continue;
+                }
+                let (x, y) = (p.0 as usize, p.1 as usize);
+                let (was, is) = (bare.at(x, y)[1] as f64, fig.at(x, y)[1] as f64);
+                assert!(
+                    is - was >= 0.5 * (255.0 - was) - 1.0,
+                    "{perspective:?} {zoom}: ({x}, {y}) {was} -> {is}"
+                );
+                on += 1;
+            }
+        }
+        assert!(on > 100, "{perspective:?} {zoom}: {on}");
+        // Far from every edge, the picture is the bare one.
+        let mut far = 0;
+        for y in 0..240 {
+            for x in 0..240 {
+                let p = (x as f64 + 0.5, y as f64 + 0.5);
+                if segments.iter().all(|&s| distance(p, s) > 1.8) {
+                    assert_eq!(fig.at(x, y), bare.at(x, y), "({x}, {y})");
+                    far += 1;
+                }
+            }
+        }
+        assert!(far > 240 * 200, "{far}");
+    }
+}
+
+/// The mean position of the pixels of `fig` that differ from `bare` and
+/// are mostly channel `k` (the triad's red x, green y, blue z), and how
+/// many there are.
+fn ink_of(fig: &Picture, bare: &Picture, k: usize) -> ((f64, f64), usize) {
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0);
+    for y in 0..fig.height {
+        for x in 0..fig.width {
+            let p = fig.at(x, y);
+            let others = (0..3).filter(|&o| o != k);
+            if p != bare.at(x, y)
+                && p[k] > 100
+                && others
+                    .clone()
+                    .all(|o| u32::from(p[o]) * 10 < u32::from(p[k]) * 7)
+            {
+                sx += x as f64;
+                sy += y as f64;
+                n += 1;
+            }
+        }
+    }
+    ((sx / n.max(1) as f64, sy / n.max(1) as f64), n)
+}
+
+#[test]
+fn the_axes_point_as_the_view_turns_them() {
+    let dir = tempfile::tempdir().unwrap();
+    for azimuth in ["0", "90"] {
+        let args = ["--azimuth", azimuth, "--colormap", "gray"];
+        let (bare, _) = render(dir.path(), "bare.png", 240, &args);
+        let (fig, _) = render(
+            dir.path(),
+            "axes.png",
+            240,
+            &[&args[..], &["--axes"]].concat(),
+        );
+        let (x, nx) = ink_of(&fig, &bare, 0);
+        let (y, ny) = ink_of(&fig, &bare, 1);
+        let (z, nz) = ink_of(&fig, &bare, 2);
+        // z is up in both views: its ink lies above the others'.
+        assert!(
+            nz > 20 && z.1 < x.1 - 5.0 && z.1 < y.1 - 5.0,
+            "{azimuth}: {x:?} {y:?} {z:?}"
+        );
+        // The triad sits in the bottom right corner, clear of the volume.
+        assert!(z.0 > 180.0 && z.1 > 150.0, "{azimuth}: {z:?}");
+        let view = View::frame(
+            &Camera {
+                azimuth: azimuth.parse().unwrap(),
+                ..Camera::default()
+            },
+            (DVec3::splat(-1.0), DVec3::ONE),
+            240,
+            240,
+        )
+        .unwrap();
+        let o = view.project(DVec3::ZERO).unwrap();
+        let along = |axis: DVec3| {
+            let p = view.project(axis).unwrap();
+            (p.0 - o.0, p.1 - o.1)
+        };
+        if azimuth == "0" {
+            // Along −x: +x points at the viewer (a dot), +y to the right.
+            assert!(along(DVec3::X).0.abs() < 1e-9 && along(DVec3::Y).0 > 0.0);
+            assert!(
+                y.0 > z.0 + 5.0 && nx * 2 < ny,
+                "{x:?} {nx} {y:?} {ny} {z:?}"
+            );
+        } else {
+            // Along −y: +x points to the left, +y at the viewer.
+            assert!(along(DVec3::X).0 < 0.0 && along(DVec3::Y).0.abs() < 1e-9);
+            assert!(
+                x.0 < z.0 - 5.0 && ny * 2 < nx,
+                "{x:?} {nx} {y:?} {ny} {z:?}"
+            );
+        }
+    }
+}
+
+/// The frames of a PNG sequence `pattern` (`…_%03d.png`) wrote.
+fn frames(dir: &Path, stem: &str, n: usize) -> Vec<Picture> {
+    (0..n)
+        .map(|i| Picture::read(&dir.join(format!("{stem}_{i:03}.png"))))
+        .collect()
+}
+
+#[test]
+fn turntables_are_annotated_frame_by_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_turn = |stem: &str, extra: &[&str]| {
+        let pattern = dir.path().join(format!("{stem}_%03d.png"));
+        let mut all = vec![
+            "render",
+            "fractal:33",
+            "--size",
+            "240",
+            "--turntable",
+            "4",
+            "--colormap",
+            "viridis",
+            "-o",
+            pattern.to_str().unwrap(),
+        ];
+        all.extend_from_slice(extra);
+        let run = volray(&all);
+        assert!(run.status.success(), "{all:?}: {}", stderr(&run));
+        frames(dir.path(), stem, 4)
+    };
+    let bare = run_turn("bare", &[]);
+    let fig = run_turn(
+        "fig",
+        &["--scale-bar", "0.5", "--axes", "--title", "Turning"],
+    );
+    // The scale bar in each frame: 0.5 over the turntable's pixel (the
+    // view fits the box's bounding sphere, the same at every azimuth).
+    let (lo, hi) = (DVec3::splat(-1.0), DVec3::ONE);
+    for (i, (fig, bare)) in fig.iter().zip(&bare).enumerate() {
+        let view = View::frame(
+            &Camera {
+                azimuth: 90.0 * i as f64,
+                fit: Fit::Sphere,
+                ..Camera::default()
+            },
+            (lo, hi),
+            240,
+            240,
+        )
+        .unwrap();
+        let want = 0.5 / view.as_orthographic().unwrap().pixel_size;
+        let longest = (200..240)
+            .map(|y| {
+                let (mut best, mut run) = (0, 0);
+                for x in 0..240 {
+                    run = if fig.at(x, y) == [255; 3] { run + 1 } else { 0 };
+                    best = best.max(run);
+                }
+                best
+            })
+            .max()
+            .unwrap();
+        assert!(
+            (longest as f64 - want).abs() <= 1.0,
+            "{i}: {longest} vs {want}"
+        );
+        // The title and the triad; the middle is the volume's.
+        let differs = |x0: usize, x1: usize, y0: usize, y1: usize| {
+            (y0..y1).any(|y| (x0..x1).any(|x| fig.at(x, y) != bare.at(x, y)))
+        };
+        assert!(differs(60, 180, 0, 30), "{i}: no title");
+        assert!(differs(180, 240, 170, 240), "{i}: no triad");
+        assert!(!differs(60, 180, 60, 180), "{i}: the volume was drawn over");
+    }
+    // The triad turns: the pixels it changes differ from frame to frame.
+    let changed = |i: usize| -> Vec<(usize, usize)> {
+        (170..240)
+            .flat_map(|y| (180..240).map(move |x| (x, y)))
+            .filter(|&(x, y)| fig[i].at(x, y) != bare[i].at(x, y))
+            .collect()
+    };
+    assert!(!changed(0).is_empty());
+    assert_ne!(changed(0), changed(1));
+}
+
+#[test]
+fn a_series_has_one_colour_bar_and_scale_bar_for_every_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_series = |stem: &str, extra: &[&str]| {
+        let pattern = dir.path().join(format!("{stem}_%03d.png"));
+        let mut all = vec![
+            "render",
+            "sphere:32",
+            "blobs:32",
+            "--size",
+            "240",
+            // The volumes in the middle half, clear of the bars.
+            "--zoom",
+            "0.5",
+            "--colormap",
+            "viridis",
+            "-o",
+            pattern.to_str().unwrap(),
+        ];
+        all.extend_from_slice(extra);
+        let run = volray(&all);
+        assert!(run.status.success(), "{all:?}: {}", stderr(&run));
+        frames(dir.path(), stem, 2)
+    };
+    let bare = run_series("bare", &[]);
+    let fig = run_series("fig", &["--colorbar", "--scale-bar", "--outline"]);
+    assert_ne!(bare[0].rgb, bare[1].rgb, "the volumes differ");
+    // Where the bars are drawn, the two frames are the same pixels.
+    let region = |p: &Picture, x0: usize, x1: usize, y0: usize, y1: usize| -> Vec<[u8; 3]> {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .map(|(x, y)| p.at(x, y))
+            .collect()
+    };
+    for (x0, x1, y0, y1, what) in [
+        (190, 240, 48, 192, "colour bar"),
+        (0, 110, 200, 240, "scale bar"),
+    ] {
+        let (a, b) = (
+            region(&fig[0], x0, x1, y0, y1),
+            region(&fig[1], x0, x1, y0, y1),
+        );
+        assert!(a != region(&bare[0], x0, x1, y0, y1), "no {what}");
+        let first = (0..a.len()).find(|&i| a[i] != b[i]);
+        assert!(
+            first.is_none(),
+            "the {what} differs between frames at {:?}",
+            first.map(|i| (x0 + i % (x1 - x0), y0 + i / (x1 - x0), a[i], b[i]))
+        );
+    }
 }

@@ -1,5 +1,5 @@
-//! What makes a still a figure: `--colorbar`, `--scale-bar`, `--title`,
-//! `--label`, drawn into the image by volray-annotate (`figure.rs` beside
+//! What makes a frame a figure: `--colorbar`, `--scale-bar`, `--axes`,
+//! `--outline`, `--title`, `--label`, drawn into the image by volray-annotate (`figure.rs` beside
 //! `main.rs` says what was rendered).
 
 use clap::Args;
@@ -18,6 +18,17 @@ pub struct FigureArgs {
     /// depth of the volume's centre and is marked ≈.
     #[arg(long, value_name = "LENGTH", num_args = 0..=1, default_missing_value = "auto", value_parser = parse_length, help_heading = "Figures")]
     pub scale_bar: Option<ScaleLength>,
+
+    /// An orientation triad in a corner: the world's x, y, z (R, A, S or
+    /// L, P, S where the file's world is anatomical) turned as the camera
+    /// is, red, green, blue.
+    #[arg(long, help_heading = "Figures")]
+    pub axes: bool,
+
+    /// The volume's box, its twelve edges drawn over the frame as the
+    /// camera sees them (each volume's box with --channels or --overlay).
+    #[arg(long, help_heading = "Figures")]
+    pub outline: bool,
 
     /// A title over the image.
     #[arg(long, value_name = "TEXT", help_heading = "Figures")]
@@ -59,6 +70,8 @@ impl FigureArgs {
             || self.scale_bar.is_some()
             || self.title.is_some()
             || self.label.is_some()
+            || self.axes
+            || self.outline
     }
 
     /// The first annotation flag given, for messages.
@@ -67,6 +80,10 @@ impl FigureArgs {
             "--colorbar"
         } else if self.scale_bar.is_some() {
             "--scale-bar"
+        } else if self.axes {
+            "--axes"
+        } else if self.outline {
+            "--outline"
         } else if self.title.is_some() {
             "--title"
         } else {

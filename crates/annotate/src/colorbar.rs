@@ -39,6 +39,8 @@ pub struct ColorBar<'a> {
 /// tick's value and row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Drawn {
+    /// The left edge of all it drew (strip, bar, ticks, labels).
+    pub left: usize,
     pub bar: (usize, usize, usize, usize),
     pub ticks: Vec<(f64, usize)>,
 }
@@ -179,6 +181,7 @@ impl ColorBar<'_> {
             font.draw(image, unit, l.text, (x.max(1.0), y), ink);
         }
         Drawn {
+            left,
             bar: (bar, top, bar + l.bar, top + bar_h),
             ticks: drawn,
         }
@@ -186,8 +189,13 @@ impl ColorBar<'_> {
 }
 
 /// A legend of a label volume's labels: a swatch of each label's colour
-/// and its name, one per line, top to bottom.
-pub fn legend(image: &mut Image, entries: &[(String, [f32; 3])], side: Side, ink: [f32; 3]) {
+/// and its name, one per line, top to bottom; its left edge.
+pub fn legend(
+    image: &mut Image,
+    entries: &[(String, [f32; 3])],
+    side: Side,
+    ink: [f32; 3],
+) -> usize {
     let font = Font::embedded();
     let l = Layout::of(image);
     let (w, h) = (image.width(), image.height());
@@ -220,6 +228,7 @@ pub fn legend(image: &mut Image, entries: &[(String, [f32; 3])], side: Side, ink
         let at = ((left + l.bar) as f32, y as f32 + swatch as f32);
         font.draw(image, name, l.text, at, ink);
     }
+    left
 }
 
 #[cfg(test)]

@@ -1,11 +1,13 @@
 //! A frame made a figure: the annotations a front end asks for
-//! ([`Annotations`]: colour bar, scale bar, title, panel label) drawn
+//! ([`Annotations`]: colour bar, scale bar, orientation axes, the
+//! volume's outline, title, panel label) drawn
 //! for what was rendered ([`Subject`]: the view, the transfer function's
 //! colours and opacity over its window, the units), in an ink that reads
 //! on the frame's background. The command line, Python and the viewer
 //! draw through this one function.
 
-use crate::colorbar::{ColorBar, Side, legend};
+use crate::colorbar::{ColorBar, Layout, Side, legend};
+use crate::line::width_for;
 use crate::scalebar::ScaleBar;
 use crate::text::Font;
 use volray_core::camera::View;
@@ -24,6 +26,10 @@ pub struct Annotations {
     pub title: Option<String>,
     /// Text in the top left corner (a panel's letter).
     pub label: Option<String>,
+    /// An orientation triad of the world's axes ([`crate::axes`]).
+    pub axes: bool,
+    /// The edges of the volume's box ([`crate::outline`]).
+    pub outline: bool,
 }
 
 impl Annotations {
@@ -33,6 +39,8 @@ impl Annotations {
             || self.scale_bar.is_some()
             || self.title.is_some()
             || self.label.is_some()
+            || self.axes
+            || self.outline
     }
 }
 
@@ -61,6 +69,12 @@ pub struct Subject<'a> {
     pub length_unit: Option<&'a str>,
     /// The frame's background colour.
     pub background: [f32; 3],
+    /// The names of the world's +x, +y, +z for the triad (`["R", "A",
+    /// "S"]` for RAS+), `["x", "y", "z"]` where the volume names none.
+    pub axis_names: [&'a str; 3],
+    /// The boxes the outline draws: the volume's (`bounds`), or each of a
+    /// scene's volumes.
+    pub boxes: &'a [(DVec3, DVec3)],
 }
 
 /// The ink that reads on `background`: white on dark, black on light
@@ -90,8 +104,18 @@ pub fn pixel_size(view: &View, bounds: (DVec3, DVec3)) -> (f64, bool) {
 /// Draws `what` for `subject` into `image`.
 pub fn annotate(image: &mut Image, what: &Annotations, subject: &Subject) {
     let ink = ink(subject.background);
+    // The outline first: the other annotations lie over it.
+    if what.outline {
+        let width = width_for(image);
+        for &bounds in subject.boxes {
+            crate::outline::draw(image, subject.view, bounds, width, ink);
+        }
+    }
+    // Where the triad's corner ends on the right: before a colour bar
+    // there.
+    let mut right = image.width() as f64 - Layout::of(image).margin as f64;
     if let Some(side) = what.colorbar {
-        match &subject.labels {
+        let left = match &subject.labels {
             Some(entries) if !entries.is_empty() => legend(image, entries, side, ink),
             _ => {
                 let projection = subject.blend != Blend::Composite;
@@ -104,8 +128,11 @@ pub fn annotate(image: &mut Image, what: &Annotations, subject: &Subject) {
                     unit: subject.value_unit,
                     side,
                 };
-                bar.draw(image, ink);
+                bar.draw(image, ink).left
             }
+        };
+        if side == Side::Right {
+            right = left as f64 - Layout::of(image).margin as f64 / 2.0;
         }
     }
     if let Some(length) = what.scale_bar {
@@ -117,6 +144,9 @@ pub fn annotate(image: &mut Image, what: &Annotations, subject: &Subject) {
             approximate,
         }
         .draw(image, ink);
+    }
+    if what.axes {
+        crate::axes::draw(image, subject.view, subject.axis_names, right);
     }
     let font = Font::embedded();
     let side = image.width().min(image.height()) as f32;
@@ -183,6 +213,8 @@ mod tests {
             value_unit: None,
             length_unit: None,
             background: [0.2; 3],
+            axis_names: ["x", "y", "z"],
+            boxes: &[(DVec3::ZERO, DVec3::ONE)],
         };
         annotate(&mut image, &Annotations::default(), &subject);
         assert_eq!(image, before);
@@ -191,6 +223,8 @@ mod tests {
             scale_bar: Some(None),
             title: Some("A title".into()),
             label: Some("a".into()),
+            axes: true,
+            outline: true,
         };
         assert!(all.any());
         annotate(&mut image, &all, &subject);

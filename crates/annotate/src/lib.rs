@@ -35,8 +35,11 @@
 //! assert_eq!(scale.draw(&mut frame, [1.0; 3]).length, 50.0); // about a fifth of 240 mm
 //! ```
 
+pub mod axes;
 pub mod colorbar;
 pub mod figure;
+pub mod line;
+pub mod outline;
 pub mod scalebar;
 pub mod text;
 pub mod ticks;
