@@ -10,6 +10,9 @@
 //!
 //! `cargo run --release -p volray-core --example scene_bench [-- N FRAMES]`
 //! (N: grid side, default 256; FRAMES: timed frames per case, default 7).
+//! `SCENE_BENCH_ONLY=TEXT` runs the cases whose names hold TEXT (the first
+//! one shown is the ratios' unit), `SCENE_BENCH_CLASS=pre|post` one
+//! classification.
 
 use std::time::Instant;
 use volray_core::camera::Camera;
@@ -79,7 +82,13 @@ fn main() {
         ),
         color: Some(PiecewiseLinear::constant(rgb)),
     };
+    // SCENE_BENCH_CLASS=pre or post: that classification only.
+    let class = std::env::var("SCENE_BENCH_CLASS").ok();
     for classification in [Classification::Pre, Classification::Post] {
+        let name = format!("{classification:?}").to_lowercase();
+        if class.as_deref().is_some_and(|c| c != name) {
+            continue;
+        }
         let settings = |frame: usize| RenderSettings {
             width: 512,
             height: 512,

@@ -411,6 +411,73 @@ fn the_additive_mix_sums_the_channels_colours() {
 }
 
 #[test]
+fn channels_marched_together_in_the_additive_mix_sum_as_each_alone() {
+    // Five channels of one grid (one march of four, then one of one, their
+    // colours summed), shaded, in perspective, jittered, cropped: each
+    // channel's colour is what it renders alone, over black.
+    let dims = [34, 30, 26];
+    let volumes: Vec<Volume> = (0..5)
+        .map(|c| waves(dims, DVec3::ONE, DVec3::ZERO, c as f64 * 1.3))
+        .collect();
+    let settings = RenderSettings {
+        opacity_ramp: (0.0, 0.1),
+        jitter: true,
+        background: [0.0; 3],
+        camera: Camera {
+            projection: Projection::Perspective { fov_degrees: 35.0 },
+            ..small(40).camera
+        },
+        crop: Some((DVec3::new(2.0, 0.0, 1.0), DVec3::new(30.0, 29.0, 22.0))),
+        ..small(40)
+    };
+    let colours = [
+        [1.0, 0.0, 1.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 1.0, 1.0],
+        [1.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+    ];
+    let looks: Vec<Look> = colours.iter().map(|&c| coloured(&settings, c)).collect();
+    for k in [2, 3, 5] {
+        let scene = Scene::new(
+            (volumes[..k].iter())
+                .map(|v| Renderer::new(v).unwrap())
+                .collect(),
+        )
+        .unwrap();
+        let request = SceneSettings {
+            settings: settings.clone(),
+            looks: looks[..k].to_vec(),
+            mix: Mix::Additive,
+        };
+        let image = render(&scene, &request);
+        let alone: Vec<Image> = (0..k)
+            .map(|c| {
+                let one = Scene::new(vec![Renderer::new(&volumes[c]).unwrap()]).unwrap();
+                let request = SceneSettings {
+                    looks: vec![looks[c].clone()],
+                    ..request.clone()
+                };
+                render(&one, &request)
+            })
+            .collect();
+        for (i, p) in image.pixels().iter().enumerate() {
+            let (mut sum, mut keep) = ([0.0f32; 3], 1.0f32);
+            for a in &alone {
+                let q = a.pixels()[i];
+                (0..3).for_each(|c| sum[c] += q[c]);
+                keep *= 1.0 - q[3];
+            }
+            for c in 0..3 {
+                assert!((p[c] - sum[c].min(1.0)).abs() < 1e-5, "{k}: {p:?} {sum:?}");
+            }
+            assert!((p[3] - (1.0 - keep)).abs() < 1e-5, "{k}: {p:?} {keep}");
+        }
+        assert_fast_matches(&scene, &request, &format!("{k} channels additive"));
+    }
+}
+
+#[test]
 fn a_label_overlay_shows_each_label_in_its_table_colour_over_a_translucent_scan() {
     // A faint scan, and labels 3 and 7 (two opaque blocks) with 0 elsewhere.
     let dims = [32, 32, 32];
@@ -488,7 +555,10 @@ fn the_image_is_the_same_on_one_and_on_several_threads() {
             .collect(),
     )
     .unwrap();
-    for classification in [Classification::Pre, Classification::Post] {
+    let cases = [Classification::Pre, Classification::Post]
+        .into_iter()
+        .flat_map(|c| [(c, Mix::Composite), (c, Mix::Additive)]);
+    for (classification, mix) in cases {
         let settings = RenderSettings {
             classification,
             jitter: true,
@@ -501,7 +571,7 @@ fn the_image_is_the_same_on_one_and_on_several_threads() {
                 look(&settings, colorful()),
             ],
             settings,
-            mix: Mix::Composite,
+            mix,
         };
         let on = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -511,8 +581,8 @@ fn the_image_is_the_same_on_one_and_on_several_threads() {
             pool.install(|| render(&scene, &request))
         };
         let one = on(1);
-        assert_eq!(one, on(2), "{classification:?}");
-        assert_eq!(one, on(5), "{classification:?}");
+        assert_eq!(one, on(2), "{classification:?} {mix:?}");
+        assert_eq!(one, on(5), "{classification:?} {mix:?}");
     }
 }
 

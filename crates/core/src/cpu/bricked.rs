@@ -206,6 +206,9 @@ impl Steppings for [Stepping] {
 /// caster is the same code for both (monomorphised), so one volume's
 /// frames are exactly what they were before there were several.
 pub(crate) trait BrickSource: Sync {
+    /// What a ray accumulates: one compositor ([`FrontToBack`]), or one
+    /// per volume (the additive mix).
+    type Acc: Accumulator;
     /// A brick's voxels, lit for the frame, as [`Self::march`] reads them.
     type Lit<'l>
     where
@@ -220,13 +223,30 @@ pub(crate) trait BrickSource: Sync {
     /// returns whether the ray has terminated.
     fn march<'l>(
         &'l self,
-        acc: &mut FrontToBack,
+        acc: &mut Self::Acc,
         lit: &Self::Lit<'l>,
         n: usize,
         segment: &Segment,
     ) -> bool;
     /// A tile is done with list entry `n`.
     fn done(&self, n: usize);
+}
+
+/// What a ray carries from brick to brick: its compositing so far.
+pub(crate) trait Accumulator: Copy + Send {
+    /// Nothing composited yet.
+    const NEW: Self;
+    /// The ray's partial pixel.
+    fn partial(&self) -> PartialPixel;
+}
+
+impl Accumulator for FrontToBack {
+    const NEW: Self = FrontToBack::NEW;
+
+    #[inline]
+    fn partial(&self) -> PartialPixel {
+        FrontToBack::partial(self)
+    }
 }
 
 /// One volume's occupied bricks, lit into `lit` by `lighting`.
@@ -237,6 +257,7 @@ struct One<'a> {
 }
 
 impl BrickSource for One<'_> {
+    type Acc = FrontToBack;
     type Lit<'l>
         = CacheRef<'l, [[f32; 4]; SLOTS]>
     where
@@ -413,7 +434,7 @@ impl<'a> Rays<'a> {
         let cols = tx * TILE..tx * TILE + rows[0].len();
         let count = cols.len() * rows.len();
         let pixel = |i: usize| (cols.start + i % cols.len(), ty * TILE + i / cols.len());
-        let mut states = [RayState::EMPTY; TILE * TILE];
+        let mut states = [RayState::<B::Acc>::EMPTY; TILE * TILE];
         let states = &mut states[..count];
         match self.geometry {
             Geometry::Parallel {
@@ -460,7 +481,12 @@ impl<'a> Rays<'a> {
     /// the reference's ray ([`View::pixel_ray`]), its samples counted from
     /// the one nearest to where the ray passes `centre`, and none behind
     /// the eye.
-    fn ray_from_eye(&self, col: usize, row: usize, centre: DVec3) -> (RayState, Stepping) {
+    fn ray_from_eye<A: Accumulator>(
+        &self,
+        col: usize,
+        row: usize,
+        centre: DVec3,
+    ) -> (RayState<A>, Stepping) {
         let (grid, step) = (&self.sampling.grid, self.sampling.step);
         let (eye, direction) = self.view.pixel_ray(col, row);
         let offset = if self.sampling.jitter {
@@ -495,7 +521,7 @@ impl<'a> Rays<'a> {
         scene: &B,
         list: &[u32],
         pixel: &impl Fn(usize) -> (usize, usize),
-        states: &mut [RayState],
+        states: &mut [RayState<B::Acc>],
         steppings: &S,
     ) {
         // Where a brick the lit-brick cache has no room for is lit.
@@ -539,7 +565,7 @@ impl<'a> Rays<'a> {
         n: usize,
         scratch: &'l mut B::Scratch,
         pixel: &impl Fn(usize) -> (usize, usize),
-        states: &mut [RayState],
+        states: &mut [RayState<B::Acc>],
         steppings: &S,
     ) -> usize {
         let mut scratch = Some(scratch);
@@ -651,11 +677,11 @@ pub(crate) fn march(
 
 /// A ray of a tile, between bricks.
 #[derive(Clone, Copy)]
-struct RayState {
+struct RayState<A> {
     /// Index-space position of the ray's sample 0 (for parallel rays on
     /// the image plane, `t = 0`; see [`Stepping::base`]).
     origin: f32x4,
-    acc: FrontToBack,
+    acc: A,
     /// The first sample not yet taken (a perspective ray's first is the
     /// first ahead of the eye).
     next: i32,
@@ -667,10 +693,10 @@ struct RayState {
     done: bool,
 }
 
-impl RayState {
-    const EMPTY: RayState = RayState {
+impl<A: Accumulator> RayState<A> {
+    const EMPTY: RayState<A> = RayState {
         origin: f32x4::ZERO,
-        acc: FrontToBack::NEW,
+        acc: A::NEW,
         next: i32::MIN,
         exact: None,
         done: false,

@@ -22,10 +22,10 @@ use super::SceneFrame;
 use crate::bricks::cache::CacheRef;
 use crate::bricks::occupied::{ClassifiedBricks, Source};
 use crate::bricks::{BRICK, BrickGrid, CELLS, SIDE, SLOTS, cell, slot};
-use crate::cpu::bricked::{self, BrickSource, CellBox, Segment, render_source};
+use crate::cpu::bricked::{self, Accumulator, BrickSource, CellBox, Segment, render_source};
 use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::TileBins;
-use crate::kernels::composite::{Finish, FrontToBack};
+use crate::kernels::composite::{EMPTY, Finish, FrontToBack, PartialPixel};
 use crate::kernels::mix::Mixer;
 use crate::kernels::trilinear::{corners, interpolate};
 use crate::partial::{PartialImage, PartialPixels};
@@ -110,30 +110,62 @@ impl Channels<'_> {
     }
 }
 
-impl BrickSource for Channels<'_> {
-    /// The volumes occupied in the brick: their lit voxels and occupied
-    /// cells.
-    type Lit<'l>
-        = Vec<(CacheRef<'l, [[f32; 4]; SLOTS]>, &'l [u64; CELLS / 64])>
-    where
-        Self: 'l;
-    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+/// The volumes occupied in a brick: each one's number `k` in the scene,
+/// its lit voxels and its occupied cells.
+type LitVolumes<'l> = Vec<(
+    usize,
+    CacheRef<'l, [[f32; 4]; SLOTS]>,
+    &'l [u64; CELLS / 64],
+)>;
 
+impl Channels<'_> {
     fn cell_box(&self, u: usize) -> CellBox {
         CellBox::new(&self.grid, self.union.bricks[u], self.union.boxes[u])
     }
 
-    fn light<'l>(&'l self, u: usize, scratch: &'l mut Self::Scratch) -> Self::Lit<'l> {
+    fn light<'l>(
+        &'l self,
+        u: usize,
+        scratch: &'l mut Vec<Option<Box<[[f32; 4]; SLOTS]>>>,
+    ) -> LitVolumes<'l> {
         scratch.resize_with(self.channels.len(), || None);
         (self.channels.iter().zip(scratch.iter_mut()).enumerate())
             .filter_map(|(k, (channel, scratch))| {
                 let n = self.number(u, k) as usize;
                 (n != NONE as usize).then(|| {
                     let lit = channel.lit.get(n, &channel.lighting, scratch);
-                    (lit, &channel.bricks.cells[n])
+                    (k, lit, &channel.bricks.cells[n])
                 })
             })
             .collect()
+    }
+
+    fn done(&self, u: usize) {
+        for (k, channel) in self.channels.iter().enumerate() {
+            let n = self.number(u, k);
+            if n != NONE {
+                channel.lit.done(n as usize);
+            }
+        }
+    }
+}
+
+impl BrickSource for Channels<'_> {
+    type Acc = FrontToBack;
+    /// The volumes occupied in the brick: their lit voxels and occupied
+    /// cells.
+    type Lit<'l>
+        = LitVolumes<'l>
+    where
+        Self: 'l;
+    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+
+    fn cell_box(&self, u: usize) -> CellBox {
+        Channels::cell_box(self, u)
+    }
+
+    fn light<'l>(&'l self, u: usize, scratch: &'l mut Self::Scratch) -> Self::Lit<'l> {
+        Channels::light(self, u, scratch)
     }
 
     fn march<'l>(
@@ -148,12 +180,15 @@ impl BrickSource for Channels<'_> {
             ([[0.0; 4]; SLOTS], [0; CELLS / 64]);
         match lit.len() {
             // One volume occupied here: the single-volume caster's march.
-            1 => return bricked::march(acc, &lit[0].0, lit[0].1, segment),
-            n if n > DIRECT => return march(acc, lit, segment),
+            1 => return bricked::march(acc, &lit[0].1, lit[0].2, segment),
+            n if n > DIRECT => {
+                let guarded: Vec<_> = lit.iter().map(|(_, v, c)| (&**v, *c)).collect();
+                return march(acc, &guarded, segment);
+            }
             _ => {}
         }
         let mut direct = [(&NOTHING.0, &NOTHING.1); DIRECT];
-        for (d, (voxels, cells)) in direct.iter_mut().zip(lit) {
+        for (d, (_, voxels, cells)) in direct.iter_mut().zip(lit) {
             *d = (&**voxels, *cells);
         }
         match lit.len() {
@@ -164,12 +199,7 @@ impl BrickSource for Channels<'_> {
     }
 
     fn done(&self, u: usize) {
-        for (k, channel) in self.channels.iter().enumerate() {
-            let n = self.number(u, k);
-            if n != NONE {
-                channel.lit.done(n as usize);
-            }
-        }
+        Channels::done(self, u)
     }
 }
 
@@ -254,6 +284,138 @@ fn march_body<L: Deref<Target = [[f32; 4]; SLOTS]>>(
     terminated
 }
 
+/// Up to this many volumes are composited side by side in one march of
+/// the additive mix; more are marched in groups of this many, the groups'
+/// partial pixels summed.
+const GROUP: usize = 4;
+
+/// The additive mix's ray: one front-to-back compositor per volume, each
+/// taking its volume's samples exactly as that volume's own renderer
+/// takes them (and stopping where that one stops); the partial pixel is
+/// theirs summed as [`super::add`] sums the volumes' frames, in order
+/// from [`EMPTY`], so the result is what rendering each apart and
+/// summing gives (up to the rounding of samples on the faces of boxes
+/// that differ: the union's and each volume's own).
+#[derive(Clone, Copy)]
+struct Sums<const N: usize>([FrontToBack; N]);
+
+impl<const N: usize> Accumulator for Sums<N> {
+    const NEW: Self = Sums([FrontToBack::NEW; N]);
+
+    #[inline]
+    fn partial(&self) -> PartialPixel {
+        (self.0.iter()).fold(EMPTY, |sum, acc| super::add(sum, acc.partial()))
+    }
+}
+
+/// `N` volumes on one grid in the additive mix: the same bricks, lists
+/// and lit voxels as the composite mix ([`Channels`]), a compositor per
+/// volume along each ray. A ray ends when every volume's compositor is
+/// opaque; a brick is skipped where every volume is empty (the union's
+/// lists), and a volume empty in a brick takes no sample there.
+struct Additive<'c, 'a, const N: usize>(&'c Channels<'a>);
+
+impl<const N: usize> BrickSource for Additive<'_, '_, N> {
+    type Acc = Sums<N>;
+    type Lit<'l>
+        = LitVolumes<'l>
+    where
+        Self: 'l;
+    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+
+    fn cell_box(&self, u: usize) -> CellBox {
+        self.0.cell_box(u)
+    }
+
+    fn light<'l>(&'l self, u: usize, scratch: &'l mut Self::Scratch) -> Self::Lit<'l> {
+        self.0.light(u, scratch)
+    }
+
+    fn march<'l>(
+        &'l self,
+        acc: &mut Sums<N>,
+        lit: &Self::Lit<'l>,
+        _: usize,
+        segment: &Segment,
+    ) -> bool {
+        static NOTHING: ([[f32; 4]; SLOTS], [u64; CELLS / 64]) =
+            ([[0.0; 4]; SLOTS], [0; CELLS / 64]);
+        // The volumes occupied here whose rays still take light: a volume
+        // whose ray is opaque has stopped, as its own renderer's has.
+        let mut live: [Numbered; N] = [(0, &NOTHING.0, &NOTHING.1); N];
+        let mut m = 0;
+        for (k, voxels, cells) in lit {
+            if !acc.0[*k].is_opaque() {
+                live[m] = (*k, &**voxels, *cells);
+                m += 1;
+            }
+        }
+        match m {
+            0 => {}
+            // One volume: the single-volume caster's march.
+            1 => {
+                let (k, voxels, cells) = live[0];
+                bricked::march(&mut acc.0[k], voxels, cells, segment);
+            }
+            2 => march_apart::<N, 2>(&mut acc.0, &live, segment),
+            3 => march_apart::<N, 3>(&mut acc.0, &live, segment),
+            _ => march_apart::<N, GROUP>(&mut acc.0, &live, segment),
+        }
+        acc.0.iter().all(FrontToBack::is_opaque)
+    }
+
+    fn done(&self, u: usize) {
+        self.0.done(u)
+    }
+}
+
+/// A volume occupied in a brick: its number in the scene, its lit voxels
+/// and its occupied cells.
+type Numbered<'l> = (usize, &'l [[f32; 4]; SLOTS], &'l [u64; CELLS / 64]);
+
+/// Composites the samples of `segment` into the compositors `rays` of the
+/// first `M` of `volumes` (each its number `k`, lit voxels and occupied
+/// cells; each not yet opaque), each volume's samples into its own ray as
+/// [`bricked::march`] composites one volume's, until every one of them is
+/// opaque.
+#[inline(never)]
+fn march_apart<const N: usize, const M: usize>(
+    rays: &mut [FrontToBack; N],
+    volumes: &[Numbered; N],
+    segment: &Segment,
+) {
+    let volumes: [_; M] = std::array::from_fn(|v| volumes[v]);
+    let last_cell = f32x4::splat((BRICK - 1) as f32);
+    // The volumes' rays, in registers for the loop.
+    let mut acc: [FrontToBack; M] = std::array::from_fn(|v| rays[volumes[v].0]);
+    let mut p = segment.origin + segment.delta * f32x4::splat(segment.first as f32);
+    let mut live = M;
+    let mut left = segment.last - segment.first + 1;
+    while left > 0 {
+        left -= 1;
+        let here = p.fast_max(segment.lo).fast_min(segment.hi);
+        p += segment.delta;
+        let c = here.fast_min(last_cell).fast_trunc_int();
+        let [i, j, l, _] = c.to_array().map(|x| x as usize & (BRICK - 1));
+        let bit = cell(i, j, l);
+        let [fx, fy, fz, _] = (here - f32x4::from_i32x4(c)).to_array();
+        for (ray, (_, lit, cells)) in acc.iter_mut().zip(&volumes) {
+            if ray.is_opaque() || cells[bit / 64] >> (bit % 64) & 1 == 0 {
+                continue;
+            }
+            let voxels = corners(|s| f32x4::new(lit[s]), slot(i, j, l), SIDE, SIDE * SIDE);
+            ray.add(interpolate(voxels, [fx, fy, fz]));
+            live -= usize::from(ray.is_opaque());
+        }
+        if live == 0 {
+            break;
+        }
+    }
+    for (v, (k, _, _)) in volumes.iter().enumerate() {
+        rays[*k] = acc[v];
+    }
+}
+
 /// Whether every volume of `layers` is on one grid: the same points,
 /// origin and spacing (so that their bricks coincide).
 pub(super) fn one_grid(layers: &[(&Renderer, &RenderSettings)]) -> bool {
@@ -265,12 +427,85 @@ pub(super) fn one_grid(layers: &[(&Renderer, &RenderSettings)]) -> bool {
 }
 
 /// Renders `layers` (pre-classified volumes on one grid, each with its
-/// settings) mixed, as `frame` says, into a partial image.
+/// settings) in the composite mix, as `frame` says, into a partial image.
 pub(super) fn render(
     layers: &[(&Renderer, &RenderSettings)],
     frame: &SceneFrame,
     progress: &Progress,
 ) -> PartialImage {
+    with_channels(layers, frame, |channels, bins, sampling| {
+        cast_with(channels, (bins, sampling, frame, progress))
+    })
+}
+
+/// Renders `layers` (pre-classified volumes on one grid) in the additive
+/// mix, as `frame` says: each volume composited on its own along the
+/// rays of one march, the colours summed and the transmittances
+/// multiplied, into a partial image (the background and the clamp are
+/// the caller's, as for volumes rendered apart).
+pub(super) fn render_additive(
+    layers: &[(&Renderer, &RenderSettings)],
+    frame: &SceneFrame,
+    progress: &Progress,
+) -> PartialImage {
+    let mut groups = layers.chunks(GROUP).map(|group| {
+        with_channels(group, frame, |channels, bins, sampling| {
+            let args = (bins, sampling, frame, progress);
+            match group.len() {
+                1 => cast_with(&Additive::<1>(channels), args),
+                2 => cast_with(&Additive::<2>(channels), args),
+                3 => cast_with(&Additive::<3>(channels), args),
+                _ => cast_with(&Additive::<GROUP>(channels), args),
+            }
+        })
+    });
+    let mut image = groups.next().expect("a volume shown");
+    for group in groups {
+        let (PartialPixels::Composite(sum), PartialPixels::Composite(more)) =
+            (image.pixels_mut(), group.pixels())
+        else {
+            unreachable!("composited frames")
+        };
+        for (s, p) in sum.iter_mut().zip(more) {
+            *s = super::add(*s, *p);
+        }
+    }
+    image
+}
+
+/// Casts `source`'s rays, binned into `bins` and sampled as `sampling`
+/// says, through `frame`'s view into a partial image.
+fn cast_with<S: BrickSource>(
+    source: &S,
+    (bins, sampling, frame, progress): (&TileBins, &Sampling, &SceneFrame, &Progress),
+) -> PartialImage {
+    let view = &frame.view;
+    let mut image = PartialImage::composite(view.width(), view.height());
+    let PartialPixels::Composite(pixels) = image.pixels_mut() else {
+        unreachable!("a composite image")
+    };
+    render_source(
+        source,
+        bins,
+        sampling,
+        view,
+        pixels,
+        Finish::Partial,
+        progress,
+    );
+    image
+}
+
+/// Calls `cast` with the lit bricks of `layers` (pre-classified volumes on
+/// one grid, each with its settings) in a frame as `frame` says, the
+/// union of their occupied bricks binned into the image's tiles, and the
+/// frame's samples in their grid; then ends the frame of each volume's
+/// lit bricks.
+fn with_channels<R>(
+    layers: &[(&Renderer, &RenderSettings)],
+    frame: &SceneFrame,
+    cast: impl FnOnce(&Channels, &TileBins, &Sampling) -> R,
+) -> R {
     let view = &frame.view;
     let volume = layers[0].0.volume();
     let grid = BrickGrid::new(volume.dims());
@@ -330,20 +565,7 @@ pub(super) fn render(
             })
             .collect(),
     };
-    let (width, height) = (view.width(), view.height());
-    let mut image = PartialImage::composite(width, height);
-    let PartialPixels::Composite(pixels) = image.pixels_mut() else {
-        unreachable!("a composite image")
-    };
-    render_source(
-        &channels,
-        &bins,
-        &sampling,
-        view,
-        pixels,
-        Finish::Partial,
-        progress,
-    );
+    let result = cast(&channels, &bins, &sampling);
     let lit: Vec<usize> = channels
         .channels
         .iter()
@@ -353,7 +575,7 @@ pub(super) fn render(
     for (guard, lit) in states.iter_mut().zip(lit) {
         state_mut(guard).lit.end_frame(lit);
     }
-    image
+    result
 }
 
 fn state<'g>(guard: &'g MutexGuard<Option<FastState>>) -> &'g FastState {

@@ -41,9 +41,11 @@
 //! stepped over (post-classified), and stops the ray when less than
 //! 1/1024 of the light gets through. A brick of one volume costs nothing
 //! where it is transparent, so empty space is skipped only where every
-//! volume is transparent. Additive mixes and projections render each
-//! volume with its own [`Renderer`], whose paths are the single-volume
-//! ones. A scene of one volume renders exactly as that volume's
+//! volume is transparent. The additive mix of pre-classified volumes on
+//! one grid is one march too (`channels.rs`): a compositor per volume
+//! along each ray, the colours summed at its end. Other additive mixes and
+//! the projections render each volume with its own [`Renderer`], whose
+//! paths are the single-volume ones. A scene of one volume renders exactly as that volume's
 //! [`Renderer`] does.
 //!
 //! ```
@@ -262,8 +264,8 @@ impl<'v> Scene<'v> {
     }
 
     /// Renders one frame, calling `progress` with the pixels finished as
-    /// the work proceeds (`width·height` in all, per volume rendered
-    /// apart), stopped when `stop` is set ([`RenderError::Stopped`]).
+    /// the work proceeds (`width·height` in all per march: once for one
+    /// march, once per volume rendered apart), stopped when `stop` is set ([`RenderError::Stopped`]).
     pub fn render_with_progress(
         &self,
         request: &SceneSettings,
@@ -414,6 +416,30 @@ impl<'v> Scene<'v> {
         let background = shared.background;
         if shared.blend.is_projection() {
             return self.projections(&settings, &shown, shared, progress);
+        }
+        if request.mix == Mix::Additive && shown.len() > 1 {
+            let layers: Vec<(&Renderer, &RenderSettings)> = shown
+                .iter()
+                .map(|&i| (&self.layers[i], &settings[i]))
+                .collect();
+            if shared.method == Method::Fast
+                && shared.classification == Classification::Pre
+                && channels::one_grid(&layers)
+            {
+                // One march, a compositor per volume along each ray.
+                let frame = self.frame(shared, &settings[shown[0]], layers[0].0.volume())?;
+                let partial = channels::render_additive(&layers, &frame, progress);
+                for (layer, _) in &layers {
+                    layer.verify()?;
+                }
+                let PartialPixels::Composite(sum) = partial.pixels() else {
+                    unreachable!("a composited frame")
+                };
+                let pixels = (sum.par_iter())
+                    .map(|p| clamp_colour(over_background(*p, background)))
+                    .collect();
+                return Ok(Image::from_pixels(width, height, pixels).expect("the frame's size"));
+            }
         }
         if request.mix == Mix::Additive || shown.len() <= 1 {
             // Each volume on its own, the colours summed.
