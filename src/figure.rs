@@ -9,12 +9,9 @@ use crate::flags::{ColorBarSide, FigureArgs, RenderArgs, ScaleLength};
 use crate::input::Input;
 use crate::render::OutputKind;
 use volray_annotate::colorbar::Side;
-use volray_annotate::figure::{Annotations, Subject, annotate};
+use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
 use volray_core::glam::DVec3;
-use volray_core::transfer::classifier::Classifier;
-use volray_core::transfer::labels::{MAX_LABELS, labels_of};
-use volray_core::{Blend, Image, RenderSettings, Renderer};
-use volray_io::VolumeFormat;
+use volray_core::{Image, RenderSettings, Renderer};
 
 /// The annotations the flags ask for.
 pub fn annotations(args: &FigureArgs) -> Annotations {
@@ -34,37 +31,12 @@ pub fn annotations(args: &FigureArgs) -> Annotations {
     }
 }
 
-/// The names of the world's +x, +y, +z where the file says what they
-/// are: a NIfTI, Analyze, MGH or MINC world is RAS+ (x towards the
-/// subject's right, y anterior, z superior), DICOM's LPS+, NRRD's its
-/// `space`; x, y, z otherwise, and for a grid rendered in its own axes
-/// because they are rotated away from the world's.
+/// The names of the world's +x, +y, +z for the triad: the file's
+/// ([`volray_io::world_axis_names`]), else x, y, z.
 pub fn axis_names(input: &Input) -> [&'static str; 3] {
-    const XYZ: [&str; 3] = ["x", "y", "z"];
-    let Some((format, info)) = &input.file else {
-        return XYZ;
-    };
-    if (info.notes.iter()).any(|n| n.contains("own axes")) {
-        return XYZ;
-    }
-    match format {
-        VolumeFormat::Nifti | VolumeFormat::Analyze | VolumeFormat::Mgh | VolumeFormat::Minc => {
-            ["R", "A", "S"]
-        }
-        VolumeFormat::Dicom => ["L", "P", "S"],
-        VolumeFormat::Nrrd => {
-            let space = (info.header.iter())
-                .find(|(k, _)| k == "space")
-                .map(|(_, v)| v.trim().to_ascii_lowercase());
-            match space.as_deref() {
-                Some("right-anterior-superior" | "ras") => ["R", "A", "S"],
-                Some("left-anterior-superior" | "las") => ["L", "A", "S"],
-                Some("left-posterior-superior" | "lps") => ["L", "P", "S"],
-                _ => XYZ,
-            }
-        }
-        _ => XYZ,
-    }
+    (input.file.as_ref())
+        .and_then(|(format, info)| volray_io::world_axis_names(*format, info))
+        .unwrap_or(["x", "y", "z"])
 }
 
 /// Refuses annotations where they are not drawn yet: volumes rendered
@@ -128,71 +100,25 @@ pub fn draw_framed(
         );
         return Ok(());
     }
-    let volume = renderer.volume();
-    let frame = (renderer.prepare(settings)).map_err(|e| CliError::input(e.to_string()))?;
-    let classifier = Classifier::for_frame(
-        settings,
-        renderer.value_range(),
-        volume.spacing().min_element() as f32,
-        || renderer.max_gradient(),
-    );
-    let (lo, inv) = classifier.normalisation();
-    let (lo, hi) = (
-        f64::from(lo),
-        f64::from(lo) + if inv > 0.0 { 1.0 / f64::from(inv) } else { 0.0 },
-    );
-    // The data were rendered as log10 of themselves (--log): the bar's
-    // values are the data's own.
-    let log = args.view.look.log;
-    let value = |v: f64| if log { v.log10() as f32 } else { v as f32 };
-    let window = if log {
-        (10f64.powf(lo), 10f64.powf(hi))
-    } else {
-        (lo, hi)
-    };
-    let projection = settings.blend != Blend::Composite;
-    let colour = |v: f64| {
-        if projection {
-            classifier.projection_colour(value(v))
-        } else {
-            classifier.material(value(v))
-        }
-    };
-    let opacity = |v: f64| classifier.unit_opacity(value(v));
-    let labels = if volume.is_labels() {
-        let found = labels_of(volume, MAX_LABELS)
-            .ok()
-            .flatten()
-            .unwrap_or_default();
-        Some(
-            (found.into_iter())
-                .filter(|&l| classifier.unit_opacity(l as f32) > 0.0)
-                .map(|l| (l.to_string(), classifier.material(l as f32)))
-                .collect(),
-        )
-    } else {
-        None
-    };
     let length_unit = input
         .file
         .as_ref()
         .and_then(|(_, info)| info.length_unit.clone());
     let hounsfield = (args.view.look.preset.as_deref()).is_some_and(|p| p.starts_with("ct-"));
-    let subject = Subject {
-        view: &frame.view,
-        bounds: scale_box,
-        window,
-        log,
-        colour: &colour,
-        opacity: &opacity,
-        labels,
-        blend: settings.blend,
+    let rendered = Rendered {
+        log: args.view.look.log,
         value_unit: hounsfield.then_some("HU"),
         length_unit: length_unit.as_deref(),
-        background: settings.background,
         axis_names: axis_names(input),
         boxes,
+        scale_box,
     };
-    annotate(image, &annotations(&args.figure), &subject);
-    Ok(())
+    annotate_frame(
+        image,
+        &annotations(&args.figure),
+        renderer,
+        settings,
+        &rendered,
+    )
+    .map_err(|e| CliError::input(e.to_string()))
 }

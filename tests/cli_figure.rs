@@ -447,3 +447,81 @@ fn a_series_has_one_colour_bar_and_scale_bar_for_every_frame() {
         );
     }
 }
+
+/// An 8³ NRRD ball, its world named by `space` (or not), in `dir`.
+fn nrrd(dir: &Path, name: &str, space: Option<&str>) -> String {
+    let mut header = String::from("NRRD0004\ntype: float\ndimension: 3\nsizes: 8 8 8\n");
+    match space {
+        Some(space) => header.push_str(&format!(
+            "space: {space}\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (0,0,0)\n"
+        )),
+        None => header.push_str("spacings: 1 1 1\n"),
+    }
+    header.push_str("encoding: raw\nendian: little\n\n");
+    let mut bytes = header.into_bytes();
+    for k in 0..8 {
+        for j in 0..8 {
+            for i in 0..8 {
+                let r = ((i as f32 - 3.5).powi(2)
+                    + (j as f32 - 3.5).powi(2)
+                    + (k as f32 - 3.5).powi(2))
+                .sqrt();
+                bytes.extend_from_slice(&(1.0 - r / 4.0).max(0.0).to_le_bytes());
+            }
+        }
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn the_axes_are_named_as_the_files_world_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let draw = |input: &str, out: &str, axes: bool| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "render",
+            input,
+            "--size",
+            "240",
+            "--azimuth",
+            "30",
+            "--elevation",
+            "20",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if axes {
+            args.push("--axes");
+        }
+        let run = volray(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        Picture::read(&out)
+    };
+    let ras = nrrd(dir.path(), "ras.nrrd", Some("right-anterior-superior"));
+    let lps = nrrd(dir.path(), "lps.nrrd", Some("LPS"));
+    let plain = nrrd(dir.path(), "plain.nrrd", None);
+    let bare = draw(&plain, "bare.png", false);
+    assert_eq!(
+        draw(&ras, "ras_bare.png", false).rgb,
+        bare.rgb,
+        "the same volume"
+    );
+    let xyz = draw(&plain, "xyz.png", true);
+    let named = draw(&ras, "ras.png", true);
+    let other = draw(&lps, "lps.png", true);
+    // The same lines, other names: they differ only in the triad's corner.
+    for (a, b) in [(&xyz, &named), (&named, &other)] {
+        let mut differ = 0;
+        for y in 0..240 {
+            for x in 0..240 {
+                if a.at(x, y) != b.at(x, y) {
+                    assert!(x > 160 && y > 160, "({x}, {y})");
+                    differ += 1;
+                }
+            }
+        }
+        assert!(differ > 10, "{differ}");
+    }
+}

@@ -4,7 +4,9 @@
 //! for what was rendered ([`Subject`]: the view, the transfer function's
 //! colours and opacity over its window, the units), in an ink that reads
 //! on the frame's background. The command line, Python and the viewer
-//! draw through this one function.
+//! draw through this one function; [`annotate_frame`] builds the subject
+//! from the renderer and settings of the frame, so that they draw the
+//! same pixels for the same frame.
 
 use crate::colorbar::{ColorBar, Layout, Side, legend};
 use crate::line::width_for;
@@ -12,7 +14,9 @@ use crate::scalebar::ScaleBar;
 use crate::text::Font;
 use volray_core::camera::View;
 use volray_core::glam::DVec3;
-use volray_core::{Blend, Image};
+use volray_core::transfer::classifier::Classifier;
+use volray_core::transfer::labels::{MAX_LABELS, labels_of};
+use volray_core::{Blend, Image, RenderError, RenderSettings, Renderer};
 
 /// What to draw.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -162,6 +166,116 @@ pub fn annotate(image: &mut Image, what: &Annotations, subject: &Subject) {
         let margin = side / 40.0;
         font.draw(image, label, size, (margin, ascent + margin), ink);
     }
+}
+
+/// What a frame was rendered with beyond its renderer and settings.
+#[derive(Debug, Clone)]
+pub struct Rendered<'a> {
+    /// The data were rendered as log10 of themselves (`--log`).
+    pub log: bool,
+    /// The unit of the values (`HU`) and of lengths (`mm`), if known.
+    pub value_unit: Option<&'a str>,
+    pub length_unit: Option<&'a str>,
+    /// The names of the world's +x, +y, +z ([`Subject::axis_names`]).
+    pub axis_names: [&'a str; 3],
+    /// The boxes the outline draws (the renderer's volume's, or each of a
+    /// scene's volumes).
+    pub boxes: &'a [(DVec3, DVec3)],
+    /// The box at whose centre a perspective scale bar holds (the
+    /// volume's; a series': the box framing every frame).
+    pub scale_box: (DVec3, DVec3),
+}
+
+impl<'a> Rendered<'a> {
+    /// A volume's own: its box, no units, the axes x, y, z.
+    pub fn of(bounds: &'a [(DVec3, DVec3)]) -> Self {
+        Rendered {
+            log: false,
+            value_unit: None,
+            length_unit: None,
+            axis_names: ["x", "y", "z"],
+            boxes: bounds,
+            scale_box: bounds.first().copied().unwrap_or((DVec3::ZERO, DVec3::ONE)),
+        }
+    }
+}
+
+/// Draws `what` into `image`, a frame `renderer` rendered with
+/// `settings`: the view framed as the renderer frames it, the colour bar
+/// over the classifier's value window (the data's own values for a log
+/// volume), a legend of the labels shown for a label volume.
+pub fn annotate_frame(
+    image: &mut Image,
+    what: &Annotations,
+    renderer: &Renderer,
+    settings: &RenderSettings,
+    rendered: &Rendered,
+) -> Result<(), RenderError> {
+    if !what.any() {
+        return Ok(());
+    }
+    let volume = renderer.volume();
+    let frame = renderer.prepare(settings)?;
+    let classifier = Classifier::for_frame(
+        settings,
+        renderer.value_range(),
+        volume.spacing().min_element() as f32,
+        || renderer.max_gradient(),
+    );
+    let (lo, inv) = classifier.normalisation();
+    let (lo, hi) = (
+        f64::from(lo),
+        f64::from(lo) + if inv > 0.0 { 1.0 / f64::from(inv) } else { 0.0 },
+    );
+    // The data were rendered as log10 of themselves: the bar's values are
+    // the data's own.
+    let log = rendered.log;
+    let value = |v: f64| if log { v.log10() as f32 } else { v as f32 };
+    let window = if log {
+        (10f64.powf(lo), 10f64.powf(hi))
+    } else {
+        (lo, hi)
+    };
+    let projection = settings.blend != Blend::Composite;
+    let colour = |v: f64| {
+        if projection {
+            classifier.projection_colour(value(v))
+        } else {
+            classifier.material(value(v))
+        }
+    };
+    let opacity = |v: f64| classifier.unit_opacity(value(v));
+    let labels = if volume.is_labels() {
+        let found = labels_of(volume, MAX_LABELS)
+            .ok()
+            .flatten()
+            .unwrap_or_default();
+        Some(
+            (found.into_iter())
+                .filter(|&l| classifier.unit_opacity(l as f32) > 0.0)
+                .map(|l| (l.to_string(), classifier.material(l as f32)))
+                .collect(),
+        )
+    } else {
+        None
+    };
+    let subject = Subject {
+        view: &frame.view,
+        bounds: rendered.scale_box,
+        window,
+        log,
+        colour: &colour,
+        opacity: &opacity,
+        labels,
+        blend: settings.blend,
+        value_unit: rendered.value_unit,
+        length_unit: rendered.length_unit,
+        background: settings.background,
+        axis_names: rendered.axis_names,
+        boxes: rendered.boxes,
+    };
+    annotate(image, what, &subject);
+    Ok(())
 }
 
 #[cfg(test)]

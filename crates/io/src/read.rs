@@ -196,6 +196,36 @@ impl OmeroChannel {
     }
 }
 
+/// The names of the world's +x, +y, +z where a file of `format` says
+/// what they are: a NIfTI, Analyze, MGH or MINC world is RAS+ (x towards
+/// the subject's right, y anterior, z superior), DICOM's LPS+, NRRD's its
+/// `space` (RAS, LAS, LPS); `None` otherwise, and for a grid kept in its
+/// own axes because they are rotated away from the world's (its axes are
+/// then the grid's, not the world's).
+pub fn world_axis_names(format: VolumeFormat, info: &FileInfo) -> Option<[&'static str; 3]> {
+    if (info.notes.iter()).any(|n| n.contains("rendered in the grid's own axes")) {
+        return None;
+    }
+    match format {
+        VolumeFormat::Nifti | VolumeFormat::Analyze | VolumeFormat::Mgh | VolumeFormat::Minc => {
+            Some(["R", "A", "S"])
+        }
+        VolumeFormat::Dicom => Some(["L", "P", "S"]),
+        VolumeFormat::Nrrd => {
+            let space = (info.header.iter())
+                .find(|(k, _)| k.trim() == "space")
+                .map(|(_, v)| v.trim().to_ascii_lowercase());
+            match space.as_deref() {
+                Some("right-anterior-superior" | "ras") => Some(["R", "A", "S"]),
+                Some("left-anterior-superior" | "las") => Some(["L", "A", "S"]),
+                Some("left-posterior-superior" | "lps") => Some(["L", "P", "S"]),
+                _ => None,
+            }
+        }
+        _ => None,
+    }
+}
+
 /// One resolution level of a multiscale image, for `volray info`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LevelInfo {
