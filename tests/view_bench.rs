@@ -316,3 +316,134 @@ async fn a_slow_frame_gives_way_to_an_ordinary_one_and_to_its_tab_closing() {
     println!("status at the end: {status}");
     b.close().await;
 }
+
+/// Drags of `moves` moves over the frame, `dx` apart, timed in the page:
+/// (frames shown during the drag per second, mouse-up to the first frame
+/// shown, mouse-up to the full-quality frame), in milliseconds.
+async fn timed_drag(b: &Browser, moves: u32, dx: f64) -> (f64, f64, f64) {
+    b.drag(
+        "#frame",
+        (-dx * moves as f64 / 2.0, 0.0),
+        (dx * moves as f64, 20.0),
+        moves,
+    )
+    .await;
+    b.wait_still().await;
+    let e = events(b).await;
+    if std::env::var("VOLRAY_VIEW_BENCH_DEBUG").is_ok() {
+        println!("{e:?}");
+    }
+    let down = first(&e, "viewport:pointerdown", 0.0).unwrap();
+    let up = first(&e, "viewport:pointerup", down).unwrap();
+    let shown = (e.iter())
+        .filter(|(n, t)| n == "frame" && *t > down && *t <= up)
+        .count();
+    let next = first(&e, "frame", up).unwrap_or(f64::NAN) - up;
+    let still = first(&e, "still", up).unwrap() - up;
+    (shown as f64 / ((up - down) / 1000.0), next, still)
+}
+
+/// Issue 27's goals in a 1280×800 viewport, the frame filling the window
+/// (no --size): `VOLRAY_VIEW_BENCH_ARGS` (default `fractal:257`), e.g.
+/// `"/tmp/ct512.raw --dims 512,512,512 --dtype i16 --preset ct-bone"`.
+#[tokio::test(flavor = "current_thread")]
+#[ignore = "a benchmark: run on a quiet machine with --ignored --nocapture"]
+async fn the_application_at_1280_by_800() {
+    if !browser::available() {
+        return;
+    }
+    let args = std::env::var("VOLRAY_VIEW_BENCH_ARGS").unwrap_or("fractal:257".into());
+    let mut words: Vec<&str> = args.split_whitespace().collect();
+    words.extend(["--threads", "2"]);
+    let viewer = Viewer::start(&words);
+    let b = Browser::start().await;
+    // A 1280×800 viewport: the window less what the browser keeps of it.
+    b.client.set_window_size(1280, 800).await.unwrap();
+    let inner = b
+        .eval("return [window.innerWidth, window.innerHeight];")
+        .await;
+    let (w, h) = (inner[0].as_u64().unwrap(), inner[1].as_u64().unwrap());
+    b.client
+        .set_window_size((2560 - w) as u32, (1600 - h) as u32)
+        .await
+        .unwrap();
+    b.client.goto(&viewer.url).await.unwrap();
+    b.wait_still().await;
+    b.eval(INSTRUMENT).await;
+    let geometry = b
+        .eval(
+            r#"const f = document.getElementById('frame').getBoundingClientRect();
+               const free = (window.innerWidth - document.getElementById('panel').offsetWidth)
+                 * (window.innerHeight - document.querySelector('header').offsetHeight);
+               const s = window.volrayView.state();
+               return [window.innerWidth, window.innerHeight, s.width, s.height, f.width * f.height / free];"#,
+        )
+        .await;
+    println!("viewport, frame and share of the free area: {geometry}");
+    // Warm up.
+    timed_drag(&b, 10, 6.0).await;
+    events(&b).await;
+
+    let mut fps = Vec::new();
+    let mut first_frame = Vec::new();
+    let mut still = Vec::new();
+    let mut scales = Vec::new();
+    for _ in 0..5 {
+        let (f, n, s) = timed_drag(&b, 120, 3.0).await;
+        fps.push(f);
+        first_frame.push(n);
+        still.push(s);
+        scales.push(
+            b.eval("return window.volrayView.draftScale();")
+                .await
+                .as_f64()
+                .unwrap(),
+        );
+    }
+    let header = b.eval("return window.volrayView.header();").await;
+    println!(
+        "drags of 120 moves: {:?} frames/s (median {:.1}); draft scale after each: {scales:?}",
+        fps.iter()
+            .map(|f| (f * 10.0).round() / 10.0)
+            .collect::<Vec<_>>(),
+        median(fps.clone())
+    );
+    summary("mouse-up to the first frame after it", &first_frame);
+    summary("mouse-up to the full-size still", &still);
+    println!("the last still: {} ms to render", header["render_ms"]);
+
+    // A 4096² frame at step 0.01 under way, then the view moves again
+    // (a draft of the window's view, as a drag's first move sends): from
+    // that request to its frame shown.
+    let mut waits = Vec::new();
+    for i in 0..5 {
+        b.eval(
+            "window.normal = window.volrayView.state(); \
+             window.volrayView.sendState({width: 4096, height: 4096, step: 0.01}); return 0;",
+        )
+        .await;
+        viewer.wait_status(browser::PATIENCE, |s| s["rendering"] == 1);
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        events(&b).await;
+        let t = b
+            .eval(&format!(
+                "const n = window.normal; const t = performance.now(); \
+                 window.volrayView.sendState({{width: n.width, height: n.height, step: n.step, azimuth: {}}}, 'draft'); \
+                 return t;",
+                10 * i
+            ))
+            .await
+            .as_f64()
+            .unwrap();
+        tokio::time::sleep(Duration::from_millis(1500)).await;
+        let e = events(&b).await;
+        waits.push(first(&e, "frame", t).unwrap() - t);
+        b.eval("window.volrayView.sendState({}); return 0;").await;
+        b.wait_still().await;
+    }
+    summary(
+        "a 4096² step-0.01 frame under way, then a draft of the view: its frame",
+        &waits,
+    );
+    b.close().await;
+}

@@ -10,7 +10,12 @@
 //! request for the slot whose frame is being rendered sets it (the frame
 //! is superseded: its view is no longer the page's), and so does closing.
 //! A view does not stop a save, nor a save a view: the file asked for is
-//! still wanted while the view moves. The renderer passes the flag to
+//! still wanted while the view moves. Nor does a draft stop a draft: while
+//! the view moves, each draft is finished and the newest waiting one
+//! rendered next, so that a drag whose moves come faster than its drafts
+//! render still shows frames (and the page learns their times to shrink
+//! them); a draft does stop a full-size frame, and a full-size request a
+//! draft. The renderer passes the flag to
 //! volray-core, whose casters stop within a tile's work.
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -27,6 +32,14 @@ struct Slots<T> {
     dropped: u64,
     /// The slot of the request taken last, until [`Mailbox::finished`].
     rendering: Option<Slot>,
+    /// Whether the request taken last is a draft.
+    rendering_draft: bool,
+}
+
+/// What the mailbox asks of a request.
+pub trait Kind {
+    /// A draft, which does not stop a draft being rendered.
+    fn is_draft(&self) -> bool;
 }
 
 /// A single-slot mailbox of requests `T`.
@@ -50,7 +63,7 @@ pub enum Slot {
     Probe,
 }
 
-impl<T> Default for Mailbox<T> {
+impl<T: Kind> Default for Mailbox<T> {
     fn default() -> Self {
         Mailbox {
             slots: Mutex::new(Slots {
@@ -60,6 +73,7 @@ impl<T> Default for Mailbox<T> {
                 closed: false,
                 dropped: 0,
                 rendering: None,
+                rendering_draft: false,
             }),
             ready: Condvar::new(),
             stop: AtomicBool::new(false),
@@ -67,7 +81,7 @@ impl<T> Default for Mailbox<T> {
     }
 }
 
-impl<T> Mailbox<T> {
+impl<T: Kind> Mailbox<T> {
     fn lock(&self) -> MutexGuard<'_, Slots<T>> {
         // A panic elsewhere cannot leave the slots inconsistent.
         self.slots.lock().unwrap_or_else(|e| e.into_inner())
@@ -81,7 +95,7 @@ impl<T> Mailbox<T> {
         if slots.closed {
             return;
         }
-        if slots.rendering == Some(slot) {
+        if slots.rendering == Some(slot) && !(slots.rendering_draft && request.is_draft()) {
             // Under the lock, so that `take` cannot clear it for the
             // request that supersedes the frame.
             self.stop.store(true, Ordering::Relaxed);
@@ -112,6 +126,7 @@ impl<T> Mailbox<T> {
                 .or_else(|| slots.latest.take().map(|view| (Slot::Latest, view)));
             if let Some((slot, request)) = taken {
                 slots.rendering = Some(slot);
+                slots.rendering_draft = request.is_draft();
                 self.stop.store(false, Ordering::Relaxed);
                 return Some(request);
             }
@@ -168,6 +183,42 @@ impl<T> Mailbox<T> {
 mod tests {
     use super::*;
     use std::sync::Arc;
+
+    impl Kind for u32 {
+        fn is_draft(&self) -> bool {
+            false
+        }
+    }
+
+    impl Kind for i32 {
+        fn is_draft(&self) -> bool {
+            false
+        }
+    }
+
+    /// "draft ..." is a draft.
+    impl Kind for &str {
+        fn is_draft(&self) -> bool {
+            self.starts_with("draft")
+        }
+    }
+
+    #[test]
+    fn a_draft_does_not_stop_a_draft_but_a_full_frame_and_is_stopped_by_one() {
+        let mailbox = Mailbox::default();
+        mailbox.put(Slot::Latest, "draft 1");
+        assert_eq!(mailbox.take(), Some("draft 1"));
+        mailbox.put(Slot::Latest, "draft 2");
+        assert!(!mailbox.stopped(), "a draft finishes while the next waits");
+        mailbox.put(Slot::Latest, "draft 3");
+        assert!(!mailbox.stopped());
+        mailbox.put(Slot::Latest, "full 1");
+        assert!(mailbox.stopped(), "the still supersedes the draft");
+        assert_eq!(mailbox.take(), Some("full 1"));
+        mailbox.put(Slot::Latest, "draft 4");
+        assert!(mailbox.stopped(), "a moving view supersedes the still");
+        assert_eq!(mailbox.dropped(), 2);
+    }
 
     #[test]
     fn a_burst_leaves_only_the_latest() {

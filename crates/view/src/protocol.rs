@@ -78,6 +78,12 @@ pub struct Request {
     pub probe: Option<[usize; 2]>,
 }
 
+impl crate::mailbox::Kind for Request {
+    fn is_draft(&self) -> bool {
+        self.quality == Quality::Draft && self.probe.is_none()
+    }
+}
+
 /// The smallest and largest scale of a draft, per side.
 pub const DRAFT_SCALE_RANGE: (f64, f64) = (1.0 / 16.0, 1.0);
 
