@@ -447,3 +447,41 @@ async fn the_application_at_1280_by_800() {
     );
     b.close().await;
 }
+
+/// Screenshots of the page at three window sizes (docs/viewer.md), into
+/// `VOLRAY_VIEW_SCREENSHOTS` (a folder), of `VOLRAY_VIEW_BENCH_ARGS`.
+#[tokio::test(flavor = "current_thread")]
+#[ignore = "writes the docs' screenshots: run with --ignored"]
+async fn screenshots_at_three_window_sizes() {
+    let Ok(dir) = std::env::var("VOLRAY_VIEW_SCREENSHOTS") else {
+        return;
+    };
+    if !browser::available() {
+        return;
+    }
+    let args = std::env::var("VOLRAY_VIEW_BENCH_ARGS").unwrap_or("fractal:129".into());
+    let words: Vec<&str> = args.split_whitespace().collect();
+    let viewer = Viewer::start(&words);
+    let b = Browser::start().await;
+    for (w, h) in [(1024, 640), (1440, 900), (1920, 1080)] {
+        b.client.set_window_size(w, h).await.unwrap();
+        let inner = b
+            .eval("return [window.innerWidth, window.innerHeight];")
+            .await;
+        let (iw, ih) = (inner[0].as_u64().unwrap(), inner[1].as_u64().unwrap());
+        b.client
+            .set_window_size(2 * w - iw as u32, 2 * h - ih as u32)
+            .await
+            .unwrap();
+        b.client.goto(&viewer.url).await.unwrap();
+        b.wait_still().await;
+        // The probe, over the middle of the frame.
+        b.hover("#frame", (20.0, -20.0)).await;
+        b.wait_for("document.getElementById('probe').textContent !== ''")
+            .await;
+        b.wait_still().await;
+        let png = b.client.screenshot().await.unwrap();
+        std::fs::write(format!("{dir}/viewer-{w}x{h}.png"), png).unwrap();
+    }
+    b.close().await;
+}
