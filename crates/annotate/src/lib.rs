@@ -10,9 +10,27 @@
 //!   (log-spaced for `--log`); a legend for label volumes;
 //! - [`scalebar`]: a round length in world units, as many pixels long as
 //!   the view's pixel size says;
+//! - [`axes`]: an orientation triad, the world's axes turned as the
+//!   camera turns them, red, green and blue, named as the file's world is;
+//! - [`outline`]: the volume's box, its edges projected through the
+//!   frame's own view (orthographic or perspective) and clipped;
+//! - [`line`]: the anti-aliased, clipped segments both draw;
 //! - [`ticks`]: round tick values and short labels;
 //! - [`figure`]: the annotations a front end asks for, drawn for what was
-//!   rendered (one function for the command line, Python and the viewer).
+//!   rendered (one function for the command line, Python and the viewer;
+//!   [`figure::annotate_frame`] from the frame's renderer and settings).
+//!
+//! ## Where each lands
+//!
+//! The title is centred at the top, the label in the top left corner, the
+//! colour bar (or a label volume's legend) on the right or left over the
+//! middle three fifths of the height, the scale bar in the bottom left
+//! corner, the triad in the bottom right (left of a colour bar there);
+//! the outline is drawn first, under the others. Sizes follow the
+//! frame's smaller side, so a figure reads alike at 240² and 4096². Ink
+//! is white on a dark background and black on a light one ([`figure::ink`]).
+//! Nothing asked, nothing drawn: a frame without annotations is the
+//! renderer's, bit for bit.
 //!
 //! ```
 //! use volray_annotate::colorbar::{ColorBar, Side};

@@ -28,6 +28,7 @@ use pyo3::prelude::*;
 mod array;
 mod digest;
 mod errors;
+mod figure;
 mod frame;
 mod generate;
 mod keywords;

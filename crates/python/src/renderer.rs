@@ -20,6 +20,7 @@
 
 use crate::array::{self, ArrayBytes, Order};
 use crate::errors::{io_error, option_error, render_error, settings_error, value_error};
+use crate::figure::{self, FIGURE};
 use crate::frame::Frame;
 use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
 use crate::volume::{LazyFile, Volume};
@@ -30,6 +31,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
+use volray_annotate::figure::Annotations;
 use volray_core::transfer::auto;
 use volray_core::{
     DEFAULT_CACHE_BUDGET, Histogram, Image, MemoryBound, NonFinite, RenderError, RenderSettings,
@@ -350,6 +352,15 @@ impl Recipe {
         Ok((options, settings))
     }
 
+    /// What the annotations take from the volume: its file's units and
+    /// axes, and whether it is rendered as log10.
+    pub(crate) fn facts(&self, py: Python<'_>) -> figure::Facts {
+        match &self.source {
+            Source::Volume(v) => figure::Facts::of(v.bind(py).get().file.as_ref(), self.log),
+            Source::Array { .. } => figure::Facts::of(None, self.log),
+        }
+    }
+
     /// The look options the recipe fixes (labels, log).
     pub(crate) fn look(&self) -> LookOptions {
         LookOptions {
@@ -499,18 +510,20 @@ impl Renderer {
     /// was prepared just now, so its samples need no second digest.
     fn frame(&self, py: Python<'_>, k: &Keywords<'_>, fresh: bool) -> PyResult<Frame> {
         let (options, settings, pool) = self.settings_of(k)?;
+        let what = figure::annotations(k)?;
         let memory = match &self.road {
             Road::Memory(memory) => memory,
-            Road::Lazy(lazy) => return self.lazy_frame(py, lazy, &options, settings, pool),
+            Road::Lazy(lazy) => return self.lazy_frame(py, lazy, &options, settings, pool, &what),
         };
         let prepared = match fresh {
             true => Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner())),
             false => self.current(py, memory, pool.as_ref())?,
         };
-        self.render_prepared(py, &prepared, &options, settings, pool.as_ref())
+        self.render_prepared(py, &prepared, &options, settings, pool.as_ref(), &what)
     }
 
-    /// A frame of a prepared volume, with what the options leave to it.
+    /// A frame of a prepared volume, with what the options leave to it,
+    /// annotated as `what` asks.
     fn render_prepared(
         &self,
         py: Python<'_>,
@@ -518,6 +531,7 @@ impl Renderer {
         options: &Options,
         mut settings: RenderSettings,
         pool: Option<&rayon::ThreadPool>,
+        what: &Annotations,
     ) -> PyResult<Frame> {
         let name = &self.recipe.name;
         (self.recipe).leave_to_volume(&prepared.known, options, &mut settings)?;
@@ -533,9 +547,23 @@ impl Renderer {
         if let Some(e) = interrupt {
             return Err(e);
         }
-        let image = rendered
+        let mut image = rendered
             .map_err(|panic| internal_error(name, &panic))?
             .map_err(|e| render_error(e, &options.camera, name))?;
+        if what.any() {
+            let bounds = inner.volume().bounds();
+            let facts = self.recipe.facts(py);
+            figure::draw(
+                &mut image,
+                what,
+                inner,
+                settings,
+                options,
+                &facts,
+                &[bounds],
+                bounds,
+            )?;
+        }
         Ok(Frame { image })
     }
 
@@ -548,6 +576,7 @@ impl Renderer {
         options: &Options,
         mut settings: RenderSettings,
         pool: Option<rayon::ThreadPool>,
+        what: &Annotations,
     ) -> PyResult<Frame> {
         let level = self.level_for(lazy, &settings, &options.camera)?;
         let pool = pool.as_ref();
@@ -566,6 +595,7 @@ impl Renderer {
             else {
                 unreachable!("settled above")
             };
+            figure::refuse_pieces(what, name)?;
             lazy.stop.store(false, Ordering::SeqCst);
             let settings = &mut *settings_ref;
             let (rendered, interrupt) = interruptible(pool, &lazy.stop, |report| {
@@ -589,7 +619,7 @@ impl Renderer {
         })?;
         match next {
             (Next::Whole(prepared), _) => {
-                self.render_prepared(py, &prepared, options, settings, pool)
+                self.render_prepared(py, &prepared, options, settings, pool, what)
             }
             (Next::Pieces, image) => Ok(Frame {
                 image: image.expect("a frame in pieces returns its image"),
@@ -840,7 +870,7 @@ impl Renderer {
     /// One frame: the keywords of `render` but the volume's own.
     #[pyo3(signature = (**kwargs))]
     fn render(&self, py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Frame> {
-        let k = Keywords::new(kwargs, &[CAMERA, FRAME], "render")?;
+        let k = Keywords::new(kwargs, &[CAMERA, FRAME, FIGURE], "render")?;
         self.frame(py, &k, false)
     }
 
@@ -1017,7 +1047,7 @@ pub fn render(
     if crate::scene::is_scene(volume, kwargs)? {
         return crate::scene::render(py, volume, kwargs);
     }
-    let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME], "render")?;
+    let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME, FIGURE], "render")?;
     Renderer::build(py, volume, &k)?.frame(py, &k, true)
 }
 

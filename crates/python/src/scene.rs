@@ -16,6 +16,7 @@
 //! renderers and hands none back).
 
 use crate::errors::{render_error, value_error};
+use crate::figure::{self, FIGURE};
 use crate::frame::Frame;
 use crate::keywords::{self, CAMERA, FRAME, Keywords, extract};
 use crate::renderer::{Known, Recipe, internal_error, interruptible, need, pool};
@@ -125,7 +126,15 @@ pub fn render(
             "level: several volumes are each read whole; level picks the level of one lazy volume",
         ));
     }
-    let known = [LAYER_VOLUME, MAX_MEMORY, CAMERA, FRAME, LAYER_EXTRA, SCENE];
+    let known = [
+        LAYER_VOLUME,
+        MAX_MEMORY,
+        CAMERA,
+        FRAME,
+        LAYER_EXTRA,
+        SCENE,
+        FIGURE,
+    ];
     Keywords::new(kwargs, &known, "render")?;
     let (volume_kwargs, frame_kwargs) = (PyDict::new(py), PyDict::new(py));
     let (mut looks, mut mix, mut channel_axis) = (None, None, None);
@@ -244,7 +253,8 @@ impl Scene {
         kwargs: Option<&Bound<'_, PyDict>>,
         fresh: bool,
     ) -> PyResult<Frame> {
-        let k = Keywords::new(kwargs, &[CAMERA, FRAME, LAYER_EXTRA], "render")?;
+        let k = Keywords::new(kwargs, &[CAMERA, FRAME, LAYER_EXTRA, FIGURE], "render")?;
+        let what = figure::annotations(&k)?;
         let pool = keywords::threads(&k)?.map(pool).transpose()?;
         let built = match fresh {
             true => Arc::clone(&self.state.lock().unwrap_or_else(|e| e.into_inner())),
@@ -282,6 +292,12 @@ impl Scene {
         let Some((options, settings)) = first else {
             unreachable!("a scene has a volume")
         };
+        // The first volume's colour bar and scale bar, in the view that
+        // frames every volume; the box of each volume for the outline (as
+        // `volray render --channels/--overlay` draws them).
+        let mut first_settings = settings.clone();
+        first_settings.camera.bounds =
+            Some((first_settings.camera).framed_bounds(built.scene.bounds()));
         let max_memory = self.layers[0].recipe.max_memory;
         if needed > u128::from(max_memory) {
             return Err(value_error(format!(
@@ -311,9 +327,24 @@ impl Scene {
         if let Some(e) = interrupt {
             return Err(e);
         }
-        let image = rendered
+        let mut image = rendered
             .map_err(|panic| internal_error(&name, &panic))?
             .map_err(|e| render_error(e, &options.camera, &name))?;
+        if what.any() {
+            let renderers = built.scene.layers();
+            let boxes: Vec<_> = renderers.iter().map(|r| r.volume().bounds()).collect();
+            let facts = self.layers[0].recipe.facts(py);
+            figure::draw(
+                &mut image,
+                &what,
+                &renderers[0],
+                &first_settings,
+                &options,
+                &facts,
+                &boxes,
+                boxes[0],
+            )?;
+        }
         Ok(Frame { image })
     }
 
@@ -357,7 +388,8 @@ impl Scene {
             .map(|v| extract::<bool>(&v, "visible", "True or False"))
             .transpose()?
             .unwrap_or(true);
-        let k = Keywords::new(Some(&given), &[CAMERA, FRAME], "render")?;
+        // The annotations are the frame's, drawn after it (`frame`).
+        let k = Keywords::new(Some(&given), &[CAMERA, FRAME, FIGURE], "render")?;
         let recipe = &layer.recipe;
         let (options, mut settings) = recipe.settings_of(&k)?;
         let tf = &mut settings.transfer_function;

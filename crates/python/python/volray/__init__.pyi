@@ -177,6 +177,12 @@ class Renderer:
         label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
         show_labels: Optional[Sequence[int]] = None,
         threads: Optional[int] = None,
+        colorbar: Optional[Literal["right", "left"]] = None,
+        scale_bar: Union[None, bool, float] = None,
+        title: Optional[str] = None,
+        label: Optional[str] = None,
+        axes: bool = False,
+        outline: bool = False,
     ) -> Frame: ...
     @property
     def value_range(self) -> Pair: ...
@@ -280,6 +286,12 @@ class Scene:
         label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
         show_labels: Optional[Sequence[int]] = None,
         threads: Optional[int] = None,
+        colorbar: Optional[Literal["right", "left"]] = None,
+        scale_bar: Union[None, bool, float] = None,
+        title: Optional[str] = None,
+        label: Optional[str] = None,
+        axes: bool = False,
+        outline: bool = False,
         color: Optional[Color] = None,
         opacity_scale: Optional[float] = None,
         visible: Optional[bool] = None,
@@ -346,6 +358,12 @@ def render(
     label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
     show_labels: Optional[Sequence[int]] = None,
     threads: Optional[int] = None,
+    colorbar: Optional[Literal["right", "left"]] = None,
+    scale_bar: Union[None, bool, float] = None,
+    title: Optional[str] = None,
+    label: Optional[str] = None,
+    axes: bool = False,
+    outline: bool = False,
     color: Optional[Color] = None,
     opacity_scale: Optional[float] = None,
     visible: Optional[bool] = None,
@@ -401,6 +419,12 @@ def render(
     label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
     show_labels: Optional[Sequence[int]] = None,
     threads: Optional[int] = None,
+    colorbar: Optional[Literal["right", "left"]] = None,
+    scale_bar: Union[None, bool, float] = None,
+    title: Optional[str] = None,
+    label: Optional[str] = None,
+    axes: bool = False,
+    outline: bool = False,
 ) -> Frame: ...
 
 def read(
