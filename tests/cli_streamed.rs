@@ -241,6 +241,52 @@ fn a_turntable_of_a_level_over_max_memory_turns_piece_by_piece() {
 }
 
 #[test]
+fn annotations_are_refused_in_pieces_in_one_line_and_drawn_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let path = image.to_str().unwrap();
+    for (extra, out) in [
+        (&[][..], "still.png"),
+        (&["--turntable", "2"][..], "turn.gif"),
+    ] {
+        let out = dir.path().join(out);
+        let args = [
+            &[
+                "render",
+                path,
+                "--max-memory",
+                "100K",
+                "--axes",
+                "-o",
+                out.to_str().unwrap(),
+            ][..],
+            &LOOK[..],
+            extra,
+        ]
+        .concat();
+        let run = volray(&args);
+        assert_eq!(run.status.code(), Some(1), "{extra:?}: {}", stderr(&run));
+        let err = stderr(&run);
+        assert!(
+            err.starts_with("volray: error: --axes: ") && err.contains("piece by piece"),
+            "{err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!out.exists());
+        // Read whole, the same frame is annotated.
+        let whole = [
+            &["render", path, "--outline", "-o", out.to_str().unwrap()][..],
+            &LOOK[..],
+            extra,
+        ]
+        .concat();
+        let run = volray(&whole);
+        assert!(run.status.success(), "{extra:?}: {}", stderr(&run));
+    }
+}
+
+#[test]
 fn info_reads_the_metadata_of_a_large_level_and_the_values_of_a_smaller_one() {
     let dir = tempfile::tempdir().unwrap();
     let image = dir.path().join("img.ome.zarr");
