@@ -310,6 +310,59 @@ mod tests {
     }
 
     #[test]
+    fn the_triad_keeps_left_of_a_colour_bar_on_the_right() {
+        let bounds = (DVec3::ZERO, DVec3::ONE);
+        let camera = Camera {
+            azimuth: 30.0,
+            elevation: 20.0,
+            ..Camera::default()
+        };
+        let view = View::frame(&camera, bounds, 240, 240).unwrap();
+        let black = |v: f64| [0.0, 0.0, (v as f32).clamp(0.0, 1.0)];
+        let subject = Subject {
+            view: &view,
+            bounds,
+            window: (0.0, 1.0),
+            log: false,
+            colour: &black,
+            opacity: &|_| 0.0,
+            labels: None,
+            blend: Blend::Composite,
+            value_unit: None,
+            length_unit: None,
+            background: [0.0; 3],
+            axis_names: ["x", "y", "z"],
+            boxes: &[],
+        };
+        let bar = Annotations {
+            colorbar: Some(Side::Right),
+            ..Annotations::default()
+        };
+        let mut with_bar = Image::new(240, 240, [0.0, 0.0, 0.0, 1.0]);
+        annotate(&mut with_bar, &bar, &subject);
+        // The bar's leftmost ink.
+        let left = (0..240)
+            .find(|&x| (0..240).any(|y| with_bar.get(x, y) != [0.0, 0.0, 0.0, 1.0]))
+            .unwrap();
+        let both = Annotations {
+            axes: true,
+            ..bar.clone()
+        };
+        let mut image = Image::new(240, 240, [0.0, 0.0, 0.0, 1.0]);
+        annotate(&mut image, &both, &subject);
+        let mut triad = 0;
+        for y in 0..240 {
+            for x in 0..240 {
+                if image.get(x, y) != with_bar.get(x, y) {
+                    assert!(x < left, "({x}, {y}) over the bar, which starts at {left}");
+                    triad += 1;
+                }
+            }
+        }
+        assert!(triad > 30, "{triad}");
+    }
+
+    #[test]
     fn nothing_asked_draws_nothing() {
         let view = View::frame(&Camera::default(), (DVec3::ZERO, DVec3::ONE), 64, 64).unwrap();
         let mut image = Image::new(64, 64, [0.2, 0.2, 0.2, 1.0]);
