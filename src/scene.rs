@@ -93,15 +93,12 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         Some(n) => animate::turntable_frame(&settings, 0, n as usize),
         None => settings.clone(),
     };
-    let input_args = match crate::streamed::plan(&args.input, &args.view, &first_frame)? {
-        Plan::Streamed(streamed) => {
-            return Err(CliError::input(format!(
-                "{}: too large to read whole under --max-memory (it would be rendered in pieces from its chunks), which --channels and --overlay do not support: give a coarser --level or raise --max-memory",
-                streamed.name
-            )));
-        }
-        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
-    };
+    let input_args = whole_input(
+        &args.input,
+        &args.view,
+        &first_frame,
+        "--channels and --overlay",
+    )?;
     let layers = read_layers(&input_args, &args.view, &args.scene, &overlays, &settings)?;
 
     let names: Vec<&str> = layers.iter().map(|l| l.input.name.as_str()).collect();
@@ -170,6 +167,24 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             annotate(layers[0].settings.camera, &mut image)?;
             write_still(args, kind, &image)
         }
+    }
+}
+
+/// INPUT read whole (a chunked file at the level `plan` picks for a frame
+/// of `settings`), refused where it would be rendered in pieces, which
+/// `what` does not support.
+pub fn whole_input(
+    input: &InputArgs,
+    view: &ViewArgs,
+    settings: &RenderSettings,
+    what: &str,
+) -> Result<InputArgs, CliError> {
+    match crate::streamed::plan(input, view, settings)? {
+        Plan::Streamed(streamed) => Err(CliError::input(format!(
+            "{}: too large to read whole under --max-memory (it would be rendered in pieces from its chunks), which {what} do not support: give a coarser --level or raise --max-memory",
+            streamed.name
+        ))),
+        Plan::Whole { level } => Ok(crate::streamed::at_level(input, level)),
     }
 }
 

@@ -100,6 +100,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     hello.fit = args.view.camera.size.is_none();
     let pool = thread_pool(args.view.threads)?;
     let labels = input.volume.is_labels();
+    let figure = figure_context(args, &input);
     let viewer = Viewer {
         volume: Arc::new(input.volume),
         non_finite,
@@ -112,6 +113,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         levels: pyramid.map(|p| p.into_levels(labels)),
         others: Vec::new(),
         time: None,
+        figure,
     };
     serve(args, viewer)
 }
@@ -182,5 +184,43 @@ pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
             .map(|&(point, normal)| [point, normal])
             .collect(),
         lighting: None,
+        figure: figure_state(&args.figure),
+    }
+}
+
+/// The page's figure as the flags start it.
+fn figure_state(args: &crate::flags::FigureArgs) -> volray_view::Figure {
+    use crate::flags::{ColorBarSide as Flag, ScaleLength};
+    volray_view::Figure {
+        colorbar: args.colorbar.map(|side| match side {
+            Flag::Right => volray_view::ColorBarSide::Right,
+            Flag::Left => volray_view::ColorBarSide::Left,
+        }),
+        scale_bar: args.scale_bar.is_some(),
+        scale_length: match args.scale_bar {
+            Some(ScaleLength::Given(l)) => Some(l),
+            _ => None,
+        },
+        axes: args.axes,
+        outline: args.outline,
+        title: args.title.clone(),
+        label: args.label.clone(),
+    }
+}
+
+/// What the frames' annotations need of `input`, as `volray render`
+/// takes it (`figure.rs`).
+pub fn figure_context(
+    args: &ViewerArgs,
+    input: &crate::input::Input,
+) -> volray_view::FigureContext {
+    let look = &args.view.look;
+    volray_view::FigureContext {
+        log: look.log,
+        value_unit: (look.preset.as_deref())
+            .is_some_and(|p| p.starts_with("ct-"))
+            .then(|| "HU".to_string()),
+        length_unit: (input.file.as_ref()).and_then(|(_, info)| info.length_unit.clone()),
+        axis_names: crate::figure::axis_names(input).map(String::from),
     }
 }

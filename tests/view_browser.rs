@@ -891,3 +891,52 @@ async fn the_pointer_probes_the_world_point_and_value_under_it() {
         .await;
     b.close().await;
 }
+
+#[tokio::test(flavor = "current_thread")]
+async fn the_figure_controls_draw_what_render_draws_into_the_frame() {
+    let Some((_viewer, b)) = open(&["sphere:32", "--size", "160", "--colormap", "viridis"]).await
+    else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let bare = picture(&b.frame_bytes().await, dir.path(), "bare.png");
+    for id in ["f-colorbar", "f-scale", "f-axes", "f-outline"] {
+        b.client
+            .find(fantoccini::Locator::Id(id))
+            .await
+            .unwrap()
+            .click()
+            .await
+            .unwrap();
+        b.wait_still().await;
+    }
+    b.eval(
+        "const el = document.getElementById('f-title'); el.value = 'A sphere'; \
+         el.dispatchEvent(new Event('change')); return 0;",
+    )
+    .await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    for part in [
+        "--colorbar right",
+        "--scale-bar",
+        "--axes",
+        "--outline",
+        "--title 'A sphere'",
+    ] {
+        assert!(command.contains(part), "{part}: {command}");
+    }
+    let figure = picture(&b.frame_bytes().await, dir.path(), "figure.png");
+    assert_ne!(figure, bare, "nothing was drawn");
+    assert_eq!(
+        run_shown(&b, dir.path()).await,
+        figure,
+        "the command's figure"
+    );
+    // A draft is annotated too, at its size.
+    b.eval("window.volrayView.sendState({azimuth: 20}, 'draft'); return 0;")
+        .await;
+    b.wait_for("window.volrayView.header().quality === 'draft'")
+        .await;
+    b.close().await;
+}

@@ -4,6 +4,7 @@
 //! `--bind`, `--no-browser`. (`view.rs` beside this file is the group of
 //! flags that render a frame, which `render` and `bench` share too.)
 
+use super::figure::FigureArgs;
 use super::input::InputArgs;
 use super::scene::SceneArgs;
 use super::view::ViewArgs;
@@ -24,6 +25,11 @@ pub struct ViewerArgs {
     /// (`--frames`).
     #[command(flatten)]
     pub scene: SceneArgs,
+
+    /// What the frames start with drawn into them (the page's Figure
+    /// controls change it).
+    #[command(flatten)]
+    pub figure: FigureArgs,
 
     /// The port to serve on; 0 picks a free one.
     #[arg(long, value_name = "N", default_value_t = 0, help_heading = "Serving")]

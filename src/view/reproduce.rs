@@ -417,6 +417,24 @@ impl CliReproduce {
             };
             w.opt("--mix", Some(mix.to_string()));
         }
+        let figure = &state.figure;
+        w.opt(
+            "--colorbar",
+            figure.colorbar.map(|side| match side {
+                volray_view::ColorBarSide::Right => "right".to_string(),
+                volray_view::ColorBarSide::Left => "left".to_string(),
+            }),
+        );
+        if figure.scale_bar {
+            match figure.scale_length {
+                Some(l) => w.opt("--scale-bar", Some(l.to_string())),
+                None => w.word("--scale-bar"),
+            }
+        }
+        w.flag("--axes", figure.axes);
+        w.flag("--outline", figure.outline);
+        w.opt("--title", figure.title.clone());
+        w.opt("--label", figure.label.clone());
         w.opt("-o", Some(OUTPUT.to_string()));
         if dashed {
             w.word("--");

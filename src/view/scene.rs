@@ -20,10 +20,9 @@ use super::{MAX_TABS, serve, start_state};
 use crate::error::CliError;
 use crate::flags::{MixMode, ViewerArgs};
 use crate::input;
-use crate::scene::{Layer, LayerSource, overlay_specs, read_layers};
+use crate::scene::{Layer, LayerSource, overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{read_tf_file, settings_with_tf_text};
-use crate::streamed::Plan;
 use std::sync::Arc;
 use volray_core::scene::Mix;
 use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
@@ -34,15 +33,12 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let tf_text = look.tf_file().map(read_tf_file).transpose()?;
     let settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
     let spec = args.input.input.as_deref().unwrap_or(input::DEMO);
-    let input_args = match crate::streamed::plan(&args.input, &args.view, &settings)? {
-        Plan::Streamed(streamed) => {
-            return Err(CliError::input(format!(
-                "{}: too large to read whole under --max-memory (it would be rendered in pieces from its chunks), which the viewer's --channels, --overlay and --frames do not support: give a coarser --level or raise --max-memory",
-                streamed.name
-            )));
-        }
-        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
-    };
+    let input_args = whole_input(
+        &args.input,
+        &args.view,
+        &settings,
+        "the viewer's --channels, --overlay and --frames",
+    )?;
     let overlays = overlay_specs(&args.scene)?;
 
     // A time axis: its first time point read now, the others as asked.
@@ -136,6 +132,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     .hello();
     hello.fit = args.view.camera.size.is_none();
     let pool = thread_pool(args.view.threads)?;
+    let figure = super::figure_context(args, &first.input);
     let max_memory = u128::from(first.input.max_memory);
     let mut volumes = layers.into_iter().map(|l| Arc::new(l.input.volume));
     let viewer = Viewer {
@@ -150,6 +147,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         levels: None,
         others: volumes.collect(),
         time,
+        figure,
     };
     serve(args, viewer)
 }

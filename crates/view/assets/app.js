@@ -307,6 +307,7 @@ function start(message) {
   state.crop = state.crop ?? null;
   state.lighting = state.lighting ?? null;
   state.layers = state.layers ?? [];
+  state.figure = state.figure ?? {};
   const [nx, ny, nz] = message.dims;
   const [lo, hi] = message.range;
   const levels = message.levels ? ` · ${message.levels.length} levels` : "";
@@ -433,6 +434,7 @@ function showControls() {
   $("fov").disabled = state.perspective === null;
   $("background").value = toHex(state.background);
   showCuts();
+  showFigure();
   const [wlo, whi] = windowOf();
   $("window-lo").value = round(wlo, 6);
   $("window-hi").value = round(whi, 6);
@@ -479,6 +481,35 @@ function showCuts() {
     $("l-elevation").value = Math.asin(clamp(z / n, -1, 1)) * 180 / Math.PI;
   }
   $("l-azimuth").disabled = $("l-elevation").disabled = !l.light;
+}
+
+// The figure: what volray-annotate draws into the frame.
+function showFigure() {
+  const f = state.figure;
+  $("f-colorbar").checked = !!f.colorbar;
+  $("f-side").value = f.colorbar || "right";
+  $("f-side").disabled = !f.colorbar;
+  $("f-scale").checked = !!f.scale_bar;
+  $("f-axes").checked = !!f.axes;
+  $("f-outline").checked = !!f.outline;
+  if (document.activeElement !== $("f-title")) $("f-title").value = f.title ?? "";
+  if (document.activeElement !== $("f-label")) $("f-label").value = f.label ?? "";
+  for (const el of $("figure-box").querySelectorAll("input, select")) {
+    if (hello.levels) el.disabled = true;
+  }
+}
+
+function readFigure() {
+  const text = (id) => $(id).value.trim() || null;
+  return {
+    ...state.figure,
+    colorbar: $("f-colorbar").checked ? $("f-side").value : null,
+    scale_bar: $("f-scale").checked,
+    axes: $("f-axes").checked,
+    outline: $("f-outline").checked,
+    title: text("f-title"),
+    label: text("f-label"),
+  };
 }
 
 function readCrop() {
@@ -715,6 +746,9 @@ onControl("window-hi", "change", (el) => { setWindow(windowOf()[0], Number(el.va
 onControl("window-reset", "click", () => { look().window = null; });
 onControl("opacity-reset", "click", () => { look().opacity = null; });
 
+for (const id of ["f-colorbar", "f-side", "f-scale", "f-axes", "f-outline", "f-title", "f-label"]) {
+  onControl(id, "change", () => { state.figure = readFigure(); });
+}
 for (const id of ["crop-on", "crop-x0", "crop-x1", "crop-y0", "crop-y1", "crop-z0", "crop-z1"]) {
   onControl(id, "input", () => { state.crop = readCrop(); }, "draft");
   onControl(id, "change", () => { state.crop = readCrop(); });

@@ -56,10 +56,10 @@ pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage
 pub use pyramid::{CACHED_LEVELS, DRAFT_SHARE, Pyramid, PyramidError};
 pub use reproduce::{Refusal, Reproduce, Reproduction, SceneLooks};
 pub use server::{ServeError, Server, Stopper};
-pub use session::{ReadTimePoint, TimePoints, draft_side};
+pub use session::{FigureContext, ReadTimePoint, TimePoints, draft_side};
 pub use state::{
-    BlendMode, LayerState, Lighting, MAX_SIDE, START_COLOURS, STEP_RANGE, StateError, ViewState,
-    WHITE, ZOOM_RANGE, solid_colour,
+    BlendMode, ColorBarSide, Figure, LayerState, Lighting, MAX_SIDE, START_COLOURS, STEP_RANGE,
+    StateError, ViewState, WHITE, ZOOM_RANGE, solid_colour,
 };
 pub use stats::Snapshot;
 pub use token::{NoRandomness, Token};
@@ -101,6 +101,8 @@ pub struct Viewer {
     /// A time axis served one time point at a time (`volume` is the
     /// starting one); not with `levels`.
     pub time: Option<TimePoints>,
+    /// What the frames' annotations need of the volume.
+    pub figure: FigureContext,
 }
 
 /// A viewer that could not start.
@@ -172,6 +174,7 @@ impl Viewer {
             levels,
             others: self.others,
             time: self.time.map(Arc::new),
+            figure: Arc::new(self.figure),
         };
         Ok(Server::bind(addr, token, hello, shared, held)?)
     }

@@ -26,11 +26,14 @@ use crate::protocol::{
 };
 use crate::pyramid::{LevelError, Levels};
 use crate::reproduce::{Refusal, Reproduce};
+use crate::state::{ColorBarSide, Figure};
 use crate::stats::Stats;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use tokio::sync::mpsc;
+use volray_annotate::colorbar::Side;
+use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
 use volray_core::camera::View;
 use volray_core::scene::{Look, Scene, SceneSettings};
 use volray_core::{Image, NonFinite, RenderError, RenderSettings, Renderer, Volume};
@@ -69,6 +72,34 @@ pub struct Shared {
     pub others: Vec<Arc<Volume>>,
     /// A time axis served one time point at a time.
     pub time: Option<Arc<TimePoints>>,
+    /// What the annotations need of the volume beyond its renderer.
+    pub figure: Arc<FigureContext>,
+}
+
+/// What a frame's annotations (`ViewState::figure`) need to know of the
+/// volume beyond its renderer, as `volray render` takes it from the file
+/// and the flags: whether it was rendered as log10, its units, the names
+/// of its axes.
+#[derive(Debug, Clone)]
+pub struct FigureContext {
+    pub log: bool,
+    /// `HU` for a CT preset.
+    pub value_unit: Option<String>,
+    /// The file's length unit (`mm`).
+    pub length_unit: Option<String>,
+    /// The names of the world's +x, +y, +z (`R`, `A`, `S` for NIfTI).
+    pub axis_names: [String; 3],
+}
+
+impl Default for FigureContext {
+    fn default() -> Self {
+        FigureContext {
+            log: false,
+            value_unit: None,
+            length_unit: None,
+            axis_names: ["x", "y", "z"].map(String::from),
+        }
+    }
 }
 
 /// Reads one time point of a file as a volume, or says why not in one line.
@@ -143,6 +174,7 @@ pub fn spawn(
     let levels = shared.levels.clone();
     let others = shared.others.clone();
     let time = shared.time.clone();
+    let figure = Arc::clone(&shared.figure);
     let volume = Arc::clone(&shared.volume);
     let reproduce = Arc::clone(&shared.reproduce);
     let pool = Arc::clone(&shared.pool);
@@ -197,6 +229,7 @@ pub fn spawn(
                 time: time.as_deref(),
                 volume: &volume,
                 last_still_ms: None,
+                figure: &figure,
             };
             while let Some(request) = mailbox.take() {
                 if request.probe.is_some() {
@@ -281,6 +314,7 @@ struct Tab<'a> {
     volume: &'a Volume,
     /// Milliseconds the last full-size frame took to render.
     last_still_ms: Option<f64>,
+    figure: &'a FigureContext,
 }
 
 /// A still that took longer than this to render is preceded by a quick
@@ -306,6 +340,52 @@ impl Tab<'_> {
     /// (the time goes with the pixels, the square of the scale).
     fn quick(&self, request: &Request) -> Option<Request> {
         quick_request(self.last_still_ms, request)
+    }
+
+    /// Draws `figure` into `image`, a frame of `settings`, as `volray
+    /// render` draws it: the first volume's colour bar and scale bar in
+    /// the view framing every volume, the box of each for the outline.
+    fn annotate(
+        &self,
+        image: &mut Image,
+        figure: &Figure,
+        settings: &RenderSettings,
+    ) -> Result<(), FrameError> {
+        let what = Annotations {
+            colorbar: figure.colorbar.map(|side| match side {
+                ColorBarSide::Right => Side::Right,
+                ColorBarSide::Left => Side::Left,
+            }),
+            scale_bar: figure.scale_bar.then_some(figure.scale_length),
+            title: figure.title.clone(),
+            label: figure.label.clone(),
+            axes: figure.axes,
+            outline: figure.outline,
+        };
+        let (first, framed, boxes) = match &self.source {
+            Source::Whole { renderer, .. } => {
+                (renderer, settings.clone(), vec![renderer.volume().bounds()])
+            }
+            Source::Scene(scene) => {
+                let mut framed = settings.clone();
+                framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
+                let boxes = scene.layers().iter().map(|r| r.volume().bounds()).collect();
+                (&scene.layers()[0], framed, boxes)
+            }
+            Source::Levels(_) => return Ok(()),
+        };
+        let cx = self.figure;
+        let [x, y, z] = &cx.axis_names;
+        let rendered = Rendered {
+            log: cx.log,
+            value_unit: cx.value_unit.as_deref(),
+            length_unit: cx.length_unit.as_deref(),
+            axis_names: [x.as_str(), y.as_str(), z.as_str()],
+            boxes: &boxes,
+            scale_box: first.volume().bounds(),
+        };
+        annotate_frame(image, &what, first, &framed, &rendered)?;
+        Ok(())
     }
 
     /// What the pixel `request` probes shows, in the frame of its state
@@ -367,7 +447,13 @@ impl Tab<'_> {
             stop,
             what: &what,
         };
-        let drawn = match &mut self.source {
+        let figure = &request.state.figure;
+        if !figure.is_bare() && matches!(self.source, Source::Levels(_)) {
+            return Err(FrameError::Refused(Refusal(
+                "the figure's annotations are not drawn on a multiscale volume's levels yet".into(),
+            )));
+        }
+        let mut drawn = match &mut self.source {
             Source::Whole { renderer, time } => {
                 if let Some(points) = self.time {
                     at_time(points, self.volume, request.state.time, renderer, time, &cx)?;
@@ -391,6 +477,9 @@ impl Tab<'_> {
             }
             Source::Levels(tab) => tab.draw(&cx, request.quality, full, &settings)?,
         };
+        if !figure.is_bare() {
+            self.annotate(&mut drawn.image, figure, &settings)?;
+        }
         let Drawn {
             image,
             basis,
@@ -484,11 +573,8 @@ impl Context<'_> {
             message_bytes = m;
         }
         let reserved = self.ledger.reserve(self.what, bytes)?;
-        let image = {
-            let _rendering = self.stats.rendering();
-            self.pool
-                .install(|| scene.render_with_progress(request, &|_| {}, Some(self.stop)))?
-        };
+        let image =
+            self.rendering(|| scene.render_with_progress(request, &|_| {}, Some(self.stop)))?;
         Ok(Drawn {
             image,
             basis,
@@ -499,12 +585,18 @@ impl Context<'_> {
     }
 
     fn render(&self, renderer: &Renderer, settings: &RenderSettings) -> Result<Image, FrameError> {
-        let _rendering = self.stats.rendering();
         // A fresh frame buffer each time (not one kept across frames):
         // what a tab holds between frames is then its caches alone.
-        Ok(self
-            .pool
-            .install(|| renderer.render_stoppable(settings, &|_| {}, self.stop))?)
+        self.rendering(|| renderer.render_stoppable(settings, &|_| {}, self.stop))
+    }
+
+    /// `work` on the pool, counted as a frame rendering.
+    fn rendering(
+        &self,
+        work: impl FnOnce() -> Result<Image, RenderError> + Send,
+    ) -> Result<Image, FrameError> {
+        let _rendering = self.stats.rendering();
+        Ok(self.pool.install(work)?)
     }
 }
 
@@ -846,6 +938,7 @@ mod tests {
             levels: None,
             others: Vec::new(),
             time: None,
+            figure: Arc::new(FigureContext::default()),
         }
     }
 

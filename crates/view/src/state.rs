@@ -119,6 +119,44 @@ pub struct ViewState {
     /// Phong's terms and the light; `None`: as started.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lighting: Option<Lighting>,
+    /// What is drawn into the frame (`--colorbar`, `--scale-bar`, ...).
+    #[serde(default, skip_serializing_if = "Figure::is_bare")]
+    pub figure: Figure,
+}
+
+/// The most characters of a title or a label.
+pub const MAX_TEXT: usize = 200;
+
+/// The annotations drawn into the frame, as `volray render` draws them
+/// (volray-annotate): a colour bar (`"right"` or `"left"`), a scale bar
+/// of a round length, the axes' triad, the box's outline, a title and a
+/// panel label.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Figure {
+    pub colorbar: Option<ColorBarSide>,
+    pub scale_bar: bool,
+    /// The scale bar's length in world units; `None`: a round one.
+    pub scale_length: Option<f64>,
+    pub axes: bool,
+    pub outline: bool,
+    pub title: Option<String>,
+    pub label: Option<String>,
+}
+
+/// Where the colour bar goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ColorBarSide {
+    Right,
+    Left,
+}
+
+impl Figure {
+    /// Nothing drawn.
+    pub fn is_bare(&self) -> bool {
+        *self == Figure::default()
+    }
 }
 
 /// What the page's lighting controls set: Phong's reflection terms as
@@ -185,6 +223,8 @@ pub enum StateError {
     ZeroDirection { field: &'static str },
     #[error("at most {MAX_CLIP_PLANES} clip planes, not {0}")]
     ClipPlanes(usize),
+    #[error("the {0} must be one line of at most {MAX_TEXT} characters")]
+    Text(&'static str),
     /// A field of a scene's volume (numbered from 1, the first's being
     /// the state's own fields).
     #[error("volume {0}: {1}")]
@@ -249,6 +289,15 @@ impl ViewState {
         for [point, normal] in &self.clip {
             finite("clip", &[*point, *normal].concat())?;
             nonzero("the clip plane's normal", normal)?;
+        }
+        if let Some(l) = self.figure.scale_length {
+            within("scale_length", l, (f64::MIN_POSITIVE, f64::from(f32::MAX)))?;
+        }
+        for (field, text) in [("title", &self.figure.title), ("label", &self.figure.label)] {
+            let text = text.as_deref().unwrap_or("");
+            if text.chars().count() > MAX_TEXT || text.chars().any(char::is_control) {
+                return Err(StateError::Text(field));
+            }
         }
         if let Some(l) = &self.lighting {
             for (field, v) in [
@@ -388,6 +437,7 @@ pub(crate) mod tests {
             crop: None,
             clip: Vec::new(),
             lighting: None,
+            figure: Figure::default(),
         }
     }
 
@@ -444,6 +494,14 @@ pub(crate) mod tests {
             ),
             (|s| s.colormap = "jet".into(), "unknown colour map \"jet\""),
             (|s| s.colormap = "#ff00f".into(), "unknown colour map"),
+            (
+                |s| s.figure.title = Some("two\nlines".into()),
+                "the title must be one line",
+            ),
+            (
+                |s| s.figure.label = Some("x".repeat(201)),
+                "the label must be one line of at most 200 characters",
+            ),
             (
                 |s| s.crop = Some([[0.0, 0.0, 0.0], [1.0, -1.0, 1.0]]),
                 "the crop box's y range [0, -1] must have lo < hi",
