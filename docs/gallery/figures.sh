@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Renders the gallery's figures with annotations (docs/options.md,
+# "Figures"): |psi_621|^2 under --log with a colour bar in decades, a
+# scale bar and the axes; a
+# fractal cloud with its outline; a CT-like head (scripts/make_ct_phantom.py
+# at 256^3, 1 mm voxels) with a colour bar in HU and a scale bar.
+#
+#     docs/gallery/figures.sh docs/gallery [path/to/volray]
+set -euo pipefail
+out=${1:?"the folder to write into"}
+volray=${2:-target/release/volray}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+"$volray" render hydrogen:6,2,1 --view 150,150,500 --size 420 \
+  --log --range 1e-8,3e-5 --colormap viridis \
+  --colorbar --scale-bar --axes --title "hydrogen 6,2,1, log" --label a \
+  -o "$out/figure-hydrogen.png"
+"$volray" render fractal:129 --colormap inferno --size 420 --azimuth 30 --elevation 20 \
+  --colorbar --scale-bar --outline --label b \
+  -o "$out/figure-cloud.png"
+python3 scripts/make_ct_phantom.py 256 "$tmp/head.raw" >/dev/null
+"$volray" render "$tmp/head.raw" --dims 256,256,256 --dtype i16 --spacing 1,1,1 \
+  --preset ct-bone --size 420 --azimuth 30 --elevation 15 \
+  --colorbar --scale-bar --axes --label c \
+  -o "$out/figure-ct.png"
