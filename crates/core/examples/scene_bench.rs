@@ -6,7 +6,8 @@
 //! overlap); and, for comparison, channels of blobs at different places
 //! (every channel's bricks are then extra work). Prints the median frame
 //! time of each case and its ratio to the one channel's, all measured in
-//! one run, alternating the cases frame by frame.
+//! one run, alternating the cases frame by frame; and the median
+//! processor time of each (all threads), steadier on a shared machine.
 //!
 //! `cargo run --release -p volray-core --example scene_bench [-- N FRAMES]`
 //! (N: grid side, default 256; FRAMES: timed frames per case, default 7).
@@ -57,6 +58,21 @@ fn channel(n: usize, places: u64, seed: u64) -> Volume {
 
 /// One case: renders frame `n`.
 type Frame<'a> = Box<dyn Fn(usize) + 'a>;
+
+/// The processor time of every thread of this process so far, in seconds
+/// (Linux: `/proc/self/task/*/schedstat`; elsewhere 0). On a machine
+/// shared with other work, a frame's processor time is steadier than its
+/// wall time.
+fn cpu_seconds() -> f64 {
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return 0.0;
+    };
+    let ns: u64 = tasks
+        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .sum();
+    ns as f64 * 1e-9
+}
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -178,23 +194,32 @@ fn main() {
             case(0);
         }
         let mut times = vec![Vec::new(); cases.len()];
+        let mut cpu = vec![Vec::new(); cases.len()];
         for frame in 1..=frames {
             for (i, (_, case)) in cases.iter().enumerate() {
-                let t = Instant::now();
+                let (t, c) = (Instant::now(), cpu_seconds());
                 case(frame);
                 times[i].push(t.elapsed().as_secs_f64());
+                cpu[i].push(cpu_seconds() - c);
             }
         }
         let medians: Vec<f64> = times.into_iter().map(median).collect();
+        let cpu: Vec<f64> = cpu.into_iter().map(median).collect();
         println!(
             "{n}³ channels at 512², step 0.5, {classification:?}-classified, {} threads, {frames} frames:",
             rayon::current_num_threads()
         );
-        for ((name, _), m) in cases.iter().zip(&medians) {
+        println!(
+            "  {:<26} {:>8} {:>7} {:>10} {:>7}",
+            "", "wall", "", "processor", ""
+        );
+        for (((name, _), m), c) in cases.iter().zip(&medians).zip(&cpu) {
             println!(
-                "  {name:<26} {:>8.1} ms  {:>5.2}×",
+                "  {name:<26} {:>8.1} ms {:>5.2}× {:>8.1} ms {:>5.2}×",
                 m * 1e3,
-                m / medians[0] /* the first case shown */
+                m / medians[0], /* the first case shown */
+                c * 1e3,
+                c / cpu[0],
             );
         }
     }
