@@ -230,7 +230,8 @@ impl CliReproduce {
             .map(|(words, json, _)| (words, json))
     }
 
-    /// [`Self::words`], with the files a scene's `--overlay`s name.
+    /// The command's words, its `--tf` file's JSON, and the files a
+    /// scene's `--overlay`s name.
     fn scene_words(&self, state: &ViewState) -> Result<SceneWordsOf, Refusal> {
         let mut w = Words::default();
         w.word("render");

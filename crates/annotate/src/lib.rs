@@ -14,7 +14,7 @@
 //!   camera turns them, red, green and blue, named as the file's world is;
 //! - [`outline`]: the volume's box, its edges projected through the
 //!   frame's own view (orthographic or perspective) and clipped;
-//! - [`line`]: the anti-aliased, clipped segments both draw;
+//! - [`line`](mod@line): the anti-aliased, clipped segments both draw;
 //! - [`ticks`]: round tick values and short labels;
 //! - [`figure`]: the annotations a front end asks for, drawn for what was
 //!   rendered (one function for the command line, Python and the viewer;
