@@ -14,7 +14,9 @@
 
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::{ChannelColors, Channels, InputArgs, MixMode, RenderArgs, SceneArgs, ViewArgs};
+use crate::flags::{
+    ChannelColors, Channels, InputArgs, LookArgs, MixMode, RenderArgs, SceneArgs, ViewArgs,
+};
 use crate::input::{self, Input};
 use crate::render::{OutputKind, output_kind, write_still};
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
@@ -322,17 +324,23 @@ fn refuse_unsupported(args: &RenderArgs) -> Result<(), CliError> {
         )));
     }
     if args.scene.channels.is_some() {
-        let look = &args.view.look;
-        for (given, other) in [
-            (look.labels, "--labels"),
-            (look.preset.is_some(), "--preset"),
-            (look.colormap.is_some(), "--colormap"),
-        ] {
-            if given {
-                return Err(CliError::input(format!(
-                    "--channels colours each channel (--channel-colors): {other} does not apply to channels (give it to an --overlay instead)"
-                )));
-            }
+        refuse_channel_look(&args.view.look)?;
+    }
+    Ok(())
+}
+
+/// Refuses the look flags that do not apply to `--channels`, whose
+/// colours are `--channel-colors`' (render's and view's).
+pub fn refuse_channel_look(look: &LookArgs) -> Result<(), CliError> {
+    for (given, other) in [
+        (look.labels, "--labels"),
+        (look.preset.is_some(), "--preset"),
+        (look.colormap.is_some(), "--colormap"),
+    ] {
+        if given {
+            return Err(CliError::input(format!(
+                "--channels colours each channel (--channel-colors): {other} does not apply to channels (give it to an --overlay instead)"
+            )));
         }
     }
     Ok(())

@@ -173,17 +173,7 @@ fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
         ));
     }
     if scene.channels.is_some() {
-        for (given, other) in [
-            (look.labels, "--labels"),
-            (look.preset.is_some(), "--preset"),
-            (look.colormap.is_some(), "--colormap"),
-        ] {
-            if given {
-                return Err(CliError::input(format!(
-                    "--channels colours each channel (--channel-colors): {other} does not apply to channels (give it to an --overlay instead)"
-                )));
-            }
-        }
+        crate::scene::refuse_channel_look(look)?;
     }
     if scene.is_scene() && look.log {
         return Err(CliError::input(format!(

@@ -367,10 +367,8 @@ impl Tab<'_> {
                 (renderer, settings.clone(), vec![renderer.volume().bounds()])
             }
             Source::Scene(scene) => {
-                let mut framed = settings.clone();
-                framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
                 let boxes = scene.layers().iter().map(|r| r.volume().bounds()).collect();
-                (&scene.layers()[0], framed, boxes)
+                (&scene.layers()[0], framed(scene, settings), boxes)
             }
             Source::Levels(_) => return Ok(()),
         };
@@ -398,9 +396,7 @@ impl Tab<'_> {
             Ok(match &self.source {
                 Source::Whole { renderer, .. } => renderer.probe(&settings, col, row)?,
                 Source::Scene(scene) => {
-                    let mut framed = settings.clone();
-                    framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
-                    scene.layers()[0].probe(&framed, col, row)?
+                    scene.layers()[0].probe(&framed(scene, &settings), col, row)?
                 }
                 Source::Levels(_) => None,
             })
@@ -560,9 +556,7 @@ impl Context<'_> {
         full: &RenderSettings,
         request: &SceneSettings,
     ) -> Result<Drawn, FrameError> {
-        let mut framed = full.clone();
-        framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
-        let basis = basis(&scene.layers()[0], &framed)?;
+        let basis = basis(&scene.layers()[0], &framed(scene, full))?;
         // Each volume's path and frame, as if each were rendered apart
         // (the additive mix and the projections are): an upper bound.
         let mut bytes = 0;
@@ -819,6 +813,15 @@ fn quick_request(last_still_ms: Option<f64>, request: &Request) -> Option<Reques
         ..request.clone()
     })
     .filter(|_| request.probe.is_none())
+}
+
+/// `settings` for the scene's first volume alone, its camera framing
+/// every volume's box as the scene's frames do (for its basis, probe and
+/// annotations).
+fn framed(scene: &Scene, settings: &RenderSettings) -> RenderSettings {
+    let mut framed = settings.clone();
+    framed.camera.bounds = Some(framed.camera.framed_bounds(scene.bounds()));
+    framed
 }
 
 /// A side of `full` pixels at `scale`, at least one pixel.
