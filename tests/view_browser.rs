@@ -725,13 +725,7 @@ async fn without_a_size_the_frame_fills_the_window_and_follows_it() {
     );
 
     // Hiding the controls gives the frame their room.
-    b.client
-        .find(fantoccini::Locator::Id("panel-toggle"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    b.click("#panel-toggle").await;
     b.wait_for(&format!(
         "window.volrayView.state().width > {} && document.body.dataset.state === 'still'",
         first[0] + 300.0
@@ -752,13 +746,7 @@ async fn without_a_size_the_frame_fills_the_window_and_follows_it() {
     assert_eq!((small[0], small[1]), (small[2], small[3]), "{small:?}");
 
     // The views from each side: buttons and keys.
-    b.client
-        .find(fantoccini::Locator::Css("#toolbar [data-view='+z']"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    b.click("#toolbar [data-view='+z']").await;
     b.wait_still().await;
     let command = b.text("command").await;
     assert!(
@@ -786,18 +774,6 @@ async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is
     };
     let dir = tempfile::tempdir().unwrap();
     let start = picture(&b.frame_bytes().await, dir.path(), "start.png");
-    let click = |id: &'static str| {
-        let b = &b;
-        async move {
-            b.client
-                .find(fantoccini::Locator::Id(id))
-                .await
-                .unwrap()
-                .click()
-                .await
-                .unwrap();
-        }
-    };
     // Sets a control's value as a user would, and lets it tell the page.
     let set = |id: &'static str, value: &'static str| {
         let b = &b;
@@ -811,7 +787,7 @@ async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is
     };
 
     // A crop box: its x from the middle of the box.
-    click("crop-on").await;
+    b.click("#crop-on").await;
     set("crop-x0", "0.5").await;
     b.wait_still().await;
     let cropped = picture(&b.frame_bytes().await, dir.path(), "cropped.png");
@@ -819,11 +795,11 @@ async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is
     let command = b.text("command").await;
     assert!(command.contains("--crop "), "{command}");
     assert_eq!(run_shown(&b, dir.path()).await, cropped, "crop");
-    click("crop-on").await;
+    b.click("#crop-on").await;
 
     // A clip plane across z, keeping the low side.
     set("clip-axis", "z").await;
-    click("clip-flip").await;
+    b.click("#clip-flip").await;
     b.wait_still().await;
     let state = b.eval("return window.volrayView.state();").await;
     assert_eq!(state["crop"], serde_json::Value::Null, "the crop is off");
@@ -839,7 +815,7 @@ async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is
 
     // The lighting: no ambient, a light from +y.
     set("l-ambient", "0").await;
-    click("headlight").await;
+    b.click("#headlight").await;
     set("l-azimuth", "90").await;
     b.wait_still().await;
     let command = b.text("command").await;
@@ -901,13 +877,7 @@ async fn the_figure_controls_draw_what_render_draws_into_the_frame() {
     let dir = tempfile::tempdir().unwrap();
     let bare = picture(&b.frame_bytes().await, dir.path(), "bare.png");
     for id in ["f-colorbar", "f-scale", "f-axes", "f-outline"] {
-        b.client
-            .find(fantoccini::Locator::Id(id))
-            .await
-            .unwrap()
-            .click()
-            .await
-            .unwrap();
+        b.click(&format!("#{id}")).await;
         b.wait_still().await;
     }
     b.eval(

@@ -257,6 +257,12 @@ impl Browser {
         self.clicks(selector, (x, y), 1).await;
     }
 
+    /// Clicks the element `selector` (a CSS selector) as WebDriver does.
+    pub async fn click(&self, selector: &str) {
+        let element = self.client.find(Locator::Css(selector)).await.unwrap();
+        element.click().await.unwrap();
+    }
+
     /// Moves the pointer (no button) to `at` from the centre of the
     /// element `selector`.
     pub async fn hover(&self, selector: &str, at: (f64, f64)) {
