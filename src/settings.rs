@@ -111,6 +111,7 @@ pub fn look(look: &LookArgs) -> LookOptions {
         shininess: look.shininess,
         light: look.light,
         light_color: look.light_color,
+        shadows: look.shadows,
         shading: !look.no_shading,
         background: look.background,
         blend: match look.blend {

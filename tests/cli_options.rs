@@ -524,3 +524,52 @@ fn tf_auto_conflicts_with_a_preset() {
     let err = stderr(&run);
     assert!(err.contains("--preset conflicts with --tf"), "{err}");
 }
+
+#[test]
+fn shadows_darken_what_the_light_cannot_reach_and_are_refused_where_nothing_is_lit() {
+    // The fractal cloud lit from above and the side: with --shadows the
+    // far side of the cloud from the light darkens, the near side keeps
+    // its light, and the reference path agrees within two levels.
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["fractal:33", "--size", "64x64", "--light", "1,0,1"];
+    let plain = render(dir.path(), &base);
+    let with = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        render(dir.path(), &args)
+    };
+    let shadowed = with(&["--shadows"]);
+    let reference = with(&["--shadows", "--reference"]);
+    let sum = |p: &Picture| p.rgb.iter().flatten().map(|&c| c as u64).sum::<u64>();
+    assert!(
+        sum(&shadowed) * 10 < sum(&plain) * 9,
+        "shadows darken the picture: {} vs {}",
+        sum(&shadowed),
+        sum(&plain)
+    );
+    assert!(
+        shadowed
+            .rgb
+            .iter()
+            .zip(&plain.rgb)
+            .all(|(s, p)| (0..3).all(|c| s[c] <= p[c]))
+    );
+    let worst = (shadowed.rgb.iter().zip(&reference.rgb))
+        .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
+        .max()
+        .unwrap();
+    assert!(worst <= 2, "fast vs reference with shadows: {worst} levels");
+    for refused in [
+        &["--shadows", "--blend", "mip"][..],
+        &["--shadows", "--no-shading"][..],
+    ] {
+        let out = dir.path().join("refused.png");
+        let mut args = vec!["render", "fractal:17"];
+        args.extend_from_slice(refused);
+        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+        let run = volray(&args);
+        assert!(!run.status.success(), "{refused:?}");
+        assert!(stderr(&run).contains("--shadows"), "{}", stderr(&run));
+        assert!(!out.exists());
+    }
+}

@@ -93,6 +93,12 @@ pub struct LookArgs {
     #[arg(long, value_name = "R,G,B", default_value = "1,1,1", value_parser = parse_rgb, allow_hyphen_values = true)]
     pub light_color: [f32; 3],
 
+    /// Shadows: each point lit by the light that reaches it through the
+    /// volume (ambient light stays). Without --light, the light is the
+    /// camera's key light, 45° above and 30° left of the view.
+    #[arg(long)]
+    pub shadows: bool,
+
     /// No lighting: voxels take their material colour.
     #[arg(long)]
     pub no_shading: bool,

@@ -60,6 +60,10 @@ pub enum SceneError {
     },
     #[error("a scene of pieces: {0}")]
     Piece(&'static str),
+    /// Shadows are cast by one volume on itself; several volumes' light
+    /// volumes would have to be swept together.
+    #[error("shadows are cast within one volume: a scene of several volumes cannot show them yet")]
+    Shadows,
 }
 
 /// A render setting out of its range: which one, its value and the bound.
@@ -112,6 +116,9 @@ pub enum SettingError {
     GradientOpacity { lo: f32, hi: f32 },
     #[error("gradient opacity maximum {0} must be a finite gradient magnitude above 0")]
     GradientOpacityMax(f32),
+    /// Shadows asked for where nothing is lit.
+    #[error("shadows need lit, composited samples: {0}")]
+    Shadows(&'static str),
 }
 
 /// Which side of the image [`SettingError::ImageSide`] is about.

@@ -93,6 +93,7 @@ mod renderer;
 pub mod sampling;
 pub mod scene;
 mod settings;
+pub mod shadows;
 pub mod transfer;
 mod volume;
 
@@ -114,7 +115,7 @@ pub use renderer::{DEFAULT_CACHE_BUDGET, FrameTimes, Renderer};
 pub use sampling::clipping::ClipPlane;
 pub use settings::{
     Blend, Classification, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_SAMPLES_PER_RAY, Method,
-    RenderSettings,
+    RenderSettings, key_light,
 };
 pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;

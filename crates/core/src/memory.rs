@@ -17,6 +17,11 @@
 //! | reference, pre-classified | — | gradients (12) and shaded voxels (16 bytes a voxel) |
 //! | reference, post-classified | — | gradients (12) |
 //!
+//! With shadows ([`crate::shadows`]) the fast paths keep a light volume
+//! (2 bytes a voxel) and its two running slices while it is swept; the
+//! reference adds the voxels' opacities and the light reaching them (4 + 4
+//! bytes a voxel).
+//!
 //! plus the frame (16 bytes a pixel, partial and finished image sharing
 //! one buffer; a projection 32) and, with non-finite values rendered as
 //! empty space, the cleaned copy of the volume and its mask. A renderer
@@ -29,6 +34,7 @@ use crate::kernels::projection::Projected;
 use crate::non_finite::{self, NonFinite};
 use crate::reference::{self, stage1};
 use crate::settings::{Blend, Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
+use crate::shadows::light_volume;
 use crate::volume::{SampleType, Volume};
 use crate::{bricks, image::Image};
 use glam::DVec3;
@@ -96,6 +102,16 @@ impl MemoryBound {
             }
             (Method::Reference, _, _) => reference_values,
         };
+        let path = path
+            + match (settings.shadows, settings.method) {
+                (false, _) => 0,
+                (true, Method::Fast) => {
+                    let plane = dims.iter().map(|&n| n as u128).max().unwrap_or(0).pow(2);
+                    voxels * light_volume::BYTES_PER_VOXEL as u128
+                        + 4 * plane * size_of::<f32>() as u128
+                }
+                (true, Method::Reference) => voxels * 2 * size_of::<f32>() as u128,
+            };
         let pixels = settings.width as u128 * settings.height as u128;
         let image = size_of::<[f32; 4]>() as u128;
         let frame = match settings.blend {

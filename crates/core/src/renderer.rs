@@ -34,6 +34,7 @@ use crate::error::RenderError;
 use crate::frame::Frame;
 use crate::image::Image;
 use crate::kernels::composite::{Finish, PartialPixel};
+use crate::kernels::gradient::Differences;
 use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
 use crate::non_finite::{NonFinite, NonFiniteMask};
@@ -43,9 +44,13 @@ use crate::reference;
 use crate::reference::Shader;
 use crate::reference::post::PostClassifier;
 use crate::reference::stage1::{ShadedVolume, shade_and_classify};
-use crate::settings::{Blend, Classification, Method, RenderSettings};
+use crate::settings::{Blend, Classification, Method, RenderSettings, key_light};
+use crate::shadows::light_volume::LightVolume;
+use crate::shadows::{self, ShadowRay};
 use crate::transfer::classifier::Classifier;
+use crate::volume::Sample;
 use crate::volume::Volume;
+use rayon::prelude::*;
 use std::borrow::Cow;
 use std::sync::atomic::AtomicBool;
 use std::sync::{Mutex, MutexGuard, OnceLock};
@@ -75,6 +80,8 @@ pub struct Renderer<'v> {
     /// (16 bytes per voxel).
     packed_voxels: OnceLock<Vec<wide::f32x4>>,
     fast: Mutex<Option<FastState>>,
+    /// The last light volume the fast paths swept, for shadows.
+    light: Mutex<Option<KeptLight>>,
     /// The most bytes the bricked fast path keeps of classified and lit
     /// bricks ([`Renderer::with_cache_budget`]).
     cache_budget: usize,
@@ -102,6 +109,13 @@ pub(crate) struct FastState {
     pub bricks: ClassifiedBricks,
     /// The frame's lit bricks, buffers reused from frame to frame.
     pub lit: LitBricks,
+}
+
+/// A light volume and what it was swept for.
+pub(crate) struct KeptLight {
+    /// The classifier and the direction towards the light (its bits).
+    key: (Classifier, [u32; 3]),
+    light: LightVolume,
 }
 
 /// Where a fast frame's time went.
@@ -187,6 +201,7 @@ impl<'v> Renderer<'v> {
             max_gradient: OnceLock::new(),
             packed_voxels: OnceLock::new(),
             fast: Mutex::new(None),
+            light: Mutex::new(None),
             cache_budget: DEFAULT_CACHE_BUDGET,
         })
     }
@@ -460,12 +475,114 @@ impl<'v> Renderer<'v> {
     /// perspective views too (as a headlight at infinity): one light
     /// geometry for the whole frame, so that pre-classification can light
     /// the voxels once.
+    /// With shadows and no light direction, the light is the camera's key
+    /// light ([`key_light`]).
     pub(crate) fn light(settings: &RenderSettings, view: &View) -> LightGeometry {
-        let to_viewer = (-view.direction()).as_vec3();
-        match settings.light_direction {
-            Some(l) => LightGeometry::new(l.as_vec3(), to_viewer),
-            None => LightGeometry::headlight(to_viewer),
+        let to_viewer = -view.direction();
+        match (settings.light_direction, settings.shadows) {
+            (Some(l), _) => LightGeometry::new(l.as_vec3(), to_viewer.as_vec3()),
+            (None, true) => LightGeometry::new(
+                key_light(to_viewer, settings.camera.up).as_vec3(),
+                to_viewer.as_vec3(),
+            ),
+            (None, false) => LightGeometry::headlight(to_viewer.as_vec3()),
         }
+    }
+
+    /// The shadow rays of a frame of `settings` lit by `light`.
+    fn shadow_ray(&self, settings: &RenderSettings, light: &LightGeometry) -> ShadowRay {
+        let spacing = self.volume.spacing();
+        ShadowRay::new(
+            light.to_light.as_dvec3(),
+            self.volume.dims(),
+            spacing,
+            settings.step * spacing.min_element(),
+        )
+    }
+
+    /// Every voxel's step-corrected opacity for `classifier` (stage 1's),
+    /// from `gradients`; masked non-finite voxels are transparent.
+    fn opacities(&self, classifier: &Classifier, gradients: &[[f32; 3]]) -> Vec<f32> {
+        let values = self.volume.values();
+        let masked = self.masked();
+        (values.par_iter().zip(gradients).enumerate())
+            .map(|(v, (&f, &g))| {
+                if masked(v) {
+                    0.0
+                } else {
+                    classifier.opacity_at(f, g)
+                }
+            })
+            .collect()
+    }
+
+    /// The reference path's light reaching every voxel, for a frame of
+    /// `settings` with shadows (see [`crate::shadows`]).
+    fn reference_light(
+        &self,
+        settings: &RenderSettings,
+        light: &LightGeometry,
+        classifier: &Classifier,
+        gradients: &[[f32; 3]],
+    ) -> Vec<f32> {
+        let alpha = self.opacities(classifier, gradients);
+        shadows::reference_light(
+            &alpha,
+            self.volume.dims(),
+            &self.shadow_ray(settings, light),
+        )
+    }
+
+    /// The kept light volume, locked for a frame; a frame without
+    /// shadows drops it.
+    fn kept_light(&self, shadows: bool) -> MutexGuard<'_, Option<KeptLight>> {
+        let mut guard = self.light.lock().unwrap_or_else(|e| e.into_inner());
+        if !shadows {
+            *guard = None;
+        }
+        guard
+    }
+
+    /// The fast paths' light volume for `classifier` and `light`: swept
+    /// ([`LightVolume::sweep`]) unless `kept` was swept for both.
+    fn light_volume<'k>(
+        &self,
+        settings: &RenderSettings,
+        classifier: &Classifier,
+        light: &LightGeometry,
+        kept: &'k mut Option<KeptLight>,
+    ) -> &'k LightVolume {
+        let key = (
+            classifier.clone(),
+            light.to_light.to_array().map(f32::to_bits),
+        );
+        if kept.as_ref().is_none_or(|k| k.key != key) {
+            *kept = None;
+            let volume = &*self.volume;
+            let [nx, ny, _] = volume.dims();
+            let masked = self.masked();
+            let spacing = volume.spacing();
+            let step_world = settings.step * spacing.min_element();
+            let to_light = light.to_light.as_dvec3();
+            let light = crate::with_samples!(volume.samples(), |data| {
+                let differences = Differences::new(data, volume);
+                let gradient = classifier.uses_gradient();
+                LightVolume::sweep(volume.dims(), spacing, to_light, step_world, |i, j, k| {
+                    let v = i + nx * (j + ny * k);
+                    if masked(v) {
+                        return 0.0;
+                    }
+                    let g = if gradient {
+                        differences.at(i, j, k)
+                    } else {
+                        [0.0; 3]
+                    };
+                    classifier.opacity_at(data[v].to_f32(), g)
+                })
+            });
+            *kept = Some(KeptLight { key, light });
+        }
+        &kept.as_ref().expect("swept above").light
     }
 
     /// The reference path's stage 1: colour and opacity of every voxel for
@@ -474,11 +591,16 @@ impl<'v> Renderer<'v> {
     pub fn stage1(&self, settings: &RenderSettings, view: &View) -> ShadedVolume {
         let light = Self::light(settings, view);
         let lighting = settings.shading.then_some((&settings.phong, &light));
+        let gradients = gradients(&self.volume);
+        let classifier = self.classifier(settings);
+        let light_reaching = (settings.shadows)
+            .then(|| self.reference_light(settings, &light, &classifier, &gradients));
         let mut shaded = shade_and_classify(
             &self.volume,
-            &gradients(&self.volume),
-            &self.classifier(settings),
+            &gradients,
+            &classifier,
             lighting,
+            light_reaching.as_deref(),
         );
         if let Some(mask) = &self.non_finite {
             for (i, voxel) in shaded.voxels.iter_mut().enumerate() {
@@ -511,6 +633,12 @@ impl<'v> Renderer<'v> {
                 let lighting = settings.shading.then_some((&settings.phong, light));
                 let post = PostClassifier::new(&self.volume, &classifier, lighting)
                     .with_mask(self.non_finite.as_ref());
+                if settings.shadows {
+                    let gradients = gradients(&self.volume);
+                    let alpha = self.opacities(&classifier, &gradients);
+                    let post = post.with_shadows(&alpha, self.shadow_ray(settings, &light));
+                    return render(&Shader::Post(&post));
+                }
                 render(&Shader::Post(&post))
             }
             (blend, _) => render(&Shader::Projection {
@@ -576,13 +704,17 @@ impl<'v> Renderer<'v> {
         let start = Instant::now();
         let classifier = self.classifier(settings);
         let voxels = self.packed_voxels();
+        let light = Self::light(settings, &frame.view);
+        let mut kept = self.kept_light(settings.shadows);
+        let light_volume =
+            (settings.shadows).then(|| self.light_volume(settings, &classifier, &light, &mut kept));
         let scene = post_cast::Scene {
             voxels,
             macrocells: self.macrocells(),
             classifier: &classifier,
-            lighting: (settings.shading)
-                .then(|| (&settings.phong, Self::light(settings, &frame.view))),
+            lighting: (settings.shading).then_some((&settings.phong, light)),
             mask: self.non_finite.as_ref(),
+            light: light_volume,
         };
         let (view, sampling) = (&frame.view, &frame.sampling);
         post_cast::render(&scene, view, sampling, pixels, finish, progress);
@@ -653,6 +785,9 @@ impl<'v> Renderer<'v> {
         let bins = TileBins::new(&state.bricks, &frame.sampling, &frame.view);
         let t2 = Instant::now();
         let light = Self::light(settings, &frame.view);
+        let mut kept = self.kept_light(settings.shadows);
+        let light_volume = (settings.shadows)
+            .then(|| self.light_volume(settings, &state.classifier, &light, &mut kept));
         let number = state.lit.next_frame(bins.entries());
         let classified_before = state.bricks.classified_count();
         let source = Source {
@@ -665,6 +800,7 @@ impl<'v> Renderer<'v> {
             &state.bricks,
             number,
             settings.shading.then_some((&settings.phong, &light)),
+            light_volume,
         );
         bricked::render(
             &state.bricks,

@@ -90,6 +90,11 @@ pub struct RenderSettings {
     /// distributed render does (see [`crate::piece`]); `None` renders the
     /// renderer's volume as the whole.
     pub piece: Option<Piece>,
+    /// Shade with the light that reaches each point through the volume
+    /// ([`crate::shadows`]). Without a `light_direction` the light is the
+    /// camera's key light ([`key_light`]) rather than the headlight, whose
+    /// shadows would hide behind what casts them.
+    pub shadows: bool,
 }
 
 impl Default for RenderSettings {
@@ -115,6 +120,7 @@ impl Default for RenderSettings {
             gradient_opacity: None,
             gradient_opacity_max: None,
             piece: None,
+            shadows: false,
         }
     }
 }
@@ -196,6 +202,33 @@ impl RenderSettings {
         {
             return Err(E::GradientOpacityMax(max));
         }
+        if self.shadows {
+            if self.blend != Blend::Composite {
+                return Err(E::Shadows("a projection has no light to shadow"));
+            }
+            if !self.shading {
+                return Err(E::Shadows("the lighting is off"));
+            }
+            if self.piece.is_some() {
+                return Err(E::Shadows(
+                    "a piece of a volume cannot see the pieces that shadow it",
+                ));
+            }
+        }
         Ok(())
     }
+}
+
+/// The light of a frame with shadows and no light direction: a key light
+/// 45° above the viewer and 30° to the left, as photographers and VTK's
+/// light kit place theirs, so that shadows fall down and to the right of
+/// what casts them. `to_viewer` and `up` are the camera's (world, unit
+/// and not parallel); the light turns with the camera.
+pub fn key_light(to_viewer: DVec3, up: DVec3) -> DVec3 {
+    let right = up.cross(to_viewer).normalize_or_zero();
+    let up = to_viewer.cross(right).normalize_or_zero();
+    let (elevation, azimuth) = (45f64.to_radians(), 30f64.to_radians());
+    (to_viewer * elevation.cos() * azimuth.cos() + up * elevation.sin()
+        - right * elevation.cos() * azimuth.sin())
+    .normalize()
 }

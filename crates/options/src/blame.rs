@@ -50,6 +50,7 @@ pub fn option_of(e: &RenderError, camera: &CameraOptions) -> Option<Opt> {
             S::Shininess(_) => Opt::Shininess,
             S::Background(_) => Opt::Background,
             S::LightDirection(_) => Opt::Light,
+            S::Shadows(_) => Opt::Shadows,
             S::Crop { .. } => Opt::Crop,
             S::ClipPoint(_) | S::ClipNormal(_) => Opt::Clip,
             S::IsoValue(_) => Opt::Iso,

@@ -41,6 +41,8 @@ pub enum Opt {
     Shininess,
     Light,
     LightColor,
+    /// Shadows from the light through the volume.
+    Shadows,
     /// Shading turned off (the command line's `--no-shading`).
     NoShading,
     Background,
@@ -84,6 +86,7 @@ impl Opt {
             Opt::Shininess => "shininess",
             Opt::Light => "light",
             Opt::LightColor => "light-color",
+            Opt::Shadows => "shadows",
             Opt::NoShading => "no-shading",
             Opt::Background => "background",
             Opt::Blend => "blend",

@@ -148,6 +148,9 @@ pub struct LookOptions {
     pub light: Option<[f64; 3]>,
     /// The light's colour (`--light-color`).
     pub light_color: [f32; 3],
+    /// Shadows: the light reaching each point through the volume
+    /// (`--shadows`); without `light`, the camera's key light.
+    pub shadows: bool,
     /// Shading on (off: `--no-shading`).
     pub shading: bool,
     /// The colour behind the volume (`--background`).
@@ -186,6 +189,7 @@ impl Default for LookOptions {
             shininess: lit.shininess,
             light: None,
             light_color: lit.light_color,
+            shadows: false,
             shading: true,
             background: RenderSettings::default().background,
             blend: BlendMode::Composite,

@@ -74,6 +74,7 @@ pub fn settings(options: &Options) -> Result<RenderSettings, OptionError> {
         gradient_opacity: look.gradient_opacity,
         gradient_opacity_max: None,
         piece: None,
+        shadows: look.shadows,
     };
     (settings.validate()).map_err(|e| OptionError::Invalid(e.into()))?;
     (settings.camera.validate()).map_err(|e| OptionError::Invalid(e.into()))?;
@@ -229,6 +230,7 @@ fn lighting_option(look: &LookOptions) -> Option<Opt> {
         (look.shininess != lit.shininess, Opt::Shininess),
         (look.light_color != lit.light_color, Opt::LightColor),
         (look.light.is_some(), Opt::Light),
+        (look.shadows, Opt::Shadows),
     ]
     .into_iter()
     .find_map(|(given, opt)| given.then_some(opt))

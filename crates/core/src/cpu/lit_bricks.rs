@@ -20,6 +20,7 @@ use crate::bricks::cache::{BrickCache, Budget, CacheRef};
 use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, Source, UNIT, Voxel};
 use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
+use crate::shadows::light_volume::LightVolume;
 use crate::transfer::classifier::Classifier;
 use crate::transfer::function::PiecewiseLinear;
 use crate::transfer::labels::colour_value;
@@ -193,18 +194,22 @@ pub struct Lighting<'a> {
     material: Material,
     /// `None`: unlit, the colour is the material colour.
     light: Option<FrameLight>,
+    /// With shadows, the light reaching each voxel ([`crate::shadows`]).
+    light_reaching: Option<&'a LightVolume>,
     /// Bricks lit ([`Self::count`]).
     lit: AtomicUsize,
 }
 
 impl<'a> Lighting<'a> {
     /// The lighting of `bricks` (classified from `source`) under
-    /// `lighting` (`None` for unlit rendering) in frame `frame`.
+    /// `lighting` (`None` for unlit rendering) in frame `frame`, shadowed
+    /// by `light_reaching` (`None`: no shadows).
     pub fn new(
         source: Source<'a>,
         bricks: &'a ClassifiedBricks,
         frame: u64,
         lighting: Option<(&Phong, &LightGeometry)>,
+        light_reaching: Option<&'a LightVolume>,
     ) -> Self {
         Lighting {
             source,
@@ -212,6 +217,7 @@ impl<'a> Lighting<'a> {
             frame,
             material: Material::new(source.classifier),
             light: lighting.map(|(phong, light)| FrameLight::new(phong, light)),
+            light_reaching,
             lit: AtomicUsize::new(0),
         }
     }
@@ -251,12 +257,23 @@ impl<'a> Lighting<'a> {
                 }
             }
         });
+        // The light reaching a slot's voxel (slots past the volume's end
+        // repeat its last voxel, as their values do).
+        let last = bricks.grid.dims.map(|n| n - 1);
+        let origin = bricks.grid.origin(b);
+        let reaching = |s: usize| {
+            self.light_reaching.map_or(1.0, |light| {
+                let local = [s % SIDE, (s / SIDE) % SIDE, s / (SIDE * SIDE)];
+                light.at(std::array::from_fn(|a| (origin[a] + local[a]).min(last[a])))
+            })
+        };
         // Four slots at a time, one per SIMD lane.
         let mut group = |slots: [usize; 4], lanes: usize| {
             let colours = shade4(
                 slots.map(|s| &voxels[s]),
                 f32x4::new(slots.map(|s| values[s])),
                 self.light.as_ref(),
+                f32x4::new(slots.map(reaching)),
                 &self.material,
             );
             for (lane, colour) in colours.iter().take(lanes).enumerate() {
@@ -291,19 +308,21 @@ fn slot_values<T: Sample>(data: &[T], grid: &BrickGrid, b: [usize; 3], values: &
     }
 }
 
-/// The RGBA of four voxels with values `values`.
+/// The RGBA of four voxels with values `values`, reached by the fraction
+/// `reaching` of the light.
 #[inline]
 fn shade4(
     voxels: [&Voxel; 4],
     values: f32x4,
     light: Option<&FrameLight>,
+    reaching: f32x4,
     material: &Material,
 ) -> [f32x4; 4] {
     let [x, y, z, alpha] = unpack4(voxels);
     let [mr, mg, mb] = material.at(values);
     let (r, g, b) = match light {
         Some(light) => {
-            let [lr, lg, lb] = light.lit(x, y, z);
+            let [lr, lg, lb] = light.lit(x, y, z, reaching);
             (lr * mr, lg * mg, lb * mb)
         }
         None => (mr, mg, mb),
@@ -373,9 +392,11 @@ impl FrameLight {
     }
 
     /// The lit colour (before the material), per channel, of four voxels
-    /// whose quantised unit normals have components `x`, `y` and `z`.
+    /// whose quantised unit normals have components `x`, `y` and `z`,
+    /// reached by the fraction `reaching` of the light (the ambient term
+    /// is not shadowed, as in [`Phong::shade_in_shadow`]).
     #[inline]
-    fn lit(&self, x: f32x4, y: f32x4, z: f32x4) -> [f32x4; 3] {
+    fn lit(&self, x: f32x4, y: f32x4, z: f32x4, reaching: f32x4) -> [f32x4; 3] {
         let dot = |d: [f32x4; 3]| x * d[0] + y * d[1] + z * d[2];
         let (diffuse, highlight) = two_sided(
             dot(self.to_viewer),
@@ -383,6 +404,7 @@ impl FrameLight {
             dot(self.half),
             self.shininess,
         );
+        let (diffuse, highlight) = (diffuse * reaching, highlight * reaching);
         std::array::from_fn(|c| {
             reflect(
                 self.ambient[c],
@@ -520,7 +542,7 @@ mod tests {
                         alpha: 0,
                     });
                     let [x, y, z, _] = unpack4(voxels.each_ref());
-                    let lit = frame.lit(x, y, z);
+                    let lit = frame.lit(x, y, z, f32x4::ONE);
                     for (k, g) in g.iter().enumerate() {
                         let exact = phong.shade(*g, light);
                         for c in 0..3 {
@@ -596,13 +618,19 @@ mod tests {
             alpha: 32768,
         };
         let voxels = [&flat, &facing, &flat, &facing];
-        let lit = shade4(voxels, f32x4::splat(0.5), Some(&frame), &material);
+        let lit = shade4(
+            voxels,
+            f32x4::splat(0.5),
+            Some(&frame),
+            f32x4::ONE,
+            &material,
+        );
         // Ambient only, then full light (ka + kd + ks = 1) on the back face.
         assert_eq!(lit[0].to_array(), [0.1, 0.05, 0.0, 1.0]);
         let full = lit[1].to_array();
         assert!((full[0] - 1.0).abs() < 1e-6 && (full[1] - 0.5).abs() < 1e-6);
         assert_eq!(full[3], 32768.0 / UNIT);
-        let unlit = shade4(voxels, f32x4::splat(0.5), None, &material);
+        let unlit = shade4(voxels, f32x4::splat(0.5), None, f32x4::ONE, &material);
         assert_eq!(unlit[1].to_array(), [1.0, 0.5, 0.0, 32768.0 / UNIT]);
     }
 }

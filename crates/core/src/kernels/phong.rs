@@ -90,6 +90,20 @@ impl Phong {
     /// with world-space gradient `gradient`.
     #[inline]
     pub fn shade(&self, gradient: Vec3, light: &LightGeometry) -> [f32; 3] {
+        self.shade_in_shadow(gradient, light, 1.0)
+    }
+
+    /// [`Self::shade`] where only the fraction `light_reaching` of the
+    /// light arrives (see [`crate::shadows`]): it scales the diffuse and
+    /// specular terms; the ambient term stands for light from everywhere
+    /// and is not shadowed.
+    #[inline]
+    pub fn shade_in_shadow(
+        &self,
+        gradient: Vec3,
+        light: &LightGeometry,
+        light_reaching: f32,
+    ) -> [f32; 3] {
         let len = gradient.length();
         let (diffuse, highlight) = if len > 0.0 && len.is_finite() {
             let n = gradient / len;
@@ -102,6 +116,7 @@ impl Phong {
         } else {
             (0.0, 0.0)
         };
+        let (diffuse, highlight) = (diffuse * light_reaching, highlight * light_reaching);
         std::array::from_fn(|c| {
             self.light_color[c]
                 * reflect(
@@ -124,8 +139,20 @@ pub fn lit_colour(
     gradient: Vec3,
     material: [f32; 3],
 ) -> [f32; 3] {
+    lit_colour_in_shadow(lighting, gradient, material, 1.0)
+}
+
+/// [`lit_colour`] where only the fraction `light_reaching` of the light
+/// arrives ([`Phong::shade_in_shadow`]).
+#[inline]
+pub fn lit_colour_in_shadow(
+    lighting: Option<(&Phong, &LightGeometry)>,
+    gradient: Vec3,
+    material: [f32; 3],
+    light_reaching: f32,
+) -> [f32; 3] {
     let lit = match lighting {
-        Some((phong, light)) => Vec3::from(phong.shade(gradient, light)),
+        Some((phong, light)) => Vec3::from(phong.shade_in_shadow(gradient, light, light_reaching)),
         None => Vec3::ONE,
     };
     (lit * Vec3::from(material))

@@ -20,9 +20,10 @@
 //! the same picture.
 
 use crate::kernels::gradient::gradients;
-use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
+use crate::kernels::phong::{LightGeometry, Phong, lit_colour_in_shadow};
 use crate::kernels::trilinear;
 use crate::non_finite::NonFiniteMask;
+use crate::shadows::ShadowRay;
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
 use glam::{DVec3, DVec4, Vec3};
@@ -38,6 +39,9 @@ pub struct PostClassifier<'a> {
     lighting: Option<(&'a Phong, LightGeometry)>,
     /// Samples this skips are empty ([`NonFinite`](crate::NonFinite)).
     mask: Option<&'a NonFiniteMask>,
+    /// With shadows: the voxels' step-corrected opacities (stage 1's) and
+    /// the shadow rays marched through them ([`crate::shadows`]).
+    shadows: Option<(&'a [f32], ShadowRay)>,
 }
 
 impl<'a> PostClassifier<'a> {
@@ -55,6 +59,16 @@ impl<'a> PostClassifier<'a> {
             classifier,
             lighting,
             mask: None,
+            shadows: None,
+        }
+    }
+
+    /// The same, each sample lit by the light reaching it through the
+    /// voxels' opacities `alpha`, along `ray` ([`crate::shadows`]).
+    pub fn with_shadows(self, alpha: &'a [f32], ray: ShadowRay) -> Self {
+        PostClassifier {
+            shadows: Some((alpha, ray)),
+            ..self
         }
     }
 
@@ -77,10 +91,17 @@ impl<'a> PostClassifier<'a> {
         })
         .as_vec3();
         let lighting = self.lighting.as_ref().map(|(phong, light)| (*phong, light));
-        let color = lit_colour(lighting, g, self.classifier.material(f));
-        Vec3::from(color)
-            .extend(self.classifier.opacity_at(f, g.to_array()))
-            .as_dvec4()
+        let opacity = self.classifier.opacity_at(f, g.to_array());
+        // A transparent sample's colour counts for nothing: no march.
+        let light_reaching = match &self.shadows {
+            Some((alpha, ray)) if opacity > 0.0 => {
+                let alpha = |q| trilinear::reference(q, dims, 0.0, |i| alpha[i] as f64);
+                ray.transmittance(DVec3::from_array(p), alpha) as f32
+            }
+            _ => 1.0,
+        };
+        let color = lit_colour_in_shadow(lighting, g, self.classifier.material(f), light_reaching);
+        Vec3::from(color).extend(opacity).as_dvec4()
     }
 }
 

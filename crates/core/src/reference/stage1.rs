@@ -10,7 +10,7 @@
 //! voxel, dense; the fast path's is [`crate::bricks::occupied`] (view-independent,
 //! kept across frames) and [`crate::cpu::lit_bricks`] (the light, per frame).
 
-use crate::kernels::phong::{LightGeometry, Phong, lit_colour};
+use crate::kernels::phong::{LightGeometry, Phong, lit_colour_in_shadow};
 use crate::transfer::classifier::Classifier;
 use crate::transfer::labels::colour_value;
 use crate::volume::Volume;
@@ -29,12 +29,15 @@ pub struct ShadedVolume {
 
 /// Shades and classifies every voxel of `volume`. `gradients` are the
 /// volume's (see [`crate::kernels::gradient`]); `lighting` is `None` for unlit
-/// rendering (the colour is the material colour).
+/// rendering (the colour is the material colour); `light_reaching` is the
+/// light reaching each voxel, with shadows ([`crate::shadows`]; `None`: all
+/// of it).
 pub fn shade_and_classify(
     volume: &Volume,
     gradients: &[[f32; 3]],
     classifier: &Classifier,
     lighting: Option<(&Phong, &LightGeometry)>,
+    light_reaching: Option<&[f32]>,
 ) -> ShadedVolume {
     let mut voxels = vec![Vec4::ZERO; volume.len()];
     let dims = volume.dims();
@@ -57,7 +60,9 @@ pub fn shade_and_classify(
         .enumerate()
         .for_each(|(k, ((out, values), grads))| {
             for (n, ((o, &f), g)) in out.iter_mut().zip(values).zip(grads).enumerate() {
-                let color = lit_colour(lighting, Vec3::from(*g), colour_of(f, k * slice + n));
+                let at = k * slice + n;
+                let t = light_reaching.map_or(1.0, |l| l[at]);
+                let color = lit_colour_in_shadow(lighting, Vec3::from(*g), colour_of(f, at), t);
                 *o = Vec3::from(color).extend(classifier.opacity_at(f, *g));
             }
         });
@@ -91,7 +96,7 @@ mod tests {
             Some(color),
             1.0,
         );
-        let s = shade_and_classify(&v, &gradients(&v), &c, None);
+        let s = shade_and_classify(&v, &gradients(&v), &c, None, None);
         assert_eq!(s.voxels[v.index(0, 1, 1)], Vec4::new(1.0, 0.0, 0.0, 0.2));
         assert!(
             (s.voxels[v.index(1, 2, 0)] - Vec4::new(0.5, 0.0, 0.5, 0.4))
@@ -115,7 +120,13 @@ mod tests {
             1.0,
         );
         let light = LightGeometry::headlight(Vec3::X);
-        let s = shade_and_classify(&v, &gradients(&v), &c, Some((&Phong::default(), &light)));
+        let s = shade_and_classify(
+            &v,
+            &gradients(&v),
+            &c,
+            Some((&Phong::default(), &light)),
+            None,
+        );
         let got = s.voxels[v.index(1, 1, 1)];
         assert!(
             (got - Vec4::new(0.5, 0.25, 1.0, 0.5)).abs().max_element() < 1e-6,
@@ -148,7 +159,7 @@ mod tests {
             // With the ramp, α_v is its top opacity q.
             let alpha_v = c.iso().unwrap().alpha();
             assert_eq!(alpha_v, 0.6);
-            let s = shade_and_classify(&v, &g, &c, None);
+            let s = shade_and_classify(&v, &g, &c, None, None);
             let half_width = thickness * 0.25; // world units
             let mut opaque = 0;
             for i in 0..17 {
@@ -179,7 +190,7 @@ mod tests {
         })
         .unwrap();
         let c = iso_classifier(&vz, 3.0, 4.0, 1.0);
-        let s = shade_and_classify(&vz, &gradients(&vz), &c, None);
+        let s = shade_and_classify(&vz, &gradients(&vz), &c, None, None);
         let alphas: Vec<f32> = (0..9).map(|k| s.voxels[vz.index(1, 1, k)].w).collect();
         let mut want = vec![0.0; 9];
         want[3] = c.iso().unwrap().alpha();

@@ -569,7 +569,7 @@ fn with_channels<R>(
                 Channel {
                     bricks: &state.bricks,
                     lit: &state.lit,
-                    lighting: Lighting::new(source, &state.bricks, numbers[k], lighting),
+                    lighting: Lighting::new(source, &state.bricks, numbers[k], lighting, None),
                 }
             })
             .collect(),

@@ -610,6 +610,7 @@ pub(super) fn render(
                             bricks,
                             numbers[i],
                             lighting.as_ref().map(|(p, l)| (*p, l)),
+                            None,
                         )),
                         occupied,
                     };

@@ -351,6 +351,9 @@ impl<'v> Scene<'v> {
     fn layer_settings(&self, request: &SceneSettings) -> Result<Vec<RenderSettings>, RenderError> {
         let shared = &request.settings;
         shared.validate()?;
+        if shared.shadows {
+            return Err(SceneError::Shadows.into());
+        }
         if request.looks.len() != self.layers.len() {
             return Err(SceneError::Looks {
                 layers: self.layers.len(),

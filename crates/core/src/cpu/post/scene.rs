@@ -8,6 +8,7 @@ use wide::f32x4;
 use crate::bricks::macrocells::Macrocells;
 use crate::kernels::phong::{LightGeometry, Phong};
 use crate::non_finite::NonFiniteMask;
+use crate::shadows::light_volume::LightVolume;
 use crate::transfer::classifier::Classifier;
 use crate::volume::{Sample, Volume};
 
@@ -29,6 +30,8 @@ pub struct Scene<'a> {
     /// The samples to pass over, where `voxels` are those of a cleaned
     /// volume ([`NonFinite`](crate::NonFinite)); `None`: every sample counts.
     pub mask: Option<&'a NonFiniteMask>,
+    /// With shadows, the light reaching each voxel ([`crate::shadows`]).
+    pub light: Option<&'a LightVolume>,
 }
 
 /// Every voxel's world gradient (from `gradients`, see
