@@ -22,6 +22,7 @@
 //! [`NonFinite::Transparent`] renders them as empty space, from a cleaned
 //! copy and a mask (see [`NonFinite`](crate::NonFinite) for the exact rules).
 
+use crate::bricks::BRICK;
 use crate::bricks::cache::Budget;
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::occupied::{Classified, ClassifiedBricks, Source};
@@ -489,15 +490,24 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// The shadow rays of a frame of `settings` lit by `light`.
-    fn shadow_ray(&self, settings: &RenderSettings, light: &LightGeometry) -> ShadowRay {
+    /// The shadow rays of a frame of `settings` lit by `light`, and the
+    /// classifier of their samples: a step of the frame's, or of one voxel
+    /// where the frame's is shorter (see [`crate::shadows`]).
+    fn shadow_ray(
+        &self,
+        settings: &RenderSettings,
+        light: &LightGeometry,
+        classifier: &Classifier,
+    ) -> (ShadowRay, Classifier) {
         let spacing = self.volume.spacing();
-        ShadowRay::new(
+        let step = shadows::shadow_step(settings.step);
+        let ray = ShadowRay::new(
             light.to_light.as_dvec3(),
             self.volume.dims(),
             spacing,
-            settings.step * spacing.min_element(),
-        )
+            step * spacing.min_element(),
+        );
+        (ray, classifier.with_step(step as f32))
     }
 
     /// Every voxel's step-corrected opacity for `classifier` (stage 1's),
@@ -525,12 +535,9 @@ impl<'v> Renderer<'v> {
         classifier: &Classifier,
         gradients: &[[f32; 3]],
     ) -> Vec<f32> {
-        let alpha = self.opacities(classifier, gradients);
-        shadows::reference_light(
-            &alpha,
-            self.volume.dims(),
-            &self.shadow_ray(settings, light),
-        )
+        let (ray, classifier) = self.shadow_ray(settings, light, classifier);
+        let alpha = self.opacities(&classifier, gradients);
+        shadows::reference_light(&alpha, self.volume.dims(), &ray)
     }
 
     /// The kept light volume, locked for a frame; a frame without
@@ -562,12 +569,27 @@ impl<'v> Renderer<'v> {
             let [nx, ny, _] = volume.dims();
             let masked = self.masked();
             let spacing = volume.spacing();
-            let step_world = settings.step * spacing.min_element();
+            let step = shadows::shadow_step(settings.step);
+            let step_world = step * spacing.min_element();
+            let classifier = &classifier.with_step(step as f32);
             let to_light = light.to_light.as_dvec3();
+            // Bricks whose values are all transparent need no classifying
+            // (on the peers' 257³ cloud, a tenth of the sweep's time).
+            let macrocells = self.macrocells();
+            let grid = macrocells.grid;
+            let transparent: Vec<bool> = (macrocells.ranges.iter())
+                .map(|&(lo, hi)| classifier.is_transparent_between(lo, hi))
+                .collect();
+            let last_brick = grid.bricks.map(|n| n - 1);
             let light = crate::with_samples!(volume.samples(), |data| {
                 let differences = Differences::new(data, volume);
                 let gradient = classifier.uses_gradient();
                 LightVolume::sweep(volume.dims(), spacing, to_light, step_world, |i, j, k| {
+                    let brick = [i, j, k].map(|c| c / BRICK);
+                    let brick = std::array::from_fn(|a| brick[a].min(last_brick[a]));
+                    if transparent[grid.index(brick)] {
+                        return 0.0;
+                    }
                     let v = i + nx * (j + ny * k);
                     if masked(v) {
                         return 0.0;
@@ -635,8 +657,9 @@ impl<'v> Renderer<'v> {
                     .with_mask(self.non_finite.as_ref());
                 if settings.shadows {
                     let gradients = gradients(&self.volume);
-                    let alpha = self.opacities(&classifier, &gradients);
-                    let post = post.with_shadows(&alpha, self.shadow_ray(settings, &light));
+                    let (ray, shadow) = self.shadow_ray(settings, &light, &classifier);
+                    let alpha = self.opacities(&shadow, &gradients);
+                    let post = post.with_shadows(&alpha, ray);
                     return render(&Shader::Post(&post));
                 }
                 render(&Shader::Post(&post))

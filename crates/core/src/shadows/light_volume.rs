@@ -42,6 +42,9 @@ use rayon::prelude::*;
 /// Bytes per voxel of a [`LightVolume`].
 pub const BYTES_PER_VOXEL: usize = size_of::<u16>();
 
+/// A row's span of no voxels.
+const NONE: (usize, usize) = (usize::MAX, 0);
+
 /// `T` is stored in units of `1/UNIT`.
 const UNIT: f32 = u16::MAX as f32;
 
@@ -102,16 +105,35 @@ impl LightVolume {
         // for its last sample to lie beyond the slice behind (where the
         // light is known) whatever the step.
         let reach_most = REACH.max((1.0 / per_slice).ceil() as usize + 1);
-        let ring_size = reach_most.max(EXIT + 1) + 1;
+        // Rays that leave the grid within this many slices are marched to
+        // its face (at least the segment's reach: the slices a segment
+        // reads exist).
+        let exit_slices = EXIT.max(reach_most);
+        let ring_size = exit_slices + 2;
         // The last `ring_size` slices' opacities and light, by slice
         // number modulo `ring_size`.
         let ring = |_| vec![0.0f32; plane];
         let mut alphas: Vec<Vec<f32>> = (0..ring_size).map(ring).collect();
         let mut lights: Vec<Vec<f32>> = (0..ring_size).map(ring).collect();
+        // Per slice of the ring and row, the voxels of the row that are
+        // not transparent, `lo..=hi` (`lo > hi`: none): most voxels' rays
+        // cross nothing near them, and skip their samples.
+        let mut spans: Vec<Vec<(usize, usize)>> = (0..ring_size).map(|_| vec![NONE; nc]).collect();
+        // How far across the slices a ray's samples reach, within the
+        // ring: rows `ic + c_reach.0 ..= ic + c_reach.1` and columns
+        // likewise (one more for the interpolation's far corner).
+        let reach_across = |d: f64| {
+            let far = ring_size as f64 * d;
+            (
+                far.min(0.0).floor() as isize - 1,
+                far.max(0.0).ceil() as isize + 1,
+            )
+        };
+        let (b_reach, c_reach) = (reach_across(d[b]), reach_across(d[c]));
         let mut light = vec![0u16; plane * dims[a]];
         let across = [d[b], d[c]];
         let segment = Segment::new(reach_most, per_slice, across, false);
-        let to_exit = Segment::new(EXIT + 1, per_slice, across, true);
+        let to_exit = Segment::new(exit_slices + 1, per_slice, across, true);
         // Slices from voxel `i` of `n` to where its ray leaves the grid
         // across one axis, at `d` voxels a slice.
         let exit = |i: usize, n: usize, d: f64| {
@@ -127,10 +149,18 @@ impl LightVolume {
             let here = n % ring_size;
             // The slice's opacities first: the samples between it and the
             // slices behind read them.
-            (alphas[here].par_chunks_mut(nb).enumerate()).for_each(|(ic, row)| {
+            (alphas[here]
+                .par_chunks_mut(nb)
+                .zip(spans[here].par_iter_mut())
+                .enumerate())
+            .for_each(|(ic, (row, span))| {
+                *span = NONE;
                 for (ib, alpha_v) in row.iter_mut().enumerate() {
                     let v = voxel(s, ib, ic);
                     *alpha_v = alpha(v[0], v[1], v[2]);
+                    if *alpha_v > 0.0 {
+                        *span = (span.0.min(ib), ib);
+                    }
                 }
             });
             // Slice `k` back from this one, in the rings: past the first
@@ -144,18 +174,40 @@ impl LightVolume {
                 .enumerate()
                 .for_each(|(ic, (out, t_row))| {
                     let exit_c = exit(ic, nc, d[c]).min(n as f64);
+                    // The columns of the rows and slices this row's rays
+                    // sample that are not transparent.
+                    let rows = (ic as isize + c_reach.0).max(0) as usize
+                        ..=(ic as isize + c_reach.1).clamp(0, nc as isize - 1) as usize;
+                    let opaque = (0..ring_size.min(n + 1))
+                        .flat_map(|k| rows.clone().map(move |r| (k, r)))
+                        .map(|(k, r)| spans[(n - k) % ring_size][r])
+                        .fold(NONE, |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
                     for (ib, (o, t_out)) in out.iter_mut().zip(t_row.iter_mut()).enumerate() {
+                        let clear = opaque.0 > opaque.1
+                            || ib as isize + b_reach.1 < opaque.0 as isize
+                            || ib as isize + b_reach.0 > opaque.1 as isize;
                         // A ray that leaves the grid within `EXIT` slices
                         // is marched to there, as the reference does.
                         let exit_f = exit(ib, nb, d[b]).min(exit_c);
-                        let t = if exit_f < EXIT as f64 {
-                            let exit = Some((exit_f, Tap::at(exit_f, across)));
-                            to_exit.light([ib, ic], [nb, nc], &slice_alpha, &slice_light, exit)
+                        let (segment, exit) = if exit_f < exit_slices as f64 {
+                            (&to_exit, Some((exit_f, Tap::at(exit_f, across))))
                         } else {
-                            segment.light([ib, ic], [nb, nc], &slice_alpha, &slice_light, None)
+                            (&segment, None)
+                        };
+                        let t = match (clear, exit) {
+                            (true, Some(_)) => 1.0,
+                            // Nothing absorbs along the segment: the light
+                            // `reach` slices back, one interpolation.
+                            (true, None) => (segment.far)
+                                .bilinear(ib, ic, nb, nc, slice_light(reach_most).unwrap_or(&[]))
+                                .unwrap_or(1.0),
+                            (false, _) => {
+                                segment.light([ib, ic], [nb, nc], &slice_alpha, &slice_light, exit)
+                            }
                         };
                         *t_out = t;
-                        *o = (t.clamp(0.0, 1.0) * UNIT).round() as u16;
+                        // `+ 0.5` and truncation: rounding, without a call to `roundf`.
+                        *o = (t.clamp(0.0, 1.0) * UNIT + 0.5) as u16;
                     }
                 });
             lights[here] = t_here;
@@ -232,6 +284,8 @@ struct Segment {
     weight: f32,
     /// Samples per slice.
     per_slice: f64,
+    /// Where the segment's ray crosses the slice `reach` back.
+    far: Tap,
 }
 
 /// A point on every voxel's shadow ray of a slice, at the same offset from
@@ -276,7 +330,7 @@ impl Tap {
 
     /// The corners around the point from voxel `i` on an axis of `n`
     /// voxels (`offset`, `w`): `None` outside it.
-    #[inline]
+    #[inline(always)]
     fn corners(i: usize, offset: isize, w: f32, n: usize) -> Option<(usize, usize, f32)> {
         let lo = i as isize + offset;
         let hi = lo + isize::from(w > 0.0);
@@ -285,7 +339,7 @@ impl Tap {
 
     /// The bilinear interpolation of `plane` (rows `nb` long, `nc` of
     /// them) at the point from voxel (`ib`, `ic`); `None` outside it.
-    #[inline]
+    #[inline(always)]
     fn bilinear(&self, ib: usize, ic: usize, nb: usize, nc: usize, plane: &[f32]) -> Option<f32> {
         let (b0, b1, wb) = Self::corners(ib, self.b, self.wb, nb)?;
         let (c0, c1, wc) = Self::corners(ic, self.c, self.wc, nc)?;
@@ -312,6 +366,7 @@ impl Segment {
                 .collect(),
             weight: spread as f32,
             per_slice,
+            far: Tap::at(reach as f64, d),
         }
     }
 

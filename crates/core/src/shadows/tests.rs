@@ -101,3 +101,28 @@ fn the_light_volume_interpolates_between_voxels() {
     assert!((between - 0.75).abs() < 1e-4, "{between}");
     assert_eq!(light.bytes(), 64 * light_volume::BYTES_PER_VOXEL);
 }
+
+#[test]
+fn a_step_of_many_slices_sweeps_as_the_march_takes_it() {
+    // Step 10 along z: one sample every ten slices, farther than the
+    // segments reach by default; the sweep reads only slices it has done
+    // and still takes the march's samples.
+    let dims = [5, 4, 31];
+    let alpha: Vec<f32> = (0..dims.iter().product::<usize>())
+        .map(|v| ((v * 31) % 7) as f32 / 10.0)
+        .collect();
+    let [nx, ny, nz] = dims;
+    let ray = ShadowRay::new(DVec3::Z, dims, DVec3::ONE, 10.0);
+    let reference = reference_light(&alpha, dims, &ray);
+    let swept = LightVolume::sweep(dims, DVec3::ONE, DVec3::Z, 10.0, |i, j, k| {
+        alpha[i + nx * (j + ny * k)]
+    });
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let (want, got) = (reference[i + nx * (j + ny * k)], swept.at([i, j, k]));
+                assert!((got - want).abs() < 1e-4, "{i},{j},{k}: {got} vs {want}");
+            }
+        }
+    }
+}

@@ -205,6 +205,15 @@ impl Classifier {
         correct_opacity(alpha, self.step_voxels)
     }
 
+    /// The same classification for samples `step_voxels` voxels apart
+    /// (the shadow rays', [`crate::shadows`]).
+    pub fn with_step(&self, step_voxels: f32) -> Classifier {
+        Classifier {
+            step_voxels,
+            ..self.clone()
+        }
+    }
+
     /// Whether every value in `[lo, hi]` gets zero opacity, so that a
     /// region whose values all lie there contributes nothing to any ray
     /// (the zero-opacity test of empty-space skipping, Levoy 1990),
