@@ -227,7 +227,10 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
     for (dataset, window) in cases {
         let dataset = dataset.as_str();
         let (volume, side) = load(dir, dataset)?;
-        let settings = workload(&volume, (side.min, side.max), window);
+        let settings = RenderSettings {
+            shadows: args.view.look.shadows,
+            ..workload(&volume, (side.min, side.max), window)
+        };
         let fail = |e: volray_core::RenderError| CliError::input(format!("{dataset}: {e}"));
         // VTK first, then volray: each sees the machine as the other left it.
         let vtk = match &harness {

@@ -25,7 +25,8 @@ pub struct BenchArgs {
     /// make_volumes.py), each exactly as the peers define it: view along
     /// +x, step 0.5 voxel, their transfer functions and shading. The input,
     /// camera, rendering and sampling options do not apply, and are
-    /// refused (--threads does).
+    /// refused (--threads does, and --shadows adds shadows, the camera's
+    /// key light).
     #[arg(long, value_name = "DIR", conflicts_with_all = peers_ignores())]
     pub peers: Option<PathBuf>,
 
@@ -69,7 +70,8 @@ const PEERS_IGNORE: [fn(Command) -> Command; 4] = [
 ];
 
 /// The flags of the [`PEERS_IGNORE`] groups, which `--peers` conflicts
-/// with. Flag by flag rather than by group id, so that clap's error names
+/// with, but `--shadows`, which adds shadows to the workloads. Flag by
+/// flag rather than by group id, so that clap's error names
 /// the flag given, not every flag of its group; without INPUT, which
 /// `bench.rs` refuses with a message saying what `--peers` does instead.
 fn peers_ignores() -> Vec<clap::Id> {
@@ -78,6 +80,8 @@ fn peers_ignores() -> Vec<clap::Id> {
         .fold(Command::new("peers"), |cmd, group| group(cmd))
         .get_arguments()
         .filter(|arg| !arg.is_positional())
+        // The peers' workloads with shadows: the depth cue's cost.
+        .filter(|arg| arg.get_id() != "shadows")
         .map(|arg| arg.get_id().clone())
         .collect()
 }

@@ -53,6 +53,7 @@ pub const FRAME: &[&str] = &[
     "shininess",
     "light",
     "light_color",
+    "shadows",
     "background",
     "label_opacity",
     "show_labels",
@@ -293,6 +294,9 @@ pub fn options(k: &Keywords<'_>, mut look: LookOptions) -> PyResult<Options> {
     look.light = k.take("light", VEC3)?;
     if let Some(c) = rgb(k, "light_color")? {
         look.light_color = c;
+    }
+    if let Some(shadows) = k.take("shadows", "True or False")? {
+        look.shadows = shadows;
     }
     if let Some(b) = rgb(k, "background")? {
         look.background = b;

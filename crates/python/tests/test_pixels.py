@@ -34,6 +34,8 @@ CASES = [
     ("blobs:48", ["--iso", "0.5", "--background", "0.2,0.2,0.3"], {"iso": 0.5, "background": (0.2, 0.2, 0.3)}),
     ("fractal:65", ["--preset", "electron-density", "--step", "0.5", "--size", "96x64"], {"preset": "electron-density", "step": 0.5, "size": (96, 64)}),
     ("hydrogen:3,2,0", ["--reference", "--size", "48"], {"reference": True, "size": 48}),
+    ("fractal:65", ["--shadows", "--light", "1,0.5,1"], {"shadows": True, "light": (1, 0.5, 1)}),
+    ("blobs:48", ["--shadows", "--post-classification"], {"shadows": True, "post_classification": True}),
 ]
 
 
