@@ -3,7 +3,9 @@
 # "Figures"): |psi_621|^2 under --log with a colour bar in decades, a
 # scale bar and the axes; a
 # fractal cloud with its outline; a CT-like head (scripts/make_ct_phantom.py
-# at 256^3, 1 mm voxels) with a colour bar in HU and a scale bar.
+# at 256^3, 1 mm voxels) with a colour bar in HU and a scale bar; and the
+# head and the cloud without and with --shadows (docs/options.md,
+# "Shadows").
 #
 #     docs/gallery/figures.sh docs/gallery [path/to/volray]
 set -euo pipefail
@@ -24,3 +26,17 @@ python3 scripts/make_ct_phantom.py 256 "$tmp/head.raw" >/dev/null
   --preset ct-bone --size 420 --azimuth 30 --elevation 15 \
   --colorbar --scale-bar --axes --label c \
   -o "$out/figure-ct.png"
+
+# Depth cues: the same frames without and with shadows, the camera's key
+# light in both (given as --light, so that the pair differs only in the
+# shadows).
+"$volray" render "$tmp/head.raw" --dims 256,256,256 --dtype i16 --spacing 1,1,1 \
+  --preset ct-bone --size 420 --azimuth 30 --elevation 15 --light 0.6,-0.1,0.8 \
+  --label "without shadows" -o "$out/shadows-ct-off.png"
+"$volray" render "$tmp/head.raw" --dims 256,256,256 --dtype i16 --spacing 1,1,1 \
+  --preset ct-bone --size 420 --azimuth 30 --elevation 15 --light 0.6,-0.1,0.8 \
+  --shadows --label "with shadows" -o "$out/shadows-ct-on.png"
+"$volray" render fractal:129 --size 420 --azimuth 30 --elevation 20 \
+  --light 0.6,-0.1,0.8 --label "without shadows" -o "$out/shadows-cloud-off.png"
+"$volray" render fractal:129 --size 420 --azimuth 30 --elevation 20 \
+  --light 0.6,-0.1,0.8 --shadows --label "with shadows" -o "$out/shadows-cloud-on.png"
