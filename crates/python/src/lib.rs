@@ -20,7 +20,9 @@
 //! options), `renderer.rs` (`Renderer`, `render`, Ctrl-C), `frame.rs`
 //! (`Frame`), `transfer.rs` (`TransferFunction`, `Camera`), `generate.rs`
 //! (`hydrogen`, `fractal`), `scene.rs` (`Scene`, `render` of several
-//! volumes), `errors.rs` (library errors as Python
+//! volumes), `view.rs` (the viewer in a notebook: `volray.view`'s
+//! host and tabs, the widget itself in `python/volray/_jupyter.py`),
+//! `errors.rs` (library errors as Python
 //! exceptions, options named as Python spells them).
 
 use pyo3::prelude::*;
@@ -35,6 +37,7 @@ mod keywords;
 mod renderer;
 mod scene;
 mod transfer;
+mod view;
 mod volume;
 
 #[pymodule]
@@ -45,6 +48,8 @@ fn _volray(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<frame::Frame>()?;
     m.add_class::<transfer::TransferFunction>()?;
     m.add_class::<transfer::Camera>()?;
+    m.add_class::<view::ViewHost>()?;
+    m.add_class::<view::ViewTab>()?;
     m.add_function(wrap_pyfunction!(renderer::render, m)?)?;
     m.add_function(wrap_pyfunction!(volume::read, m)?)?;
     m.add_function(wrap_pyfunction!(generate::hydrogen, m)?)?;

@@ -361,6 +361,16 @@ impl Recipe {
         }
     }
 
+    /// Whether the volume is read lazily from a chunked file.
+    pub(crate) fn is_lazy(&self) -> bool {
+        matches!(&self.source, Source::Volume(v) if v.get().lazy.is_some())
+    }
+
+    /// The file's display window (an OME-Zarr `omero` window), if any.
+    pub(crate) fn window(&self) -> Option<(f64, f64)> {
+        self.window
+    }
+
     /// The look options the recipe fixes (labels, log).
     pub(crate) fn look(&self) -> LookOptions {
         LookOptions {
@@ -837,7 +847,7 @@ pub(crate) fn need(
 /// left under `max_memory` after a default frame when that is less (the
 /// command line's rule, `src/memory.rs`; the budget changes speed, never
 /// pixels).
-fn cache_budget(renderer: &CoreRenderer<'_>, mode: NonFinite, max_memory: u64) -> usize {
+pub(crate) fn cache_budget(renderer: &CoreRenderer<'_>, mode: NonFinite, max_memory: u64) -> usize {
     let need = need(renderer, &RenderSettings::default(), mode);
     (u128::from(max_memory).saturating_sub(need)).min(DEFAULT_CACHE_BUDGET as u128) as usize
 }

@@ -40,8 +40,13 @@ const DRAFT_MS = 30;
 function connect() {
   // Relative to the page, so that the viewer works behind a proxy that
   // serves it under a path (JupyterHub's, jupyter-server-proxy's).
-  const url = new URL(`ws?token=${encodeURIComponent(token)}`, location.href);
-  url.protocol = location.protocol === "https:" ? "wss:" : "ws:";
+  // In a notebook (embed.js) the socket is the parent window's and takes
+  // no URL: the page is an iframe's srcdoc, with no address of its own.
+  let url = "";
+  if (!window.volrayEmbedded) {
+    url = new URL(`ws?token=${encodeURIComponent(token)}`, location.href);
+    url.protocol = location.protocol === "https:" ? "wss:" : "ws:";
+  }
   socket = new WebSocket(url);
   socket.binaryType = "arraybuffer";
   socket.onmessage = (event) => {

@@ -28,9 +28,11 @@
 //! | `ledger.rs` | the memory limit shared by every tab: the volume, each tab's renderer, each frame in flight |
 //! | `reproduce.rs` | [`Reproduce`]: the caller turns a state into settings and a command |
 //! | `hello.rs` | the page's first message: histogram, colours, the start |
+//! | `link.rs` | [`Host`]: the viewer without a server, its tabs' messages carried by the caller (the Jupyter widget) |
+//! | `options.rs` | a state as volray-options' [`volray_options::Options`], for front ends that render from options (Python) |
 //! | `encode.rs` | JPEG and PNG, quantised as `volray render` writes PNGs |
 //! | `stats.rs` | counters for `/api/status` |
-//! | `page.rs`, `assets/` | the page, embedded |
+//! | `page.rs`, `assets/` | the page, embedded; `assets/embed.js` carries its messages in an iframe of a notebook |
 //!
 //! The crate knows nothing of command-line flags: the caller's
 //! [`Reproduce`] writes the state as a command and builds the settings
@@ -39,7 +41,9 @@
 mod encode;
 mod hello;
 mod ledger;
+mod link;
 mod mailbox;
+mod options;
 mod page;
 mod protocol;
 mod pyramid;
@@ -52,11 +56,14 @@ mod token;
 
 pub use hello::Start;
 pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
+pub use link::{Host, Message, Tab};
+pub use options::{OptionsStart, start_state, state_options};
+pub use page::embedded_html;
 pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello};
 pub use pyramid::{CACHED_LEVELS, DRAFT_SHARE, Pyramid, PyramidError};
 pub use reproduce::{Refusal, Reproduce, Reproduction, SceneLooks};
 pub use server::{ServeError, Server, Stopper};
-pub use session::{FigureContext, ReadTimePoint, TimePoints, draft_side};
+pub use session::{FigureContext, ReadTimePoint, SpawnError, TimePoints, draft_side};
 pub use state::{
     BlendMode, ColorBarSide, Figure, LayerState, Lighting, MAX_SIDE, START_COLOURS, STEP_RANGE,
     StateError, ViewState, WHITE, ZOOM_RANGE, solid_colour,
@@ -122,6 +129,13 @@ impl Viewer {
     /// Binds `addr` with a new access token; [`Server::run`] serves.
     pub fn bind(self, addr: SocketAddr) -> Result<Server, ViewError> {
         let token = Token::generate()?;
+        Ok(Server::bind(addr, token, self.host()?)?)
+    }
+
+    /// The viewer without a server: its tabs' messages carried by the
+    /// caller ([`Host::open`]), as the Python module's Jupyter widget
+    /// carries them over the notebook's connection.
+    pub fn host(self) -> Result<Host, ViewError> {
         if self.levels.is_some() && (!self.others.is_empty() || self.time.is_some()) {
             return Err(ViewError::Start(Refusal(
                 "a multiscale volume is served alone, without other volumes or a time axis".into(),
@@ -176,6 +190,10 @@ impl Viewer {
             time: self.time.map(Arc::new),
             figure: Arc::new(self.figure),
         };
-        Ok(Server::bind(addr, token, hello, shared, held)?)
+        Ok(Host {
+            hello,
+            shared,
+            volume: held,
+        })
     }
 }

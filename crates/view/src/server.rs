@@ -7,10 +7,12 @@
 //! when its [`Stopper`] is called, closing every tab's renderer.
 
 use crate::ledger::Reservation;
+use crate::link::Host;
 use crate::mailbox::{Mailbox, Slot};
 use crate::page;
 use crate::protocol::{self, MAX_MESSAGE_BYTES, MessageError, Quality, Request, ServerMessage};
 use crate::session::{self, Outgoing, Shared};
+use crate::state::ViewState;
 use crate::token::Token;
 use axum::Router;
 use axum::body::Body;
@@ -70,13 +72,12 @@ impl Stopper {
 
 impl Server {
     /// Binds `addr` (port 0: any free port).
-    pub fn bind(
-        addr: SocketAddr,
-        token: Token,
-        hello: String,
-        shared: Shared,
-        volume: Reservation,
-    ) -> Result<Server, ServeError> {
+    pub fn bind(addr: SocketAddr, token: Token, host: Host) -> Result<Server, ServeError> {
+        let Host {
+            hello,
+            shared,
+            volume,
+        } = host;
         let bind_error = |source| ServeError::Bind { addr, source };
         let listener = TcpListener::bind(addr).map_err(bind_error)?;
         listener.set_nonblocking(true).map_err(bind_error)?;
@@ -317,17 +318,26 @@ async fn serve_tab(app: Arc<App>, mut socket: WebSocket) {
 
 /// Files a request from the page, or says why it was refused.
 fn receive(mailbox: &Mailbox<Request>, text: &str) -> Option<ServerMessage> {
+    file(mailbox, text).err()
+}
+
+/// Files a request from a page in its slot, giving back its state where
+/// it asks for a view ("draft" or "full"); or says why it was refused.
+pub(crate) fn file(
+    mailbox: &Mailbox<Request>,
+    text: &str,
+) -> Result<Option<ViewState>, ServerMessage> {
     match protocol::parse(text) {
         Ok(request) => {
-            let slot = match request.quality {
-                _ if request.probe.is_some() => Slot::Probe,
-                Quality::Save => Slot::Save,
-                Quality::Draft | Quality::Full => Slot::Latest,
+            let (slot, view) = match request.quality {
+                _ if request.probe.is_some() => (Slot::Probe, None),
+                Quality::Save => (Slot::Save, None),
+                Quality::Draft | Quality::Full => (Slot::Latest, Some(request.state.clone())),
             };
             mailbox.put(slot, request);
-            None
+            Ok(view)
         }
-        Err(e) => Some(ServerMessage::Error {
+        Err(e) => Err(ServerMessage::Error {
             seq: MessageError::seq_of(text),
             message: e.to_string(),
         }),

@@ -32,6 +32,11 @@ keywords (``tf``, ``colormap``, ``range``, ``labels``, ...) with
 4-D array into channels, coloured magenta, green, cyan, yellow, ...
 :class:`Scene` keeps the volumes prepared across frames.
 
+In Jupyter, ``volray.view(volume, **options)`` shows the interactive
+viewer in the notebook (an anywidget; ``pip install anywidget``): its
+frames travel over the kernel's connection, and ``w.camera`` and
+``w.transfer_function`` read the view back for :func:`render`.
+
 Every keyword of :func:`render` is the ``volray render`` flag of the same
 name (``look_at`` is ``--look-at``; ``shading=False`` is ``--no-shading``)
 with the same default and the same pixels. Bad input raises ``ValueError``
@@ -55,6 +60,15 @@ from ._volray import (
     render,
 )
 
+
+def view(volume, *, height=560, **options):
+    """The interactive viewer of ``volume`` in a notebook (see
+    ``volray._jupyter.view``; needs anywidget)."""
+    from ._jupyter import view as _view
+
+    return _view(volume, height=height, **options)
+
+
 __all__ = [
     "COLORMAPS",
     "PRESETS",
@@ -69,4 +83,5 @@ __all__ = [
     "hydrogen",
     "read",
     "render",
+    "view",
 ]

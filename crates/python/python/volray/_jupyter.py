@@ -1,0 +1,165 @@
+"""``volray.view``: the viewer in a notebook, an anywidget.
+
+The page of ``volray view`` runs in a sandboxed iframe of the widget, and
+its messages travel over the kernel's own connection (the widget's comm)
+instead of a WebSocket: no port, no token, nothing to forward, so it works
+behind JupyterHub's proxy prefix and over SSH as the notebook does. Each
+output showing the widget is a page with its own renderer thread in the
+kernel; frames are rendered on the kernel's CPU cores, JPEG while the view
+moves and PNG once it stops, as ``volray view`` renders them.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from pathlib import Path
+from typing import Any, Dict, Optional
+
+from ._volray import _ViewHost
+
+try:
+    import anywidget
+    import traitlets
+except ImportError as e:  # pragma: no cover - the message is the point
+    raise ImportError(
+        "volray.view needs anywidget in the kernel's environment: pip install anywidget"
+    ) from e
+
+_MAX_HEIGHT = 4096
+
+
+class Viewer(anywidget.AnyWidget):
+    """The viewer of one volume in a notebook (:func:`volray.view`).
+
+    ``camera`` and ``transfer_function`` read back the view shown last,
+    so that ``volray.render(volume, camera=w.camera,
+    tf=w.transfer_function)`` renders its still frame, pixel for pixel,
+    where the other keywords are left at their defaults;
+    ``volray.render(volume, **w.keywords)`` does whatever they are.
+    """
+
+    _esm = Path(__file__).parent / "_widget.js"
+    _page = traitlets.Unicode("").tag(sync=True)
+    height = traitlets.Int(560).tag(sync=True)
+
+    def __init__(self, host: _ViewHost, height: int = 560, **kwargs: Any) -> None:
+        if isinstance(height, bool) or not isinstance(height, int):
+            raise TypeError("height: expected an int (pixels)")
+        if not 100 <= height <= _MAX_HEIGHT:
+            raise ValueError(f"height: {height} pixels is not in 100 to {_MAX_HEIGHT}")
+        super().__init__(_page=host.page, height=height, **kwargs)
+        self._host = host
+        self._tabs: Dict[str, Any] = {}
+        self._lock = threading.Lock()
+        self.on_msg(self._on_message)
+
+    # ---------------------------------------------------------- read back
+
+    @property
+    def camera(self):
+        """The camera of the view shown last, as a :class:`volray.Camera`."""
+        return self._host.camera
+
+    @property
+    def transfer_function(self):
+        """The transfer function of the view shown last, whole (window,
+        opacity points, colours), as a :class:`volray.TransferFunction`."""
+        return self._host.transfer_function
+
+    @property
+    def keywords(self) -> Dict[str, Any]:
+        """The keywords of :func:`volray.render` that render the view
+        shown last (beside those of the volume given to ``view``)."""
+        return dict(self._host.keywords())
+
+    @property
+    def state(self) -> Dict[str, Any]:
+        """The view shown last as the page's state (its JSON form)."""
+        return json.loads(self._host.state())
+
+    def __repr__(self) -> str:
+        return f"volray.Viewer({self._host.call()})"
+
+    # ---------------------------------------------------------- the pages
+
+    def _on_message(self, _widget: Any, content: Any, _buffers: Any) -> None:
+        if not isinstance(content, dict) or not isinstance(content.get("view"), str):
+            return
+        view = content["view"][:64]
+        if content.get("open"):
+            self._open(view)
+        elif isinstance(content.get("text"), str):
+            with self._lock:
+                tab = self._tabs.get(view)
+            if tab is None:
+                return
+            refused = tab.receive(content["text"])
+            if refused is not None:
+                self.send({"view": view, "text": refused})
+        elif content.get("close"):
+            self._close(view)
+
+    def _open(self, view: str) -> None:
+        self._close(view)
+        try:
+            tab = self._host.open()
+        except RuntimeError as e:
+            message = json.dumps({"type": "error", "seq": None, "message": str(e)})
+            self.send({"view": view, "text": message})
+            self.send({"view": view, "closed": True})
+            return
+        with self._lock:
+            self._tabs[view] = tab
+        threading.Thread(
+            target=self._pump, args=(view, tab), name=f"volray-view-{view}", daemon=True
+        ).start()
+
+    def _pump(self, view: str, tab: Any) -> None:
+        """Sends the tab's messages to its page until the tab closes."""
+        try:
+            while True:
+                message = tab.next()
+                if message is None:
+                    break
+                is_frame, data = message
+                if is_frame:
+                    self.send({"view": view, "frame": True}, buffers=[data])
+                else:
+                    self.send({"view": view, "text": data})
+        finally:
+            tab.close()
+            with self._lock:
+                if self._tabs.get(view) is tab:
+                    del self._tabs[view]
+
+    def _close(self, view: str) -> None:
+        with self._lock:
+            tab = self._tabs.pop(view, None)
+        if tab is not None:
+            tab.close()
+
+    def close(self) -> None:
+        """Closes every page's renderer, then the widget."""
+        with self._lock:
+            tabs = list(self._tabs.values())
+            self._tabs.clear()
+        for tab in tabs:
+            tab.close()
+        super().close()
+
+
+def view(volume: Any, *, height: int = 560, **options: Any) -> Viewer:
+    """The viewer of ``volume`` (an array, a :class:`volray.Volume`, or
+    the path of a file to :func:`volray.read`) in a notebook: drag to
+    orbit, shift-drag to pan, the wheel to zoom, the transfer function
+    edited over the histogram, as ``volray view`` shows it. ``options``
+    are the keywords of :func:`volray.render` (but the figure's and
+    ``level``): the view it starts with. ``height`` is the widget's
+    height in pixels. Without ``size`` the frame fits the widget."""
+    if isinstance(volume, (str, Path)):
+        from ._volray import read
+
+        volume = read(volume)
+    host = _ViewHost(volume, **options)
+    return Viewer(host, height=height)

@@ -1,0 +1,461 @@
+//! The viewer in a notebook (`volray.view`, `python/volray/_jupyter.py`):
+//! `_ViewHost` is volray-view's [`Host`] (the viewer without a server)
+//! of one volume prepared as `render` prepares it, and `_ViewTab` one
+//! page's renderer, whose messages the widget carries over the kernel's
+//! connection. The page's states become `render`'s options
+//! ([`volray_view::state_options`]): the camera and one whole transfer
+//! function, so that `render(volume, camera=w.camera,
+//! tf=w.transfer_function)` renders the frame the page shows, and the
+//! page's command box shows that call.
+
+use crate::errors::{Keywords as Names, value_error};
+use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
+use crate::renderer::{Recipe, cache_budget, pool};
+use crate::transfer::{Camera, TransferFunction};
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use std::fmt::Write;
+use std::sync::{Arc, Mutex};
+use volray_core::{NonFinite, Phong, RenderSettings};
+use volray_options::{BlendMode, CameraOptions, Options, Tf};
+use volray_view::{
+    FigureContext, Host, Message, OptionsStart, Refusal, Reproduce, Reproduction, Start, Tab,
+    ViewState, Viewer,
+};
+
+/// The most pages of one widget rendering at once.
+const MAX_TABS: usize = 8;
+
+/// The viewer of one volume.
+#[pyclass(frozen, name = "_ViewHost", module = "volray")]
+pub struct ViewHost {
+    host: Host,
+    reproduce: Arc<PyReproduce>,
+    /// The state of the last view a page asked for (the start's before).
+    current: Arc<Mutex<ViewState>>,
+    page: String,
+}
+
+/// One page's renderer.
+#[pyclass(frozen, name = "_ViewTab", module = "volray")]
+pub struct ViewTab {
+    tab: Tab,
+    current: Arc<Mutex<ViewState>>,
+}
+
+/// States to options, settings and the `volray.render` call.
+struct PyReproduce {
+    start: OptionsStart,
+    /// The file's display window, `render`'s default range.
+    window: Option<(f64, f64)>,
+}
+
+impl PyReproduce {
+    fn options(&self, state: &ViewState) -> Result<Options, Refusal> {
+        state.check().map_err(|e| Refusal(e.to_string()))?;
+        volray_view::state_options(state, &self.start)
+    }
+
+    fn settings(&self, options: &Options) -> Result<RenderSettings, Refusal> {
+        let mut settings =
+            volray_options::settings(options).map_err(|e| Refusal(e.message(&Names)))?;
+        volray_options::file_window(&options.look, &mut settings.transfer_function, self.window);
+        Ok(settings)
+    }
+}
+
+impl Reproduce for PyReproduce {
+    fn reproduce(&self, state: &ViewState) -> Result<Reproduction, Refusal> {
+        let options = self.options(state)?;
+        let settings = self.settings(&options)?;
+        Ok(Reproduction {
+            settings,
+            command: call(&options),
+            tf_file: None,
+            scene: None,
+        })
+    }
+}
+
+#[pymethods]
+impl ViewHost {
+    /// `_ViewHost(volume, **kwargs)`: `render`'s keywords but the
+    /// figure's and `level`.
+    #[new]
+    #[pyo3(signature = (volume, **kwargs))]
+    fn new(
+        py: Python<'_>,
+        volume: &Bound<'_, PyAny>,
+        kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME], "view")?;
+        if k.get("level").is_some() {
+            return Err(value_error(
+                "level: the viewer in a notebook shows a volume in memory: read a level with volray.read(path, level=N)",
+            ));
+        }
+        let recipe = Recipe::build(volume, &k)?;
+        let name = recipe.name.clone();
+        if recipe.is_lazy() {
+            return Err(value_error(format!(
+                "{name}: a volume read lazily from a chunked file is not shown in a notebook yet: read a level whole with volray.read(path, level=N)"
+            )));
+        }
+        if recipe.labels {
+            return Err(value_error(format!(
+                "{name}: a label volume (labels=True) is not shown in a notebook yet: render it with volray.render"
+            )));
+        }
+        let digest = recipe.digest(py, None)?;
+        let prepared = recipe.prepare(py, digest)?;
+        let (options, mut settings) = recipe.settings_of(&k)?;
+        let threads = keywords::threads(&k)?.unwrap_or(0);
+        recipe.leave_to_volume(&prepared.known, &options, &mut settings)?;
+        recipe.check_memory(&prepared.inner, &settings)?;
+        let non_finite = recipe.nonfinite;
+        let cache_budget = cache_budget(&prepared.inner, non_finite, recipe.max_memory);
+        let volume = Arc::new(prepared.inner.volume().clone());
+        drop(prepared);
+        let state = volray_view::start_state(&options, &settings);
+        state.check().map_err(|e| {
+            value_error(format!(
+                "the starting view is beyond the viewer's bounds: {e}"
+            ))
+        })?;
+        let sized = k.get("size").is_some() || k.get("camera").is_some();
+        let reproduce = Arc::new(PyReproduce {
+            start: OptionsStart {
+                options: options.clone(),
+                transfer_function: settings.transfer_function.clone(),
+            },
+            window: recipe.window(),
+        });
+        reproduce
+            .reproduce(&state)
+            .map_err(|e| value_error(format!("{name}: {e}")))?;
+        let mut hello = Start {
+            name: &name,
+            volume: &volume,
+            log: options.look.log,
+            state: &state,
+            settings: &settings,
+            others: Vec::new(),
+            time: None,
+        }
+        .hello();
+        hello.fit = !sized;
+        let viewer = Viewer {
+            volume,
+            non_finite,
+            cache_budget,
+            max_memory: u128::from(recipe.max_memory),
+            hello,
+            reproduce: Arc::clone(&reproduce) as Arc<dyn Reproduce>,
+            pool: Arc::new(pool(threads)?),
+            max_sessions: MAX_TABS,
+            levels: None,
+            others: Vec::new(),
+            time: None,
+            figure: FigureContext {
+                log: options.look.log,
+                ..FigureContext::default()
+            },
+        };
+        let host = py
+            .detach(|| viewer.host())
+            .map_err(|e| value_error(format!("{name}: {e}")))?;
+        let nonce =
+            volray_view::Token::generate().map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        Ok(ViewHost {
+            host,
+            reproduce,
+            current: Arc::new(Mutex::new(state)),
+            page: volray_view::embedded_html(nonce.as_str()),
+        })
+    }
+
+    /// The page, as one document for an iframe's `srcdoc`.
+    #[getter]
+    fn page(&self) -> &str {
+        &self.page
+    }
+
+    /// A new page's renderer; `RuntimeError` where too many are open or
+    /// memory is short.
+    fn open(&self) -> PyResult<ViewTab> {
+        let tab = (self.host.open()).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        Ok(ViewTab {
+            tab,
+            current: Arc::clone(&self.current),
+        })
+    }
+
+    /// The camera of the view shown last.
+    #[getter]
+    fn camera(&self) -> PyResult<Camera> {
+        let options = self.current_options()?;
+        Ok(Camera {
+            options: options.camera,
+        })
+    }
+
+    /// The transfer function of the view shown last, whole: its window
+    /// (the domain), opacity points and colours.
+    #[getter]
+    fn transfer_function(&self) -> PyResult<TransferFunction> {
+        match self.current_options()?.look.tf {
+            Some(Tf::Function(function)) => Ok(TransferFunction { function }),
+            _ => Err(PyRuntimeError::new_err("the view has no transfer function")),
+        }
+    }
+
+    /// The keywords of `render` that render the view shown last (beside
+    /// the volume's own given to the viewer).
+    fn keywords<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let options = self.current_options()?;
+        let dict = PyDict::new(py);
+        for (key, value) in words(&options) {
+            let object: Bound<'py, PyAny> = match value {
+                Value::Camera(options) => Bound::new(py, Camera { options })?.into_any(),
+                Value::Tf(function) => Bound::new(py, TransferFunction { function })?.into_any(),
+                Value::Str(s) => s.into_pyobject(py)?.into_any(),
+                Value::Number(x) => x.into_pyobject(py)?.into_any(),
+                Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+                Value::Numbers(v) => pyo3::types::PyTuple::new(py, v)?.into_any(),
+            };
+            dict.set_item(key, object)?;
+        }
+        Ok(dict)
+    }
+
+    /// The `render` call of the view shown last, as the page shows it.
+    fn call(&self) -> PyResult<String> {
+        Ok(call(&self.current_options()?))
+    }
+
+    /// The view shown last, as the page's JSON state.
+    fn state(&self) -> String {
+        serde_json::to_string(&*lock(&self.current)).expect("a state serialises")
+    }
+}
+
+impl ViewHost {
+    fn current_options(&self) -> PyResult<Options> {
+        let state = lock(&self.current).clone();
+        (self.reproduce.options(&state)).map_err(|e| value_error(e.to_string()))
+    }
+}
+
+#[pymethods]
+impl ViewTab {
+    /// Files a message from the page; the error message for the page
+    /// (JSON) where it is refused.
+    fn receive(&self, text: &str) -> Option<String> {
+        match self.tab.receive(text) {
+            Ok(Some(state)) => {
+                *lock(&self.current) = state;
+                None
+            }
+            Ok(None) => None,
+            Err(reply) => Some(reply),
+        }
+    }
+
+    /// The next message for the page, waiting for it with the GIL
+    /// released: `(False, text)` or `(True, frame bytes)`; `None` once
+    /// the tab is closed.
+    fn next<'py>(&self, py: Python<'py>) -> Option<(bool, Bound<'py, PyAny>)> {
+        match py.detach(|| self.tab.next())? {
+            Message::Text(text) => Some((false, text.into_pyobject(py).ok()?.into_any())),
+            Message::Frame(bytes) => Some((true, PyBytes::new(py, &bytes).into_any())),
+        }
+    }
+
+    /// Stops the page's renderer: `next` returns `None` once it ends.
+    fn close(&self) {
+        self.tab.close();
+    }
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A keyword's value.
+enum Value {
+    Camera(CameraOptions),
+    Tf(volray_core::TransferFunction),
+    Str(&'static str),
+    Number(f64),
+    Bool(bool),
+    Numbers(Vec<f64>),
+}
+
+/// The keywords of `render` that give `options` (a state's: the look's
+/// transfer function whole), the defaults left out.
+fn words(options: &Options) -> Vec<(&'static str, Value)> {
+    let look = &options.look;
+    let sampling = &options.sampling;
+    let lit = Phong::default();
+    let rgb = |c: [f32; 3]| match c {
+        [r, g, b] if r == g && g == b => Value::Number(f64::from(r)),
+        c => Value::Numbers(c.iter().map(|&x| f64::from(x)).collect()),
+    };
+    let mut w = vec![("camera", Value::Camera(options.camera.clone()))];
+    if let Some(Tf::Function(f)) = &look.tf {
+        w.push(("tf", Value::Tf(f.clone())));
+    }
+    if let Some((p, q)) = look.opacity {
+        w.push(("opacity", Value::Numbers(vec![f64::from(p), f64::from(q)])));
+    }
+    if look.blend != BlendMode::Composite {
+        w.push(("blend", Value::Str(look.blend.name())));
+    }
+    if let Some(iso) = look.iso {
+        w.push(("iso", Value::Number(f64::from(iso))));
+    }
+    if let Some(r) = look.iso_thickness {
+        w.push(("iso_thickness", Value::Number(f64::from(r))));
+    }
+    if let Some((lo, hi)) = look.gradient_opacity {
+        w.push((
+            "gradient_opacity",
+            Value::Numbers(vec![f64::from(lo), f64::from(hi)]),
+        ));
+    }
+    if look.post_classification {
+        w.push(("post_classification", Value::Bool(true)));
+    }
+    if !look.shading {
+        w.push(("shading", Value::Bool(false)));
+    }
+    for (key, value, default) in [
+        ("ambient", look.ambient, lit.ambient),
+        ("diffuse", look.diffuse, lit.diffuse),
+        ("specular", look.specular, lit.specular),
+        ("light_color", look.light_color, lit.light_color),
+    ] {
+        if value != default {
+            w.push((key, rgb(value)));
+        }
+    }
+    if look.shininess != lit.shininess {
+        w.push(("shininess", Value::Number(f64::from(look.shininess))));
+    }
+    if let Some(light) = look.light {
+        w.push(("light", Value::Numbers(light.to_vec())));
+    }
+    if look.background != RenderSettings::default().background {
+        w.push(("background", rgb(look.background)));
+    }
+    if sampling.step != 1.0 {
+        w.push(("step", Value::Number(sampling.step)));
+    }
+    if sampling.jitter {
+        w.push(("jitter", Value::Bool(true)));
+    }
+    if sampling.reference {
+        w.push(("reference", Value::Bool(true)));
+    }
+    if look.log {
+        w.push(("log", Value::Bool(true)));
+    }
+    if sampling.nonfinite == NonFinite::Transparent {
+        w.push(("nonfinite", Value::Str("transparent")));
+    }
+    w
+}
+
+/// `volray.render(volume, ...)` with `options` as keywords.
+fn call(options: &Options) -> String {
+    let mut s = "volray.render(volume".to_string();
+    for (key, value) in words(options) {
+        let _ = write!(s, ", {key}={}", code(&value));
+    }
+    s.push(')');
+    s
+}
+
+/// A value as Python code.
+fn code(value: &Value) -> String {
+    let tuple = |v: &[f64]| {
+        let inner: Vec<String> = v.iter().map(|x| num(*x)).collect();
+        format!("({})", inner.join(", "))
+    };
+    match value {
+        Value::Str(s) => format!("\"{s}\""),
+        Value::Number(x) => num(*x),
+        Value::Bool(b) => if *b { "True" } else { "False" }.to_string(),
+        Value::Numbers(v) => tuple(v),
+        Value::Camera(c) => {
+            let defaults = CameraOptions::default();
+            let mut parts = vec![format!("size=({}, {})", c.size.0, c.size.1)];
+            let mut v3 = |key: &str, v: Option<[f64; 3]>| {
+                if let Some(v) = v {
+                    parts.push(format!("{key}={}", tuple(&v)));
+                }
+            };
+            v3("view", c.view);
+            v3("look_at", c.look_at);
+            v3("up", (c.up != defaults.up).then_some(c.up));
+            if let Some(f) = c.perspective {
+                parts.push(format!("perspective={}", num(f)));
+            }
+            parts.push(format!("azimuth={}", num(c.azimuth)));
+            parts.push(format!("elevation={}", num(c.elevation)));
+            parts.push(format!("zoom={}", num(c.zoom)));
+            if !c.clip.is_empty() {
+                let planes: Vec<String> = (c.clip.iter())
+                    .map(|(p, n)| format!("({}, {})", tuple(p), tuple(n)))
+                    .collect();
+                parts.push(format!("clip=[{}]", planes.join(", ")));
+            }
+            if let Some((lo, hi)) = c.crop {
+                parts.push(format!(
+                    "crop={}",
+                    tuple(&[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
+                ));
+            }
+            format!("volray.Camera({})", parts.join(", "))
+        }
+        Value::Tf(f) => {
+            let mut parts = Vec::new();
+            if let Some(o) = &f.opacity {
+                let points: Vec<String> = (o.points().iter())
+                    .map(|(t, [a])| format!("({}, {})", num32(*t), num32(*a)))
+                    .collect();
+                parts.push(format!("opacity=[{}]", points.join(", ")));
+            }
+            if let Some(c) = &f.color {
+                let points: Vec<String> = (c.points().iter())
+                    .map(|(t, [r, g, b])| {
+                        format!(
+                            "({}, {}, {}, {})",
+                            num32(*t),
+                            num32(*r),
+                            num32(*g),
+                            num32(*b)
+                        )
+                    })
+                    .collect();
+                parts.push(format!("color=[{}]", points.join(", ")));
+            }
+            if let Some((lo, hi)) = f.domain {
+                parts.push(format!("domain=({}, {})", num(lo), num(hi)));
+            }
+            format!("volray.TransferFunction({})", parts.join(", "))
+        }
+    }
+}
+
+/// A number as Python reads it back to the same `f64`.
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+/// A number as Python reads it back to the same `f32` (Python's float is
+/// an `f64`; the shortest `f32` text rounds back to it).
+fn num32(x: f32) -> String {
+    format!("{x:?}")
+}
