@@ -1,9 +1,10 @@
 //! The Python module's tests (crates/python/tests, pytest), run by `cargo
 //! test`: a virtual environment in `target/pyenv` with maturin, pytest and
-//! numpy from PyPI (made once), the module built into it by `maturin
-//! develop --release`, then pytest with this build's `volray` binary as
-//! the oracle. Without python3 the test fails under `CI=true` and says so
-//! otherwise.
+//! numpy from PyPI (made once), and jupyterlab, notebook and anywidget for
+//! `volray.view`'s widget (test_jupyter.py drives them in Debian's
+//! chromium), the module built into it by `maturin develop --release`,
+//! then pytest with this build's `volray` binary as the oracle. Without
+//! python3 the test fails under `CI=true` and says so otherwise.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -39,8 +40,18 @@ fn venv(python: &str) -> PathBuf {
             ]),
         );
     }
+    if !bin.join("jupyter-lab").exists() || !bin.join("jupyter-notebook").exists() {
+        run(
+            "pip install jupyterlab notebook anywidget",
+            Command::new(bin.join("pip")).args(JUPYTER),
+        );
+    }
     venv
 }
+
+/// What `volray.view` needs in a notebook, and the front ends its test
+/// drives: `pip` arguments.
+const JUPYTER: [&str; 5] = ["install", "--quiet", "jupyterlab", "notebook", "anywidget"];
 
 fn python3() -> Option<String> {
     let found = Command::new("python3").arg("--version").output();

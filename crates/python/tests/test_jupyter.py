@@ -1,12 +1,13 @@
-"""volray.view in JupyterLab: a notebook executed in a headless Chromium
-(Debian's chromium and chromedriver, over WebDriver) by a ``jupyter lab``
-this test starts on a free loopback port with a token, under a base URL
-as JupyterHub's proxy gives one (``/user/volray/``). The widget shows the
+"""volray.view in JupyterLab and in Notebook 7: a notebook executed in a
+headless Chromium (Debian's chromium and chromedriver, over WebDriver) by
+a ``jupyter lab`` (``jupyter notebook``) this test starts on a free
+loopback port with a token, under a base URL as JupyterHub's proxy gives
+one (``/user/volray/``). The widget shows the
 viewer's page with the notebook's colours, a drag changes its frame, and
 ``volray.render(ball, camera=w.camera, tf=w.transfer_function)`` in the
 next cell equals the still frame the page shows, pixel for pixel.
 
-Without chromium, chromedriver, jupyterlab or anywidget the test is
+Without chromium, chromedriver, jupyterlab, notebook or anywidget the test is
 skipped with the reason, except under ``CI=true``, where it fails.
 """
 
@@ -31,6 +32,8 @@ from conftest import read_png
 CHROMIUM = "/usr/bin/chromium"
 CHROMEDRIVER = "/usr/bin/chromedriver"
 BASE = "/user/volray/"
+# Each front end: its command and its package.
+APPS = {"lab": ("jupyter-lab", "jupyterlab"), "notebook": ("jupyter-notebook", "notebook")}
 # Far more than anything needs (seconds), so that a slow machine never
 # fails the test while a broken widget does not hang it.
 PATIENCE = 120.0
@@ -38,9 +41,9 @@ PATIENCE = 120.0
 
 def missing_tools():
     missing = [p for p in (CHROMIUM, CHROMEDRIVER) if not Path(p).exists()]
-    lab = Path(sys.executable).parent / "jupyter-lab"
-    if not lab.exists():
-        missing.append("jupyterlab (pip install jupyterlab)")
+    for command, package in APPS.values():
+        if not (Path(sys.executable).parent / command).exists():
+            missing.append(f"{package} (pip install {package})")
     try:
         import anywidget  # noqa: F401
     except ImportError:
@@ -207,10 +210,12 @@ def notebook():
     }
 
 
-@pytest.fixture
-def lab(tools, tmp_path):
-    """A JupyterLab on a free loopback port, under BASE, with a token;
-    its root is `tmp_path/root`, which holds the notebook."""
+@pytest.fixture(params=["lab", "notebook"])
+def lab(request, tools, tmp_path):
+    """A JupyterLab (a Notebook 7) on a free loopback port, under BASE,
+    with a token; its root is `tmp_path/root`, which holds the notebook.
+    Gives the notebook's URL, the token, the root and `tmp_path`."""
+    app = request.param
     root = tmp_path / "root"
     root.mkdir()
     (root / "view.ipynb").write_text(json.dumps(notebook()))
@@ -226,7 +231,7 @@ def lab(tools, tmp_path):
     log = open(tmp_path / "lab.log", "wb")
     server = subprocess.Popen(
         [
-            str(Path(sys.executable).parent / "jupyter-lab"),
+            str(Path(sys.executable).parent / APPS[app][0]),
             "--no-browser",
             "--ip=127.0.0.1",
             f"--port={port}",
@@ -234,12 +239,18 @@ def lab(tools, tmp_path):
             f"--IdentityProvider.token={token}",
             f"--ServerApp.base_url={BASE}",
             f"--ServerApp.root_dir={root}",
-            f"--LabApp.workspaces_dir={tmp_path / 'workspaces'}",
-            "--LabApp.expose_app_in_browser=True",
             "--allow-root",
-            "--LabApp.news_url=",
-            "--LabApp.extension_manager=readonly",
-            "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+            "--expose-app-in-browser",
+            *(
+                [
+                    f"--LabApp.workspaces_dir={tmp_path / 'workspaces'}",
+                    "--LabApp.news_url=",
+                    "--LabApp.extension_manager=readonly",
+                    "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+                ]
+                if app == "lab"
+                else []
+            ),
         ],
         stdout=log,
         stderr=subprocess.STDOUT,
@@ -259,7 +270,8 @@ def lab(tools, tmp_path):
 
     try:
         wait("jupyter lab to answer", up)
-        yield url, token, root, tmp_path
+        page = "lab/tree" if app == "lab" else "notebooks"
+        yield f"{url}{page}/view.ipynb?token={token}", root, tmp_path
     finally:
         server.terminate()
         try:
@@ -320,16 +332,16 @@ fetch(document.getElementById("frame").src)
 """
 
 
-def test_the_widget_in_jupyterlab_shows_the_view_and_reads_it_back(lab, browser, tmp_path):
-    url, token, root, tmp = lab
+def test_the_widget_shows_the_view_and_reads_it_back(lab, browser):
+    notebook_url, root, tmp = lab
     web = browser
-    web.go(f"{url}lab/tree/view.ipynb?token={token}")
-    web.until("JupyterLab with the notebook's kernel idle", KERNEL_IDLE)
+    web.go(notebook_url)
+    web.until("the notebook with its kernel idle", KERNEL_IDLE)
 
     # The widget: the page in its iframe, with the notebook's colours.
     web.run(RUN_CELL, 0)
     web.until("the widget's iframe", "document.querySelector('iframe.volray-view') !== null")
-    lab_bg = web.run(
+    theirs = web.run(
         "return getComputedStyle(document.querySelector('iframe.volray-view'))"
         ".getPropertyValue('--jp-layout-color2').trim();"
     )
@@ -337,9 +349,9 @@ def test_the_widget_in_jupyterlab_shows_the_view_and_reads_it_back(lab, browser,
     web.into_frame(iframe)
     web.until("the first still frame", "document.body.dataset.state === 'still'")
     assert web.run("return document.getElementById('frame').naturalWidth;") == 160
-    assert lab_bg, "JupyterLab's theme has --jp-layout-color2"
-    assert web.run("return document.documentElement.style.getPropertyValue('--bg');") == lab_bg
-    assert web.run("return getComputedStyle(document.body).getPropertyValue('--bg').trim();") == lab_bg
+    assert theirs, "the notebook's theme has --jp-layout-color2"
+    assert web.run("return document.documentElement.style.getPropertyValue('--bg');") == theirs
+    assert web.run("return getComputedStyle(document.body).getPropertyValue('--bg').trim();") == theirs
     before = frame_bytes(web)
     frames = int(web.run("return document.body.dataset.frames;"))
 

@@ -62,8 +62,15 @@ from ._volray import (
 
 
 def view(volume, *, height=560, **options):
-    """The interactive viewer of ``volume`` in a notebook (see
-    ``volray._jupyter.view``; needs anywidget)."""
+    """The interactive viewer of ``volume`` (an array, a :class:`Volume`
+    or a file's path) in a notebook, an anywidget: ``volray view``'s page
+    in the cell's output, its frames rendered in the kernel and carried
+    over the kernel's connection. ``options`` are :func:`render`'s
+    keywords (but the figure's, ``level`` and ``labels``): the view it
+    starts with; without ``size`` the frame fits the widget, ``height``
+    pixels high. The widget's ``camera`` and ``transfer_function`` read
+    the view shown back: ``render(volume, camera=w.camera,
+    tf=w.transfer_function)`` renders its still frame."""
     from ._jupyter import view as _view
 
     return _view(volume, height=height, **options)

@@ -462,3 +462,71 @@ def fractal(
     raw_field: bool = False,
     random_additions: bool = False,
 ) -> npt.NDArray[np.float32]: ...
+
+class Viewer:
+    """The viewer in a notebook (an ``anywidget.AnyWidget``), made by
+    :func:`view`. ``camera`` and ``transfer_function`` read back the view
+    shown last: ``render(volume, camera=w.camera, tf=w.transfer_function)``
+    renders its still frame where the other keywords are the defaults,
+    ``render(volume, **w.keywords)`` whatever they are."""
+
+    height: int
+    @property
+    def camera(self) -> Camera: ...
+    @property
+    def transfer_function(self) -> TransferFunction: ...
+    @property
+    def keywords(self) -> Dict[str, Any]: ...
+    @property
+    def state(self) -> Dict[str, Any]: ...
+    def close(self) -> None: ...
+
+def view(
+    volume: Union[Volume, ArrayLike, Path],
+    *,
+    height: int = 560,
+    spacing: Optional[Vec3] = None,
+    origin: Optional[Vec3] = None,
+    order: Literal["xyz", "zyx"] = "xyz",
+    log: bool = False,
+    nonfinite: Literal["refuse", "transparent"] = "refuse",
+    max_memory: Optional[int] = None,
+    size: Optional[Union[int, Tuple[int, int]]] = None,
+    view: Optional[Vec3] = None,
+    look_at: Optional[Vec3] = None,
+    up: Vec3 = (0, 0, 1),
+    perspective: Optional[float] = None,
+    azimuth: float = 0,
+    elevation: float = 0,
+    zoom: float = 1,
+    clip: Optional[Union[Plane, Sequence[Plane]]] = None,
+    crop: Optional[Tuple[float, float, float, float, float, float]] = None,
+    camera: Optional[Camera] = None,
+    step: float = 1,
+    jitter: bool = False,
+    reference: bool = False,
+    opacity: Optional[Pair] = None,
+    tf: Union[None, Literal["auto"], TransferFunction, Mapping[str, Any], Path] = None,
+    preset: Optional[str] = None,
+    colormap: Optional[str] = None,
+    range: Optional[Pair] = None,
+    blend: Blend = "composite",
+    iso: Optional[float] = None,
+    iso_thickness: Optional[float] = None,
+    gradient_opacity: Optional[Pair] = None,
+    post_classification: bool = False,
+    shading: bool = True,
+    ambient: Rgb = 0.1,
+    diffuse: Rgb = 0.7,
+    specular: Rgb = 0.2,
+    shininess: float = 10,
+    light: Optional[Vec3] = None,
+    light_color: Rgb = 1,
+    background: Rgb = 0,
+    threads: Optional[int] = None,
+) -> Viewer:
+    """The interactive viewer of ``volume`` in a notebook (needs
+    anywidget): ``volray view``'s page in the output, its frames rendered
+    in the kernel and carried over the kernel's connection. The keywords
+    are :func:`render`'s (but the figure's, ``level`` and ``labels``): the
+    view it starts with; without ``size`` the frame fits the widget."""

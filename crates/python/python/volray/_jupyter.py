@@ -79,7 +79,14 @@ class Viewer(anywidget.AnyWidget):
         return json.loads(self._host.state())
 
     def __repr__(self) -> str:
-        return f"volray.Viewer({self._host.call()})"
+        try:
+            c = self.camera
+        except ValueError:  # the last view asked for was refused
+            return "volray.Viewer()"
+        return (
+            f"volray.Viewer(size={c.size}, azimuth={c.azimuth:g}, "
+            f"elevation={c.elevation:g}, zoom={c.zoom:g})"
+        )
 
     # ---------------------------------------------------------- the pages
 
@@ -141,9 +148,12 @@ class Viewer(anywidget.AnyWidget):
 
     def close(self) -> None:
         """Closes every page's renderer, then the widget."""
-        with self._lock:
-            tabs = list(self._tabs.values())
-            self._tabs.clear()
+        lock = getattr(self, "_lock", None)  # None: __init__ refused its arguments
+        tabs = []
+        if lock is not None:
+            with lock:
+                tabs = list(self._tabs.values())
+                self._tabs.clear()
         for tab in tabs:
             tab.close()
         super().close()

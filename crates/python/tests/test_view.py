@@ -1,0 +1,140 @@
+"""volray.view's kernel side, without a browser: the viewer's messages as
+the widget carries them (``_ViewHost``, ``_ViewTab``), the frames it sends
+equal to ``volray.render`` of the view read back, and bad input refused
+with Python exceptions. tests/test_jupyter.py drives the widget in a
+browser."""
+
+import json
+import threading
+
+import numpy as np
+import pytest
+
+import volray
+from volray._volray import _ViewHost
+from conftest import read_png, rgb
+
+
+@pytest.fixture(scope="module")
+def ball():
+    x, y, z = np.mgrid[-1:1:32j, -1:1:32j, -1:1:32j]
+    return (np.exp(-4 * (x * x + y * y + z * z)) * (1.2 + np.sin(4 * x + 2 * y))).astype(
+        np.float32
+    )
+
+
+def frame_of(message, tmp_path):
+    """A frame message's header and pixels."""
+    is_frame, data = message
+    assert is_frame, data
+    n = int.from_bytes(data[:4], "little")
+    header = json.loads(data[4 : 4 + n])
+    path = tmp_path / "frame.png"
+    path.write_bytes(data[4 + n :])
+    return header, read_png(path)
+
+
+def ask(tab, state, seq, quality="full"):
+    refused = tab.receive(json.dumps({"type": "view", "seq": seq, "quality": quality, "state": state}))
+    assert refused is None, refused
+    return tab.next()
+
+
+def test_the_frames_are_render_of_the_view_read_back(ball, tmp_path):
+    host = _ViewHost(ball, size=(64, 48), azimuth=20, elevation=10)
+    tab = host.open()
+    is_frame, hello = tab.next()
+    hello = json.loads(hello)
+    assert not is_frame and hello["type"] == "hello"
+    state = hello["start"]
+    assert (state["width"], state["height"], state["azimuth"]) == (64, 48, 20)
+    assert host.camera.azimuth == 20
+
+    # An orbit: the camera and the transfer function read back render it.
+    state["azimuth"] = 75
+    header, shown = frame_of(ask(tab, state, 1), tmp_path)
+    assert header["quality"] == "full" and header["command"].startswith("volray.render(volume,")
+    assert host.camera.azimuth == 75
+    expected = rgb(volray.render(ball, camera=host.camera, tf=host.transfer_function))
+    assert np.array_equal(shown[:, :, :3], expected)
+    assert expected.std() > 5
+
+    # The page's look: its keywords render it.
+    state.update(
+        window=[0.1, 1.5],
+        opacity=[[0, 0], [0.4, 0.1], [1, 0.8]],
+        colormap="magma",
+        step=0.5,
+        shading=False,
+        background=[0.2, 0.1, 0.0],
+    )
+    header, shown = frame_of(ask(tab, state, 2), tmp_path)
+    keywords = host.keywords()
+    assert keywords["step"] == 0.5 and keywords["shading"] is False
+    assert host.transfer_function.domain == (0.1, 1.5)
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **keywords)))
+    assert not np.array_equal(shown[:, :, :3], expected)
+
+    # A projection, and its command.
+    state.update(blend="mip", colormap="grey")
+    header, shown = frame_of(ask(tab, state, 3), tmp_path)
+    assert 'blend="mip"' in header["command"]
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **host.keywords())))
+    tab.close()
+    assert tab.next() is None
+
+
+def test_bad_messages_are_answered_and_closed_tabs_end(ball):
+    host = _ViewHost(ball, size=32)
+    tab = host.open()
+    tab.next()  # the hello
+    answer = json.loads(tab.receive("{not json"))
+    assert answer["type"] == "error" and "malformed" in answer["message"]
+    state = json.loads(host.state())
+    state["zoom"] = -1
+    answer = json.loads(tab.receive(json.dumps({"type": "view", "seq": 5, "quality": "full", "state": state})))
+    assert answer["seq"] == 5 and "zoom" in answer["message"]
+    state["zoom"] = 1
+    state["colormap"] = "nope"
+    answer = json.loads(tab.receive(json.dumps({"type": "view", "seq": 6, "quality": "full", "state": state})))
+    assert answer["seq"] == 6 and "nope" in answer["message"]
+    # A state the page may send but this viewer does not render.
+    state["colormap"] = "viridis"
+    state["figure"] = {"title": "a title"}
+    assert tab.receive(json.dumps({"type": "view", "seq": 7, "quality": "full", "state": state})) is None
+    is_frame, text = tab.next()
+    assert not is_frame and "colorbar=" in json.loads(text)["message"]
+    # The last view asked for cannot be read back: said so.
+    with pytest.raises(ValueError, match="annotations"):
+        host.camera
+    # Closing ends the tab's messages, whoever waits for them.
+    got = []
+    waiter = threading.Thread(target=lambda: got.append(tab.next()))
+    waiter.start()
+    tab.close()
+    waiter.join(timeout=30)
+    assert not waiter.is_alive() and got == [None]
+
+
+def test_bad_input_is_refused_with_python_exceptions(ball, tmp_path):
+    pytest.importorskip("anywidget")
+    with pytest.raises(TypeError, match="colorbar"):
+        volray.view(ball, colorbar="right")
+    with pytest.raises(ValueError, match="level"):
+        volray.view(ball, level=1)
+    with pytest.raises(ValueError, match="label volume"):
+        volray.view(ball.astype(np.uint8), labels=True)
+    with pytest.raises(ValueError, match="zoom"):
+        volray.view(ball, zoom=-1)
+    with pytest.raises(ValueError, match="height"):
+        volray.view(ball, height=10)
+    with pytest.raises(TypeError, match="height"):
+        volray.view(ball, height="tall")
+    with pytest.raises(OSError):
+        volray.view(tmp_path / "missing.npy")
+    w = volray.view(ball, size=(40, 30), azimuth=10)
+    assert w.camera.size == (40, 30) and w.camera.azimuth == 10
+    assert w.keywords["camera"].azimuth == 10
+    assert w.state["azimuth"] == 10
+    assert "<!doctype html>" in w._page and "Content-Security-Policy" in w._page
+    w.close()
