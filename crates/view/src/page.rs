@@ -26,7 +26,7 @@ fn embedded_csp(nonce: &str) -> String {
 
 /// The page as one document for an iframe's `srcdoc` (the Jupyter
 /// widget's): the style sheet and the scripts inline, allowed by `nonce`
-/// in a Content-Security-Policy `meta` element, [`EMBED_JS`] before the
+/// in a Content-Security-Policy `meta` element, `assets/embed.js` before the
 /// page's script so that its messages go through the parent window.
 pub fn embedded_html(nonce: &str) -> String {
     let head = format!(
