@@ -343,6 +343,9 @@ fn words(options: &Options) -> Vec<(&'static str, Value)> {
     if look.shininess != lit.shininess {
         w.push(("shininess", Value::Number(f64::from(look.shininess))));
     }
+    if look.shadows {
+        w.push(("shadows", Value::Bool(true)));
+    }
     if let Some(light) = look.light {
         w.push(("light", Value::Numbers(light.to_vec())));
     }

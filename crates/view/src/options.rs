@@ -9,8 +9,8 @@
 //! the camera and the transfer function read back from the page
 //! reproduce the frame on their own. What the page does not set comes
 //! from the options the viewer was started with, dropped where the state
-//! makes it inapplicable (lighting and opacity options under a
-//! projection), as `src/view/reproduce.rs` drops the flags for `volray
+//! makes it inapplicable (lighting, shadows and opacity options under a
+//! projection or without shading), as `src/view/reproduce.rs` drops the flags for `volray
 //! view`.
 
 use crate::reproduce::Refusal;
@@ -148,6 +148,7 @@ pub fn state_options(state: &ViewState, start: &OptionsStart) -> Result<Options,
         look.shininess = lit.shininess;
         look.light = None;
         look.light_color = lit.light_color;
+        look.shadows = false;
     };
     let start_tf = &start.transfer_function;
     let opacity = match &state.opacity {
@@ -297,14 +298,19 @@ mod tests {
         );
         volray_options::settings(&got).unwrap();
 
-        // A projection drops the opacity and the lighting.
+        // A projection drops the opacity, the lighting and the shadows.
+        let mut shadowed = start.clone();
+        shadowed.options.look.shadows = true;
+        state.shading = true;
+        assert!(state_options(&state, &shadowed).unwrap().look.shadows);
         state.blend = BlendMode::Mip;
-        let got = state_options(&state, &start).unwrap();
+        let got = state_options(&state, &shadowed).unwrap();
         let Some(Tf::Function(tf)) = &got.look.tf else {
             panic!()
         };
         assert_eq!(tf.opacity, None);
         assert_eq!(got.look.ambient, Phong::default().ambient);
+        assert!(!got.look.shadows);
         volray_options::settings(&got).unwrap();
     }
 
