@@ -5,7 +5,8 @@ loopback port with a token, under a base URL as JupyterHub's proxy gives
 one (``/user/volray/``). The widget shows the
 viewer's page with the notebook's colours, a drag changes its frame, and
 ``volray.render(ball, camera=w.camera, tf=w.transfer_function)`` in the
-next cell equals the still frame the page shows, pixel for pixel.
+next cell equals the still frame the page shows, pixel for pixel; then
+the page follows the notebook into its dark theme.
 
 Without chromium, chromedriver, jupyterlab, notebook or anywidget the test is
 skipped with the reason, except under ``CI=true``, where it fails.
@@ -383,6 +384,28 @@ def test_the_widget_shows_the_view_and_reads_it_back(lab, browser):
     diff = np.abs(expected[:, :, :3].astype(np.int32) - shown[:, :, :3].astype(np.int32))
     assert diff.max() == 0, f"{np.count_nonzero(diff.max(axis=2))} pixels differ, by up to {diff.max()}"
     assert expected[:, :, :3].std() > 5, "the frame shows something"
+
+    # The page follows a change of the notebook's theme.
+    web.run("window.jupyterapp.commands.execute('apputils:change-theme', {theme: 'JupyterLab Dark'});")
+    web.until("the dark theme", "document.body.dataset.jpThemeLight === 'false'")
+    dark = wait(
+        "the dark theme's colours",
+        lambda: (
+            web.run(
+                "return getComputedStyle(document.querySelector('iframe.volray-view'))"
+                ".getPropertyValue('--jp-layout-color2').trim();"
+            )
+            or ""
+        ).lower()
+        not in ("", theirs.lower())
+        and web.run(
+            "return getComputedStyle(document.querySelector('iframe.volray-view'))"
+            ".getPropertyValue('--jp-layout-color2').trim();"
+        ),
+    )
+    web.into_frame(web.element("iframe.volray-view"))
+    web.until("the page's dark colours", f"document.documentElement.style.getPropertyValue('--bg') === {json.dumps(dark)}")
+    assert web.run("return document.body.dataset.theme;") == "dark"
 
 
 def frame_bytes(web):
