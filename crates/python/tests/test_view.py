@@ -84,6 +84,22 @@ def test_the_frames_are_render_of_the_view_read_back(ball, tmp_path):
     assert tab.next() is None
 
 
+def test_shadows_are_kept_while_lit_and_dropped_under_a_projection(ball, tmp_path):
+    host = _ViewHost(ball, size=(48, 40), shadows=True, azimuth=40)
+    tab = host.open()
+    state = json.loads(tab.next()[1])["start"]
+    header, shown = frame_of(ask(tab, state, 1), tmp_path)
+    assert host.keywords()["shadows"] is True and "shadows=True" in header["command"]
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **host.keywords())))
+    unshadowed = rgb(volray.render(ball, camera=host.camera, tf=host.transfer_function))
+    assert not np.array_equal(shown[:, :, :3], unshadowed)
+    state["blend"] = "mip"
+    header, shown = frame_of(ask(tab, state, 2), tmp_path)
+    assert "shadows" not in host.keywords()
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **host.keywords())))
+    tab.close()
+
+
 def test_bad_messages_are_answered_and_closed_tabs_end(ball):
     host = _ViewHost(ball, size=32)
     tab = host.open()

@@ -522,6 +522,7 @@ def view(
     shininess: float = 10,
     light: Optional[Vec3] = None,
     light_color: Rgb = 1,
+    shadows: bool = False,
     background: Rgb = 0,
     threads: Optional[int] = None,
 ) -> Viewer:
