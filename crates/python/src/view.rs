@@ -423,6 +423,12 @@ fn code(value: &Value) -> String {
             format!("volray.Camera({})", parts.join(", "))
         }
         Value::Tf(f) => {
+            // Colours of a named map are written as its name.
+            let named = (f.color.as_ref()).and_then(|c| {
+                (volray_core::transfer::colormap::NAMES.iter()).find(|name| {
+                    volray_core::transfer::colormap::colormap(name).as_ref() == Some(c)
+                })
+            });
             let mut parts = Vec::new();
             if let Some(o) = &f.opacity {
                 let points: Vec<String> = (o.points().iter())
@@ -430,7 +436,7 @@ fn code(value: &Value) -> String {
                     .collect();
                 parts.push(format!("opacity=[{}]", points.join(", ")));
             }
-            if let Some(c) = &f.color {
+            if let (Some(c), None) = (&f.color, named) {
                 let points: Vec<String> = (c.points().iter())
                     .map(|(t, [r, g, b])| {
                         format!(
@@ -447,7 +453,11 @@ fn code(value: &Value) -> String {
             if let Some((lo, hi)) = f.domain {
                 parts.push(format!("domain=({}, {})", num(lo), num(hi)));
             }
-            format!("volray.TransferFunction({})", parts.join(", "))
+            let tf = format!("volray.TransferFunction({})", parts.join(", "));
+            match named {
+                Some(name) => format!("{tf}.with_colormap(\"{name}\")"),
+                None => tf,
+            }
         }
     }
 }

@@ -69,6 +69,10 @@ def test_the_frames_are_render_of_the_view_read_back(ball, tmp_path):
         background=[0.2, 0.1, 0.0],
     )
     header, shown = frame_of(ask(tab, state, 2), tmp_path)
+    # The Command box's call, run, renders the frame too.
+    assert '.with_colormap("magma")' in header["command"]
+    ran = eval(header["command"], {"volray": volray, "volume": ball})
+    assert np.array_equal(shown[:, :, :3], rgb(ran))
     keywords = host.keywords()
     assert keywords["step"] == 0.5 and keywords["shading"] is False
     assert host.transfer_function.domain == (0.1, 1.5)
@@ -79,6 +83,8 @@ def test_the_frames_are_render_of_the_view_read_back(ball, tmp_path):
     state.update(blend="mip", colormap="grey")
     header, shown = frame_of(ask(tab, state, 3), tmp_path)
     assert 'blend="mip"' in header["command"]
+    ran = eval(header["command"], {"volray": volray, "volume": ball})
+    assert np.array_equal(shown[:, :, :3], rgb(ran))
     assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **host.keywords())))
     tab.close()
     assert tab.next() is None
@@ -90,6 +96,8 @@ def test_shadows_are_kept_while_lit_and_dropped_under_a_projection(ball, tmp_pat
     state = json.loads(tab.next()[1])["start"]
     header, shown = frame_of(ask(tab, state, 1), tmp_path)
     assert host.keywords()["shadows"] is True and "shadows=True" in header["command"]
+    ran = eval(header["command"], {"volray": volray, "volume": ball})
+    assert np.array_equal(shown[:, :, :3], rgb(ran))
     assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **host.keywords())))
     unshadowed = rgb(volray.render(ball, camera=host.camera, tf=host.transfer_function))
     assert not np.array_equal(shown[:, :, :3], unshadowed)
