@@ -14,14 +14,14 @@ mod reproduce;
 mod scene;
 
 use crate::error::CliError;
-use crate::flags::{BlendMode as BlendFlag, ViewerArgs};
+use crate::flags::ViewerArgs;
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{from_volume, named_transfer_function, read_tf_file, settings_with_tf_text};
 use reproduce::CliReproduce;
 use std::net::SocketAddr;
 use std::sync::Arc;
-use volray_core::{Projection, RenderSettings};
-use volray_view::{BlendMode, Reproduce, START_COLOURS, Start, ViewState, Viewer, WHITE};
+use volray_core::RenderSettings;
+use volray_view::{Reproduce, Start, ViewState, Viewer};
 
 /// The most tabs rendering at once, whatever the memory allows (the
 /// memory itself is held to `--max-memory` by the viewer's ledger:
@@ -140,51 +140,18 @@ fn serve(args: &ViewerArgs, viewer: Viewer) -> Result<(), CliError> {
     server.run().map_err(|e| CliError::io(e.to_string()))
 }
 
-/// The page's starting state: the view the flags describe.
+/// The page's starting state: the view the flags describe (as
+/// `volray.view` starts from its keywords, [`volray_view::start_state`]),
+/// with the figure the flags ask for.
 pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
-    let look = &args.view.look;
-    let camera = &settings.camera;
-    let colormap = match &look.colormap {
-        Some(name) if name == "gray" => "grey".to_string(),
-        Some(name) => name.clone(),
-        None if settings.transfer_function.color.is_some() => START_COLOURS.to_string(),
-        None => WHITE.to_string(),
+    let options = volray_options::Options {
+        camera: crate::settings::camera(&args.view.camera),
+        look: crate::settings::look(&args.view.look),
+        ..Default::default()
     };
     ViewState {
-        width: settings.width,
-        height: settings.height,
-        azimuth: camera.azimuth,
-        elevation: camera.elevation,
-        zoom: camera.zoom,
-        look_at: camera.look_at.map(|p| p.to_array()),
-        view_point: camera.view_point.map(|p| p.to_array()),
-        perspective: match camera.projection {
-            Projection::Perspective { fov_degrees } => Some(fov_degrees),
-            Projection::Orthographic => None,
-        },
-        blend: match look.blend {
-            BlendFlag::Mip => BlendMode::Mip,
-            BlendFlag::Minip => BlendMode::Minip,
-            BlendFlag::Average => BlendMode::Average,
-            BlendFlag::Iso => BlendMode::Iso,
-            BlendFlag::Composite if settings.iso.is_some() => BlendMode::Iso,
-            BlendFlag::Composite => BlendMode::Composite,
-        },
-        iso: settings.iso.map(|iso| iso.value),
-        step: settings.step,
-        shading: settings.shading,
-        background: settings.background,
-        window: None,
-        opacity: None,
-        colormap,
-        layers: Vec::new(),
-        time: None,
-        crop: args.view.camera.crop.map(|(lo, hi)| [lo, hi]),
-        clip: (args.view.camera.clip.iter())
-            .map(|&(point, normal)| [point, normal])
-            .collect(),
-        lighting: None,
         figure: figure_state(&args.figure),
+        ..volray_view::start_state(&options, settings)
     }
 }
 
