@@ -160,6 +160,30 @@ fn in_the_shadow_the_plate_keeps_its_ambient_light_and_elsewhere_all_of_it() {
     }
 }
 
+/// A 48×40 frame with shadows, seen from above and the side, lit from
+/// `light` (`None`: the key light).
+fn shadowed(
+    tf: volray_core::TransferFunction,
+    light: Option<DVec3>,
+    classification: Classification,
+    step: f64,
+) -> RenderSettings {
+    RenderSettings {
+        width: 48,
+        height: 40,
+        camera: Camera {
+            view_point: Some(DVec3::new(60.0, -80.0, 50.0)),
+            ..Camera::default()
+        },
+        step,
+        transfer_function: tf,
+        light_direction: light,
+        classification,
+        shadows: true,
+        ..RenderSettings::default()
+    }
+}
+
 #[test]
 fn the_fast_paths_are_within_two_levels_of_the_marched_shadows_on_smooth_volumes() {
     // Blobs on two grids (one of unequal spacings), lights along an axis
@@ -178,20 +202,7 @@ fn the_fast_paths_are_within_two_levels_of_the_marched_shadows_on_smooth_volumes
             (DVec3::new(0.8, -0.3, 0.5), Classification::Pre, 1.0),
             (DVec3::new(-1.0, 1.0, 1.0), Classification::Post, 1.0),
         ] {
-            let settings = RenderSettings {
-                width: 48,
-                height: 40,
-                camera: Camera {
-                    view_point: Some(DVec3::new(60.0, -80.0, 50.0)),
-                    ..Camera::default()
-                },
-                step,
-                transfer_function: colorful(),
-                light_direction: Some(light),
-                classification,
-                shadows: true,
-                ..RenderSettings::default()
-            };
+            let settings = shadowed(colorful(), Some(light), classification, step);
             let fast = renderer.render(&settings).unwrap();
             let reference = renderer.render(&on_the_reference(&settings)).unwrap();
             let plain = renderer
@@ -248,20 +259,7 @@ fn where_the_sweep_is_known_to_part_from_the_march_it_stays_within_its_measured_
     ];
     for (volume, tf, light, classification, bound) in cases {
         let renderer = Renderer::new(&volume).unwrap();
-        let settings = RenderSettings {
-            width: 48,
-            height: 40,
-            camera: Camera {
-                view_point: Some(DVec3::new(60.0, -80.0, 50.0)),
-                ..Camera::default()
-            },
-            step: 0.5,
-            transfer_function: tf,
-            light_direction: light,
-            classification,
-            shadows: true,
-            ..RenderSettings::default()
-        };
+        let settings = shadowed(tf, light, classification, 0.5);
         let fast = renderer.render(&settings).unwrap();
         let reference = renderer.render(&on_the_reference(&settings)).unwrap();
         let diff = fast.max_abs_diff(&reference).unwrap() * 255.0;
