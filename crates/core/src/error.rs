@@ -64,6 +64,11 @@ pub enum SceneError {
     /// volumes would have to be swept together.
     #[error("shadows are cast within one volume: a scene of several volumes cannot show them yet")]
     Shadows,
+    /// Ambient occlusion, likewise.
+    #[error(
+        "ambient occlusion is found within one volume: a scene of several volumes cannot show it yet"
+    )]
+    AmbientOcclusion,
 }
 
 /// A render setting out of its range: which one, its value and the bound.
@@ -119,6 +124,11 @@ pub enum SettingError {
     /// Shadows asked for where nothing is lit.
     #[error("shadows need lit, composited samples: {0}")]
     Shadows(&'static str),
+    /// Ambient occlusion asked for where nothing is composited.
+    #[error("ambient occlusion needs composited samples: {0}")]
+    AmbientOcclusion(&'static str),
+    #[error("ambient occlusion radius {0} must be 1 to 32 voxels")]
+    AmbientOcclusionRadius(f64),
 }
 
 /// Which side of the image [`SettingError::ImageSide`] is about.

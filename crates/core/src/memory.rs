@@ -18,9 +18,11 @@
 //! | reference, post-classified | — | gradients (12) |
 //!
 //! With shadows ([`crate::shadows`]) the fast paths keep a light volume
-//! (2 bytes a voxel) and its two running slices while it is swept; the
-//! reference adds the voxels' opacities and the light reaching them (4 + 4
-//! bytes a voxel).
+//! (2 bytes a voxel) and its running slices while it is swept; with
+//! ambient occlusion ([`crate::shadows::ambient`]) an ambient volume (2
+//! bytes a voxel) and its ring of slices while it is computed. The
+//! reference adds the light reaching each voxel (4 bytes a voxel each)
+//! and the opacities it is marched through (see `depth_cues`).
 //!
 //! plus the frame (16 bytes a pixel, partial and finished image sharing
 //! one buffer; a projection 32) and, with non-finite values rendered as
@@ -34,6 +36,8 @@ use crate::kernels::projection::Projected;
 use crate::non_finite::{self, NonFinite};
 use crate::reference::{self, stage1};
 use crate::settings::{Blend, Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
+use crate::shadows::ambient::AmbientRays;
+use crate::shadows::ambient_volume::{self, AmbientVolume};
 use crate::shadows::light_volume;
 use crate::volume::{SampleType, Volume};
 use crate::{bricks, image::Image};
@@ -80,14 +84,17 @@ impl MemoryBound {
             SampleType::F32 => 0,
             _ => voxels * size_of::<f32>() as u128,
         };
+        let cues = depth_cues(dims, spacing, settings);
         let path = match (settings.method, settings.blend, settings.classification) {
             (Method::Fast, Blend::Composite, Classification::Pre) => {
-                macrocells + bricked_path(grid, settings, cache_budget)
+                macrocells + bricked_path(grid, settings, cache_budget) + cues
             }
+            // The gradients are held while the packed voxels are made, and
+            // let go before the depth cues are computed.
             (Method::Fast, Blend::Composite, Classification::Post) => {
                 macrocells
                     + voxels * post::BYTES_PER_VOXEL as u128
-                    + gradients
+                    + gradients.max(cues)
                     + bricks * post::FRAME_BYTES_PER_BRICK as u128
             }
             (Method::Fast, _, _) => macrocells,
@@ -96,22 +103,13 @@ impl MemoryBound {
                     + gradients
                     + voxels * stage1::BYTES_PER_VOXEL as u128
                     + ray_samples(dims, spacing, settings)
+                    + cues
             }
             (Method::Reference, Blend::Composite, Classification::Post) => {
-                reference_values + gradients + ray_samples(dims, spacing, settings)
+                reference_values + gradients + ray_samples(dims, spacing, settings) + cues
             }
             (Method::Reference, _, _) => reference_values,
         };
-        let path = path
-            + match (settings.shadows, settings.method) {
-                (false, _) => 0,
-                (true, Method::Fast) => {
-                    let plane = dims.iter().map(|&n| n as u128).max().unwrap_or(0).pow(2);
-                    voxels * light_volume::BYTES_PER_VOXEL as u128
-                        + 4 * plane * size_of::<f32>() as u128
-                }
-                (true, Method::Reference) => voxels * 2 * size_of::<f32>() as u128,
-            };
         let pixels = settings.width as u128 * settings.height as u128;
         let image = size_of::<[f32; 4]>() as u128;
         let frame = match settings.blend {
@@ -155,6 +153,45 @@ impl MemoryBound {
 }
 
 /// The reference path's samples of the rays being composited, one ray per
+/// The bytes shadows and ambient occlusion add to a frame of `settings`:
+/// on the fast paths, the light and ambient volumes (kept) and what each
+/// holds while it is computed, one after the other; on the reference, the
+/// light and ambient light reaching each voxel (4 bytes each), the
+/// opacities they are marched through (4 bytes, let go before the shaded
+/// voxels are made; held for the frame where samples are classified),
+/// and a second copy of the gradients for post-classified samples.
+fn depth_cues(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u128 {
+    let voxels: u128 = dims.iter().map(|&n| n as u128).product();
+    let cues = u128::from(settings.shadows) + u128::from(settings.ambient_occlusion.is_some());
+    if cues == 0 {
+        return 0;
+    }
+    let float = size_of::<f32>() as u128;
+    if settings.method == Method::Reference {
+        return match settings.classification {
+            Classification::Pre => voxels * float * cues,
+            Classification::Post => voxels * (2 * float * cues + gradient::BYTES_PER_VOXEL as u128),
+        };
+    }
+    let shadows = match settings.shadows {
+        false => (0, 0),
+        true => {
+            let plane = dims.iter().map(|&n| n as u128).max().unwrap_or(0).pow(2);
+            let kept = voxels * light_volume::BYTES_PER_VOXEL as u128;
+            (kept, 4 * plane * float)
+        }
+    };
+    let ambient = match settings.ambient_occlusion {
+        None => (0, 0),
+        Some(radius) => {
+            let rays = AmbientRays::new(radius, spacing);
+            let kept = voxels * ambient_volume::BYTES_PER_VOXEL as u128;
+            (kept, AmbientVolume::ring_bytes(dims, &rays) as u128)
+        }
+    };
+    shadows.0 + ambient.0 + shadows.1.max(ambient.1)
+}
+
 /// worker thread: a ray takes at most the grid's diagonal over the step.
 fn ray_samples(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u128 {
     let extent = DVec3::new(

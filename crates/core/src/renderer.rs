@@ -22,7 +22,8 @@
 //! [`NonFinite::Transparent`] renders them as empty space, from a cleaned
 //! copy and a mask (see [`NonFinite`](crate::NonFinite) for the exact rules).
 
-use crate::bricks::BRICK;
+mod depth_cues;
+
 use crate::bricks::cache::Budget;
 use crate::bricks::macrocells::Macrocells;
 use crate::bricks::occupied::{Classified, ClassifiedBricks, Source};
@@ -35,7 +36,6 @@ use crate::error::RenderError;
 use crate::frame::Frame;
 use crate::image::Image;
 use crate::kernels::composite::{Finish, PartialPixel};
-use crate::kernels::gradient::Differences;
 use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
 use crate::non_finite::{NonFinite, NonFiniteMask};
@@ -44,14 +44,11 @@ use crate::progress::Progress;
 use crate::reference;
 use crate::reference::Shader;
 use crate::reference::post::PostClassifier;
-use crate::reference::stage1::{ShadedVolume, shade_and_classify};
+use crate::reference::stage1::{Reached, ShadedVolume, shade_and_classify};
 use crate::settings::{Blend, Classification, Method, RenderSettings, key_light};
-use crate::shadows::light_volume::LightVolume;
-use crate::shadows::{self, ShadowRay};
 use crate::transfer::classifier::Classifier;
-use crate::volume::Sample;
 use crate::volume::Volume;
-use rayon::prelude::*;
+use depth_cues::{KeptAmbient, KeptLight};
 use std::borrow::Cow;
 use std::sync::atomic::AtomicBool;
 use std::sync::{Mutex, MutexGuard, OnceLock};
@@ -83,6 +80,9 @@ pub struct Renderer<'v> {
     fast: Mutex<Option<FastState>>,
     /// The last light volume the fast paths swept, for shadows.
     light: Mutex<Option<KeptLight>>,
+    /// The last ambient volume the fast paths computed, for ambient
+    /// occlusion.
+    ambient: Mutex<Option<KeptAmbient>>,
     /// The most bytes the bricked fast path keeps of classified and lit
     /// bricks ([`Renderer::with_cache_budget`]).
     cache_budget: usize,
@@ -110,13 +110,6 @@ pub(crate) struct FastState {
     pub bricks: ClassifiedBricks,
     /// The frame's lit bricks, buffers reused from frame to frame.
     pub lit: LitBricks,
-}
-
-/// A light volume and what it was swept for.
-pub(crate) struct KeptLight {
-    /// The classifier and the direction towards the light (its bits).
-    key: (Classifier, [u32; 3]),
-    light: LightVolume,
 }
 
 /// Where a fast frame's time went.
@@ -203,6 +196,7 @@ impl<'v> Renderer<'v> {
             packed_voxels: OnceLock::new(),
             fast: Mutex::new(None),
             light: Mutex::new(None),
+            ambient: Mutex::new(None),
             cache_budget: DEFAULT_CACHE_BUDGET,
         })
     }
@@ -490,123 +484,6 @@ impl<'v> Renderer<'v> {
         }
     }
 
-    /// The shadow rays of a frame of `settings` lit by `light`, and the
-    /// classifier of their samples: a step of the frame's, or of one voxel
-    /// where the frame's is shorter (see [`crate::shadows`]).
-    fn shadow_ray(
-        &self,
-        settings: &RenderSettings,
-        light: &LightGeometry,
-        classifier: &Classifier,
-    ) -> (ShadowRay, Classifier) {
-        let spacing = self.volume.spacing();
-        let step = shadows::shadow_step(settings.step);
-        let ray = ShadowRay::new(
-            light.to_light.as_dvec3(),
-            self.volume.dims(),
-            spacing,
-            step * spacing.min_element(),
-        );
-        (ray, classifier.with_step(step as f32))
-    }
-
-    /// Every voxel's step-corrected opacity for `classifier` (stage 1's),
-    /// from `gradients`; masked non-finite voxels are transparent.
-    fn opacities(&self, classifier: &Classifier, gradients: &[[f32; 3]]) -> Vec<f32> {
-        let values = self.volume.values();
-        let masked = self.masked();
-        (values.par_iter().zip(gradients).enumerate())
-            .map(|(v, (&f, &g))| {
-                if masked(v) {
-                    0.0
-                } else {
-                    classifier.opacity_at(f, g)
-                }
-            })
-            .collect()
-    }
-
-    /// The reference path's light reaching every voxel, for a frame of
-    /// `settings` with shadows (see [`crate::shadows`]).
-    fn reference_light(
-        &self,
-        settings: &RenderSettings,
-        light: &LightGeometry,
-        classifier: &Classifier,
-        gradients: &[[f32; 3]],
-    ) -> Vec<f32> {
-        let (ray, classifier) = self.shadow_ray(settings, light, classifier);
-        let alpha = self.opacities(&classifier, gradients);
-        shadows::reference_light(&alpha, self.volume.dims(), &ray)
-    }
-
-    /// The kept light volume, locked for a frame; a frame without
-    /// shadows drops it.
-    fn kept_light(&self, shadows: bool) -> MutexGuard<'_, Option<KeptLight>> {
-        let mut guard = self.light.lock().unwrap_or_else(|e| e.into_inner());
-        if !shadows {
-            *guard = None;
-        }
-        guard
-    }
-
-    /// The fast paths' light volume for `classifier` and `light`: swept
-    /// ([`LightVolume::sweep`]) unless `kept` was swept for both.
-    fn light_volume<'k>(
-        &self,
-        settings: &RenderSettings,
-        classifier: &Classifier,
-        light: &LightGeometry,
-        kept: &'k mut Option<KeptLight>,
-    ) -> &'k LightVolume {
-        let key = (
-            classifier.clone(),
-            light.to_light.to_array().map(f32::to_bits),
-        );
-        if kept.as_ref().is_none_or(|k| k.key != key) {
-            *kept = None;
-            let volume = &*self.volume;
-            let [nx, ny, _] = volume.dims();
-            let masked = self.masked();
-            let spacing = volume.spacing();
-            let step = shadows::shadow_step(settings.step);
-            let step_world = step * spacing.min_element();
-            let classifier = &classifier.with_step(step as f32);
-            let to_light = light.to_light.as_dvec3();
-            // Bricks whose values are all transparent need no classifying
-            // (on the peers' 257³ cloud, a tenth of the sweep's time).
-            let macrocells = self.macrocells();
-            let grid = macrocells.grid;
-            let transparent: Vec<bool> = (macrocells.ranges.iter())
-                .map(|&(lo, hi)| classifier.is_transparent_between(lo, hi))
-                .collect();
-            let last_brick = grid.bricks.map(|n| n - 1);
-            let light = crate::with_samples!(volume.samples(), |data| {
-                let differences = Differences::new(data, volume);
-                let gradient = classifier.uses_gradient();
-                LightVolume::sweep(volume.dims(), spacing, to_light, step_world, |i, j, k| {
-                    let brick = [i, j, k].map(|c| c / BRICK);
-                    let brick = std::array::from_fn(|a| brick[a].min(last_brick[a]));
-                    if transparent[grid.index(brick)] {
-                        return 0.0;
-                    }
-                    let v = i + nx * (j + ny * k);
-                    if masked(v) {
-                        return 0.0;
-                    }
-                    let g = if gradient {
-                        differences.at(i, j, k)
-                    } else {
-                        [0.0; 3]
-                    };
-                    classifier.opacity_at(data[v].to_f32(), g)
-                })
-            });
-            *kept = Some(KeptLight { key, light });
-        }
-        &kept.as_ref().expect("swept above").light
-    }
-
     /// The reference path's stage 1: colour and opacity of every voxel for
     /// this frame's light and view, from gradients computed afresh. Masked
     /// non-finite voxels get zero opacity.
@@ -617,12 +494,16 @@ impl<'v> Renderer<'v> {
         let classifier = self.classifier(settings);
         let light_reaching = (settings.shadows)
             .then(|| self.reference_light(settings, &light, &classifier, &gradients));
+        let ambient_reaching = self.reference_ambient(settings, &classifier, &gradients);
         let mut shaded = shade_and_classify(
             &self.volume,
             &gradients,
             &classifier,
             lighting,
-            light_reaching.as_deref(),
+            Reached {
+                light: light_reaching.as_deref(),
+                ambient: ambient_reaching.as_deref(),
+            },
         );
         if let Some(mask) = &self.non_finite {
             for (i, voxel) in shaded.voxels.iter_mut().enumerate() {
@@ -653,14 +534,22 @@ impl<'v> Renderer<'v> {
                 let classifier = self.classifier(settings);
                 let light = Self::light(settings, &frame.view);
                 let lighting = settings.shading.then_some((&settings.phong, light));
-                let post = PostClassifier::new(&self.volume, &classifier, lighting)
+                let mut post = PostClassifier::new(&self.volume, &classifier, lighting)
                     .with_mask(self.non_finite.as_ref());
-                if settings.shadows {
-                    let gradients = gradients(&self.volume);
+                let depth_cues = settings.shadows || settings.ambient_occlusion.is_some();
+                let gradients = depth_cues.then(|| gradients(&self.volume));
+                let shadows = (settings.shadows).then(|| {
                     let (ray, shadow) = self.shadow_ray(settings, &light, &classifier);
-                    let alpha = self.opacities(&shadow, &gradients);
-                    let post = post.with_shadows(&alpha, ray);
-                    return render(&Shader::Post(&post));
+                    (self.opacities(&shadow, gradients.as_ref().unwrap()), ray)
+                });
+                if let Some((alpha, ray)) = &shadows {
+                    post = post.with_shadows(alpha, *ray);
+                }
+                let ambient = gradients
+                    .as_ref()
+                    .and_then(|g| self.reference_ambient(settings, &classifier, g));
+                if let Some(ambient) = &ambient {
+                    post = post.with_ambient_occlusion(ambient);
                 }
                 render(&Shader::Post(&post))
             }
@@ -731,6 +620,8 @@ impl<'v> Renderer<'v> {
         let mut kept = self.kept_light(settings.shadows);
         let light_volume =
             (settings.shadows).then(|| self.light_volume(settings, &classifier, &light, &mut kept));
+        let mut kept_ambient = self.kept_ambient(settings.ambient_occlusion.is_some());
+        let ambient_volume = self.ambient_volume(settings, &classifier, &mut kept_ambient);
         let scene = post_cast::Scene {
             voxels,
             macrocells: self.macrocells(),
@@ -738,6 +629,7 @@ impl<'v> Renderer<'v> {
             lighting: (settings.shading).then_some((&settings.phong, light)),
             mask: self.non_finite.as_ref(),
             light: light_volume,
+            ambient: ambient_volume,
         };
         let (view, sampling) = (&frame.view, &frame.sampling);
         post_cast::render(&scene, view, sampling, pixels, finish, progress);
@@ -811,6 +703,8 @@ impl<'v> Renderer<'v> {
         let mut kept = self.kept_light(settings.shadows);
         let light_volume = (settings.shadows)
             .then(|| self.light_volume(settings, &state.classifier, &light, &mut kept));
+        let mut kept_ambient = self.kept_ambient(settings.ambient_occlusion.is_some());
+        let ambient_volume = self.ambient_volume(settings, &state.classifier, &mut kept_ambient);
         let number = state.lit.next_frame(bins.entries());
         let classified_before = state.bricks.classified_count();
         let source = Source {
@@ -824,7 +718,8 @@ impl<'v> Renderer<'v> {
             number,
             settings.shading.then_some((&settings.phong, &light)),
             light_volume,
-        );
+        )
+        .with_ambient(ambient_volume);
         bricked::render(
             &state.bricks,
             &state.lit,

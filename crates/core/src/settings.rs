@@ -95,6 +95,10 @@ pub struct RenderSettings {
     /// camera's key light ([`key_light`]) rather than the headlight, whose
     /// shadows would hide behind what casts them.
     pub shadows: bool,
+    /// Scale the ambient light by the mean transmittance over short rays
+    /// of this many voxels around each point (ambient occlusion,
+    /// [`crate::shadows::ambient`]); `None`: off.
+    pub ambient_occlusion: Option<f64>,
 }
 
 impl Default for RenderSettings {
@@ -121,6 +125,7 @@ impl Default for RenderSettings {
             gradient_opacity_max: None,
             piece: None,
             shadows: false,
+            ambient_occlusion: None,
         }
     }
 }
@@ -212,6 +217,19 @@ impl RenderSettings {
             if self.piece.is_some() {
                 return Err(E::Shadows(
                     "a piece of a volume cannot see the pieces that shadow it",
+                ));
+            }
+        }
+        if let Some(radius) = self.ambient_occlusion {
+            if !crate::shadows::ambient::RADII.contains(&radius) {
+                return Err(E::AmbientOcclusionRadius(radius));
+            }
+            if self.blend != Blend::Composite {
+                return Err(E::AmbientOcclusion("a projection has no light to occlude"));
+            }
+            if self.piece.is_some() {
+                return Err(E::AmbientOcclusion(
+                    "a piece of a volume cannot see the pieces around it",
                 ));
             }
         }

@@ -117,6 +117,23 @@ fn the_bound_holds_within_ten_percent_on_every_path() {
             },
         ),
         (
+            "fast, pre-classified, with shadows and ambient occlusion",
+            RenderSettings {
+                opacity_ramp: (0.01, 0.03),
+                shadows: true,
+                ambient_occlusion: Some(8.0),
+                ..base.clone()
+            },
+        ),
+        (
+            "fast, post-classified, with ambient occlusion",
+            RenderSettings {
+                classification: Classification::Post,
+                ambient_occlusion: Some(8.0),
+                ..base.clone()
+            },
+        ),
+        (
             "fast, maximum",
             RenderSettings {
                 blend: Blend::Maximum,
@@ -137,6 +154,14 @@ fn the_bound_holds_within_ten_percent_on_every_path() {
             RenderSettings {
                 method: Method::Reference,
                 classification: Classification::Post,
+                ..base.clone()
+            },
+        ),
+        (
+            "reference, pre-classified, with ambient occlusion",
+            RenderSettings {
+                method: Method::Reference,
+                ambient_occlusion: Some(2.0),
                 ..base.clone()
             },
         ),

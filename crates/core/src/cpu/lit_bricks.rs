@@ -20,6 +20,7 @@ use crate::bricks::cache::{BrickCache, Budget, CacheRef};
 use crate::bricks::occupied::{ClassifiedBricks, NORMAL_UNIT, Source, UNIT, Voxel};
 use crate::bricks::{BrickGrid, SIDE, SLOTS, slot_coords};
 use crate::kernels::phong::{Exponent, LightGeometry, Phong, reflect, two_sided};
+use crate::shadows::ambient_volume::AmbientVolume;
 use crate::shadows::light_volume::LightVolume;
 use crate::transfer::classifier::Classifier;
 use crate::transfer::function::PiecewiseLinear;
@@ -196,6 +197,9 @@ pub struct Lighting<'a> {
     light: Option<FrameLight>,
     /// With shadows, the light reaching each voxel ([`crate::shadows`]).
     light_reaching: Option<&'a LightVolume>,
+    /// With ambient occlusion, the ambient light reaching each voxel
+    /// ([`crate::shadows::ambient`]).
+    ambient_reaching: Option<&'a AmbientVolume>,
     /// Bricks lit ([`Self::count`]).
     lit: AtomicUsize,
 }
@@ -218,7 +222,17 @@ impl<'a> Lighting<'a> {
             material: Material::new(source.classifier),
             light: lighting.map(|(phong, light)| FrameLight::new(phong, light)),
             light_reaching,
+            ambient_reaching: None,
             lit: AtomicUsize::new(0),
+        }
+    }
+
+    /// The same, the ambient term scaled by the ambient light reaching each
+    /// voxel, `ambient_reaching` (`None`: all of it).
+    pub fn with_ambient(self, ambient_reaching: Option<&'a AmbientVolume>) -> Self {
+        Lighting {
+            ambient_reaching,
+            ..self
         }
     }
 
@@ -261,12 +275,12 @@ impl<'a> Lighting<'a> {
         // repeat its last voxel, as their values do).
         let last = bricks.grid.dims.map(|n| n - 1);
         let origin = bricks.grid.origin(b);
-        let reaching = |s: usize| {
-            self.light_reaching.map_or(1.0, |light| {
-                let local = [s % SIDE, (s / SIDE) % SIDE, s / (SIDE * SIDE)];
-                light.at(std::array::from_fn(|a| (origin[a] + local[a]).min(last[a])))
-            })
+        let voxel = |s: usize| {
+            let local = [s % SIDE, (s / SIDE) % SIDE, s / (SIDE * SIDE)];
+            std::array::from_fn(|a| (origin[a] + local[a]).min(last[a]))
         };
+        let reaching = |s: usize| self.light_reaching.map_or(1.0, |light| light.at(voxel(s)));
+        let ambient = |s: usize| (self.ambient_reaching).map_or(1.0, |a| a.at(voxel(s)));
         // Four slots at a time, one per SIMD lane.
         let mut group = |slots: [usize; 4], lanes: usize| {
             let colours = shade4(
@@ -274,6 +288,7 @@ impl<'a> Lighting<'a> {
                 f32x4::new(slots.map(|s| values[s])),
                 self.light.as_ref(),
                 f32x4::new(slots.map(reaching)),
+                f32x4::new(slots.map(ambient)),
                 &self.material,
             );
             for (lane, colour) in colours.iter().take(lanes).enumerate() {
@@ -309,23 +324,25 @@ fn slot_values<T: Sample>(data: &[T], grid: &BrickGrid, b: [usize; 3], values: &
 }
 
 /// The RGBA of four voxels with values `values`, reached by the fraction
-/// `reaching` of the light.
+/// `reaching` of the light and `ambient` of the ambient light (which is
+/// all the light of an unlit frame).
 #[inline]
 fn shade4(
     voxels: [&Voxel; 4],
     values: f32x4,
     light: Option<&FrameLight>,
     reaching: f32x4,
+    ambient: f32x4,
     material: &Material,
 ) -> [f32x4; 4] {
     let [x, y, z, alpha] = unpack4(voxels);
     let [mr, mg, mb] = material.at(values);
     let (r, g, b) = match light {
         Some(light) => {
-            let [lr, lg, lb] = light.lit(x, y, z, reaching);
+            let [lr, lg, lb] = light.lit(x, y, z, reaching, ambient);
             (lr * mr, lg * mg, lb * mb)
         }
-        None => (mr, mg, mb),
+        None => (mr * ambient, mg * ambient, mb * ambient),
     };
     let unit = |c: f32x4| c.fast_max(f32x4::ZERO).fast_min(f32x4::ONE);
     f32x4::transpose([unit(r), unit(g), unit(b), alpha * f32x4::splat(1.0 / UNIT)])
@@ -393,10 +410,10 @@ impl FrameLight {
 
     /// The lit colour (before the material), per channel, of four voxels
     /// whose quantised unit normals have components `x`, `y` and `z`,
-    /// reached by the fraction `reaching` of the light (the ambient term
-    /// is not shadowed, as in [`Phong::shade_in_shadow`]).
+    /// reached by the fraction `reaching` of the light and `ambient` of the
+    /// ambient light, as in [`Phong::shade_reached`].
     #[inline]
-    fn lit(&self, x: f32x4, y: f32x4, z: f32x4, reaching: f32x4) -> [f32x4; 3] {
+    fn lit(&self, x: f32x4, y: f32x4, z: f32x4, reaching: f32x4, ambient: f32x4) -> [f32x4; 3] {
         let dot = |d: [f32x4; 3]| x * d[0] + y * d[1] + z * d[2];
         let (diffuse, highlight) = two_sided(
             dot(self.to_viewer),
@@ -407,7 +424,7 @@ impl FrameLight {
         let (diffuse, highlight) = (diffuse * reaching, highlight * reaching);
         std::array::from_fn(|c| {
             reflect(
-                self.ambient[c],
+                self.ambient[c] * ambient,
                 self.diffuse[c],
                 self.specular[c],
                 diffuse,
@@ -542,7 +559,7 @@ mod tests {
                         alpha: 0,
                     });
                     let [x, y, z, _] = unpack4(voxels.each_ref());
-                    let lit = frame.lit(x, y, z, f32x4::ONE);
+                    let lit = frame.lit(x, y, z, f32x4::ONE, f32x4::ONE);
                     for (k, g) in g.iter().enumerate() {
                         let exact = phong.shade(*g, light);
                         for c in 0..3 {
@@ -623,6 +640,7 @@ mod tests {
             f32x4::splat(0.5),
             Some(&frame),
             f32x4::ONE,
+            f32x4::ONE,
             &material,
         );
         // Ambient only, then full light (ka + kd + ks = 1) on the back face.
@@ -630,7 +648,23 @@ mod tests {
         let full = lit[1].to_array();
         assert!((full[0] - 1.0).abs() < 1e-6 && (full[1] - 0.5).abs() < 1e-6);
         assert_eq!(full[3], 32768.0 / UNIT);
-        let unlit = shade4(voxels, f32x4::splat(0.5), None, f32x4::ONE, &material);
+        let unlit = shade4(
+            voxels,
+            f32x4::splat(0.5),
+            None,
+            f32x4::ONE,
+            f32x4::ONE,
+            &material,
+        );
         assert_eq!(unlit[1].to_array(), [1.0, 0.5, 0.0, 32768.0 / UNIT]);
+        // Half the ambient light: half the ambient term, and half an unlit
+        // voxel's colour; the light's terms unchanged.
+        let half = f32x4::splat(0.5);
+        let occluded = shade4(voxels, half, Some(&frame), f32x4::ONE, half, &material);
+        assert_eq!(occluded[0].to_array(), [0.05, 0.025, 0.0, 1.0]);
+        let full_occluded = occluded[1].to_array();
+        assert!((full_occluded[0] - 0.95).abs() < 1e-6, "{full_occluded:?}");
+        let unlit = shade4(voxels, half, None, f32x4::ONE, half, &material);
+        assert_eq!(unlit[1].to_array(), [0.5, 0.25, 0.0, 32768.0 / UNIT]);
     }
 }

@@ -90,19 +90,19 @@ impl Phong {
     /// with world-space gradient `gradient`.
     #[inline]
     pub fn shade(&self, gradient: Vec3, light: &LightGeometry) -> [f32; 3] {
-        self.shade_in_shadow(gradient, light, 1.0)
+        self.shade_reached(gradient, light, Reaching::ALL)
     }
 
-    /// [`Self::shade`] where only the fraction `light_reaching` of the
-    /// light arrives (see [`crate::shadows`]): it scales the diffuse and
-    /// specular terms; the ambient term stands for light from everywhere
-    /// and is not shadowed.
+    /// [`Self::shade`] where only the parts `reaching` of the light and of
+    /// the ambient light arrive: the light's ([`crate::shadows`]) scales
+    /// the diffuse and specular terms, the ambient light's
+    /// ([`crate::shadows::ambient`]) the ambient term.
     #[inline]
-    pub fn shade_in_shadow(
+    pub fn shade_reached(
         &self,
         gradient: Vec3,
         light: &LightGeometry,
-        light_reaching: f32,
+        reaching: Reaching,
     ) -> [f32; 3] {
         let len = gradient.length();
         let (diffuse, highlight) = if len > 0.0 && len.is_finite() {
@@ -116,11 +116,11 @@ impl Phong {
         } else {
             (0.0, 0.0)
         };
-        let (diffuse, highlight) = (diffuse * light_reaching, highlight * light_reaching);
+        let (diffuse, highlight) = (diffuse * reaching.light, highlight * reaching.light);
         std::array::from_fn(|c| {
             self.light_color[c]
                 * reflect(
-                    self.ambient[c],
+                    self.ambient[c] * reaching.ambient,
                     self.diffuse[c],
                     self.specular[c],
                     diffuse,
@@ -128,6 +128,25 @@ impl Phong {
                 )
         })
     }
+}
+
+/// How much of the light and of the ambient light reaches a point, each
+/// in `[0, 1]`: the light through the volume towards it (shadows,
+/// [`crate::shadows`]) and the mean over short rays around it (ambient
+/// occlusion, [`crate::shadows::ambient`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reaching {
+    pub light: f32,
+    pub ambient: f32,
+}
+
+impl Reaching {
+    /// All of both: shading as without shadows or ambient occlusion
+    /// (multiplying by 1 changes no bit).
+    pub const ALL: Reaching = Reaching {
+        light: 1.0,
+        ambient: 1.0,
+    };
 }
 
 /// The colour of a voxel or a sample: the lit colour of its `gradient`
@@ -139,21 +158,22 @@ pub fn lit_colour(
     gradient: Vec3,
     material: [f32; 3],
 ) -> [f32; 3] {
-    lit_colour_in_shadow(lighting, gradient, material, 1.0)
+    lit_colour_reached(lighting, gradient, material, Reaching::ALL)
 }
 
-/// [`lit_colour`] where only the fraction `light_reaching` of the light
-/// arrives ([`Phong::shade_in_shadow`]).
+/// [`lit_colour`] where only the parts `reaching` of the light and the
+/// ambient light arrive ([`Phong::shade_reached`]). Unlit, the material
+/// colour is the light from everywhere, and the ambient part scales it.
 #[inline]
-pub fn lit_colour_in_shadow(
+pub fn lit_colour_reached(
     lighting: Option<(&Phong, &LightGeometry)>,
     gradient: Vec3,
     material: [f32; 3],
-    light_reaching: f32,
+    reaching: Reaching,
 ) -> [f32; 3] {
     let lit = match lighting {
-        Some((phong, light)) => Vec3::from(phong.shade_in_shadow(gradient, light, light_reaching)),
-        None => Vec3::ONE,
+        Some((phong, light)) => Vec3::from(phong.shade_reached(gradient, light, reaching)),
+        None => Vec3::splat(reaching.ambient),
     };
     (lit * Vec3::from(material))
         .clamp(Vec3::ZERO, Vec3::ONE)

@@ -20,7 +20,7 @@
 //! the same picture.
 
 use crate::kernels::gradient::gradients;
-use crate::kernels::phong::{LightGeometry, Phong, lit_colour_in_shadow};
+use crate::kernels::phong::{LightGeometry, Phong, Reaching, lit_colour_reached};
 use crate::kernels::trilinear;
 use crate::non_finite::NonFiniteMask;
 use crate::shadows::ShadowRay;
@@ -42,6 +42,9 @@ pub struct PostClassifier<'a> {
     /// With shadows: the voxels' step-corrected opacities (stage 1's) and
     /// the shadow rays marched through them ([`crate::shadows`]).
     shadows: Option<(&'a [f32], ShadowRay)>,
+    /// With ambient occlusion: the ambient light reaching each voxel, the
+    /// reference's march ([`crate::shadows::ambient`]).
+    ambient: Option<&'a [f32]>,
 }
 
 impl<'a> PostClassifier<'a> {
@@ -60,6 +63,7 @@ impl<'a> PostClassifier<'a> {
             lighting,
             mask: None,
             shadows: None,
+            ambient: None,
         }
     }
 
@@ -68,6 +72,16 @@ impl<'a> PostClassifier<'a> {
     pub fn with_shadows(self, alpha: &'a [f32], ray: ShadowRay) -> Self {
         PostClassifier {
             shadows: Some((alpha, ray)),
+            ..self
+        }
+    }
+
+    /// The same, each sample lit by the ambient light reaching the voxels,
+    /// `ambient`, interpolated trilinearly as their gradients are
+    /// ([`crate::shadows::ambient`]).
+    pub fn with_ambient_occlusion(self, ambient: &'a [f32]) -> Self {
+        PostClassifier {
+            ambient: Some(ambient),
             ..self
         }
     }
@@ -93,14 +107,19 @@ impl<'a> PostClassifier<'a> {
         let lighting = self.lighting.as_ref().map(|(phong, light)| (*phong, light));
         let opacity = self.classifier.opacity_at(f, g.to_array());
         // A transparent sample's colour counts for nothing: no march.
-        let light_reaching = match &self.shadows {
+        let light = match &self.shadows {
             Some((alpha, ray)) if opacity > 0.0 => {
                 let alpha = |q| trilinear::reference(q, dims, 0.0, |i| alpha[i] as f64);
                 ray.transmittance(DVec3::from_array(p), alpha) as f32
             }
             _ => 1.0,
         };
-        let color = lit_colour_in_shadow(lighting, g, self.classifier.material(f), light_reaching);
+        let ambient = match self.ambient {
+            Some(a) if opacity > 0.0 => trilinear::reference(p, dims, 0.0, |i| a[i] as f64) as f32,
+            _ => 1.0,
+        };
+        let reaching = Reaching { light, ambient };
+        let color = lit_colour_reached(lighting, g, self.classifier.material(f), reaching);
         Vec3::from(color).extend(opacity).as_dvec4()
     }
 }

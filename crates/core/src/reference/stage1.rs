@@ -10,7 +10,7 @@
 //! voxel, dense; the fast path's is [`crate::bricks::occupied`] (view-independent,
 //! kept across frames) and [`crate::cpu::lit_bricks`] (the light, per frame).
 
-use crate::kernels::phong::{LightGeometry, Phong, lit_colour_in_shadow};
+use crate::kernels::phong::{LightGeometry, Phong, Reaching, lit_colour_reached};
 use crate::transfer::classifier::Classifier;
 use crate::transfer::labels::colour_value;
 use crate::volume::Volume;
@@ -27,17 +27,25 @@ pub struct ShadedVolume {
     pub voxels: Vec<Vec4>,
 }
 
+/// How much of the light and of the ambient light reaches each voxel (x
+/// fastest), where the frame has shadows ([`crate::shadows`]) or ambient
+/// occlusion ([`crate::shadows::ambient`]); `None`: all of it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Reached<'a> {
+    pub light: Option<&'a [f32]>,
+    pub ambient: Option<&'a [f32]>,
+}
+
 /// Shades and classifies every voxel of `volume`. `gradients` are the
 /// volume's (see [`crate::kernels::gradient`]); `lighting` is `None` for unlit
-/// rendering (the colour is the material colour); `light_reaching` is the
-/// light reaching each voxel, with shadows ([`crate::shadows`]; `None`: all
-/// of it).
+/// rendering (the colour is the material colour); `reached` is the light
+/// and ambient light reaching each voxel.
 pub fn shade_and_classify(
     volume: &Volume,
     gradients: &[[f32; 3]],
     classifier: &Classifier,
     lighting: Option<(&Phong, &LightGeometry)>,
-    light_reaching: Option<&[f32]>,
+    reached: Reached,
 ) -> ShadedVolume {
     let mut voxels = vec![Vec4::ZERO; volume.len()];
     let dims = volume.dims();
@@ -61,8 +69,12 @@ pub fn shade_and_classify(
         .for_each(|(k, ((out, values), grads))| {
             for (n, ((o, &f), g)) in out.iter_mut().zip(values).zip(grads).enumerate() {
                 let at = k * slice + n;
-                let t = light_reaching.map_or(1.0, |l| l[at]);
-                let color = lit_colour_in_shadow(lighting, Vec3::from(*g), colour_of(f, at), t);
+                let reaching = Reaching {
+                    light: reached.light.map_or(1.0, |l| l[at]),
+                    ambient: reached.ambient.map_or(1.0, |a| a[at]),
+                };
+                let color =
+                    lit_colour_reached(lighting, Vec3::from(*g), colour_of(f, at), reaching);
                 *o = Vec3::from(color).extend(classifier.opacity_at(f, *g));
             }
         });
@@ -96,7 +108,7 @@ mod tests {
             Some(color),
             1.0,
         );
-        let s = shade_and_classify(&v, &gradients(&v), &c, None, None);
+        let s = shade_and_classify(&v, &gradients(&v), &c, None, Reached::default());
         assert_eq!(s.voxels[v.index(0, 1, 1)], Vec4::new(1.0, 0.0, 0.0, 0.2));
         assert!(
             (s.voxels[v.index(1, 2, 0)] - Vec4::new(0.5, 0.0, 0.5, 0.4))
@@ -125,7 +137,7 @@ mod tests {
             &gradients(&v),
             &c,
             Some((&Phong::default(), &light)),
-            None,
+            Reached::default(),
         );
         let got = s.voxels[v.index(1, 1, 1)];
         assert!(
@@ -159,7 +171,7 @@ mod tests {
             // With the ramp, α_v is its top opacity q.
             let alpha_v = c.iso().unwrap().alpha();
             assert_eq!(alpha_v, 0.6);
-            let s = shade_and_classify(&v, &g, &c, None, None);
+            let s = shade_and_classify(&v, &g, &c, None, Reached::default());
             let half_width = thickness * 0.25; // world units
             let mut opaque = 0;
             for i in 0..17 {
@@ -190,7 +202,7 @@ mod tests {
         })
         .unwrap();
         let c = iso_classifier(&vz, 3.0, 4.0, 1.0);
-        let s = shade_and_classify(&vz, &gradients(&vz), &c, None, None);
+        let s = shade_and_classify(&vz, &gradients(&vz), &c, None, Reached::default());
         let alphas: Vec<f32> = (0..9).map(|k| s.voxels[vz.index(1, 1, k)].w).collect();
         let mut want = vec![0.0; 9];
         want[3] = c.iso().unwrap().alpha();

@@ -354,6 +354,9 @@ impl<'v> Scene<'v> {
         if shared.shadows {
             return Err(SceneError::Shadows.into());
         }
+        if shared.ambient_occlusion.is_some() {
+            return Err(SceneError::AmbientOcclusion.into());
+        }
         if request.looks.len() != self.layers.len() {
             return Err(SceneError::Looks {
                 layers: self.layers.len(),

@@ -240,19 +240,7 @@ impl LightVolume {
     /// interpolated trilinearly between the voxels'.
     #[inline]
     pub fn sample(&self, p: Vec3) -> f32 {
-        let last = self.dims.map(|n| n - 1);
-        let c = std::array::from_fn::<_, 3, _>(|a| (p[a].max(0.0) as usize).min(last[a]));
-        let f: [f32; 3] = std::array::from_fn(|a| (p[a] - c[a] as f32).clamp(0.0, 1.0));
-        let next = |a: usize| (c[a] + 1).min(last[a]);
-        let mut sum = 0.0;
-        for (dz, wz) in [(c[2], 1.0 - f[2]), (next(2), f[2])] {
-            for (dy, wy) in [(c[1], 1.0 - f[1]), (next(1), f[1])] {
-                for (dx, wx) in [(c[0], 1.0 - f[0]), (next(0), f[0])] {
-                    sum += wx * wy * wz * self.at([dx, dy, dz]);
-                }
-            }
-        }
-        sum
+        super::sample_voxels(self.dims, p, |v| self.at(v))
     }
 }
 

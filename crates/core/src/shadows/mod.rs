@@ -30,7 +30,7 @@
 //! paper's Phong model; the ambient term stands for light scattered in
 //! from everywhere and is not shadowed:
 //! `C = C_s·m·(k_a + T·(k_d·(N·L) + k_s·(N·H)^n))`
-//! ([`crate::kernels::phong::Phong::shade_in_shadow`]). Pre-classified
+//! ([`crate::kernels::phong::Phong::shade_reached`]). Pre-classified
 //! frames shade each voxel with its `T`; post-classified ones each sample
 //! with the `T` at its position.
 //!
@@ -41,7 +41,13 @@
 //! function ([`light_volume`]): each voxel's `T` from the slice before it
 //! on the way to the light, `O(n³)`, and kept while neither changes (a
 //! light fixed in the world, `--light`, is swept once for a whole orbit).
+//!
+//! **Ambient occlusion**, the other depth cue, is here too: the ambient
+//! light reaching each point along short rays around it ([`ambient`]; the
+//! fast path's [`ambient_volume`]).
 
+pub mod ambient;
+pub mod ambient_volume;
 pub mod light_volume;
 
 /// The step of the shadow rays, in voxels, for view rays `step` voxels
@@ -117,10 +123,22 @@ impl ShadowRay {
 /// The reference path's light reaching every voxel of a grid of `dims`
 /// voxels whose step-corrected opacities are `alpha` (x fastest): each
 /// voxel's shadow ray marched ([`ShadowRay::transmittance`]) through their
-/// trilinear interpolation. A voxel whose every neighbour (the 26 around it
-/// and itself) is transparent gets 1 without a march: every cell it is a
-/// corner of is transparent, so no composited sample sees its colour.
+/// trilinear interpolation.
 pub fn reference_light(alpha: &[f32], dims: [usize; 3], ray: &ShadowRay) -> Vec<f32> {
+    let sample = |p: [f64; 3]| trilinear::reference(p, dims, 0.0, |v| alpha[v] as f64);
+    march_every_voxel(alpha, dims, |from| ray.transmittance(from, sample))
+}
+
+/// `march(voxel)` for every voxel of a grid of `dims` voxels of opacities
+/// `alpha` (x fastest), in parallel. A voxel whose every neighbour (the 26
+/// around it and itself) is transparent gets 1 without a march: every cell
+/// it is a corner of is transparent, so no composited sample sees its
+/// colour.
+fn march_every_voxel(
+    alpha: &[f32],
+    dims: [usize; 3],
+    march: impl Fn(DVec3) -> f64 + Sync,
+) -> Vec<f32> {
     let [nx, ny, nz] = dims;
     let slice = nx * ny;
     let opaque_near = |i: usize, j: usize, k: usize| {
@@ -129,21 +147,41 @@ pub fn reference_light(alpha: &[f32], dims: [usize; 3], ray: &ShadowRay) -> Vec<
             around(j, ny).any(|y| around(i, nx).any(|x| alpha[x + nx * (y + ny * z)] > 0.0))
         })
     };
-    let sample = |p: [f64; 3]| trilinear::reference(p, dims, 0.0, |v| alpha[v] as f64);
-    let mut light = vec![1.0f32; alpha.len()];
-    light
-        .par_chunks_mut(slice)
-        .enumerate()
-        .for_each(|(k, out)| {
-            for (n, t) in out.iter_mut().enumerate() {
-                let (i, j) = (n % nx, n / nx);
-                if opaque_near(i, j, k) {
-                    let from = DVec3::new(i as f64, j as f64, k as f64);
-                    *t = ray.transmittance(from, sample) as f32;
-                }
+    let mut out = vec![1.0f32; alpha.len()];
+    out.par_chunks_mut(slice).enumerate().for_each(|(k, out)| {
+        for (n, t) in out.iter_mut().enumerate() {
+            let (i, j) = (n % nx, n / nx);
+            if opaque_near(i, j, k) {
+                *t = march(DVec3::new(i as f64, j as f64, k as f64)) as f32;
             }
-        });
-    light
+        }
+    });
+    out
+}
+
+/// The value at index-space point `p` (in `[0, n − 1]³`, clamped) of a
+/// grid of `dims` voxels read by `at`, interpolated trilinearly: the fast
+/// paths' light and ambient volumes, sampled where post-classified samples
+/// fall.
+#[inline]
+pub(crate) fn sample_voxels(
+    dims: [usize; 3],
+    p: glam::Vec3,
+    at: impl Fn([usize; 3]) -> f32,
+) -> f32 {
+    let last = dims.map(|n| n - 1);
+    let c = std::array::from_fn::<_, 3, _>(|a| (p[a].max(0.0) as usize).min(last[a]));
+    let f: [f32; 3] = std::array::from_fn(|a| (p[a] - c[a] as f32).clamp(0.0, 1.0));
+    let next = |a: usize| (c[a] + 1).min(last[a]);
+    let mut sum = 0.0;
+    for (dz, wz) in [(c[2], 1.0 - f[2]), (next(2), f[2])] {
+        for (dy, wy) in [(c[1], 1.0 - f[1]), (next(1), f[1])] {
+            for (dx, wx) in [(c[0], 1.0 - f[0]), (next(0), f[0])] {
+                sum += wx * wy * wz * at([dx, dy, dz]);
+            }
+        }
+    }
+    sum
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use super::skipping::{TransparentValues, transparent_bricks, value_range};
 use crate::bricks::{BRICK, BrickGrid};
 use crate::camera::View;
 use crate::kernels::composite::{EMPTY, Finish, FrontToBack, PartialPixel};
-use crate::kernels::phong::lit_colour_in_shadow;
+use crate::kernels::phong::{Reaching, lit_colour_reached};
 use crate::kernels::trilinear::{cell_of, corners, interpolate};
 use crate::progress::Progress;
 use crate::sampling::grid::clamp_to_grid;
@@ -218,13 +218,12 @@ impl Rays<'_> {
                 .lighting
                 .as_ref()
                 .map(|(phong, light)| (*phong, light));
-            let light_reaching = scene.light.map_or(1.0, |light| light.sample(p));
-            let [r, g, b] = lit_colour_in_shadow(
-                lighting,
-                Vec3::from(g),
-                classifier.material(f),
-                light_reaching,
-            );
+            let reaching = Reaching {
+                light: scene.light.map_or(1.0, |light| light.sample(p)),
+                ambient: scene.ambient.map_or(1.0, |ambient| ambient.sample(p)),
+            };
+            let [r, g, b] =
+                lit_colour_reached(lighting, Vec3::from(g), classifier.material(f), reaching);
             acc.add(f32x4::new([r, g, b, alpha]));
             if acc.is_opaque() {
                 return true;

@@ -8,6 +8,7 @@ use wide::f32x4;
 use crate::bricks::macrocells::Macrocells;
 use crate::kernels::phong::{LightGeometry, Phong};
 use crate::non_finite::NonFiniteMask;
+use crate::shadows::ambient_volume::AmbientVolume;
 use crate::shadows::light_volume::LightVolume;
 use crate::transfer::classifier::Classifier;
 use crate::volume::{Sample, Volume};
@@ -32,6 +33,9 @@ pub struct Scene<'a> {
     pub mask: Option<&'a NonFiniteMask>,
     /// With shadows, the light reaching each voxel ([`crate::shadows`]).
     pub light: Option<&'a LightVolume>,
+    /// With ambient occlusion, the ambient light reaching each voxel
+    /// ([`crate::shadows::ambient`]).
+    pub ambient: Option<&'a AmbientVolume>,
 }
 
 /// Every voxel's world gradient (from `gradients`, see

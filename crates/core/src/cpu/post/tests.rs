@@ -104,6 +104,7 @@ fn post_cast_work(renderer: &Renderer, settings: &RenderSettings) -> (Image, Pos
         lighting: Some((&settings.phong, light)),
         mask: None,
         light: None,
+        ambient: None,
     };
     let mut partial = PartialImage::composite(settings.width, settings.height);
     let PartialPixels::Composite(pixels) = partial.pixels_mut() else {
