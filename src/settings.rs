@@ -112,6 +112,7 @@ pub fn look(look: &LookArgs) -> LookOptions {
         light: look.light,
         light_color: look.light_color,
         shadows: look.shadows,
+        ambient_occlusion: look.ambient_occlusion,
         shading: !look.no_shading,
         background: look.background,
         blend: match look.blend {

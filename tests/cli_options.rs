@@ -573,3 +573,51 @@ fn shadows_darken_what_the_light_cannot_reach_and_are_refused_where_nothing_is_l
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn ambient_occlusion_darkens_the_ambient_light_in_creases_and_is_refused_where_nothing_is_composited()
+ {
+    // Unlit, the colour is the ambient light's: every pixel darkens or
+    // stays, the reference path agrees within a level, and a longer
+    // radius reaches more of the cloud around each point.
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["fractal:33", "--size", "64x64", "--no-shading"];
+    let with = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        render(dir.path(), &args)
+    };
+    let plain = with(&[]);
+    let occluded = with(&["--ambient-occlusion", "4"]);
+    let reference = with(&["--ambient-occlusion", "4", "--reference"]);
+    let wider = with(&["--ambient-occlusion"]);
+    let sum = |p: &Picture| p.rgb.iter().flatten().map(|&c| c as u64).sum::<u64>();
+    assert!(sum(&occluded) * 10 < sum(&plain) * 9);
+    assert!(sum(&wider) < sum(&occluded));
+    assert!(
+        (occluded.rgb.iter().zip(&plain.rgb)).all(|(o, p)| (0..3).all(|c| o[c] <= p[c])),
+        "ambient occlusion only takes light away"
+    );
+    let worst = (occluded.rgb.iter().zip(&reference.rgb))
+        .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "fast vs reference: {worst} levels");
+    for (refused, why) in [
+        (&["--ambient-occlusion", "--blend", "mip"][..], "unshaded"),
+        (&["--ambient-occlusion", "40"][..], "1 to 32 voxels"),
+    ] {
+        let out = dir.path().join("refused.png");
+        let mut args = vec!["render", "fractal:17"];
+        args.extend_from_slice(refused);
+        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+        let run = volray(&args);
+        assert!(!run.status.success(), "{refused:?}");
+        let err = stderr(&run);
+        assert!(
+            err.contains("--ambient-occlusion") && err.contains(why),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+}

@@ -229,6 +229,7 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
         let (volume, side) = load(dir, dataset)?;
         let settings = RenderSettings {
             shadows: args.view.look.shadows,
+            ambient_occlusion: args.view.look.ambient_occlusion,
             ..workload(&volume, (side.min, side.max), window)
         };
         let fail = |e: volray_core::RenderError| CliError::input(format!("{dataset}: {e}"));

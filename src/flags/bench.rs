@@ -25,8 +25,8 @@ pub struct BenchArgs {
     /// make_volumes.py), each exactly as the peers define it: view along
     /// +x, step 0.5 voxel, their transfer functions and shading. The input,
     /// camera, rendering and sampling options do not apply, and are
-    /// refused (--threads does, and --shadows adds shadows, the camera's
-    /// key light).
+    /// refused (--threads does, --shadows adds shadows, the camera's key
+    /// light, and --ambient-occlusion [RADIUS] ambient occlusion).
     #[arg(long, value_name = "DIR", conflicts_with_all = peers_ignores())]
     pub peers: Option<PathBuf>,
 
@@ -70,7 +70,8 @@ const PEERS_IGNORE: [fn(Command) -> Command; 4] = [
 ];
 
 /// The flags of the [`PEERS_IGNORE`] groups, which `--peers` conflicts
-/// with, but `--shadows`, which adds shadows to the workloads. Flag by
+/// with, but `--shadows` and `--ambient-occlusion`, which add depth cues
+/// to the workloads. Flag by
 /// flag rather than by group id, so that clap's error names
 /// the flag given, not every flag of its group; without INPUT, which
 /// `bench.rs` refuses with a message saying what `--peers` does instead.
@@ -80,8 +81,8 @@ fn peers_ignores() -> Vec<clap::Id> {
         .fold(Command::new("peers"), |cmd, group| group(cmd))
         .get_arguments()
         .filter(|arg| !arg.is_positional())
-        // The peers' workloads with shadows: the depth cue's cost.
-        .filter(|arg| arg.get_id() != "shadows")
+        // The peers' workloads with depth cues: their cost.
+        .filter(|arg| !["shadows", "ambient_occlusion"].contains(&arg.get_id().as_str()))
         .map(|arg| arg.get_id().clone())
         .collect()
 }

@@ -6,9 +6,9 @@
 //! `--background`). `settings.rs` turns them into volray-core's settings.
 
 use super::parse::{
-    LabelList, LabelOpacities, parse_background, parse_direction, parse_gradient_opacity,
-    parse_iso_value, parse_label_list, parse_label_opacity, parse_opacity, parse_range, parse_rgb,
-    parse_shininess, parse_thickness,
+    LabelList, LabelOpacities, parse_ao_radius, parse_background, parse_direction,
+    parse_gradient_opacity, parse_iso_value, parse_label_list, parse_label_opacity, parse_opacity,
+    parse_range, parse_rgb, parse_shininess, parse_thickness,
 };
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -98,6 +98,12 @@ pub struct LookArgs {
     /// camera's key light, 45° above and 30° left of the view.
     #[arg(long)]
     pub shadows: bool,
+
+    /// Ambient occlusion: the ambient light (an unlit frame's whole colour)
+    /// scaled by how much reaches each point along 26 short rays, RADIUS
+    /// voxels long [default: 8]. Raise --ambient to see more of it.
+    #[arg(long, value_name = "RADIUS", num_args = 0..=1, default_missing_value = "8", value_parser = parse_ao_radius)]
+    pub ambient_occlusion: Option<f64>,
 
     /// No lighting: voxels take their material colour.
     #[arg(long)]

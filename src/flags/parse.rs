@@ -152,6 +152,19 @@ pub fn parse_shininess(s: &str) -> Result<f32, String> {
     }
 }
 
+/// `--ambient-occlusion`'s radius, in voxels.
+pub fn parse_ao_radius(s: &str) -> Result<f64, String> {
+    let radii = volray_core::shadows::ambient::RADII;
+    match parse_number(s)? {
+        r if radii.contains(&r) => Ok(r),
+        r => Err(format!(
+            "radius {r} must be {} to {} voxels",
+            radii.start(),
+            radii.end()
+        )),
+    }
+}
+
 pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
     match finite(numbers::<f64>(s, "number")?)?[..] {
         [lo, hi] if lo < hi => Ok((lo, hi)),

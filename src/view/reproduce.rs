@@ -57,6 +57,9 @@ pub struct CliReproduce {
     lighting: Vec<String>,
     /// `--light-color`, when lit.
     light_color: Vec<String>,
+    /// `--shadows`, when lit; `--ambient-occlusion`, when composited.
+    shadows: bool,
+    ambient_occlusion: Option<f64>,
     /// `--opacity P,Q` as given.
     ramp: Option<(f32, f32)>,
     /// The transfer function the flags named, its window in the data's
@@ -188,6 +191,8 @@ impl CliReproduce {
             iso_thickness: iso_thickness.0,
             lighting: lighting.0,
             light_color: light_color.0,
+            shadows: look.shadows,
+            ambient_occlusion: look.ambient_occlusion,
             ramp: look.opacity,
             start,
             log: look.log,
@@ -343,6 +348,9 @@ impl CliReproduce {
             } else {
                 w.word("--no-shading");
             }
+            w.flag("--shadows", state.shading && self.shadows);
+            let radius = self.ambient_occlusion.map(|r| r.to_string());
+            w.opt("--ambient-occlusion", radius);
         }
         let colours = match state.colormap.as_str() {
             START_COLOURS => self.start.color.as_ref().map(|f| f.points().to_vec()),
@@ -779,6 +787,30 @@ mod tests {
         );
         assert!(out.command.contains("--no-shading") && !out.command.contains("--specular"));
         assert_eq!(out.settings.iso.unwrap().value, 0.25);
+    }
+
+    #[test]
+    fn the_starting_depth_cues_are_in_the_command_where_they_apply() {
+        let (r, start) = reproduce(&["--shadows", "--ambient-occlusion", "5"]);
+        let out = r.reproduce(&start).unwrap();
+        assert!(
+            out.command.contains("--shadows --ambient-occlusion 5"),
+            "{}",
+            out.command
+        );
+        assert!(out.settings.shadows);
+        assert_eq!(out.settings.ambient_occlusion, Some(5.0));
+        // Unlit: no light to shadow, but the ambient light is still occluded.
+        let mut state = start.clone();
+        state.shading = false;
+        let out = r.reproduce(&state).unwrap();
+        assert!(!out.settings.shadows, "{}", out.command);
+        assert_eq!(out.settings.ambient_occlusion, Some(5.0));
+        // A projection drops both.
+        state.blend = BlendMode::Mip;
+        let out = r.reproduce(&state).unwrap();
+        assert!(!out.command.contains("--shadows") && !out.command.contains("--ambient-occlusion"));
+        assert_eq!(out.settings.ambient_occlusion, None);
     }
 
     #[test]

@@ -51,6 +51,7 @@ pub fn option_of(e: &RenderError, camera: &CameraOptions) -> Option<Opt> {
             S::Background(_) => Opt::Background,
             S::LightDirection(_) => Opt::Light,
             S::Shadows(_) => Opt::Shadows,
+            S::AmbientOcclusion(_) | S::AmbientOcclusionRadius(_) => Opt::AmbientOcclusion,
             S::Crop { .. } => Opt::Crop,
             S::ClipPoint(_) | S::ClipNormal(_) => Opt::Clip,
             S::IsoValue(_) => Opt::Iso,

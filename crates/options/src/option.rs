@@ -43,6 +43,8 @@ pub enum Opt {
     LightColor,
     /// Shadows from the light through the volume.
     Shadows,
+    /// Ambient occlusion: the ambient light through the volume around.
+    AmbientOcclusion,
     /// Shading turned off (the command line's `--no-shading`).
     NoShading,
     Background,
@@ -87,6 +89,7 @@ impl Opt {
             Opt::Light => "light",
             Opt::LightColor => "light-color",
             Opt::Shadows => "shadows",
+            Opt::AmbientOcclusion => "ambient-occlusion",
             Opt::NoShading => "no-shading",
             Opt::Background => "background",
             Opt::Blend => "blend",

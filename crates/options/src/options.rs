@@ -151,6 +151,9 @@ pub struct LookOptions {
     /// Shadows: the light reaching each point through the volume
     /// (`--shadows`); without `light`, the camera's key light.
     pub shadows: bool,
+    /// Ambient occlusion of this radius in voxels
+    /// (`--ambient-occlusion [RADIUS]`); `None`: off.
+    pub ambient_occlusion: Option<f64>,
     /// Shading on (off: `--no-shading`).
     pub shading: bool,
     /// The colour behind the volume (`--background`).
@@ -190,6 +193,7 @@ impl Default for LookOptions {
             light: None,
             light_color: lit.light_color,
             shadows: false,
+            ambient_occlusion: None,
             shading: true,
             background: RenderSettings::default().background,
             blend: BlendMode::Composite,

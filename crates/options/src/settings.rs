@@ -75,6 +75,7 @@ pub fn settings(options: &Options) -> Result<RenderSettings, OptionError> {
         gradient_opacity_max: None,
         piece: None,
         shadows: look.shadows,
+        ambient_occlusion: look.ambient_occlusion,
     };
     (settings.validate()).map_err(|e| OptionError::Invalid(e.into()))?;
     (settings.camera.validate()).map_err(|e| OptionError::Invalid(e.into()))?;
@@ -215,6 +216,14 @@ fn blend(look: &LookOptions) -> Result<Blend, OptionError> {
     };
     if let (Some(projection), Some(opt)) = (unlit, lighting_option(look)) {
         return Err(OptionError::Unlit { opt, projection });
+    }
+    // Ambient occlusion dims the ambient light, which an unlit composite
+    // has too (its colour); a projection has none.
+    if blend.is_projection() && look.ambient_occlusion.is_some() {
+        return Err(OptionError::Unlit {
+            opt: Opt::AmbientOcclusion,
+            projection: Some(name),
+        });
     }
     Ok(blend)
 }

@@ -9,9 +9,10 @@ use crate::errors::value_error;
 use crate::transfer::{Camera, TransferFunction};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyBool, PyDict, PyString};
 use std::collections::HashSet;
 use volray_core::NonFinite;
+use volray_core::shadows::ambient;
 use volray_options::{BlendMode, CameraOptions, LookOptions, Options, Tf};
 
 /// The camera's keywords, for `Camera(...)`, `Renderer.render` and
@@ -54,6 +55,7 @@ pub const FRAME: &[&str] = &[
     "light",
     "light_color",
     "shadows",
+    "ambient_occlusion",
     "background",
     "label_opacity",
     "show_labels",
@@ -297,6 +299,16 @@ pub fn options(k: &Keywords<'_>, mut look: LookOptions) -> PyResult<Options> {
     }
     if let Some(shadows) = k.take("shadows", "True or False")? {
         look.shadows = shadows;
+    }
+    if let Some(v) = k.get("ambient_occlusion") {
+        // `True` is an `int` too: it means the default radius, not 1.
+        look.ambient_occlusion = match v.cast::<PyBool>() {
+            Ok(on) => on.is_true().then_some(ambient::DEFAULT_RADIUS),
+            Err(_) => {
+                let what = "True, False or a radius in voxels";
+                Some(extract::<f64>(v, "ambient_occlusion", what)?)
+            }
+        };
     }
     if let Some(b) = rgb(k, "background")? {
         look.background = b;

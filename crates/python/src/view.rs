@@ -346,6 +346,9 @@ fn words(options: &Options) -> Vec<(&'static str, Value)> {
     if look.shadows {
         w.push(("shadows", Value::Bool(true)));
     }
+    if let Some(radius) = look.ambient_occlusion {
+        w.push(("ambient_occlusion", Value::Number(radius)));
+    }
     if let Some(light) = look.light {
         w.push(("light", Value::Numbers(light.to_vec())));
     }

@@ -58,6 +58,9 @@ def test_arrays_that_are_not_volumes_are_refused(volume, error, message):
         (dict(max_memory=1000), ValueError, "more than max_memory"),
         (dict(tf="/no/such/file.json"), OSError, "tf /no/such/file.json: cannot read"),
         (dict(order="yxz"), ValueError, "order: 'yxz' is not an axis order"),
+        (dict(ambient_occlusion=40), ValueError, "^ambient_occlusion: ambient occlusion radius 40 must be 1 to 32 voxels$"),
+        (dict(ambient_occlusion="yes"), TypeError, "ambient_occlusion: expected True, False or a radius in voxels"),
+        (dict(ambient_occlusion=True, blend="mip"), ValueError, "ambient_occlusion sets the lighting, but blend='mip' is unshaded"),
     ],
 )
 def test_bad_options_raise_the_command_lines_messages(keywords, error, message):

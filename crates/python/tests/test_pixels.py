@@ -36,6 +36,9 @@ CASES = [
     ("hydrogen:3,2,0", ["--reference", "--size", "48"], {"reference": True, "size": 48}),
     ("fractal:65", ["--shadows", "--light", "1,0.5,1"], {"shadows": True, "light": (1, 0.5, 1)}),
     ("blobs:48", ["--shadows", "--post-classification"], {"shadows": True, "post_classification": True}),
+    # True is the default radius (8), not the number 1.
+    ("fractal:65", ["--ambient-occlusion", "--ambient", "0.5"], {"ambient_occlusion": True, "ambient": 0.5}),
+    ("blobs:48", ["--ambient-occlusion", "3", "--no-shading", "--post-classification"], {"ambient_occlusion": 3, "shading": False, "post_classification": True}),
 ]
 
 

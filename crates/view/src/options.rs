@@ -162,6 +162,7 @@ pub fn state_options(state: &ViewState, start: &OptionsStart) -> Result<Options,
         look.gradient_opacity = None;
         look.post_classification = false;
         look.shading = true;
+        look.ambient_occlusion = None;
         unlit(look);
     } else {
         if opacity.is_some() {
@@ -311,6 +312,21 @@ mod tests {
         assert_eq!(tf.opacity, None);
         assert_eq!(got.look.ambient, Phong::default().ambient);
         assert!(!got.look.shadows);
+        volray_options::settings(&got).unwrap();
+        // And the ambient occlusion, which an unlit composite keeps.
+        let mut occluded = start.clone();
+        occluded.options.look.ambient_occlusion = Some(4.0);
+        assert_eq!(
+            state_options(&state, &occluded)
+                .unwrap()
+                .look
+                .ambient_occlusion,
+            None
+        );
+        state.blend = BlendMode::Composite;
+        state.shading = false;
+        let got = state_options(&state, &occluded).unwrap();
+        assert_eq!(got.look.ambient_occlusion, Some(4.0));
         volray_options::settings(&got).unwrap();
     }
 
