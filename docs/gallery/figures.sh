@@ -5,7 +5,8 @@
 # fractal cloud with its outline; a CT-like head (scripts/make_ct_phantom.py
 # at 256^3, 1 mm voxels) with a colour bar in HU and a scale bar; and the
 # head and the cloud without and with --shadows (docs/options.md,
-# "Shadows").
+# "Shadows"); blobs and the cloud's isosurface without and with
+# --ambient-occlusion ("Ambient occlusion").
 #
 #     docs/gallery/figures.sh docs/gallery [path/to/volray]
 set -euo pipefail
@@ -40,3 +41,16 @@ python3 scripts/make_ct_phantom.py 256 "$tmp/head.raw" >/dev/null
   --light 0.6,-0.1,0.8 --label "without shadows" -o "$out/shadows-cloud-off.png"
 "$volray" render fractal:129 --size 420 --azimuth 30 --elevation 20 \
   --light 0.6,-0.1,0.8 --shadows --label "with shadows" -o "$out/shadows-cloud-on.png"
+
+# Ambient occlusion: the same frames without and with it, the ambient
+# light raised to half of the light so that it shows.
+for ao in off on; do
+  flag=(); [ "$ao" = on ] && flag=(--ambient-occlusion)
+  label="without ambient occlusion"; [ "$ao" = on ] && label="with ambient occlusion"
+  "$volray" render blobs:128 --blend iso --iso 0.3 --size 420 --azimuth 30 --elevation 30 \
+    --ambient 0.5 --diffuse 0.45 --specular 0.05 "${flag[@]}" --label "$label" \
+    -o "$out/ao-blobs-$ao.png"
+  "$volray" render fractal:129 --blend iso --iso 0.12 --size 420 --azimuth 30 --elevation 20 \
+    --ambient 0.5 --diffuse 0.45 --specular 0.05 "${flag[@]}" --label "$label" \
+    -o "$out/ao-cloud-$ao.png"
+done

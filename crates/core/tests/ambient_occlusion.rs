@@ -18,32 +18,48 @@ use volray_core::{
 };
 
 /// The reference's and the fast path's occlusion of every voxel of a grid
-/// of unit opacities `alpha`.
-fn both(alpha: &[f32], dims: [usize; 3], rays: &AmbientRays) -> (Vec<f32>, AmbientVolume) {
+/// of unit opacities `alpha`, `spacing` apart.
+fn both(
+    alpha: &[f32],
+    dims: [usize; 3],
+    spacing: DVec3,
+    rays: &AmbientRays,
+) -> (Vec<f32>, AmbientVolume) {
     let [nx, ny, _] = dims;
-    let marched = reference_occlusion(alpha, dims, rays);
-    let computed = AmbientVolume::compute(dims, rays, |i, j, k| alpha[i + nx * (j + ny * k)]);
+    let marched = reference_occlusion(alpha, dims, spacing, rays);
+    let at = |i, j, k| alpha[i + nx * (j + ny * k)];
+    let computed = AmbientVolume::compute(dims, spacing, rays, at);
     (marched, computed)
 }
 
+/// The weights of the rays up from a surface facing +z: 1 straight up,
+/// `1/√2` on the four edges, `1/√3` on the four corners.
+const UP: f64 = 1.0 + 4.0 * std::f64::consts::FRAC_1_SQRT_2 + 4.0 / 1.732_050_807_568_877_2;
+
 #[test]
-fn on_a_flat_opaque_surface_nine_of_the_twenty_six_rays_see_the_sky() {
-    // An opaque slab fills z = 0..=6 of a 20³ grid. From its top layer the
-    // 9 rays going up leave it; the 8 along the layer and the 9 going down
-    // stay in it: A = 9/26. One layer down no ray gets out (the radius, 4,
-    // is longer than the layer above), and far above nothing is in reach.
+fn a_flat_open_surface_sees_the_whole_sky_and_a_crease_less() {
+    // An opaque slab fills z = 0..=6 of a 20³ grid, and a wall x = 0..=6
+    // stands on it along y. On the slab's top away from the wall, the
+    // rays of the hemisphere facing up (+z, the way out of the slab) all
+    // leave: A = 1. Next to the wall, the three leaning into it are
+    // stopped at their first sample: A = 1 − (1/√2 + 2/√3)/UP. Inside the
+    // slab the opacity does not change, every ray counts, and none gets
+    // out; far above nothing is in reach.
     let dims = [20, 20, 20];
+    let opaque = |i: usize, k: usize| k <= 6 || i <= 6;
     let alpha: Vec<f32> = (0..8000)
-        .map(|v| f32::from(u8::from(v / 400 <= 6)))
+        .map(|v| f32::from(u8::from(opaque(v % 20, v / 400))))
         .collect();
     let rays = AmbientRays::new(4.0, DVec3::ONE);
-    let (marched, computed) = both(&alpha, dims, &rays);
+    let (marched, computed) = both(&alpha, dims, DVec3::ONE, &rays);
     let at = |i: usize, j: usize, k: usize| i + 20 * (j + 20 * k);
+    let crease = 1.0 - (std::f64::consts::FRAC_1_SQRT_2 + 2.0 / 3f64.sqrt()) / UP;
     for (voxel, want) in [
-        ([10, 10, 6], 9.0 / 26.0),
-        ([3, 15, 6], 9.0 / 26.0),
-        ([10, 10, 5], 0.0),
-        ([10, 10, 16], 1.0),
+        ([14, 10, 6], 1.0),
+        ([12, 15, 6], 1.0),
+        ([7, 10, 6], crease),
+        ([14, 10, 3], 0.0),
+        ([14, 10, 16], 1.0),
     ] {
         let [i, j, k] = voxel;
         let m = marched[at(i, j, k)] as f64;
@@ -57,8 +73,6 @@ fn on_a_flat_opaque_surface_nine_of_the_twenty_six_rays_see_the_sky() {
             "{voxel:?}: computed {c}, want {want}"
         );
     }
-    // Just above the top, the rays going down hit it: 17 of 26 get out.
-    assert!((computed.at([10, 10, 7]) as f64 - 17.0 / 26.0).abs() < 1e-4);
 }
 
 #[test]
@@ -81,7 +95,7 @@ fn in_a_uniform_medium_each_ray_keeps_the_transmittance_of_its_length() {
             })
             .sum::<f64>()
             / 26.0;
-        let (marched, computed) = both(&alpha, dims, &rays);
+        let (marched, computed) = both(&alpha, dims, spacing, &rays);
         let centre = 10 + 21 * (10 + 21 * 10);
         let (m, c) = (marched[centre] as f64, computed.at([10, 10, 10]) as f64);
         assert!(
@@ -112,7 +126,7 @@ fn the_ambient_volume_is_the_marched_occlusion_of_every_voxel() {
             .map(|&f| (f * 0.8).clamp(0.0, 1.0))
             .collect();
         let rays = AmbientRays::new(radius, volume.spacing());
-        let (marched, computed) = both(&alpha, dims, &rays);
+        let (marched, computed) = both(&alpha, dims, volume.spacing(), &rays);
         let mut worst = 0.0f32;
         let mut darkest = 1.0f32;
         for k in 0..dims[2] {
@@ -165,21 +179,24 @@ fn occluded(tf: volray_core::TransferFunction, radius: Option<f64>) -> RenderSet
 #[test]
 fn the_plate_under_the_ball_gets_less_ambient_light_than_the_plate_in_the_open() {
     // The contact shadow ambient occlusion is for: from the plate's top
-    // under the ball, 5 of the 9 rays that leave the plate meet the ball
-    // (A = 4/26); in the open none do (9/26).
+    // under the ball, the ray straight up and the four on the edges meet
+    // the ball; only the four on the corners get past it. In the open all
+    // nine leave.
     let volume = ball_near_plate();
     let dims = volume.dims();
     let alpha: Vec<f32> = volume.values().to_vec();
     let rays = AmbientRays::new(6.0, DVec3::ONE);
-    let (_, computed) = both(&alpha, dims, &rays);
-    let open = computed.at([3, 3, 5]);
-    let under = computed.at([18, 18, 5]);
-    assert!((open - 9.0 / 26.0).abs() < 1e-4, "open {open}");
-    assert!((under - 4.0 / 26.0).abs() < 1e-4, "under the ball {under}");
-    // The ball's top sees the sky, its bottom faces the plate.
+    let (_, computed) = both(&alpha, dims, DVec3::ONE, &rays);
+    let open = computed.at([3, 3, 5]) as f64;
+    let under = computed.at([18, 18, 5]) as f64;
+    let corners = 4.0 / 3f64.sqrt() / UP;
+    assert!((open - 1.0).abs() < 1e-4, "open {open}");
+    assert!((under - corners).abs() < 1e-4, "under the ball {under}");
+    // The ball's top sees the sky; its bottom faces the plate a voxel
+    // away, which every ray of its hemisphere meets.
     let top = computed.at([18, 18, 19]);
     let bottom = computed.at([18, 18, 7]);
-    assert!(top > bottom + 0.1, "top {top}, bottom {bottom}");
+    assert!(top > 0.999 && bottom < 1e-4, "top {top}, bottom {bottom}");
 }
 
 #[test]

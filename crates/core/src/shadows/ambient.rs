@@ -3,12 +3,13 @@
 //!
 //! **What is computed.** The ambient term of the paper's Phong model
 //! stands for light scattered in from every direction. Ambient occlusion
-//! scales it by the mean transmittance over a fixed set of short rays from
-//! the point (Zhukov et al. 1998's obscurance; for volumes, Hernell et al.
-//! 2010's local ambient occlusion):
+//! scales it by how much of that light reaches the point through the
+//! classified volume around it (Zhukov et al. 1998's obscurance; for
+//! volumes, Hernell et al. 2010's local ambient occlusion): a weighted
+//! mean of the transmittance along a fixed set of short rays,
 //!
 //! ```text
-//! A(p) = 1/26 · Σ_d ∏ (1 − α_d(p + m·d)),  m = 1 … n_d
+//! A(v) = Σ_d w_d·T_d / Σ_d w_d,   T_d = ∏ (1 − α_d(v + m·d)),  m = 1 … n_d
 //! ```
 //!
 //! over the 26 directions `d` from a voxel to its neighbours (in index
@@ -16,10 +17,19 @@
 //! whole number of steps nearest the radius `R` (in voxels of the smallest
 //! spacing, as the step is; at least one step). `α_d` is the voxels'
 //! classified opacity corrected for one step of `d` (`|d·spacing|` world
-//! units, [`correct_opacity`]),
-//! interpolated trilinearly, as the shadow rays' is ([`super`]). A point
-//! does not occlude itself (`m` starts at 1), and samples outside the grid
-//! are empty: the volume's faces let the light in.
+//! units, [`correct_opacity`]), interpolated trilinearly, as the shadow
+//! rays' is ([`super`]). A point does not occlude itself (`m` starts at 1),
+//! and samples outside the grid are empty: the volume's faces let the
+//! light in.
+//!
+//! **The hemisphere a surface faces.** A surface is lit by the sky on its
+//! open side, not by the material behind it: the weights are the cosines
+//! `w_d = max(0, d̂·N̂)` of the rays with the way out of the material, `N =
+//! −∇α` (world; the central differences of the voxels' opacities, one-sided
+//! at the grid's faces), as for a Lambertian surface under a uniform sky.
+//! So a flat open surface gets `A = 1`, a crease or a hollow less. Where
+//! the opacity does not change (`∇α = 0`: inside a uniform medium, in
+//! empty space) every ray weighs alike, `w_d = 1`.
 //!
 //! `A` is found at the voxels and interpolated trilinearly to the samples
 //! between them, as their gradients are: post-classified samples read it
@@ -27,8 +37,7 @@
 //! sphere: from a voxel their samples are voxels, so the fast path's
 //! [`AmbientVolume`](super::ambient_volume::AmbientVolume) gets each
 //! voxel's `A` as the reference marches it (to rounding), with no
-//! interpolation error. On a flat opaque surface 9 of the 26 rays leave
-//! it: `A = 9/26`.
+//! interpolation error.
 //!
 //! **How it shades.** `A` scales the ambient term:
 //! `C = C_s·m·(A·k_a + T·(k_d·(N·L) + k_s·(N·H)^n))`
@@ -119,36 +128,87 @@ impl AmbientRays {
         })
     }
 
-    /// `A(p)` from index-space point `from` in a grid of `dims` voxels, of
-    /// the opacity `alpha(q, length)` at index-space points `q` corrected
-    /// for a step of `length` voxels: the mean over the rays of the
-    /// product of `1 − α` along each (samples outside the grid are empty).
+    /// The unit vectors of the rays in world space, for the weights.
+    pub fn world_directions(&self, spacing: DVec3) -> Vec<DVec3> {
+        (self.directions.iter())
+            .map(|d| (DVec3::from_array(d.step.map(|s| s as f64)) * spacing).normalize())
+            .collect()
+    }
+
+    /// The weight of each ray at a voxel whose way out of the material is
+    /// `outward` (world, any length; zero: none): the cosines of the rays
+    /// with it, not below 0, or all 1 where it is zero.
+    pub fn weights(world: &[DVec3], outward: DVec3) -> impl Iterator<Item = f64> + '_ {
+        let n = outward.normalize_or_zero();
+        world.iter().map(move |d| match n == DVec3::ZERO {
+            true => 1.0,
+            false => d.dot(n).max(0.0),
+        })
+    }
+
+    /// `A` at voxel `v` of a grid of `dims` voxels `spacing` apart, of the
+    /// opacity `alpha(q, length)` at index-space points `q` corrected for a
+    /// step of `length` voxels, and the weights of [`Self::weights`] for
+    /// the way out of the material `outward`: the weighted mean over the
+    /// rays of the product of `1 − α` along each (samples outside the grid
+    /// are empty).
     pub fn occlusion(
         &self,
-        from: DVec3,
+        v: [usize; 3],
         dims: [usize; 3],
+        world: &[DVec3],
+        outward: DVec3,
         alpha: impl Fn([f64; 3], f32) -> f64,
     ) -> f64 {
+        let from = DVec3::from_array(v.map(|c| c as f64));
         let last = DVec3::from_array(dims.map(|n| (n - 1) as f64));
-        let sum: f64 = (self.directions.iter())
-            .map(|d| {
-                let step = DVec3::from_array(d.step.map(|s| s as f64));
-                let mut t = 1.0;
-                for m in 1..=d.steps {
-                    let q = from + step * m as f64;
-                    if q.cmplt(DVec3::ZERO).any() || q.cmpgt(last).any() {
-                        break;
-                    }
-                    t *= 1.0 - alpha(q.to_array(), d.length);
-                    if t == 0.0 {
-                        break;
-                    }
+        let (mut sum, mut weights) = (0.0, 0.0);
+        for (d, w) in self.directions.iter().zip(Self::weights(world, outward)) {
+            if w == 0.0 {
+                continue;
+            }
+            let step = DVec3::from_array(d.step.map(|s| s as f64));
+            let mut t = 1.0;
+            for m in 1..=d.steps {
+                let q = from + step * m as f64;
+                if q.cmplt(DVec3::ZERO).any() || q.cmpgt(last).any() {
+                    break;
                 }
-                t
-            })
-            .sum();
-        sum / self.directions.len() as f64
+                t *= 1.0 - alpha(q.to_array(), d.length);
+                if t == 0.0 {
+                    break;
+                }
+            }
+            sum += w * t;
+            weights += w;
+        }
+        sum / weights
     }
+}
+
+/// The way out of the material at voxel `(i, j, k)` of a grid of `dims`
+/// voxels `spacing` apart whose opacities are `alpha(i, j, k)`: `−∇α`
+/// (world), by central differences, one-sided at the grid's faces.
+#[inline]
+pub fn outward(
+    [i, j, k]: [usize; 3],
+    dims: [usize; 3],
+    spacing: [f32; 3],
+    alpha: impl Fn(usize, usize, usize) -> f32,
+) -> [f32; 3] {
+    let v = [i, j, k];
+    std::array::from_fn(|a| {
+        let (lo, hi) = (v[a].saturating_sub(1), (v[a] + 1).min(dims[a] - 1));
+        if lo == hi {
+            return 0.0;
+        }
+        let at = |c: usize| {
+            let mut q = v;
+            q[a] = c;
+            alpha(q[0], q[1], q[2])
+        };
+        (at(lo) - at(hi)) / ((hi - lo) as f32 * spacing[a])
+    })
 }
 
 /// The opacity of `unit` (the opacity of one voxel's length) at
@@ -163,7 +223,20 @@ pub fn reference_tap(unit: &[f32], dims: [usize; 3], q: [f64; 3], length: f32) -
 /// rays marched ([`AmbientRays::occlusion`]). A voxel whose every
 /// neighbour is transparent gets 1 without a march, as in
 /// [`super::reference_light`].
-pub fn reference_occlusion(unit: &[f32], dims: [usize; 3], rays: &AmbientRays) -> Vec<f32> {
+pub fn reference_occlusion(
+    unit: &[f32],
+    dims: [usize; 3],
+    spacing: DVec3,
+    rays: &AmbientRays,
+) -> Vec<f32> {
+    let [nx, ny, _] = dims;
+    let world = rays.world_directions(spacing);
+    let spacing32 = spacing.as_vec3().to_array();
     let tap = |q: [f64; 3], length: f32| reference_tap(unit, dims, q, length);
-    super::march_every_voxel(unit, dims, |from| rays.occlusion(from, dims, tap))
+    super::march_every_voxel(unit, dims, |from| {
+        let v = from.to_array().map(|c| c as usize);
+        let n = outward(v, dims, spacing32, |i, j, k| unit[i + nx * (j + ny * k)]);
+        let n = glam::Vec3::from(n).as_dvec3();
+        rays.occlusion(v, dims, &world, n, tap)
+    })
 }
