@@ -34,6 +34,7 @@ use crate::renderer::{FastState, Renderer};
 use crate::sampling::Sampling;
 use crate::sampling::grid::GridFrame;
 use crate::settings::RenderSettings;
+use std::cell::{Cell, OnceCell};
 use std::ops::Deref;
 use std::sync::MutexGuard;
 use wide::f32x4;
@@ -110,13 +111,39 @@ impl Channels<'_> {
     }
 }
 
-/// A volume occupied in a brick: its number `k` in the scene, its lit
-/// voxels and its occupied cells.
-type LitVolume<'l> = (
-    usize,
-    CacheRef<'l, [[f32; 4]; SLOTS]>,
-    &'l [u64; CELLS / 64],
-);
+/// A volume occupied in a brick: its number `k` in the scene and its
+/// occupied cells, and its voxels, lit when a ray first needs them (see
+/// [`Self::voxels`]).
+struct LitVolume<'l> {
+    k: usize,
+    /// Its number among the volume's occupied bricks.
+    n: usize,
+    channel: &'l Channel<'l>,
+    cells: &'l [u64; CELLS / 64],
+    /// Where it is lit if the lit-brick cache has no room (taken then).
+    scratch: Cell<Option<&'l mut Option<Box<[[f32; 4]; SLOTS]>>>>,
+    voxels: OnceCell<CacheRef<'l, [[f32; 4]; SLOTS]>>,
+}
+
+impl LitVolume<'_> {
+    /// The brick's voxels of this volume, lit for the frame now unless
+    /// they are.
+    #[inline]
+    fn voxels(&self) -> &[[f32; 4]; SLOTS] {
+        self.voxels.get_or_init(|| {
+            let scratch = self.scratch.take().expect("a brick's volume is lit once");
+            self.channel
+                .lit
+                .get(self.n, &self.channel.lighting, scratch)
+        })
+    }
+
+    /// The voxels, lit now unless they are, and the occupied cells.
+    #[inline]
+    fn lit(&self) -> (&[[f32; 4]; SLOTS], &[u64; CELLS / 64]) {
+        (self.voxels(), self.cells)
+    }
+}
 
 /// The volumes occupied in a brick: the first [`DIRECT`] in an array, any
 /// more in a vector (a vector for every brick a tile crosses cost an
@@ -140,11 +167,10 @@ impl<'l> LitVolumes<'l> {
         self.few.iter().flatten().chain(&self.more)
     }
 
-    /// Volume `v`'s lit voxels and occupied cells (`v` < [`DIRECT`]).
+    /// Volume `v` (`v` < [`DIRECT`]).
     #[inline]
-    fn direct(&self, v: usize) -> (&[[f32; 4]; SLOTS], &[u64; CELLS / 64]) {
-        let (_, voxels, cells) = self.few[v].as_ref().expect("a lit volume");
-        (voxels, cells)
+    fn direct(&self, v: usize) -> &LitVolume<'l> {
+        self.few[v].as_ref().expect("a volume occupied here")
     }
 }
 
@@ -164,11 +190,20 @@ impl Channels<'_> {
             more: Vec::new(),
             len: 0,
         };
+        // Each volume is lit when a ray first takes a sample in one of its
+        // occupied cells (the additive mix: when a ray whose compositor of
+        // that volume is not opaque crosses the brick).
         for (k, (channel, scratch)) in self.channels.iter().zip(scratch.iter_mut()).enumerate() {
             let n = self.number(u, k) as usize;
             if n != NONE as usize {
-                let voxels = channel.lit.get(n, &channel.lighting, scratch);
-                lit.push((k, voxels, &channel.bricks.cells[n]));
+                lit.push(LitVolume {
+                    k,
+                    n,
+                    channel,
+                    cells: &channel.bricks.cells[n],
+                    scratch: Cell::new(Some(scratch)),
+                    voxels: OnceCell::new(),
+                });
             }
         }
         lit
@@ -213,22 +248,22 @@ impl BrickSource for Channels<'_> {
         match lit.len {
             // One volume occupied here: the single-volume caster's march.
             1 => {
-                let (voxels, cells) = lit.direct(0);
-                bricked::march(acc, voxels, cells, segment)
+                let volume = lit.direct(0);
+                bricked::march(acc, volume.voxels(), volume.cells, segment)
             }
-            2 => march_n(acc, &[lit.direct(0), lit.direct(1)], segment),
-            3 => march_n(acc, &[lit.direct(0), lit.direct(1), lit.direct(2)], segment),
+            2 => march_n(acc, &[0, 1].map(|v| lit.direct(v).lit()), segment),
+            3 => march_n(acc, &[0, 1, 2].map(|v| lit.direct(v).lit()), segment),
             n if n <= DIRECT => {
                 static NOTHING: ([[f32; 4]; SLOTS], [u64; CELLS / 64]) =
                     ([[0.0; 4]; SLOTS], [0; CELLS / 64]);
                 let mut direct = [(&NOTHING.0, &NOTHING.1); DIRECT];
-                for (v, d) in direct[..n].iter_mut().enumerate() {
-                    *d = lit.direct(v);
+                for (d, volume) in direct[..n].iter_mut().zip(lit.iter()) {
+                    *d = (volume.voxels(), volume.cells);
                 }
                 march(acc, &direct[..n], segment)
             }
             _ => {
-                let volumes: Vec<_> = lit.iter().map(|(_, v, c)| (&**v, *c)).collect();
+                let volumes: Vec<_> = lit.iter().map(|v| (v.voxels(), v.cells)).collect();
                 march(acc, &volumes, segment)
             }
         }
@@ -444,9 +479,9 @@ impl<const N: usize> BrickSource for Additive<'_, '_, N> {
         // whose ray is opaque has stopped, as its own renderer's has.
         let mut live: [Numbered; N] = [(0, &NOTHING.0, &NOTHING.1); N];
         let mut m = 0;
-        for (k, voxels, cells) in lit.iter() {
-            if !acc.0[*k].is_opaque() {
-                live[m] = (*k, &**voxels, *cells);
+        for volume in lit.iter() {
+            if !acc.0[volume.k].is_opaque() {
+                live[m] = (volume.k, volume.voxels(), volume.cells);
                 m += 1;
             }
         }
