@@ -8,7 +8,8 @@
 //! each such brick together before the next (the brick's voxels stay in
 //! the cache for all 256 rays). In a brick, each volume occupied there
 //! has its lit voxels ([`crate::cpu::lit_bricks`], each volume's own
-//! cache); a sample takes, from each volume whose cell is occupied, its
+//! cache), lit when the first ray that needs them crosses the brick; a
+//! sample takes, from each volume whose cell is occupied, its
 //! trilinear colour and opacity, mixes them ([`Mixer`]) and composites
 //! the mix (the sample of a volume alone there as it is: the mix of one
 //! sample is itself, up to rounding). A volume transparent in a cell adds exactly nothing there
@@ -111,6 +112,9 @@ impl Channels<'_> {
     }
 }
 
+/// Where one volume's brick is lit when the lit-brick cache has no room.
+type Scratch = Option<Box<[[f32; 4]; SLOTS]>>;
+
 /// A volume occupied in a brick: its number `k` in the scene and its
 /// occupied cells, and its voxels, lit when a ray first needs them (see
 /// [`Self::voxels`]).
@@ -121,7 +125,7 @@ struct LitVolume<'l> {
     channel: &'l Channel<'l>,
     cells: &'l [u64; CELLS / 64],
     /// Where it is lit if the lit-brick cache has no room (taken then).
-    scratch: Cell<Option<&'l mut Option<Box<[[f32; 4]; SLOTS]>>>>,
+    scratch: Cell<Option<&'l mut Scratch>>,
     voxels: OnceCell<CacheRef<'l, [[f32; 4]; SLOTS]>>,
 }
 
@@ -179,11 +183,7 @@ impl Channels<'_> {
         CellBox::new(&self.grid, self.union.bricks[u], self.union.boxes[u])
     }
 
-    fn light<'l>(
-        &'l self,
-        u: usize,
-        scratch: &'l mut Vec<Option<Box<[[f32; 4]; SLOTS]>>>,
-    ) -> LitVolumes<'l> {
+    fn light<'l>(&'l self, u: usize, scratch: &'l mut Vec<Scratch>) -> LitVolumes<'l> {
         scratch.resize_with(self.channels.len(), || None);
         let mut lit = LitVolumes {
             few: [const { None }; DIRECT],
@@ -227,7 +227,7 @@ impl BrickSource for Channels<'_> {
         = LitVolumes<'l>
     where
         Self: 'l;
-    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+    type Scratch = Vec<Scratch>;
 
     fn cell_box(&self, u: usize) -> CellBox {
         Channels::cell_box(self, u)
@@ -447,7 +447,11 @@ impl<const N: usize> Accumulator for Sums<N> {
 /// and lit voxels as the composite mix ([`Channels`]), a compositor per
 /// volume along each ray. A ray ends when every volume's compositor is
 /// opaque; a brick is skipped where every volume is empty (the union's
-/// lists), and a volume empty in a brick takes no sample there.
+/// lists), and a volume empty in a brick takes no sample there. A brick
+/// is lit for a volume only when a ray whose compositor of that volume is
+/// not opaque crosses it (one bench frame of two channels lit 5497
+/// bricks, against 5856 when every volume occupied in a brick was lit
+/// with the first ray; one channel alone lights 2559).
 struct Additive<'c, 'a, const N: usize>(&'c Channels<'a>);
 
 impl<const N: usize> BrickSource for Additive<'_, '_, N> {
@@ -456,7 +460,7 @@ impl<const N: usize> BrickSource for Additive<'_, '_, N> {
         = LitVolumes<'l>
     where
         Self: 'l;
-    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+    type Scratch = Vec<Scratch>;
 
     fn cell_box(&self, u: usize) -> CellBox {
         self.0.cell_box(u)
