@@ -190,9 +190,10 @@ impl Channels<'_> {
             more: Vec::new(),
             len: 0,
         };
-        // Each volume is lit when a ray first takes a sample in one of its
-        // occupied cells (the additive mix: when a ray whose compositor of
-        // that volume is not opaque crosses the brick).
+        // Each volume is lit when the first ray that uses it crosses the
+        // brick: in the composite mix, the first ray with samples here; in
+        // the additive mix, the first whose compositor of that volume is
+        // not opaque.
         for (k, (channel, scratch)) in self.channels.iter().zip(scratch.iter_mut()).enumerate() {
             let n = self.number(u, k) as usize;
             if n != NONE as usize {
