@@ -8,7 +8,8 @@
 //! each such brick together before the next (the brick's voxels stay in
 //! the cache for all 256 rays). In a brick, each volume occupied there
 //! has its lit voxels ([`crate::cpu::lit_bricks`], each volume's own
-//! cache); a sample takes, from each volume whose cell is occupied, its
+//! cache), lit when the first ray that needs them crosses the brick; a
+//! sample takes, from each volume whose cell is occupied, its
 //! trilinear colour and opacity, mixes them ([`Mixer`]) and composites
 //! the mix (the sample of a volume alone there as it is: the mix of one
 //! sample is itself, up to rounding). A volume transparent in a cell adds exactly nothing there
@@ -34,6 +35,7 @@ use crate::renderer::{FastState, Renderer};
 use crate::sampling::Sampling;
 use crate::sampling::grid::GridFrame;
 use crate::settings::RenderSettings;
+use std::cell::{Cell, OnceCell};
 use std::ops::Deref;
 use std::sync::MutexGuard;
 use wide::f32x4;
@@ -110,34 +112,102 @@ impl Channels<'_> {
     }
 }
 
-/// The volumes occupied in a brick: each one's number `k` in the scene,
-/// its lit voxels and its occupied cells.
-type LitVolumes<'l> = Vec<(
-    usize,
-    CacheRef<'l, [[f32; 4]; SLOTS]>,
-    &'l [u64; CELLS / 64],
-)>;
+/// Where one volume's brick is lit when the lit-brick cache has no room.
+type Scratch = Option<Box<[[f32; 4]; SLOTS]>>;
+
+/// A volume occupied in a brick: its number `k` in the scene and its
+/// occupied cells, and its voxels, lit when a ray first needs them (see
+/// [`Self::voxels`]).
+struct LitVolume<'l> {
+    k: usize,
+    /// Its number among the volume's occupied bricks.
+    n: usize,
+    channel: &'l Channel<'l>,
+    cells: &'l [u64; CELLS / 64],
+    /// Where it is lit if the lit-brick cache has no room (taken then).
+    scratch: Cell<Option<&'l mut Scratch>>,
+    voxels: OnceCell<CacheRef<'l, [[f32; 4]; SLOTS]>>,
+}
+
+impl LitVolume<'_> {
+    /// The brick's voxels of this volume, lit for the frame now unless
+    /// they are.
+    #[inline]
+    fn voxels(&self) -> &[[f32; 4]; SLOTS] {
+        self.voxels.get_or_init(|| {
+            let scratch = self.scratch.take().expect("a brick's volume is lit once");
+            self.channel
+                .lit
+                .get(self.n, &self.channel.lighting, scratch)
+        })
+    }
+
+    /// The voxels, lit now unless they are, and the occupied cells.
+    #[inline]
+    fn lit(&self) -> (&[[f32; 4]; SLOTS], &[u64; CELLS / 64]) {
+        (self.voxels(), self.cells)
+    }
+}
+
+/// The volumes occupied in a brick: the first [`DIRECT`] in an array, any
+/// more in a vector (a vector for every brick a tile crosses cost an
+/// allocation each).
+struct LitVolumes<'l> {
+    few: [Option<LitVolume<'l>>; DIRECT],
+    more: Vec<LitVolume<'l>>,
+    len: usize,
+}
+
+impl<'l> LitVolumes<'l> {
+    fn push(&mut self, volume: LitVolume<'l>) {
+        match self.few.get_mut(self.len) {
+            Some(slot) => *slot = Some(volume),
+            None => self.more.push(volume),
+        }
+        self.len += 1;
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &LitVolume<'l>> {
+        self.few.iter().flatten().chain(&self.more)
+    }
+
+    /// Volume `v` (`v` < [`DIRECT`]).
+    #[inline]
+    fn direct(&self, v: usize) -> &LitVolume<'l> {
+        self.few[v].as_ref().expect("a volume occupied here")
+    }
+}
 
 impl Channels<'_> {
     fn cell_box(&self, u: usize) -> CellBox {
         CellBox::new(&self.grid, self.union.bricks[u], self.union.boxes[u])
     }
 
-    fn light<'l>(
-        &'l self,
-        u: usize,
-        scratch: &'l mut Vec<Option<Box<[[f32; 4]; SLOTS]>>>,
-    ) -> LitVolumes<'l> {
+    fn light<'l>(&'l self, u: usize, scratch: &'l mut Vec<Scratch>) -> LitVolumes<'l> {
         scratch.resize_with(self.channels.len(), || None);
-        (self.channels.iter().zip(scratch.iter_mut()).enumerate())
-            .filter_map(|(k, (channel, scratch))| {
-                let n = self.number(u, k) as usize;
-                (n != NONE as usize).then(|| {
-                    let lit = channel.lit.get(n, &channel.lighting, scratch);
-                    (k, lit, &channel.bricks.cells[n])
-                })
-            })
-            .collect()
+        let mut lit = LitVolumes {
+            few: [const { None }; DIRECT],
+            more: Vec::new(),
+            len: 0,
+        };
+        // Each volume is lit when the first ray that uses it crosses the
+        // brick: in the composite mix, the first ray with samples here; in
+        // the additive mix, the first whose compositor of that volume is
+        // not opaque.
+        for (k, (channel, scratch)) in self.channels.iter().zip(scratch.iter_mut()).enumerate() {
+            let n = self.number(u, k) as usize;
+            if n != NONE as usize {
+                lit.push(LitVolume {
+                    k,
+                    n,
+                    channel,
+                    cells: &channel.bricks.cells[n],
+                    scratch: Cell::new(Some(scratch)),
+                    voxels: OnceCell::new(),
+                });
+            }
+        }
+        lit
     }
 
     fn done(&self, u: usize) {
@@ -158,7 +228,7 @@ impl BrickSource for Channels<'_> {
         = LitVolumes<'l>
     where
         Self: 'l;
-    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+    type Scratch = Vec<Scratch>;
 
     fn cell_box(&self, u: usize) -> CellBox {
         Channels::cell_box(self, u)
@@ -176,25 +246,27 @@ impl BrickSource for Channels<'_> {
         segment: &Segment,
     ) -> bool {
         // The voxels read straight, not through each lock's guard.
-        static NOTHING: ([[f32; 4]; SLOTS], [u64; CELLS / 64]) =
-            ([[0.0; 4]; SLOTS], [0; CELLS / 64]);
-        match lit.len() {
+        match lit.len {
             // One volume occupied here: the single-volume caster's march.
-            1 => return bricked::march(acc, &lit[0].1, lit[0].2, segment),
-            n if n > DIRECT => {
-                let guarded: Vec<_> = lit.iter().map(|(_, v, c)| (&**v, *c)).collect();
-                return march(acc, &guarded, segment);
+            1 => {
+                let volume = lit.direct(0);
+                bricked::march(acc, volume.voxels(), volume.cells, segment)
             }
-            _ => {}
-        }
-        let mut direct = [(&NOTHING.0, &NOTHING.1); DIRECT];
-        for (d, (_, voxels, cells)) in direct.iter_mut().zip(lit) {
-            *d = (&**voxels, *cells);
-        }
-        match lit.len() {
-            2 => march_n(acc, &[direct[0], direct[1]], segment),
-            3 => march_n(acc, &[direct[0], direct[1], direct[2]], segment),
-            n => march(acc, &direct[..n], segment),
+            2 => march_n(acc, &[0, 1].map(|v| lit.direct(v).lit()), segment),
+            3 => march_n(acc, &[0, 1, 2].map(|v| lit.direct(v).lit()), segment),
+            n if n <= DIRECT => {
+                static NOTHING: ([[f32; 4]; SLOTS], [u64; CELLS / 64]) =
+                    ([[0.0; 4]; SLOTS], [0; CELLS / 64]);
+                let mut direct = [(&NOTHING.0, &NOTHING.1); DIRECT];
+                for (d, volume) in direct[..n].iter_mut().zip(lit.iter()) {
+                    *d = (volume.voxels(), volume.cells);
+                }
+                march(acc, &direct[..n], segment)
+            }
+            _ => {
+                let volumes: Vec<_> = lit.iter().map(|v| (v.voxels(), v.cells)).collect();
+                march(acc, &volumes, segment)
+            }
         }
     }
 
@@ -216,26 +288,81 @@ fn march<L: Deref<Target = [[f32; 4]; SLOTS]>>(
     march_body(acc, volumes, segment)
 }
 
-/// [`march`] for exactly `N` volumes, the loop over them unrolled: two
-/// channels of the bench's 256³ specimen took 1.79 times one channel's
-/// frame, against 1.86 through the slice (`examples/scene_bench.rs`,
-/// one run each).
+/// [`march`] for exactly `N` volumes, the loop over them unrolled. Which
+/// volumes are occupied in the sample's cell is one bit mask: none, one
+/// (interpolated and composited as it is, no mixer) or several (mixed).
+/// Against the loop that counted the occupied volumes as it went (one
+/// sample kept aside until a second came), with the other changes of the
+/// same commit in both (`examples/scene_bench.rs`, processor time, three
+/// alternated runs on 2026-11-27, load average 5.7 to 6.0): two channels
+/// took 1.65, 1.78 and 1.69 times one channel against 1.80, 1.95 and
+/// 1.84; three 2.24, 2.15 and 2.18 against 2.34, 2.40 and 2.45.
 ///
-/// Tried (2026-11-27, `examples/scene_bench.rs`, processor time, same
-/// binary switched at run time, two runs each): two volumes occupied at a
-/// sample interpolated in one 8-lane AVX vector (`vinsertf128` of the two
-/// corners, seven 8-lane lerps; the same sums lane by lane) took 1.80 and
-/// 2.05 times one channel for two channels against 1.84 and 1.86 without,
-/// and 2.44 and 2.60 against 2.19 and 2.35 for three: no gain, so not
-/// kept. Neither was a loop that first gathers which volumes are occupied
-/// (1.89 and 1.89 against 1.85 and 1.81).
+/// Tried before (2026-11-27, `examples/scene_bench.rs`, processor time,
+/// same binary switched at run time, two runs each): two volumes occupied
+/// at a sample interpolated in one 8-lane AVX vector (`vinsertf128` of the
+/// two corners, seven 8-lane lerps; the same sums lane by lane) took 1.80
+/// and 2.05 times one channel for two channels against 1.84 and 1.86
+/// without, and 2.44 and 2.60 against 2.19 and 2.35 for three: no gain,
+/// so not kept. Neither was a loop that first gathered the occupied
+/// volumes into a list (1.89 and 1.89 against 1.85 and 1.81).
 #[inline(never)]
 fn march_n<const N: usize>(
     acc: &mut FrontToBack,
     volumes: &[(&[[f32; 4]; SLOTS], &[u64; CELLS / 64]); N],
     segment: &Segment,
 ) -> bool {
-    march_body(acc, volumes, segment)
+    let last_cell = f32x4::splat((BRICK - 1) as f32);
+    let mut ray = *acc;
+    let mut p = segment.origin + segment.delta * f32x4::splat(segment.first as f32);
+    let mut terminated = false;
+    let mut left = segment.last - segment.first + 1;
+    while left > 0 {
+        left -= 1;
+        let here = p.fast_max(segment.lo).fast_min(segment.hi);
+        p += segment.delta;
+        let c = here.fast_min(last_cell).fast_trunc_int();
+        let [i, j, l, _] = c.to_array().map(|x| x as usize & (BRICK - 1));
+        let bit = cell(i, j, l);
+        let (word, shift) = (bit / 64, bit % 64);
+        // Bit k: volume k is occupied in the sample's cell.
+        let mut occupied = 0u32;
+        for (k, (_, cells)) in volumes.iter().enumerate() {
+            occupied |= ((cells[word] >> shift & 1) as u32) << k;
+        }
+        if occupied == 0 {
+            continue;
+        }
+        let [fx, fy, fz, _] = (here - f32x4::from_i32x4(c)).to_array();
+        let base = slot(i, j, l);
+        let at = |k: usize| {
+            let lit = volumes[k].0;
+            let voxels = corners(|s| f32x4::new(lit[s]), base, SIDE, SIDE * SIDE);
+            interpolate(voxels, [fx, fy, fz])
+        };
+        // One volume's sample is composited as it is; several are mixed.
+        let sample = if occupied & (occupied - 1) == 0 {
+            at(occupied.trailing_zeros() as usize)
+        } else {
+            let mut mixer = Mixer::NEW;
+            for k in 0..N {
+                if occupied >> k & 1 != 0 {
+                    mixer.add(at(k));
+                }
+            }
+            match mixer.sample() {
+                Some(sample) => sample,
+                None => continue,
+            }
+        };
+        ray.add(sample);
+        if ray.is_opaque() {
+            terminated = true;
+            break;
+        }
+    }
+    *acc = ray;
+    terminated
 }
 
 #[inline(always)]
@@ -321,7 +448,11 @@ impl<const N: usize> Accumulator for Sums<N> {
 /// and lit voxels as the composite mix ([`Channels`]), a compositor per
 /// volume along each ray. A ray ends when every volume's compositor is
 /// opaque; a brick is skipped where every volume is empty (the union's
-/// lists), and a volume empty in a brick takes no sample there.
+/// lists), and a volume empty in a brick takes no sample there. A brick
+/// is lit for a volume only when a ray whose compositor of that volume is
+/// not opaque crosses it (one bench frame of two channels lit 5497
+/// bricks, against 5856 when every volume occupied in a brick was lit
+/// with the first ray; one channel alone lights 2559).
 struct Additive<'c, 'a, const N: usize>(&'c Channels<'a>);
 
 impl<const N: usize> BrickSource for Additive<'_, '_, N> {
@@ -330,7 +461,7 @@ impl<const N: usize> BrickSource for Additive<'_, '_, N> {
         = LitVolumes<'l>
     where
         Self: 'l;
-    type Scratch = Vec<Option<Box<[[f32; 4]; SLOTS]>>>;
+    type Scratch = Vec<Scratch>;
 
     fn cell_box(&self, u: usize) -> CellBox {
         self.0.cell_box(u)
@@ -353,9 +484,9 @@ impl<const N: usize> BrickSource for Additive<'_, '_, N> {
         // whose ray is opaque has stopped, as its own renderer's has.
         let mut live: [Numbered; N] = [(0, &NOTHING.0, &NOTHING.1); N];
         let mut m = 0;
-        for (k, voxels, cells) in lit {
-            if !acc.0[*k].is_opaque() {
-                live[m] = (*k, &**voxels, *cells);
+        for volume in lit.iter() {
+            if !acc.0[volume.k].is_opaque() {
+                live[m] = (volume.k, volume.voxels(), volume.cells);
                 m += 1;
             }
         }
