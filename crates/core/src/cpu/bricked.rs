@@ -776,7 +776,7 @@ mod tests {
             }
         }
 
-        fn march<'l>(&'l self, _: &mut FrontToBack, _: &(), _: usize, _: &Segment) -> bool {
+        fn march(&self, _: &mut FrontToBack, _: &(), _: usize, _: &Segment) -> bool {
             self.marched.fetch_add(1, Ordering::Relaxed);
             false
         }
