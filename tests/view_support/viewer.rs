@@ -19,9 +19,13 @@ pub struct Viewer {
 }
 
 impl Viewer {
-    /// Starts `volray view ARGS --port 0 --no-browser` and reads its URL.
+    /// Starts `volray view ARGS --port 0 --no-browser` and reads its URL:
+    /// the `volray` this test was built with, or `VOLRAY_VIEW_BIN` (a
+    /// benchmark alternating a baseline build with this one).
     pub fn start(args: &[&str]) -> Viewer {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_volray"))
+        let volray = std::env::var_os("VOLRAY_VIEW_BIN")
+            .unwrap_or_else(|| env!("CARGO_BIN_EXE_volray").into());
+        let mut child = Command::new(volray)
             .arg("view")
             .args(args)
             .args(["--port", "0", "--no-browser"])

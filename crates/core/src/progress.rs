@@ -1,9 +1,10 @@
 //! A frame's progress, told and asked: the casters report the pixels they
 //! finish after each tile or row ([`Progress::done`]), and ask before
-//! each whether the frame was stopped ([`Progress::stopped`]): a caller
-//! that sets the stop flag (Ctrl-C in Python, a newer frame in the
-//! viewer) gets its thread back within one tile's work, about a
-//! millisecond, and the renderer answers
+//! each whether the frame was stopped ([`Progress::stopped`]), the
+//! bricked caster also between the bricks of a tile: a caller that sets
+//! the stop flag (Ctrl-C in Python, a newer frame in the viewer) gets its
+//! thread back within one tile's work (one brick's on the bricked path),
+//! about a millisecond at the usual steps, and the renderer answers
 //! [`RenderError::Stopped`](crate::RenderError::Stopped). A stopped frame
 //! leaves the renderer's caches as they were: each brick is lit or not,
 //! never half.

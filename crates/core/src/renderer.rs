@@ -643,6 +643,17 @@ impl<'v> Renderer<'v> {
     /// the occupied bricks classified by it (classified again only when
     /// it differs from the last frame's) and the lit bricks' buffers.
     pub(crate) fn fast_state(&self, classifier: Classifier) -> MutexGuard<'_, Option<FastState>> {
+        self.fast_state_until(classifier, &|| false)
+            .expect("never stopped")
+    }
+
+    /// [`Self::fast_state`], `None` if `stopped` says so while the bricks
+    /// are classified (the state is then left empty).
+    pub(crate) fn fast_state_until(
+        &self,
+        classifier: Classifier,
+        stopped: &(dyn Fn() -> bool + Sync),
+    ) -> Option<MutexGuard<'_, Option<FastState>>> {
         let mut guard = self.fast.lock().unwrap_or_else(|e| e.into_inner());
         if guard.as_ref().is_none_or(|s| s.classifier != classifier) {
             // Drop the old bricks before building the new ones.
@@ -656,7 +667,8 @@ impl<'v> Renderer<'v> {
             // One budget for both caches: the lit bricks in use first,
             // the classified ones in what they leave (see `LitBricks`).
             let budget = Budget::new(self.cache_budget);
-            let bricks = ClassifiedBricks::sharing(&source, self.macrocells(), budget.clone());
+            let bricks =
+                ClassifiedBricks::sharing(&source, self.macrocells(), budget.clone(), stopped)?;
             let lit = LitBricks::sharing(bricks.len(), budget, size_of::<Classified>());
             *guard = Some(FastState {
                 classifier,
@@ -664,7 +676,7 @@ impl<'v> Renderer<'v> {
                 lit,
             });
         }
-        guard
+        Some(guard)
     }
 
     /// Whether voxel `v` is a non-finite one rendered as empty space.
@@ -693,7 +705,11 @@ impl<'v> Renderer<'v> {
         let mut times = FrameTimes::default();
         let classifier = self.classifier(settings);
         let t0 = Instant::now();
-        let mut guard = self.fast_state(classifier);
+        // Stopped while classifying: nothing drawn (the caller answers
+        // `Stopped`).
+        let Some(mut guard) = self.fast_state_until(classifier, &|| progress.stopped()) else {
+            return times;
+        };
         let masked = self.masked();
         let state = guard.as_mut().expect("the state was just made");
         let t1 = Instant::now();

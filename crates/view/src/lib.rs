@@ -38,6 +38,7 @@
 //! [`Reproduce`] writes the state as a command and builds the settings
 //! from that command, so that the still frame and the command agree.
 
+mod coarse;
 mod encode;
 mod hello;
 mod ledger;
@@ -189,6 +190,7 @@ impl Viewer {
             others: self.others,
             time: self.time.map(Arc::new),
             figure: Arc::new(self.figure),
+            copy_above: coarse::COARSE_ABOVE,
         };
         Ok(Host {
             hello,

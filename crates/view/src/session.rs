@@ -8,15 +8,23 @@
 //!
 //! A frame is rendered with the mailbox's stop flag
 //! (`Renderer::render_stoppable`): a newer request for the tab, or the
-//! tab closing, stops it within a tile's work, and the thread goes on to
+//! tab closing, stops it within a tile's work (a brick's, on the bricked
+//! path; a frame stopped before it starts is not started), and the
+//! thread goes on to
 //! the newer request or ends. Before a frame is rendered its bytes are
 //! reserved from the server's [`Ledger`]; a frame that does not fit
 //! beside what the other tabs hold is answered with the reason, not
 //! queued.
 //!
+//! A large volume's drafts are drawn from a coarse copy of it
+//! (`coarse.rs`), made after the tab's first still is sent (or on its
+//! first draft) and kept with the tab's renderer, its bytes reserved from the ledger; the stills are always
+//! the volume's own frames.
+//!
 //! When the tab goes away the mailbox closes, the thread ends and the
 //! renderer with its caches is freed, and its reservation given back.
 
+use crate::coarse;
 use crate::encode::{self, DRAFT_QUALITY};
 use crate::ledger::{Costs, Ledger, Overdrawn, Reservation};
 use crate::mailbox::Mailbox;
@@ -36,7 +44,7 @@ use volray_annotate::colorbar::Side;
 use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
 use volray_core::camera::View;
 use volray_core::scene::{Look, Scene, SceneSettings};
-use volray_core::{Image, NonFinite, RenderError, RenderSettings, Renderer, Volume};
+use volray_core::{Image, MemoryBound, NonFinite, RenderError, RenderSettings, Renderer, Volume};
 use volray_distributed::streamed::{StreamError, Streamed};
 
 /// What the renderer thread sends to the tab's socket.
@@ -74,6 +82,10 @@ pub struct Shared {
     pub time: Option<Arc<TimePoints>>,
     /// What the annotations need of the volume beyond its renderer.
     pub figure: Arc<FigureContext>,
+    /// A volume of more voxels than this, served whole without a time
+    /// axis, is drafted from a coarse copy (`coarse.rs`,
+    /// [`coarse::COARSE_ABOVE`]).
+    pub copy_above: usize,
 }
 
 /// What a frame's annotations (`ViewState::figure`) need to know of the
@@ -183,6 +195,7 @@ pub fn spawn(
     let costs = shared.costs;
     let non_finite = shared.non_finite;
     let cache_budget = shared.cache_budget;
+    let copy_above = shared.copy_above;
     std::thread::Builder::new()
         .name("view-render".into())
         .spawn(move || {
@@ -201,6 +214,7 @@ pub fn spawn(
                 None if others.is_empty() => renderer(&volume).map(|r| Source::Whole {
                     renderer: r,
                     time: None,
+                    copy: DraftCopy::NotYet,
                 }),
                 None => (std::iter::once(&volume).chain(&others))
                     .map(|v| renderer(v))
@@ -230,6 +244,7 @@ pub fn spawn(
                 volume: &volume,
                 last_still_ms: None,
                 figure: &figure,
+                copy_above,
             };
             while let Some(request) = mailbox.take() {
                 if request.probe.is_some() {
@@ -240,19 +255,29 @@ pub fn spawn(
                     }
                     continue;
                 }
-                // A still slow to render: a quick frame of it first.
-                if let Some(quick) = tab.quick(&request)
-                    && let Ok((message, reservation)) = tab.frame(&quick, mailbox.stop_flag())
+                // A still slow to render: a quick frame of it first. A
+                // quick frame stopped stops its still too (the stop flag
+                // stays set: the still would be stopped at its first
+                // check, after classifying its bricks for nothing).
+                let frame = match tab
+                    .quick(&request)
+                    .map(|q| tab.frame(&q, mailbox.stop_flag()))
                 {
-                    stats.frame_rendered();
-                    if out
-                        .blocking_send(Outgoing::Frame(message, reservation))
-                        .is_err()
-                    {
-                        break;
+                    Some(Ok((message, reservation))) => {
+                        stats.frame_rendered();
+                        if out
+                            .blocking_send(Outgoing::Frame(message, reservation))
+                            .is_err()
+                        {
+                            break;
+                        }
+                        tab.frame(&request, mailbox.stop_flag())
                     }
-                }
-                let frame = tab.frame(&request, mailbox.stop_flag());
+                    Some(Err(FrameError::Render(RenderError::Stopped))) => {
+                        Err(FrameError::Render(RenderError::Stopped))
+                    }
+                    _ => tab.frame(&request, mailbox.stop_flag()),
+                };
                 mailbox.finished();
                 let outgoing = match frame {
                     Ok((message, reservation)) => {
@@ -278,8 +303,13 @@ pub fn spawn(
                         )
                     }
                 };
+                let sent_still =
+                    request.quality == Quality::Full && matches!(outgoing, Outgoing::Frame(..));
                 if out.blocking_send(outgoing).is_err() {
                     break;
+                }
+                if sent_still {
+                    tab.prepare_drafts(&request);
                 }
             }
             stats.add_dropped(mailbox.dropped());
@@ -296,6 +326,8 @@ enum Source<'a> {
     Whole {
         renderer: Renderer<'a>,
         time: Option<(usize, Reservation)>,
+        /// The drafts' coarse copy of the volume.
+        copy: DraftCopy,
     },
     Scene(Scene<'a>),
     Levels(LevelTab),
@@ -315,6 +347,75 @@ struct Tab<'a> {
     /// Milliseconds the last full-size frame took to render.
     last_still_ms: Option<f64>,
     figure: &'a FigureContext,
+    /// See [`Shared::copy_above`].
+    copy_above: usize,
+}
+
+/// A tab's coarse copy of its volume for the drafts (`coarse.rs`), made
+/// after the first still or on the first draft that takes it, and kept
+/// with the tab's renderer.
+// One per tab: the sizes do not matter.
+#[allow(clippy::large_enum_variant)]
+enum DraftCopy {
+    NotYet,
+    /// The copy's renderer, its smallest spacing over the volume's, and
+    /// the bytes reserved for it (its samples and its renderer's
+    /// structures, its brick caches at an eighth of the tab's budget).
+    Made {
+        renderer: Renderer<'static>,
+        ratio: f64,
+        _reserved: Reservation,
+    },
+    /// It did not fit what the memory limit has left: the drafts come
+    /// from the volume, as for a small one.
+    Refused,
+}
+
+impl DraftCopy {
+    /// The copy's renderer and spacing ratio for a draft of `settings`
+    /// of `renderer`'s volume, made now if it is the first; `None` where
+    /// the drafts come from the volume itself.
+    fn renderer(
+        &mut self,
+        cx: &Context,
+        renderer: &Renderer,
+        settings: &RenderSettings,
+        above: usize,
+    ) -> Option<(&Renderer<'static>, f64)> {
+        let volume = renderer.volume();
+        if volume.len() <= above || !coarse::drafts_from_copy(volume, settings) {
+            return None;
+        }
+        if let DraftCopy::NotYet = self {
+            *self = Self::make(cx, volume, settings).unwrap_or(DraftCopy::Refused);
+        }
+        match self {
+            DraftCopy::Made {
+                renderer, ratio, ..
+            } => Some((renderer, *ratio)),
+            _ => None,
+        }
+    }
+
+    fn make(cx: &Context, volume: &Volume, settings: &RenderSettings) -> Option<DraftCopy> {
+        let copy = cx.pool.install(|| coarse::halved(volume));
+        let ratio = coarse::spacing_ratio(volume, &copy);
+        let budget = cx.costs.cache_budget() / 8;
+        let non_finite = cx.costs.non_finite();
+        let bound = MemoryBound::for_volume(&copy, settings, non_finite, budget);
+        let reserved = (cx.ledger)
+            .reserve(
+                "the drafts' coarse copy of the volume",
+                bound.volume + bound.cleaned + bound.path,
+            )
+            .ok()?;
+        let renderer = Renderer::owning(copy, non_finite).ok()?;
+        Some(DraftCopy::Made {
+            renderer: renderer.with_cache_budget(budget),
+            ratio,
+            _reserved: reserved,
+        })
+    }
 }
 
 /// A still that took longer than this to render is preceded by a quick
@@ -335,6 +436,34 @@ struct Drawn {
 }
 
 impl Tab<'_> {
+    /// After the still `request` was sent: the drafts' coarse copy made
+    /// now, while the page shows the still, rather than on the first
+    /// draft of a drag, which would wait for it (0.08 s for 257³ voxels,
+    /// 0.7 s for 512³ on two busy cores). A request that comes meanwhile
+    /// waits as long.
+    fn prepare_drafts(&mut self, request: &Request) {
+        let Source::Whole { renderer, copy, .. } = &mut self.source else {
+            return;
+        };
+        let small = renderer.volume().len() <= self.copy_above;
+        if self.time.is_some() || small || !matches!(copy, DraftCopy::NotYet) {
+            return;
+        }
+        let Ok(reproduction) = self.reproduce.reproduce(&request.state) else {
+            return;
+        };
+        let never = AtomicBool::new(false);
+        let cx = Context {
+            pool: self.pool,
+            stats: self.stats,
+            ledger: self.ledger,
+            costs: self.costs,
+            stop: &never,
+            what: "the drafts' copy",
+        };
+        copy.renderer(&cx, renderer, &reproduction.settings, self.copy_above);
+    }
+
     /// A quick draft of the still `request` asks for, where the last still
     /// took longer than [`SLOW_STILL_MS`]: its scale aims at [`QUICK_MS`]
     /// (the time goes with the pixels, the square of the scale).
@@ -450,11 +579,29 @@ impl Tab<'_> {
             )));
         }
         let mut drawn = match &mut self.source {
-            Source::Whole { renderer, time } => {
+            Source::Whole {
+                renderer,
+                time,
+                copy,
+            } => {
                 if let Some(points) = self.time {
                     at_time(points, self.volume, request.state.time, renderer, time, &cx)?;
                 }
-                cx.whole(renderer, full, &settings)?
+                let drafted = (request.quality == Quality::Draft && self.time.is_none())
+                    .then(|| copy.renderer(&cx, renderer, &settings, self.copy_above))
+                    .flatten();
+                match drafted {
+                    Some((coarse, ratio)) => {
+                        let drawn = coarse::draft_settings(
+                            &settings,
+                            renderer.value_range(),
+                            ratio,
+                            || renderer.max_gradient(),
+                        );
+                        cx.whole(renderer, coarse, full, &drawn)?
+                    }
+                    None => cx.whole(renderer, renderer, full, &settings)?,
+                }
             }
             Source::Scene(scene) => {
                 let Some(looks) = &reproduction.scene else {
@@ -527,18 +674,20 @@ struct Context<'a> {
 }
 
 impl Context<'_> {
-    /// A frame of `settings` from `renderer`, whose tab reserved
-    /// `reserved` for its structures; its basis is that of `full`.
+    /// A frame of `settings` drawn by `drawing` (`renderer`, or its
+    /// volume's coarse copy for a draft); its basis is that of `full`
+    /// from `renderer`.
     fn whole(
         &self,
         renderer: &Renderer,
+        drawing: &Renderer,
         full: &RenderSettings,
         settings: &RenderSettings,
     ) -> Result<Drawn, FrameError> {
         let basis = basis(renderer, full)?;
-        let (bytes, message_bytes) = self.costs.frame(renderer.volume(), settings);
+        let (bytes, message_bytes) = self.costs.frame(drawing.volume(), settings);
         let reserved = self.ledger.reserve(self.what, bytes)?;
-        let image = self.render(renderer, settings)?;
+        let image = self.render(drawing, settings)?;
         Ok(Drawn {
             image,
             basis,
@@ -584,11 +733,17 @@ impl Context<'_> {
         self.rendering(|| renderer.render_stoppable(settings, &|_| {}, self.stop))
     }
 
-    /// `work` on the pool, counted as a frame rendering.
+    /// `work` on the pool, counted as a frame rendering; not started
+    /// when the frame is stopped already (a renderer would classify its
+    /// bricks before its first check: 0.44 s for `fractal:257` at step
+    /// 0.01, more for a 512³ volume).
     fn rendering(
         &self,
         work: impl FnOnce() -> Result<Image, RenderError> + Send,
     ) -> Result<Image, FrameError> {
+        if self.stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(RenderError::Stopped.into());
+        }
         let _rendering = self.stats.rendering();
         Ok(self.pool.install(work)?)
     }
@@ -942,6 +1097,7 @@ mod tests {
             others: Vec::new(),
             time: None,
             figure: Arc::new(FigureContext::default()),
+            copy_above: usize::MAX,
         }
     }
 
@@ -1267,6 +1423,71 @@ mod tests {
         let info = reader.next_frame(&mut buf).unwrap();
         buf.truncate(info.buffer_size());
         buf
+    }
+
+    #[test]
+    fn a_large_volumes_drafts_come_from_its_coarse_copy_and_its_still_from_the_volume() {
+        for large in [false, true] {
+            let mut shared = shared();
+            // The 17³ volume counts as large, or not.
+            shared.copy_above = if large { 0 } else { usize::MAX };
+            let mailbox = Arc::new(Mailbox::default());
+            let (tx, mut rx) = mpsc::channel(1);
+            spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+            let tab = shared.ledger.held();
+            let (h, _) = one_frame(&mailbox, &mut rx, request(1, Quality::Draft, 64, 30.0));
+            assert_eq!(
+                (h["quality"].as_str(), h["width"].as_u64()),
+                (Some("draft"), Some(32))
+            );
+            // The copy (9³ voxels and its renderer) is held with the tab.
+            let copy = shared.ledger.held() - tab;
+            assert_eq!(
+                copy > 9 * 9 * 9 * 4,
+                large,
+                "{copy} bytes held beside the tab"
+            );
+            // The still after it is the volume's own frame, pixel for
+            // pixel, as the Command box reproduces it.
+            let still = request(2, Quality::Full, 64, 30.0);
+            let settings = Plain::default().reproduce(&still.state).unwrap().settings;
+            let want = Renderer::new(&shared.volume)
+                .unwrap()
+                .render(&settings)
+                .unwrap();
+            let (h, png) = one_frame(&mailbox, &mut rx, still);
+            assert_eq!(h["quality"], "full");
+            let want = encode::png(&want, &mut Vec::new()).unwrap();
+            assert!(pixels(&png) == pixels(&want), "large: {large}");
+            // A second draft uses the copy made for the first.
+            one_frame(&mailbox, &mut rx, request(3, Quality::Draft, 64, 40.0));
+            assert_eq!(shared.ledger.held(), tab + copy);
+            mailbox.close();
+            assert!(rx.blocking_recv().is_none());
+            assert_eq!(shared.ledger.held(), 0, "given back with the tab");
+
+            // A tab whose first frame is a still makes the copy after
+            // sending it, before any draft: once a probe that follows is
+            // answered, it is held.
+            let mailbox = Arc::new(Mailbox::default());
+            let (tx, mut rx) = mpsc::channel(1);
+            spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+            one_frame(&mailbox, &mut rx, request(4, Quality::Full, 64, 30.0));
+            let mut probe = request(5, Quality::Full, 64, 30.0);
+            probe.probe = Some([32, 32]);
+            mailbox.put(Slot::Probe, probe);
+            assert!(matches!(rx.blocking_recv(), Some(Outgoing::Text(_))));
+            // (Its renderer's bound is the still's here, the draft's above.)
+            let held = shared.ledger.held() - tab;
+            assert_eq!(
+                held > 9 * 9 * 9 * 4,
+                large,
+                "{held} bytes held beside the tab"
+            );
+            mailbox.close();
+            assert!(rx.blocking_recv().is_none());
+            assert_eq!(shared.ledger.held(), 0);
+        }
     }
 
     #[test]
