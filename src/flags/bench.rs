@@ -26,7 +26,7 @@ pub struct BenchArgs {
     /// +x, step 0.5 voxel, their transfer functions and shading. The input,
     /// camera, rendering and sampling options do not apply, and are
     /// refused (--threads does, --shadows adds shadows, the camera's key
-    /// light, and --ambient-occlusion [RADIUS] ambient occlusion).
+    /// light, and --ambient-occlusion ambient occlusion).
     #[arg(long, value_name = "DIR", conflicts_with_all = peers_ignores())]
     pub peers: Option<PathBuf>,
 
