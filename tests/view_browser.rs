@@ -830,6 +830,38 @@ async fn the_crop_clip_and_lighting_controls_change_the_frame_and_the_command_is
     let lit = picture(&b.frame_bytes().await, dir.path(), "lit.png");
     assert_ne!(lit, start);
     assert_eq!(run_shown(&b, dir.path()).await, lit, "lighting");
+
+    // The depth cues: shadows from that light, then ambient occlusion of
+    // radius 3 with more ambient light to show it.
+    b.click("#shadows").await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(command.contains("--shadows"), "{command}");
+    let shadowed = picture(&b.frame_bytes().await, dir.path(), "shadowed.png");
+    assert_ne!(shadowed, lit, "the shadows changed nothing");
+    assert_eq!(run_shown(&b, dir.path()).await, shadowed, "shadows");
+    set("l-ambient", "0.6").await;
+    set("ao-radius", "3").await;
+    b.click("#ao").await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(command.contains("--ambient-occlusion 3"), "{command}");
+    let occluded = picture(&b.frame_bytes().await, dir.path(), "occluded.png");
+    assert_eq!(
+        run_shown(&b, dir.path()).await,
+        occluded,
+        "ambient occlusion"
+    );
+    // Unlit, the shadows go and the ambient occlusion stays.
+    b.click("#shading").await;
+    b.wait_still().await;
+    let command = b.text("command").await;
+    assert!(
+        !command.contains("--shadows") && command.contains("--ambient-occlusion 3"),
+        "{command}"
+    );
+    let disabled = "return document.getElementById('shadows').disabled;";
+    assert_eq!(b.eval(disabled).await, serde_json::json!(true));
     b.close().await;
 }
 

@@ -57,9 +57,6 @@ pub struct CliReproduce {
     lighting: Vec<String>,
     /// `--light-color`, when lit.
     light_color: Vec<String>,
-    /// `--shadows`, when lit; `--ambient-occlusion`, when composited.
-    shadows: bool,
-    ambient_occlusion: Option<f64>,
     /// `--opacity P,Q` as given.
     ramp: Option<(f32, f32)>,
     /// The transfer function the flags named, its window in the data's
@@ -191,8 +188,6 @@ impl CliReproduce {
             iso_thickness: iso_thickness.0,
             lighting: lighting.0,
             light_color: light_color.0,
-            shadows: look.shadows,
-            ambient_occlusion: look.ambient_occlusion,
             ramp: look.opacity,
             start,
             log: look.log,
@@ -348,8 +343,8 @@ impl CliReproduce {
             } else {
                 w.word("--no-shading");
             }
-            w.flag("--shadows", state.shading && self.shadows);
-            let radius = self.ambient_occlusion.map(|r| r.to_string());
+            w.flag("--shadows", state.shading && state.shadows);
+            let radius = state.ambient_occlusion.map(|r| r.to_string());
             w.opt("--ambient-occlusion", radius);
         }
         let colours = match state.colormap.as_str() {

@@ -108,6 +108,25 @@ def test_shadows_are_kept_while_lit_and_dropped_under_a_projection(ball, tmp_pat
     tab.close()
 
 
+def test_the_pages_depth_cues_are_the_keywords(ball, tmp_path):
+    # The page turns ambient occlusion on and shading off: the shadows
+    # go, the occlusion stays, and the keywords render the frame shown.
+    host = _ViewHost(ball, size=(48, 40), shadows=True, azimuth=40)
+    tab = host.open()
+    state = json.loads(tab.next()[1])["start"]
+    assert state["shadows"] is True and "ambient_occlusion" not in state
+    state["ambient_occlusion"] = 3
+    state["shading"] = False
+    header, shown = frame_of(ask(tab, state, 1), tmp_path)
+    keywords = host.keywords()
+    assert keywords["ambient_occlusion"] == 3 and "shadows" not in keywords, keywords
+    assert "ambient_occlusion=3" in header["command"], header["command"]
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **keywords)))
+    plain = {k: v for k, v in keywords.items() if k != "ambient_occlusion"}
+    assert not np.array_equal(shown[:, :, :3], rgb(volray.render(ball, **plain)))
+    tab.close()
+
+
 def test_bad_messages_are_answered_and_closed_tabs_end(ball):
     host = _ViewHost(ball, size=32)
     tab = host.open()

@@ -311,6 +311,8 @@ function start(message) {
   state.clip = state.clip ?? [];
   state.crop = state.crop ?? null;
   state.lighting = state.lighting ?? null;
+  state.shadows = state.shadows ?? false;
+  state.ambient_occlusion = state.ambient_occlusion ?? null;
   state.layers = state.layers ?? [];
   state.figure = state.figure ?? {};
   const [nx, ny, nz] = message.dims;
@@ -486,6 +488,15 @@ function showCuts() {
     $("l-elevation").value = Math.asin(clamp(z / n, -1, 1)) * 180 / Math.PI;
   }
   $("l-azimuth").disabled = $("l-elevation").disabled = !l.light;
+  // Depth cues: shadows where lit, ambient occlusion where composited;
+  // one volume's (a scene refuses them).
+  const scene = state.layers.length > 0;
+  $("shadows").checked = state.shadows;
+  $("shadows").disabled = scene || isProjection() || !state.shading;
+  $("ao").checked = state.ambient_occlusion !== null;
+  $("ao").disabled = scene || isProjection();
+  if (state.ambient_occlusion !== null) $("ao-radius").value = state.ambient_occlusion;
+  $("ao-radius").disabled = $("ao").disabled || state.ambient_occlusion === null;
 }
 
 // The figure: what volray-annotate draws into the frame.
@@ -762,6 +773,13 @@ for (const id of ["clip-axis", "clip-flip", "clip-at"]) {
   onControl(id, "input", () => { state.clip = readClip(); }, "draft");
   onControl(id, "change", () => { state.clip = readClip(); });
 }
+onControl("shadows", "change", (el) => { state.shadows = el.checked; });
+onControl("ao", "change", (el) => {
+  state.ambient_occlusion = el.checked ? clamp(Math.round(Number($("ao-radius").value)) || 8, 1, 32) : null;
+});
+onControl("ao-radius", "change", (el) => {
+  if (state.ambient_occlusion !== null) state.ambient_occlusion = clamp(Math.round(Number(el.value)) || 8, 1, 32);
+});
 for (const id of ["l-ambient", "l-diffuse", "l-specular", "l-shininess", "headlight", "l-azimuth", "l-elevation"]) {
   onControl(id, "input", () => { state.lighting = readLighting(); }, "draft");
   onControl(id, "change", () => { state.lighting = readLighting(); });

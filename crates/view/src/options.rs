@@ -77,6 +77,8 @@ pub fn start_state(options: &Options, settings: &RenderSettings) -> ViewState {
             .map(|&(point, normal)| [point, normal])
             .collect(),
         lighting: None,
+        shadows: look.shadows,
+        ambient_occlusion: look.ambient_occlusion,
         figure: crate::state::Figure::default(),
     }
 }
@@ -165,6 +167,8 @@ pub fn state_options(state: &ViewState, start: &OptionsStart) -> Result<Options,
         look.ambient_occlusion = None;
         unlit(look);
     } else {
+        look.shadows = state.shadows;
+        look.ambient_occlusion = state.ambient_occlusion;
         if opacity.is_some() {
             look.opacity = None;
         }
@@ -300,12 +304,11 @@ mod tests {
         volray_options::settings(&got).unwrap();
 
         // A projection drops the opacity, the lighting and the shadows.
-        let mut shadowed = start.clone();
-        shadowed.options.look.shadows = true;
         state.shading = true;
-        assert!(state_options(&state, &shadowed).unwrap().look.shadows);
+        state.shadows = true;
+        assert!(state_options(&state, &start).unwrap().look.shadows);
         state.blend = BlendMode::Mip;
-        let got = state_options(&state, &shadowed).unwrap();
+        let got = state_options(&state, &start).unwrap();
         let Some(Tf::Function(tf)) = &got.look.tf else {
             panic!()
         };
@@ -313,19 +316,15 @@ mod tests {
         assert_eq!(got.look.ambient, Phong::default().ambient);
         assert!(!got.look.shadows);
         volray_options::settings(&got).unwrap();
-        // And the ambient occlusion, which an unlit composite keeps.
-        let mut occluded = start.clone();
-        occluded.options.look.ambient_occlusion = Some(4.0);
-        assert_eq!(
-            state_options(&state, &occluded)
-                .unwrap()
-                .look
-                .ambient_occlusion,
-            None
-        );
+        // And the ambient occlusion, which an unlit composite keeps (but
+        // not its shadows).
+        state.ambient_occlusion = Some(4.0);
+        let got = state_options(&state, &start).unwrap();
+        assert_eq!(got.look.ambient_occlusion, None);
         state.blend = BlendMode::Composite;
         state.shading = false;
-        let got = state_options(&state, &occluded).unwrap();
+        let got = state_options(&state, &start).unwrap();
+        assert!(!got.look.shadows);
         assert_eq!(got.look.ambient_occlusion, Some(4.0));
         volray_options::settings(&got).unwrap();
     }

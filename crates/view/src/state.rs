@@ -119,6 +119,13 @@ pub struct ViewState {
     /// Phong's terms and the light; `None`: as started.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lighting: Option<Lighting>,
+    /// Shadows (`--shadows`), where the frame is lit.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub shadows: bool,
+    /// Ambient occlusion's radius in voxels (`--ambient-occlusion`);
+    /// `None`: off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ambient_occlusion: Option<f64>,
     /// What is drawn into the frame (`--colorbar`, `--scale-bar`, ...).
     #[serde(default, skip_serializing_if = "Figure::is_bare")]
     pub figure: Figure,
@@ -245,6 +252,10 @@ impl ViewState {
             if point.is_some_and(|p| !p.iter().all(|x| x.is_finite())) {
                 return Err(StateError::NotFinite { field });
             }
+        }
+        if let Some(radius) = self.ambient_occlusion {
+            let radii = volray_core::shadows::ambient::RADII;
+            within("ambient_occlusion", radius, (*radii.start(), *radii.end()))?;
         }
         if let Some(fov) = self.perspective {
             within("perspective", fov, (0.0, 180.0))?;
@@ -437,6 +448,8 @@ pub(crate) mod tests {
             crop: None,
             clip: Vec::new(),
             lighting: None,
+            shadows: false,
+            ambient_occlusion: None,
             figure: Figure::default(),
         }
     }
@@ -452,8 +465,12 @@ pub(crate) mod tests {
         s.iso = Some(0.25);
         assert_eq!(s.check(), Ok(()));
         let json = serde_json::to_value(&s).unwrap();
-        // One volume's state says nothing of scenes or time.
-        assert!(json.get("layers").is_none() && json.get("time").is_none());
+        // One volume's state says nothing of scenes, time or depth cues.
+        for field in ["layers", "time", "shadows", "ambient_occlusion"] {
+            assert!(json.get(field).is_none(), "{field}");
+        }
+        s.shadows = true;
+        s.ambient_occlusion = Some(6.0);
         s.layers.push(LayerState {
             visible: false,
             window: Some([0.0, 1.0]),
@@ -476,6 +493,10 @@ pub(crate) mod tests {
             (|s| s.azimuth = f64::NAN, "azimuth must be finite"),
             (|s| s.elevation = 2e6, "elevation"),
             (|s| s.zoom = 0.0, "zoom"),
+            (
+                |s| s.ambient_occlusion = Some(0.5),
+                "ambient_occlusion 0.5 is outside 1 to 32",
+            ),
             (|s| s.look_at = Some([0.0, f64::INFINITY, 0.0]), "look_at"),
             (|s| s.perspective = Some(180.0), "perspective"),
             (|s| s.perspective = Some(0.0), "perspective"),
