@@ -344,7 +344,8 @@ async fn timed_drag(b: &Browser, moves: u32, dx: f64) -> (f64, f64, f64) {
 }
 
 /// Issue 27's goals in a 1280×800 viewport, the frame filling the window
-/// (no --size): `VOLRAY_VIEW_BENCH_ARGS` (default `fractal:257`), e.g.
+/// (no --size): `VOLRAY_VIEW_BENCH_ARGS` (default `fractal:257 --colormap
+/// magma`, as docs/viewer.md measures it), e.g.
 /// `"/tmp/ct512.raw --dims 512,512,512 --dtype i16 --preset ct-bone"`.
 #[tokio::test(flavor = "current_thread")]
 #[ignore = "a benchmark: run on a quiet machine with --ignored --nocapture"]
@@ -352,7 +353,8 @@ async fn the_application_at_1280_by_800() {
     if !browser::available() {
         return;
     }
-    let args = std::env::var("VOLRAY_VIEW_BENCH_ARGS").unwrap_or("fractal:257".into());
+    let args =
+        std::env::var("VOLRAY_VIEW_BENCH_ARGS").unwrap_or("fractal:257 --colormap magma".into());
     let mut words: Vec<&str> = args.split_whitespace().collect();
     words.extend(["--threads", "2"]);
     let viewer = Viewer::start(&words);
@@ -437,7 +439,8 @@ async fn the_application_at_1280_by_800() {
             .unwrap();
         tokio::time::sleep(Duration::from_millis(1500)).await;
         let e = events(&b).await;
-        waits.push(first(&e, "frame", t).unwrap() - t);
+        // No frame within the 1.5 s waited: a miss, counted as infinite.
+        waits.push(first(&e, "frame", t).map_or(f64::INFINITY, |f| f - t));
         b.eval("window.volrayView.sendState({}); return 0;").await;
         b.wait_still().await;
     }
