@@ -253,7 +253,8 @@ impl<'v> Renderer<'v> {
 
     /// [`Self::render_with_progress`], stopped when `stop` is set (by
     /// another thread): the work left is skipped, within about one tile's
-    /// time, and the answer is [`RenderError::Stopped`].
+    /// time (one brick's on the bricked path, see [`crate::progress`]),
+    /// and the answer is [`RenderError::Stopped`].
     pub fn render_stoppable(
         &self,
         settings: &RenderSettings,
