@@ -253,7 +253,7 @@ impl<'v> Renderer<'v> {
 
     /// [`Self::render_with_progress`], stopped when `stop` is set (by
     /// another thread): the work left is skipped, within about one tile's
-    /// time (one brick's on the bricked path, see [`crate::progress`]),
+    /// time (one brick's on the bricked path),
     /// and the answer is [`RenderError::Stopped`].
     pub fn render_stoppable(
         &self,
