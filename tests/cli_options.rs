@@ -21,6 +21,37 @@ impl Picture {
             .filter(|&(c, r)| self.lit(c, r))
             .count()
     }
+
+    /// The sum of every pixel's channels.
+    fn brightness(&self) -> u64 {
+        self.rgb.iter().flatten().map(|&c| c as u64).sum()
+    }
+
+    /// Whether no channel of any pixel is brighter than in `other`.
+    fn nowhere_brighter_than(&self, other: &Picture) -> bool {
+        (self.rgb.iter().zip(&other.rgb)).all(|(a, b)| (0..3).all(|c| a[c] <= b[c]))
+    }
+
+    /// The largest difference of a channel from `other`'s, in levels.
+    fn worst_difference(&self, other: &Picture) -> u8 {
+        (self.rgb.iter().zip(&other.rgb))
+            .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
+            .max()
+            .unwrap()
+    }
+}
+
+/// `render fractal:17` with `flags`, which must be refused: its message,
+/// no output written.
+fn refused(dir: &Path, flags: &[&str]) -> String {
+    let out = dir.join("refused.png");
+    let mut args = vec!["render", "fractal:17"];
+    args.extend_from_slice(flags);
+    args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+    let run = volray(&args);
+    assert!(!run.status.success(), "{flags:?}");
+    assert!(!out.exists());
+    stderr(&run)
 }
 
 /// Renders with `args` to a PNG in `dir` and reads it back.
@@ -540,37 +571,21 @@ fn shadows_darken_what_the_light_cannot_reach_and_are_refused_where_nothing_is_l
     };
     let shadowed = with(&["--shadows"]);
     let reference = with(&["--shadows", "--reference"]);
-    let sum = |p: &Picture| p.rgb.iter().flatten().map(|&c| c as u64).sum::<u64>();
     assert!(
-        sum(&shadowed) * 10 < sum(&plain) * 9,
+        shadowed.brightness() * 10 < plain.brightness() * 9,
         "shadows darken the picture: {} vs {}",
-        sum(&shadowed),
-        sum(&plain)
+        shadowed.brightness(),
+        plain.brightness()
     );
-    assert!(
-        shadowed
-            .rgb
-            .iter()
-            .zip(&plain.rgb)
-            .all(|(s, p)| (0..3).all(|c| s[c] <= p[c]))
-    );
-    let worst = (shadowed.rgb.iter().zip(&reference.rgb))
-        .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
-        .max()
-        .unwrap();
+    assert!(shadowed.nowhere_brighter_than(&plain));
+    let worst = shadowed.worst_difference(&reference);
     assert!(worst <= 2, "fast vs reference with shadows: {worst} levels");
-    for refused in [
+    for flags in [
         &["--shadows", "--blend", "mip"][..],
         &["--shadows", "--no-shading"][..],
     ] {
-        let out = dir.path().join("refused.png");
-        let mut args = vec!["render", "fractal:17"];
-        args.extend_from_slice(refused);
-        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
-        let run = volray(&args);
-        assert!(!run.status.success(), "{refused:?}");
-        assert!(stderr(&run).contains("--shadows"), "{}", stderr(&run));
-        assert!(!out.exists());
+        let err = refused(dir.path(), flags);
+        assert!(err.contains("--shadows"), "{err}");
     }
 }
 
@@ -591,33 +606,22 @@ fn ambient_occlusion_darkens_the_ambient_light_in_creases_and_is_refused_where_n
     let occluded = with(&["--ambient-occlusion", "4"]);
     let reference = with(&["--ambient-occlusion", "4", "--reference"]);
     let wider = with(&["--ambient-occlusion"]);
-    let sum = |p: &Picture| p.rgb.iter().flatten().map(|&c| c as u64).sum::<u64>();
-    assert!(sum(&occluded) * 10 < sum(&plain) * 9);
-    assert!(sum(&wider) < sum(&occluded));
+    assert!(occluded.brightness() * 10 < plain.brightness() * 9);
+    assert!(wider.brightness() < occluded.brightness());
     assert!(
-        (occluded.rgb.iter().zip(&plain.rgb)).all(|(o, p)| (0..3).all(|c| o[c] <= p[c])),
+        occluded.nowhere_brighter_than(&plain),
         "ambient occlusion only takes light away"
     );
-    let worst = (occluded.rgb.iter().zip(&reference.rgb))
-        .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
-        .max()
-        .unwrap();
+    let worst = occluded.worst_difference(&reference);
     assert!(worst <= 1, "fast vs reference: {worst} levels");
-    for (refused, why) in [
+    for (flags, why) in [
         (&["--ambient-occlusion", "--blend", "mip"][..], "unshaded"),
         (&["--ambient-occlusion", "40"][..], "1 to 32 voxels"),
     ] {
-        let out = dir.path().join("refused.png");
-        let mut args = vec!["render", "fractal:17"];
-        args.extend_from_slice(refused);
-        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
-        let run = volray(&args);
-        assert!(!run.status.success(), "{refused:?}");
-        let err = stderr(&run);
+        let err = refused(dir.path(), flags);
         assert!(
             err.contains("--ambient-occlusion") && err.contains(why),
             "{err}"
         );
-        assert!(!out.exists());
     }
 }
