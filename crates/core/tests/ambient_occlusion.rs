@@ -18,17 +18,12 @@ use volray_core::{
 };
 
 /// The reference's and the fast path's occlusion of every voxel of a grid
-/// of unit opacities `alpha`, `spacing` apart.
-fn both(
-    alpha: &[f32],
-    dims: [usize; 3],
-    spacing: DVec3,
-    rays: &AmbientRays,
-) -> (Vec<f32>, AmbientVolume) {
+/// of unit opacities `alpha`, the rays' spacing apart.
+fn both(alpha: &[f32], dims: [usize; 3], rays: &AmbientRays) -> (Vec<f32>, AmbientVolume) {
     let [nx, ny, _] = dims;
-    let marched = reference_occlusion(alpha, dims, spacing, rays);
+    let marched = reference_occlusion(alpha, dims, rays);
     let at = |i, j, k| alpha[i + nx * (j + ny * k)];
-    let computed = AmbientVolume::compute(dims, spacing, rays, at);
+    let computed = AmbientVolume::compute(dims, rays, at);
     (marched, computed)
 }
 
@@ -68,7 +63,7 @@ fn a_flat_open_surface_sees_the_whole_sky_and_a_crease_less() {
         .map(|v| f32::from(u8::from(opaque(v % 20, v / 400))))
         .collect();
     let rays = AmbientRays::new(4.0, DVec3::ONE);
-    let both = both(&alpha, dims, DVec3::ONE, &rays);
+    let both = both(&alpha, dims, &rays);
     let crease = 1.0 - (std::f64::consts::FRAC_1_SQRT_2 + 2.0 / 3f64.sqrt()) / UP;
     for (voxel, want) in [
         ([14, 10, 6], 1.0),
@@ -101,7 +96,7 @@ fn in_a_uniform_medium_each_ray_keeps_the_transmittance_of_its_length() {
             })
             .sum::<f64>()
             / 26.0;
-        assert_occlusion(&both(&alpha, dims, spacing, &rays), [10, 10, 10], want);
+        assert_occlusion(&both(&alpha, dims, &rays), [10, 10, 10], want);
     }
 }
 
@@ -122,7 +117,7 @@ fn the_ambient_volume_is_the_marched_occlusion_of_every_voxel() {
             .map(|&f| (f * 0.8).clamp(0.0, 1.0))
             .collect();
         let rays = AmbientRays::new(radius, volume.spacing());
-        let (marched, computed) = both(&alpha, dims, volume.spacing(), &rays);
+        let (marched, computed) = both(&alpha, dims, &rays);
         let mut worst = 0.0f32;
         let mut darkest = 1.0f32;
         for k in 0..dims[2] {
@@ -182,7 +177,7 @@ fn the_plate_under_the_ball_gets_less_ambient_light_than_the_plate_in_the_open()
     let dims = volume.dims();
     let alpha: Vec<f32> = volume.values().to_vec();
     let rays = AmbientRays::new(6.0, DVec3::ONE);
-    let (_, computed) = both(&alpha, dims, DVec3::ONE, &rays);
+    let (_, computed) = both(&alpha, dims, &rays);
     let open = computed.at([3, 3, 5]) as f64;
     let under = computed.at([18, 18, 5]) as f64;
     let corners = 4.0 / 3f64.sqrt() / UP;

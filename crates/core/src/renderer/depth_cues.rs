@@ -161,8 +161,11 @@ impl Renderer<'_> {
     ) -> Option<Vec<f32>> {
         let (rays, unit) = self.ambient_rays(settings, classifier)?;
         let unit = self.opacities(&unit, gradients);
-        let (dims, spacing) = (self.volume.dims(), self.volume.spacing());
-        Some(ambient::reference_occlusion(&unit, dims, spacing, &rays))
+        Some(ambient::reference_occlusion(
+            &unit,
+            self.volume.dims(),
+            &rays,
+        ))
     }
 
     /// The kept light volume, locked for a frame; a frame without
@@ -235,8 +238,7 @@ impl Renderer<'_> {
             let volume = &*self.volume;
             let ambient = crate::with_samples!(volume.samples(), |data| {
                 let alpha = VoxelOpacity::new(self, data, &unit, self.masked());
-                let (dims, spacing) = (volume.dims(), volume.spacing());
-                AmbientVolume::compute(dims, spacing, &rays, |i, j, k| alpha.at(i, j, k))
+                AmbientVolume::compute(volume.dims(), &rays, |i, j, k| alpha.at(i, j, k))
             });
             *kept = Some(KeptAmbient { key, ambient });
         }

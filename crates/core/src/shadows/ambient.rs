@@ -68,6 +68,8 @@ pub struct Direction {
     /// One step's length in voxels of the smallest spacing: the opacity
     /// correction's step.
     pub length: f32,
+    /// The unit vector along the ray in world space, for its weight.
+    pub world: DVec3,
 }
 
 /// The fixed set of rays of ambient occlusion of a radius, in a grid of
@@ -75,6 +77,7 @@ pub struct Direction {
 #[derive(Debug, Clone, PartialEq)]
 pub struct AmbientRays {
     directions: Vec<Direction>,
+    spacing: DVec3,
 }
 
 impl AmbientRays {
@@ -95,11 +98,15 @@ impl AmbientRays {
                         step: [x, y, z],
                         steps: ((radius / length).round() as usize).max(1),
                         length: length as f32,
+                        world: world.normalize(),
                     });
                 }
             }
         }
-        AmbientRays { directions }
+        AmbientRays {
+            directions,
+            spacing,
+        }
     }
 
     /// The rays, 26.
@@ -128,25 +135,23 @@ impl AmbientRays {
         })
     }
 
-    /// The unit vectors of the rays in world space, for the weights.
-    pub fn world_directions(&self, spacing: DVec3) -> Vec<DVec3> {
-        (self.directions.iter())
-            .map(|d| (DVec3::from_array(d.step.map(|s| s as f64)) * spacing).normalize())
-            .collect()
+    /// The grid's spacing the rays were made for.
+    pub fn spacing(&self) -> DVec3 {
+        self.spacing
     }
 
     /// The weight of each ray at a voxel whose way out of the material is
     /// `outward` (world, any length; zero: none): the cosines of the rays
     /// with it, not below 0, or all 1 where it is zero.
-    pub fn weights(world: &[DVec3], outward: DVec3) -> impl Iterator<Item = f64> + '_ {
+    pub fn weights(&self, outward: DVec3) -> impl Iterator<Item = f64> + '_ {
         let n = outward.normalize_or_zero();
-        world.iter().map(move |d| match n == DVec3::ZERO {
+        self.directions.iter().map(move |d| match n == DVec3::ZERO {
             true => 1.0,
-            false => d.dot(n).max(0.0),
+            false => d.world.dot(n).max(0.0),
         })
     }
 
-    /// `A` at voxel `v` of a grid of `dims` voxels `spacing` apart, of the
+    /// `A` at voxel `v` of a grid of `dims` voxels, of the
     /// opacity `alpha(q, length)` at index-space points `q` corrected for a
     /// step of `length` voxels, and the weights of [`Self::weights`] for
     /// the way out of the material `outward`: the weighted mean over the
@@ -156,14 +161,13 @@ impl AmbientRays {
         &self,
         v: [usize; 3],
         dims: [usize; 3],
-        world: &[DVec3],
         outward: DVec3,
         alpha: impl Fn([f64; 3], f32) -> f64,
     ) -> f64 {
         let from = DVec3::from_array(v.map(|c| c as f64));
         let last = DVec3::from_array(dims.map(|n| (n - 1) as f64));
         let (mut sum, mut weights) = (0.0, 0.0);
-        for (d, w) in self.directions.iter().zip(Self::weights(world, outward)) {
+        for (d, w) in self.directions.iter().zip(self.weights(outward)) {
             if w == 0.0 {
                 continue;
             }
@@ -223,20 +227,14 @@ pub fn reference_tap(unit: &[f32], dims: [usize; 3], q: [f64; 3], length: f32) -
 /// rays marched ([`AmbientRays::occlusion`]). A voxel whose every
 /// neighbour is transparent gets 1 without a march, as in
 /// [`super::reference_light`].
-pub fn reference_occlusion(
-    unit: &[f32],
-    dims: [usize; 3],
-    spacing: DVec3,
-    rays: &AmbientRays,
-) -> Vec<f32> {
+pub fn reference_occlusion(unit: &[f32], dims: [usize; 3], rays: &AmbientRays) -> Vec<f32> {
     let [nx, ny, _] = dims;
-    let world = rays.world_directions(spacing);
-    let spacing32 = spacing.as_vec3().to_array();
+    let spacing32 = rays.spacing.as_vec3().to_array();
     let tap = |q: [f64; 3], length: f32| reference_tap(unit, dims, q, length);
     super::march_every_voxel(unit, dims, |from| {
         let v = from.to_array().map(|c| c as usize);
         let n = outward(v, dims, spacing32, |i, j, k| unit[i + nx * (j + ny * k)]);
         let n = glam::Vec3::from(n).as_dvec3();
-        rays.occlusion(v, dims, &world, n, tap)
+        rays.occlusion(v, dims, n, tap)
     })
 }

@@ -27,7 +27,7 @@
 
 use super::ambient::{AmbientRays, outward};
 use crate::transfer::classifier::correct_opacity;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// Bytes per voxel of an [`AmbientVolume`].
@@ -176,12 +176,11 @@ impl Row {
 }
 
 impl AmbientVolume {
-    /// The ambient occlusion of `rays` in a grid of `dims` voxels
-    /// `spacing` apart whose voxel `(i, j, k)` has the opacity of one
+    /// The ambient occlusion of `rays` in a grid of `dims` voxels (the
+    /// rays' spacing apart) whose voxel `(i, j, k)` has the opacity of one
     /// voxel's length `unit(i, j, k)`.
     pub fn compute(
         dims: [usize; 3],
-        spacing: DVec3,
         rays: &AmbientRays,
         unit: impl Fn(usize, usize, usize) -> f32 + Sync,
     ) -> Self {
@@ -219,18 +218,17 @@ impl AmbientVolume {
                 });
         };
         let walks: Vec<Walk> = (rays.directions().iter())
-            .zip(rays.world_directions(spacing))
-            .map(|(d, world)| Walk {
+            .map(|d| Walk {
                 step: d.step,
                 steps: d.steps,
                 plane: lengths
                     .iter()
                     .position(|&x| x == d.length)
                     .expect("a length"),
-                world: world.as_vec3(),
+                world: d.world.as_vec3(),
             })
             .collect();
-        let spacing = spacing.as_vec3().to_array();
+        let spacing = rays.spacing().as_vec3().to_array();
         let mut values = vec![0u16; nx * ny * nz];
         for s in 0..rz.min(nz) {
             fill(&mut ring[s % ring_size], s);
