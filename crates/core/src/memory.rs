@@ -158,8 +158,8 @@ impl MemoryBound {
 /// holds while it is computed, one after the other; on the reference, the
 /// light and ambient light reaching each voxel (4 bytes each), the
 /// opacities they are marched through (4 bytes, let go before the shaded
-/// voxels are made; held for the frame where samples are classified),
-/// and a second copy of the gradients for post-classified samples.
+/// voxels are made; where samples are classified, the shadows' are held
+/// for the frame and the ambient occlusion's until it is computed).
 fn depth_cues(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u128 {
     let voxels: u128 = dims.iter().map(|&n| n as u128).product();
     let cues = u128::from(settings.shadows) + u128::from(settings.ambient_occlusion.is_some());
@@ -170,7 +170,10 @@ fn depth_cues(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u1
     if settings.method == Method::Reference {
         return match settings.classification {
             Classification::Pre => voxels * float * cues,
-            Classification::Post => voxels * (2 * float * cues + gradient::BYTES_PER_VOXEL as u128),
+            Classification::Post => {
+                let ambient = u128::from(settings.ambient_occlusion.is_some());
+                voxels * float * (u128::from(settings.shadows) + 2 * ambient)
+            }
         };
     }
     let shadows = match settings.shadows {

@@ -535,20 +535,20 @@ impl<'v> Renderer<'v> {
                 let classifier = self.classifier(settings);
                 let light = Self::light(settings, &frame.view);
                 let lighting = settings.shading.then_some((&settings.phong, light));
-                let mut post = PostClassifier::new(&self.volume, &classifier, lighting)
-                    .with_mask(self.non_finite.as_ref());
-                let depth_cues = settings.shadows || settings.ambient_occlusion.is_some();
-                let gradients = depth_cues.then(|| gradients(&self.volume));
+                // The depth cues' opacities from the gradients the samples
+                // interpolate: computed once.
+                let gradients = gradients(&self.volume);
                 let shadows = (settings.shadows).then(|| {
                     let (ray, shadow) = self.shadow_ray(settings, &light, &classifier);
-                    (self.opacities(&shadow, gradients.as_ref().unwrap()), ray)
+                    (self.opacities(&shadow, &gradients), ray)
                 });
+                let ambient = self.reference_ambient(settings, &classifier, &gradients);
+                let mut post =
+                    PostClassifier::with_gradients(&self.volume, gradients, &classifier, lighting)
+                        .with_mask(self.non_finite.as_ref());
                 if let Some((alpha, ray)) = &shadows {
                     post = post.with_shadows(alpha, *ray);
                 }
-                let ambient = gradients
-                    .as_ref()
-                    .and_then(|g| self.reference_ambient(settings, &classifier, g));
                 if let Some(ambient) = &ambient {
                     post = post.with_ambient_occlusion(ambient);
                 }

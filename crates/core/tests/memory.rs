@@ -158,6 +158,16 @@ fn the_bound_holds_within_ten_percent_on_every_path() {
             },
         ),
         (
+            "reference, post-classified, with shadows and ambient occlusion",
+            RenderSettings {
+                method: Method::Reference,
+                classification: Classification::Post,
+                shadows: true,
+                ambient_occlusion: Some(2.0),
+                ..base.clone()
+            },
+        ),
+        (
             "reference, pre-classified, with ambient occlusion",
             RenderSettings {
                 method: Method::Reference,

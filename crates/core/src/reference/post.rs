@@ -55,10 +55,21 @@ impl<'a> PostClassifier<'a> {
         classifier: &'a Classifier,
         lighting: Option<(&'a Phong, LightGeometry)>,
     ) -> Self {
+        Self::with_gradients(volume, gradients(volume), classifier, lighting)
+    }
+
+    /// [`Self::new`] with the volume's `gradients` already computed
+    /// ([`crate::kernels::gradient::gradients`]).
+    pub fn with_gradients(
+        volume: &'a Volume,
+        gradients: Vec<[f32; 3]>,
+        classifier: &'a Classifier,
+        lighting: Option<(&'a Phong, LightGeometry)>,
+    ) -> Self {
         PostClassifier {
             volume,
             values: volume.values(),
-            gradients: gradients(volume),
+            gradients,
             classifier,
             lighting,
             mask: None,
