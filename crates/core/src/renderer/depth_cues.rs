@@ -18,7 +18,7 @@ use crate::shadows::{self, ShadowRay};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Sample;
 use rayon::prelude::*;
-use std::sync::MutexGuard;
+use std::sync::{Mutex, MutexGuard};
 
 /// A light volume and what it was swept for.
 pub(crate) struct KeptLight {
@@ -171,21 +171,13 @@ impl Renderer<'_> {
     /// The kept light volume, locked for a frame; a frame without
     /// shadows drops it.
     pub(super) fn kept_light(&self, shadows: bool) -> MutexGuard<'_, Option<KeptLight>> {
-        let mut guard = self.light.lock().unwrap_or_else(|e| e.into_inner());
-        if !shadows {
-            *guard = None;
-        }
-        guard
+        kept(&self.light, shadows)
     }
 
     /// The kept ambient volume, locked for a frame; a frame without
     /// ambient occlusion drops it.
     pub(super) fn kept_ambient(&self, on: bool) -> MutexGuard<'_, Option<KeptAmbient>> {
-        let mut guard = self.ambient.lock().unwrap_or_else(|e| e.into_inner());
-        if !on {
-            *guard = None;
-        }
-        guard
+        kept(&self.ambient, on)
     }
 
     /// The fast paths' light volume for `classifier` and `light`: swept
@@ -244,4 +236,14 @@ impl Renderer<'_> {
         }
         kept.as_ref().map(|k| &k.ambient)
     }
+}
+
+/// `slot` locked for a frame, emptied first where the frame does not use
+/// what it keeps (`on` false): its memory goes back.
+fn kept<T>(slot: &Mutex<Option<T>>, on: bool) -> MutexGuard<'_, Option<T>> {
+    let mut guard = slot.lock().unwrap_or_else(|e| e.into_inner());
+    if !on {
+        *guard = None;
+    }
+    guard
 }
