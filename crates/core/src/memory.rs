@@ -152,7 +152,6 @@ impl MemoryBound {
     }
 }
 
-/// The reference path's samples of the rays being composited, one ray per
 /// The bytes shadows and ambient occlusion add to a frame of `settings`:
 /// on the fast paths, the light and ambient volumes (kept) and what each
 /// holds while it is computed, one after the other; on the reference, the
@@ -195,6 +194,7 @@ fn depth_cues(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u1
     shadows.0 + ambient.0 + shadows.1.max(ambient.1)
 }
 
+/// The reference path's samples of the rays being composited, one ray per
 /// worker thread: a ray takes at most the grid's diagonal over the step.
 fn ray_samples(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u128 {
     let extent = DVec3::new(
