@@ -151,12 +151,12 @@ impl AmbientRays {
         })
     }
 
-    /// `A` at voxel `v` of a grid of `dims` voxels, of the
-    /// opacity `alpha(q, length)` at index-space points `q` corrected for a
-    /// step of `length` voxels, and the weights of [`Self::weights`] for
-    /// the way out of the material `outward`: the weighted mean over the
-    /// rays of the product of `1 − α` along each (samples outside the grid
-    /// are empty).
+    /// `A` at voxel `v` of a grid of `dims` voxels, of the opacity
+    /// `alpha(q, length)` at index-space points `q` corrected for a step of
+    /// `length` voxels, and the weights of [`Self::weights`] for the way
+    /// out of the material `outward`: the weighted mean over the rays of
+    /// the product of `1 − α` along each (samples outside the grid are
+    /// empty).
     pub fn occlusion(
         &self,
         v: [usize; 3],
