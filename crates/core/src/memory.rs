@@ -38,7 +38,8 @@ use crate::reference::{self, stage1};
 use crate::settings::{Blend, Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
 use crate::shadows::ambient::AmbientRays;
 use crate::shadows::ambient_volume::{self, AmbientVolume};
-use crate::shadows::light_volume;
+use crate::shadows::light_volume::{self, LightVolume};
+use crate::shadows::opacities;
 use crate::volume::{SampleType, Volume};
 use crate::{bricks, image::Image};
 use glam::DVec3;
@@ -153,12 +154,13 @@ impl MemoryBound {
 }
 
 /// The bytes shadows and ambient occlusion add to a frame of `settings`:
-/// on the fast paths, the light and ambient volumes (kept) and what each
-/// holds while it is computed, one after the other; on the reference, the
-/// light and ambient light reaching each voxel (4 bytes each), the
-/// opacities they are marched through (4 bytes, let go before the shaded
-/// voxels are made; where samples are classified, the shadows' are held
-/// for the frame and the ambient occlusion's until it is computed).
+/// on the fast paths, the light and ambient volumes and the opacities the
+/// light is swept through (kept) and what each holds while it is
+/// computed, one after the other; on the reference, the light and ambient
+/// light reaching each voxel (4 bytes each), the opacities they are
+/// marched through (4 bytes, let go before the shaded voxels are made;
+/// where samples are classified, the shadows' are held for the frame and
+/// the ambient occlusion's until it is computed).
 fn depth_cues(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u128 {
     let voxels: u128 = dims.iter().map(|&n| n as u128).product();
     let cues = u128::from(settings.shadows) + u128::from(settings.ambient_occlusion.is_some());
@@ -178,9 +180,14 @@ fn depth_cues(dims: [usize; 3], spacing: DVec3, settings: &RenderSettings) -> u1
     let shadows = match settings.shadows {
         false => (0, 0),
         true => {
-            let plane = dims.iter().map(|&n| n as u128).max().unwrap_or(0).pow(2);
-            let kept = voxels * light_volume::BYTES_PER_VOXEL as u128;
-            (kept, 4 * plane * float)
+            let bytes = light_volume::BYTES_PER_VOXEL + opacities::BYTES_PER_VOXEL;
+            let kept = voxels * bytes as u128;
+            let step = crate::shadows::shadow_step(settings.step);
+            // The opacities' second copy while they are arranged for the
+            // sweep, then its ring of slices.
+            let arranging = voxels * opacities::BYTES_PER_VOXEL as u128;
+            let ring = LightVolume::ring_bytes(dims, step) as u128;
+            (kept, arranging.max(ring))
         }
     };
     let ambient = match settings.ambient_occlusion {

@@ -619,8 +619,8 @@ impl<'v> Renderer<'v> {
         let voxels = self.packed_voxels();
         let light = Self::light(settings, &frame.view);
         let mut kept = self.kept_light(settings.shadows);
-        let light_volume =
-            (settings.shadows).then(|| self.light_volume(settings, &classifier, &light, &mut kept));
+        let light_volume = (settings.shadows)
+            .then(|| self.light_volume(settings.step, &classifier, &light, &mut kept));
         let mut kept_ambient = self.kept_ambient(settings.ambient_occlusion.is_some());
         let ambient_volume = self.ambient_volume(settings, &classifier, &mut kept_ambient);
         let scene = post_cast::Scene {
@@ -719,7 +719,7 @@ impl<'v> Renderer<'v> {
         let light = Self::light(settings, &frame.view);
         let mut kept = self.kept_light(settings.shadows);
         let light_volume = (settings.shadows)
-            .then(|| self.light_volume(settings, &state.classifier, &light, &mut kept));
+            .then(|| self.light_volume(settings.step, &state.classifier, &light, &mut kept));
         let mut kept_ambient = self.kept_ambient(settings.ambient_occlusion.is_some());
         let ambient_volume = self.ambient_volume(settings, &state.classifier, &mut kept_ambient);
         let number = state.lit.next_frame(bins.entries());

@@ -9,6 +9,7 @@ use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
 use volray_core::scene::{Look, Mix, Scene, SceneSettings};
 use volray_core::shadows::light_volume::LightVolume;
+use volray_core::shadows::opacities::VoxelOpacities;
 use volray_core::shadows::{ShadowRay, reference_light};
 use volray_core::{
     Blend, Classification, Image, RenderError, RenderSettings, Renderer, SettingError, Volume,
@@ -60,9 +61,8 @@ fn a_ball_over_a_plate_casts_the_shadow_the_geometry_predicts() {
     let to_light = DVec3::new(1.0, 0.0, 2.0);
     let ray = ShadowRay::new(to_light, dims, DVec3::ONE, 1.0);
     let marched = reference_light(&alpha, dims, &ray);
-    let swept = LightVolume::sweep(dims, DVec3::ONE, to_light, 1.0, |i, j, k| {
-        alpha[volume.index(i, j, k)]
-    });
+    let mut opacities = VoxelOpacities::from_fn(dims, 1.0, |i, j, k| alpha[volume.index(i, j, k)]);
+    let swept = LightVolume::sweep(DVec3::ONE, to_light, &mut opacities);
     let top = 6;
     for (what, light) in [
         (

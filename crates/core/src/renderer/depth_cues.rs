@@ -14,17 +14,24 @@ use crate::settings::RenderSettings;
 use crate::shadows::ambient::{self, AmbientRays};
 use crate::shadows::ambient_volume::AmbientVolume;
 use crate::shadows::light_volume::LightVolume;
+use crate::shadows::opacities::VoxelOpacities;
 use crate::shadows::{self, ShadowRay};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Sample;
 use rayon::prelude::*;
 use std::sync::{Mutex, MutexGuard};
 
-/// A light volume and what it was swept for.
+/// The voxels' opacities for a classifier and the shadow rays' step, and
+/// the light volume swept from them for a light direction: an orbit under
+/// a light that turns with the camera sweeps again each frame, from the
+/// same opacities.
 pub(crate) struct KeptLight {
-    /// The classifier and the direction towards the light (its bits).
-    key: (Classifier, [u32; 3]),
-    light: LightVolume,
+    classifier: Classifier,
+    /// The shadow rays' step in voxels (its bits).
+    step: u64,
+    opacities: VoxelOpacities,
+    /// The direction towards the light (its bits), and the light volume.
+    swept: Option<([u32; 3], LightVolume)>,
 }
 
 /// An ambient volume and what it was computed for.
@@ -180,36 +187,56 @@ impl Renderer<'_> {
         kept(&self.ambient, on)
     }
 
-    /// The fast paths' light volume for `classifier` and `light`: swept
-    /// ([`LightVolume::sweep`]) unless `kept` was swept for both.
+    /// The fast paths' light volume for `classifier`, `light` and frames
+    /// of `step`: swept ([`LightVolume::sweep`]) unless `kept` was swept for
+    /// all three, from the voxels' opacities kept for `classifier` and the
+    /// shadow rays' step (classified again only for another).
     pub(super) fn light_volume<'k>(
         &self,
-        settings: &RenderSettings,
+        step: f64,
         classifier: &Classifier,
         light: &LightGeometry,
         kept: &'k mut Option<KeptLight>,
     ) -> &'k LightVolume {
-        let key = (
-            classifier.clone(),
-            light.to_light.to_array().map(f32::to_bits),
-        );
-        if kept.as_ref().is_none_or(|k| k.key != key) {
+        let step = shadows::shadow_step(step);
+        if kept
+            .as_ref()
+            .is_none_or(|k| k.classifier != *classifier || k.step != step.to_bits())
+        {
             *kept = None;
             let volume = &*self.volume;
-            let spacing = volume.spacing();
-            let step = shadows::shadow_step(settings.step);
-            let step_world = step * spacing.min_element();
-            let classifier = &classifier.with_step(step as f32);
-            let to_light = light.to_light.as_dvec3();
-            let light = crate::with_samples!(volume.samples(), |data| {
-                let alpha = VoxelOpacity::new(self, data, classifier, self.masked());
-                LightVolume::sweep(volume.dims(), spacing, to_light, step_world, |i, j, k| {
-                    alpha.at(i, j, k)
-                })
+            // Opacities for the shadow rays' samples, `step` voxels of
+            // the shortest spacing apart.
+            let for_step = &classifier.with_step(step as f32);
+            let opacities = crate::with_samples!(volume.samples(), |data| {
+                let alpha = VoxelOpacity::new(self, data, for_step, self.masked());
+                let step_world = step * volume.spacing().min_element();
+                VoxelOpacities::from_fn(volume.dims(), step_world, |i, j, k| alpha.at(i, j, k))
             });
-            *kept = Some(KeptLight { key, light });
+            *kept = Some(KeptLight {
+                classifier: classifier.clone(),
+                step: step.to_bits(),
+                opacities,
+                swept: None,
+            });
         }
-        &kept.as_ref().expect("swept above").light
+        let kept = kept.as_mut().expect("classified above");
+        let spacing = self.volume.spacing();
+        let key = light.to_light.to_array().map(f32::to_bits);
+        if kept.swept.as_ref().is_none_or(|(k, _)| *k != key) {
+            let to_light = light.to_light.as_dvec3();
+            let opacities = &mut kept.opacities;
+            // The last light volume is swept again in place.
+            let swept = match kept.swept.take() {
+                Some((_, mut old)) => {
+                    old.resweep(spacing, to_light, opacities);
+                    old
+                }
+                None => LightVolume::sweep(spacing, to_light, opacities),
+            };
+            kept.swept = Some((key, swept));
+        }
+        &kept.swept.as_ref().expect("swept above").1
     }
 
     /// The fast paths' ambient volume for `classifier` and a frame of

@@ -36,11 +36,13 @@
 //!
 //! **Two ways to get `T`.** The reference path marches every shadow ray as
 //! written above ([`ShadowRay::transmittance`]) from every voxel that any
-//! sample can see, in `f64`: exact, and `O(n⁴)`. The fast path sweeps a
-//! light volume across the grid once per light direction and transfer
-//! function ([`light_volume`]): each voxel's `T` from the slice before it
-//! on the way to the light, `O(n³)`, and kept while neither changes (a
-//! light fixed in the world, `--light`, is swept once for a whole orbit).
+//! sample can see, in `f64`: exact, and `O(n⁴)`. The fast path keeps
+//! every voxel's opacity per transfer function ([`opacities`]) and sweeps
+//! a light volume through them across the grid once per light direction
+//! ([`light_volume`]): each voxel's `T` from the slices before it on the
+//! way to the light, its ray sampled where the march samples it for four
+//! slices, `O(n³)`, and kept while neither changes (a light fixed in the
+//! world, `--light`, is swept once for a whole orbit).
 //!
 //! **Ambient occlusion**, the other depth cue, is here too: the ambient
 //! light reaching each point along short rays around it ([`ambient`]; the
@@ -49,6 +51,7 @@
 pub mod ambient;
 pub mod ambient_volume;
 pub mod light_volume;
+pub mod opacities;
 
 /// The step of the shadow rays, in voxels, for view rays `step` voxels
 /// apart: the same, but never less than a voxel. The light changes
