@@ -50,7 +50,7 @@
 //! read ([`LightVolume::ring_bytes`]), so that rounding does not
 //! accumulate.
 
-use super::opacities::VoxelOpacities;
+use super::opacities::{self, VoxelOpacities};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -134,11 +134,7 @@ impl LightVolume {
         let towards = to_light.normalize() / spacing;
         let a = towards.abs().max_position();
         // The other two axes, in order: `b` runs fastest in a slice.
-        let (b, c) = match a {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
+        let (b, c) = opacities::across(a);
         // One slice towards the light, in index space (`d[a] = ±1`), and
         // the shadow ray's samples per slice.
         let length = 1.0 / towards[a].abs();
@@ -379,11 +375,7 @@ struct Sweep {
 
 impl Sweep {
     fn new(n: [usize; 2], d: [f64; 2], per_slice: f64) -> Self {
-        // Slices a segment reaches back: at least `REACH`, and far enough
-        // for its last sample to lie beyond the slice behind (where the
-        // light is known) whatever the step.
-        let reach = REACH.max((1.0 / per_slice).ceil() as usize + 1);
-        let exit_slices = EXIT.max(reach);
+        let (reach, exit_slices) = Self::reaches(per_slice);
         let samples = (reach as f64 * per_slice + 1e-9).floor() as usize;
         let count = samples.min(MAX_SAMPLES);
         let spread = samples as f64 / count.max(1) as f64;
@@ -404,10 +396,19 @@ impl Sweep {
         }
     }
 
+    /// For `per_slice` of the march's samples a slice: the slices a
+    /// segment reaches back (at least `REACH`, and far enough for its last
+    /// sample to lie beyond the slice behind, where the light is known,
+    /// whatever the step), and those within which rays are marched to the
+    /// face.
+    fn reaches(per_slice: f64) -> (usize, usize) {
+        let reach = REACH.max((1.0 / per_slice).ceil() as usize + 1);
+        (reach, EXIT.max(reach))
+    }
+
     /// The ring's slices for `per_slice` of the march's samples a slice.
     fn ring_size(per_slice: f64) -> usize {
-        let reach = REACH.max((1.0 / per_slice).ceil() as usize + 1);
-        EXIT.max(reach) + 2
+        Self::reaches(per_slice).1 + 2
     }
 
     /// Slices from voxel `i` of `n` to where its ray leaves the grid

@@ -24,6 +24,16 @@ pub const BYTES_PER_VOXEL: usize = size_of::<u16>();
 /// Opacities are stored in units of `1/UNIT`.
 const UNIT: f64 = u16::MAX as f64;
 
+/// The two axes across axis `a`, the lower first: a slice across `a`
+/// is stored in rows along the first (see [`VoxelOpacities::arrange`]).
+pub(crate) fn across(a: usize) -> (usize, usize) {
+    match a {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    }
+}
+
 /// Every voxel's opacity for a sample every `unit_world` world units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VoxelOpacities {
@@ -63,11 +73,7 @@ impl VoxelOpacities {
     /// they are not so already: one pass over the grid, holding a second
     /// copy while it runs.
     pub fn arrange(&mut self, a: usize) {
-        let (b, c) = match a {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
+        let (b, c) = across(a);
         let order = [b, c, a];
         if order == self.order {
             return;
@@ -98,11 +104,6 @@ impl VoxelOpacities {
     /// rays' step.
     pub fn unit_world(&self) -> f64 {
         self.unit_world
-    }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        self.values.len() * BYTES_PER_VOXEL
     }
 
     /// Voxel `(i, j, k)`'s opacity, in [0, 1].
