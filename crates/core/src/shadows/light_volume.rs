@@ -199,8 +199,8 @@ impl LightVolume {
                 .zip(t_here[pb..].par_chunks_mut(pb))
                 .enumerate()
                 .with_min_len(min_rows)
-                .for_each_init(Vec::new, |taken, (ic, (out, t_row))| {
-                    sweep.row(isa, [ic, n], &back, &mut t_row[1..=nb], out, taken);
+                .for_each_init(Scratch::default, |scratch, (ic, (out, t_row))| {
+                    sweep.row(isa, [ic, n], &back, &mut t_row[1..=nb], out, scratch);
                 });
             ring[here].light = t_here;
         }
@@ -298,6 +298,14 @@ impl Slice {
             spans: vec![NONE; nc],
         }
     }
+}
+
+/// A thread's buffers for a row: how many samples each voxel near the
+/// faces takes, and the opacity on the face for those that share one.
+#[derive(Default)]
+struct Scratch {
+    taken: Vec<usize>,
+    face_alpha: Vec<f32>,
 }
 
 /// A point on every voxel's shadow ray of a slice, at the same offset from
@@ -433,7 +441,7 @@ impl Sweep {
         back: &[Option<&Slice>],
         t: &mut [f32],
         out: &mut [u16],
-        taken: &mut Vec<usize>,
+        scratch: &mut Scratch,
     ) {
         #[cfg(target_arch = "x86_64")]
         if isa.avx2 {
@@ -441,11 +449,11 @@ impl Sweep {
             // for AVX2 is that the CPU has it, and `isa.avx2` is private
             // to this module, true only where `Isa::best` found it
             // (`is_x86_feature_detected!`).
-            unsafe { self.row_avx2([ic, n], back, t, out, taken) };
+            unsafe { self.row_avx2([ic, n], back, t, out, scratch) };
             return;
         }
         let _ = isa;
-        self.row_body([ic, n], back, t, out, taken);
+        self.row_body([ic, n], back, t, out, scratch);
     }
 
     /// [`Self::row_body`] compiled for AVX2: the passes take eight voxels
@@ -459,9 +467,9 @@ impl Sweep {
         back: &[Option<&Slice>],
         t: &mut [f32],
         out: &mut [u16],
-        taken: &mut Vec<usize>,
+        scratch: &mut Scratch,
     ) {
-        self.row_body(at, back, t, out, taken);
+        self.row_body(at, back, t, out, scratch);
     }
 
     /// [`Self::light`], then each voxel's light rounded into `u16` units.
@@ -472,9 +480,9 @@ impl Sweep {
         back: &[Option<&Slice>],
         t: &mut [f32],
         out: &mut [u16],
-        taken: &mut Vec<usize>,
+        scratch: &mut Scratch,
     ) {
-        self.light(ic, n, back, t, taken);
+        self.light(ic, n, back, t, scratch);
         // `+ 0.5` and truncation: rounding, without a call to `roundf`.
         for (o, &t) in out.iter_mut().zip(t.iter()) {
             *o = (t.clamp(0.0, 1.0) * UNIT + 0.5) as u16;
@@ -482,8 +490,8 @@ impl Sweep {
     }
 
     /// The light reaching each voxel of row `ic` of the `n`-th slice from
-    /// the light, into `t`, from the slices `back[k]` `k` back (`taken`: a
-    /// thread's buffer). Each sample is one pass along the row over the
+    /// the light, into `t`, from the slices `back[k]` `k` back (`scratch`: a
+    /// thread's buffers). Each sample is one pass along the row over the
     /// voxels that take it (a run of the row), made only where it meets
     /// material:
     /// - a voxel whose ray leaves the grid no sooner than `exit_slices`
@@ -497,7 +505,7 @@ impl Sweep {
         n: usize,
         back: &[Option<&Slice>],
         t: &mut [f32],
-        taken: &mut Vec<usize>,
+        Scratch { taken, face_alpha }: &mut Scratch,
     ) {
         let [nb, nc] = self.n;
         let pb = nb + 2;
@@ -563,13 +571,54 @@ impl Sweep {
             };
             self.absorb(tap, ic, back, run, t);
         }
-        // The fraction of a step left at the face, for the band.
-        for (ib, &whole) in band.zip(taken.iter()) {
+        // The fraction of a step left at the face, for the band. Its
+        // voxels whose rays leave by the face `exit_c` names (the light's,
+        // or a side across the rows) share their face point, one pass;
+        // the few that leave by a row's end first are taken one by one.
+        let shares = |ib: usize| Self::exit(ib, nb, self.d[0]) >= exit_c;
+        let (shared, single) = if band.is_empty() {
+            (band.clone(), band.clone())
+        } else if rising {
+            let start = (band.clone()).find(|&ib| shares(ib)).unwrap_or(band.end);
+            (start..band.end, band.start..start)
+        } else {
+            let end = (band.clone())
+                .rev()
+                .find(|&ib| shares(ib))
+                .map_or(band.start, |ib| ib + 1);
+            (band.start..end, end..band.end)
+        };
+        let alpha = |k: usize| &done(k).alpha[..];
+        let rest = |exit: f64, whole: usize| (exit * self.per_slice - whole as f64).max(0.0) as f32;
+        if let Some(&whole) = taken.get(shared.start - band.start) {
+            let rest = rest(exit_c, whole);
+            if !shared.is_empty() && rest > 0.0 {
+                let face = Tap::at(exit_c, self.d);
+                let near = alpha(face.slices);
+                let far = (face.w > 0.0).then(|| alpha(face.slices + 1));
+                let row = (ic as isize + face.c + 1) as usize;
+                face_alpha.clear();
+                face_alpha.resize(shared.len(), 0.0);
+                Self::pass(
+                    (near, far),
+                    &face,
+                    [pb, row],
+                    shared.start,
+                    face_alpha,
+                    |f, a| *f = a,
+                );
+                for (t, &a) in t[shared].iter_mut().zip(face_alpha.iter()) {
+                    if a > 0.0 {
+                        *t *= (1.0 - a).max(0.0).powf(rest);
+                    }
+                }
+            }
+        }
+        for ib in single {
             let exit = exit(ib);
-            let rest = (exit * self.per_slice - whole as f64).max(0.0) as f32;
+            let rest = rest(exit, taken[ib - band.start]);
             if rest > 0.0 {
                 let face = Tap::at(exit, self.d);
-                let alpha = |k: usize| &done(k).alpha[..];
                 let mut alpha_face = face.bilinear(ib, ic, pb, alpha(face.slices));
                 if face.w > 0.0 {
                     let far = face.bilinear(ib, ic, pb, alpha(face.slices + 1));
