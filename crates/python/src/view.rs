@@ -102,11 +102,6 @@ impl ViewHost {
                 "{name}: a volume read lazily from a chunked file is not shown in a notebook yet: read a level whole with volray.read(path, level=N)"
             )));
         }
-        if recipe.labels {
-            return Err(value_error(format!(
-                "{name}: a label volume (labels=True) is not shown in a notebook yet: render it with volray.render"
-            )));
-        }
         let digest = recipe.digest(py, None)?;
         let prepared = recipe.prepare(py, digest)?;
         let (options, mut settings) = recipe.settings_of(&k)?;
@@ -366,6 +361,11 @@ fn words(options: &Options) -> Vec<(&'static str, Value)> {
     }
     if look.log {
         w.push(("log", Value::Bool(true)));
+    }
+    // A label volume's colours (and the labels shown) are its whole
+    // transfer function's, its label table.
+    if look.labels {
+        w.push(("labels", Value::Bool(true)));
     }
     if sampling.nonfinite == NonFinite::Transparent {
         w.push(("nonfinite", Value::Str("transparent")));

@@ -165,8 +165,6 @@ def test_bad_input_is_refused_with_python_exceptions(ball, tmp_path):
         volray.view(ball, colorbar="right")
     with pytest.raises(ValueError, match="level"):
         volray.view(ball, level=1)
-    with pytest.raises(ValueError, match="label volume"):
-        volray.view(ball.astype(np.uint8), labels=True)
     with pytest.raises(ValueError, match="zoom"):
         volray.view(ball, zoom=-1)
     with pytest.raises(ValueError, match="height"):
@@ -181,3 +179,35 @@ def test_bad_input_is_refused_with_python_exceptions(ball, tmp_path):
     assert w.state["azimuth"] == 10
     assert "<!doctype html>" in w._page and "Content-Security-Policy" in w._page
     w.close()
+
+
+def test_a_label_volume_is_shown_in_its_label_colours_and_read_back(tmp_path):
+    # Three labelled balls and an empty background (label 0).
+    x, y, z = np.mgrid[0:24, 0:24, 0:24]
+    seg = np.zeros((24, 24, 24), np.uint8)
+    for label, (cx, cy, cz) in [(1, (7, 8, 12)), (2, (16, 9, 12)), (5, (12, 16, 10))]:
+        seg[(x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2 < 25] = label
+    host = _ViewHost(seg, labels=True, show_labels=[1, 5], size=(48, 40), azimuth=30)
+    tab = host.open()
+    is_frame, hello = tab.next()
+    hello = json.loads(hello)
+    state = hello["start"]
+    state["azimuth"] = 60
+    header, shown = frame_of(ask(tab, state, 1), tmp_path)
+    # The read-back names the label table whole, as the transfer function.
+    keywords = host.keywords()
+    assert keywords["labels"] is True and "tf" in keywords
+    assert "labels=True" in header["command"]
+    expected = rgb(volray.render(seg, **keywords))
+    assert np.array_equal(shown[:, :, :3], expected)
+    ran = eval(header["command"], {"volray": volray, "volume": seg})
+    assert np.array_equal(shown[:, :, :3], rgb(ran))
+    # ... which is the table of `labels=True, show_labels=[1, 5]`: label 2
+    # hidden, which showing changes the picture.
+    camera = keywords["camera"]
+    assert np.array_equal(
+        expected, rgb(volray.render(seg, labels=True, show_labels=[1, 5], camera=camera))
+    )
+    every = rgb(volray.render(seg, labels=True, camera=camera))
+    assert not np.array_equal(every, expected)
+    tab.close()

@@ -66,7 +66,7 @@ def view(volume, *, height=560, **options):
     or a file's path) in a notebook, an anywidget: ``volray view``'s page
     in the cell's output, its frames rendered in the kernel and carried
     over the kernel's connection. ``options`` are :func:`render`'s
-    keywords (but the figure's, ``level`` and ``labels``): the view it
+    keywords (but the figure's and ``level``): the view it
     starts with; without ``size`` the frame fits the widget, ``height``
     pixels high. The widget's ``camera`` and ``transfer_function`` read
     the view shown back: ``render(volume, camera=w.camera,
