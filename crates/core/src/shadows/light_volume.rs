@@ -205,11 +205,14 @@ impl LightVolume {
                 Slice::read_row(&opacities.values()[first..first + nb], row, span);
             });
             drop(rows);
+            for &n in group {
+                let slice = &mut ring[n % ring_size];
+                Slice::count_rows(&slice.material, &mut slice.material_rows);
+            }
             // Their light: out of the ring while it is written.
             let mut lit: Vec<Lit> = (group.iter())
                 .map(|&n| {
                     let slice = &mut ring[n % ring_size];
-                    Slice::count_rows(&slice.material, &mut slice.material_rows);
                     Lit {
                         n,
                         light: std::mem::take(&mut slice.light),
@@ -762,9 +765,7 @@ impl Sweep {
         // end first (`single`, at the row's end) do not.
         let shares = |ib: usize| Self::exit(ib, nb, self.d[0]) >= exit_c;
         let rising = self.d[0] < 0.0;
-        let (shared, single) = if band.is_empty() {
-            (band.clone(), band.clone())
-        } else if rising {
+        let (shared, single) = if rising {
             let start = (band.clone()).find(|&ib| shares(ib)).unwrap_or(band.end);
             (start..band.end, band.start..start)
         } else {
