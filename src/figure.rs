@@ -28,6 +28,7 @@ pub fn annotations(args: &FigureArgs) -> Annotations {
         label: args.label.clone(),
         axes: args.axes,
         outline: args.outline,
+        units: args.units.clone(),
     }
 }
 
@@ -104,10 +105,9 @@ pub fn draw_framed(
         .file
         .as_ref()
         .and_then(|(_, info)| info.length_unit.clone());
-    let hounsfield = (args.view.look.preset.as_deref()).is_some_and(|p| p.starts_with("ct-"));
     let rendered = Rendered {
         log: args.view.look.log,
-        value_unit: hounsfield.then_some("HU"),
+        value_unit: volray_annotate::figure::preset_unit(args.view.look.preset.as_deref()),
         length_unit: length_unit.as_deref(),
         axis_names: axis_names(input),
         boxes,

@@ -184,9 +184,7 @@ pub fn figure_context(
     let look = &args.view.look;
     volray_view::FigureContext {
         log: look.log,
-        value_unit: (look.preset.as_deref())
-            .is_some_and(|p| p.starts_with("ct-"))
-            .then(|| "HU".to_string()),
+        value_unit: volray_annotate::figure::preset_unit(look.preset.as_deref()).map(String::from),
         length_unit: (input.file.as_ref()).and_then(|(_, info)| info.length_unit.clone()),
         axis_names: crate::figure::axis_names(input).map(String::from),
     }

@@ -1,5 +1,5 @@
-//! Figures from the command line: `--colorbar`, `--scale-bar`, `--axes`,
-//! `--outline`, `--title` and `--label` drawn into a still or each frame
+//! Figures from the command line: `--colorbar` (its `--units`),
+//! `--scale-bar`, `--axes`, `--outline`, `--title` and `--label` drawn into a still or each frame
 //! of an animation by volray-annotate (whose own tests hold the bar's
 //! colours at its ticks, the text to the font's rasterisation, the
 //! triad's directions). Here: the annotations land where they belong and
@@ -104,6 +104,51 @@ fn the_scale_bar_is_its_length_over_the_views_pixel_size() {
             "{size}: {longest} vs {want}"
         );
     }
+}
+
+#[test]
+fn the_colour_bar_says_the_units_given_and_hounsfield_units_under_a_ct_preset() {
+    let dir = tempfile::tempdir().unwrap();
+    let (plain, _) = render(dir.path(), "plain.png", 200, &["--colorbar"]);
+    let (kelvin, _) = render(dir.path(), "k.png", 200, &["--colorbar", "--units", "K"]);
+    let changed: Vec<usize> = (0..200 * 200)
+        .filter(|&k| plain.at(k % 200, k / 200) != kelvin.at(k % 200, k / 200))
+        .collect();
+    assert!(!changed.is_empty(), "the unit was not written");
+    assert!(
+        changed.iter().all(|&k| k % 200 >= 150),
+        "the unit changed more than the bar's ticks"
+    );
+    // A CT preset's bar is in HU, as if --units HU were given; --units wins.
+    let ct = ["--colorbar", "--preset", "ct-bone"];
+    let (preset, _) = render(dir.path(), "ct.png", 200, &ct);
+    let (hu, _) = render(
+        dir.path(),
+        "hu.png",
+        200,
+        &[&ct[..], &["--units", "HU"]].concat(),
+    );
+    let (k, _) = render(
+        dir.path(),
+        "ctk.png",
+        200,
+        &[&ct[..], &["--units", "K"]].concat(),
+    );
+    assert_eq!(preset, hu);
+    assert_ne!(preset, k);
+    let out = dir.path().join("bad.png");
+    let run = volray(&[
+        "render",
+        "sphere:16",
+        "--colorbar",
+        "--units",
+        " ",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert!(stderr(&run).contains("not a unit"), "{}", stderr(&run));
+    assert!(!out.exists());
 }
 
 #[test]

@@ -1,5 +1,5 @@
 //! What makes a frame a figure: `--colorbar`, `--scale-bar`, `--axes`,
-//! `--outline`, `--title`, `--label`, drawn into the image by volray-annotate (`figure.rs` beside
+//! `--outline`, `--title`, `--label` (and `--units`, the colour bar's), drawn into the image by volray-annotate (`figure.rs` beside
 //! `main.rs` says what was rendered).
 
 use clap::Args;
@@ -12,6 +12,11 @@ pub struct FigureArgs {
     /// window, ticks in the data's units (decades with --log).
     #[arg(long, value_name = "right|left", num_args = 0..=1, default_missing_value = "right", help_heading = "Figures")]
     pub colorbar: Option<ColorBarSide>,
+
+    /// The values' unit, written on the colour bar's ticks ("K",
+    /// "counts") [default: HU under a ct- preset, else none].
+    #[arg(long, value_name = "UNIT", value_parser = volray_annotate::figure::parse_unit, help_heading = "Figures")]
+    pub units: Option<String>,
 
     /// A scale bar in the volume's units, LENGTH long [default: a round
     /// length, about a fifth of the image]; in perspective it holds at the

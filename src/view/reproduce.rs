@@ -73,6 +73,9 @@ pub struct CliReproduce {
     /// Whether the viewer serves a time axis: the state's time point is
     /// the command's `--frame`.
     time: bool,
+    /// The unit the page's colour bar gives its values (`HU` under a CT
+    /// preset): the command, which names no preset, says it as `--units`.
+    value_unit: Option<String>,
 }
 
 /// A scene's volumes after the first as the command writes them: each
@@ -196,6 +199,8 @@ impl CliReproduce {
             max_memory,
             scene: None,
             time: false,
+            value_unit: volray_annotate::figure::preset_unit(look.preset.as_deref())
+                .map(String::from),
         }
     }
 
@@ -429,6 +434,9 @@ impl CliReproduce {
                 volray_view::ColorBarSide::Left => "left".to_string(),
             }),
         );
+        if figure.colorbar.is_some() {
+            w.opt("--units", self.value_unit.clone());
+        }
         if figure.scale_bar {
             match figure.scale_length {
                 Some(l) => w.opt("--scale-bar", Some(l.to_string())),
@@ -684,6 +692,25 @@ mod tests {
             unreachable!()
         };
         assert_eq!(out.settings, settings(&args.view).unwrap());
+    }
+
+    #[test]
+    fn a_ct_presets_colour_bar_is_in_hounsfield_units_on_the_command_too() {
+        let (r, mut state) = reproduce(&["--preset", "ct-bone"]);
+        let without = r.reproduce(&state).unwrap().command;
+        assert!(!without.contains("--units"), "{without}");
+        state.figure.colorbar = Some(volray_view::ColorBarSide::Right);
+        let (words, _) = r.words(&state).unwrap();
+        assert!(
+            words.windows(2).any(|w| w == ["--units", "HU"]),
+            "{words:?}"
+        );
+        assert!(!words.iter().any(|w| w == "--preset"), "{words:?}");
+        // Without a CT preset, render would say no unit either.
+        let (r, mut state) = reproduce(&["--colormap", "magma"]);
+        state.figure.colorbar = Some(volray_view::ColorBarSide::Right);
+        let command = r.reproduce(&state).unwrap().command;
+        assert!(!command.contains("--units"), "{command}");
     }
 
     #[test]

@@ -34,6 +34,10 @@ pub struct Annotations {
     pub axes: bool,
     /// The edges of the volume's box ([`crate::outline`]).
     pub outline: bool,
+    /// The values' unit on the colour bar, as given (`--units`): it wins
+    /// over the one known from how the volume was rendered
+    /// ([`Rendered::value_unit`]). Draws nothing by itself.
+    pub units: Option<String>,
 }
 
 impl Annotations {
@@ -168,6 +172,26 @@ pub fn annotate(image: &mut Image, what: &Annotations, subject: &Subject) {
     }
 }
 
+/// The unit of a volume's values under `preset`: Hounsfield units under a
+/// CT preset (`ct-bone`, ...), else none known. One rule for `volray
+/// render`, `volray view` and Python ([`Rendered::value_unit`]); a unit
+/// given ([`Annotations::units`]) wins over it.
+pub fn preset_unit(preset: Option<&str>) -> Option<&'static str> {
+    preset.is_some_and(|p| p.starts_with("ct-")).then_some("HU")
+}
+
+/// A unit as given (`--units`, `units=`): trimmed, 1 to 32 printable
+/// characters (it is written beside the colour bar's ticks), or why not.
+pub fn parse_unit(text: &str) -> Result<String, String> {
+    let unit = text.trim();
+    match unit.is_empty() || unit.chars().count() > 32 || unit.chars().any(char::is_control) {
+        true => Err(format!(
+            "{text:?} is not a unit: give 1 to 32 printable characters"
+        )),
+        false => Ok(unit.to_string()),
+    }
+}
+
 /// What a frame was rendered with beyond its renderer and settings.
 #[derive(Debug, Clone)]
 pub struct Rendered<'a> {
@@ -268,7 +292,7 @@ pub fn annotate_frame(
         opacity: &opacity,
         labels,
         blend: settings.blend,
-        value_unit: rendered.value_unit,
+        value_unit: what.units.as_deref().or(rendered.value_unit),
         length_unit: rendered.length_unit,
         background: settings.background,
         axis_names: rendered.axis_names,
@@ -288,6 +312,20 @@ mod tests {
         assert_eq!(ink([0.0; 3]), [1.0; 3]);
         assert_eq!(ink([1.0; 3]), [0.0; 3]);
         assert_eq!(ink([0.1, 0.2, 0.5]), [1.0; 3]);
+    }
+
+    #[test]
+    fn a_ct_preset_means_hounsfield_units() {
+        assert_eq!(preset_unit(Some("ct-bone")), Some("HU"));
+        assert_eq!(preset_unit(Some("electron-density")), None);
+        assert_eq!(preset_unit(None), None);
+        assert_eq!(parse_unit(" mg/mL ").as_deref(), Ok("mg/mL"));
+        for bad in ["", "  ", "a\nb", &"x".repeat(33)] {
+            assert!(
+                parse_unit(bad).unwrap_err().contains("not a unit"),
+                "{bad:?}"
+            );
+        }
     }
 
     #[test]
@@ -392,8 +430,14 @@ mod tests {
             label: Some("a".into()),
             axes: true,
             outline: true,
+            units: None,
         };
         assert!(all.any());
+        let unit_alone = Annotations {
+            units: Some("K".into()),
+            ..Annotations::default()
+        };
+        assert!(!unit_alone.any());
         annotate(&mut image, &all, &subject);
         assert_ne!(image, before);
     }

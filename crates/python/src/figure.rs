@@ -1,5 +1,5 @@
-//! The annotations' keywords (`colorbar`, `scale_bar`, `title`, `label`,
-//! `axes`, `outline`), drawn into a frame by volray-annotate's
+//! The annotations' keywords (`colorbar` and its `units`, `scale_bar`,
+//! `title`, `label`, `axes`, `outline`), drawn into a frame by volray-annotate's
 //! `annotate_frame` from the frame's renderer and settings, as `volray
 //! render`'s flags of the same names draw them (`src/figure.rs`): the same
 //! pixels for the same frame.
@@ -9,7 +9,7 @@ use crate::keywords::{Keywords, extract};
 use pyo3::prelude::*;
 use pyo3::types::PyBool;
 use volray_annotate::colorbar::Side;
-use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
+use volray_annotate::figure::{Annotations, Rendered, annotate_frame, parse_unit, preset_unit};
 use volray_core::glam::DVec3;
 use volray_core::{Image, RenderSettings, Renderer as CoreRenderer};
 use volray_io::{FileInfo, VolumeFormat};
@@ -17,7 +17,15 @@ use volray_options::Options;
 
 /// The annotations' keywords, for `render`, `Renderer.render` and a
 /// `Scene`'s `render`.
-pub const FIGURE: &[&str] = &["colorbar", "scale_bar", "title", "label", "axes", "outline"];
+pub const FIGURE: &[&str] = &[
+    "colorbar",
+    "units",
+    "scale_bar",
+    "title",
+    "label",
+    "axes",
+    "outline",
+];
 
 /// The annotations `k` asks for.
 pub fn annotations(k: &Keywords<'_>) -> PyResult<Annotations> {
@@ -60,6 +68,9 @@ pub fn annotations(k: &Keywords<'_>) -> PyResult<Annotations> {
         label: k.take("label", "a str")?,
         axes: flag("axes")?,
         outline: flag("outline")?,
+        units: (k.take::<String>("units", "a str")?)
+            .map(|text| parse_unit(&text).map_err(|e| value_error(format!("units: {e}"))))
+            .transpose()?,
     })
 }
 
@@ -100,10 +111,9 @@ pub fn draw(
     if !what.any() {
         return Ok(());
     }
-    let hounsfield = (options.look.preset.as_deref()).is_some_and(|p| p.starts_with("ct-"));
     let rendered = Rendered {
         log: facts.log,
-        value_unit: hounsfield.then_some("HU"),
+        value_unit: preset_unit(options.look.preset.as_deref()),
         length_unit: facts.length_unit.as_deref(),
         axis_names: facts.axis_names,
         boxes,

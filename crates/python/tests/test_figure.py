@@ -1,5 +1,5 @@
-"""Annotations as keywords (colorbar, scale_bar, title, label, axes,
-outline): the same pixels as `volray render`'s flags of the same names
+"""Annotations as keywords (colorbar and its units, scale_bar, title,
+label, axes, outline): the same pixels as `volray render`'s flags of the same names
 for the same frame, on render, Renderer.render and a scene; without them
 the frame is as it was; wrong values are refused in one line."""
 
@@ -30,6 +30,11 @@ CASES = [
         ["--blend", "mip", "--colorbar", "--axes", "--background", "1,1,1"],
         {"blend": "mip", "colorbar": "right", "axes": True, "background": (1, 1, 1)},
     ),
+    (
+        "sphere:32",
+        ["--colorbar", "--units", "K"],
+        {"colorbar": "right", "units": "K"},
+    ),
 ]
 
 
@@ -37,7 +42,7 @@ CASES = [
 def test_figure_keywords_give_the_command_lines_pixels(cli_image, spec, flags, keywords):
     expected = cli_image(spec, "--size", "160", *flags)
     got = rgb(volray.render(volray.read(spec), size=160, **keywords))
-    figure = ("colorbar", "scale_bar", "title", "label", "axes", "outline")
+    figure = ("colorbar", "units", "scale_bar", "title", "label", "axes", "outline")
     view = {k: v for k, v in keywords.items() if k not in figure}
     bare = rgb(volray.render(volray.read(spec), size=160, **view))
     assert np.abs(got - expected).max() == 0, f"{spec}: annotations differ from volray render's"
@@ -79,6 +84,8 @@ def test_wrong_annotation_values_are_refused_in_one_line():
         ({"scale_bar": "long"}, TypeError, "scale_bar: expected"),
         ({"title": 5}, TypeError, "title: expected a str"),
         ({"axes": "yes"}, TypeError, "axes: expected True or False"),
+        ({"colorbar": "right", "units": ""}, ValueError, "units: .* is not a unit"),
+        ({"units": 3}, TypeError, "units: expected a str"),
     ]:
         with pytest.raises(error, match=message) as caught:
             volray.render(volume, size=32, **keywords)

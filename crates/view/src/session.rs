@@ -490,6 +490,8 @@ impl Tab<'_> {
             label: figure.label.clone(),
             axes: figure.axes,
             outline: figure.outline,
+            // The start's unit, the context's value_unit.
+            units: None,
         };
         let (first, framed, boxes) = match &self.source {
             Source::Whole { renderer, .. } => {
