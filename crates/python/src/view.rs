@@ -6,9 +6,14 @@
 //! ([`volray_view::state_options`]): the camera and one whole transfer
 //! function, so that `render(volume, camera=w.camera,
 //! tf=w.transfer_function)` renders the frame the page shows, and the
-//! page's command box shows that call.
+//! page's command box shows that call. The page's figure (colour bar,
+//! scale bar, text) is drawn into its frames as `render`'s annotation
+//! keywords draw it, and read back as those keywords, the colour bar's
+//! unit with them (`units="HU"` for a CT preset's: the keywords name the
+//! transfer function whole, not the preset).
 
 use crate::errors::{Keywords as Names, value_error};
+use crate::figure::{self, FIGURE};
 use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
 use crate::renderer::{Recipe, cache_budget, pool};
 use crate::transfer::{Camera, TransferFunction};
@@ -17,11 +22,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::fmt::Write;
 use std::sync::{Arc, Mutex};
+use volray_annotate::colorbar::Side;
+use volray_annotate::figure::{Annotations, preset_unit};
 use volray_core::{NonFinite, Phong, RenderSettings};
 use volray_options::{BlendMode, CameraOptions, Options, Tf};
 use volray_view::{
-    FigureContext, Host, Message, OptionsStart, Refusal, Reproduce, Reproduction, Start, Tab,
-    ViewState, Viewer,
+    ColorBarSide, Figure, FigureContext, Host, Message, OptionsStart, Refusal, Reproduce,
+    Reproduction, Start, Tab, ViewState, Viewer,
 };
 
 /// The most pages of one widget rendering at once.
@@ -49,12 +56,49 @@ struct PyReproduce {
     start: OptionsStart,
     /// The file's display window, `render`'s default range.
     window: Option<(f64, f64)>,
+    /// The unit the frames' colour bar gives the values: `units=`, else
+    /// the preset's.
+    value_unit: Option<String>,
 }
 
 impl PyReproduce {
     fn options(&self, state: &ViewState) -> Result<Options, Refusal> {
         state.check().map_err(|e| Refusal(e.to_string()))?;
         volray_view::state_options(state, &self.start)
+    }
+
+    /// The annotation keywords that draw `figure` as the page does.
+    fn figure_words(&self, figure: &Figure) -> Vec<(&'static str, Value)> {
+        let mut w = Vec::new();
+        if let Some(side) = figure.colorbar {
+            let side = match side {
+                ColorBarSide::Right => "right",
+                ColorBarSide::Left => "left",
+            };
+            w.push(("colorbar", Value::Str(side.into())));
+            if let Some(unit) = &self.value_unit {
+                w.push(("units", Value::Str(unit.clone())));
+            }
+        }
+        if figure.scale_bar {
+            w.push((
+                "scale_bar",
+                figure.scale_length.map_or(Value::Bool(true), Value::Number),
+            ));
+        }
+        if let Some(title) = &figure.title {
+            w.push(("title", Value::Str(title.clone())));
+        }
+        if let Some(label) = &figure.label {
+            w.push(("label", Value::Str(label.clone())));
+        }
+        if figure.axes {
+            w.push(("axes", Value::Bool(true)));
+        }
+        if figure.outline {
+            w.push(("outline", Value::Bool(true)));
+        }
+        w
     }
 
     fn settings(&self, options: &Options) -> Result<RenderSettings, Refusal> {
@@ -71,7 +115,7 @@ impl Reproduce for PyReproduce {
         let settings = self.settings(&options)?;
         Ok(Reproduction {
             settings,
-            command: call(&options),
+            command: call(&options, &self.figure_words(&state.figure)),
             tf_file: None,
             scene: None,
         })
@@ -80,8 +124,8 @@ impl Reproduce for PyReproduce {
 
 #[pymethods]
 impl ViewHost {
-    /// `_ViewHost(volume, **kwargs)`: `render`'s keywords but the
-    /// figure's and `level`.
+    /// `_ViewHost(volume, **kwargs)`: `render`'s keywords but `level`;
+    /// the figure's give the page's starting figure.
     #[new]
     #[pyo3(signature = (volume, **kwargs))]
     fn new(
@@ -89,7 +133,8 @@ impl ViewHost {
         volume: &Bound<'_, PyAny>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME], "view")?;
+        let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME, FIGURE], "view")?;
+        let what = figure::annotations(&k)?;
         if k.get("level").is_some() {
             return Err(value_error(
                 "level: the viewer in a notebook shows a volume in memory: read a level with volray.read(path, level=N)",
@@ -102,6 +147,7 @@ impl ViewHost {
                 "{name}: a volume read lazily from a chunked file is not shown in a notebook yet: read a level whole with volray.read(path, level=N)"
             )));
         }
+        let facts = recipe.facts(py);
         let digest = recipe.digest(py, None)?;
         let prepared = recipe.prepare(py, digest)?;
         let (options, mut settings) = recipe.settings_of(&k)?;
@@ -112,7 +158,8 @@ impl ViewHost {
         let cache_budget = cache_budget(&prepared.inner, non_finite, recipe.max_memory);
         let volume = Arc::new(prepared.inner.volume().clone());
         drop(prepared);
-        let state = volray_view::start_state(&options, &settings);
+        let mut state = volray_view::start_state(&options, &settings);
+        state.figure = start_figure(&what);
         state.check().map_err(|e| {
             value_error(format!(
                 "the starting view is beyond the viewer's bounds: {e}"
@@ -125,6 +172,8 @@ impl ViewHost {
                 transfer_function: settings.transfer_function.clone(),
             },
             window: recipe.window(),
+            value_unit: (what.units.clone())
+                .or_else(|| preset_unit(options.look.preset.as_deref()).map(String::from)),
         });
         reproduce
             .reproduce(&state)
@@ -153,8 +202,10 @@ impl ViewHost {
             others: Vec::new(),
             time: None,
             figure: FigureContext {
-                log: options.look.log,
-                ..FigureContext::default()
+                log: facts.log,
+                value_unit: reproduce.value_unit.clone(),
+                length_unit: facts.length_unit,
+                axis_names: facts.axis_names.map(String::from),
             },
         };
         let host = py
@@ -208,9 +259,9 @@ impl ViewHost {
     /// The keywords of `render` that render the view shown last (beside
     /// the volume's own given to the viewer).
     fn keywords<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let options = self.current_options()?;
+        let (options, figure) = self.current_words()?;
         let dict = PyDict::new(py);
-        for (key, value) in words(&options) {
+        for (key, value) in words(&options).into_iter().chain(figure) {
             let object: Bound<'py, PyAny> = match value {
                 Value::Camera(options) => Bound::new(py, Camera { options })?.into_any(),
                 Value::Tf(function) => Bound::new(py, TransferFunction { function })?.into_any(),
@@ -226,7 +277,8 @@ impl ViewHost {
 
     /// The `render` call of the view shown last, as the page shows it.
     fn call(&self) -> PyResult<String> {
-        Ok(call(&self.current_options()?))
+        let (options, figure) = self.current_words()?;
+        Ok(call(&options, &figure))
     }
 
     /// The view shown last, as the page's JSON state.
@@ -237,8 +289,30 @@ impl ViewHost {
 
 impl ViewHost {
     fn current_options(&self) -> PyResult<Options> {
+        Ok(self.current_words()?.0)
+    }
+
+    /// The options of the view shown last, and its figure's keywords.
+    fn current_words(&self) -> PyResult<(Options, Vec<(&'static str, Value)>)> {
         let state = lock(&self.current).clone();
-        (self.reproduce.options(&state)).map_err(|e| value_error(e.to_string()))
+        let options = (self.reproduce.options(&state)).map_err(|e| value_error(e.to_string()))?;
+        Ok((options, self.reproduce.figure_words(&state.figure)))
+    }
+}
+
+/// The page's starting figure: the annotations `volray.view` was given.
+fn start_figure(what: &Annotations) -> Figure {
+    Figure {
+        colorbar: what.colorbar.map(|side| match side {
+            Side::Right => ColorBarSide::Right,
+            Side::Left => ColorBarSide::Left,
+        }),
+        scale_bar: what.scale_bar.is_some(),
+        scale_length: what.scale_bar.flatten(),
+        axes: what.axes,
+        outline: what.outline,
+        title: what.title.clone(),
+        label: what.label.clone(),
     }
 }
 
@@ -281,7 +355,7 @@ fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 enum Value {
     Camera(CameraOptions),
     Tf(volray_core::TransferFunction),
-    Str(&'static str),
+    Str(String),
     Number(f64),
     Bool(bool),
     Numbers(Vec<f64>),
@@ -305,7 +379,7 @@ fn words(options: &Options) -> Vec<(&'static str, Value)> {
         w.push(("opacity", Value::Numbers(vec![f64::from(p), f64::from(q)])));
     }
     if look.blend != BlendMode::Composite {
-        w.push(("blend", Value::Str(look.blend.name())));
+        w.push(("blend", Value::Str(look.blend.name().into())));
     }
     if let Some(iso) = look.iso {
         w.push(("iso", Value::Number(f64::from(iso))));
@@ -368,16 +442,17 @@ fn words(options: &Options) -> Vec<(&'static str, Value)> {
         w.push(("labels", Value::Bool(true)));
     }
     if sampling.nonfinite == NonFinite::Transparent {
-        w.push(("nonfinite", Value::Str("transparent")));
+        w.push(("nonfinite", Value::Str("transparent".into())));
     }
     w
 }
 
-/// `volray.render(volume, ...)` with `options` as keywords.
-fn call(options: &Options) -> String {
+/// `volray.render(volume, ...)` with `options` and the `figure`'s
+/// keywords.
+fn call(options: &Options, figure: &[(&'static str, Value)]) -> String {
     let mut s = "volray.render(volume".to_string();
-    for (key, value) in words(options) {
-        let _ = write!(s, ", {key}={}", code(&value));
+    for (key, value) in words(options).iter().chain(figure) {
+        let _ = write!(s, ", {key}={}", code(value));
     }
     s.push(')');
     s
@@ -390,7 +465,9 @@ fn code(value: &Value) -> String {
         format!("({})", inner.join(", "))
     };
     match value {
-        Value::Str(s) => format!("\"{s}\""),
+        // A JSON string is a Python string literal: quotes, backslashes
+        // and control characters escaped.
+        Value::Str(s) => serde_json::to_string(s).expect("a str serialises"),
         Value::Number(x) => num(*x),
         Value::Bool(b) => if *b { "True" } else { "False" }.to_string(),
         Value::Numbers(v) => tuple(v),

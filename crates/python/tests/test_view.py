@@ -127,6 +127,64 @@ def test_the_pages_depth_cues_are_the_keywords(ball, tmp_path):
     tab.close()
 
 
+def test_the_pages_figure_is_drawn_as_renders_figure_keywords_draw_it(ball, tmp_path):
+    # A CT-like ball in Hounsfield units under a CT preset, started with
+    # a colour bar and a title: the bar says HU in the frame, and the
+    # keywords read back (a whole transfer function, no preset) say it too.
+    ct = (ball * 1500 - 400).astype(np.float32)
+    host = _ViewHost(ct, size=(120, 96), preset="ct-bone", colorbar="right", title="A ball")
+    tab = host.open()
+    start = json.loads(tab.next()[1])["start"]
+    figure = start["figure"]
+    assert (figure["colorbar"], figure["title"], figure["axes"]) == ("right", "A ball", False), figure
+    header, shown = frame_of(ask(tab, start, 1), tmp_path)
+    keywords = host.keywords()
+    assert keywords["colorbar"] == "right" and keywords["units"] == "HU", keywords
+    assert keywords["title"] == "A ball" and "preset" not in keywords, keywords
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ct, **keywords)))
+    ran = eval(header["command"], {"volray": volray, "volume": ct})
+    assert np.array_equal(shown[:, :, :3], rgb(ran))
+    # The unit is on the bar: without it the picture differs.
+    unitless = {k: v for k, v in keywords.items() if k != "units"}
+    assert not np.array_equal(shown[:, :, :3], rgb(volray.render(ct, **unitless)))
+
+    # The Figure box's every annotation, the page's state to keywords.
+    state = dict(start)
+    state["figure"] = {
+        "colorbar": "left",
+        "scale_bar": True,
+        "scale_length": 0.5,
+        "axes": True,
+        "outline": True,
+        "title": 'a "quoted" title',
+        "label": "b",
+    }
+    header, shown = frame_of(ask(tab, state, 2), tmp_path)
+    keywords = host.keywords()
+    for key, value in [("colorbar", "left"), ("scale_bar", 0.5), ("axes", True), ("outline", True), ("label", "b")]:
+        assert keywords[key] == value, (key, keywords)
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ct, **keywords)))
+    ran = eval(header["command"], {"volray": volray, "volume": ct})
+    assert np.array_equal(shown[:, :, :3], rgb(ran))
+    # The camera and transfer function read back as before: the bare frame.
+    bare = rgb(volray.render(ct, camera=host.camera, tf=host.transfer_function))
+    assert not np.array_equal(shown[:, :, :3], bare)
+    state["figure"] = {}
+    _, shown = frame_of(ask(tab, state, 3), tmp_path)
+    assert np.array_equal(shown[:, :, :3], bare)
+    assert not any(k in host.keywords() for k in ("colorbar", "units", "title"))
+    tab.close()
+
+    # A unit given wins over the preset's.
+    host = _ViewHost(ct, size=(64, 48), preset="ct-bone", colorbar=True, units="mg/mL")
+    tab = host.open()
+    start = json.loads(tab.next()[1])["start"]
+    _, shown = frame_of(ask(tab, start, 1), tmp_path)
+    assert host.keywords()["units"] == "mg/mL"
+    assert np.array_equal(shown[:, :, :3], rgb(volray.render(ct, **host.keywords())))
+    tab.close()
+
+
 def test_bad_messages_are_answered_and_closed_tabs_end(ball):
     host = _ViewHost(ball, size=32)
     tab = host.open()
@@ -143,12 +201,12 @@ def test_bad_messages_are_answered_and_closed_tabs_end(ball):
     assert answer["seq"] == 6 and "nope" in answer["message"]
     # A state the page may send but this viewer does not render.
     state["colormap"] = "viridis"
-    state["figure"] = {"title": "a title"}
+    state["time"] = 1
     assert tab.receive(json.dumps({"type": "view", "seq": 7, "quality": "full", "state": state})) is None
     is_frame, text = tab.next()
-    assert not is_frame and "colorbar=" in json.loads(text)["message"]
+    assert not is_frame and "time" in json.loads(text)["message"]
     # The last view asked for cannot be read back: said so.
-    with pytest.raises(ValueError, match="annotations"):
+    with pytest.raises(ValueError, match="time"):
         host.camera
     # Closing ends the tab's messages, whoever waits for them.
     got = []
@@ -161,8 +219,10 @@ def test_bad_messages_are_answered_and_closed_tabs_end(ball):
 
 def test_bad_input_is_refused_with_python_exceptions(ball, tmp_path):
     pytest.importorskip("anywidget")
-    with pytest.raises(TypeError, match="colorbar"):
-        volray.view(ball, colorbar="right")
+    with pytest.raises(ValueError, match="colorbar"):
+        volray.view(ball, colorbar="up")
+    with pytest.raises(ValueError, match="not a unit"):
+        volray.view(ball, colorbar="right", units=" ")
     with pytest.raises(ValueError, match="level"):
         volray.view(ball, level=1)
     with pytest.raises(ValueError, match="zoom"):

@@ -86,18 +86,15 @@ pub fn start_state(options: &Options, settings: &RenderSettings) -> ViewState {
 /// The options of the frame of `state` (checked), the viewer having
 /// started as `start` says: the camera and sampling the state sets, and
 /// one whole transfer function ([`Tf::Function`], no preset, colour map
-/// or range beside it).
+/// or range beside it). The state's figure is not among the options: the
+/// front end names it as its own annotations (`volray.render`'s
+/// `colorbar=`, `title=`, ...).
 pub fn state_options(state: &ViewState, start: &OptionsStart) -> Result<Options, Refusal> {
     if !state.layers.is_empty() {
         return Err(Refusal("this viewer shows one volume".into()));
     }
     if state.time.is_some() {
         return Err(Refusal("this viewer serves no time axis".into()));
-    }
-    if !state.figure.is_bare() {
-        return Err(Refusal(
-            "the figure's annotations are drawn by volray.render's keywords (colorbar=, title=, ...), not in this viewer".into(),
-        ));
     }
     let mut options = start.options.clone();
     let log = options.look.log;

@@ -180,6 +180,7 @@ class Renderer:
         show_labels: Optional[Sequence[int]] = None,
         threads: Optional[int] = None,
         colorbar: Optional[Literal["right", "left"]] = None,
+        units: Optional[str] = None,
         scale_bar: Union[None, bool, float] = None,
         title: Optional[str] = None,
         label: Optional[str] = None,
@@ -291,6 +292,7 @@ class Scene:
         show_labels: Optional[Sequence[int]] = None,
         threads: Optional[int] = None,
         colorbar: Optional[Literal["right", "left"]] = None,
+        units: Optional[str] = None,
         scale_bar: Union[None, bool, float] = None,
         title: Optional[str] = None,
         label: Optional[str] = None,
@@ -365,6 +367,7 @@ def render(
     show_labels: Optional[Sequence[int]] = None,
     threads: Optional[int] = None,
     colorbar: Optional[Literal["right", "left"]] = None,
+    units: Optional[str] = None,
     scale_bar: Union[None, bool, float] = None,
     title: Optional[str] = None,
     label: Optional[str] = None,
@@ -428,6 +431,7 @@ def render(
     show_labels: Optional[Sequence[int]] = None,
     threads: Optional[int] = None,
     colorbar: Optional[Literal["right", "left"]] = None,
+    units: Optional[str] = None,
     scale_bar: Union[None, bool, float] = None,
     title: Optional[str] = None,
     label: Optional[str] = None,
@@ -529,10 +533,21 @@ def view(
     shadows: bool = False,
     ambient_occlusion: bool | float = False,
     background: Rgb = 0,
+    labels: bool = False,
+    label_opacity: Optional[Union[Mapping[int, float], Sequence[Tuple[int, float]]]] = None,
+    show_labels: Optional[Sequence[int]] = None,
     threads: Optional[int] = None,
+    colorbar: Optional[Literal["right", "left"]] = None,
+    units: Optional[str] = None,
+    scale_bar: Union[None, bool, float] = None,
+    title: Optional[str] = None,
+    label: Optional[str] = None,
+    axes: bool = False,
+    outline: bool = False,
 ) -> Viewer:
     """The interactive viewer of ``volume`` in a notebook (needs
     anywidget): ``volray view``'s page in the output, its frames rendered
     in the kernel and carried over the kernel's connection. The keywords
-    are :func:`render`'s (but the figure's, ``level`` and ``labels``): the
-    view it starts with; without ``size`` the frame fits the widget."""
+    are :func:`render`'s (but ``level``): the view it starts with, the
+    figure's its Figure box; without ``size`` the frame fits the
+    widget."""
