@@ -187,6 +187,10 @@ w""",
 np.save("expected.npy", np.asarray(frame))
 json.dump({"azimuth": w.camera.azimuth, "elevation": w.camera.elevation,
            "size": list(w.camera.size), "state": w.state}, open("camera.json", "w"))""",
+    # The page's Figure box read back: render's keywords, the colour bar too.
+    """figure = volray.render(ball, **w.keywords)
+np.save("figure.npy", np.asarray(figure))
+json.dump(sorted(w.keywords), open("keywords.json", "w"))""",
 ]
 
 
@@ -317,8 +321,8 @@ KERNEL_IDLE = """(() => {
   const panel = app && app.shell.currentWidget;
   const kernel = panel && panel.sessionContext && panel.sessionContext.session
     && panel.sessionContext.session.kernel;
-  return !!(kernel && kernel.status === "idle" && panel.content.widgets.length === 2);
-})()"""
+  return !!(kernel && kernel.status === "idle" && panel.content.widgets.length === CELLS);
+})()""".replace("CELLS", str(len(NOTEBOOK_CELLS)))
 
 FRAME_BYTES = """
 const done = arguments[arguments.length - 1];
@@ -384,6 +388,28 @@ def test_the_widget_shows_the_view_and_reads_it_back(lab, browser):
     diff = np.abs(expected[:, :, :3].astype(np.int32) - shown[:, :, :3].astype(np.int32))
     assert diff.max() == 0, f"{np.count_nonzero(diff.max(axis=2))} pixels differ, by up to {diff.max()}"
     assert expected[:, :, :3].std() > 5, "the frame shows something"
+
+    # The Figure box: a colour bar and the box's outline drawn into the
+    # frame, and `render(ball, **w.keywords)` draws them alike.
+    web.into_frame(web.element("iframe.volray-view"))
+    web.run("document.getElementById('f-colorbar').click(); document.getElementById('f-outline').click();")
+    # The command comes with its frame: the still that shows both.
+    web.until(
+        "the still with the figure",
+        "document.body.dataset.state === 'still'"
+        " && document.getElementById('command').textContent.includes('outline=True')"
+        " && document.getElementById('command').textContent.includes('colorbar=')",
+    )
+    (tmp / "figure.png").write_bytes(frame_bytes(web))
+    annotated = read_png(tmp / "figure.png")
+    assert not np.array_equal(annotated[:, :, :3], shown[:, :, :3]), "the figure was drawn"
+    web.out_of_frames()
+    web.run(RUN_CELL, 2)
+    wait("the figure cell's files", lambda: (root / "figure.npy").exists() and _json(root / "keywords.json"))
+    assert {"colorbar", "outline", "camera", "tf"} <= set(_json(root / "keywords.json"))
+    rendered = np.load(root / "figure.npy")
+    diff = np.abs(rendered[:, :, :3].astype(np.int32) - annotated[:, :, :3].astype(np.int32))
+    assert diff.max() == 0, f"{np.count_nonzero(diff.max(axis=2))} pixels differ, by up to {diff.max()}"
 
     # The page follows a change of the notebook's theme.
     web.run("window.jupyterapp.commands.execute('apputils:change-theme', {theme: 'JupyterLab Dark'});")
