@@ -64,18 +64,18 @@ pub fn open(args: &ViewerArgs, settings: &RenderSettings) -> Result<Option<Opene
         Pyramid::new(sources, fixed).map_err(|e| CliError::input(format!("{spec}: {e}")))?;
     let camera = |e| CliError::input(format!("{spec}: {e}"));
     let still = pyramid.still_level(settings).map_err(camera)?;
-    let draft = RenderSettings {
-        width: draft_side(settings.width),
-        height: draft_side(settings.height),
-        ..settings.clone()
-    };
     let non_finite: NonFinite = args.view.sampling.nonfinite.into();
     let limit = u128::from(max_memory);
     let Some(start) = pyramid
-        .draft_level(&draft, still, non_finite, limit)
+        .first_draft_level(settings, non_finite, limit)
         .map_err(camera)?
     else {
         let last = count - 1;
+        let draft = RenderSettings {
+            width: draft_side(settings.width),
+            height: draft_side(settings.height),
+            ..settings.clone()
+        };
         let [x, y, z] = pyramid.grid(last).dims;
         return Err(CliError::input(format!(
             "{spec}: its coarsest level ({x}x{y}x{z}) may take up to {} to render whole, more than the 1/{DRAFT_SHARE} of --max-memory {} the viewer gives the frames while the view moves: raise --max-memory",
@@ -142,14 +142,7 @@ impl Opened {
     /// The page's first message names the finest level's grid and every
     /// level.
     pub fn describe(&self, hello: &mut Hello) {
-        let finest = self.pyramid.grid(0);
-        hello.dims = finest.dims;
-        hello.spacing = finest.spacing.to_array();
-        hello.levels = Some(
-            (0..self.pyramid.len())
-                .map(|l| self.pyramid.grid(l).dims)
-                .collect(),
-        );
+        self.pyramid.describe(hello);
     }
 
     /// The pyramid (its values labels or not) and the level read first.

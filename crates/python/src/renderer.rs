@@ -227,7 +227,7 @@ impl Recipe {
     }
 
     /// [`Recipe::prepare`] of the samples `core`.
-    fn prepare_core(
+    pub(crate) fn prepare_core(
         &self,
         py: Python<'_>,
         mut core: CoreVolume,
@@ -361,9 +361,18 @@ impl Recipe {
         }
     }
 
-    /// Whether the volume is read lazily from a chunked file.
-    pub(crate) fn is_lazy(&self) -> bool {
-        matches!(&self.source, Source::Volume(v) if v.get().lazy.is_some())
+    /// The chunked file a lazy volume is read from, if it is one.
+    pub(crate) fn lazy(&self) -> Option<&LazyFile> {
+        match &self.source {
+            Source::Volume(v) => v.get().lazy.as_ref(),
+            Source::Array { .. } => None,
+        }
+    }
+
+    /// Whether a spacing or origin was given with the volume (or `log`):
+    /// what applies to a level read whole, not yet to a pyramid's levels.
+    pub(crate) fn reshaped(&self) -> bool {
+        self.spacing.is_some() || self.origin.is_some() || self.log
     }
 
     /// The file's display window (an OME-Zarr `omero` window), if any.
@@ -1029,7 +1038,7 @@ fn stream_error(e: StreamError, camera: &CameraOptions, name: &str) -> PyErr {
 }
 
 /// `level=`: `"auto"` or a level number, if given.
-fn level_choice(k: &Keywords<'_>) -> PyResult<Option<LevelChoice>> {
+pub(crate) fn level_choice(k: &Keywords<'_>) -> PyResult<Option<LevelChoice>> {
     let Some(level) = k.get("level") else {
         return Ok(None);
     };

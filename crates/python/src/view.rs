@@ -10,14 +10,17 @@
 //! scale bar, text) is drawn into its frames as `render`'s annotation
 //! keywords draw it, and read back as those keywords, the colour bar's
 //! unit with them (`units="HU"` for a CT preset's: the keywords name the
-//! transfer function whole, not the preset).
+//! transfer function whole, not the preset). A lazy volume (a chunked
+//! file) is served level by level as `volray view` serves it
+//! (volray-view's [`Pyramid`]), its read-back naming the stills' `level`.
 
 use crate::errors::{Keywords as Names, value_error};
 use crate::figure::{self, FIGURE};
 use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
-use crate::renderer::{Recipe, cache_budget, pool};
+use crate::renderer::{Recipe, cache_budget, level_choice, pool};
 use crate::transfer::{Camera, TransferFunction};
-use pyo3::exceptions::PyRuntimeError;
+use crate::volume::LazyFile;
+use pyo3::exceptions::{PyOSError, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::fmt::Write;
@@ -25,10 +28,11 @@ use std::sync::{Arc, Mutex};
 use volray_annotate::colorbar::Side;
 use volray_annotate::figure::{Annotations, preset_unit};
 use volray_core::{NonFinite, Phong, RenderSettings};
+use volray_options::level::LevelChoice;
 use volray_options::{BlendMode, CameraOptions, Options, Tf};
 use volray_view::{
-    ColorBarSide, Figure, FigureContext, Host, Message, OptionsStart, Refusal, Reproduce,
-    Reproduction, Start, Tab, ViewState, Viewer,
+    ColorBarSide, DRAFT_SHARE, Figure, FigureContext, Host, Message, OptionsStart, Pyramid,
+    Refusal, Reproduce, Reproduction, Start, Tab, ViewState, Viewer,
 };
 
 /// The most pages of one widget rendering at once.
@@ -59,6 +63,9 @@ struct PyReproduce {
     /// The unit the frames' colour bar gives the values: `units=`, else
     /// the preset's.
     value_unit: Option<String>,
+    /// A chunked file's level the stills show, as `render`'s `level=`:
+    /// `Some(None)` for `"auto"`; `None` for a volume in memory.
+    level: Option<Option<usize>>,
 }
 
 impl PyReproduce {
@@ -67,9 +74,15 @@ impl PyReproduce {
         volray_view::state_options(state, &self.start)
     }
 
-    /// The annotation keywords that draw `figure` as the page does.
-    fn figure_words(&self, figure: &Figure) -> Vec<(&'static str, Value)> {
+    /// The keywords beside the options': a chunked file's `level`, and
+    /// the annotations that draw `figure` as the page does.
+    fn extra_words(&self, figure: &Figure) -> Vec<(&'static str, Value)> {
         let mut w = Vec::new();
+        match self.level {
+            Some(Some(n)) => w.push(("level", Value::Int(n))),
+            Some(None) => w.push(("level", Value::Str("auto".into()))),
+            None => {}
+        }
         if let Some(side) = figure.colorbar {
             let side = match side {
                 ColorBarSide::Right => "right",
@@ -115,7 +128,7 @@ impl Reproduce for PyReproduce {
         let settings = self.settings(&options)?;
         Ok(Reproduction {
             settings,
-            command: call(&options, &self.figure_words(&state.figure)),
+            command: call(&options, &self.extra_words(&state.figure)),
             tf_file: None,
             scene: None,
         })
@@ -124,8 +137,8 @@ impl Reproduce for PyReproduce {
 
 #[pymethods]
 impl ViewHost {
-    /// `_ViewHost(volume, **kwargs)`: `render`'s keywords but `level`;
-    /// the figure's give the page's starting figure.
+    /// `_ViewHost(volume, **kwargs)`: `render`'s keywords; the figure's
+    /// give the page's starting figure, `level` a lazy volume's stills'.
     #[new]
     #[pyo3(signature = (volume, **kwargs))]
     fn new(
@@ -135,22 +148,35 @@ impl ViewHost {
     ) -> PyResult<Self> {
         let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME, FIGURE], "view")?;
         let what = figure::annotations(&k)?;
-        if k.get("level").is_some() {
-            return Err(value_error(
-                "level: the viewer in a notebook shows a volume in memory: read a level with volray.read(path, level=N)",
-            ));
-        }
+        let level = level_choice(&k)?;
         let recipe = Recipe::build(volume, &k)?;
         let name = recipe.name.clone();
-        if recipe.is_lazy() {
+        let facts = recipe.facts(py);
+        let (options, mut settings) = recipe.settings_of(&k)?;
+        let (prepared, levels) = match recipe.lazy() {
+            None => {
+                if level.is_some() {
+                    return Err(value_error(format!(
+                        "level: {name} is in memory: level picks a level of a volume read lazily from a chunked file (volray.read of a Zarr or OME-Zarr image)"
+                    )));
+                }
+                let digest = recipe.digest(py, None)?;
+                (recipe.prepare(py, digest)?, None)
+            }
+            Some(file) => {
+                let opened = open_levels(py, &recipe, file, level, &settings)?;
+                let dims = opened.pyramid.grid(opened.start).dims;
+                let source = Arc::clone(opened.pyramid.source(opened.start));
+                let core = (py.detach(|| source.read_box([0; 3], dims)))
+                    .map_err(|e| PyOSError::new_err(format!("{name}: {e}")))?;
+                (recipe.prepare_core(py, core, None)?, Some(opened))
+            }
+        };
+        if levels.is_some() && what.any() {
             return Err(value_error(format!(
-                "{name}: a volume read lazily from a chunked file is not shown in a notebook yet: read a level whole with volray.read(path, level=N)"
+                "{name}: the figure's annotations are not drawn on a chunked file's levels yet: leave them out, or read a level whole with volray.read(path, level=N)"
             )));
         }
-        let facts = recipe.facts(py);
-        let digest = recipe.digest(py, None)?;
-        let prepared = recipe.prepare(py, digest)?;
-        let (options, mut settings) = recipe.settings_of(&k)?;
         let threads = keywords::threads(&k)?.unwrap_or(0);
         recipe.leave_to_volume(&prepared.known, &options, &mut settings)?;
         recipe.check_memory(&prepared.inner, &settings)?;
@@ -174,6 +200,7 @@ impl ViewHost {
             window: recipe.window(),
             value_unit: (what.units.clone())
                 .or_else(|| preset_unit(options.look.preset.as_deref()).map(String::from)),
+            level: levels.as_ref().map(|o| o.pyramid.fixed()),
         });
         reproduce
             .reproduce(&state)
@@ -188,7 +215,11 @@ impl ViewHost {
             time: None,
         }
         .hello();
+        if let Some(opened) = &levels {
+            opened.pyramid.describe(&mut hello);
+        }
         hello.fit = !sized;
+        let labels = volume.is_labels();
         let viewer = Viewer {
             volume,
             non_finite,
@@ -198,7 +229,7 @@ impl ViewHost {
             reproduce: Arc::clone(&reproduce) as Arc<dyn Reproduce>,
             pool: Arc::new(pool(threads)?),
             max_sessions: MAX_TABS,
-            levels: None,
+            levels: levels.map(|o| (o.pyramid.with_labels(labels), o.start)),
             others: Vec::new(),
             time: None,
             figure: FigureContext {
@@ -267,6 +298,7 @@ impl ViewHost {
                 Value::Tf(function) => Bound::new(py, TransferFunction { function })?.into_any(),
                 Value::Str(s) => s.into_pyobject(py)?.into_any(),
                 Value::Number(x) => x.into_pyobject(py)?.into_any(),
+                Value::Int(n) => n.into_pyobject(py)?.into_any(),
                 Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
                 Value::Numbers(v) => pyo3::types::PyTuple::new(py, v)?.into_any(),
             };
@@ -296,8 +328,65 @@ impl ViewHost {
     fn current_words(&self) -> PyResult<(Options, Vec<(&'static str, Value)>)> {
         let state = lock(&self.current).clone();
         let options = (self.reproduce.options(&state)).map_err(|e| value_error(e.to_string()))?;
-        Ok((options, self.reproduce.figure_words(&state.figure)))
+        Ok((options, self.reproduce.extra_words(&state.figure)))
     }
+}
+
+/// A chunked file opened for the viewer level by level.
+struct Opened {
+    pyramid: Pyramid,
+    /// The level the first drafts show, read whole before the viewer
+    /// starts (the page's first message is made from it).
+    start: usize,
+}
+
+/// Opens `file`'s levels as the viewer's pyramid, as `volray view` opens
+/// a chunked file (`src/view/levels.rs`): the stills show `level` (auto
+/// by default), the drafts a coarse level held whole, the first of them
+/// read before the page opens.
+fn open_levels(
+    py: Python<'_>,
+    recipe: &Recipe,
+    file: &LazyFile,
+    level: Option<LevelChoice>,
+    settings: &RenderSettings,
+) -> PyResult<Opened> {
+    let name = &recipe.name;
+    if recipe.reshaped() || file.spacing_given {
+        return Err(value_error(format!(
+            "{name}: the viewer reads a chunked file's levels as its frames need them, but not yet with log=True or a spacing or origin given: read a level whole with volray.read(path, level=N)"
+        )));
+    }
+    let count = file.chunked.levels().len();
+    let fixed = match level {
+        Some(LevelChoice::Index(n)) if n >= count => {
+            return Err(value_error(format!(
+                "{name}: level {n} is not among the file's {count} levels (0 to {})",
+                count - 1
+            )));
+        }
+        Some(LevelChoice::Index(n)) => Some(n),
+        Some(LevelChoice::Auto) | None => None,
+    };
+    let sources = py.detach(|| {
+        (0..count)
+            .map(|l| Ok(Arc::clone(file.chunked.open_level(l)?.source())))
+            .collect::<Result<Vec<_>, volray_io::IoError>>()
+    });
+    let sources = sources.map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let pyramid = Pyramid::new(sources, fixed).map_err(|e| value_error(format!("{name}: {e}")))?;
+    let limit = u128::from(recipe.max_memory);
+    let start = pyramid
+        .first_draft_level(settings, recipe.nonfinite, limit)
+        .map_err(|e| value_error(format!("{name}: {e}")))?;
+    let Some(start) = start else {
+        let [x, y, z] = pyramid.grid(count - 1).dims;
+        return Err(value_error(format!(
+            "{name}: its coarsest level ({x}x{y}x{z}) takes more than the 1/{DRAFT_SHARE} of max_memory {} the viewer gives the frames while the view moves: raise max_memory",
+            volray_io::format_bytes(limit)
+        )));
+    };
+    Ok(Opened { pyramid, start })
 }
 
 /// The page's starting figure: the annotations `volray.view` was given.
@@ -356,6 +445,7 @@ enum Value {
     Camera(CameraOptions),
     Tf(volray_core::TransferFunction),
     Str(String),
+    Int(usize),
     Number(f64),
     Bool(bool),
     Numbers(Vec<f64>),
@@ -469,6 +559,7 @@ fn code(value: &Value) -> String {
         // and control characters escaped.
         Value::Str(s) => serde_json::to_string(s).expect("a str serialises"),
         Value::Number(x) => num(*x),
+        Value::Int(n) => n.to_string(),
         Value::Bool(b) => if *b { "True" } else { "False" }.to_string(),
         Value::Numbers(v) => tuple(v),
         Value::Camera(c) => {

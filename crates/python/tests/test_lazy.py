@@ -7,6 +7,7 @@ same pixels as the level read whole) or piece by piece from its chunks
 stores are written by ome-zarr-py and zarr-python (in target/pyenv),
 independently of volray's own writer."""
 
+import json
 import os
 
 import numpy as np
@@ -329,3 +330,67 @@ def test_an_omero_window_is_the_default_range_whole_and_in_pieces(zarr_modules, 
     pieces = rgb(renderer.render(**args))
     assert renderer.pieces > 1
     assert np.abs(pieces - hinted).max() <= 1
+
+
+def _view_frame(tab, state, seq, tmp_path, quality="full"):
+    """The header and pixels of the frame `state` asks for."""
+    refused = tab.receive(json.dumps({"type": "view", "seq": seq, "quality": quality, "state": state}))
+    assert refused is None, refused
+    while True:
+        is_frame, data = tab.next()
+        if is_frame:
+            break
+        assert json.loads(data)["type"] != "error", data
+    n = int.from_bytes(data[:4], "little")
+    header = json.loads(data[4 : 4 + n])
+    if header["mime"] != "image/png":  # a draft may come as JPEG
+        return header, None
+    png = tmp_path / "frame.png"
+    png.write_bytes(data[4 + n :])
+    return header, read_png(png)[:, :, :3]
+
+
+def test_the_notebook_viewer_reads_a_chunked_files_levels_as_its_frames_need_them(store, tmp_path):
+    from volray._volray import _ViewHost
+
+    path, _ = store
+    host = _ViewHost(volray.read(path), size=SIZE, azimuth=30)
+    tab = host.open()
+    hello = json.loads(tab.next()[1])
+    assert hello["dims"] == [64, 64, 64]
+    assert hello["levels"] == [[64, 64, 64], [32, 32, 32], [16, 16, 16]]
+    state = hello["start"]
+    # The still: the level render's level="auto" picks, whole; the
+    # keywords read back name that choice and render the same frame.
+    header, still = _view_frame(tab, state, 1, tmp_path)
+    assert header["level"]["index"] == 0 and header["level"]["pieces"] == 1, header["level"]
+    keywords = host.keywords()
+    assert keywords["level"] == "auto", keywords
+    assert 'level="auto"' in header["command"]
+    expected = rgb(volray.render(volray.read(path), **keywords))
+    assert np.array_equal(still, expected)
+    # A draft, while the view moves: a coarser level held whole.
+    state["azimuth"] = 60
+    header, _ = _view_frame(tab, state, 2, tmp_path, "draft")
+    assert header["level"]["index"] > 0, header["level"]
+    tab.close()
+
+    # A level asked for: the stills show it, and the keywords say it.
+    host = _ViewHost(volray.read(path), size=SIZE, level=1)
+    tab = host.open()
+    state = json.loads(tab.next()[1])["start"]
+    header, still = _view_frame(tab, state, 1, tmp_path)
+    assert header["level"]["index"] == 1 and host.keywords()["level"] == 1
+    expected = rgb(volray.render(volray.read(path), **host.keywords()))
+    assert np.array_equal(still, expected)
+    assert np.array_equal(still, rgb(volray.render(volray.read(path, level=1), size=SIZE)))
+    tab.close()
+
+    # What the levels do not take yet is refused, naming the way round.
+    for keywords, message in [
+        ({"colorbar": "right"}, "not drawn on a chunked file's levels"),
+        ({"log": True}, "not yet with log=True"),
+        ({"level": 3}, "not among the file's 3 levels"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            _ViewHost(volray.read(path), size=SIZE, **keywords)

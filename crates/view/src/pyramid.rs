@@ -155,6 +155,35 @@ impl Pyramid {
             .find(|&level| self.whole_bytes(level, draft, non_finite) <= limit / DRAFT_SHARE))
     }
 
+    /// The level the first drafts of a view starting at `settings` show
+    /// (read whole before the viewer starts, for the page's first
+    /// message): [`Pyramid::draft_level`] of the draft-sized settings
+    /// under the still's level; `None` when even the coarsest level's
+    /// draft frame takes more than 1/[`DRAFT_SHARE`] of `limit`.
+    pub fn first_draft_level(
+        &self,
+        settings: &RenderSettings,
+        non_finite: NonFinite,
+        limit: u128,
+    ) -> Result<Option<usize>, CameraError> {
+        let still = self.still_level(settings)?;
+        let draft = RenderSettings {
+            width: crate::session::draft_side(settings.width),
+            height: crate::session::draft_side(settings.height),
+            ..settings.clone()
+        };
+        self.draft_level(&draft, still, non_finite, limit)
+    }
+
+    /// Names in the page's first message the finest level's grid and
+    /// every level's dims (the page's level read-out).
+    pub fn describe(&self, hello: &mut crate::Hello) {
+        let finest = self.grid(0);
+        hello.dims = finest.dims;
+        hello.spacing = finest.spacing.to_array();
+        hello.levels = Some((0..self.len()).map(|l| self.grid(l).dims).collect());
+    }
+
     /// The most bytes a frame of `settings` may take with level `level`
     /// read whole, the volume included, no brick cache (volray-core's
     /// bound, as volray-lazy's `Chunked::whole_bytes`).

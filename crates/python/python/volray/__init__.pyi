@@ -499,6 +499,7 @@ def view(
     log: bool = False,
     nonfinite: Literal["refuse", "transparent"] = "refuse",
     max_memory: Optional[int] = None,
+    level: Optional[Level] = None,
     size: Optional[Union[int, Tuple[int, int]]] = None,
     view: Optional[Vec3] = None,
     look_at: Optional[Vec3] = None,
@@ -548,6 +549,7 @@ def view(
     """The interactive viewer of ``volume`` in a notebook (needs
     anywidget): ``volray view``'s page in the output, its frames rendered
     in the kernel and carried over the kernel's connection. The keywords
-    are :func:`render`'s (but ``level``): the view it starts with, the
-    figure's its Figure box; without ``size`` the frame fits the
+    are :func:`render`'s: the view it starts with, the figure's its
+    Figure box, ``level`` the level of a chunked file its stills show
+    (``"auto"`` by default); without ``size`` the frame fits the
     widget."""

@@ -164,9 +164,10 @@ def view(volume: Any, *, height: int = 560, **options: Any) -> Viewer:
     the path of a file to :func:`volray.read`) in a notebook: drag to
     orbit, shift-drag to pan, the wheel to zoom, the transfer function
     edited over the histogram, as ``volray view`` shows it. ``options``
-    are the keywords of :func:`volray.render` (but ``level``): the view
-    it starts with, the figure's (``colorbar``, ``title``, ...) its
-    Figure box. ``height`` is the widget's height in pixels. Without
+    are the keywords of :func:`volray.render`: the view it starts with,
+    the figure's (``colorbar``, ``title``, ...) its Figure box; a chunked
+    file's levels are read as the frames need them (``level``: the
+    stills', ``"auto"`` by default). ``height`` is the widget's height in pixels. Without
     ``size`` the frame fits the widget."""
     if isinstance(volume, (str, Path)):
         from ._volray import read
