@@ -429,10 +429,7 @@ impl CliReproduce {
         let figure = &state.figure;
         w.opt(
             "--colorbar",
-            figure.colorbar.map(|side| match side {
-                volray_view::ColorBarSide::Right => "right".to_string(),
-                volray_view::ColorBarSide::Left => "left".to_string(),
-            }),
+            figure.colorbar.map(|side| side.name().to_string()),
         );
         if figure.colorbar.is_some() {
             w.opt("--units", self.value_unit.clone());

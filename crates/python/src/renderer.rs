@@ -462,13 +462,7 @@ impl Renderer {
                     .lazy
                     .as_ref()
                     .map_or(1, |l| l.chunked.levels().len());
-                if n >= levels {
-                    return Err(value_error(format!(
-                        "{}: level {n} is not among the file's {levels} levels (0 to {})",
-                        recipe.name,
-                        levels - 1
-                    )));
-                }
+                check_level(&recipe.name, n, levels)?;
             }
             return Ok(Renderer {
                 recipe,
@@ -481,10 +475,7 @@ impl Renderer {
             });
         }
         if level.is_some() {
-            return Err(value_error(format!(
-                "level: {} is in memory: level picks a level of a volume read lazily from a chunked file (volray.read of a Zarr or OME-Zarr image)",
-                recipe.name
-            )));
+            return Err(level_in_memory(&recipe.name));
         }
         let digest = recipe.digest(py, None)?;
         let prepared = recipe.prepare(py, digest)?;
@@ -1035,6 +1026,25 @@ fn stream_error(e: StreamError, camera: &CameraOptions, name: &str) -> PyErr {
         )),
         StreamError::Render(e) => render_error(e, camera, name),
     }
+}
+
+/// Level `n` of a file of `levels` levels, or the `ValueError` naming the
+/// levels it has.
+pub(crate) fn check_level(name: &str, n: usize, levels: usize) -> PyResult<()> {
+    match n < levels {
+        true => Ok(()),
+        false => Err(value_error(format!(
+            "{name}: level {n} is not among the file's {levels} levels (0 to {})",
+            levels - 1
+        ))),
+    }
+}
+
+/// `level=` given for the volume `name`, which is in memory.
+pub(crate) fn level_in_memory(name: &str) -> PyErr {
+    value_error(format!(
+        "level: {name} is in memory: level picks a level of a volume read lazily from a chunked file (volray.read of a Zarr or OME-Zarr image)"
+    ))
 }
 
 /// `level=`: `"auto"` or a level number, if given.

@@ -17,7 +17,7 @@
 use crate::errors::{Keywords as Names, value_error};
 use crate::figure::{self, FIGURE};
 use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
-use crate::renderer::{Recipe, cache_budget, level_choice, pool};
+use crate::renderer::{Recipe, cache_budget, check_level, level_choice, level_in_memory, pool};
 use crate::transfer::{Camera, TransferFunction};
 use crate::volume::LazyFile;
 use pyo3::exceptions::{PyOSError, PyRuntimeError};
@@ -25,14 +25,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::fmt::Write;
 use std::sync::{Arc, Mutex};
-use volray_annotate::colorbar::Side;
-use volray_annotate::figure::{Annotations, preset_unit};
+use volray_annotate::figure::preset_unit;
 use volray_core::{NonFinite, Phong, RenderSettings};
 use volray_options::level::LevelChoice;
 use volray_options::{BlendMode, CameraOptions, Options, Tf};
 use volray_view::{
-    ColorBarSide, DRAFT_SHARE, Figure, FigureContext, Host, Message, OptionsStart, Pyramid,
-    Refusal, Reproduce, Reproduction, Start, Tab, ViewState, Viewer,
+    DRAFT_SHARE, Figure, FigureContext, Host, Message, OptionsStart, Pyramid, Refusal, Reproduce,
+    Reproduction, Start, Tab, ViewState, Viewer,
 };
 
 /// The most pages of one widget rendering at once.
@@ -84,11 +83,7 @@ impl PyReproduce {
             None => {}
         }
         if let Some(side) = figure.colorbar {
-            let side = match side {
-                ColorBarSide::Right => "right",
-                ColorBarSide::Left => "left",
-            };
-            w.push(("colorbar", Value::Str(side.into())));
+            w.push(("colorbar", Value::Str(side.name().into())));
             if let Some(unit) = &self.value_unit {
                 w.push(("units", Value::Str(unit.clone())));
             }
@@ -156,9 +151,7 @@ impl ViewHost {
         let (prepared, levels) = match recipe.lazy() {
             None => {
                 if level.is_some() {
-                    return Err(value_error(format!(
-                        "level: {name} is in memory: level picks a level of a volume read lazily from a chunked file (volray.read of a Zarr or OME-Zarr image)"
-                    )));
+                    return Err(level_in_memory(&name));
                 }
                 let digest = recipe.digest(py, None)?;
                 (recipe.prepare(py, digest)?, None)
@@ -185,7 +178,7 @@ impl ViewHost {
         let volume = Arc::new(prepared.inner.volume().clone());
         drop(prepared);
         let mut state = volray_view::start_state(&options, &settings);
-        state.figure = start_figure(&what);
+        state.figure = Figure::of(&what);
         state.check().map_err(|e| {
             value_error(format!(
                 "the starting view is beyond the viewer's bounds: {e}"
@@ -359,13 +352,10 @@ fn open_levels(
     }
     let count = file.chunked.levels().len();
     let fixed = match level {
-        Some(LevelChoice::Index(n)) if n >= count => {
-            return Err(value_error(format!(
-                "{name}: level {n} is not among the file's {count} levels (0 to {})",
-                count - 1
-            )));
+        Some(LevelChoice::Index(n)) => {
+            check_level(name, n, count)?;
+            Some(n)
         }
-        Some(LevelChoice::Index(n)) => Some(n),
         Some(LevelChoice::Auto) | None => None,
     };
     let sources = py.detach(|| {
@@ -387,22 +377,6 @@ fn open_levels(
         )));
     };
     Ok(Opened { pyramid, start })
-}
-
-/// The page's starting figure: the annotations `volray.view` was given.
-fn start_figure(what: &Annotations) -> Figure {
-    Figure {
-        colorbar: what.colorbar.map(|side| match side {
-            Side::Right => ColorBarSide::Right,
-            Side::Left => ColorBarSide::Left,
-        }),
-        scale_bar: what.scale_bar.is_some(),
-        scale_length: what.scale_bar.flatten(),
-        axes: what.axes,
-        outline: what.outline,
-        title: what.title.clone(),
-        label: what.label.clone(),
-    }
 }
 
 #[pymethods]

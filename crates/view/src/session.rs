@@ -34,14 +34,13 @@ use crate::protocol::{
 };
 use crate::pyramid::{LevelError, Levels};
 use crate::reproduce::{Refusal, Reproduce};
-use crate::state::{ColorBarSide, Figure};
+use crate::state::Figure;
 use crate::stats::Stats;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use tokio::sync::mpsc;
-use volray_annotate::colorbar::Side;
-use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
+use volray_annotate::figure::{Rendered, annotate_frame};
 use volray_core::camera::View;
 use volray_core::scene::{Look, Scene, SceneSettings};
 use volray_core::{Image, MemoryBound, NonFinite, RenderError, RenderSettings, Renderer, Volume};
@@ -480,19 +479,8 @@ impl Tab<'_> {
         figure: &Figure,
         settings: &RenderSettings,
     ) -> Result<(), FrameError> {
-        let what = Annotations {
-            colorbar: figure.colorbar.map(|side| match side {
-                ColorBarSide::Right => Side::Right,
-                ColorBarSide::Left => Side::Left,
-            }),
-            scale_bar: figure.scale_bar.then_some(figure.scale_length),
-            title: figure.title.clone(),
-            label: figure.label.clone(),
-            axes: figure.axes,
-            outline: figure.outline,
-            // The start's unit, the context's value_unit.
-            units: None,
-        };
+        // The unit is the context's value_unit (the start's).
+        let what = figure.annotations();
         let (first, framed, boxes) = match &self.source {
             Source::Whole { renderer, .. } => {
                 (renderer, settings.clone(), vec![renderer.volume().bounds()])

@@ -9,6 +9,8 @@
 //! a message from a page is untrusted input.
 
 use serde::{Deserialize, Serialize};
+use volray_annotate::colorbar::Side;
+use volray_annotate::figure::Annotations;
 use volray_core::transfer::colormap;
 
 /// The largest side of a frame a page may ask for (the full-quality view
@@ -163,6 +165,50 @@ impl Figure {
     /// Nothing drawn.
     pub fn is_bare(&self) -> bool {
         *self == Figure::default()
+    }
+
+    /// The figure that draws `what` (a front end's starting figure); its
+    /// unit is the viewer's, not the state's.
+    pub fn of(what: &Annotations) -> Figure {
+        Figure {
+            colorbar: what.colorbar.map(|side| match side {
+                Side::Right => ColorBarSide::Right,
+                Side::Left => ColorBarSide::Left,
+            }),
+            scale_bar: what.scale_bar.is_some(),
+            scale_length: what.scale_bar.flatten(),
+            axes: what.axes,
+            outline: what.outline,
+            title: what.title.clone(),
+            label: what.label.clone(),
+        }
+    }
+
+    /// What volray-annotate draws for this figure (the unit left to the
+    /// viewer's [`crate::FigureContext`]).
+    pub fn annotations(&self) -> Annotations {
+        Annotations {
+            colorbar: self.colorbar.map(|side| match side {
+                ColorBarSide::Right => Side::Right,
+                ColorBarSide::Left => Side::Left,
+            }),
+            scale_bar: self.scale_bar.then_some(self.scale_length),
+            title: self.title.clone(),
+            label: self.label.clone(),
+            axes: self.axes,
+            outline: self.outline,
+            units: None,
+        }
+    }
+}
+
+impl ColorBarSide {
+    /// `right` or `left`, as `--colorbar` and `colorbar=` take it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorBarSide::Right => "right",
+            ColorBarSide::Left => "left",
+        }
     }
 }
 
@@ -452,6 +498,28 @@ pub(crate) mod tests {
             ambient_occlusion: None,
             figure: Figure::default(),
         }
+    }
+
+    #[test]
+    fn a_figure_and_its_annotations_are_one_another() {
+        let figure = Figure {
+            colorbar: Some(ColorBarSide::Left),
+            scale_bar: true,
+            scale_length: Some(2.5),
+            axes: true,
+            outline: false,
+            title: Some("t".into()),
+            label: None,
+        };
+        let what = figure.annotations();
+        assert_eq!(what.colorbar, Some(Side::Left));
+        assert_eq!(what.scale_bar, Some(Some(2.5)));
+        assert_eq!(Figure::of(&what), figure);
+        assert_eq!(
+            Figure::of(&Figure::default().annotations()),
+            Figure::default()
+        );
+        assert!(!Figure::default().annotations().any());
     }
 
     #[test]
