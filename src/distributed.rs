@@ -32,6 +32,7 @@ use crate::input::{self, Input};
 use crate::render::{self, OutputKind};
 use crate::session::render_failure;
 use crate::settings::settings;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 use volray_core::SampleType;
 use volray_core::glam::DVec3;
@@ -53,6 +54,11 @@ pub fn launched() -> bool {
 
 /// `volray render` under `mpirun`: one still image, written by rank 0.
 pub fn render(args: &RenderArgs) -> Result<(), CliError> {
+    ranked(|| render_rank(args))
+}
+
+/// [`render`] on this rank.
+fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
     if !args.scene.overlay.is_empty() || args.scene.frames.is_some() {
         return Err(CliError::input(
             "under mpirun, render writes one still image of one grid: --overlay (volumes on other grids) and --frames are rendered by one process",
@@ -272,6 +278,11 @@ fn channel_count(args: &InputArgs, spec: &str) -> Result<(usize, bool), CliError
 /// over the frames (each turned half a degree further, as `bench` does),
 /// printed by rank 0.
 pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
+    ranked(|| bench_rank(args))
+}
+
+/// [`bench`] on this rank.
+fn bench_rank(args: &BenchArgs) -> Result<(), CliError> {
     if args.peers.is_some() {
         return Err(CliError::input(
             "under mpirun, bench renders INPUT: --peers runs in one process",
@@ -334,16 +345,29 @@ fn threads(threads: Option<u16>) -> Result<(), CliError> {
         .map_err(|e| CliError::io(format!("cannot start worker threads: {e}")))
 }
 
-/// MPI, with a panic on this rank ending every rank (`MPI_Abort`): else
-/// the panicking rank would wait in `MPI_Finalize` and the others for it.
+/// Whether [`initialize`] has started MPI in this process.
+static STARTED: AtomicBool = AtomicBool::new(false);
+
+/// MPI, started.
 fn initialize() -> Result<Mpi, CliError> {
     let mpi = Mpi::initialize().ok_or_else(|| CliError::io("MPI could not be initialised"))?;
-    let default_hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        default_hook(info);
-        volray_distributed::mpi::abort_world(101);
-    }));
+    STARTED.store(true, Ordering::SeqCst);
     Ok(mpi)
+}
+
+/// Runs one rank's command, with a panic that nothing caught ending every
+/// rank (`MPI_Abort`) once MPI has started: else the panicking rank would
+/// wait in `MPI_Finalize` and the others for it. The abort comes after
+/// unwinding, not in the panic hook: a hook runs before unwinding, when a
+/// decoder's panic that its reader catches ([`volray_io::panics`]) cannot
+/// be told from a bug, and aborting there ended the whole job for a
+/// corrupt file that every rank would have reported on one line.
+fn ranked(run: impl FnOnce() -> Result<(), CliError>) -> Result<(), CliError> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        Ok(result) => result,
+        Err(_) if STARTED.load(Ordering::SeqCst) => volray_distributed::mpi::abort_world(101),
+        Err(payload) => std::panic::resume_unwind(payload),
+    }
 }
 
 /// `settings` with what the flags leave to the volume, as one process

@@ -424,6 +424,60 @@ fn a_rank_that_cannot_read_ends_every_rank_with_one_error_and_no_file() {
     assert!(!out.exists());
 }
 
+/// A JPEG-LS DICOM whose scan header's length points past the end of the
+/// stream (a frame cut short): the committed multi-frame fixture with the
+/// first SOS segment's length set to 0xFFFF.
+fn corrupt_jpegls(dir: &Path) -> PathBuf {
+    let fixture = root().join("crates/io/tests/fixtures/dicom/jpegls_frames.dcm");
+    let mut bytes = std::fs::read(fixture).unwrap();
+    let sos = bytes
+        .windows(2)
+        .position(|w| w == [0xFF, 0xDA])
+        .expect("a JPEG-LS scan header");
+    bytes[sos + 2] = 0xFF;
+    bytes[sos + 3] = 0xFF;
+    let path = dir.join("corrupt_jpegls.dcm");
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+#[test]
+fn a_decoder_failing_on_every_rank_is_one_line_each_and_exit_1_not_an_abort() {
+    if mpirun().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let dcm = corrupt_jpegls(dir.path());
+    let out = dir.path().join("out.png");
+    let run = ranks(
+        2,
+        &with_output(&[dcm.to_str().unwrap()], out.to_str().unwrap()),
+    );
+    assert_ne!(run.status.code(), Some(124), "timed out: a rank hung");
+    // mpirun exits with the ranks' code: 1, bad input; an MPI_Abort
+    // would give 101 and mpirun's abort banner.
+    assert_eq!(
+        run.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        !stderr.contains("MPI_ABORT") && !stderr.contains("MPI_Abort"),
+        "{stderr}"
+    );
+    let errors: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("volray: error:"))
+        .collect();
+    assert!(!errors.is_empty() && errors.len() <= 2, "{stderr}");
+    assert!(errors.iter().all(|e| *e == errors[0]), "{stderr}");
+    assert!(errors[0].contains("corrupt_jpegls.dcm"), "{stderr}");
+    assert!(!out.exists());
+}
+
 #[test]
 fn bench_reports_each_ranks_stages() {
     if mpirun().is_none() {

@@ -144,3 +144,4 @@ pub use shared::limits::{
     format_bytes, parse_size,
 };
 pub use shared::mapped::{MapPolicy, MappedFile};
+pub use shared::panics;

@@ -17,6 +17,7 @@
 //! | `rescale.rs` | stored values rescaled (slope, intercept), kept in an integer type where exact | NIfTI, DICOM |
 //! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
+//! | `panics.rs` | a panic inside a third-party decoder as an error, with no panic text | DICOM |
 //! | `cf.rs` | the CF conventions, format neutral: axes, coordinate variables, packing, fill values | NetCDF-3, MINC1, NetCDF-4 |
 
 pub(crate) mod cf;
@@ -26,6 +27,7 @@ pub(crate) mod hdf5;
 pub(crate) mod input;
 pub(crate) mod limits;
 pub(crate) mod mapped;
+pub mod panics;
 pub(crate) mod payload;
 pub(crate) mod periodic_cell;
 pub(crate) mod rescale;

@@ -18,7 +18,7 @@
 //! to more samples than the header declares. Both decoders can still panic
 //! on some corrupt streams (jpeg-decoder's `info` on an unexpected
 //! component count, arithmetic in openjp2's tier-1 decoder): each call is
-//! wrapped in [`catch_unwind`], so a corrupt codestream is a one-line
+//! wrapped in [`guarded`](crate::shared::panics::guarded), so a corrupt codestream is a one-line
 //! error naming the file and frame, never a crash.
 //!
 //! JPEG-LS is decoded by volray's own [`jpegls`] (dicom-pixeldata's adapter
@@ -26,8 +26,6 @@
 //!
 //! Not decoded: 12-bit DCT JPEG (JPEG Extended, process 4: `jpeg-decoder`
 //! reads 8-bit DCT only), refused by name.
-
-use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use super::header::ImageFormat;
 use super::jpegls;
@@ -348,7 +346,7 @@ fn guarded(
     codec: &str,
     decode: impl FnOnce() -> Result<Samples, String>,
 ) -> Result<Samples, String> {
-    match catch_unwind(AssertUnwindSafe(decode)) {
+    match crate::shared::panics::guarded(decode) {
         Ok(Ok(s)) => Ok(s),
         Ok(Err(e)) => Err(format!(
             "the {codec} stream of frame {frame} is corrupt: {e}"

@@ -4,7 +4,6 @@
 
 use std::fs::File;
 use std::io::Read;
-use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 
 use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
@@ -222,13 +221,13 @@ fn extend_to(
 /// checked; `head_only` stops before the pixel data. A panic inside the
 /// parser becomes an error.
 pub(super) fn parse(bytes: &[u8], head_only: bool) -> Result<DefaultDicomObject, String> {
-    let result = catch_unwind(AssertUnwindSafe(|| {
+    let result = crate::shared::panics::guarded(|| {
         let mut options = OpenFileOptions::new();
         if head_only {
             options = options.read_until(tags::FLOAT_PIXEL_DATA);
         }
         options.from_reader(bytes)
-    }));
+    });
     match result {
         Ok(Ok(obj)) => Ok(obj),
         Ok(Err(e)) => Err(format!("cannot parse: {e}")),

@@ -5,7 +5,6 @@
 //! integer type [`kept_type`] finds when every value fits it exactly (a CT
 //! series in `i16`), as `f32` otherwise.
 
-use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
 use dicom_dictionary_std::tags;
@@ -67,7 +66,7 @@ pub(super) fn decode(
     if let Some(codec) = Codec::of(syntax) {
         return decode_encapsulated(path, obj, format, frames, codec).map(Frames::Int);
     }
-    let result = catch_unwind(AssertUnwindSafe(|| obj.decode_pixel_data()));
+    let result = crate::shared::panics::guarded(|| obj.decode_pixel_data());
     let decoded = match result {
         Ok(Ok(d)) => d,
         Ok(Err(e)) => {
