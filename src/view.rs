@@ -132,9 +132,12 @@ fn serve(args: &ViewerArgs, viewer: Viewer) -> Result<(), CliError> {
             args.bind
         );
     }
-    if !args.no_browser {
-        browser::open(&url);
-    }
+    // The redirect page the browser was given stays until the viewer stops.
+    let _redirect = if args.no_browser {
+        None
+    } else {
+        browser::open(&url)
+    };
     let stopper = server.stopper();
     crate::interrupt::stop_instead(move || stopper.stop());
     server.run().map_err(|e| CliError::io(e.to_string()))

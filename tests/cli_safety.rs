@@ -241,3 +241,84 @@ fn fifos_and_devices_are_refused_without_blocking() {
         assert!(!out_png.exists());
     }
 }
+
+/// `volray view` where there is a display: the browser is opened through
+/// a redirect page of this user's alone, so that the URL's access token
+/// is in no process's arguments (`ps` shows them to every user).
+#[cfg(unix)]
+#[test]
+fn the_viewers_access_token_never_reaches_a_programs_arguments() {
+    use std::io::{BufRead, BufReader};
+    use std::os::unix::fs::PermissionsExt;
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, runtime) = (dir.path().join("bin"), dir.path().join("runtime"));
+    fs::create_dir_all(&bin).unwrap();
+    fs::create_dir_all(&runtime).unwrap();
+    // A stand-in for xdg-open: it records its arguments, and a copy of
+    // the page it was given with that page's mode.
+    let record = dir.path().join("opened");
+    let opener = bin.join("xdg-open");
+    fs::write(
+        &opener,
+        format!(
+            "#!/bin/sh\nr='{0}'\nprintf '%s\\n' \"$@\" > \"$r.args\"\npage=\"${{1#file://}}\"\nstat -c %a \"$page\" > \"$r.mode\"\ncp \"$page\" \"$r.html\"\nmv \"$r.args\" \"$r\"\n",
+            record.display()
+        ),
+    )
+    .unwrap();
+    fs::set_permissions(&opener, fs::Permissions::from_mode(0o755)).unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_volray"))
+        .args(["view", "fractal:17", "--port", "0"])
+        .env("DISPLAY", ":99")
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .env("PATH", path)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut url = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut url)
+        .unwrap();
+    let url = url.trim().to_string();
+    let token = url.split_once("token=").expect("a token URL").1.to_string();
+    assert!(token.len() >= 16, "{url}");
+
+    let start = Instant::now();
+    while !record.exists() && start.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let args = fs::read_to_string(&record).expect("the opener was run");
+    let page_path = args.trim().strip_prefix("file://").expect("a file URL");
+    let html = fs::read_to_string(record.with_extension("html")).unwrap();
+    let mode = fs::read_to_string(record.with_extension("mode")).unwrap();
+
+    // Stopped as Ctrl-C would, the viewer removes the page.
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    child.wait().unwrap();
+
+    assert!(
+        !args.contains(&token),
+        "the opener's arguments hold the token: {args}"
+    );
+    assert!(Path::new(page_path).starts_with(&runtime), "{page_path}");
+    assert_eq!(mode.trim(), "600", "the page is this user's alone");
+    assert!(html.contains(&url.replace('&', "&amp;")), "{html}");
+    assert!(
+        !Path::new(page_path).exists(),
+        "the page outlived the viewer"
+    );
+}
