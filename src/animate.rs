@@ -49,12 +49,21 @@ pub fn turntable(
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
             let base = &streamed.settings_from_volume(&args.view, base.clone())?;
             let mut writer = Writer::new(args, base, frames)?;
+            let mut last = None;
             for i in 0..frames {
                 let frame = turntable_frame(base, i, frames);
-                let (image, _) = pool.install(|| streamed.render(&args.view, &frame, &|_| {}))?;
+                let (image, times) =
+                    pool.install(|| streamed.render(&args.view, &frame, &|_| {}))?;
                 writer.push(&image)?;
+                last = Some(times);
             }
-            return writer.finish();
+            writer.finish()?;
+            // As a still says it was rendered in pieces, once for the
+            // animation: the last frame's pieces and times.
+            if let Some(times) = last {
+                eprintln!("{} (the last of {frames} frames)", streamed.note(&times));
+            }
+            return Ok(());
         }
         Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
     };

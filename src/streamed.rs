@@ -7,8 +7,9 @@
 //! picks the level for the picture (volray-options' `level`); the level's
 //! frame is bounded as a whole volume's would be (`memory.rs`). Within
 //! `--max-memory` it is read whole and rendered as any file is (the same
-//! pixels as `--level N`); beyond it, in pieces of at most
-//! [`volray_lazy::PIECE_BUDGET`] each.
+//! pixels as `--level N`); beyond it, or beyond one piece's
+//! [`volray_lazy::PIECE_BUDGET`] (lighter and faster then), in pieces of at
+//! most that each.
 
 use crate::error::CliError;
 use crate::flags::{InputArgs, ViewArgs};
@@ -192,17 +193,29 @@ impl StreamedInput {
     pub fn note(&self, times: &StreamTimes) -> String {
         let [x, y, z] = self.streamed.grid().dims;
         format!(
-            "volray: {}: level {} ({x}x{y}x{z}) rendered in pieces, as it may take up to {} whole, over --max-memory {}: {} of {} pieces read ({} voxels), {:.2} s reading, {:.2} s rendering",
+            "volray: {}: level {} ({x}x{y}x{z}) rendered in pieces, as it may take up to {} whole, over {}: {} of {} pieces read ({} voxels), {:.2} s reading, {:.2} s rendering",
             display(&self.name),
             self.level,
             format_bytes(self.whole),
-            format_bytes(u128::from(self.max_memory)),
+            self.bound(),
             times.read_pieces,
             times.pieces,
             times.read_voxels,
             times.read.as_secs_f64(),
             times.render.as_secs_f64()
         )
+    }
+
+    /// What the level's frame went over: --max-memory, or one piece's
+    /// budget beneath it ([`volray_lazy::Chunked::plan`]).
+    fn bound(&self) -> String {
+        let limit = format_bytes(u128::from(self.max_memory));
+        if self.max_memory > volray_lazy::PIECE_BUDGET {
+            let piece = format_bytes(u128::from(volray_lazy::PIECE_BUDGET));
+            format!("a piece's {piece} (under --max-memory {limit})")
+        } else {
+            format!("--max-memory {limit}")
+        }
     }
 
     /// A failed step as the CLI's error.

@@ -219,12 +219,18 @@ fn a_turntable_of_a_level_over_max_memory_turns_piece_by_piece() {
     let whole = dir.path().join("whole_%02d.png");
     let pieces = dir.path().join("pieces_%02d.png");
     let turn = ["--turntable", "3"];
-    render(&[&[path], &LOOK[..], &turn[..]].concat(), &whole);
+    let said = render(&[&[path], &LOOK[..], &turn[..]].concat(), &whole);
+    assert!(!said.contains("pieces"), "{said}");
     let said = render(
         &[&[path, "--max-memory", "100K"], &LOOK[..], &turn[..]].concat(),
         &pieces,
     );
-    assert!(said.is_empty() || !said.contains("error"), "{said}");
+    // Each frame was rendered from pieces: the note names them.
+    assert!(
+        said.contains("rendered in pieces") && said.contains("the last of 3 frames"),
+        "{said}"
+    );
+    assert_eq!(said.lines().count(), 1, "{said}");
     for i in 0..3 {
         let a = Picture::read(&dir.path().join(format!("whole_{i:02}.png")));
         let b = Picture::read(&dir.path().join(format!("pieces_{i:02}.png")));

@@ -221,8 +221,16 @@ impl Chunked {
 
     /// How frames of `settings` render the level under `max_memory`:
     /// whole when [`whole_bytes`](Self::whole_bytes) plus the front end's
-    /// `extra` (say, a 16-bit PNG's buffer) fits, else in pieces of at
-    /// most min(`max_memory`, [`PIECE_BUDGET`]).
+    /// `extra` (say, a 16-bit PNG's buffer) fits in one piece's budget,
+    /// min(`max_memory`, [`PIECE_BUDGET`]), else in pieces of at most that.
+    ///
+    /// Not "whole whenever it fits `max_memory`": a level that takes more
+    /// than a piece is lighter in pieces (their frames never take more
+    /// than a piece's budget), and was faster too. The 2048³ OME-Zarr
+    /// pyramid's 1024² image at `--level auto` took 37.3 s and 3.27 GiB
+    /// read whole under the default limit, 8.3 s and 0.62 GiB in pieces:
+    /// the pieces' reads and renders overlap, and empty chunks are never
+    /// read.
     pub fn plan(
         &self,
         settings: &RenderSettings,
@@ -232,7 +240,7 @@ impl Chunked {
     ) -> Plan {
         let level = self.level();
         let need = self.whole_bytes(settings, non_finite) + extra;
-        if need <= u128::from(max_memory) {
+        if need <= u128::from(max_memory.min(PIECE_BUDGET)) {
             return Plan::Whole { level, need };
         }
         let budget = max_memory.min(PIECE_BUDGET);
@@ -256,7 +264,7 @@ impl Chunked {
     ) -> Result<Plan, String> {
         let level = self.level();
         let need = self.whole_log_bytes(settings, non_finite) + extra;
-        if need <= u128::from(max_memory) {
+        if need <= u128::from(max_memory.min(PIECE_BUDGET)) {
             return Ok(Plan::Whole { level, need });
         }
         Ok(Plan::Pieces {
