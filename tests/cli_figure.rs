@@ -155,23 +155,29 @@ fn the_colour_bar_says_the_units_given_and_hounsfield_units_under_a_ct_preset() 
 fn openexr_keeps_the_bare_frame_and_bad_lengths_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("out.exr");
-    for flag in ["--colorbar", "--axes", "--outline"] {
-        let run = volray(&[
-            "render",
-            "sphere:16",
-            "--size",
-            "32",
-            flag,
-            "-o",
-            exr.to_str().unwrap(),
-        ]);
+    let bare = dir.path().join("bare.exr");
+    let base = ["render", "hydrogen:6,2,1", "--size", "32", "--colormap", "magma"];
+    let run = volray(&[&base[..], &["-o", bare.to_str().unwrap()]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    let bare = std::fs::read(&bare).unwrap();
+    for flags in [
+        &["--colorbar"][..],
+        &["--axes"],
+        &["--outline"],
+        &["--scale-bar", "--title", "T", "--label", "a"],
+        &["--colorbar", "left", "--units", "K"],
+    ] {
+        let run = volray(&[&base[..], flags, &["-o", exr.to_str().unwrap()]].concat());
         assert!(run.status.success(), "{}", stderr(&run));
         let message = stderr(&run);
         assert!(
-            message.contains("keeps the bare frame") && message.starts_with(flag),
+            message.contains("keeps the bare frame") && message.starts_with(flags[0]),
             "{message}"
         );
         assert_eq!(message.lines().count(), 1, "{message}");
+        // The frame's values as rendered, byte for byte: the figure is
+        // drawn into 8- and 16-bit pictures only.
+        assert!(std::fs::read(&exr).unwrap() == bare, "{flags:?} changed the EXR");
     }
     let gif = dir.path().join("out.gif");
     let run = volray(&[
