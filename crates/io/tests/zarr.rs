@@ -265,7 +265,7 @@ fn levels_time_points_and_channels_out_of_range_are_refused() {
     let (_, err) = refused(&npy, &opts(Some(0), None, None));
     assert!(matches!(err, IoError::LevelNotApplicable { .. }), "{err}");
     let (_, err) = refused(&npy, &opts(None, None, Some(1)));
-    assert!(matches!(err, IoError::LevelNotApplicable { .. }), "{err}");
+    assert!(matches!(err, IoError::ChannelOutOfRange { .. }), "{err}");
 }
 
 /// A copy of store `name` in a new directory, to break.
