@@ -155,7 +155,7 @@ fn four_d_series_picks_frames() {
     assert_eq!(
         err.to_string(),
         format!(
-            "{}: frame 3 is out of range: the file holds 3 volumes (frames 0 to 2)",
+            "{}: frame 3 is out of range: the file holds 3 volumes (frames 0 to 2), numbered from 0",
             path.display()
         )
     );

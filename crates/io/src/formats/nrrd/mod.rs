@@ -125,8 +125,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         opts,
         AxisNames {
             holder: "the file",
-            time: &along,
-            channel: &along,
+            time: if channels { "" } else { &along },
+            channel: if channels { &along } else { "" },
         },
     )?;
     let frame = picked.time_point.max(picked.channel);
