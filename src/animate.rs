@@ -138,7 +138,7 @@ pub fn time_points(
     }
     // The count, from the first time point's file information.
     let count = match &load(&args.input, false)?.file {
-        Some((_, info)) => info.frames,
+        Some((_, info)) => info.time_points,
         None => 1,
     };
     if count < 2 {

@@ -30,6 +30,7 @@ use crate::error::CliError;
 use crate::flags::{BenchArgs, Channels, InputArgs, MixMode, RenderArgs, ViewArgs};
 use crate::input::{self, Input};
 use crate::render::{self, OutputKind};
+use crate::scene::{ChannelAxis, channel_axis};
 use crate::session::render_failure;
 use crate::settings::settings;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -149,10 +150,9 @@ fn channels(
         .as_deref()
         .unwrap_or(input::DEMO)
         .to_string();
-    let picked = args.input.frame.is_some() || args.input.channel.is_some();
-    if volray_data::is_source_spec(&spec) || picked {
+    if volray_data::is_source_spec(&spec) || args.input.channel.is_some() {
         return Err(CliError::input(format!(
-            "--channels: give a file holding several channels, without --frame or --channel ({spec})"
+            "--channels: give a file holding several channels, without --channel ({spec})"
         )));
     }
     // How many channels, and which reader option picks one: rank 0 asks
@@ -160,28 +160,36 @@ fn channels(
     let probe = if mpi.rank() == 0 {
         channel_count(&args.input, &spec)
     } else {
-        Ok((0, false))
+        Ok((0, ChannelAxis::Channel))
     };
-    let told = probe.map(|(n, zarr)| {
+    let told = probe.map(|(n, axis)| {
         let mut bytes = (n as u32).to_le_bytes().to_vec();
-        bytes.push(u8::from(zarr));
+        bytes.push(u8::from(axis == ChannelAxis::Channel));
         bytes
     });
     let all = agree(mpi, told.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
     let word = |b: &[u8]| u32::from_le_bytes(b[..4].try_into().expect("four bytes")) as usize;
-    let (count, zarr) = (word(&all[0]), all[0][4] == 1);
-    let (indices, colors) =
-        crate::scene::picked_channels(args.scene.channel_colors.as_ref(), which, &spec, count)?;
+    let (count, axis) = (
+        word(&all[0]),
+        if all[0][4] == 1 {
+            ChannelAxis::Channel
+        } else {
+            ChannelAxis::Time
+        },
+    );
+    if axis == ChannelAxis::Time && args.input.frame.is_some() {
+        return Err(CliError::input(format!(
+            "--channels renders the time points of {spec} (one channel) together; --frame picks one: give one of them"
+        )));
+    }
+    let (indices, colors) = crate::scene::channels::picked_channels(
+        args.scene.channel_colors.as_ref(),
+        which,
+        &spec,
+        count,
+    )?;
     let sources = (indices.iter())
-        .map(|&i| {
-            let mut one = args.input.clone();
-            if zarr {
-                one.channel = Some(i);
-            } else {
-                one.frame = Some(i);
-            }
-            CliSource::open(mpi, &one, view, &settings)
-        })
+        .map(|&i| CliSource::open(mpi, &axis.pick(&args.input, i), view, &settings))
         .collect::<Result<Vec<_>, _>>()?;
     let mode = sources[0].non_finite;
     let fail = |e| failure(view, &spec, e);
@@ -256,22 +264,21 @@ fn channels(
     Ok(image)
 }
 
-/// INPUT's channels, as rank 0 finds them: how many, and whether they
-/// are an OME-Zarr image's `c` axis (else the file's frames).
-fn channel_count(args: &InputArgs, spec: &str) -> Result<(usize, bool), CliError> {
+/// INPUT's channels, as rank 0 finds them: how many, and along which
+/// axis (`scene::channel_axis`).
+fn channel_count(args: &InputArgs, spec: &str) -> Result<(usize, ChannelAxis), CliError> {
     let path = std::path::PathBuf::from(spec);
     let max_memory = args
         .max_memory
         .unwrap_or_else(volray_io::default_max_memory);
     let opts = input::read_options(args, spec, &path, max_memory, MapPolicy::IfLarger)?;
     if let Some(lazy) = volray_io::open_lazy(&path, &opts)? {
-        let count = crate::scene::channel_count(lazy.format, &lazy.info);
-        return Ok((count, lazy.format == volray_io::VolumeFormat::Zarr));
+        return Ok(channel_axis(&lazy.info));
     }
     let input = input::load_with(args, MapPolicy::AlwaysInFileOrder)?;
-    Ok(input.file.map_or((1, false), |(format, info)| {
-        (crate::scene::channel_count(format, &info), false)
-    }))
+    Ok(input
+        .file
+        .map_or((1, ChannelAxis::Channel), |(_, info)| channel_axis(&info)))
 }
 
 /// `volray bench` under `mpirun`: per-rank times of each stage, medians

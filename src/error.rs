@@ -80,11 +80,14 @@ fn naming_flags(e: &IoError) -> String {
         IoError::FrameNotApplicable { format, .. } => {
             format!("{file}: --frame does not apply to {format} files: they hold one volume")
         }
-        IoError::LevelNotApplicable { format, .. } => format!(
-            "{file}: --level and --channel apply to Zarr/OME-Zarr images only, not to {format} files"
-        ),
+        IoError::LevelNotApplicable { format, .. } => {
+            format!("{file}: --level applies to Zarr/OME-Zarr images only, not to {format} files")
+        }
         IoError::FrameOutOfRange { frame, held, .. } => {
             format!("{file}: --frame {frame} is out of range: {held}")
+        }
+        IoError::ChannelOutOfRange { channel, held, .. } => {
+            format!("{file}: --channel {channel} is out of range: {held}")
         }
         IoError::FrameNeeded { held, choices, .. } => {
             format!("{file}: {held}; pick one with --frame N: {choices}")

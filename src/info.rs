@@ -288,21 +288,21 @@ fn stored(l: &volray_io::LevelInfo) -> String {
 
 fn print_stored(i: &FileInfo, name: &str) {
     outln!("stored as: {}", i.stored_type);
-    if i.frames > 1 {
+    let (t, c) = (i.time_points, i.channels);
+    if t > 1 {
         outln!(
-            "frame:     {} of {} (--frame picks another)",
-            i.frame,
-            i.frames
+            "time points: {t} (read: {}; --frame picks another; as an animation: volray render {name} --frames all -o OUT.gif)",
+            i.time_point
         );
     }
-    let channels = channels(i);
-    if channels > 1 {
-        outln!("channels:  {channels} (render them together: volray render {name} --channels all)");
-    }
-    if i.frames > 1 {
+    if c > 1 {
         outln!(
-            "           (its {} frames as an animation: volray render {name} --frames all -o OUT.gif)",
-            i.frames
+            "channels:  {c} (read: {}; --channel picks another; together: volray render {name} --channels all)",
+            i.channel
+        );
+    } else if t > 1 {
+        outln!(
+            "channels:  1 (its {t} time points rendered together as channels: volray render {name} --channels all)"
         );
     }
     if !i.levels.is_empty() {
@@ -358,18 +358,6 @@ fn print_stored(i: &FileInfo, name: &str) {
     }
 }
 
-/// How many channels `--channels` finds in the file: an OME-Zarr image's
-/// `c` axis (its frames are time points), else its frames.
-fn channels(i: &FileInfo) -> usize {
-    if i.levels.is_empty() {
-        return i.frames;
-    }
-    (i.header.iter())
-        .find(|(k, _)| k == "channels")
-        .and_then(|(_, v)| v.parse().ok())
-        .unwrap_or(1)
-}
-
 /// The header as written and the notes of how the file was read.
 fn print_header_and_notes(i: &FileInfo) {
     if !i.header.is_empty() {
@@ -389,9 +377,14 @@ fn print_header_and_notes(i: &FileInfo) {
 /// The file's own fields in `volray info --json`.
 fn add_file_json(out: &mut Value, i: &FileInfo) {
     out["stored_type"] = json!(i.stored_type);
+    // The volumes: `frames` = time points × channels, `frame` the one
+    // read (t·C + c); `channels` counts the channels alone.
     out["frames"] = json!(i.frames);
-    out["channels"] = json!(channels(i));
     out["frame"] = json!(i.frame);
+    out["time_points"] = json!(i.time_points);
+    out["time_point"] = json!(i.time_point);
+    out["channels"] = json!(i.channels);
+    out["channel"] = json!(i.channel);
     out["arrays"] = json!(i.arrays);
     out["array"] = json!(i.array);
     out["header"] = json!(

@@ -12,57 +12,36 @@
 //! shared shading. Each volume is read whole and checked against
 //! `--max-memory` on its own (`session.rs`). Plain renders never come here.
 
+pub(crate) mod channels;
+mod layer;
+
+use channels::read_channels;
+pub use channels::refuse_channel_look;
+use layer::Budget;
+pub use layer::{ChannelAxis, Layer, LayerSource, channel_axis};
+
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::{
-    ChannelColors, Channels, InputArgs, LookArgs, MixMode, RenderArgs, SceneArgs, ViewArgs,
-};
-use crate::input::{self, Input};
+use crate::flags::{InputArgs, MixMode, RenderArgs, SceneArgs, ViewArgs};
+use crate::input;
 use crate::render::{OutputKind, output_kind, write_still};
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
 use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
 use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
-use volray_core::{PiecewiseLinear, RenderError, RenderSettings, SceneError};
-use volray_io::{FileInfo, VolumeFormat};
+use volray_core::{RenderError, RenderSettings, SceneError};
 use volray_options::{LookOptions, Naming, Opt, Options, Tf};
 
 /// The overlay options, as the refusal of an unknown one lists them.
 const OVERLAY_OPTIONS: &str = "labels, colormap=NAME, preset=NAME, range=LO,HI, opacity=P,Q, tf=FILE.json, frame=N, channel=N, hidden";
 
-/// One volume of the picture: what was read, its settings alone (whose
-/// look becomes its [`Look`]), and where it came from.
-pub struct Layer {
-    pub input: Input,
-    pub settings: RenderSettings,
-    pub source: LayerSource,
-}
-
-impl Layer {
-    /// Its look in the picture: shown unless an overlay's `hidden`.
-    pub fn look(&self) -> Look {
-        Look {
-            visible: !matches!(&self.source, LayerSource::Overlay(o) if o.hidden),
-            ..Look::of(&self.settings)
-        }
-    }
-}
-
-/// Where a volume of the picture came from.
-#[derive(Debug, Clone, PartialEq)]
-pub enum LayerSource {
-    /// INPUT, alone.
-    Input,
-    /// A channel of INPUT: its number, and whether OME-Zarr's `c` picks
-    /// it (`--channel`) rather than the file's frames (`--frame`).
-    Channel { index: usize, zarr: bool },
-    /// An `--overlay`.
-    Overlay(OverlaySpec),
-}
-
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
-    let animation = args.animation.turntable.map(|_| "--turntable");
+    let animation = match (args.animation.turntable, args.scene.frames) {
+        (Some(_), _) => Some("--turntable"),
+        (None, Some(_)) => Some("--frames"),
+        (None, None) => None,
+    };
     let kind = output_kind(&args.out.output, args.out.bit_depth, animation)?;
     if args.animation.fps.is_some() && animation.is_none() {
         return Err(CliError::input(
@@ -102,6 +81,22 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         "--channels and --overlay",
     )?;
     let layers = read_layers(&input_args, &args.view, &args.scene, &overlays, &settings)?;
+    let mix = match args.scene.mix {
+        Some(MixMode::Composite) => Mix::Composite,
+        Some(MixMode::Additive) => Mix::Additive,
+        None if args.scene.channels.is_some() => Mix::Additive,
+        None => Mix::Composite,
+    };
+    if let Some(range) = args.scene.frames {
+        let walk = TimeWalk {
+            args,
+            kind,
+            settings: &settings,
+            pool: &pool,
+            mix,
+        };
+        return walk.run(&input_args, layers, range);
+    }
 
     let names: Vec<&str> = layers.iter().map(|l| l.input.name.as_str()).collect();
     let renderers = (layers.iter())
@@ -110,12 +105,6 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let fail = |e: RenderError| scene_failure(&args.view, &names, e);
     let scene = Scene::new(renderers).map_err(|e| fail(RenderError::Scene(e)))?;
     let looks: Vec<Look> = layers.iter().map(Layer::look).collect();
-    let mix = match args.scene.mix {
-        Some(MixMode::Composite) => Mix::Composite,
-        Some(MixMode::Additive) => Mix::Additive,
-        None if args.scene.channels.is_some() => Mix::Additive,
-        None => Mix::Composite,
-    };
     // The progress bar counts each volume rendered apart (the additive
     // mix, the projections).
     let apart = mix == Mix::Additive || settings.blend.is_projection();
@@ -172,6 +161,142 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
 }
 
+/// `--channels` with `--frames`: the channels at each time point of the
+/// range, one frame each, every channel with the look (transfer function,
+/// window) it has at the first, as a series of inputs has one transfer
+/// function; each time point's volumes read after the last one's are
+/// dropped.
+struct TimeWalk<'a> {
+    args: &'a RenderArgs,
+    kind: OutputKind,
+    settings: &'a RenderSettings,
+    pool: &'a rayon::ThreadPool,
+    mix: Mix,
+}
+
+impl TimeWalk<'_> {
+    fn run(
+        &self,
+        input_args: &InputArgs,
+        first: Vec<Layer>,
+        range: crate::flags::Frames,
+    ) -> Result<(), CliError> {
+        let args = self.args;
+        let spec = args.input.input.as_deref().unwrap_or(input::DEMO);
+        let (count, axis) = match &first[0].input.file {
+            Some((_, info)) => channel_axis(info),
+            None => (1, ChannelAxis::Channel),
+        };
+        let count = match (axis, &first[0].input.file) {
+            (ChannelAxis::Channel, Some((_, info))) => info.time_points,
+            _ => {
+                return Err(CliError::input(format!(
+                    "--channels renders the {count} time points of {spec} (one channel) together: --frames cannot walk them too"
+                )));
+            }
+        };
+        let end = range.end.unwrap_or(count);
+        if count < 2 || range.start >= count || end > count {
+            return Err(CliError::input(format!(
+                "--frames {}:{end}: {spec} holds {count} time point(s), numbered from 0",
+                range.start
+            )));
+        }
+        let n = end - range.start;
+        let files = crate::render::output_files(args, self.kind, n);
+        crate::overwrite::refuse_overwriting_inputs(&files, &[spec.to_string()], &[])?;
+        let per_frame = self.settings.width * self.settings.height * first.len();
+        let mut writer = animate::Writer::with_pixels(args, self.settings, n, n * per_frame)?;
+        // The looks of time point 0, read first; its volumes rendered if
+        // the range starts there, else dropped now.
+        let looks: Vec<(LayerSource, RenderSettings)> = (first.iter())
+            .map(|l| (l.source.clone(), l.settings.clone()))
+            .collect();
+        let mut layers = (range.start == 0).then_some(first);
+        for t in range.start..end {
+            let now = match layers.take() {
+                Some(first) => first,
+                None => self.read_at(input_args, t, &looks)?,
+            };
+            let image = self.picture(&now, &writer.bar)?;
+            drop(now);
+            writer.push(&image)?;
+        }
+        writer.finish()
+    }
+
+    /// The channels of `looks` at time point `t`, each with its look.
+    fn read_at(
+        &self,
+        input_args: &InputArgs,
+        t: usize,
+        looks: &[(LayerSource, RenderSettings)],
+    ) -> Result<Vec<Layer>, CliError> {
+        let spec = input_args.input.as_deref().unwrap_or(input::DEMO);
+        let at = InputArgs {
+            frame: Some(t),
+            ..input_args.clone()
+        };
+        let mut budget = Budget::new(at.max_memory);
+        let mut layers = Vec::with_capacity(looks.len());
+        for (source, settings) in looks {
+            let LayerSource::Channel { index, axis } = source else {
+                unreachable!("--frames takes channels only");
+            };
+            let mut one = axis.pick(&at, *index);
+            one.max_memory = budget.left();
+            let mut input = load(&one, self.args.view.look.log).map_err(|e| budget.explain(e))?;
+            budget.add(&input.volume);
+            input.max_memory = budget.limit;
+            input.name = format!("{spec} (channel {index}, time point {t})");
+            layers.push(Layer {
+                input,
+                settings: settings.clone(),
+                source: source.clone(),
+            });
+        }
+        Ok(layers)
+    }
+
+    /// One frame of `layers`, annotated as the first volume's.
+    fn picture(
+        &self,
+        layers: &[Layer],
+        bar: &indicatif::ProgressBar,
+    ) -> Result<volray_core::Image, CliError> {
+        let view = &self.args.view;
+        let names: Vec<&str> = layers.iter().map(|l| l.input.name.as_str()).collect();
+        let renderers = (layers.iter())
+            .map(|l| renderer_for(view, &l.settings, &l.input))
+            .collect::<Result<Vec<_>, _>>()?;
+        let fail = |e: RenderError| scene_failure(view, &names, e);
+        let scene = Scene::new(renderers).map_err(|e| fail(RenderError::Scene(e)))?;
+        let request = SceneSettings {
+            settings: self.settings.clone(),
+            looks: layers.iter().map(Layer::look).collect(),
+            mix: self.mix,
+        };
+        let mut image = (self.pool)
+            .install(|| scene.render_with_progress(&request, &|n| bar.inc(n as u64), None))
+            .map_err(fail)?;
+        let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
+        let mut first = layers[0].settings.clone();
+        first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
+        let renderer = &scene.layers()[0];
+        crate::figure::draw_framed(
+            self.args,
+            self.kind,
+            &first,
+            renderer,
+            &layers[0].input,
+            &boxes,
+            renderer.volume().bounds(),
+            &mut image,
+        )?;
+        Ok(image)
+    }
+}
+
 /// INPUT read whole (a chunked file at the level `plan` picks for a frame
 /// of `settings`), refused where it would be rendered in pieces, which
 /// `what` does not support.
@@ -216,7 +341,7 @@ pub fn read_layers(
         .collect::<Result<Vec<_>, _>>()?;
     let mut budget = Budget::new(input_args.max_memory);
     let mut layers = match &scene.channels {
-        Some(which) => channels(input_args, view, scene, which, settings, &mut budget)?,
+        Some(which) => read_channels(input_args, view, scene, which, settings, &mut budget)?,
         None => {
             let mut input = load(input_args, view.look.log)?;
             budget.add(&input.volume);
@@ -257,55 +382,6 @@ pub fn read_layers(
     Ok(layers)
 }
 
-/// `--max-memory` shared by the volumes of one picture: each is read
-/// under what the ones read before it left (a mapped volume's pages are
-/// the system's to drop, and hold nothing). Each volume's renderer is
-/// then checked against the whole limit on its own (`renderer_for`), not
-/// against what the others' hold: a gap, for volumes whose renderers'
-/// structures (brick caches, a cleaned copy) are large beside them.
-pub struct Budget {
-    limit: u64,
-    held: u64,
-}
-
-impl Budget {
-    fn new(max_memory: Option<u64>) -> Self {
-        Budget {
-            limit: max_memory.unwrap_or_else(volray_io::default_max_memory),
-            held: 0,
-        }
-    }
-
-    fn add(&mut self, volume: &volray_core::Volume) {
-        if !volume.samples().is_external() {
-            let [x, y, z] = volume.dims();
-            let bytes = (x * y * z * volume.sample_type().bytes()) as u64;
-            self.held = self.held.saturating_add(bytes);
-        }
-    }
-
-    /// The limit the next volume is read under.
-    fn left(&self) -> Option<u64> {
-        Some(self.limit.saturating_sub(self.held))
-    }
-
-    /// A refusal of the next volume, saying what the others hold.
-    fn explain(&self, e: CliError) -> CliError {
-        if self.held == 0 {
-            return e;
-        }
-        CliError {
-            message: format!(
-                "{} (the volumes read before it hold {} of --max-memory {})",
-                e.message,
-                volray_io::format_bytes(u128::from(self.held)),
-                volray_io::format_bytes(u128::from(self.limit))
-            ),
-            ..e
-        }
-    }
-}
-
 /// The refusals of what several volumes in one picture do not take.
 fn refuse_unsupported(args: &RenderArgs) -> Result<(), CliError> {
     let flag = if args.scene.channels.is_some() {
@@ -318,30 +394,23 @@ fn refuse_unsupported(args: &RenderArgs) -> Result<(), CliError> {
             "{flag} renders INPUT with its channels or overlays in one picture: several inputs (a series) are not supported with it"
         )));
     }
-    if args.scene.frames.is_some() {
-        return Err(CliError::input(format!(
-            "{flag} and --frames cannot be combined: give one of them"
-        )));
+    if args.scene.frames.is_some() && !args.scene.overlay.is_empty() {
+        return Err(CliError::input(
+            "--overlay and --frames cannot be combined: give one of them",
+        ));
+    }
+    if args.scene.frames.is_some() && args.animation.turntable.is_some() {
+        return Err(CliError::input(
+            "--frames animates the time points of INPUT: give --frames or --turntable, not both",
+        ));
+    }
+    if args.scene.frames.is_some() && args.input.frame.is_some() {
+        return Err(CliError::input(
+            "--frames renders the time points of INPUT; --frame picks one: give one of them",
+        ));
     }
     if args.scene.channels.is_some() {
         refuse_channel_look(&args.view.look)?;
-    }
-    Ok(())
-}
-
-/// Refuses the look flags that do not apply to `--channels`, whose
-/// colours are `--channel-colors`' (render's and view's).
-pub fn refuse_channel_look(look: &LookArgs) -> Result<(), CliError> {
-    for (given, other) in [
-        (look.labels, "--labels"),
-        (look.preset.is_some(), "--preset"),
-        (look.colormap.is_some(), "--colormap"),
-    ] {
-        if given {
-            return Err(CliError::input(format!(
-                "--channels colours each channel (--channel-colors): {other} does not apply to channels (give it to an --overlay instead)"
-            )));
-        }
     }
     Ok(())
 }
@@ -353,148 +422,6 @@ fn scene_failure(view: &ViewArgs, names: &[&str], e: RenderError) -> CliError {
             render_failure(view, names.get(layer).unwrap_or(&names[0]), *error)
         }
         e => render_failure(view, names[0], e),
-    }
-}
-
-/// The channels `which` of INPUT (read as `input_args` say), each with
-/// its look.
-fn channels(
-    input_args: &InputArgs,
-    view: &ViewArgs,
-    scene: &SceneArgs,
-    which: &Channels,
-    settings: &RenderSettings,
-    budget: &mut Budget,
-) -> Result<Vec<Layer>, CliError> {
-    let spec = input_args.input.as_deref().unwrap_or(input::DEMO);
-    if volray_data::is_source_spec(spec) {
-        return Err(CliError::input(format!(
-            "--channels: {spec} is a built-in source, one volume: give a file holding several channels"
-        )));
-    }
-    let log = view.look.log;
-    let first = load(input_args, log)?;
-    budget.add(&first.volume);
-    let Some((format, info)) = &first.file else {
-        return Err(CliError::input(format!(
-            "--channels: {spec} is not a file holding several channels"
-        )));
-    };
-    let zarr = *format == VolumeFormat::Zarr;
-    let count = channel_count(*format, info);
-    // Which reader option picks a channel: OME-Zarr's `c` (its `t` stays
-    // --frame's), else the file's frames.
-    let (picked, flag) = if zarr {
-        (input_args.channel, "--channel")
-    } else {
-        (input_args.frame, "--frame")
-    };
-    if picked.is_some() {
-        return Err(CliError::input(format!(
-            "--channels picks the channels of {spec}; {flag} picks one: give one of them"
-        )));
-    }
-    let (indices, colors) = picked_channels(scene.channel_colors.as_ref(), which, spec, count)?;
-    let mut first = Some(first);
-    let mut layers = Vec::with_capacity(indices.len());
-    for (&index, &rgb) in indices.iter().zip(&colors) {
-        let mut input = match first.take() {
-            Some(input) if index == 0 => input,
-            _ => {
-                let mut one = input_args.clone();
-                if zarr {
-                    one.channel = Some(index);
-                } else {
-                    one.frame = Some(index);
-                }
-                one.max_memory = budget.left();
-                let mut input = load(&one, log).map_err(|e| budget.explain(e))?;
-                budget.add(&input.volume);
-                input.max_memory = budget.limit;
-                input
-            }
-        };
-        input.name = format!("{spec} (channel {index})");
-        let mut settings = settings.clone();
-        let tf = &mut settings.transfer_function;
-        tf.color = Some(channel_color(rgb, settings.blend.is_projection()));
-        crate::settings::file_window(
-            &view.look,
-            tf,
-            input.file.as_ref().and_then(|(_, i)| i.display_window()),
-        );
-        crate::settings::from_volume(&view.look, tf, &mut input.volume, &input.name)?;
-        layers.push(Layer {
-            input,
-            settings,
-            source: LayerSource::Channel { index, zarr },
-        });
-    }
-    Ok(layers)
-}
-
-/// How many channels a file holds, as its reader says: an OME-Zarr
-/// image's `c` axis (the `channels` header entry), else its frames.
-pub fn channel_count(format: VolumeFormat, info: &FileInfo) -> usize {
-    if format == VolumeFormat::Zarr {
-        (info.header.iter())
-            .find(|(k, _)| k == "channels")
-            .and_then(|(_, v)| v.parse::<usize>().ok())
-            .unwrap_or(1)
-    } else {
-        info.frames
-    }
-}
-
-/// The channels `which` of the `count` that `spec` holds, and their
-/// colours (`--channel-colors`, else the palette): refused in one line
-/// where there are none to render together, one is out of range, or the
-/// colours do not match them.
-pub fn picked_channels(
-    channel_colors: Option<&ChannelColors>,
-    which: &Channels,
-    spec: &str,
-    count: usize,
-) -> Result<(Vec<usize>, Vec<[f32; 3]>), CliError> {
-    if count < 2 {
-        return Err(CliError::input(format!(
-            "--channels: {spec} holds one volume, no channels to render together (volray info {spec} says what it holds)"
-        )));
-    }
-    let indices: Vec<usize> = match which {
-        Channels::All => (0..count).collect(),
-        Channels::Some(list) => list.clone(),
-    };
-    if let Some(bad) = indices.iter().find(|&&i| i >= count) {
-        return Err(CliError::input(format!(
-            "--channels {bad}: {spec} holds {count} channels, numbered from 0"
-        )));
-    }
-    let colors = match channel_colors {
-        Some(given) if given.0.len() != indices.len() => {
-            return Err(CliError::input(format!(
-                "--channel-colors: {} colour(s) for {} channels: give one per channel",
-                given.0.len(),
-                indices.len()
-            )));
-        }
-        Some(given) => given.0.clone(),
-        None => (0..indices.len())
-            .map(volray_options::colors::channel_colour)
-            .collect(),
-    };
-    Ok((indices, colors))
-}
-
-/// A channel's colour transfer function: its colour at every value where
-/// samples are composited (the opacity says how much of it), from black
-/// to it over the window where the projections show the value through
-/// the colour map.
-fn channel_color(rgb: [f32; 3], projection: bool) -> PiecewiseLinear<3> {
-    if projection {
-        PiecewiseLinear::new("color", vec![(0.0, [0.0; 3]), (1.0, rgb)]).expect("colours in [0, 1]")
-    } else {
-        PiecewiseLinear::constant(rgb)
     }
 }
 

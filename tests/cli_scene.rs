@@ -240,6 +240,52 @@ fn the_volumes_of_one_picture_share_max_memory() {
     );
 }
 
+#[test]
+fn channels_not_asked_for_are_not_charged_and_none_is_read_twice() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    // Three channels of 54 KiB, read whole (compressed): two fit 150000
+    // bytes, three do not.
+    let plain = nifti(
+        dir.path(),
+        "three.nii",
+        &[ball(6.0), ball(12.0), ball(17.0)],
+    );
+    let gz = dir.path().join("three.nii.gz");
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    e.write_all(&std::fs::read(&plain).unwrap()).unwrap();
+    std::fs::write(&gz, e.finish().unwrap()).unwrap();
+    let gz = gz.to_str().unwrap();
+    let two = |which: &str, colors: &str| {
+        render(
+            dir.path(),
+            &format!("{}.png", which.replace(',', "_")),
+            &[
+                gz,
+                "--channels",
+                which,
+                "--channel-colors",
+                colors,
+                "--max-memory",
+                "150000",
+                "--no-shading",
+            ],
+        )
+    };
+    // Channel 0, read to count the channels, is dropped and not charged.
+    let p = two("1,2", "magenta,green");
+    assert_eq!(p.at(11, 24), [0, 0, 0], "channel 0 not drawn");
+    // Channel 0 asked for after another is the one read first, kept.
+    let later = two("2,0", "green,magenta");
+    let first = two("0,2", "magenta,green");
+    assert!(later.max_diff(&first) <= 1);
+    let refused = refused(
+        dir.path(),
+        &[gz, "--channels", "all", "--max-memory", "150000"],
+    );
+    assert!(refused.contains("--max-memory"), "{refused}");
+}
+
 /// An OME-Zarr image (v2, uncompressed) of `channels` along its `c` axis.
 fn ome_zarr(dir: &Path, name: &str, channels: &[Vec<f32>]) -> String {
     let root = dir.join(name);
@@ -281,7 +327,7 @@ fn channels_of_an_ome_zarr_image_are_its_c_axis() {
     let run = volray(&["info", &image]);
     let text = stdout(&run);
     assert!(
-        text.contains("channels:  2 (render them together"),
+        text.contains("channels:  2 (read: 0; --channel picks another; together: volray render"),
         "{text}"
     );
 }
@@ -372,7 +418,9 @@ fn info_says_how_to_render_the_channels_together() {
     let run = volray(&["info", &file]);
     assert!(run.status.success(), "{}", stderr(&run));
     let text = stdout(&run);
-    let want = format!("channels:  2 (render them together: volray render {file} --channels all)");
+    let want = format!(
+        "channels:  1 (its 2 time points rendered together as channels: volray render {file} --channels all)"
+    );
     assert!(text.lines().any(|l| l == want), "{text}");
 }
 

@@ -145,7 +145,7 @@ fn level_flags_are_refused_where_they_cannot_apply() {
             "--level",
             "0",
         ],
-        "--level and --channel apply to Zarr/OME-Zarr images only, not to raw samples files",
+        "--level applies to Zarr/OME-Zarr images only, not to raw samples files",
     );
 }
 

@@ -47,8 +47,10 @@ pub struct InputArgs {
     )]
     pub format: Option<String>,
 
-    /// Which volume of a file that holds several, from 0: a 4-D NIfTI,
-    /// NRRD or MetaImage time point, a cube file's orbital, ... [default: 0].
+    /// Which time point of a file that holds several, from 0: a 4-D NIfTI,
+    /// NRRD or MetaImage volume, a hyperstack's or OME-TIFF's, an HDF5
+    /// dataset's or OME-Zarr image's `t`; for files of other volumes, a
+    /// cube file's orbital, a DICOM directory's series, ... [default: 0].
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub frame: Option<usize>,
 
@@ -64,7 +66,10 @@ pub struct InputArgs {
     #[arg(long, value_name = "N|auto", value_parser = parse_level)]
     pub level: Option<LevelChoice>,
 
-    /// Zarr/OME-Zarr: which channel (the image's `c` axis), from 0
+    /// Which channel, from 0, of a file that holds several: an OME-Zarr
+    /// image's or HDF5 dataset's `c` axis, a hyperstack's or OME-TIFF's
+    /// channels, a 5-D NIfTI's components (dim[5]), an NRRD's or
+    /// MetaImage's vector components; --frame picks the time point
     /// [default: 0].
     #[arg(long, value_name = "N")]
     pub channel: Option<usize>,

@@ -48,7 +48,7 @@ pub use paper::{PaperArgs, PaperItem};
 pub use parse::{one_line_error, parse_opacity, parse_range};
 pub use render::RenderArgs;
 pub use sampling::SamplingArgs;
-pub use scene::{ChannelColors, Channels, MixMode, SceneArgs};
+pub use scene::{ChannelColors, Channels, Frames, MixMode, SceneArgs};
 pub use view::ViewArgs;
 pub use viewer::ViewerArgs;
 

@@ -9,11 +9,13 @@ use clap::Args;
 #[derive(Debug, Default, Args)]
 pub struct SceneArgs {
     /// Render channels of INPUT together, each in its colour: `all`, or
-    /// their numbers from 0 (the file's frames, as --frame counts them:
-    /// a 4-D/5-D NIfTI's volumes, a hyperstack's or OME-TIFF's channels,
-    /// an HDF5 dataset's time/channel axes; an OME-Zarr image's `c` axis).
-    /// Each has its own value window (unless --range) and the opacity of
-    /// the look flags (by default chosen from its own histogram).
+    /// their numbers from 0, as --channel counts them (a hyperstack's or
+    /// OME-TIFF's channels, an HDF5 dataset's or OME-Zarr image's `c`
+    /// axis, a 5-D NIfTI's components), at the time point --frame picks;
+    /// a file of one channel and several time points (a 4-D NIfTI) has
+    /// its time points rendered together. Each has its own value window
+    /// (unless --range) and the opacity of the look flags (by default
+    /// chosen from its own histogram).
     #[arg(long, value_name = "all|I,J,...", value_parser = parse_channels, help_heading = "Several volumes")]
     pub channels: Option<Channels>,
 
@@ -46,8 +48,9 @@ pub struct SceneArgs {
     /// Render the time points of INPUT as an animation (`all`, or `A:B`:
     /// A up to B−1, as a Python slice; either may be left out), with one
     /// transfer function and one framing for all, as a series of inputs:
-    /// a 4-D NIfTI's volumes, an OME-Zarr image's `t`, NetCDF time (the
-    /// file's frames, as --frame counts them). Read one at a time.
+    /// a 4-D NIfTI's volumes, a hyperstack's or OME-Zarr image's `t`,
+    /// NetCDF time (as --frame counts them), of the channel --channel
+    /// picks. Read one at a time.
     #[arg(long, value_name = "all|A:B", value_parser = parse_frames, help_heading = "Animations")]
     pub frames: Option<Frames>,
 }

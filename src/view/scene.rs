@@ -7,7 +7,8 @@
 //! `volray_core::Scene`. The command each frame prints writes every
 //! volume after the first as an `--overlay` with its look in full
 //! (`range=`, `tf=view-tf-N.json`, `hidden`), the channels of INPUT
-//! included (`frame=K` or `channel=K`), with `--mix`: the frame the page
+//! included (`channel=K` and the `frame=T` of `--frame`, or `frame=K`
+//! for a file whose time points are rendered as channels), with `--mix`: the frame the page
 //! shows is that command's.
 //!
 //! A time axis (`--frames A:B`) is served one time point at a time: the
@@ -20,7 +21,7 @@ use super::{MAX_TABS, serve, start_state};
 use crate::error::CliError;
 use crate::flags::{MixMode, ViewerArgs};
 use crate::input;
-use crate::scene::{Layer, LayerSource, overlay_specs, read_layers, whole_input};
+use crate::scene::{ChannelAxis, Layer, LayerSource, overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use std::sync::Arc;
@@ -47,7 +48,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     if let Some(frames) = args.scene.frames {
         first_args.frame = Some(frames.start);
         let first = load(&first_args, look.log)?;
-        let count = first.file.as_ref().map_or(1, |(_, info)| info.frames);
+        let count = first.file.as_ref().map_or(1, |(_, info)| info.time_points);
         let end = frames.end.unwrap_or(count);
         if count < 2 || frames.start >= count || end > count {
             return Err(CliError::input(format!(
@@ -167,7 +168,7 @@ fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
             "{flag} and --frames cannot be combined: give one of them"
         )));
     }
-    if scene.frames.is_some() && (args.input.frame.is_some() || args.input.channel.is_some()) {
+    if scene.frames.is_some() && args.input.frame.is_some() {
         return Err(CliError::input(
             "--frames serves a range of time points; --frame picks one: give one of them",
         ));
@@ -190,23 +191,24 @@ fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
 
 /// The scene's volumes after the first as the commands write them.
 fn scene_words(args: &ViewerArgs, spec: &str, layers: &[Layer]) -> SceneWords {
-    let channel = |index: usize, zarr: bool| {
-        let flag = if zarr { "channel" } else { "frame" };
-        (flag, index)
-    };
+    // A channel is INPUT at the time point --frame picks (if any), the
+    // channel its axis names.
+    let time = args.input.frame;
     let first = match layers[0].source {
-        LayerSource::Channel { index, zarr } => {
-            let (flag, index) = channel(index, zarr);
-            vec![format!("--{flag}"), index.to_string()]
+        LayerSource::Channel { index, axis } => {
+            vec![format!("--{}", axis.option()), index.to_string()]
         }
         _ => Vec::new(),
     };
     let others = (layers[1..].iter())
         .map(|layer| {
             let (file, fixed, labels) = match &layer.source {
-                LayerSource::Channel { index, zarr } => {
-                    let (flag, index) = channel(*index, *zarr);
-                    (spec.to_string(), vec![format!("{flag}={index}")], false)
+                LayerSource::Channel { index, axis } => {
+                    let mut fixed = vec![format!("{}={index}", axis.option())];
+                    if let (ChannelAxis::Channel, Some(t)) = (axis, time) {
+                        fixed.push(format!("frame={t}"));
+                    }
+                    (spec.to_string(), fixed, false)
                 }
                 LayerSource::Overlay(o) => {
                     let mut fixed = Vec::new();

@@ -124,10 +124,20 @@ pub enum IoError {
     #[error("{}: frame selection does not apply to {format} files: they hold one volume", path.display())]
     FrameNotApplicable { path: PathBuf, format: &'static str },
 
-    /// A resolution level or channel ([`ReadOptions::level`],
-    /// [`ReadOptions::channel`]) chosen in a file whose format has neither.
-    #[error("{}: level and channel selection apply to Zarr/OME-Zarr images only, not to {format} files", path.display())]
+    /// A resolution level ([`ReadOptions::level`]) chosen in a file whose
+    /// format has one.
+    #[error("{}: level selection applies to Zarr/OME-Zarr images only, not to {format} files", path.display())]
     LevelNotApplicable { path: PathBuf, format: &'static str },
+
+    /// A channel ([`ReadOptions::channel`]) the file does not hold. `held`
+    /// says what it holds, e.g. `the file holds 3 channels (dim[5]),
+    /// numbered from 0` (see [`Volumes`](crate::Volumes)).
+    #[error("{}: channel {channel} is out of range: {held}", path.display())]
+    ChannelOutOfRange {
+        path: PathBuf,
+        channel: usize,
+        held: String,
+    },
 
     /// A frame ([`ReadOptions::frame`]) the file does not hold. `held` says
     /// what it holds, e.g. `the file holds 2 volumes (dim[4]), numbered from 0`.
@@ -234,6 +244,7 @@ impl IoError {
             | IoError::FrameNotApplicable { .. }
             | IoError::LevelNotApplicable { .. }
             | IoError::FrameOutOfRange { .. }
+            | IoError::ChannelOutOfRange { .. }
             | IoError::FrameNeeded { .. }
             | IoError::ArrayNotApplicable { .. }
             | IoError::NoSuchArray { .. }
@@ -263,6 +274,7 @@ impl IoError {
             | IoError::FrameNotApplicable { path, .. }
             | IoError::LevelNotApplicable { path, .. }
             | IoError::FrameOutOfRange { path, .. }
+            | IoError::ChannelOutOfRange { path, .. }
             | IoError::FrameNeeded { path, .. }
             | IoError::ArrayNotApplicable { path, .. }
             | IoError::NoSuchArray { path, .. }
@@ -309,6 +321,20 @@ impl IoError {
         IoError::FrameOutOfRange {
             path: path.to_path_buf(),
             frame,
+            held: one_line(held),
+        }
+    }
+
+    /// [`IoError::ChannelOutOfRange`]: `channel` is not among what the
+    /// file holds, which `held` says.
+    pub(crate) fn channel_out_of_range(
+        path: &Path,
+        channel: usize,
+        held: impl Into<String>,
+    ) -> Self {
+        IoError::ChannelOutOfRange {
+            path: path.to_path_buf(),
+            channel,
             held: one_line(held),
         }
     }

@@ -76,6 +76,12 @@
 //! HDF5 files and reads their attributes and datasets (HDF5, MINC2);
 //! `shared/vtk_arrays.rs` chooses the array of a VTK file.
 //!
+//! The axes beside space are one model for every reader (`axes.rs`):
+//! a file holds [`Volumes`], time points of channels (OME's TCZYX), and
+//! [`ReadOptions::frame`] picks the time point, [`ReadOptions::channel`]
+//! the channel, in every format; [`FileInfo`] says how many of each
+//! the file holds and which was read.
+//!
 //! Sample types and byte orders ([`DType`], [`Endian`]) are in `dtype.rs`.
 //! Images are written by `images/` (`png.rs`, `exr.rs`, `animation.rs`),
 //! every file through `atomic.rs`.
@@ -111,6 +117,7 @@
 //! ```
 
 mod atomic;
+mod axes;
 mod dtype;
 mod error;
 mod formats;
@@ -119,6 +126,7 @@ mod read;
 mod shared;
 
 pub use atomic::{AtomicDir, AtomicFile, remove_unfinished_files, write_atomically};
+pub use axes::{AxisNames, Picked, Volumes};
 pub use dtype::{
     DType, Endian, ParseNameError, bytes_to_f32, bytes_to_samples, extend_f32, f16_to_f32,
 };

@@ -25,12 +25,14 @@ pub struct ReadOptions {
     /// The layout of a raw file (the CLI's `--dims`, `--dtype`, `--endian`,
     /// `--spacing`).
     pub raw: Option<RawOptions>,
-    /// Which volume of a file holding several, counted from 0 (the CLI's
-    /// `--frame`): the 4th dimension of NIfTI, NRRD, MetaImage and HDF5,
-    /// the orbital of a cube file, the frame set of a TIFF stack, the
-    /// density block of a CHGCAR (0 total, 1 magnetisation), the series of
-    /// a DICOM directory, the 3-D images of a FITS file (and the steps of
-    /// their 4th axis) in file order.
+    /// Which time point of a file holding several, counted from 0 (the
+    /// CLI's `--frame`; see [`Volumes`](crate::Volumes)): the 4th
+    /// dimension of NIfTI, NRRD, MetaImage and HDF5, an HDF5 dataset's or
+    /// Zarr image's `t` axis, a TIFF hyperstack's time points; and for
+    /// formats whose volumes are no time series, the orbital of a cube
+    /// file, the density block of a CHGCAR (0 total, 1 magnetisation),
+    /// the series of a DICOM directory, the 3-D images of a FITS file
+    /// (and the steps of their 4th axis) in file order.
     pub frame: Option<usize>,
     /// Which named array of a file holding several (the CLI's `--array`):
     /// VTK point or cell data arrays; the image of an OME-Zarr plate
@@ -41,7 +43,11 @@ pub struct ReadOptions {
     /// 0 the finest: the `datasets` of an OME-Zarr image.
     pub level: Option<usize>,
     /// Which channel of an image holding several (the CLI's `--channel`),
-    /// counted from 0: an OME-Zarr image's `c` axis.
+    /// counted from 0, in every format (see [`Volumes`](crate::Volumes)):
+    /// an OME-Zarr image's or HDF5 dataset's `c` axis, a TIFF
+    /// hyperstack's or OME-TIFF's channels, a 5-D NIfTI's components
+    /// (`dim[5]`), an NRRD's or MetaImage's vector components; a file
+    /// of one channel takes channel 0 only.
     pub channel: Option<usize>,
     /// The most bytes the decoded volume and the reader's whole-payload
     /// buffers may take (the CLI's `--max-memory`): a header asking for
@@ -134,11 +140,18 @@ pub struct FileInfo {
     /// The unit of spacing and origin, as the file gives it (`"mm"`,
     /// `"bohr"`, `"angstrom"`), if it gives one.
     pub length_unit: Option<String>,
-    /// How many volumes the file holds (4th dimension, orbitals, arrays);
-    /// 1 for most files.
+    /// How many volumes the file holds (time points × channels;
+    /// orbitals, series); 1 for most files.
     pub frames: usize,
-    /// Which of them was read.
+    /// Which of them was read: `time_point · channels + channel`.
     pub frame: usize,
+    /// How many time points and channels the file holds (OME's T and
+    /// C; see [`Volumes`](crate::Volumes)), `frames` their product, and
+    /// which time point and channel was read.
+    pub time_points: usize,
+    pub channels: usize,
+    pub time_point: usize,
+    pub channel: usize,
     /// The named arrays the file holds (VTK; an OME-Zarr plate's or
     /// collection's images), if any, and the one read.
     pub arrays: Vec<String>,
@@ -277,6 +290,8 @@ impl FileInfo {
         FileInfo {
             stored_type: stored_type.into(),
             frames: 1,
+            time_points: 1,
+            channels: 1,
             ..FileInfo::default()
         }
     }
@@ -302,13 +317,16 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let format = detect(path, opts)?;
     let spec = format.spec();
     check_options(path, format, opts)?;
-    let loaded = (spec.read)(path, opts).map_err(|e| match e {
+    let mut loaded = (spec.read)(path, opts).map_err(|e| match e {
         IoError::FlatImage { path, mut image } => {
             image.format = format;
+            image.info.fill_volumes();
             IoError::FlatImage { path, image }
         }
         other => other,
     })?;
+    loaded.info.fill_volumes();
+    check_channel_read(path, opts, &loaded.info)?;
     if loaded.info.reorientation.is_some() && opts.map != MapPolicy::AlwaysInFileOrder {
         return Err(IoError::invalid(
             path,
@@ -354,11 +372,20 @@ fn check_options(path: &Path, format: VolumeFormat, opts: &ReadOptions) -> Resul
     // reads whole what it opened box by box (`open_lazy`).
     let one_level =
         matches!(format, VolumeFormat::Hdf5 | VolumeFormat::Netcdf) && opts.level == Some(0);
-    if ((opts.level.is_some() && !one_level) || opts.channel.is_some()) && !spec.levels {
+    if opts.level.is_some() && !one_level && !spec.levels {
         return Err(IoError::LevelNotApplicable {
             path: path.to_path_buf(),
             format: spec.description,
         });
+    }
+    if let Some(channel) = opts.channel.filter(|&c| c > 0)
+        && !has_channels(format)
+    {
+        return Err(IoError::channel_out_of_range(
+            path,
+            channel,
+            format!("{} files hold one channel (channel 0)", spec.description),
+        ));
     }
     if opts.array.is_some() && !spec.arrays {
         return Err(IoError::ArrayNotApplicable {
@@ -367,6 +394,35 @@ fn check_options(path: &Path, format: VolumeFormat, opts: &ReadOptions) -> Resul
         });
     }
     Ok(())
+}
+
+/// Whether a file of `format` may hold several channels (see
+/// [`Volumes`](crate::Volumes)), one of which [`ReadOptions::channel`]
+/// picks; the others hold one.
+fn has_channels(format: VolumeFormat) -> bool {
+    use VolumeFormat as F;
+    matches!(
+        format,
+        F::Tiff | F::Hdf5 | F::Nifti | F::Zarr | F::Nrrd | F::MetaImage
+    )
+}
+
+/// Refuses a volume read from a file of fewer channels than
+/// [`ReadOptions::channel`] asks for: what a reader that knows of no
+/// channel axis read is channel 0.
+fn check_channel_read(path: &Path, opts: &ReadOptions, info: &FileInfo) -> Result<(), IoError> {
+    match opts.channel {
+        Some(c) if c >= info.channels.max(1) => Err(IoError::channel_out_of_range(
+            path,
+            c,
+            info.volumes().channels_held(crate::AxisNames {
+                holder: "the file",
+                time: "",
+                channel: "",
+            }),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// A volume opened without reading its samples: a source of boxes of it
@@ -388,6 +444,20 @@ pub struct Lazy {
 pub fn open_lazy(path: &Path, opts: &ReadOptions) -> Result<Option<Lazy>, IoError> {
     let format = detect(path, opts)?;
     check_options(path, format, opts)?;
+    let mut lazy = open_lazy_as(path, format, opts)?;
+    if let Some(lazy) = &mut lazy {
+        lazy.info.fill_volumes();
+        check_channel_read(path, opts, &lazy.info)?;
+    }
+    Ok(lazy)
+}
+
+/// [`open_lazy`] of a file of `format`, the options checked.
+fn open_lazy_as(
+    path: &Path,
+    format: VolumeFormat,
+    opts: &ReadOptions,
+) -> Result<Option<Lazy>, IoError> {
     match format {
         VolumeFormat::Zarr => {
             let (level, info) = crate::formats::zarr::open(path, opts)?;

@@ -106,7 +106,7 @@ fn series_frames_with_element_size() {
     assert_frame_out_of_range(
         &err,
         3,
-        "HDF5 dataset \"/series\" holds 3 volume(s) along its first axis",
+        "HDF5 dataset \"/series\" holds 3 volumes (its first axis), numbered from 0",
     );
 }
 
@@ -115,12 +115,12 @@ fn bad_datasets_and_paths_are_refused_clearly() {
     let none = ReadOptions::default();
     let msg = error("many.h5", &none);
     assert!(
-            msg.contains("HDF5 file holds 8 3-D/4-D numeric datasets: name one as FILE:/path (/bad_spacing [4, 3, 5], /f64 [4, 3, 5],"),
+            msg.contains("HDF5 file holds 8 3-D to 5-D numeric datasets: name one as FILE:/path (/bad_spacing [4, 3, 5], /f64 [4, 3, 5],"),
             "{msg}"
         );
     let msg = error("one.h5:/fields/nothing", &none);
     assert!(
-            msg.contains("no dataset \"/fields/nothing\"; its 3-D/4-D numeric datasets: /fields/density [4, 3, 5]"),
+            msg.contains("no dataset \"/fields/nothing\"; its 3-D to 5-D numeric datasets: /fields/density [4, 3, 5]"),
             "{msg}"
         );
     let msg = error("one.h5:/fields/labels", &none);

@@ -72,31 +72,51 @@ fn dimension_labels_give_the_order_where_there_is_no_axes_attribute() {
 
 #[test]
 fn ilastik_axistags_name_a_channel_axis_whose_channels_are_frames() {
-    for f in 0..2 {
-        let l = load("ilastik", &frame(f));
-        assert_ramp("ilastik", &l.volume, f);
-        assert_eq!((l.info.frames, l.info.frame), (2, f));
+    for c in 0..2 {
+        let l = load("ilastik", &common::at(0, c));
+        assert_ramp("ilastik", &l.volume, c);
+        assert_eq!((l.info.channels, l.info.channel), (2, c));
+        assert_eq!((l.info.frames, l.info.frame), (2, c));
         assert_eq!(
             header_value(&l, "axis order"),
             "a[z, y, x, c] from attribute axistags"
         );
     }
-    let err = read(&fixture("ilastik"), &frame(2)).unwrap_err();
-    assert_frame_out_of_range(&err, 2, "HDF5 dataset \"/ilastik\" holds 2 volume(s)");
+    let err = read(&fixture("ilastik"), &common::at(0, 2)).unwrap_err();
+    assert!(
+        err.to_string().ends_with(
+            "channel 2 is out of range: HDF5 dataset \"/ilastik\" holds 2 channels (axis c), numbered from 0"
+        ),
+        "{err}"
+    );
+    // One time point: --frame 1 is out of range.
+    let err = read(&fixture("ilastik"), &frame(1)).unwrap_err();
+    assert_frame_out_of_range(
+        &err,
+        1,
+        "HDF5 dataset \"/ilastik\" holds 1 time point (axis t) of 2 channels (axis c)",
+    );
 }
 
 #[test]
-fn time_and_channel_axes_number_frames_time_slowest() {
-    // a[t, c, z, y, x] of 2 time points and 2 channels: frame 2t + c.
+fn time_and_channel_axes_are_picked_apart() {
+    // a[t, c, z, y, x] of 2 time points and 2 channels: the file's
+    // volume 2t + c.
     for f in 0..4 {
-        let l = load("tczyx", &frame(f));
+        let (t, c) = (f / 2, f % 2);
+        let l = load("tczyx", &common::at(t, c));
         assert_ramp("tczyx", &l.volume, f);
-        assert_eq!(l.info.frames, 4);
+        assert_eq!((l.info.frames, l.info.frame), (4, f));
+        assert_eq!((l.info.time_points, l.info.channels), (2, 2));
         // spacing [1, 1, 3, 2, 1.5], one per dataset axis.
         assert_eq!(l.volume.spacing(), DVec3::new(1.5, 2.0, 3.0));
     }
-    let err = read(&fixture("tczyx"), &frame(4)).unwrap_err();
-    assert_frame_out_of_range(&err, 4, "HDF5 dataset \"/tczyx\" holds 4 volume(s)");
+    let err = read(&fixture("tczyx"), &frame(2)).unwrap_err();
+    assert_frame_out_of_range(
+        &err,
+        2,
+        "HDF5 dataset \"/tczyx\" holds 2 time points (axis t) of 2 channels (axis c)",
+    );
 }
 
 #[test]
@@ -166,7 +186,13 @@ fn every_box_read_box_by_box_equals_the_eager_read() {
         ("cf_names", 1, "contiguous"),
     ] {
         for f in 0..frames {
-            let opts = frame(f);
+            // The file's volume f: time point f / C, channel f % C.
+            let channels = if dataset == "ilastik" {
+                2
+            } else {
+                frames.min(2)
+            };
+            let opts = common::at(f / channels, f % channels);
             let whole = load(dataset, &opts);
             assert_ramp(dataset, &whole.volume, f);
             let lazy = open_lazy(&fixture(dataset), &opts)

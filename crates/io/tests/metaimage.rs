@@ -155,7 +155,7 @@ fn four_d_series_picks_frames() {
     assert_eq!(
         err.to_string(),
         format!(
-            "{}: frame 3 is out of range: the file holds 3 volumes (frames 0 to 2)",
+            "{}: frame 3 is out of range: the file holds 3 volumes (frames 0 to 2), numbered from 0",
             path.display()
         )
     );
@@ -194,15 +194,47 @@ fn text_data() {
 }
 
 #[test]
-fn vector_images_are_refused() {
+fn vector_images_are_read_a_channel_at_a_time() {
+    // SimpleITK's vector image: the ramp in each of 3 channels.
     let path = fixture("vector.mha");
-    let err = read(&path, &ReadOptions::default()).unwrap_err();
-    assert!(!err.is_io_failure());
-    assert!(
-        err.to_string().starts_with(&format!(
-            "{}: MetaImage field ElementNumberOfChannels = 3: images with several values per voxel",
+    for c in 0..3 {
+        let l = read(&path, &common::at(0, c)).unwrap();
+        check_values(&l.volume, |i, j, k| ramp(i, j, k) as f32);
+        assert_eq!((l.info.channels, l.info.channel), (3, c));
+        check_default_geometry(&l);
+    }
+    let err = read(&path, &common::at(0, 3)).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "{}: channel 3 is out of range: the file holds 3 channels (ElementNumberOfChannels), numbered from 0",
             path.display()
-        )),
+        )
+    );
+    // Each voxel's values together, as MetaIO stores them: channel c of
+    // voxel n holds 10n + c.
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = b"ObjectType = Image\nNDims = 3\nDimSize = 2 3 2\nElementNumberOfChannels = 2\nElementType = MET_SHORT\nElementDataFile = LOCAL\n".to_vec();
+    bytes.extend((0..24i16).flat_map(|i| (10 * (i / 2) + i % 2).to_le_bytes()));
+    let two = dir.path().join("two.mha");
+    fs::write(&two, bytes).unwrap();
+    for c in 0..2 {
+        let l = read(&two, &common::at(0, c)).unwrap();
+        check_voxels("two.mha", &l.volume, [2, 3, 2], |x, y, z| {
+            (10 * (x + 2 * (y + 3 * z)) + c) as f32
+        });
+    }
+    // A 4-D series of vectors is refused.
+    let four = dir.path().join("four.mha");
+    fs::write(
+        &four,
+        b"NDims = 4\nDimSize = 2 2 2 2\nElementNumberOfChannels = 2\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n",
+    )
+    .unwrap();
+    let err = read(&four, &ReadOptions::default()).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("ElementNumberOfChannels = 2: volray reads"),
         "{err}"
     );
 }

@@ -241,41 +241,50 @@ fn four_d_files_pick_a_frame() {
 }
 
 #[test]
-fn five_d_vector_components_are_frames_in_the_files_order() {
+fn five_d_vector_components_are_channels_and_dim4_the_time_points() {
     // (4, 3, 5, 1, 3): three components, one time point.
     let l = load("vector5d.nii");
+    assert_eq!((l.info.time_points, l.info.channels), (1, 3));
     assert_eq!((l.info.frames, l.info.frame), (3, 0));
     assert_eq!(header_value(&l, "dim"), "5 4 3 5 1 3 1 1");
     assert!(
         has_note(
             &l,
-            "5-D: 3 components (dim[5], intent_code 1007 = vector) x 1 time point (dim[4]); --frame picks one: frame = t + 1*c"
+            "5-D: 3 components (dim[5], intent_code 1007 = vector) read as channels, x 1 time point (dim[4])"
         ),
         "{:?}",
         l.info.notes
     );
     for c in 0..3 {
-        let l = load_with("vector5d.nii", &frame(c));
+        let l = load_with("vector5d.nii", &common::at(0, c));
         check_world("vector5d", &l, &ALIGNED, |i, j, k| {
             (ramp(i, j, k) + 10000 * c as i64) as f32
         });
+        assert_eq!((l.info.channel, l.info.frame), (c, c));
     }
-    let err = read(&fixture("vector5d.nii"), &frame(3)).unwrap_err();
+    let err = read(&fixture("vector5d.nii"), &common::at(0, 3)).unwrap_err();
+    assert!(
+        err.to_string().ends_with(
+            "channel 3 is out of range: the file holds 3 channels (dim[5]), numbered from 0"
+        ),
+        "{err}"
+    );
+    let err = read(&fixture("vector5d.nii"), &frame(1)).unwrap_err();
     assert_frame_out_of_range(
         &err,
-        3,
-        "the file holds 3 volumes (3 components (dim[5]) x 1 time point (dim[4]); frame = t + 1*c)",
+        1,
+        "the file holds 1 time point (dim[4]) of 3 channels (dim[5]), numbered from 0",
     );
-    // (4, 3, 5, 2, 3), gzip: frame t + 2c holds time point t of component c.
-    for f in 0..6 {
-        let (t, c) = (f % 2, f / 2);
-        let l = load_with("vector5d_t2.nii.gz", &frame(f));
-        assert_eq!((l.info.frames, l.info.frame), (6, f));
+    // (4, 3, 5, 2, 3), gzip: the file's block t + 2c holds time point t
+    // of component c.
+    for (t, c) in (0..2).flat_map(|t| (0..3).map(move |c| (t, c))) {
+        let l = load_with("vector5d_t2.nii.gz", &common::at(t, c));
+        assert_eq!((l.info.frames, l.info.frame), (6, 3 * t + c));
         check_world("vector5d_t2", &l, &ALIGNED, |i, j, k| {
             (ramp(i, j, k) + 1000 * t as i64 + 10000 * c as i64) as f32
         });
         assert!(
-            has_note(&l, &format!("this is frame {f}: t {t}, component {c}")),
+            has_note(&l, &format!("this is time point {t}, component {c}")),
             "{:?}",
             l.info.notes
         );

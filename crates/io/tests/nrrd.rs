@@ -202,28 +202,31 @@ fn other_sample_types() {
 }
 
 #[test]
-fn four_d_vector_axis_first_picks_frames() {
+fn four_d_vector_axis_first_holds_the_channels() {
     let path = fixture("vector4d.nrrd");
     let l = load("vector4d.nrrd");
     check_values(&l.volume, |i, j, k| ramp(i, j, k) as f32);
     assert_eq!((l.info.frames, l.info.frame), (2, 0));
+    assert_eq!((l.info.time_points, l.info.channels), (1, 2));
     assert!(
-        has_note(&l, "volume 0 of 2 along axis 0 (kind 2-vector)"),
+        has_note(&l, "channel 0 of 2 along axis 0 (kind 2-vector)"),
         "{:?}",
         l.info.notes
     );
-    let l = read(&path, &frame(1)).unwrap();
+    let l = read(&path, &common::at(0, 1)).unwrap();
     check_values(&l.volume, |i, j, k| (ramp(i, j, k) + 1000) as f32);
-    assert_eq!(l.info.frame, 1);
-    let err = read(&path, &frame(2)).unwrap_err();
-    assert_frame_out_of_range(&err, 2, "the file holds 2 volumes (frames 0 to 1)");
+    assert_eq!((l.info.channel, l.info.frame), (1, 1));
+    let err = read(&path, &common::at(0, 2)).unwrap_err();
     assert_eq!(
         err.to_string(),
         format!(
-            "{}: frame 2 is out of range: the file holds 2 volumes (frames 0 to 1)",
+            "{}: channel 2 is out of range: the file holds 2 channels (kind 2-vector, frames 0 to 1), numbered from 0",
             path.display()
         )
     );
+    // Its one time point: --frame 1 is out of range.
+    let err = read(&path, &frame(1)).unwrap_err();
+    assert_frame_out_of_range(&err, 1, "the file holds 1 time point");
 }
 
 #[test]

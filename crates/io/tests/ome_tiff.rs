@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use common::{assert_frame_out_of_range, check_voxels, frame, header_value, ramp, refuse};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
-use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
     common::fixture("tiff", name)
@@ -73,26 +73,36 @@ fn sizes_in_different_units_are_converted_to_micrometres() {
 }
 
 #[test]
-fn channels_and_time_points_are_frames_whatever_the_dimension_order() {
-    // XYCZT (channel fastest), XYZCT (z fastest), and time points.
-    for (name, frames) in [
-        ("ome_zcyx.ome.tif", 2),
-        ("ome_czyx.ome.tif", 2),
-        ("ome_tzyx.ome.tif", 2),
-    ] {
-        for f in 0..frames {
-            let l = load(name, &frame(f));
-            let want = if name.starts_with("ome_tzyx") {
-                2 * f
-            } else {
-                f
-            };
-            assert_ramp(name, &l.volume, want);
-            assert_eq!((l.info.frames, l.info.frame), (frames, f), "{name}");
+fn channels_and_time_points_are_picked_apart_whatever_the_dimension_order() {
+    // XYCZT (channel fastest) and XYZCT (z fastest): two channels.
+    for name in ["ome_zcyx.ome.tif", "ome_czyx.ome.tif"] {
+        for c in 0..2 {
+            let l = load(name, &common::at(0, c));
+            assert_ramp(name, &l.volume, c);
+            let i = &l.info;
+            assert_eq!((i.time_points, i.channels, i.channel), (1, 2, c), "{name}");
         }
-        let err = read(&fixture(name), &frame(frames)).unwrap_err();
-        assert_frame_out_of_range(&err, frames, "the stack holds 2 volume(s)");
+        let err = read(&fixture(name), &common::at(0, 2)).unwrap_err();
+        assert!(
+            matches!(err, IoError::ChannelOutOfRange { channel: 2, .. }),
+            "{err}"
+        );
+        assert!(
+            err.to_string().ends_with(
+                "channel 2 is out of range: the stack holds 2 channels (SizeC), numbered from 0"
+            ),
+            "{err}"
+        );
     }
+    // Two time points of one channel.
+    let name = "ome_tzyx.ome.tif";
+    for t in 0..2 {
+        let l = load(name, &frame(t));
+        assert_ramp(name, &l.volume, 2 * t);
+        assert_eq!((l.info.time_points, l.info.time_point), (2, t));
+    }
+    let err = read(&fixture(name), &frame(2)).unwrap_err();
+    assert_frame_out_of_range(&err, 2, "the stack holds 2 volumes (SizeT)");
 }
 
 #[test]

@@ -86,30 +86,31 @@ fn imagej_float_stack_with_deflate_pages() {
 }
 
 #[test]
-fn imagej_hyperstack_volumes_by_frame() {
-    // TZCYX = (2, 5, 2, 3, 4): volume n is time n / 2, channel n % 2.
-    for n in 0..4 {
-        let l = load_with("imagej_hyper.tif", &frame(n));
-        let (t, c) = (n / 2, n % 2);
+fn imagej_hyperstack_time_points_and_channels_apart() {
+    // TZCYX = (2, 5, 2, 3, 4): --frame picks the time point, --channel
+    // the channel; volume t·2 + c of the 4.
+    for (t, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+        let l = load_with("imagej_hyper.tif", &common::at(t, c));
         assert_values(&l.volume, |v, _| v + 1000.0 * c as f64 + 10000.0 * t as f64);
-        assert_eq!((l.info.frames, l.info.frame), (4, n));
+        assert_eq!((l.info.frames, l.info.frame), (4, 2 * t + c));
+        assert_eq!((l.info.time_points, l.info.channels), (2, 2));
         assert!(
             l.info
                 .notes
                 .iter()
-                .any(|s| s.contains(&format!("time point {t}, channel {c}"))),
+                .any(|s| s.contains(&format!("time point {t} of 2, channel {c} of 2 read"))),
             "{:?}",
             l.info.notes
         );
     }
-    // Without --frame the first volume is read.
+    // Without --frame and --channel the first volume is read.
     let l = load("imagej_hyper.tif");
     assert_values(&l.volume, |v, _| v);
-    let err = read(&fixture("imagej_hyper.tif"), &frame(4)).unwrap_err();
+    let err = read(&fixture("imagej_hyper.tif"), &frame(2)).unwrap_err();
     assert_frame_out_of_range(
         &err,
-        4,
-        "the stack holds 4 volume(s) (2 channel(s) x 2 time point(s))",
+        2,
+        "the stack holds 2 time points (ImageJ frames) of 2 channels (ImageJ channels), numbered from 0",
     );
 }
 

@@ -129,7 +129,10 @@ fn ome_zarr_levels_time_points_and_channels_equal_the_writers_with_their_geometr
                     assert_eq!(loaded.volume.dims(), *dims, "{name} level {level}");
                     assert_eq!(loaded.volume.spacing(), *spacing, "{name} level {level}");
                     assert_eq!(loaded.volume.origin(), *origin, "{name} level {level}");
-                    assert_eq!((loaded.info.frames, loaded.info.frame), (2, t));
+                    let i = &loaded.info;
+                    assert_eq!((i.time_points, i.channels), (2, 3));
+                    assert_eq!((i.time_point, i.channel), (t, c));
+                    assert_eq!((i.frames, i.frame), (6, 3 * t + c));
                     assert_eq!(loaded.info.level, level);
                 }
             }
@@ -265,7 +268,7 @@ fn levels_time_points_and_channels_out_of_range_are_refused() {
     let (_, err) = refused(&npy, &opts(Some(0), None, None));
     assert!(matches!(err, IoError::LevelNotApplicable { .. }), "{err}");
     let (_, err) = refused(&npy, &opts(None, None, Some(1)));
-    assert!(matches!(err, IoError::LevelNotApplicable { .. }), "{err}");
+    assert!(matches!(err, IoError::ChannelOutOfRange { .. }), "{err}");
 }
 
 /// A copy of store `name` in a new directory, to break.

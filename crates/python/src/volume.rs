@@ -340,8 +340,13 @@ impl Volume {
         if let Some((_, i)) = &self.file {
             d.set_item("length_unit", &i.length_unit)?;
             d.set_item("stored_type", &i.stored_type)?;
+            // `frames` = time points × channels, `frame` the one read.
             d.set_item("frames", i.frames)?;
             d.set_item("frame", i.frame)?;
+            d.set_item("time_points", i.time_points)?;
+            d.set_item("time_point", i.time_point)?;
+            d.set_item("channels", i.channels)?;
+            d.set_item("channel", i.channel)?;
             d.set_item("arrays", PyList::new(py, &i.arrays)?)?;
             d.set_item("array", &i.array)?;
             let header = PyDict::new(py);
@@ -381,10 +386,12 @@ impl Volume {
 /// max_memory=None)`: the volume
 /// in a file of any format volray reads (or a built-in source such as
 /// `"hydrogen:4,2,1"`), its samples moved into a numpy array without a
-/// copy, read-only (`volume.data.copy()` is a writeable copy). `level`
-/// and `channel` pick a level and a channel of an OME-Zarr image (the
-/// command line's `--level` and `--channel`; 0 by default), `frame` its
-/// time point. `dims`, `dtype` and `endian` describe a raw file.
+/// copy, read-only (`volume.data.copy()` is a writeable copy). `frame`
+/// picks the time point and `channel` the channel of a file holding
+/// several, in every format (a hyperstack's, an HDF5 dataset's `t` and
+/// `c`, a 5-D NIfTI's `dim[4]` and `dim[5]`; the command line's
+/// `--frame` and `--channel`; 0 by default); `level` a level of an
+/// OME-Zarr image. `dims`, `dtype` and `endian` describe a raw file.
 ///
 /// A chunked file (Zarr, OME-Zarr) is read lazily: the volume comes from
 /// the metadata alone, `volume.data` reads the level when first asked
@@ -413,7 +420,7 @@ pub fn read(
     let (volume, file) = if volray_data::is_source_spec(&spec) {
         if level.is_some() || channel.is_some() {
             return Err(value_error(format!(
-                "{spec}: level and channel pick a level and a channel of an OME-Zarr image, not of a built-in source"
+                "{spec}: level and channel pick a level and a channel of a file, not of a built-in source"
             )));
         }
         let volume = py

@@ -4,7 +4,8 @@
 //! Axis order: a dataset that names its axes (an `axes` attribute such as
 //! `"zyx"` or `"tczyx"`, ilastik's `axistags`, h5py's `DIMENSION_LABELS`,
 //! netCDF-C's dimension scales) is read in the order its names say, its
-//! time and channel axes numbering the volumes (`--frame`); see
+//! time axis holding the time points (`--frame`) and its channel axis the
+//! channels (`--channel`); see
 //! `hdf5_axes.rs`, which both this reader and the box-by-box one use.
 //! Without names, the convention of volray's `.npy` reader: a 3-D dataset
 //! of shape `(n0, n1, n2)` (C order, the last index varying fastest in the
@@ -34,12 +35,12 @@ use hdf5_pure::{AttrValue, Dataset, Group};
 use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
-use super::hdf5_axes::{Placement, Role, axis_order};
+use super::hdf5_axes::{self, Placement, Role, axis_order};
 use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::hdf5::{self as h5, Slabs, numbers, numeric_type, sorted_attrs, text};
-use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
+use crate::{AxisNames, FileInfo, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
 /// The search for datasets stops after this many objects or this depth
 /// (hard links can make a group its own descendant).
@@ -168,7 +169,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
             let dataset = h5.file.dataset(name).map_err(|_| {
                 let found = volumes_in(&root);
                 fail(format!(
-                    "HDF5 file has no dataset \"{name}\"; its 3-D/4-D numeric datasets: {}",
+                    "HDF5 file has no dataset \"{name}\"; its 3-D to 5-D numeric datasets: {}",
                     listing(&found)
                 ))
             })?;
@@ -190,7 +191,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
                 ),
                 _ => {
                     return Err(fail(format!(
-                        "HDF5 file holds {} 3-D/4-D numeric datasets: name one as FILE:/path ({})",
+                        "HDF5 file holds {} 3-D to 5-D numeric datasets: name one as FILE:/path ({})",
                         found.len(),
                         listing(&found)
                     )));
@@ -213,26 +214,30 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         ))
     }
     .map_err(what)?;
-    let frame = opts.frame.unwrap_or(0);
-    let placement = Placement::new(&shape, &order.roles, frame).map_err(|frames| {
-        IoError::frame_out_of_range(
-            &file_path,
-            frame,
-            format!(
-                "HDF5 dataset \"{name}\" holds {frames} volume(s) along {}, numbered from 0",
-                if order.is_default() {
-                    "its first axis".to_string()
-                } else {
-                    format!("its time/channel axes ({})", order.shown())
-                }
-            ),
-        )
-    })?;
-    let (frames, dims) = (placement.frames, placement.dims);
+    // The time point and channel asked for (`axes.rs`), found in the
+    // dataset's order of its axes (`hdf5_axes.rs`).
+    let volumes = hdf5_axes::volumes(&shape, &order.roles);
+    let holder = format!("HDF5 dataset \"{name}\"");
+    let picked = volumes.pick(
+        &file_path,
+        opts,
+        AxisNames {
+            holder: &holder,
+            time: if order.is_default() {
+                "its first axis"
+            } else {
+                "axis t"
+            },
+            channel: "axis c",
+        },
+    )?;
+    let frame = hdf5_axes::frame_of(&shape, &order.roles, picked);
+    let placement = Placement::new(&shape, &order.roles, frame)
+        .map_err(|frames| what(format!("volume {frame} of {frames}")))?;
+    let dims = placement.dims;
 
     let mut info = FileInfo::new(sample.name.clone());
-    info.frames = frames;
-    info.frame = frame;
+    info.set_volumes(volumes, picked);
     info.header = header_fields(&dataset, &name, &shape, &sample.name, &attrs);
     info.header.push((
         "axis order".into(),
@@ -254,9 +259,10 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     if let Some(why) = &order.ignored {
         info.notes.push(format!("axis names not used: {why}"));
     }
-    if frames > 1 {
+    if volumes.count() > 1 {
         info.notes.push(format!(
-            "volume {frame} of {frames} read (time/channel axes in C order, as the dataset holds them)"
+            "time point {} of {}, channel {} of {} read",
+            picked.time_point, volumes.time_points, picked.channel, volumes.channels
         ));
     }
     let (spacing, origin) = geometry(&attrs, &order.roles, &mut info).map_err(what)?;
@@ -492,7 +498,7 @@ fn visit(
             continue;
         };
         if let Ok(shape) = h5::shape(&ds)
-            && matches!(shape.len(), 3 | 4)
+            && matches!(shape.len(), 3..=5)
             && h5::is_numeric(&ds)
         {
             found.push((format!("{prefix}/{name}"), shape));

@@ -36,9 +36,12 @@
 //! image), `a[x, y, z]`, `a[t, x, y, z]`, the first axis being x; existing
 //! files read as they always have.
 //!
-//! The time and channel axes together number the volumes (`--frame`): in
-//! C order over those axes as the dataset holds them, so for `a[t, c, z,
-//! y, x]` frame `t·C + c` is time point `t` of channel `c`.
+//! The time axis holds the time points (`--frame`) and the channel axis
+//! the channels (`--channel`), kept apart as everywhere in volray
+//! ([`Volumes`]: [`volumes`] counts them, [`frame_of`] finds the volume
+//! of a time point and channel); inside the dataset the volumes lie in C
+//! order over those axes as it holds them, so `a[c, t, z, y, x]` reads
+//! as well as `a[t, c, z, y, x]`.
 
 use std::path::Path;
 
@@ -46,6 +49,7 @@ use hdf5_pure::{AttrValue, Dataset, File};
 
 use crate::shared::cf;
 use crate::shared::hdf5::text;
+use crate::{Picked, Volumes};
 
 /// What one dataset axis holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -357,6 +361,41 @@ pub(crate) fn netcdf_dimensions(file: &File, name: &str, ids: &AttrValue) -> Opt
         .collect()
 }
 
+/// The time points and channels of a dataset of `shape` whose axes are
+/// `roles`: the extent of its time axis and the product of its channel
+/// axes' (1 where it has none).
+pub(crate) fn volumes(shape: &[usize], roles: &[Role]) -> Volumes {
+    let extent = |role: Role| {
+        (roles.iter().zip(shape))
+            .filter(|(r, _)| **r == role)
+            .fold(1usize, |p, (_, &n)| p.saturating_mul(n))
+    };
+    Volumes::new(extent(Role::Time), extent(Role::Channel))
+}
+
+/// The number [`Placement::new`] takes (C order over the non-spatial
+/// axes, as the dataset holds them) of time point and channel `picked`
+/// of a dataset of `shape` whose axes are `roles`; several channel axes
+/// (CF's axes one sample long) number the channels in C order.
+pub(crate) fn frame_of(shape: &[usize], roles: &[Role], picked: Picked) -> usize {
+    let mut index = vec![0usize; shape.len()];
+    let mut channel = picked.channel;
+    for a in (0..shape.len()).rev() {
+        match roles[a] {
+            Role::Time => index[a] = picked.time_point,
+            Role::Channel => {
+                let n = shape[a].max(1);
+                index[a] = channel % n;
+                channel /= n;
+            }
+            _ => {}
+        }
+    }
+    (0..shape.len())
+        .filter(|&a| roles[a].spatial().is_none())
+        .fold(0, |f, a| f * shape[a].max(1) + index[a])
+}
+
 /// Where each sample of a dataset lands: which dataset axis is x, y, z,
 /// and at which index the other axes (time, channel) are held for the
 /// volume read.
@@ -515,6 +554,28 @@ pub(crate) fn each_index<E>(
 mod tests {
     use super::*;
     use Role::*;
+
+    #[test]
+    fn time_points_and_channels_are_found_in_either_order() {
+        let picked = |t, c| Picked {
+            time_point: t,
+            channel: c,
+        };
+        // a[t, c, z, y, x] of 2 times and 3 channels.
+        let (shape, roles) = ([2, 3, 4, 5, 6], [Time, Channel, Z, Y, X]);
+        assert_eq!(volumes(&shape, &roles), Volumes::new(2, 3));
+        let p = Placement::new(&shape, &roles, frame_of(&shape, &roles, picked(1, 2))).unwrap();
+        assert_eq!(p.fixed[..2], [Some(1), Some(2)]);
+        // a[c, t, z, y, x]: the same volume, the dataset's order.
+        let (shape, roles) = ([3, 2, 4, 5, 6], [Channel, Time, Z, Y, X]);
+        assert_eq!(volumes(&shape, &roles), Volumes::new(2, 3));
+        let p = Placement::new(&shape, &roles, frame_of(&shape, &roles, picked(1, 2))).unwrap();
+        assert_eq!(p.fixed[..2], [Some(2), Some(1)]);
+        // a[z, y, x, c] and no time.
+        let (shape, roles) = ([2, 2, 3, 4], [Z, Y, X, Channel]);
+        assert_eq!(volumes(&shape, &roles), Volumes::new(1, 4));
+        assert_eq!(frame_of(&shape, &roles, picked(0, 3)), 3);
+    }
 
     #[test]
     fn frames_number_time_and_channel_in_the_datasets_order() {

@@ -36,6 +36,15 @@ pub fn frame(n: usize) -> ReadOptions {
     with_frame(Some(n))
 }
 
+/// Reading time point `t` of channel `c` (`--frame t --channel c`).
+pub fn at(t: usize, c: usize) -> ReadOptions {
+    ReadOptions {
+        frame: Some(t),
+        channel: Some(c),
+        ..ReadOptions::default()
+    }
+}
+
 /// Reading the named array (`--array`), or the default one.
 pub fn with_array(array: Option<&str>) -> ReadOptions {
     ReadOptions {

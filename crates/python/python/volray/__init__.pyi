@@ -454,7 +454,8 @@ def read(
     max_memory: Optional[int] = None,
 ) -> Volume:
     """The volume in ``path``; a chunked file (Zarr, OME-Zarr) lazily,
-    from its metadata (see :class:`Volume`)."""
+    from its metadata (see :class:`Volume`). ``frame`` picks the time
+    point and ``channel`` the channel, in every format."""
 
 def hydrogen(
     n: int, l: int, m: int, grid: int = 50, extent: Optional[float] = None, real: bool = False

@@ -8,8 +8,10 @@
 //! `CompressedData` (zlib, or gzip found by its magic, with or without
 //! `CompressedDataSize`), `BinaryData = False` (decimal text), `HeaderSize`
 //! (bytes from the start of the data file; -1: the data ends the file),
-//! `NDims` 3, or 4 where `--frame` picks a volume along the 4th axis.
-//! `ElementNumberOfChannels` above 1 (vector and colour images) is refused.
+//! `NDims` 3, or 4 where `--frame` picks a time point along the 4th axis;
+//! `ElementNumberOfChannels` above 1 (vector and colour images, each
+//! voxel's values together) of a 3-D image: the channels, `--channel`
+//! picking one (`axes.rs`).
 //!
 //! Geometry: index axis `a` steps by `ElementSpacing[a]` (or `ElementSize`)
 //! along row `a` of `TransformMatrix` (a.k.a. `Rotation`, `Orientation`),
@@ -31,7 +33,7 @@ use crate::shared::limits::check_frame_dims;
 use crate::shared::mapped::{self, Plan};
 use crate::shared::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
 use crate::shared::text_header::Field;
-use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+use crate::{AxisNames, FileInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
 
 /// Whether the first bytes of a file, as text, look like a MetaImage
 /// header: `ObjectType` or `NDims` among the first 4 lines' keys, in a
@@ -112,16 +114,20 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     }
     let dims = field("DimSize").sizes(required(path, &header, "DimSize")?, ndims)?;
-    if let Some(c) = header.get("ElementNumberOfChannels") {
-        let channels = field("ElementNumberOfChannels").uint(c)?;
-        if channels != 1 {
-            return Err(IoError::invalid(
-                path,
-                format!(
-                    "MetaImage field ElementNumberOfChannels = {channels}: images with several values per voxel (vector, colour) are not supported; save one channel as a scalar image"
-                ),
-            ));
-        }
+    // Several values per voxel (vector, colour: MetaIO's
+    // ElementNumberOfChannels, each voxel's values together): the
+    // channels, `--channel` picking one (`axes.rs`).
+    let channels = match header.get("ElementNumberOfChannels") {
+        Some(c) => field("ElementNumberOfChannels").uint(c)?,
+        None => 1,
+    };
+    if channels == 0 || (channels > 1 && ndims == 4) {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "MetaImage field ElementNumberOfChannels = {channels}: volray reads 1 or more values per voxel of a 3-D image (a 4-D series of several values per voxel is not supported)"
+            ),
+        ));
     }
     let type_name = required(path, &header, "ElementType")?;
     let dtype = parse_type(path, type_name)?;
@@ -145,26 +151,51 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         format!("{type_name} ({dtype})")
     };
 
+    // The samples in file order: each voxel's channels, then x, y, z (t).
+    let mut sized = dims.clone();
+    if channels > 1 {
+        sized.insert(0, channels);
+    }
     // Every product of sizes below fits in memory once the total does.
-    let total = field("DimSize").sample_count(&dims, dtype.size())?;
+    let total = field("DimSize").sample_count(&sized, dtype.size())?;
 
-    // Frames along the 4th axis.
-    let frames = if ndims == 4 { dims[3] } else { 1 };
-    let frame = payload::chosen_frame(path, opts.frame, frames)?;
+    // Time points along the 4th axis, or channels (`axes.rs`).
+    let volumes = Volumes::new(if ndims == 4 { dims[3] } else { 1 }, channels);
+    let along = format!("frames 0 to {}", volumes.time_points - 1);
+    let picked = volumes.pick(
+        path,
+        opts,
+        AxisNames {
+            holder: "the file",
+            time: &along,
+            channel: "ElementNumberOfChannels",
+        },
+    )?;
+    let frame = picked.time_point;
     let select = if ndims == 4 {
         notes.push(format!(
-            "4-D image: volume {frame} of {frames} along the 4th axis read"
+            "4-D image: volume {frame} of {} along the 4th axis read",
+            volumes.time_points
         ));
         FrameSelect {
             stride: dims[0] * dims[1] * dims[2],
-            count: frames,
+            count: volumes.time_points,
             index: frame,
+        }
+    } else if channels > 1 {
+        notes.push(format!(
+            "{channels} values per voxel (ElementNumberOfChannels): channel {} read",
+            picked.channel
+        ));
+        FrameSelect {
+            stride: 1,
+            count: channels,
+            index: picked.channel,
         }
     } else {
         FrameSelect::ALL
     };
-    info.frames = frames;
-    info.frame = frame;
+    let frames = volumes.count();
 
     let geometry = Geometry::parse(path, &header, ndims, notes)?;
 
@@ -248,7 +279,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         check_frame_dims(
             path,
             "MetaImage field DimSize =",
-            &dims,
+            &sized,
             frames,
             layout.stored().bytes() as u64,
             opts.max_memory,
@@ -256,6 +287,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     )?;
 
     info.length_unit = geometry.unit.clone();
+    info.set_volumes(volumes, picked);
     let volume = grid_to_volume(
         path,
         [dims[0], dims[1], dims.get(2).copied().unwrap_or(1)],

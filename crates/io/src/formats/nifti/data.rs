@@ -6,9 +6,9 @@
 use std::path::Path;
 
 use super::header::Header;
-use crate::FileInfo;
 use crate::dtype::DType;
 use crate::error::IoError;
+use crate::{AxisNames, FileInfo, Picked, ReadOptions, Volumes};
 
 /// The sample type of NIfTI datatype `code`, or why it is refused.
 fn sample_type(code: i64) -> Result<(DType, &'static str), String> {
@@ -54,20 +54,19 @@ pub(super) struct Layout {
     /// Volumes in all: `times · components`.
     pub(super) frames: usize,
     /// `dim[4]` (time points) and `dim[5]` (components: vector or
-    /// channel data) where the header uses them, else 1.
+    /// channel data, the channels) where the header uses them, else 1.
     pub(super) times: usize,
     pub(super) components: usize,
+    /// The time point and component asked for (`axes.rs`).
+    pub(super) picked: Picked,
+    /// Its block in the file's order: `t + times·c`.
     pub(super) frame: usize,
     pub(super) frame_bytes: u64,
     pub(super) vox_offset: u64,
 }
 
 impl Layout {
-    pub(super) fn of(
-        path: &Path,
-        header: &Header,
-        frame: Option<usize>,
-    ) -> Result<Layout, IoError> {
+    pub(super) fn of(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Layout, IoError> {
         let (dtype, type_name) =
             sample_type(header.datatype).map_err(|reason| IoError::invalid(path, reason))?;
         let dim = header.dim;
@@ -144,21 +143,17 @@ impl Layout {
         let frames = times
             .checked_mul(components)
             .ok_or_else(|| too_big(path, header))?;
-        let frame_index = frame.unwrap_or(0);
-        if frame_index >= frames {
-            let held = if components > 1 {
-                format!(
-                    "the file holds {frames} volumes ({components} components (dim[5]) x {times} time point{} (dim[4]); frame = t + {times}*c), numbered from 0",
-                    if times == 1 { "" } else { "s" }
-                )
-            } else {
-                format!(
-                    "the file holds {frames} volume{} (dim[4]), numbered from 0",
-                    if frames == 1 { "" } else { "s" }
-                )
-            };
-            return Err(IoError::frame_out_of_range(path, frame_index, held));
-        }
+        // --frame is the time point and --channel the component.
+        let picked = Volumes::new(times, components).pick(
+            path,
+            opts,
+            AxisNames {
+                holder: "the file",
+                time: "dim[4]",
+                channel: "dim[5]",
+            },
+        )?;
+        let frame_index = picked.time_point + times * picked.channel;
         let count = dims[0]
             .checked_mul(dims[1])
             .and_then(|n| n.checked_mul(dims[2]))
@@ -181,6 +176,7 @@ impl Layout {
             frames,
             times,
             components,
+            picked,
             frame: frame_index,
             frame_bytes,
             vox_offset: v as u64,

@@ -32,13 +32,16 @@
 //!   (`shared/periodic_cell.rs`), within `max_memory`;
 //! - `xyzt_units` names the length unit (m, mm, µm), which is reported, not
 //!   converted;
-//! - a 4-D file holds `dim[4]` volumes and `--frame` picks one; a 5-D
-//!   file (vector or channel data, `dim[5]` components, nibabel's shape
-//!   `(x, y, z, t, c)`) holds `dim[4]·dim[5]` volumes numbered in the
-//!   file's own order, time fastest: frame `t + dim[4]·c` is one
-//!   contiguous block (a later channel axis maps component `c` to
-//!   channel `c`); 6-D and higher data (any `dim[6..]` above 1) are
-//!   refused, as are complex, RGB, bit and 128-bit float samples.
+//! - a 4-D file holds `dim[4]` time points and `--frame` picks one; a
+//!   5-D file (nibabel's shape `(x, y, z, t, c)`) holds `dim[5]`
+//!   components of each: nifti1.h's 5th dimension `u` is "the vector
+//!   (or matrix) index" of an intent such as `NIFTI_INTENT_VECTOR` (1007)
+//!   or `RGB_VECTOR` (2001), and microscopy writers (Fiji, nibabel users)
+//!   put their channels there, so the components are the channels
+//!   (`--channel`, `axes.rs`). Each (t, c) volume is one contiguous
+//!   block in the file's own order, time fastest: block `t + dim[4]·c`.
+//!   6-D and higher data (any `dim[6..]` above 1) are refused, as are
+//!   complex, RGB, bit and 128-bit float samples.
 
 mod data;
 mod geometry;
@@ -60,7 +63,7 @@ use crate::shared::limits::{F32_BYTES, check_frame_dims};
 use crate::shared::mapped::{self, Plan};
 use crate::shared::periodic_cell;
 use crate::shared::rescale::rescale;
-use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
 
 /// Samples decoded per read: bounds the scratch buffer beside the output.
 const CHUNK_SAMPLES: usize = 1 << 16;
@@ -101,15 +104,14 @@ fn read_as(path: &Path, opts: &ReadOptions, analyze: &mut bool) -> Result<Loaded
     let header = parse_header(path, &bytes, version, endian)?;
     *analyze = header.analyze.is_some();
 
-    let layout = Layout::of(path, &header, opts.frame)?;
+    let layout = Layout::of(path, &header, opts)?;
     let mut info = FileInfo::new(format!("{} ({}-endian)", layout.type_name, endian));
     info.header = header
         .fields
         .iter()
         .map(|(n, v)| (n.to_string(), v.display()))
         .collect();
-    info.frames = layout.frames;
-    info.frame = layout.frame;
+    info.set_volumes(Volumes::new(layout.times, layout.components), layout.picked);
     info.length_unit = length_unit(header.xyzt_units).map(str::to_string);
     info.notes.push(format!(
         "{} header, {} ({}-endian{})",
@@ -129,12 +131,11 @@ fn read_as(path: &Path, opts: &ReadOptions, analyze: &mut bool) -> Result<Loaded
     if layout.components > 1 {
         let (t, c) = (layout.times, layout.components);
         info.notes.push(format!(
-            "5-D: {c} components (dim[5]{}) x {t} time point{} (dim[4]); --frame picks one: frame = t + {t}*c, the file's own order (this is frame {}: t {}, component {})",
+            "5-D: {c} components (dim[5]{}) read as channels, x {t} time point{} (dim[4]); --channel picks the component, --frame the time point (this is time point {}, component {})",
             intent_name(&header),
             if t == 1 { "" } else { "s" },
-            layout.frame,
-            layout.frame % t,
-            layout.frame / t
+            layout.picked.time_point,
+            layout.picked.channel
         ));
     } else if layout.frames > 1 && opts.frame.is_none() {
         info.notes.push(format!(

@@ -16,6 +16,15 @@ use crate::shared::text_header::Field;
 /// nothing and count as spatial).
 const SPATIAL_KINDS: [&str; 4] = ["domain", "space", "???", "none"];
 
+/// Whether an axis of kind `kind` holds the components of one value
+/// (a vector, a colour, a list of measurements): every kind the format
+/// defines but the spatial ones, `time`, and `stub` and `scalar` (one
+/// sample long).
+pub(crate) fn holds_channels(kind: &str) -> bool {
+    let not = ["time", "stub", "scalar"];
+    !(SPATIAL_KINDS.iter().chain(&not)).any(|k| k.eq_ignore_ascii_case(kind))
+}
+
 /// Every kind the format defines, for checking `kinds`.
 const KINDS: [&str; 33] = [
     "domain",

@@ -10,7 +10,10 @@
 //! `endian`, `line skip`, `byte skip` (including -1: data at the end of a
 //! raw file); 3-D files, and 4-D files whose one non-spatial axis (a
 //! `space directions` entry of `none`, or a `list`, `vector`, `time`, ...
-//! kind) holds several volumes, one of which `--frame` picks. Text values
+//! kind) holds several volumes: channels where its kind makes its samples
+//! the components of one value (`vector`, `RGB-color`, `list`, ...),
+//! `--channel` picking one, else time points, `--frame` picking one
+//! (`axes.rs`). Text values
 //! are read as decimal numbers whatever the type says.
 //!
 //! Geometry: `space directions` and `space origin` (in a 3-D space, or the
@@ -29,7 +32,7 @@ mod write;
 
 use std::path::{Path, PathBuf};
 
-use self::geometry::Geometry;
+use self::geometry::{Geometry, holds_channels};
 use self::header::Header;
 use self::values::required;
 use crate::dtype::{DType, Endian};
@@ -40,7 +43,7 @@ use crate::shared::limits::check_frame_dims;
 use crate::shared::mapped::{self, Plan};
 use crate::shared::payload::{self, Encoding, FrameSelect, Layout, Region, Skip};
 use crate::shared::text_header::Field;
-use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+use crate::{AxisNames, FileInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
 
 pub use write::write_nrrd;
 
@@ -99,8 +102,34 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     } else {
         Geometry::parse(path, &header, &sizes, notes)?
     };
+    // The 4th axis holds time points, or channels where its kind says its
+    // samples are the components of one value (`vector`, `RGB-color`,
+    // `list`, ...: `geometry::holds_channels`); `axes.rs` picks one.
     let frames = geometry.frame_axis.map_or(1, |f| sizes[f]);
-    let frame = payload::chosen_frame(path, opts.frame, frames)?;
+    let kind = (geometry.frame_axis).and_then(|f| geometry.kinds.as_ref().map(|k| k[f].clone()));
+    let channels = kind.as_deref().is_some_and(holds_channels);
+    let volumes = if channels {
+        Volumes::new(1, frames)
+    } else {
+        Volumes::new(frames, 1)
+    };
+    let along = format!(
+        "{}frames 0 to {}",
+        kind.as_ref()
+            .map(|k| format!("kind {k}, "))
+            .unwrap_or_default(),
+        frames.saturating_sub(1)
+    );
+    let picked = volumes.pick(
+        path,
+        opts,
+        AxisNames {
+            holder: "the file",
+            time: if channels { "" } else { &along },
+            channel: if channels { &along } else { "" },
+        },
+    )?;
+    let frame = picked.time_point.max(picked.channel);
     let select = match geometry.frame_axis {
         None => FrameSelect::ALL,
         Some(f) => FrameSelect {
@@ -111,16 +140,13 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
     if let Some(f) = geometry.frame_axis {
         notes.push(format!(
-            "4-D file: volume {frame} of {frames} along axis {f}{} read",
-            geometry
-                .kinds
-                .as_ref()
-                .map(|k| format!(" (kind {})", k[f]))
+            "4-D file: {} {frame} of {frames} along axis {f}{} read",
+            if channels { "channel" } else { "volume" },
+            kind.as_ref()
+                .map(|k| format!(" (kind {k})"))
                 .unwrap_or_default()
         ));
     }
-    info.frames = frames;
-    info.frame = frame;
 
     // Where the data is, checked against the files before reading.
     let (files, base) = data_files(path, &header, &sizes)?;
@@ -198,6 +224,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         sizes[geometry.axes[2]],
     ];
     info.length_unit = geometry.unit.clone();
+    info.set_volumes(volumes, picked);
     let volume = grid_to_volume(
         path,
         volume_dims,

@@ -13,8 +13,8 @@
 //!
 //! ImageJ metadata (an `ImageDescription` starting with `ImageJ=`) gives:
 //! - the hyperstack shape: pages are ordered TZC (channel fastest, then
-//!   slice, then time point); each (time point, channel) pair is one volume,
-//!   numbered `t·channels + c` for `--frame`;
+//!   slice, then time point); `--frame` picks the time point and
+//!   `--channel` the channel (`axes.rs`);
 //! - the spacing: x and y from `XResolution`/`YResolution` (pixels per
 //!   `unit`), z from `spacing=`; the origin from `xorigin=`, `yorigin=`,
 //!   `zorigin=` (in pixels, as ImageJ's `Calibration` stores it);
@@ -23,8 +23,8 @@
 //!
 //! OME-TIFF (an `ImageDescription` holding OME-XML, as tifffile's
 //! `ome=True`, Bio-Formats and OMERO write it; `ome.rs`) gives the pages'
-//! order (`DimensionOrder` with `SizeZ`, `SizeC`, `SizeT`: each (time
-//! point, channel) pair one volume, numbered `t·SizeC + c` as for ImageJ)
+//! order (`DimensionOrder` with `SizeZ`, `SizeC`, `SizeT`: the time point
+//! and channel picked as for ImageJ)
 //! and the spacing from `PhysicalSizeX`/`Y`/`Z` and their units, converted
 //! to one unit. ImageJ metadata, where present, is read first, as before.
 //!
@@ -53,7 +53,7 @@ use crate::shared::geometry::grid_to_volume;
 use crate::shared::input::open_input;
 use crate::shared::limits::{F32_BYTES, check_dims};
 use crate::shared::rescale::rescale;
-use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
+use crate::{AxisNames, FileInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
 
 /// A compressed page may decode to more bytes than the file holds; a stack
 /// whose pages claim more decoded bytes than this many times the file
@@ -169,29 +169,36 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         Some(o) => ome_shape(path, o, &mut pages, &mut info)?,
         None => stack_shape(path, imagej.as_ref(), pages.len())?,
     };
-    info.frames = shape.channels * shape.times;
-    let frame = opts.frame.unwrap_or(0);
-    if frame >= info.frames {
-        return Err(IoError::frame_out_of_range(
-            path,
-            frame,
-            format!(
-                "the stack holds {} volume(s) ({} channel(s) x {} time point(s)), numbered from 0",
-                info.frames, shape.channels, shape.times
-            ),
-        ));
-    }
-    info.frame = frame;
-    let (t, c) = (frame / shape.channels, frame % shape.channels);
-    if info.frames > 1 {
+    // The time point and channel asked for (`axes.rs`).
+    let volumes = Volumes::new(shape.times, shape.channels);
+    let picked = volumes.pick(
+        path,
+        opts,
+        AxisNames {
+            holder: "the stack",
+            time: if ome.is_some() {
+                "SizeT"
+            } else {
+                "ImageJ frames"
+            },
+            channel: if ome.is_some() {
+                "SizeC"
+            } else {
+                "ImageJ channels"
+            },
+        },
+    )?;
+    info.set_volumes(volumes, picked);
+    let (t, c) = (picked.time_point, picked.channel);
+    if volumes.count() > 1 {
         info.notes.push(match &ome {
             Some(o) => format!(
-                "volume {frame} of {} read: time point {t}, channel {c} (frames numbered t x SizeC + c; pages in OME DimensionOrder {})",
-                info.frames, o.dimension_order
+                "time point {t} of {}, channel {c} of {} read (pages in OME DimensionOrder {})",
+                shape.times, shape.channels, o.dimension_order
             ),
             None => format!(
-                "volume {frame} of {} read: time point {t}, channel {c} (ImageJ page order: channel fastest, then slice, then time)",
-                info.frames
+                "time point {t} of {}, channel {c} of {} read (ImageJ page order: channel fastest, then slice, then time)",
+                shape.times, shape.channels
             ),
         });
     }

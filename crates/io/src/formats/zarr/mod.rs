@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use zarrs::array::{ArrayMetadata, ArrayShardedExt};
 
-use crate::{FileInfo, IoError, LevelInfo, Loaded, ReadOptions, VolumeFormat};
+use crate::{AxisNames, FileInfo, IoError, LevelInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
 use chunks::{ZarrArray, ZarrType, open_array};
 use ome::{Axis, AxisKind, Level};
 use store::NodeKind;
@@ -117,29 +117,20 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
     let (dir, array, ty) = opened.swap_remove(chosen);
     let shape = array.shape().to_vec();
 
-    let frames = layout.time.map_or(1, |t| shape[t]);
-    let frame = opts.frame.unwrap_or(0);
-    if frame as u64 >= frames {
-        return Err(IoError::frame_out_of_range(
-            path,
-            frame,
-            format!(
-                "the image holds {frames} time point{} (axis \"t\"), numbered from 0",
-                if frames == 1 { "" } else { "s" }
-            ),
-        ));
-    }
-    let channels = layout.channel.map_or(1, |c| shape[c]);
-    let channel = opts.channel.unwrap_or(0);
-    if channel as u64 >= channels {
-        return Err(IoError::invalid(
-            path,
-            format!(
-                "channel {channel} is out of range: the image holds {channels} channel{} (axis \"c\"), numbered from 0",
-                if channels == 1 { "" } else { "s" }
-            ),
-        ));
-    }
+    // The time point and channel asked for (`axes.rs`).
+    let extent =
+        |axis: Option<usize>| axis.map_or(1, |a| usize::try_from(shape[a]).unwrap_or(usize::MAX));
+    let volumes = Volumes::new(extent(layout.time), extent(layout.channel));
+    let picked = volumes.pick(
+        path,
+        opts,
+        AxisNames {
+            holder: "the image",
+            time: "axis \"t\"",
+            channel: "axis \"c\"",
+        },
+    )?;
+    let (frame, channel, channels) = (picked.time_point, picked.channel, volumes.channels);
     let mut start = vec![0u64; shape.len()];
     for (axis, index) in [
         (layout.time, frame as u64),
@@ -176,8 +167,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
             .push(format!("channel {channel} of {channels} read"));
     }
     file_info.length_unit = layout.unit.clone();
-    file_info.frames = frames as usize;
-    file_info.frame = frame;
+    file_info.set_volumes(volumes, picked);
     let level = ZarrLevel::new(
         path,
         &dir,

@@ -1,9 +1,5 @@
-//! Which volume of a multi-volume file is kept ([`chosen_frame`]), and
-//! which of the samples read belong to it ([`FrameSelect`]).
-
-use std::path::Path;
-
-use crate::error::IoError;
+//! Which of the samples of a multi-volume file read belong to the volume
+//! kept ([`FrameSelect`]; which volume that is, `axes.rs` says).
 
 /// Which samples of a multi-volume file to keep: sample `n` (counted
 /// across all regions, file order) belongs to frame
@@ -36,27 +32,4 @@ impl FrameSelect {
             );
         }
     }
-}
-
-/// The volume [`ReadOptions::frame`](crate::ReadOptions::frame) asks for
-/// (`requested`, default 0) of a file that holds `frames`; refused if there
-/// is no such volume.
-pub(crate) fn chosen_frame(
-    path: &Path,
-    requested: Option<usize>,
-    frames: usize,
-) -> Result<usize, IoError> {
-    let frame = requested.unwrap_or(0);
-    if frame >= frames {
-        return Err(IoError::frame_out_of_range(
-            path,
-            frame,
-            format!(
-                "the file holds {frames} volume{} (frames 0 to {})",
-                if frames == 1 { "" } else { "s" },
-                frames.saturating_sub(1)
-            ),
-        ));
-    }
-    Ok(frame)
 }

@@ -23,7 +23,7 @@ mod region;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use self::frame::{FrameSelect, chosen_frame};
+pub(crate) use self::frame::FrameSelect;
 pub(crate) use self::layout::{Encoding, Layout};
 pub(crate) use self::numbered::{MAX_FILES, format_number, number_range};
 pub(crate) use self::read::plan_frame;
