@@ -18,7 +18,7 @@
 //! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
 //! | `cf.rs` | the CF conventions, format neutral: axes, coordinate variables, packing, fill values | NetCDF-3, MINC1, NetCDF-4 |
-//! | `units.rs` | each axis's length unit brought to one (the finest), other units kept apart | OME-Zarr, OME-TIFF, CF, NRRD, MINC, NIfTI |
+//! | `units.rs` | each axis's length unit brought to one (the finest), other units kept apart | OME-Zarr, OME-TIFF, CF, NRRD, MINC, FITS |
 
 pub(crate) mod cf;
 pub(crate) mod compress;

@@ -2,10 +2,10 @@
 //!
 //! A file may give each spatial axis its own unit (OME-Zarr `axes`,
 //! OME-TIFF `PhysicalSize{X,Y,Z}Unit`, CF coordinate variables' `units`,
-//! NRRD `space units`, MINC dimensions' `units`). volray's volume has one
-//! spacing per axis and one [`FileInfo::length_unit`](crate::FileInfo),
-//! so every reader sends its axes through [`one_length_unit`], which
-//! applies one rule:
+//! NRRD `space units`, MINC dimensions' `units`, FITS `CUNITn`). volray's
+//! volume has one spacing per axis and one
+//! [`FileInfo::length_unit`](crate::FileInfo), so every reader sends its
+//! axes through [`one_length_unit`], which applies one rule:
 //!
 //! - **lengths are converted to the finest length unit among the axes**
 //!   (z in micrometer, y and x in nanometer: spacing in nanometer). The
@@ -48,6 +48,13 @@ pub(crate) fn metres(unit: &str) -> Option<f64> {
         ("\u{c5}" | "\u{212b}", _) | (_, "angstrom" | "ångström") => 1e-10,
         ("in", _) | (_, "inch" | "inche") => 0.0254,
         ("ft", _) | (_, "foot" | "feet") => 0.3048,
+        // Astronomy's (FITS Standard 4.0, Table 4): the IAU 2012 au, the
+        // parsec from it, the Julian light year.
+        ("AU" | "au", _) => 1.495_978_707e11,
+        ("pc", _) | (_, "parsec") => 3.085_677_581_491_367e16,
+        ("kpc", _) => 3.085_677_581_491_367e19,
+        ("Mpc", _) => 3.085_677_581_491_367e22,
+        ("lyr", _) => 9.460_730_472_580_8e15,
         _ => return None,
     })
 }
