@@ -201,6 +201,62 @@ fn missing_slice_is_refused_with_the_gaps() {
     );
 }
 
+/// The CT series (IPP z = 30, 32.5, 35, 37.5, 40 mm) with the slice at
+/// 37.5 (IM1603.dcm) written at `z` instead (6 characters, as padded).
+fn ct_with_slice_at(dir: &Path, z: &[u8; 6]) -> PathBuf {
+    fs::create_dir_all(dir).unwrap();
+    for e in fs::read_dir(fixture("ct")).unwrap() {
+        let e = e.unwrap();
+        let mut bytes = fs::read(e.path()).unwrap();
+        if e.file_name() == "IM1603.dcm" {
+            let at = find(&bytes, b"-10.0\\20.0\\37.5  ") + 11;
+            bytes[at..at + 6].copy_from_slice(z);
+        }
+        fs::write(dir.join(e.file_name()), bytes).unwrap();
+    }
+    dir.to_path_buf()
+}
+
+#[test]
+fn a_near_even_series_reads_at_the_mean_gap_with_a_note_and_a_20_percent_uneven_one_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    // 37.58: gaps 2.5, 2.5, 2.58, 2.42 mm, 0.08 mm (3.2 %) off their mean,
+    // as a scanner's rounding leaves them; read at (40 − 30) / 4 = 2.5 mm.
+    let near = ct_with_slice_at(&tmp.path().join("near"), b"37.58 ");
+    let l = load_path(&near, &ReadOptions::default());
+    assert_eq!(l.volume.dims(), [4, 3, 5]);
+    assert!((l.volume.spacing() - DVec3::new(0.6, 0.8, 2.5)).length() < 1e-12);
+    assert!((l.volume.origin() - DVec3::new(-10.0, 20.0, 30.0)).length() < 1e-12);
+    assert_note(
+        &l,
+        "slice gaps vary from 2.42 to 2.58 mm around their mean 2.5 mm",
+    );
+    assert_note(
+        &l,
+        "0.08 mm (3.2 % of the mean) off it, within the tolerance of 0.135 mm (5 % of the mean gap plus 0.01 mm for positions written to 2 decimal(s))",
+    );
+    assert_note(
+        &l,
+        "places IM1603.dcm 0.08 mm (3.2 % of a gap) from its written position",
+    );
+    // The slices keep their order and values: slice z holds v(z).
+    for k in 0..5 {
+        assert_eq!(
+            l.volume.get(1, 2, k),
+            (2 * (21 + 100 * k as i64 - 200) - 1024) as f32
+        );
+    }
+
+    // 38.0: gaps 2.5, 2.5, 3, 2 mm, 20 % off: refused, naming the slices.
+    let uneven = ct_with_slice_at(&tmp.path().join("uneven"), b"38.0  ");
+    let msg = refused(&uneven, &ReadOptions::default());
+    assert!(msg.contains("slice gaps are uneven: 2 mm (between IM1603.dcm and IM1007) to 3 mm (between IM5286 and IM1603.dcm), mean 2.5 mm"), "{msg}");
+    assert!(
+        msg.contains("0.5 mm (20 %) off the mean, beyond the tolerance of 0.225 mm"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn rle_and_big_endian_series() {
     let l = load("rle", &ReadOptions::default());

@@ -205,3 +205,31 @@ fn broken_minc1_files_are_refused_in_one_line() {
     let files = ["ramp_minc1.mnc", "series_minc1.mnc"].map(|n| common::fixture("minc", n));
     common::byte_flips_never_panic(&files, 0x6d31, &[ReadOptions::default(), frame(1)]);
 }
+
+#[test]
+fn a_dimension_in_cm_among_dimensions_in_mm_is_converted_to_mm() {
+    // ramp_minc1.mnc with zspace's units "mm" rewritten "cm": its step 2.5
+    // and start 4 are 25 and 40 mm; x and y stay in mm, the finest.
+    let mut bytes = std::fs::read(common::fixture("minc", "ramp_minc1.mnc")).unwrap();
+    let find = |from: usize, what: &[u8]| {
+        from + bytes[from..]
+            .windows(what.len())
+            .position(|w| w == what)
+            .unwrap()
+    };
+    // zspace's variable (its second mention: the first is its dimension).
+    let var = find(find(0, b"zspace") + 6, b"zspace");
+    let mm = find(find(var, b"units"), b"mm");
+    bytes[mm..mm + 2].copy_from_slice(b"cm");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("z_in_cm.mnc");
+    std::fs::write(&path, &bytes).unwrap();
+    let l = read(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(l.volume.spacing(), DVec3::new(1.5, 2.0, 25.0));
+    assert_eq!(l.volume.origin(), DVec3::new(-3.0, 4.0, 40.0));
+    assert_eq!(l.info.length_unit.as_deref(), Some("mm"));
+    assert_note(
+        &l,
+        "zspace in cm, yspace/xspace in mm: spacing in mm (zspace × 10)",
+    );
+}

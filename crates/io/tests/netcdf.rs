@@ -86,7 +86,10 @@ fn the_three_versions_read_alike_with_coordinates_in_mm_and_m() {
         // y decreases: flipped, its lowest value 20 - 2·9 = 2.
         assert!((l.volume.origin() - DVec3::new(-3.0, 2.0, 10.0)).length() < 1e-9);
         assert_eq!(l.info.length_unit.as_deref(), Some("mm"), "{name}");
-        assert_note(&l, "z axis in m converted to mm");
+        assert_note(
+            &l,
+            "x (x)/y (y) in mm, z (z) in m: spacing in mm (z (z) × 1000)",
+        );
         assert_note(&l, "index axis 1 -> -y");
         assert_eq!(l.info.stored_type, "float32 (big-endian)");
         assert_eq!(l.info.array.as_deref(), Some("rho"));
@@ -145,7 +148,7 @@ fn values_outside_valid_range_are_nan_and_empty() {
 fn xarray_packing_and_fill_values_with_latitude_and_longitude() {
     let l = load("packed.nc", &frame(1));
     // lon 10 + 1.5 i (degrees_east), lat 40 - 0.5 j (degrees_north), lev
-    // 100 k (m): not one length unit, each axis in its own.
+    // 100 k (m, positive up): not one length unit, each axis in its own.
     let grid = Grid {
         n: [6, 5, 4],
         steps: [DVec3::X * 1.5, DVec3::Y * -0.5, DVec3::Z * 100.0],
@@ -162,7 +165,10 @@ fn xarray_packing_and_fill_values_with_latitude_and_longitude() {
         (stored * 0.1 + 5.0) as f32
     });
     assert_eq!(l.info.length_unit, None);
-    assert_note(&l, "not one length unit (degrees_east, degrees_north, m)");
+    assert_note(
+        &l,
+        "x (lon) in degrees_east, y (lat) in degrees_north: not length units, kept as written",
+    );
     assert_note(&l, "real = stored · 0.1 + 5 (scale_factor, add_offset)");
     assert_note(&l, "-32767");
     assert_note(&l, "lon is x (standard_name = \"longitude\")");

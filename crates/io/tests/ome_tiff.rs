@@ -52,17 +52,17 @@ fn ome_physical_sizes_give_the_spacing_in_their_unit() {
 }
 
 #[test]
-fn sizes_in_different_units_are_converted_to_micrometres() {
-    // PhysicalSizeX 500 nm, Y 0.25 (the default µm), Z 0.002 mm.
+fn sizes_in_different_units_are_converted_to_the_finest() {
+    // PhysicalSizeX 500 nm, Y 0.25 (the default µm), Z 0.002 mm: in nm,
+    // the finest, by whole powers of ten: 250 nm exactly.
     let l = load("ome_zcyx.ome.tif", &ReadOptions::default());
-    // By exact powers of ten: 500 nm is 0.5 µm exactly.
-    assert_eq!(l.volume.spacing(), DVec3::new(0.5, 0.25, 2.0));
-    assert_eq!(l.info.length_unit.as_deref(), Some("\u{b5}m"));
+    assert_eq!(l.volume.spacing(), DVec3::new(500.0, 250.0, 2000.0));
+    assert_eq!(l.info.length_unit.as_deref(), Some("nm"));
     assert!(
         l.info
             .notes
             .iter()
-            .any(|n| n.contains("converted to \u{b5}m")),
+            .any(|n| n == "x in nm, y in \u{b5}m, z in mm: spacing in nm (y × 1000, z × 1000000)"),
         "{:?}",
         l.info.notes
     );

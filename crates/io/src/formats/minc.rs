@@ -34,6 +34,7 @@ use crate::shared::geometry::grid_to_volume;
 use crate::shared::hdf5::{
     self as h5, Slabs, numbers, numeric_type, read_small, shown, sorted_attrs, text,
 };
+use crate::shared::units::{AxisUnit, one_length_unit};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
 const IMAGE: &str = "minc-2.0/image/0";
@@ -211,7 +212,8 @@ pub(crate) fn geometry(
     info: &mut FileInfo,
 ) -> Result<([DVec3; 3], DVec3), String> {
     let mut steps = [DVec3::ZERO; 3];
-    let mut origin = DVec3::ZERO;
+    let mut starts = [DVec3::ZERO; 3];
+    let mut units: Vec<Option<String>> = Vec::new();
     let mut described = Vec::new();
     for (a, name) in names.iter().enumerate() {
         let default = match name.as_str() {
@@ -263,11 +265,9 @@ pub(crate) fn geometry(
                 "dimension {name} is irregularly spaced: volray reads regular grids"
             ));
         }
-        if a == 0 {
-            info.length_unit = attr("units").and_then(text);
-        }
+        units.push(attr("units").and_then(text));
         steps[a] = cosines * step;
-        origin += cosines * start;
+        starts[a] = cosines * start;
         described.push(format!(
             "{name} step {step} start {start} cosines ({}, {}, {})",
             cosines.x, cosines.y, cosines.z
@@ -277,6 +277,23 @@ pub(crate) fn geometry(
         "geometry from {source}: {}; world = Σ cosines · (start + step · index), nibabel's affine",
         described.join("; ")
     ));
+    // Each dimension's `units` to the finest length unit (units.rs).
+    let axes: Vec<AxisUnit> = names
+        .iter()
+        .zip(&units)
+        .map(|(name, unit)| AxisUnit {
+            name,
+            unit: unit.as_deref(),
+        })
+        .collect();
+    let one = one_length_unit(&axes);
+    let mut origin = DVec3::ZERO;
+    for (a, f) in one.factors.iter().enumerate() {
+        steps[a] *= *f;
+        origin += starts[a] * *f;
+    }
+    info.notes.extend(one.notes);
+    info.length_unit = one.length_unit;
     Ok((steps, origin))
 }
 

@@ -431,11 +431,12 @@ mod tests {
 
     #[test]
     fn decreasing_coordinates_are_flipped_to_run_forward() {
-        // lat 30, 20, 10, 0 and lev 1000, 850, 700 (both decreasing).
+        // lat 30, 20, 10, 0 (decreasing, flipped) and lev 1000, 850, 700
+        // hPa, positive down: at z = −lev, −1000 to −700, forward.
         let l = read(&fixture("cf_latlon.nc"), &opts(None, None)).unwrap();
-        check("t", &l.volume, |x, y, z| ramp(x, 3 - y, 2 - z));
+        check("t", &l.volume, |x, y, z| ramp(x, 3 - y, z));
         assert_eq!(l.volume.spacing(), DVec3::new(10.0, 10.0, 150.0));
-        assert_eq!(l.volume.origin(), DVec3::new(0.0, 0.0, 700.0));
+        assert_eq!(l.volume.origin(), DVec3::new(0.0, 0.0, -1000.0));
         assert!(
             open_lazy(&fixture("cf_latlon.nc"), &opts(None, None))
                 .unwrap()

@@ -25,10 +25,14 @@
 //!    **refused** naming the axis (a grid drawn at index spacing would
 //!    misplace every sample, and volray has no rectilinear grids); a
 //!    dimension without a coordinate variable has spacing 1 from 0, with
-//!    a note. Units: lengths (m, mm, cm, km, µm, nm and their long names)
-//!    are brought to the x axis's unit, which is the volume's; other
-//!    units (degrees_north, degrees_east, Pa) are kept as they are and a
-//!    note says that the axes are not in one length unit;
+//!    a note. A vertical coordinate that points down ([`points_down`]:
+//!    `positive = "down"`, or a pressure or depth without `positive`) is
+//!    placed at z = −value, so that up in the world is up in the
+//!    atmosphere or ocean: 1000 hPa below 500 hPa, the seabed below the
+//!    surface. Units go through `units.rs`: lengths (m, mm, km, µm, ...)
+//!    are brought to the finest of them, which is the volume's; other
+//!    units (degrees_north, degrees_east, hPa) are kept as they are, with
+//!    a note;
 //! 4. maps stored values to real ones ([`Packing`], CF §2.5 and §8.1):
 //!    `_FillValue`, `missing_value` and values outside `valid_min`,
 //!    `valid_max` or `valid_range` (compared with the stored values, as
@@ -48,6 +52,7 @@ use volray_core::glam::DVec3;
 
 use crate::FileInfo;
 use crate::error::IoError;
+use crate::shared::units::{AxisUnit, is_pressure, one_length_unit};
 
 /// An attribute's value: text (NetCDF `char`, a string) or numbers (any
 /// numeric type, widened to `f64`).
@@ -421,20 +426,6 @@ pub(crate) fn choose<'a>(
     }
 }
 
-/// A length unit: its canonical name and its size in metres.
-fn length_unit(unit: &str) -> Option<(&'static str, f64)> {
-    Some(match unit.trim() {
-        "m" | "meter" | "meters" | "metre" | "metres" => ("m", 1.0),
-        "mm" | "millimeter" | "millimeters" | "millimetre" | "millimetres" => ("mm", 1e-3),
-        "cm" | "centimeter" | "centimeters" | "centimetre" | "centimetres" => ("cm", 1e-2),
-        "km" | "kilometer" | "kilometers" | "kilometre" | "kilometres" => ("km", 1e3),
-        "um" | "µm" | "μm" | "micron" | "microns" | "micrometer" | "micrometers" | "micrometre"
-        | "micrometres" => ("µm", 1e-6),
-        "nm" | "nanometer" | "nanometers" | "nanometre" | "nanometres" => ("nm", 1e-9),
-        _ => return None,
-    })
-}
-
 /// A grid placed in the world: what `grid_to_volume` takes.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Placement {
@@ -464,6 +455,7 @@ pub(crate) fn place(
     // Per spatial role x, y, z: (start, step, unit).
     let mut axes: Vec<(f64, f64, Option<String>)> = Vec::new();
     let mut described = Vec::new();
+    let mut down = Vec::new();
     for (role, &d) in ["x", "y", "z"].iter().zip(&layout.spatial) {
         let dim = &var.dims[d];
         let n = var.shape[d];
@@ -498,7 +490,21 @@ pub(crate) fn place(
             "{role} ({dim}): start {start} step {step}{}",
             unit.as_ref().map(|u| format!(" {u}")).unwrap_or_default()
         ));
-        axes.push((start, step, unit));
+        if *role == "z"
+            && let Some(why) = points_down(c)
+        {
+            let (low, high) = (
+                start.min(start + step * (n - 1) as f64),
+                start.max(start + step * (n - 1) as f64),
+            );
+            down.push(format!(
+                "z ({dim}) points down ({why}): placed at z = −{dim}, so that up in the world is up in the atmosphere or ocean ({dim} {high} lowest, {low} highest)"
+            ));
+            // 0 − v: depth 0 is z = 0, not −0.
+            axes.push((0.0 - start, 0.0 - step, unit));
+        } else {
+            axes.push((start, step, unit));
+        }
     }
     info.notes.push(format!(
         "CF axes of {}: {}; geometry from the coordinate variables: {}",
@@ -507,42 +513,30 @@ pub(crate) fn place(
         described.join("; ")
     ));
 
-    // One length unit: the x axis's; lengths in others converted.
-    let units: Vec<Option<String>> = axes.iter().map(|a| a.2.clone()).collect();
-    let lengths: Vec<Option<(&str, f64)>> = units
+    info.notes.extend(down);
+
+    // One length unit: the finest; other units kept apart (units.rs).
+    let names: Vec<String> = layout
+        .spatial
         .iter()
-        .map(|u| u.as_deref().and_then(length_unit))
+        .zip(["x", "y", "z"])
+        .map(|(&d, role)| format!("{role} ({})", var.dims[d]))
         .collect();
-    let length_unit_name = if lengths.iter().all(Option::is_some) {
-        let (name, x_metres) = lengths[0].unwrap_or(("m", 1.0));
-        for (a, l) in lengths.iter().enumerate() {
-            let (other, metres) = l.unwrap_or(("m", 1.0));
-            if other != name {
-                let factor = metres / x_metres;
-                axes[a].0 *= factor;
-                axes[a].1 *= factor;
-                info.notes.push(format!(
-                    "{} axis in {other} converted to {name} (x's unit): × {factor}",
-                    ["x", "y", "z"][a]
-                ));
-            }
-        }
-        Some(name.to_string())
-    } else if units.iter().all(|u| u.is_some() && *u == units[0]) {
-        units[0].clone()
-    } else {
-        if units.iter().any(Option::is_some) {
-            info.notes.push(format!(
-                "the axes' units are not one length unit ({}): spacing and origin are in each axis's own unit",
-                units
-                    .iter()
-                    .map(|u| u.as_deref().unwrap_or("none"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
-        }
-        None
-    };
+    let axis_units: Vec<AxisUnit> = axes
+        .iter()
+        .zip(&names)
+        .map(|(a, name)| AxisUnit {
+            name,
+            unit: a.2.as_deref(),
+        })
+        .collect();
+    let one = one_length_unit(&axis_units);
+    for (a, f) in one.factors.iter().enumerate() {
+        axes[a].0 *= f;
+        axes[a].1 *= f;
+    }
+    info.notes.extend(one.notes);
+    let length_unit_name = one.length_unit;
 
     let world = [DVec3::X, DVec3::Y, DVec3::Z];
     let mut origin = DVec3::ZERO;
@@ -568,6 +562,27 @@ pub(crate) fn place(
         origin,
         length_unit: length_unit_name,
     })
+}
+
+/// Why the vertical coordinate `c` grows downward, if it does (CF §4.3):
+/// its `positive` attribute is `"down"`; or, without one, it is a
+/// pressure (`standard_name = "air_pressure"`, or units of pressure,
+/// which CF lets stand without `positive`) or a depth (`standard_name =
+/// "depth"`, positive down by its definition in the standard name
+/// table). `positive = "up"` is taken at its word.
+pub(crate) fn points_down(c: &Variable) -> Option<String> {
+    match c.text("positive").map(str::to_ascii_lowercase).as_deref() {
+        Some("down") => return Some("positive = \"down\"".into()),
+        Some("up") => return None,
+        _ => {}
+    }
+    if let Some(name) = c.text("standard_name")
+        && matches!(name, "air_pressure" | "depth")
+    {
+        return Some(format!("standard_name = \"{name}\""));
+    }
+    let unit = c.text("units").filter(|u| is_pressure(u))?;
+    Some(format!("units = \"{unit}\", a pressure"))
 }
 
 /// The first value and the step of evenly spaced `values` (within
@@ -767,70 +782,5 @@ pub(crate) fn describe(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn var(name: &str, dims: &[(&str, u64)], attrs: &[(&str, Value)]) -> Variable {
-        Variable {
-            name: name.into(),
-            dims: dims.iter().map(|d| d.0.to_string()).collect(),
-            shape: dims.iter().map(|d| d.1).collect(),
-            attrs: attrs
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.clone()))
-                .collect(),
-            type_name: "float32".into(),
-            integer: false,
-        }
-    }
-
-    #[test]
-    fn x_is_the_last_dimension_and_time_holds_the_frames() {
-        let t = Value::Text("T".into());
-        let vars = vec![
-            var("time", &[("time", 3)], &[("axis", t)]),
-            var("rho", &[("time", 3), ("a", 4), ("b", 5), ("c", 6)], &[]),
-        ];
-        let l = layout(Path::new("f.nc"), &vars[1], &vars, Some(2)).unwrap();
-        assert_eq!(l.spatial, [3, 2, 1]);
-        assert_eq!((l.frame_dim, l.frames, l.frame), (Some(0), 3, 2));
-        assert_eq!(l.fastest_first(), [3, 2, 1]);
-        assert!(layout(Path::new("f.nc"), &vars[1], &vars, Some(3)).is_err());
-    }
-
-    #[test]
-    fn named_dimensions_win_over_their_place() {
-        let vars = vec![var("v", &[("lon", 4), ("lat", 5), ("lev", 6)], &[])];
-        let l = layout(Path::new("f.nc"), &vars[0], &vars, None).unwrap();
-        assert_eq!(l.spatial, [0, 1, 2]);
-        assert_eq!(l.fastest_first(), [2, 1, 0]);
-    }
-
-    #[test]
-    fn spacing_must_be_even_and_may_decrease() {
-        assert_eq!(even_spacing(&[5.0, 3.0, 1.0]), Ok((5.0, -2.0)));
-        assert!(
-            even_spacing(&[0.0, 1.0, 3.0])
-                .unwrap_err()
-                .contains("unevenly")
-        );
-    }
-
-    #[test]
-    fn packing_maps_fill_and_range_to_nan() {
-        let v = var(
-            "v",
-            &[("x", 2)],
-            &[
-                ("scale_factor", Value::Numbers(vec![0.5])),
-                ("add_offset", Value::Numbers(vec![10.0])),
-                ("_FillValue", Value::Numbers(vec![-1.0])),
-                ("valid_max", Value::Numbers(vec![100.0])),
-            ],
-        );
-        let p = Packing::of(Path::new("f.nc"), &v).unwrap();
-        assert_eq!(p.real(4.0), 12.0);
-        assert!(p.real(-1.0).is_nan());
-        assert!(p.real(101.0).is_nan());
-    }
-}
+#[path = "cf_tests.rs"]
+mod tests;

@@ -19,6 +19,7 @@
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
 //! | `panics.rs` | a panic inside a third-party decoder as an error, with no panic text | DICOM |
 //! | `cf.rs` | the CF conventions, format neutral: axes, coordinate variables, packing, fill values | NetCDF-3, MINC1, NetCDF-4 |
+//! | `units.rs` | each axis's length unit brought to one (the finest), other units kept apart | OME-Zarr, OME-TIFF, CF, NRRD, MINC, FITS |
 
 pub(crate) mod cf;
 pub(crate) mod compress;
@@ -34,4 +35,5 @@ pub(crate) mod rescale;
 pub(crate) mod sigbus;
 pub(crate) mod text_header;
 pub(crate) mod text_reader;
+pub(crate) mod units;
 pub(crate) mod vtk_arrays;

@@ -17,15 +17,24 @@ const SAME_POSITION_MM: f64 = 1e-3;
 
 /// Gaps may differ from their mean by this fraction of it, plus the
 /// rounding of the positions ([`gap_tolerance`]), and still be read as
-/// equal spacing at the mean gap, with a note.
+/// equal spacing at the mean gap, with a note naming the largest
+/// deviation.
 ///
-/// ITK's ImageSeriesReader (itkImageSeriesReader.hxx, GenerateData) reads
-/// any series, taking the gap between the first two slices as the spacing
-/// and warning "Non uniform sampling or missing slices detected" when a gap
-/// differs from it by more than `SpacingWarningRelThreshold` (1e-4) of it;
-/// volray reads within this tolerance and refuses beyond it, where a slice
-/// is likely missing and one spacing would misplace slices.
-const GAP_TOLERANCE: f64 = 0.01;
+/// Why 5 %: ITK's ImageSeriesReader (itkImageSeriesReader.hxx,
+/// GenerateData) reads any series, taking the gap between the first two
+/// slices as the spacing and only warning ("Non uniform sampling or
+/// missing slices detected") when a gap differs from it by more than
+/// `SpacingWarningRelThreshold` (1e-4) of it; 3D Slicer loads such
+/// series and offers to regularise them. MR scanners write
+/// ImagePositionPatient rounded (to 0.01–0.1 mm, sometimes in single
+/// precision), which makes gaps of a millimetre or two differ by a few
+/// percent; a missing slice, the error worth refusing, makes one gap
+/// twice the others, at least 50 % off the mean for any series of three
+/// slices or more. 5 % keeps the scanner's rounding readable and stays an
+/// order of magnitude below a missing slice; at the mean gap no slice lies
+/// more than a few percent of a gap from its written position, which the
+/// note states in mm.
+const GAP_TOLERANCE: f64 = 0.05;
 
 /// Gap differences above this fraction of the mean are reported in a note.
 const GAP_NOTE: f64 = 1e-4;
@@ -136,7 +145,7 @@ pub(super) fn stack(planes: &[Plane], name: &dyn Fn(usize) -> String) -> Result<
     };
     if deviation > tolerance {
         return Err(format!(
-            "slice gaps are uneven: {} mm (between {} and {}) to {} mm (between {} and {}), mean {} mm; the gap of {} mm between {} and {} is {} mm off the mean, beyond the tolerance of {} mm ({stated}): a slice may be missing, and volray needs equally spaced slices",
+            "slice gaps are uneven: {} mm (between {} and {}) to {} mm (between {} and {}), mean {} mm; the gap of {} mm between {} and {} is {} mm ({} %) off the mean, beyond the tolerance of {} mm ({stated}): a slice may be missing, and volray needs equally spaced slices",
             round(gmin),
             name(order[kmin]),
             name(order[kmin + 1]),
@@ -148,17 +157,31 @@ pub(super) fn stack(planes: &[Plane], name: &dyn Fn(usize) -> String) -> Result<
             name(order[kfar]),
             name(order[kfar + 1]),
             round(deviation),
+            percent(deviation / mean),
             round(tolerance),
         ));
     }
     if deviation > GAP_NOTE * mean {
+        // The furthest slice from where the mean gap puts it.
+        let (kpos, off) = (0..n)
+            .map(|k| (k, along[order[k]] - (along[order[0]] + mean * k as f64)))
+            .fold((0, 0.0f64), |best, (k, d)| {
+                if d.abs() > best.1.abs() { (k, d) } else { best }
+            });
         notes.push(format!(
-            "slice gaps vary from {} to {} mm, at most {} mm off their mean {} mm, within the tolerance of {} mm ({stated}): read at the mean gap",
+            "slice gaps vary from {} to {} mm around their mean {} mm; the largest deviation is the gap of {} mm between {} and {}, {} mm ({} % of the mean) off it, within the tolerance of {} mm ({stated}): read at the mean gap, (last − first) / (n − 1), which places {} {} mm ({} % of a gap) from its written position, the furthest of any slice",
             round(gmin),
             round(gmax),
-            round(deviation),
             round(mean),
-            round(tolerance)
+            round(gfar),
+            name(order[kfar]),
+            name(order[kfar + 1]),
+            round(deviation),
+            percent(deviation / mean),
+            round(tolerance),
+            name(order[kpos]),
+            round(off.abs()),
+            percent(off.abs() / mean),
         ));
     }
 
@@ -205,6 +228,11 @@ fn gap_tolerance(mean: f64, normal: DVec3, decimals: Option<u32>) -> (f64, Strin
 /// strings carry binary noise: 1.2000000000000002).
 fn round(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
+}
+
+/// A fraction as a percentage to two decimals, for messages.
+fn percent(fraction: f64) -> f64 {
+    (fraction * 1e4).round() / 1e2
 }
 
 /// The index and value of the extreme element under `better`.
@@ -321,6 +349,13 @@ mod tests {
         let s = stack(&z(&[0.0, 1.0, 2.005, 3.0]), &name).unwrap();
         assert!(s.notes[0].contains("vary from 0.995"), "{:?}", s.notes);
         assert!((s.steps[2].z - 1.0).abs() < 1e-12);
+        // 20 % uneven: still refused, naming the slices and how far off.
+        let err = stack(&z(&[0.0, 1.0, 2.2, 3.0]), &name).unwrap_err();
+        assert!(
+            err.contains("between slice1 and slice2")
+                && err.contains("0.2 mm (20 %) off the mean, beyond the tolerance of 0.05 mm (5 % of the mean gap)"),
+            "{err}"
+        );
 
         let tilted: Vec<Plane> = (0..3)
             .map(|k| {
@@ -349,6 +384,26 @@ mod tests {
     }
 
     #[test]
+    fn near_even_gaps_are_read_at_the_mean_gap_naming_the_largest_deviation() {
+        // Slice 2 written 0.03 mm off: gaps 1, 1.03, 0.97 mm, 3 % off.
+        let planes: Vec<Plane> = [0.0, 1.0, 2.03, 3.0]
+            .iter()
+            .map(|&z| plane(DVec3::new(0.0, 0.0, z), DVec3::X, DVec3::Y))
+            .collect();
+        let s = stack(&planes, &name).unwrap();
+        assert!((s.steps[2].z - 1.0).abs() < 1e-12);
+        assert_eq!(s.origin, DVec3::ZERO);
+        assert_eq!(s.notes.len(), 1);
+        let note = &s.notes[0];
+        assert!(
+            note.contains("slice gaps vary from 0.97 to 1.03 mm around their mean 1 mm")
+                && note.contains("0.03 mm (3 % of the mean) off it, within the tolerance of 0.05 mm (5 % of the mean gap)")
+                && note.contains("places slice2 0.03 mm (3 % of a gap) from its written position"),
+            "{note}"
+        );
+    }
+
+    #[test]
     fn rounded_positions_widen_the_gap_tolerance() {
         // 1.15 mm steps written with one decimal: gaps 1.1 and 1.2 mm.
         let zs = [10.0, 11.2, 12.3, 13.5, 14.6, 15.8];
@@ -360,20 +415,21 @@ mod tests {
                 })
                 .collect()
         };
+        // Gaps 1.1 and 1.2 mm: 0.06 mm (5.17 %) off their mean 1.16 mm.
         let s = stack(&rounded(Some(1)), &name).unwrap();
         assert!((s.steps[2].z - 1.16).abs() < 1e-12);
         assert!(
-            s.notes[0].contains("tolerance of 0.1116 mm"),
+            s.notes[0].contains("tolerance of 0.158 mm"),
             "{:?}",
             s.notes
         );
         // Written with more decimals, the same gaps are uneven.
         let err = stack(&rounded(Some(3)), &name).unwrap_err();
-        assert!(err.contains("beyond the tolerance of 0.0126 mm (1 % of the mean gap plus 0.001 mm for positions written to 3 decimal(s))"), "{err}");
+        assert!(err.contains("beyond the tolerance of 0.059 mm (5 % of the mean gap plus 0.001 mm for positions written to 3 decimal(s))"), "{err}");
         let err = stack(&rounded(None), &name).unwrap_err();
         assert!(
             err.contains(
-                "is 0.06 mm off the mean, beyond the tolerance of 0.0116 mm (1 % of the mean gap)"
+                "is 0.06 mm (5.17 %) off the mean, beyond the tolerance of 0.058 mm (5 % of the mean gap)"
             ),
             "{err}"
         );
@@ -381,7 +437,7 @@ mod tests {
         let (_, stated) = gap_tolerance(1.0, DVec3::new(0.6, 0.0, 0.8), Some(2));
         assert_eq!(
             stated,
-            "1 % of the mean gap plus 0.014 mm for positions written to 2 decimal(s)"
+            "5 % of the mean gap plus 0.014 mm for positions written to 2 decimal(s)"
         );
     }
 

@@ -28,6 +28,7 @@
 use volray_core::glam::DVec3;
 
 use super::header::Header;
+use crate::shared::units::{AxisUnit, one_length_unit};
 
 /// The grid the reader hands to `grid_to_volume` (or resamples, where the
 /// steps are not orthogonal).
@@ -215,13 +216,28 @@ pub(super) fn geometry(h: &Header, axes: [usize; 3]) -> Result<Geometry, String>
     }
     notes.insert(0, summary);
 
-    // World coordinates where the three axes are one kind of length or
-    // angle (converted to the first axis's unit), or share one unit.
+    // World coordinates where the three axes are lengths (converted to
+    // the finest of their units, as every reader does: shared/units.rs)
+    // or angles (converted to the first axis's unit), or share one unit.
     let dims = unit.iter().map(|u| dimension(u)).collect::<Vec<_>>();
     let spatial = !ctype.iter().any(|t| is_spectral_or_other(t));
+    let mut world_unit = unit[0].clone();
+    let mut unit_notes = Vec::new();
     let scale = match (dims[0], dims[1], dims[2]) {
-        (Dimension::Length(a), Dimension::Length(b), Dimension::Length(c))
-        | (Dimension::Angle(a), Dimension::Angle(b), Dimension::Angle(c)) => {
+        (Dimension::Length(_), Dimension::Length(_), Dimension::Length(_)) => {
+            let axis_names = axes.map(|a| format!("NAXIS{a}"));
+            let lengths: Vec<AxisUnit> = (0..3)
+                .map(|r| AxisUnit {
+                    name: &axis_names[r],
+                    unit: Some(&unit[r]),
+                })
+                .collect();
+            let one = one_length_unit(&lengths);
+            world_unit = one.length_unit.unwrap_or(world_unit);
+            unit_notes = one.notes;
+            Some([one.factors[0], one.factors[1], one.factors[2]])
+        }
+        (Dimension::Angle(a), Dimension::Angle(b), Dimension::Angle(c)) => {
             Some([1.0, b / a, c / a])
         }
         _ if unit[0] == unit[1] && unit[1] == unit[2] => Some([1.0; 3]),
@@ -267,18 +283,25 @@ pub(super) fn geometry(h: &Header, axes: [usize; 3]) -> Result<Geometry, String>
             notes,
         });
     };
-    if scale != [1.0; 3] {
+    if !unit_notes.is_empty() {
+        notes.extend(unit_notes);
+    } else if scale != [1.0; 3] {
         notes.push(format!(
             "world coordinates converted to the unit of NAXIS{} ({}): {} and {} in other units",
             axes[0], unit[0], unit[1], unit[2]
         ));
     }
-    let steps = [0, 1, 2].map(|c| DVec3::new(m[0][c], m[1][c] * scale[1], m[2][c] * scale[2]));
-    let origin = DVec3::new(first(0), first(1) * scale[1], first(2) * scale[2]);
+    let steps =
+        [0, 1, 2].map(|c| DVec3::new(m[0][c] * scale[0], m[1][c] * scale[1], m[2][c] * scale[2]));
+    let origin = DVec3::new(
+        first(0) * scale[0],
+        first(1) * scale[1],
+        first(2) * scale[2],
+    );
     Ok(Geometry {
         steps,
         origin,
-        unit: (!unit[0].is_empty()).then(|| unit[0].clone()),
+        unit: (!world_unit.is_empty()).then_some(world_unit),
         notes,
     })
 }
@@ -314,6 +337,22 @@ mod tests {
         assert!((g.steps[1].y - 1.0).abs() < 1e-12);
         // CRPIX 0 by default: sample 0 is pixel 1, one step past it.
         assert!((g.origin - DVec3::new(9.0, 1.0, 1.0)).length() < 1e-12);
+        assert!(
+            g.notes
+                .contains(&"NAXIS1/NAXIS3 in mm, NAXIS2 in cm: spacing in mm (NAXIS2 × 10)".into()),
+            "{:?}",
+            g.notes
+        );
+        // The finest unit, whichever axis holds it: km, m, km in m.
+        let h = header(&[
+            "CUNIT1  = 'km'",
+            "CUNIT2  = 'm'",
+            "CUNIT3  = 'km'",
+            "CDELT1  = 0.5",
+        ]);
+        let g = geometry(&h, [1, 2, 3]).unwrap();
+        assert_eq!(g.unit.as_deref(), Some("m"));
+        assert_eq!(g.steps[0], DVec3::new(500.0, 0.0, 0.0));
     }
 
     #[test]

@@ -11,6 +11,7 @@ use super::header::Header;
 use super::values::{quoted, vectors};
 use crate::error::IoError;
 use crate::shared::text_header::Field;
+use crate::shared::units::{AxisUnit, one_length_unit};
 
 /// Axis kinds that describe positions in space (`???` and `none` say
 /// nothing and count as spatial).
@@ -501,15 +502,36 @@ impl Geometry {
             });
         }
 
+        // Units per world axis (`space units`, the space directions'
+        // components) or per volume axis (`units`, with `spacings`), to the
+        // finest length unit among them (`shared/units.rs`).
         let unit = match header.get("space units") {
             Some(v) => {
                 let u = quoted(path, "space units", v, space_dim.unwrap_or(3))?;
-                common_unit(&u[..3.min(u.len())])
+                let one = one_unit(&u[..3.min(u.len())], &["x", "y", "z"], notes);
+                // Component c of every step and of the origin is along
+                // world axis c.
+                let f = DVec3::from_slice(&one.1);
+                for step in &mut steps {
+                    *step *= f;
+                }
+                origin *= f;
+                one.0
             }
             None => match header.get("units") {
                 Some(v) => {
                     let u = quoted(path, "units", v, dim)?;
-                    common_unit(&axes.map(|a| u[a].clone()))
+                    let names = axes.map(|a| format!("axis {a}"));
+                    let names = names.each_ref().map(String::as_str);
+                    let one = one_unit(&axes.map(|a| u[a].clone()), &names, notes);
+                    for i in 0..3 {
+                        steps[i] *= one.1[i];
+                        // Without space directions, origin i lies along axis i.
+                        if directions.is_none() {
+                            origin[i] *= one.1[i];
+                        }
+                    }
+                    one.0
                 }
                 None => None,
             },
@@ -542,11 +564,35 @@ impl Geometry {
     }
 }
 
-/// The unit all of `units` share, if they share one that says something.
-fn common_unit(units: &[String]) -> Option<String> {
-    let first = units.first()?.trim();
-    (!first.is_empty() && first != "???" && units.iter().all(|u| u.trim() == first))
-        .then(|| first.to_string())
+/// `units` (one per axis, named `names` in the notes) brought to one
+/// length unit: that unit, if every axis is in a length unit, and each
+/// axis's factor (1 for `???`, empty or non-length units). A unit shared
+/// by every axis that is no length volray knows is still the volume's.
+fn one_unit(
+    units: &[String],
+    names: &[&str],
+    notes: &mut Vec<String>,
+) -> (Option<String>, [f64; 3]) {
+    let axes: Vec<AxisUnit> = units
+        .iter()
+        .zip(names)
+        .map(|(u, &name)| AxisUnit {
+            name,
+            unit: Some(u.as_str()),
+        })
+        .collect();
+    let one = one_length_unit(&axes);
+    let first = units.first().map(|u| u.trim()).unwrap_or("");
+    let shared = (!first.is_empty() && first != "???" && units.iter().all(|u| u.trim() == first))
+        .then(|| first.to_string());
+    let mut factors = [1.0; 3];
+    for (f, g) in factors.iter_mut().zip(&one.factors) {
+        *f = *g;
+    }
+    if shared.is_none() {
+        notes.extend(one.notes);
+    }
+    (one.length_unit.or(shared), factors)
 }
 
 #[cfg(test)]
@@ -554,9 +600,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn common_units() {
-        assert_eq!(common_unit(&["mm".into(), "mm".into()]), Some("mm".into()));
-        assert_eq!(common_unit(&["mm".into(), "cm".into()]), None);
-        assert_eq!(common_unit(&["???".into()]), None);
+    fn units_meet_in_the_finest_length_unit() {
+        let units = |u: &[&str]| u.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let mut notes = Vec::new();
+        let one = one_unit(&units(&["mm", "mm", "mm"]), &["x", "y", "z"], &mut notes);
+        assert_eq!(one, (Some("mm".into()), [1.0; 3]));
+        let one = one_unit(&units(&["mm", "cm", "um"]), &["x", "y", "z"], &mut notes);
+        assert_eq!(one, (Some("um".into()), [1000.0, 10000.0, 1.0]));
+        assert_eq!(
+            notes,
+            ["x in mm, y in cm, z in um: spacing in um (x × 1000, y × 10000)"]
+        );
+        let one = one_unit(&units(&["???", "???", "???"]), &["x", "y", "z"], &mut notes);
+        assert_eq!(one, (None, [1.0; 3]));
     }
 }

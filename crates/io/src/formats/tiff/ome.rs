@@ -7,9 +7,11 @@
 //!   one (c, t), and the (c, t) pairs are frames numbered `t·SizeC + c`
 //!   (as ImageJ hyperstacks number them);
 //! - `PhysicalSizeX`, `Y`, `Z` with `PhysicalSize{X,Y,Z}Unit` (the schema's
-//!   default: µm) give the spacing, all converted to the unit of x (or, an
-//!   axis without a size, µm) when they differ; a size in `pixel` or
-//!   `reference frame` is no length, and leaves that axis at spacing 1.
+//!   default: µm) give the spacing, all converted to the finest of their
+//!   units when they differ (`shared/units.rs`, as every reader does); a
+//!   size in `pixel` or `reference frame` is no length, and leaves that
+//!   axis at spacing 1; another unit is refused (the schema's
+//!   `UnitsLength` holds lengths only).
 //!
 //! `<TiffData>` elements that map planes to pages other than one after
 //! another from page 0 (`FirstZ`/`FirstC`/`FirstT`, several blocks, other
@@ -26,6 +28,7 @@ use volray_core::glam::DVec3;
 use super::imagej::Shape;
 use crate::FileInfo;
 use crate::error::IoError;
+use crate::shared::units::{AxisUnit, metres, one_length_unit};
 
 /// What the OME-XML says of the first image.
 #[derive(Debug, Clone, PartialEq)]
@@ -183,39 +186,45 @@ impl Ome {
             ),
         ));
         let mut spacing = DVec3::ONE;
-        let lengths: Vec<(usize, f64, &str)> = self
+        // A size in pixels or reference frames is no length: that axis
+        // keeps spacing 1. The others go through `shared/units.rs`: every
+        // length to the finest of their units, others kept apart.
+        let given: Vec<(usize, f64, &str)> = self
             .sizes
             .iter()
             .enumerate()
             .filter_map(|(a, s)| s.as_ref().map(|(v, u)| (a, *v, u.as_str())))
             .filter(|(_, _, u)| !matches!(*u, "pixel" | "reference frame"))
             .collect();
-        let Some(&(_, _, first_unit)) = lengths.first() else {
+        if given.is_empty() {
             info.notes.push(format!(
                 "OME-XML gives no physical size in a length unit: spacing 1, 1, 1 (DimensionOrder {})",
                 self.dimension_order
             ));
             return Ok(spacing);
-        };
-        let same = lengths.iter().all(|(_, _, u)| *u == first_unit);
-        let unit = if same { first_unit } else { "µm" };
-        let to = metres(unit).ok_or_else(|| {
-            IoError::invalid(
+        }
+        // The schema's UnitsLength allows lengths only: another unit is a
+        // malformed file, not an axis to keep apart.
+        if let Some(&(a, _, u)) = given.iter().find(|(_, _, u)| metres(u).is_none()) {
+            return Err(IoError::invalid(
                 path,
-                format!("OME-XML: length unit \"{unit}\" is not known"),
-            )
-        })?;
-        for &(a, v, u) in &lengths {
-            let from = metres(u).ok_or_else(|| {
-                IoError::invalid(
-                    path,
-                    format!(
-                        "OME-XML: PhysicalSize{}Unit \"{u}\" is not a length unit volray knows",
-                        ["X", "Y", "Z"][a]
-                    ),
-                )
-            })?;
-            spacing[a] = convert(v, from, to);
+                format!(
+                    "OME-XML: PhysicalSize{}Unit \"{u}\" is not a length unit volray knows",
+                    ["X", "Y", "Z"][a]
+                ),
+            ));
+        }
+        let names = ["x", "y", "z"];
+        let axes: Vec<AxisUnit> = given
+            .iter()
+            .map(|&(a, _, u)| AxisUnit {
+                name: names[a],
+                unit: Some(u),
+            })
+            .collect();
+        let one = one_length_unit(&axes);
+        for (&(a, v, _), f) in given.iter().zip(&one.factors) {
+            spacing[a] = v * f;
         }
         let written: Vec<String> = self
             .sizes
@@ -224,19 +233,21 @@ impl Ome {
             .filter_map(|(s, a)| s.as_ref().map(|(v, u)| format!("PhysicalSize{a} {v} {u}")))
             .collect();
         info.notes.push(format!(
-            "spacing {}, {}, {} {unit} from OME-XML ({}{}); DimensionOrder {}",
+            "spacing {}, {}, {}{} from OME-XML ({}); DimensionOrder {}",
             spacing.x,
             spacing.y,
             spacing.z,
+            one.length_unit
+                .as_ref()
+                .map(|u| format!(" {u}"))
+                .unwrap_or_default(),
             written.join(", "),
-            if same {
-                String::new()
-            } else {
-                format!("; converted to {unit}")
-            },
             self.dimension_order
         ));
-        info.length_unit = Some(unit.to_string());
+        info.notes.extend(one.notes);
+        // Every axis in one length unit: the volume's (an axis in pixels
+        // leaves it without one, as the spacing then mixes units).
+        info.length_unit = one.length_unit.filter(|_| given.len() == 3);
         Ok(spacing)
     }
 }
@@ -251,40 +262,6 @@ fn plane_order(order: &str) -> Option<[u8; 3]> {
     let mut sorted = planes;
     sorted.sort_unstable();
     (sorted == *b"CTZ").then_some(planes)
-}
-
-/// Metres per one of an OME length unit (the schema's `UnitsLength`
-/// symbols), for the units of microscopy and a few more.
-fn metres(unit: &str) -> Option<f64> {
-    Some(match unit {
-        "km" => 1e3,
-        "m" => 1.0,
-        "dm" => 1e-1,
-        "cm" => 1e-2,
-        "mm" => 1e-3,
-        // The micro sign (U+00B5) as OME writes it, the Greek mu, and "um".
-        "µm" | "μm" | "um" => 1e-6,
-        "nm" => 1e-9,
-        "pm" => 1e-12,
-        // The letter Å (U+00C5), as OME writes it, and the angstrom sign.
-        "\u{c5}" | "\u{212b}" => 1e-10,
-        "in" => 0.0254,
-        _ => return None,
-    })
-}
-
-/// `v` in a unit of `from` metres, in units of `to` metres: by an exact
-/// power of ten where the ratio is one (500 nm is 0.5 µm exactly).
-fn convert(v: f64, from: f64, to: f64) -> f64 {
-    let (up, down) = (from / to, to / from);
-    let whole = |r: f64| r >= 1.0 && (r.round() - r).abs() <= 1e-9 * r;
-    if whole(down) {
-        v / down.round()
-    } else if whole(up) {
-        v * up.round()
-    } else {
-        v * up
-    }
 }
 
 /// An element's name without its namespace prefix.
@@ -341,10 +318,15 @@ mod tests {
         let ome = Ome::parse(Path::new("a"), xml).unwrap();
         let mut info = FileInfo::default();
         let s = ome.geometry(Path::new("a"), &mut info).unwrap();
+        // The finest unit, nm: 500 nm, 0.25 µm = 250 nm, 0.002 mm = 2000 nm.
+        assert_eq!(s, DVec3::new(500.0, 250.0, 2000.0));
+        assert_eq!(info.length_unit.as_deref(), Some("nm"));
         assert!(
-            (s - DVec3::new(0.5, 0.25, 2.0)).abs().max_element() < 1e-12,
-            "{s}"
+            info.notes.contains(
+                &"x in nm, y in µm, z in mm: spacing in nm (y × 1000, z × 1000000)".to_string()
+            ),
+            "{:?}",
+            info.notes
         );
-        assert_eq!(info.length_unit.as_deref(), Some("µm"));
     }
 }

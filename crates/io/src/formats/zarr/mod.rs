@@ -37,6 +37,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use zarrs::array::{ArrayMetadata, ArrayShardedExt};
 
+use crate::shared::units::{AxisUnit, one_length_unit};
 use crate::{AxisNames, FileInfo, IoError, LevelInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
 use chunks::{ZarrArray, ZarrType, open_array};
 use ome::{Axis, AxisKind, Level};
@@ -167,6 +168,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
             .push(format!("channel {channel} of {channels} read"));
     }
     file_info.length_unit = layout.unit.clone();
+    file_info.notes.extend(layout.unit_notes.iter().cloned());
     file_info.set_volumes(volumes, picked);
     let level = ZarrLevel::new(
         path,
@@ -226,8 +228,14 @@ fn bare_axes(path: &Path, n: usize) -> Result<Vec<Axis>, IoError> {
 struct Layout {
     time: Option<usize>,
     channel: Option<usize>,
-    /// The space axes' length unit, when they agree on one.
+    /// The space axes' length unit, when all are lengths: the finest of
+    /// theirs (`shared/units.rs`).
     unit: Option<String>,
+    /// What each space axis's scale and translation are multiplied by to
+    /// be in that unit, as x, y, z.
+    factors: [f64; 3],
+    /// What the conversion did, for the notes.
+    unit_notes: Vec<String>,
     /// How many axes there are: the last three are z, y, x.
     n: usize,
 }
@@ -259,18 +267,28 @@ impl Layout {
                 ),
             ));
         }
-        let units: Vec<&Option<String>> = axes[n - 3..].iter().map(|a| &a.unit).collect();
-        let unit = units
+        let space: Vec<AxisUnit> = axes[n - 3..]
             .iter()
-            .all(|u| *u == units[0])
-            .then(|| units[0].clone())
-            .flatten();
+            .map(|a| AxisUnit {
+                name: &a.name,
+                unit: a.unit.as_deref(),
+            })
+            .collect();
+        let one = one_length_unit(&space);
         Ok(Layout {
             time,
             channel,
-            unit,
+            unit: one.length_unit,
+            factors: [one.factors[2], one.factors[1], one.factors[0]],
+            unit_notes: one.notes,
             n,
         })
+    }
+
+    /// Per-axis values (x, y, z) of the space axes in their own units, in
+    /// the one length unit.
+    fn in_unit(&self, xyz: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|a| xyz[a] * self.factors[a])
     }
 
     /// The last three values of a per-axis list, as x, y, z.
@@ -303,8 +321,8 @@ fn level_info(
         path: level.path.clone(),
         shape,
         dims,
-        spacing: layout.xyz(&level.scale),
-        origin: layout.xyz(&level.translation),
+        spacing: layout.in_unit(layout.xyz(&level.scale)),
+        origin: layout.in_unit(layout.xyz(&level.translation)),
         chunk_shape: chunk,
         shard_shape: shard,
         codecs: codecs(&serde_json::to_value(array.metadata()).unwrap_or(Value::Null)),
