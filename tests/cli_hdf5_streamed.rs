@@ -120,6 +120,9 @@ fn one_frame_of_an_lzf_series_over_max_memory_renders_piece_by_piece_as_it_would
     assert!(diff <= 1, "{diff}");
     // Frame 2 is not frame 0.
     let other = dir.path().join("frame0.png");
-    render(&[&[input.as_str(), "--frame", "0"], &LOOK[..]].concat(), &other);
+    render(
+        &[&[input.as_str(), "--frame", "0"], &LOOK[..]].concat(),
+        &other,
+    );
     assert!(Picture::read(&other).max_diff(&picture) > 1);
 }

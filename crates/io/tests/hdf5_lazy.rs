@@ -252,13 +252,21 @@ fn lzf_fletcher32_and_unwritten_chunks_read_box_by_box_from_the_chunks() {
     let Some(dir) = files() else { return };
     let h5 = dir.join("filters.h5");
     for (name, chunk, how) in [
-        ("lzf_f32", [8, 7, 5], "[8, 7, 5] a box touches, from the chunk index (lzf decoded here)"),
+        (
+            "lzf_f32",
+            [8, 7, 5],
+            "[8, 7, 5] a box touches, from the chunk index (lzf decoded here)",
+        ),
         (
             "shuffle_lzf_i16",
             [16, 9, 11],
             "from the chunk index (shuffle, lzf decoded here)",
         ),
-        ("fletcher_u8", [9, 9, 11], "from the chunk index (fletcher32 decoded here)"),
+        (
+            "fletcher_u8",
+            [9, 9, 11],
+            "from the chunk index (fletcher32 decoded here)",
+        ),
         (
             "gzip_fletcher_f64",
             [8, 7, 5],
@@ -331,7 +339,12 @@ fn each_frame_of_an_lzf_series_reads_box_by_box_within_a_limit_one_frame_exceeds
     let Some(dir) = files() else { return };
     let spec = PathBuf::from(format!("{}:/s", dir.join("series_lzf.h5").display()));
     for t in 0..4 {
-        let notes = check_boxes(&spec, Some(t), &dir.join(format!("s_lzf_t{t}.npy")), [7, 8, 5]);
+        let notes = check_boxes(
+            &spec,
+            Some(t),
+            &dir.join(format!("s_lzf_t{t}.npy")),
+            [7, 8, 5],
+        );
         assert!(
             note_of(&notes).contains("the chunks of shape [1, 5, 8, 7] a box touches"),
             "{notes:?}"
@@ -347,7 +360,11 @@ fn each_frame_of_an_lzf_series_reads_box_by_box_within_a_limit_one_frame_exceeds
     let expected = read(&dir.join("s_lzf_t2.npy"), &ReadOptions::default())
         .unwrap()
         .volume;
-    for (lo, hi) in [([0, 0, 0], [10, 10, 10]), ([3, 4, 2], [20, 18, 7]), ([10, 8, 5], [20, 18, 12])] {
+    for (lo, hi) in [
+        ([0, 0, 0], [10, 10, 10]),
+        ([3, 4, 2], [20, 18, 7]),
+        ([10, 8, 5], [20, 18, 12]),
+    ] {
         let got = l.source.read_box(lo, hi).unwrap();
         assert!(
             got == VolumeSource::read_box(&expected, lo, hi).unwrap(),
@@ -361,7 +378,12 @@ fn a_decreasing_latitude_reads_box_by_box_flipped_as_the_whole_is() {
     let Some(dir) = files() else { return };
     let spec = PathBuf::from(format!("{}:/t", dir.join("latdown.nc").display()));
     for t in 0..2 {
-        let notes = check_boxes(&spec, Some(t), &dir.join(format!("t_latdown_t{t}.npy")), [8, 5, 2]);
+        let notes = check_boxes(
+            &spec,
+            Some(t),
+            &dir.join(format!("t_latdown_t{t}.npy")),
+            [8, 5, 2],
+        );
         assert!(
             note_of(&notes).contains("the chunks of shape [1, 2, 5, 8] a box touches"),
             "{notes:?}"

@@ -62,9 +62,9 @@ use super::hdf5_axes::{Placement, each_index};
 use crate::dtype::{Stored, read_as_stored};
 use crate::shared::hdf5::{self as h5, check_stored, slab_rows, slab_samples};
 use crate::shared::limits::{check_held, format_bytes};
+use crate::{FileInfo, IoError, ReadOptions};
 use chunks::{Chunks, Indexed, StoredChunk};
 use element::Element;
-use crate::{FileInfo, IoError, ReadOptions};
 
 /// Contiguous rows of z are read a y-span at a time when the span is at
 /// most this many bytes more than the box's own rows: one read in place of
@@ -338,16 +338,18 @@ impl H5Source {
         )?;
         // The file's range of the box: mirrored along a flipped axis.
         let n = self.grid.dims;
-        let file_lo: [usize; 3] = std::array::from_fn(|a| if self.flip[a] { n[a] - hi[a] } else { lo[a] });
-        let file_hi: [usize; 3] = std::array::from_fn(|a| if self.flip[a] { n[a] - lo[a] } else { hi[a] });
-        let samples = read_as_stored!(self.stored, |T| self
-            .samples::<T>(file_lo, file_hi)
-            .map(|mut v| {
+        let file_lo: [usize; 3] =
+            std::array::from_fn(|a| if self.flip[a] { n[a] - hi[a] } else { lo[a] });
+        let file_hi: [usize; 3] =
+            std::array::from_fn(|a| if self.flip[a] { n[a] - lo[a] } else { hi[a] });
+        let samples = read_as_stored!(self.stored, |T| self.samples::<T>(file_lo, file_hi).map(
+            |mut v| {
                 for a in (0..3).filter(|&a| self.flip[a]) {
                     flip_axis(&mut v, dims, a);
                 }
                 v
-            }))?;
+            }
+        ))?;
         let origin = self.grid.origin
             + volray_core::glam::DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64)
                 * self.grid.spacing;
@@ -624,7 +626,9 @@ mod tests {
         // dims (3, 2, 2): value x + 10y + 100z.
         let dims = [3, 2, 2];
         let at = |x: usize, y: usize, z: usize| x + 3 * (y + 2 * z);
-        let v: Vec<usize> = (0..12).map(|i| i % 3 + 10 * (i / 3 % 2) + 100 * (i / 6)).collect();
+        let v: Vec<usize> = (0..12)
+            .map(|i| i % 3 + 10 * (i / 3 % 2) + 100 * (i / 6))
+            .collect();
         for axis in 0..3 {
             let mut f = v.clone();
             flip_axis(&mut f, dims, axis);

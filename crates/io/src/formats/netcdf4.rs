@@ -247,7 +247,9 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
             None if l.scale && l.shape.len() == 1 => vec![l.name.clone()],
             None => {
                 unnamed.push(l.name.clone());
-                (0..l.shape.len()).map(|i| format!("{}#{i}", l.name)).collect()
+                (0..l.shape.len())
+                    .map(|i| format!("{}#{i}", l.name))
+                    .collect()
             }
         };
         vars.push(Variable {
@@ -579,9 +581,15 @@ mod tests {
             opened.push(OPENED.with(|c| c.get()));
             // v3 holds i + 3 at C-order index i of (z, y, x).
             assert_eq!(l.volume.dims(), [4, 3, 2]);
-            assert_eq!(f64::from(l.volume.get(1, 2, 1)), (12 + 2 * 4 + 1 + 3) as f64);
+            assert_eq!(
+                f64::from(l.volume.get(1, 2, 1)),
+                (12 + 2 * 4 + 1 + 3) as f64
+            );
             assert!(
-                l.info.notes.iter().any(|n| n.contains("dimensions (z, y, x)")),
+                l.info
+                    .notes
+                    .iter()
+                    .any(|n| n.contains("dimensions (z, y, x)")),
                 "{:?}",
                 l.info.notes
             );

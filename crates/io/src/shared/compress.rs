@@ -227,7 +227,9 @@ fn lzf_exact(
         )),
         Err(e) => Err(IoError::invalid(
             path,
-            format!("{what}: corrupt LZF stream: {e} (or one decoding past the {expected} bytes the header declares)"),
+            format!(
+                "{what}: corrupt LZF stream: {e} (or one decoding past the {expected} bytes the header declares)"
+            ),
         )),
     }
 }
@@ -382,11 +384,15 @@ mod tests {
         assert!(long.contains("decodes past the 8 bytes"), "{long}");
         // 6 bytes decode to at most 6 · 88 = 528.
         let lying = lzf(529).unwrap_err().to_string();
-        assert!(lying.contains("more than 6 LZF bytes can decode to"), "{lying}");
+        assert!(
+            lying.contains("more than 6 LZF bytes can decode to"),
+            "{lying}"
+        );
         // A reference to before the first byte.
         let err = inflate_exact(p, &[4 << 5, 2], Compression::Lzf, 6, "chunk").unwrap_err();
         assert!(
-            err.to_string().starts_with("v.h5: chunk: corrupt LZF stream"),
+            err.to_string()
+                .starts_with("v.h5: chunk: corrupt LZF stream"),
             "{err}"
         );
     }

@@ -267,8 +267,7 @@ impl Chunks {
                 format!("HDF5 dataset \"{dataset}\": the chunk at offset {offset:?} {reason}"),
             )
         };
-        let applied =
-            |i: usize| i >= 32 || chunk.mask & (1 << i) == 0;
+        let applied = |i: usize| i >= 32 || chunk.mask & (1 << i) == 0;
         let mut data = stored;
         for (i, f) in self.filters.iter().enumerate().rev() {
             if !applied(i) {
