@@ -5,11 +5,14 @@
 //! and the whole with the array numpy saved beside it. Boxes: the whole,
 //! one chunk, boxes across chunk boundaries, edge chunks, two-sample
 //! slivers at every corner, and pseudo-random boxes; every sample type,
-//! both byte orders, deflate and shuffle, every chunk index hdf5-pure
-//! enumerates, contiguous data, and what goes through hdf5-pure's row
-//! windows (a B-tree v2 index, fletcher32, lzf, chunks never written).
-//! Then hostile files: a chunk stored past the end of the file, a shape of
-//! 2^40 samples, a chunk inflating past its size: one-line errors.
+//! both byte orders, deflate, shuffle, LZF and Fletcher-32 (checked: a
+//! damaged chunk refused by name), every chunk index hdf5-pure
+//! enumerates, contiguous data, chunks and data never written (the fill
+//! value), a (t, z, y, x) series box by box within a memory limit one
+//! frame would exceed, a NetCDF-4 variable along a decreasing latitude,
+//! and szip refused by name. Then hostile files: a chunk stored past the
+//! end of the file, a shape of 2^40 samples, a chunk inflating past its
+//! size: one-line errors.
 //!
 //! The writers run in `target/pyenv` (h5py, netCDF4, h5netcdf and numpy
 //! from PyPI, which `.ci/run` installs); without them these tests fail
@@ -213,17 +216,11 @@ fn other_chunk_indexes_and_filters_read_box_by_box_too() {
             "from the chunk index (shuffle, deflate decoded here)",
         ),
         ("extensible", "from the chunk index (deflate decoded here)"),
-        (
-            "fletcher",
-            "row windows, the rows of the first axis a box covers: its chunks are filtered by fletcher32",
-        ),
-        (
-            "lzf",
-            "row windows, the rows of the first axis a box covers: its chunks are filtered by lzf",
-        ),
+        ("fletcher", "from the chunk index (fletcher32 decoded here)"),
+        ("lzf", "from the chunk index (lzf decoded here)"),
         (
             "sparse",
-            "row windows, the rows of the first axis a box covers: 20 of its 125 chunks are written, the rest hold the fill value",
+            "from the chunk index; 105 of its 125 chunks are not written and read as the fill value -7",
         ),
     ] {
         let spec = PathBuf::from(format!("{}:/{name}", h5.display()));
@@ -248,6 +245,177 @@ fn other_chunk_indexes_and_filters_read_box_by_box_too() {
         "{err}"
     );
     assert_eq!(err.lines().count(), 1);
+}
+
+#[test]
+fn lzf_fletcher32_and_unwritten_chunks_read_box_by_box_from_the_chunks() {
+    let Some(dir) = files() else { return };
+    let h5 = dir.join("filters.h5");
+    for (name, chunk, how) in [
+        (
+            "lzf_f32",
+            [8, 7, 5],
+            "[8, 7, 5] a box touches, from the chunk index (lzf decoded here)",
+        ),
+        (
+            "shuffle_lzf_i16",
+            [16, 9, 11],
+            "from the chunk index (shuffle, lzf decoded here)",
+        ),
+        (
+            "fletcher_u8",
+            [9, 9, 11],
+            "from the chunk index (fletcher32 decoded here)",
+        ),
+        (
+            "gzip_fletcher_f64",
+            [8, 7, 5],
+            "from the chunk index (shuffle, deflate, fletcher32 decoded here)",
+        ),
+        (
+            "lzf_fletcher_u16",
+            [8, 7, 5],
+            "from the chunk index (lzf, fletcher32 decoded here)",
+        ),
+        (
+            "sparse_lzf_f32",
+            [8, 7, 5],
+            "(lzf decoded here); 109 of its 125 chunks are not written and read as the fill value -2.5",
+        ),
+        (
+            "unwritten_chunked_u8",
+            [8, 7, 5],
+            "; 125 of its 125 chunks are not written and read as the fill value 0",
+        ),
+        (
+            "unwritten_i16",
+            [8, 8, 8],
+            "read box by box: no data is written, every sample is the fill value -300",
+        ),
+    ] {
+        let spec = PathBuf::from(format!("{}:/{name}", h5.display()));
+        let notes = check_boxes(&spec, None, &dir.join(format!("{name}.npy")), chunk);
+        assert!(note_of(&notes).contains(how), "{name}: {notes:?}");
+    }
+}
+
+#[test]
+fn a_chunk_failing_its_fletcher32_checksum_is_refused_naming_file_dataset_and_chunk() {
+    let Some(dir) = files() else { return };
+    // 32³ u16 in 16³ chunks; one byte of the chunk at (16, 0, 16) changed.
+    let file = dir.join("fletcher_bad.h5");
+    let spec = PathBuf::from(format!("{}:/v", file.display()));
+    let o = opts(None, 1 << 30);
+    let eager = read(&spec, &o).unwrap_err().to_string();
+    assert_eq!(eager.lines().count(), 1, "{eager}");
+    let l = lazy(&spec, &o);
+    let expected = read(&dir.join("v_fletcher.npy"), &ReadOptions::default())
+        .unwrap()
+        .volume;
+    // The boxes clear of the damaged chunk read; its seven neighbours too.
+    for (lo, hi) in [
+        ([0, 0, 0], [16, 32, 32]),
+        ([16, 16, 0], [32, 32, 32]),
+        ([16, 0, 0], [32, 16, 16]),
+    ] {
+        let got = l.source.read_box(lo, hi).unwrap();
+        assert!(
+            got == VolumeSource::read_box(&expected, lo, hi).unwrap(),
+            "{lo:?}..{hi:?}"
+        );
+    }
+    let err = l.source.read_box([15, 0, 15], [17, 2, 17]).unwrap_err();
+    assert!(
+        err.starts_with(&file.display().to_string())
+            && err.contains("HDF5 dataset \"/v\": the chunk at offset [16, 0, 16] fails its Fletcher-32 checksum (stored 0x")
+            && err.ends_with("): the file is damaged"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
+
+#[test]
+fn each_frame_of_an_lzf_series_reads_box_by_box_within_a_limit_one_frame_exceeds() {
+    let Some(dir) = files() else { return };
+    let spec = PathBuf::from(format!("{}:/s", dir.join("series_lzf.h5").display()));
+    for t in 0..4 {
+        let notes = check_boxes(
+            &spec,
+            Some(t),
+            &dir.join(format!("s_lzf_t{t}.npy")),
+            [7, 8, 5],
+        );
+        assert!(
+            note_of(&notes).contains("the chunks of shape [1, 5, 8, 7] a box touches"),
+            "{notes:?}"
+        );
+    }
+    // One frame is 20·18·12 samples: 17 kB as f32, 69 kB as the f64 and
+    // stored samples hdf5-pure's row windows would hold. 12 KiB holds a
+    // box and an LZF chunk (1.1 kB) stored and decoded, not a frame.
+    let o = opts(Some(2), 12 << 10);
+    let err = read(&spec, &o).unwrap_err();
+    assert!(matches!(err, IoError::OverMemoryLimit { .. }), "{err}");
+    let l = lazy(&spec, &o);
+    let expected = read(&dir.join("s_lzf_t2.npy"), &ReadOptions::default())
+        .unwrap()
+        .volume;
+    for (lo, hi) in [
+        ([0, 0, 0], [10, 10, 10]),
+        ([3, 4, 2], [20, 18, 7]),
+        ([10, 8, 5], [20, 18, 12]),
+    ] {
+        let got = l.source.read_box(lo, hi).unwrap();
+        assert!(
+            got == VolumeSource::read_box(&expected, lo, hi).unwrap(),
+            "{lo:?}..{hi:?}"
+        );
+    }
+}
+
+#[test]
+fn a_decreasing_latitude_reads_box_by_box_flipped_as_the_whole_is() {
+    let Some(dir) = files() else { return };
+    let spec = PathBuf::from(format!("{}:/t", dir.join("latdown.nc").display()));
+    for t in 0..2 {
+        let notes = check_boxes(
+            &spec,
+            Some(t),
+            &dir.join(format!("t_latdown_t{t}.npy")),
+            [8, 5, 2],
+        );
+        assert!(
+            note_of(&notes).contains("the chunks of shape [1, 2, 5, 8] a box touches"),
+            "{notes:?}"
+        );
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains("mirrored range along y (its coordinate decreases)")),
+            "{notes:?}"
+        );
+    }
+}
+
+#[test]
+fn szip_is_refused_by_name_whole_and_box_by_box() {
+    let Some(dir) = files() else { return };
+    let file = dir.join("szip.h5");
+    let spec = PathBuf::from(format!("{}:/v", file.display()));
+    let o = opts(None, 1 << 30);
+    let eager = read(&spec, &o).unwrap_err().to_string();
+    let Err(lazy) = open_lazy(&spec, &o) else {
+        panic!("szip opened box by box")
+    };
+    for err in [eager, lazy.to_string()] {
+        assert!(
+            err.starts_with(&file.display().to_string())
+                && err.contains("HDF5 dataset \"/v\": its chunks are szip-compressed (filter 4)")
+                && err.contains("h5repack -f NONE"),
+            "{err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
 }
 
 #[test]

@@ -202,6 +202,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let what = |reason: String| fail(format!("HDF5 dataset \"{name}\": {reason}"));
 
     let sample = numeric_type(&dataset).map_err(what)?;
+    h5::check_filters(&dataset).map_err(what)?;
     let shape = h5::shape(&dataset).map_err(what)?;
     let attrs = sorted_attrs(dataset.attrs());
     let order = if (2..=5).contains(&shape.len()) {

@@ -8,31 +8,36 @@
 //! How a box is read depends on the dataset's storage:
 //! - **chunked**, its chunks enumerated from the chunk index (B-tree v1,
 //!   fixed array, extensible array, implicit, single chunk, not a B-tree
-//!   v2, which `hdf5-pure` 0.47 cannot read at all: `hdf5-pure`'s
-//!   `Dataset::chunks`, which reads the index and no data), unfiltered or
-//!   filtered by deflate and shuffle: each chunk the box touches is read
-//!   from its file address, inflated (to exactly its decoded size, no
-//!   more), unshuffled, and its part of the box copied out. Scratch: one
-//!   chunk, stored and decoded.
+//!   v2, which `hdf5-pure` 0.47 cannot read at all), unfiltered or
+//!   filtered by deflate, shuffle, Fletcher-32 (checked) and LZF
+//!   (`hdf5_lazy/chunks.rs`): each chunk the box touches is read from its
+//!   file address, decoded (to exactly its decoded size, no more), and its
+//!   part of the box copied out; a chunk never written (missing from the
+//!   index) gives the dataset's fill value. Along a time or channel axis a
+//!   box touches the chunks of its own frame only. Scratch: one chunk,
+//!   stored and decoded.
 //! - **contiguous**: each row of the dataset's last axis (z, without axis
 //!   names) the box covers is read from the file at its offset (a row of
 //!   the box's rows along the axis before it at once where that is not
 //!   much more than the box needs).
-//! - anything else (compact data, no data written, chunks missing from the
-//!   index so that the fill value stands in for them, other filters: fletcher32,
-//!   szip, lzf, scale-offset, n-bit; non-IEEE or bit-packed types):
-//!   through `hdf5-pure`'s row windows (`read_f64_rows`), which decode only
-//!   the chunks the rows of the box's range along the dataset's first axis
+//! - **no data written**: every sample is the fill value.
+//! - anything else (compact data, other filters: scale-offset, n-bit;
+//!   non-IEEE or bit-packed types): through `hdf5-pure`'s row windows
+//!   (`read_f64_rows`, the dataset opened once), which decode only the
+//!   chunks the rows of the box's range along the dataset's first axis
 //!   touch: those rows, whole along the other axes, a window of at most
 //!   about a million samples at a time (where the first axis is time or
 //!   channel, the frame's one row, read whole).
 //!
 //! Values are those of the eager reader exactly: the sample as a `f64`
-//! (as `hdf5-pure` decodes it), rounded to `f32`, kept in the volume's
-//! type; each sample placed as the dataset's axis order says
-//! (`hdf5_axes.rs`: named axes, or a[x, y, z] and a[t, x, y, z]), x
-//! fastest. A box of the volume is a box of the dataset over its x, y and
-//! z axes, one index wide along time and channel.
+//! (as `hdf5-pure` decodes it, `hdf5_lazy/element.rs`), rounded to `f32`,
+//! kept in the volume's type; each sample placed as the dataset's axis
+//! order says (`hdf5_axes.rs`: named axes, or a[x, y, z] and a[t, x, y,
+//! z]), x fastest. A box of the volume is a box of the dataset over its x,
+//! y and z axes, one index wide along time and channel. An axis whose
+//! coordinate decreases (a NetCDF-4 latitude from north to south) runs
+//! backwards in the file: the box is read from the mirrored range and
+//! flipped, as the eager reader flips the whole volume.
 //!
 //! Before anything is read, the shape is checked against the file's
 //! length (no more than deflate's 1032:1 of it), each chunk's address and
@@ -40,157 +45,31 @@
 //! `--max-memory`; before a box is read, the box and the scratch it takes
 //! against `--max-memory`.
 
-use std::collections::HashMap;
+mod chunks;
+mod element;
+
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use hdf5_pure::{ChunkIndex, Datatype, DatatypeByteOrder, FloatingPointLayout, Layout};
+use hdf5_pure::Layout;
 use volray_core::sampling::grid::GridFrame;
 use volray_core::{SampleType, Volume, VolumeSource, check_box};
 
 use super::hdf5::{Found, Opened};
 use super::hdf5_axes::{Placement, each_index};
 use crate::dtype::{Stored, read_as_stored};
-use crate::shared::compress::{Compression, inflate_exact};
 use crate::shared::hdf5::{self as h5, check_stored, slab_rows, slab_samples};
 use crate::shared::limits::{check_held, format_bytes};
 use crate::{FileInfo, IoError, ReadOptions};
-
-/// HDF5's registered filter numbers read here.
-const FILTER_DEFLATE: u16 = 1;
-const FILTER_SHUFFLE: u16 = 2;
+use chunks::{Chunks, Indexed, StoredChunk};
+use element::Element;
 
 /// Contiguous rows of z are read a y-span at a time when the span is at
 /// most this many bytes more than the box's own rows: one read in place of
 /// `ny` for a box that spans most of y and z.
 const SPAN_SLACK: usize = 1 << 20;
-
-/// A fixed-point or IEEE float sample of a standard layout: its size,
-/// byte order, and how its bytes become a `f64`.
-#[derive(Clone, Copy)]
-struct Element {
-    size: usize,
-    value: fn(&[u8]) -> f64,
-}
-
-macro_rules! decoder {
-    ($name:ident, $t:ty, $n:expr, $from:ident) => {
-        fn $name(b: &[u8]) -> f64 {
-            let mut a = [0u8; $n];
-            a.copy_from_slice(&b[..$n]);
-            <$t>::$from(a) as f64
-        }
-    };
-}
-decoder!(u16_le, u16, 2, from_le_bytes);
-decoder!(u16_be, u16, 2, from_be_bytes);
-decoder!(i16_le, i16, 2, from_le_bytes);
-decoder!(i16_be, i16, 2, from_be_bytes);
-decoder!(u32_le, u32, 4, from_le_bytes);
-decoder!(u32_be, u32, 4, from_be_bytes);
-decoder!(i32_le, i32, 4, from_le_bytes);
-decoder!(i32_be, i32, 4, from_be_bytes);
-decoder!(u64_le, u64, 8, from_le_bytes);
-decoder!(u64_be, u64, 8, from_be_bytes);
-decoder!(i64_le, i64, 8, from_le_bytes);
-decoder!(i64_be, i64, 8, from_be_bytes);
-decoder!(f32_le, f32, 4, from_le_bytes);
-decoder!(f32_be, f32, 4, from_be_bytes);
-decoder!(f64_le, f64, 8, from_le_bytes);
-decoder!(f64_be, f64, 8, from_be_bytes);
-
-fn u8_value(b: &[u8]) -> f64 {
-    f64::from(b[0])
-}
-
-fn i8_value(b: &[u8]) -> f64 {
-    f64::from(b[0] as i8)
-}
-
-impl Element {
-    /// The element of `dt`, if it is a whole-byte integer or an IEEE
-    /// binary32/binary64 float in little- or big-endian order.
-    fn of(dt: &Datatype) -> Option<Element> {
-        let big = |order: &DatatypeByteOrder| match order {
-            DatatypeByteOrder::LittleEndian => Some(false),
-            DatatypeByteOrder::BigEndian => Some(true),
-            _ => None,
-        };
-        let value: fn(&[u8]) -> f64 = match dt {
-            Datatype::FixedPoint {
-                size,
-                byte_order,
-                layout,
-            } if layout.bit_offset == 0 && u32::from(layout.bit_precision) == size * 8 => {
-                match (*size, layout.signed, big(byte_order)?) {
-                    (1, false, _) => u8_value,
-                    (1, true, _) => i8_value,
-                    (2, false, false) => u16_le,
-                    (2, false, true) => u16_be,
-                    (2, true, false) => i16_le,
-                    (2, true, true) => i16_be,
-                    (4, false, false) => u32_le,
-                    (4, false, true) => u32_be,
-                    (4, true, false) => i32_le,
-                    (4, true, true) => i32_be,
-                    (8, false, false) => u64_le,
-                    (8, false, true) => u64_be,
-                    (8, true, false) => i64_le,
-                    (8, true, true) => i64_be,
-                    _ => return None,
-                }
-            }
-            Datatype::FloatingPoint {
-                size,
-                byte_order,
-                layout,
-            } => match (*size, big(byte_order)?) {
-                (4, false) if *layout == FloatingPointLayout::IEEE754_BINARY32 => f32_le,
-                (4, true) if *layout == FloatingPointLayout::IEEE754_BINARY32 => f32_be,
-                (8, false) if *layout == FloatingPointLayout::IEEE754_BINARY64 => f64_le,
-                (8, true) if *layout == FloatingPointLayout::IEEE754_BINARY64 => f64_be,
-                _ => return None,
-            },
-            _ => return None,
-        };
-        let size = match dt {
-            Datatype::FixedPoint { size, .. } | Datatype::FloatingPoint { size, .. } => {
-                *size as usize
-            }
-            _ => return None,
-        };
-        Some(Element { size, value })
-    }
-}
-
-/// One filter of a chunk pipeline this module decodes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Filter {
-    Deflate,
-    /// Bytes of each element regrouped by significance (HDF5's shuffle),
-    /// elements of this many bytes.
-    Shuffle(usize),
-}
-
-/// One chunk as the index gives it.
-#[derive(Debug, Clone, Copy)]
-struct StoredChunk {
-    address: u64,
-    size: u64,
-    /// Bit `i` set: filter `i` of the pipeline was not applied.
-    mask: u32,
-}
-
-/// The chunks of a chunked dataset, by their position on the chunk grid.
-struct Chunks {
-    shape: Vec<usize>,
-    /// Bytes of one decoded chunk.
-    bytes: usize,
-    filters: Vec<Filter>,
-    index: HashMap<Vec<usize>, StoredChunk>,
-}
 
 /// Where a box's samples come from.
 enum Storage {
@@ -198,6 +77,8 @@ enum Storage {
         address: u64,
     },
     Chunks(Box<Chunks>),
+    /// No data written: every sample is this (the fill value).
+    Fill(f64),
     /// Through `hdf5-pure`'s row windows, for the reason given.
     Rows {
         reason: String,
@@ -222,7 +103,11 @@ pub(crate) struct H5Source {
     /// What each stored value becomes, where it is not itself.
     real: Option<RealValue>,
     grid: GridFrame,
+    /// The volume's axes (x, y, z) that run backwards in the file.
+    flip: [bool; 3],
     storage: Storage,
+    /// The file as `hdf5-pure` opened it for the row windows, once.
+    rows: Mutex<Option<Arc<h5::H5File>>>,
     max_memory: u64,
 }
 
@@ -240,7 +125,7 @@ pub(crate) fn open(
     if o.dims.iter().any(|&n| n < 2) {
         return Ok(None);
     }
-    from_opened(o, None, opts).map(Some)
+    from_opened(o, None, [false; 3], opts).map(Some)
 }
 
 /// Maps a stored sample to the value kept (CF's `scale_factor`,
@@ -249,10 +134,13 @@ pub(crate) type RealValue = Arc<dyn Fn(f64) -> f64 + Send + Sync>;
 
 /// The source of boxes of a dataset opened and placed (`hdf5.rs`'s
 /// [`Opened`], or a NetCDF-4 variable's, `netcdf4.rs`), each stored value
-/// through `real` where given (the volume then kept as `f32`).
+/// through `real` where given (the volume then kept as `f32`), the
+/// volume's axes `flip` says run backwards in the file (the grid's origin
+/// `o.origin` that of the volume flipped, as the eager reader places it).
 pub(crate) fn from_opened(
     o: Opened,
     real: Option<RealValue>,
+    flip: [bool; 3],
     opts: &ReadOptions,
 ) -> Result<(H5Source, FileInfo), IoError> {
     let Opened {
@@ -320,7 +208,7 @@ pub(crate) fn from_opened(
             }
             Storage::Contiguous { address }
         }
-        (Some(_), Layout::Chunked { chunk_shape, index }) => chunked(
+        (Some(_), Layout::Chunked { chunk_shape, index }) => match chunks::index(
             &dataset,
             &shape,
             chunk_shape,
@@ -329,10 +217,17 @@ pub(crate) fn from_opened(
             h5.len,
             opts.max_memory,
         )
-        .map_err(fail)?,
-        (Some(_), Layout::Contiguous { address: None, .. }) => Storage::Rows {
-            reason: "no data is written (every sample is the fill value)".into(),
+        .map_err(fail)?
+        {
+            Indexed::Chunks(c) => Storage::Chunks(c),
+            Indexed::Rows(reason) => Storage::Rows { reason },
         },
+        (Some(_), Layout::Contiguous { address: None, .. }) => Storage::Fill(
+            dataset
+                .fill_value::<f64>()
+                .map_err(|e| fail(format!("unreadable fill value: {e}")))?
+                .unwrap_or(0.0),
+        ),
         (Some(_), Layout::Compact { .. }) => Storage::Rows {
             reason: "its data is compact (held in its header)".into(),
         },
@@ -345,27 +240,24 @@ pub(crate) fn from_opened(
             "read box by box: each row of the last axis a box covers, from its place in the contiguous data"
                 .to_string()
         }
-        Storage::Chunks(c) => format!(
-            "read box by box: the chunks of shape {:?} a box touches, from the chunk index{}",
-            c.shape,
-            if c.filters.is_empty() {
-                String::new()
-            } else {
-                let names: Vec<&str> = c
-                    .filters
-                    .iter()
-                    .map(|f| match f {
-                        Filter::Deflate => "deflate",
-                        Filter::Shuffle(_) => "shuffle",
-                    })
-                    .collect();
-                format!(" ({} decoded here)", names.join(", "))
-            },
+        Storage::Chunks(c) => c.describe(),
+        Storage::Fill(v) => format!(
+            "read box by box: no data is written, every sample is the fill value {v}"
         ),
         Storage::Rows { reason } => format!(
             "read box by box through hdf5-pure's row windows, the rows of the first axis a box covers: {reason}"
         ),
     });
+    let flipped: Vec<&str> = (0..3)
+        .filter(|&a| flip[a])
+        .map(|a| ["x", "y", "z"][a])
+        .collect();
+    if !flipped.is_empty() {
+        info.notes.push(format!(
+            "each box read from the file's mirrored range along {} (its coordinate decreases) and flipped, as the whole volume is",
+            flipped.join(", ")
+        ));
+    }
     let file = File::open(&file_path).map_err(|e| IoError::os(&file_path, "open", e))?;
     let stored = if real.is_some() {
         SampleType::F32
@@ -389,146 +281,13 @@ pub(crate) fn from_opened(
                 origin,
                 spacing,
             },
+            flip,
             storage,
+            rows: Mutex::new(None),
             max_memory: opts.max_memory,
         },
         info,
     ))
-}
-
-/// The chunks of a chunked dataset (see the module docs), or the row
-/// windows where this module cannot decode them.
-fn chunked(
-    dataset: &hdf5_pure::Dataset,
-    shape: &[usize],
-    chunk_shape: Vec<u64>,
-    index: ChunkIndex,
-    sample_size: usize,
-    file_len: u64,
-    max_memory: u64,
-) -> Result<Storage, String> {
-    if chunk_shape.len() != shape.len() || chunk_shape.contains(&0) {
-        return Err(format!(
-            "chunk shape {chunk_shape:?} does not fit shape {shape:?}"
-        ));
-    }
-    // A decoded chunk and its stored bytes are held at once; `hdf5-pure`
-    // decodes whole chunks in the row windows too.
-    let bytes = chunk_shape
-        .iter()
-        .try_fold(sample_size as u128, |a, &n| a.checked_mul(u128::from(n)))
-        .unwrap_or(u128::MAX);
-    if bytes.saturating_mul(2) > u128::from(max_memory) {
-        return Err(format!(
-            "one chunk of shape {chunk_shape:?} takes {}, which with its stored bytes exceeds the memory limit of {}",
-            format_bytes(bytes),
-            format_bytes(u128::from(max_memory))
-        ));
-    }
-    let bytes = bytes as usize;
-    let chunk: Vec<usize> = chunk_shape.iter().map(|&n| n as usize).collect();
-    let mut filters = Vec::new();
-    for f in dataset.filter_pipeline() {
-        filters.push(match f.id {
-            FILTER_DEFLATE => Filter::Deflate,
-            FILTER_SHUFFLE => Filter::Shuffle(
-                f.client_data
-                    .first()
-                    .map(|&n| n as usize)
-                    .filter(|&n| n > 0)
-                    .unwrap_or(sample_size),
-            ),
-            _ => {
-                return Ok(Storage::Rows {
-                    reason: format!("its chunks are filtered by {f}, which hdf5-pure decodes"),
-                });
-            }
-        });
-    }
-    if index == ChunkIndex::BTreeV2 {
-        // Nor does it read one whole or by rows: the eager reader refuses
-        // it too ("a version 2 B-tree chunk index cannot be enumerated").
-        return Err(
-            "its chunks are indexed by a version 2 B-tree (several unlimited dimensions), which hdf5-pure 0.47 cannot read: rewrite it with fixed dimensions (h5repack -l CHUNK=...)"
-                .into(),
-        );
-    }
-    let listed = dataset
-        .chunks()
-        .map_err(|e| format!("unreadable chunk index: {e}"))?;
-    let grid: Vec<usize> = shape
-        .iter()
-        .zip(&chunk)
-        .map(|(&n, &c)| n.div_ceil(c))
-        .collect();
-    let expected = grid
-        .iter()
-        .try_fold(1usize, |a, &n| a.checked_mul(n))
-        .unwrap_or(usize::MAX);
-    let mut index = HashMap::with_capacity(listed.len().min(expected));
-    for c in listed {
-        let on_grid = c.offset.len() == shape.len()
-            && c.offset
-                .iter()
-                .zip(&chunk)
-                .zip(shape)
-                .all(|((&o, &k), &n)| o % k as u64 == 0 && o < n as u64);
-        if !on_grid {
-            return Err(format!(
-                "the chunk index lists a chunk at offset {:?}, not on the {chunk:?} chunk grid of shape {shape:?}",
-                c.offset
-            ));
-        }
-        let end = c.address.checked_add(c.storage_size);
-        if end.is_none_or(|e| e > file_len) || c.storage_size == 0 {
-            return Err(format!(
-                "the chunk at offset {:?} is stored at byte {} ({} bytes), past the end of the {file_len}-byte file",
-                c.offset, c.address, c.storage_size
-            ));
-        }
-        // Deflate can grow incompressible data by a few bytes per 16 KiB
-        // block; twice the chunk is far beyond that.
-        if c.storage_size > 2 * bytes as u64 + 4096 {
-            return Err(format!(
-                "the chunk at offset {:?} is stored in {} bytes, more than a chunk of {bytes} bytes can take",
-                c.offset, c.storage_size
-            ));
-        }
-        let at: Vec<usize> = c
-            .offset
-            .iter()
-            .zip(&chunk)
-            .map(|(&o, &k)| o as usize / k)
-            .collect();
-        let old = index.insert(
-            at,
-            StoredChunk {
-                address: c.address,
-                size: c.storage_size,
-                mask: c.filter_mask,
-            },
-        );
-        if old.is_some() {
-            return Err(format!(
-                "the chunk index lists the chunk at offset {:?} twice",
-                c.offset
-            ));
-        }
-    }
-    if index.len() < expected {
-        return Ok(Storage::Rows {
-            reason: format!(
-                "{} of its {expected} chunks are written, the rest hold the fill value",
-                index.len()
-            ),
-        });
-    }
-    Ok(Storage::Chunks(Box::new(Chunks {
-        shape: chunk,
-        bytes,
-        filters,
-        index,
-    })))
 }
 
 impl H5Source {
@@ -546,7 +305,8 @@ impl H5Source {
             Storage::Contiguous { .. } => {
                 (self.shape[n - 2] * self.shape[n - 1] * self.sample_size) as u128
             }
-            Storage::Chunks(c) => 2 * c.bytes as u128 + 4096,
+            Storage::Chunks(c) => c.largest as u128 + 2 * c.bytes as u128,
+            Storage::Fill(_) => 0,
             Storage::Rows { .. } => {
                 let row = self.shape[1..].iter().product::<usize>() as u128;
                 let rows = if self.placement.first_fixed().is_some() {
@@ -576,7 +336,20 @@ impl H5Source {
             ),
             self.max_memory,
         )?;
-        let samples = read_as_stored!(self.stored, |T| self.samples::<T>(lo, hi))?;
+        // The file's range of the box: mirrored along a flipped axis.
+        let n = self.grid.dims;
+        let file_lo: [usize; 3] =
+            std::array::from_fn(|a| if self.flip[a] { n[a] - hi[a] } else { lo[a] });
+        let file_hi: [usize; 3] =
+            std::array::from_fn(|a| if self.flip[a] { n[a] - lo[a] } else { hi[a] });
+        let samples = read_as_stored!(self.stored, |T| self.samples::<T>(file_lo, file_hi).map(
+            |mut v| {
+                for a in (0..3).filter(|&a| self.flip[a]) {
+                    flip_axis(&mut v, dims, a);
+                }
+                v
+            }
+        ))?;
         let origin = self.grid.origin
             + volray_core::glam::DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64)
                 * self.grid.spacing;
@@ -607,6 +380,7 @@ impl H5Source {
                 self.contiguous(*address, e, &w, &mut put)?
             }
             (Storage::Chunks(c), Some(e)) => self.chunks(c, e, &w, &mut put)?,
+            (Storage::Fill(v), _) => fill(&w, *v, &mut put),
             _ => self.rows(&w, &mut put)?,
         }
         Ok(out)
@@ -690,17 +464,21 @@ impl H5Source {
         let cs = c_strides(k);
         let grid_lo: Vec<usize> = (0..n).map(|a| w.lo[a] / k[a]).collect();
         let grid_hi: Vec<usize> = (0..n).map(|a| (w.hi[a] - 1) / k[a] + 1).collect();
-        let mut stored = Vec::new();
         each_index(&grid_lo, &grid_hi, |at| {
-            let Some(chunk) = c.index.get(at) else {
-                return Err(self.fail(format!(
-                    "the chunk at {at:?} on the chunk grid is missing from its index"
-                )));
-            };
-            let data = self.decode(c, chunk, at, &mut stored)?;
             let origin: Vec<usize> = (0..n).map(|a| at[a] * k[a]).collect();
             let from: Vec<usize> = (0..n).map(|a| w.lo[a].max(origin[a])).collect();
             let to: Vec<usize> = (0..n).map(|a| w.hi[a].min(origin[a] + k[a])).collect();
+            let Some(chunk) = c.index.get(at) else {
+                // Never written: the fill value.
+                let part = Window {
+                    lo: from,
+                    hi: to,
+                    strides: w.strides.clone(),
+                };
+                fill_part(w, &part, c.fill, put);
+                return Ok(());
+            };
+            let data = self.decode(c, chunk, at)?;
             each_index(&from[..last], &to[..last], |idx| {
                 let row: usize = (0..last).map(|a| (idx[a] - origin[a]) * cs[a]).sum();
                 let first = (row + from[last] - origin[last]) * e.size;
@@ -718,48 +496,11 @@ impl H5Source {
         })
     }
 
-    /// Reads and decodes one chunk: its stored bytes into `stored`, the
-    /// decoded chunk returned (exactly [`Chunks::bytes`] long).
-    fn decode(
-        &self,
-        c: &Chunks,
-        chunk: &StoredChunk,
-        at: &[usize],
-        stored: &mut Vec<u8>,
-    ) -> Result<Vec<u8>, IoError> {
-        let offset: Vec<usize> = at.iter().zip(&c.shape).map(|(&i, &k)| i * k).collect();
-        stored.resize(chunk.size as usize, 0);
-        self.read_at(chunk.address, stored)?;
-        let mut data: Option<Vec<u8>> = None;
-        for (i, f) in c.filters.iter().enumerate().rev() {
-            if i < 32 && chunk.mask & (1 << i) != 0 {
-                continue;
-            }
-            let input = data.as_deref().unwrap_or(stored);
-            data = Some(match *f {
-                Filter::Deflate => inflate_exact(
-                    &self.path,
-                    input,
-                    Compression::Zlib,
-                    c.bytes,
-                    &format!(
-                        "HDF5 dataset \"{}\": deflated chunk at offset {offset:?}",
-                        self.name
-                    ),
-                )?,
-                Filter::Shuffle(size) => unshuffle(input, size),
-            });
-        }
-        let data = data.unwrap_or_else(|| std::mem::take(stored));
-        if data.len() != c.bytes {
-            return Err(self.fail(format!(
-                "the chunk at offset {offset:?} holds {} bytes, but a chunk of shape {:?} is {}",
-                data.len(),
-                c.shape,
-                c.bytes
-            )));
-        }
-        Ok(data)
+    /// Reads and decodes one chunk (exactly [`Chunks::bytes`] long).
+    fn decode(&self, c: &Chunks, chunk: &StoredChunk, at: &[usize]) -> Result<Vec<u8>, IoError> {
+        let mut stored = vec![0u8; chunk.size as usize];
+        self.read_at(chunk.address, &mut stored)?;
+        c.decode(&self.path, &self.name, at, chunk, stored)
     }
 
     /// Through `hdf5-pure`'s row windows (see the module docs).
@@ -768,7 +509,13 @@ impl H5Source {
         let last = n - 1;
         let ds = c_strides(&self.shape);
         let row = ds[0];
-        let h5 = h5::open(&self.path)?;
+        let h5 = {
+            let mut opened = self.rows.lock().unwrap_or_else(|p| p.into_inner());
+            match &*opened {
+                Some(h5) => Arc::clone(h5),
+                None => Arc::clone(opened.insert(Arc::new(h5::open(&self.path)?))),
+            }
+        };
         let dataset = h5
             .file
             .dataset(&self.name)
@@ -827,22 +574,32 @@ fn c_strides(shape: &[usize]) -> Vec<usize> {
     stride
 }
 
-/// Undoes HDF5's shuffle filter: the first bytes of every element, then
-/// the second bytes, and so on, back to whole elements; bytes past the
-/// last whole element stay where they are (as H5Zshuffle leaves them).
-fn unshuffle(data: &[u8], size: usize) -> Vec<u8> {
-    if size <= 1 {
-        return data.to_vec();
-    }
-    let count = data.len() / size;
-    let mut out = data.to_vec();
-    for b in 0..size {
-        let plane = &data[b * count..(b + 1) * count];
-        for (i, &v) in plane.iter().enumerate() {
-            out[i * size + b] = v;
+/// Puts `value` at every sample of the box `w`.
+fn fill(w: &Window, value: f64, put: &mut impl FnMut(usize, f64)) {
+    fill_part(w, w, value, put);
+}
+
+/// Puts `value` at every sample of `part`, a box within the box `w`.
+fn fill_part(w: &Window, part: &Window, value: f64, put: &mut impl FnMut(usize, f64)) {
+    let _ = each_index::<()>(&part.lo, &part.hi, |idx| {
+        let at: usize = (0..idx.len())
+            .map(|a| (idx[a] - w.lo[a]) * w.strides[a])
+            .sum();
+        put(at, value);
+        Ok(())
+    });
+}
+
+/// Reverses the x-fastest samples of a box of `dims` along `axis`.
+fn flip_axis<T>(data: &mut [T], dims: [usize; 3], axis: usize) {
+    let inner: usize = dims[..axis].iter().product();
+    let n = dims[axis];
+    for block in data.chunks_exact_mut(inner * n) {
+        for i in 0..n / 2 {
+            let (front, back) = block.split_at_mut((n - 1 - i) * inner);
+            front[i * inner..(i + 1) * inner].swap_with_slice(&mut back[..inner]);
         }
     }
-    out
 }
 
 impl VolumeSource for H5Source {
@@ -865,11 +622,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unshuffle_regroups_the_bytes_of_each_element_and_keeps_the_tail() {
-        // Elements 0x0201, 0x0403, 0x0605 (little-endian) shuffled: low
-        // bytes 01 03 05, then high bytes 02 04 06; a tail byte 07.
-        let shuffled = [1, 3, 5, 2, 4, 6, 7];
-        assert_eq!(unshuffle(&shuffled, 2), vec![1, 2, 3, 4, 5, 6, 7]);
-        assert_eq!(unshuffle(&shuffled, 1), shuffled.to_vec());
+    fn flip_axis_reverses_one_axis_of_an_x_fastest_box() {
+        // dims (3, 2, 2): value x + 10y + 100z.
+        let dims = [3, 2, 2];
+        let at = |x: usize, y: usize, z: usize| x + 3 * (y + 2 * z);
+        let v: Vec<usize> = (0..12)
+            .map(|i| i % 3 + 10 * (i / 3 % 2) + 100 * (i / 6))
+            .collect();
+        for axis in 0..3 {
+            let mut f = v.clone();
+            flip_axis(&mut f, dims, axis);
+            for z in 0..2 {
+                for y in 0..2 {
+                    for x in 0..3 {
+                        let mut p = [x, y, z];
+                        p[axis] = dims[axis] - 1 - p[axis];
+                        assert_eq!(f[at(x, y, z)], v[at(p[0], p[1], p[2])], "axis {axis}");
+                    }
+                }
+            }
+        }
     }
 }

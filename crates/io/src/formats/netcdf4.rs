@@ -26,22 +26,29 @@
 //!
 //! Box by box ([`open_lazy`], through `hdf5_lazy.rs`): the same axes,
 //! spacing, origin and values, each box read from the chunks or rows it
-//! covers. A variable along a decreasing coordinate (latitude from north
-//! to south, pressure levels from the ground up) is not opened box by box
-//! (`None`: it is read whole, within `--max-memory`), as a box source's
-//! grid steps forward along every axis.
+//! covers. Along a decreasing coordinate (latitude from north to south,
+//! pressure levels from the ground up) each box is read from the file's
+//! mirrored range and flipped, so that it is the box of the volume the
+//! eager reader flips whole.
+//!
+//! Opening costs one open of each dataset of the variable's group (and of
+//! each group above it, for the dimensions' scales): the scales' dimension
+//! ids are gathered as the datasets are listed, so naming every variable's
+//! dimensions is linear in the number of variables.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use hdf5_pure::AttrValue;
+use hdf5_pure::{AttrValue, Dataset, Group};
 use volray_core::glam::DVec3;
 
 use super::hdf5::{Opened, read_opened};
-use super::hdf5_axes::{Placement, Role, netcdf_dimensions};
+use super::hdf5_axes::{Placement, Role};
 use super::hdf5_lazy::{H5Source, from_opened};
 use crate::shared::cf::{self, Packing, Value, Variable};
-use crate::shared::hdf5::{self as h5, numbers, numeric_type, read_small, sorted_attrs, text};
+use crate::shared::hdf5::{
+    self as h5, NumericType, check_filters, numbers, numeric_type, read_small, sorted_attrs, text,
+};
 use crate::{FileInfo, IoError, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
 /// The `NAME` netCDF-C gives a dimension that has no coordinate variable.
@@ -75,6 +82,20 @@ struct Found {
     steps: [DVec3; 3],
 }
 
+#[cfg(test)]
+thread_local! {
+    /// Datasets opened on this thread, for the test that opening is linear.
+    static OPENED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// Opens dataset `name` of `group`: every dataset this module opens, so
+/// that a test can count them.
+fn dataset_in(group: &Group, name: &str) -> Result<Dataset, hdf5_pure::Error> {
+    #[cfg(test)]
+    OPENED.with(|n| n.set(n.get() + 1));
+    group.dataset(name)
+}
+
 /// Reads the variable `path` names (see the module docs).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let Found {
@@ -88,26 +109,34 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
 }
 
 /// Opens the variable `path` names as a source of boxes; `None` where it
-/// is read whole instead (a decreasing coordinate, a volume one sample
-/// thick).
+/// is read whole instead (a volume one sample thick, a grid whose steps
+/// are not along x, y and z).
 pub(crate) fn open_lazy(
     path: &Path,
     opts: &ReadOptions,
 ) -> Result<Option<(H5Source, FileInfo)>, IoError> {
     let Found {
-        opened,
+        mut opened,
         packing,
         steps,
     } = open(path, opts)?;
-    let backwards = (0..3).any(|a| steps[a][a] < 0.0);
-    if backwards || opened.dims.iter().any(|&n| n < 2) {
+    let aligned = (0..3).all(|a| (0..3).all(|w| w == a || steps[a][w] == 0.0));
+    if !aligned || opened.dims.iter().any(|&n| n < 2) {
         return Ok(None);
+    }
+    // Along a decreasing coordinate the volume runs from the file's last
+    // sample: its origin as `grid_to_volume` places the eager reader's.
+    let flip: [bool; 3] = std::array::from_fn(|a| steps[a][a] < 0.0);
+    for a in 0..3 {
+        if flip[a] {
+            opened.origin += steps[a] * (opened.dims[a].saturating_sub(1)) as f64;
+        }
     }
     let real: Option<super::hdf5_lazy::RealValue> = (!packing.is_identity()).then(|| {
         let packing = packing.clone();
         Arc::new(move |v: f64| packing.real(v)) as super::hdf5_lazy::RealValue
     });
-    from_opened(opened, real, opts).map(Some)
+    from_opened(opened, real, flip, opts).map(Some)
 }
 
 /// The file and variable `path` names, the NetCDF data model of the
@@ -144,17 +173,22 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     } else {
         group_path.clone()
     };
-    let mut vars: Vec<Variable> = Vec::new();
+    // Each dataset opened once: what a variable needs kept, the scales'
+    // dimension ids noted.
+    let mut listed: Vec<Listed> = Vec::new();
     let mut dimensions: Vec<(String, u64, bool)> = Vec::new();
-    let mut unnamed = Vec::new();
+    let mut dimids: Vec<(f64, String)> = Vec::new();
     for name in &datasets {
-        let Ok(ds) = group.dataset(name) else {
+        let Ok(ds) = dataset_in(&group, name) else {
             continue;
         };
         let attrs = sorted_attrs(ds.attrs());
         let attr = |k: &str| attrs.iter().find(|(n, _)| n == k).map(|(_, v)| v);
-        let Ok(shape) = ds.shape() else { continue };
         let scale = attr("CLASS").and_then(text).as_deref() == Some("DIMENSION_SCALE");
+        if scale {
+            note_dimid(&mut dimids, name, attr("_Netcdf4Dimid"));
+        }
+        let Ok(shape) = ds.shape() else { continue };
         if scale {
             dimensions.push((name.clone(), shape.first().copied().unwrap_or(0), false));
         }
@@ -167,29 +201,69 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         let Ok(sample) = numeric_type(&ds) else {
             continue;
         };
-        let full = format!("{prefix}/{name}");
-        let dims = match attr("_Netcdf4Coordinates")
-            .and_then(|ids| netcdf_dimensions(&h5.file, &full, ids))
-            .filter(|d| d.len() == shape.len())
-        {
+        listed.push(Listed {
+            name: name.clone(),
+            shape,
+            scale,
+            attrs,
+            sample,
+        });
+    }
+    // The scales of the groups above, nearest first (netCDF-C's
+    // dimensions are visible in the groups below theirs).
+    let mut above = group_path.as_str();
+    while above != "/" {
+        above = match above.rfind('/') {
+            Some(0) | None => "/",
+            Some(at) => &above[..at],
+        };
+        let Ok(g) = h5.file.group(above) else {
+            continue;
+        };
+        for name in g.datasets().unwrap_or_default().iter().take(MAX_VARIABLES) {
+            let Ok(ds) = dataset_in(&g, name) else {
+                continue;
+            };
+            let Ok(attrs) = ds.attrs() else { continue };
+            if attrs.get("CLASS").and_then(text).as_deref() == Some("DIMENSION_SCALE") {
+                note_dimid(&mut dimids, name, attrs.get("_Netcdf4Dimid"));
+            }
+        }
+    }
+    let mut vars: Vec<Variable> = Vec::new();
+    let mut unnamed = Vec::new();
+    for l in listed {
+        let attr = |k: &str| l.attrs.iter().find(|(n, _)| n == k).map(|(_, v)| v);
+        let named = attr("_Netcdf4Coordinates")
+            .and_then(numbers)
+            .and_then(|ids| {
+                ids.iter()
+                    .map(|id| dimids.iter().find(|(i, _)| i == id).map(|(_, n)| n.clone()))
+                    .collect::<Option<Vec<String>>>()
+            })
+            .filter(|d| d.len() == l.shape.len());
+        let dims = match named {
             Some(d) => d,
-            None if scale && shape.len() == 1 => vec![name.clone()],
+            None if l.scale && l.shape.len() == 1 => vec![l.name.clone()],
             None => {
-                unnamed.push(name.clone());
-                (0..shape.len()).map(|i| format!("{name}#{i}")).collect()
+                unnamed.push(l.name.clone());
+                (0..l.shape.len())
+                    .map(|i| format!("{}#{i}", l.name))
+                    .collect()
             }
         };
         vars.push(Variable {
-            name: name.clone(),
+            name: l.name,
             dims,
-            shape,
-            attrs: attrs
+            shape: l.shape,
+            attrs: l
+                .attrs
                 .iter()
                 .filter(|(k, _)| !INTERNAL.contains(&k.as_str()))
                 .filter_map(|(k, v)| cf_value(v).map(|v| (k.clone(), v)))
                 .collect(),
-            integer: !sample.name.starts_with("float"),
-            type_name: sample.name,
+            integer: !l.sample.name.starts_with("float"),
+            type_name: l.sample.name,
         });
     }
     let var = cf::choose(&file_path, &vars, wanted.as_deref())?.clone();
@@ -212,11 +286,9 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         .map_err(|frames| what(format!("frame {} of {frames}", layout.frame)))?;
 
     let full = format!("{prefix}/{}", var.name);
-    let dataset = h5
-        .file
-        .dataset(&full)
-        .map_err(|e| what(format!("cannot open: {e}")))?;
+    let dataset = dataset_in(&group, &var.name).map_err(|e| what(format!("cannot open: {e}")))?;
     let sample = numeric_type(&dataset).map_err(&what)?;
+    check_filters(&dataset).map_err(&what)?;
     let mut info = FileInfo::new(sample.name.clone());
     let globals: Vec<(String, Value)> = sorted_attrs(h5.file.root().attrs())
         .iter()
@@ -237,8 +309,7 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         ));
     }
     let mut coordinate = |c: &Variable| -> Result<Vec<f64>, IoError> {
-        let ds = group
-            .dataset(&c.name)
+        let ds = dataset_in(&group, &c.name)
             .map_err(|e| fail(format!("coordinate variable {}: {e}", c.name)))?;
         let values = read_small(&ds, MAX_COORDINATES)
             .map_err(|e| fail(format!("coordinate variable {}: {e}", c.name)))?;
@@ -278,6 +349,27 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         packing,
         steps,
     })
+}
+
+/// A dataset of the variable's group, opened once, as a variable needs it.
+struct Listed {
+    name: String,
+    shape: Vec<u64>,
+    /// A dimension scale (a coordinate variable, or a dimension alone).
+    scale: bool,
+    attrs: Vec<(String, AttrValue)>,
+    sample: NumericType,
+}
+
+/// Notes the dimension id (`_Netcdf4Dimid`) of the scale `name`, unless a
+/// nearer scale has it already (h5netcdf gives its variables a
+/// `_Netcdf4Dimid` too: only scales name dimensions).
+fn note_dimid(dimids: &mut Vec<(f64, String)>, name: &str, id: Option<&AttrValue>) {
+    if let Some(id) = id.and_then(numbers).and_then(|v| v.first().copied())
+        && !dimids.iter().any(|(i, _)| *i == id)
+    {
+        dimids.push((id, name.to_string()));
+    }
 }
 
 /// An HDF5 attribute as CF reads it: text or numbers.
@@ -437,11 +529,76 @@ mod tests {
         check("t", &l.volume, |x, y, z| ramp(x, 3 - y, z));
         assert_eq!(l.volume.spacing(), DVec3::new(10.0, 10.0, 150.0));
         assert_eq!(l.volume.origin(), DVec3::new(0.0, 0.0, -1000.0));
+        // Box by box: each box read from the mirrored range and flipped
+        // (along y alone: z = −lev runs forward).
+        let (source, info) = open_lazy(&fixture("cf_latlon.nc"), &opts(None, None))
+            .unwrap()
+            .unwrap();
+        boxes_equal_eager("cf_latlon.nc", &source, &l.volume);
         assert!(
-            open_lazy(&fixture("cf_latlon.nc"), &opts(None, None))
-                .unwrap()
-                .is_none()
+            info.notes
+                .iter()
+                .any(|n| n.contains("mirrored range along y (its coordinate decreases)")),
+            "{:?}",
+            info.notes
         );
+    }
+
+    /// A NetCDF-4 file as netCDF-C lays one out, written by `hdf5-pure`:
+    /// dimensions x, y, z (4, 3, 2) as coordinate variables (dimension
+    /// scales with `_Netcdf4Dimid`), and `n` variables v0, v1, ... of
+    /// (z, y, x) naming them in `_Netcdf4Coordinates`.
+    fn many_variables(dir: &Path, n: usize) -> PathBuf {
+        use hdf5_pure::FileBuilder;
+        let mut fb = FileBuilder::new();
+        for (id, (name, len)) in [("x", 4), ("y", 3), ("z", 2)].into_iter().enumerate() {
+            let values: Vec<f32> = (0..len).map(|i| i as f32).collect();
+            fb.create_dataset(name)
+                .with_f32_data(&values)
+                .with_shape(&[len as u64])
+                .set_attr("CLASS", AttrValue::String("DIMENSION_SCALE".into()))
+                .set_attr("NAME", AttrValue::String(name.into()))
+                .set_attr("_Netcdf4Dimid", AttrValue::I32(id as i32));
+        }
+        for v in 0..n {
+            let values: Vec<f32> = (0..24).map(|i| (i + v) as f32).collect();
+            fb.create_dataset(&format!("v{v}"))
+                .with_f32_data(&values)
+                .with_shape(&[2, 3, 4])
+                .set_attr("_Netcdf4Coordinates", AttrValue::I32Array(vec![2, 1, 0]));
+        }
+        let path = dir.join(format!("many{n}.nc"));
+        fb.write(&path).unwrap();
+        path
+    }
+
+    #[test]
+    fn opening_a_variable_opens_each_dataset_once_whatever_their_number() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut opened = Vec::new();
+        for n in [10, 40, 160] {
+            let path = many_variables(dir.path(), n);
+            OPENED.with(|c| c.set(0));
+            let l = read(&path, &opts(None, Some("v3"))).unwrap_or_else(|e| panic!("{e}"));
+            opened.push(OPENED.with(|c| c.get()));
+            // v3 holds i + 3 at C-order index i of (z, y, x).
+            assert_eq!(l.volume.dims(), [4, 3, 2]);
+            assert_eq!(
+                f64::from(l.volume.get(1, 2, 1)),
+                (12 + 2 * 4 + 1 + 3) as f64
+            );
+            assert!(
+                l.info
+                    .notes
+                    .iter()
+                    .any(|n| n.contains("dimensions (z, y, x)")),
+                "{:?}",
+                l.info.notes
+            );
+        }
+        // n + 3 datasets listed, each opened once; then the variable and
+        // its three coordinate variables again.
+        assert_eq!(opened, vec![10 + 3 + 4, 40 + 3 + 4, 160 + 3 + 4]);
     }
 
     #[test]

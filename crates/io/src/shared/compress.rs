@@ -1,5 +1,5 @@
-//! Decompressing gzip, zlib, LZ4-block and xz payloads to exactly the size
-//! a header declares.
+//! Decompressing gzip, zlib, LZ4-block, LZF and xz payloads to exactly the
+//! size a header declares.
 //!
 //! A compressed stream is only trusted as far as its header: a declared
 //! size beyond the codec's largest ratio is refused before decoding, the
@@ -11,7 +11,10 @@
 //!
 //! LZ4 blocks (VTK's vtkLZ4DataCompressor: `LZ4_compress_fast`, the raw
 //! block format without frame) are decoded by `lz4_flex`'s safe decoder
-//! into a buffer of the declared size. xz streams (vtkLZMADataCompressor:
+//! into a buffer of the declared size; LZF streams (HDF5's filter 32000,
+//! h5py's `compression="lzf"`: liblzf's raw token stream, no header) by
+//! `lzf-rust`'s decoder (pure Rust, `#![forbid(unsafe_code)]`; the crate
+//! `lzf` is deprecated) likewise. xz streams (vtkLZMADataCompressor:
 //! `lzma_easy_buffer_encode`, one stream per block) by `xz4rust`, a
 //! pure-Rust port of xz-embedded built without `unsafe`: it decodes into
 //! a small buffer the output grows from, checks the stream's CRC, and
@@ -54,6 +57,12 @@ pub const MAX_BZIP2_RATIO: u64 = 2_400_000;
 /// are 1:1. So the output never exceeds 255 times the input.
 pub const MAX_LZ4_RATIO: u64 = 255;
 
+/// The most bytes one byte of an LZF stream can decode to: a literal run
+/// decodes 1:1 (plus its control byte), a back-reference of 2 bytes gives
+/// at most 8 bytes and one of 3 bytes (the extended length) at most
+/// 7 + 255 + 2 = 264 (liblzf's `lzf_d.c` token format), so 88:1.
+pub const MAX_LZF_RATIO: u64 = 88;
+
 /// The largest xz dictionary volray allocates: xz's `-9` preset (64 MiB),
 /// the largest that `lzma_easy_buffer_encode` (VTK's writer) uses. An xz
 /// block header declaring more is refused before anything is allocated.
@@ -73,6 +82,8 @@ pub enum Compression {
     Lz4Block,
     /// xz (.xz container, LZMA2): VTK XML `vtkLZMADataCompressor` blocks.
     Xz,
+    /// LZF (liblzf's raw token stream): HDF5 chunks of h5py's filter 32000.
+    Lzf,
 }
 
 impl Compression {
@@ -83,6 +94,7 @@ impl Compression {
             Compression::Zlib => "zlib",
             Compression::Lz4Block => "LZ4",
             Compression::Xz => "xz",
+            Compression::Lzf => "LZF",
         }
     }
 
@@ -95,6 +107,7 @@ impl Compression {
         match self {
             Compression::Gzip | Compression::Zlib => Some(MAX_DEFLATE_RATIO),
             Compression::Lz4Block => Some(MAX_LZ4_RATIO),
+            Compression::Lzf => Some(MAX_LZF_RATIO),
             Compression::Xz => None,
         }
     }
@@ -153,6 +166,7 @@ impl Decompressor {
                 read_exact(path, ZlibDecoder::new(compressed), kind, expected, what)
             }
             Compression::Lz4Block => lz4_exact(path, compressed, expected, what),
+            Compression::Lzf => lzf_exact(path, compressed, expected, what),
             Compression::Xz => {
                 let decoder = self.xz.get_or_insert_with(|| {
                     xz4rust::XzDecoder::in_heap_with_alloc_dict_size(4096, MAX_XZ_DICT)
@@ -186,6 +200,36 @@ fn lz4_exact(
         Err(e) => Err(IoError::invalid(
             path,
             format!("{what}: corrupt LZ4 block: {e}"),
+        )),
+    }
+}
+
+/// An LZF stream decoded into exactly `expected` bytes (bounded by
+/// [`MAX_LZF_RATIO`] before this allocates them). `lzf-rust` stops at the
+/// buffer's end: a stream that would write past it is refused, whichever
+/// token it is in.
+fn lzf_exact(
+    path: &Path,
+    compressed: &[u8],
+    expected: usize,
+    what: &str,
+) -> Result<Vec<u8>, IoError> {
+    let mut out = vec![0u8; expected];
+    match lzf_rust::decompress(compressed, &mut out) {
+        Ok(n) if n == expected => Ok(out),
+        Ok(n) => Err(IoError::invalid(
+            path,
+            format!("{what}: LZF stream decodes to {n} bytes, but the header declares {expected}"),
+        )),
+        Err(lzf_rust::Error::OutputTooSmall) => Err(IoError::invalid(
+            path,
+            format!("{what}: LZF stream decodes past the {expected} bytes the header declares"),
+        )),
+        Err(e) => Err(IoError::invalid(
+            path,
+            format!(
+                "{what}: corrupt LZF stream: {e} (or one decoding past the {expected} bytes the header declares)"
+            ),
         )),
     }
 }
@@ -323,6 +367,33 @@ mod tests {
         assert!(
             corrupt.to_string().starts_with("v.nrrd: block 0: "),
             "{corrupt}"
+        );
+    }
+
+    #[test]
+    fn lzf_streams_decode_to_exactly_their_size_and_others_are_refused() {
+        // A literal run of 3 ("abc": control 2), then a back-reference of
+        // 4 + 2 = 6 bytes at distance 2 + 1 = 3 (control 4 << 5, offset 2).
+        let stream = [2, b'a', b'b', b'c', 4 << 5, 2];
+        let p = Path::new("v.h5");
+        let lzf = |expected| inflate_exact(p, &stream, Compression::Lzf, expected, "chunk");
+        assert_eq!(lzf(9).unwrap(), b"abcabcabc");
+        let short = lzf(10).unwrap_err().to_string();
+        assert!(short.contains("LZF stream decodes to 9 bytes"), "{short}");
+        let long = lzf(8).unwrap_err().to_string();
+        assert!(long.contains("decodes past the 8 bytes"), "{long}");
+        // 6 bytes decode to at most 6 · 88 = 528.
+        let lying = lzf(529).unwrap_err().to_string();
+        assert!(
+            lying.contains("more than 6 LZF bytes can decode to"),
+            "{lying}"
+        );
+        // A reference to before the first byte.
+        let err = inflate_exact(p, &[4 << 5, 2], Compression::Lzf, 6, "chunk").unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("v.h5: chunk: corrupt LZF stream"),
+            "{err}"
         );
     }
 

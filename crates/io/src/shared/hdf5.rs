@@ -1,8 +1,9 @@
 //! HDF5 files through `hdf5-pure` (pure Rust: no C library, no build
 //! step): opening a file, reading attributes as numbers or text, and
 //! reading a numeric dataset's rows into `f64`s after checking its size
-//! against the file's length and the memory limit. Used by the HDF5
-//! dataset reader and the MINC2 reader.
+//! against the file's length and the memory limit, refusing by name the
+//! filters nothing here decodes (szip). Used by the HDF5 dataset reader,
+//! the NetCDF-4 reader and the MINC2 reader.
 
 use std::path::Path;
 
@@ -126,6 +127,22 @@ pub(crate) fn numeric_type(dataset: &Dataset) -> Result<NumericType, String> {
         name: format!("{name}{order}"),
         stored,
     })
+}
+
+/// HDF5's filter number for szip (H5Zpublic.h's `H5Z_FILTER_SZIP`).
+const FILTER_SZIP: u16 = 4;
+
+/// Refuses, by name, a dataset whose chunks no reader here can decode:
+/// szip-compressed ones (libaec's szip has no pure-Rust decoder, and
+/// `hdf5-pure` reads none), with the command that rewrites them.
+pub(crate) fn check_filters(dataset: &Dataset) -> Result<(), String> {
+    if dataset.filters().contains(&FILTER_SZIP) {
+        return Err(
+            "its chunks are szip-compressed (filter 4), which volray cannot decode (no pure-Rust szip decoder): rewrite the file without it, e.g. h5repack -f NONE in.h5 out.h5 (or -f GZIP=4)"
+                .into(),
+        );
+    }
+    Ok(())
 }
 
 /// Whether `dataset` holds integers or floats.

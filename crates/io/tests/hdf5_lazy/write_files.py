@@ -95,6 +95,75 @@ with h5py.File(out / "latest.h5", "w", libver=("v110", "v110")) as f:
         save(name, a)
     save("sparse", b)
 
+# The filters decoded box by box beyond deflate and shuffle: LZF (h5py's
+# filter 32000), Fletcher-32 (an odd chunk size, and a chunk longer than
+# the checksum's 360-word blocks), both with deflate and shuffle; chunks
+# never written (the fill value); data never written at all.
+with h5py.File(out / "filters.h5", "w") as f:
+    for name, dtype, chunks, filt in [
+        ("lzf_f32", "<f4", (8, 7, 5), {"compression": "lzf"}),
+        ("shuffle_lzf_i16", ">i2", (16, 9, 11), {"compression": "lzf", "shuffle": True}),
+        ("fletcher_u8", "u1", (9, 9, 11), {"fletcher32": True}),
+        ("gzip_fletcher_f64", "<f8", (8, 7, 5),
+         {"compression": "gzip", "shuffle": True, "fletcher32": True}),
+        ("lzf_fletcher_u16", "<u2", (8, 7, 5), {"compression": "lzf", "fletcher32": True}),
+    ]:
+        a = field(SHAPE, dtype)
+        f.create_dataset(name, data=a, chunks=chunks, **filt)
+        save(name, a)
+    a = field(SHAPE, "<f4")
+    d = f.create_dataset("sparse_lzf_f32", shape=SHAPE, dtype="<f4", chunks=(8, 7, 5),
+                         compression="lzf", fillvalue=-2.5)
+    d[8:24, 7:, :10] = a[8:24, 7:, :10]
+    b = np.full(SHAPE, -2.5, dtype="<f4")
+    b[8:24, 7:, :10] = a[8:24, 7:, :10]
+    save("sparse_lzf_f32", b)
+    f.create_dataset("unwritten_i16", shape=SHAPE, dtype="<i2", fillvalue=-300)
+    save("unwritten_i16", np.full(SHAPE, -300, dtype="<i2"))
+    f.create_dataset("unwritten_chunked_u8", shape=SHAPE, dtype="u1", chunks=(8, 7, 5))
+    save("unwritten_chunked_u8", np.zeros(SHAPE, dtype="u1"))
+
+# A series (t, z, y, x) named by an axes attribute, in LZF chunks of one
+# frame each, one chunk of frame 2 never written (fill value -1.5).
+with h5py.File(out / "series_lzf.h5", "w") as f:
+    shape = (4, 12, 18, 20)
+    d = f.create_dataset("s", shape=shape, dtype="<f4", chunks=(1, 5, 8, 7),
+                         compression="lzf", fillvalue=-1.5)
+    d.attrs["axes"] = "tzyx"
+    for t in range(shape[0]):
+        # field(x, y, z) as a[x, y, z]; the file holds a[z, y, x].
+        frame = field(shape[:0:-1], "<f4", t).transpose(2, 1, 0)
+        if t == 2:
+            d[t, 5:] = frame[5:]
+            d[t, :5, 8:] = frame[:5, 8:]
+            d[t, :5, :8, 7:] = frame[:5, :8, 7:]
+            frame = frame.copy()
+            frame[:5, :8, :7] = -1.5
+        else:
+            d[t] = frame
+        save(f"s_lzf_t{t}", frame.transpose(2, 1, 0))
+
+# Fletcher-32 over each chunk: one chunk's stored bytes changed.
+with h5py.File(out / "fletcher_bad.h5", "w") as f:
+    a = field((32, 32, 32), "<u2")
+    d = f.create_dataset("v", data=a, chunks=(16, 16, 16), fletcher32=True)
+    save("v_fletcher", a)
+    info = d.id.get_chunk_info_by_coord((16, 0, 16))
+    bad = info.byte_offset + 100
+data = bytearray((out / "fletcher_bad.h5").read_bytes())
+data[bad] ^= 0x40
+(out / "fletcher_bad.h5").write_bytes(bytes(data))
+
+# szip (filter 4) in the pipeline, set optional so that the file is
+# written whether or not this h5py can apply it.
+with h5py.File(out / "szip.h5", "w") as f:
+    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+    dcpl.set_chunk((8, 8, 8))
+    dcpl.set_filter(h5py.h5z.FILTER_SZIP, h5py.h5z.FLAG_OPTIONAL, (4, 8))
+    space = h5py.h5s.create_simple((16, 16, 16))
+    h5py.h5d.create(f.id, b"v", h5py.h5t.STD_U8LE, space, dcpl=dcpl)
+    f["v"][...] = field((16, 16, 16), "u1")
+
 # A chunk no box may touch is corrupt: a box that does not touch it reads,
 # one that does is refused (and so is the whole).
 with h5py.File(out / "one_bad_chunk.h5", "w") as f:
@@ -121,6 +190,28 @@ with netCDF4.Dataset(out / "netcdf4.nc", "w", format="NETCDF4") as nc:
     t = nc.createVariable("temp", "i2", ("x", "y", "z"), contiguous=True)
     t[:] = field(a.shape, "<i2")
     save("temp", field(a.shape, "<i2"))
+# ERA5's layout: t(time, z, latitude, longitude), latitude from 90 down
+# to -90 (decreasing), in zlib chunks across it. The volume a[x, y, z] runs
+# along longitude, latitude flipped to increase, z.
+with netCDF4.Dataset(out / "latdown.nc", "w", format="NETCDF4") as nc:
+    shape = (2, 5, 13, 16)
+    for name, n in zip(["time", "z", "latitude", "longitude"], shape):
+        nc.createDimension(name, n)
+    for name, values, units in [
+        ("time", np.arange(2.0), "hours since 2000-01-01"),
+        ("z", np.arange(5.0) * 2, "m"),
+        ("latitude", 90.0 - 15.0 * np.arange(13), "degrees_north"),
+        ("longitude", 22.5 * np.arange(16), "degrees_east"),
+    ]:
+        c = nc.createVariable(name, "f8", (name,))
+        c[:] = values
+        c.units = units
+    v = nc.createVariable("t", "f4", ("time", "z", "latitude", "longitude"), zlib=True,
+                          chunksizes=(1, 2, 5, 8))
+    for t in range(shape[0]):
+        frame = field(shape[:0:-1], "<f4", t).transpose(2, 1, 0)  # [z, lat, lon]
+        v[t] = frame
+        save(f"t_latdown_t{t}", frame.transpose(2, 1, 0)[:, ::-1, :])
 import h5netcdf
 
 with h5netcdf.File(out / "h5netcdf.nc", "w") as nc:
