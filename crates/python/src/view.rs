@@ -13,6 +13,13 @@
 //! transfer function whole, not the preset). A lazy volume (a chunked
 //! file) is served level by level as `volray view` serves it
 //! (volray-view's [`Pyramid`]), its read-back naming the stills' `level`.
+//!
+//! An array the caller writes in a later cell is digested again before
+//! each frame ([`Watcher`], volray-view's [`Watch`]) and prepared again
+//! where it changed, as `Renderer` does: only a write during a frame is
+//! refused. The page acknowledges each frame it is given ([`ViewTab::ack`]):
+//! at most [`volray_view::MAX_IN_FLIGHT`] go unacknowledged, their bytes
+//! held in the memory limit's ledger.
 
 use crate::errors::{Keywords as Names, value_error};
 use crate::figure::{self, FIGURE};
@@ -31,7 +38,7 @@ use volray_options::level::LevelChoice;
 use volray_options::{BlendMode, CameraOptions, Options, Tf};
 use volray_view::{
     DRAFT_SHARE, Figure, FigureContext, Host, Message, OptionsStart, Pyramid, Refusal, Reproduce,
-    Reproduction, Start, Tab, ViewState, Viewer,
+    Reproduction, Start, Tab, ViewState, Viewer, Watch,
 };
 
 /// The most pages of one widget rendering at once.
@@ -148,12 +155,13 @@ impl ViewHost {
         let name = recipe.name.clone();
         let facts = recipe.facts(py);
         let (options, mut settings) = recipe.settings_of(&k)?;
+        let mut digest = None;
         let (prepared, levels) = match recipe.lazy() {
             None => {
                 if level.is_some() {
                     return Err(level_in_memory(&name));
                 }
-                let digest = recipe.digest(py, None)?;
+                digest = recipe.digest(py, None)?;
                 (recipe.prepare(py, digest)?, None)
             }
             Some(file) => {
@@ -232,9 +240,21 @@ impl ViewHost {
                 axis_names: facts.axis_names.map(String::from),
             },
         };
-        let host = py
+        let start_volume = Arc::clone(&viewer.volume);
+        let mut host = py
             .detach(|| viewer.host())
             .map_err(|e| value_error(format!("{name}: {e}")))?;
+        // Samples the caller can write (an array, a writeable Volume's).
+        if digest.is_some() {
+            host.watch(Arc::new(Watcher {
+                recipe,
+                last: Mutex::new(Watched {
+                    digest,
+                    generation: 0,
+                    volume: start_volume,
+                }),
+            }));
+        }
         let nonce =
             volray_view::Token::generate().map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
         Ok(ViewHost {
@@ -309,6 +329,59 @@ impl ViewHost {
     /// The view shown last, as the page's JSON state.
     fn state(&self) -> String {
         serde_json::to_string(&*lock(&self.current)).expect("a state serialises")
+    }
+
+    /// The bytes the viewer's memory ledger holds now (the volume, the
+    /// pages' renderers, the frames rendering or not yet acknowledged).
+    fn held(&self) -> u128 {
+        self.host.held()
+    }
+}
+
+/// The samples of an array the caller may write between frames, prepared
+/// again where they changed (volray-view's [`Watch`]).
+struct Watcher {
+    recipe: Recipe,
+    last: Mutex<Watched>,
+}
+
+/// The volume as last prepared.
+struct Watched {
+    digest: Option<u64>,
+    generation: u64,
+    volume: Arc<volray_core::Volume>,
+}
+
+impl Watch for Watcher {
+    fn current(&self, generation: u64) -> Result<Option<(u64, volray_core::Volume)>, String> {
+        let name = &self.recipe.name;
+        let failed = |e: PyErr| format!("{name}: {e}");
+        // Called on a tab's renderer thread: attached to Python to read the
+        // array, the lock never held while detached (digesting, preparing),
+        // so that no thread holds it while waiting for the interpreter.
+        Python::attach(|py| {
+            let digest = self.recipe.digest(py, None).map_err(failed)?;
+            let (known, last_generation) = {
+                let last = lock(&self.last);
+                (last.digest, last.generation)
+            };
+            if digest != known {
+                let prepared = self.recipe.prepare(py, digest).map_err(failed)?;
+                let mut last = lock(&self.last);
+                if last.digest != digest {
+                    *last = Watched {
+                        digest,
+                        generation: last.generation + 1,
+                        volume: Arc::new(prepared.inner.volume().clone()),
+                    };
+                }
+            } else if last_generation == generation {
+                return Ok(None);
+            }
+            let last = lock(&self.last);
+            Ok((last.generation != generation)
+                .then(|| (last.generation, volray_core::Volume::clone(&last.volume))))
+        })
     }
 }
 
@@ -404,7 +477,18 @@ impl ViewTab {
         }
     }
 
-    /// Stops the page's renderer: `next` returns `None` once it ends.
+    /// The page has the oldest frame it was given: the next may go.
+    fn ack(&self) {
+        self.tab.ack();
+    }
+
+    /// The frames given to the page and not acknowledged.
+    #[getter]
+    fn in_flight(&self) -> usize {
+        self.tab.in_flight()
+    }
+
+    /// Stops the page's renderer: `next` returns `None`.
     fn close(&self) {
         self.tab.close();
     }

@@ -339,6 +339,7 @@ def _view_frame(tab, state, seq, tmp_path, quality="full"):
     while True:
         is_frame, data = tab.next()
         if is_frame:
+            tab.ack()  # as the widget's page does
             break
         assert json.loads(data)["type"] != "error", data
     n = int.from_bytes(data[:4], "little")

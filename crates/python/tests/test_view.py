@@ -6,6 +6,7 @@ browser."""
 
 import json
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -35,9 +36,14 @@ def frame_of(message, tmp_path):
 
 
 def ask(tab, state, seq, quality="full"):
+    """The next message after asking for `state`, a frame acknowledged as
+    the widget's page acknowledges it."""
     refused = tab.receive(json.dumps({"type": "view", "seq": seq, "quality": quality, "state": state}))
     assert refused is None, refused
-    return tab.next()
+    message = tab.next()
+    if message is not None and message[0]:
+        tab.ack()
+    return message
 
 
 def test_the_frames_are_render_of_the_view_read_back(ball, tmp_path):
@@ -271,3 +277,142 @@ def test_a_label_volume_is_shown_in_its_label_colours_and_read_back(tmp_path):
     every = rgb(volray.render(seg, labels=True, camera=camera))
     assert not np.array_equal(every, expected)
     tab.close()
+
+
+def test_an_array_written_in_a_later_cell_is_shown_as_it_is_now(ball, tmp_path):
+    a = ball.copy()
+    host = _ViewHost(a, size=(48, 40), azimuth=30)
+    tab = host.open()
+    state = json.loads(tab.next()[1])["start"]
+    _, before = frame_of(ask(tab, state, 1), tmp_path)
+    assert np.array_equal(before[:, :, :3], rgb(volray.render(a, **host.keywords())))
+    # A later cell writes the array between frames: the next frame shows
+    # it, every time (the digest is taken before each frame).
+    for seq, write in enumerate([lambda: a.__setitem__((slice(None), slice(None), slice(0, 16)), 0),
+                                 lambda: a.__setitem__(Ellipsis, ball[::-1])], start=2):
+        write()
+        header, shown = frame_of(ask(tab, state, seq), tmp_path)
+        assert header["seq"] == seq
+        expected = rgb(volray.render(a, **host.keywords()))
+        assert np.array_equal(shown[:, :, :3], expected)
+        assert not np.array_equal(shown[:, :, :3], before[:, :, :3])
+        before = shown
+    tab.close()
+
+
+class _Page:
+    """A widget's messages to its pages, as the kernel would send them."""
+
+    def __init__(self, widget):
+        self.lock = threading.Lock()
+        self.texts = []
+        self.frames = []
+        self.gone = []
+        self.acked = 0
+        self.most_unacknowledged = 0
+        widget.send = self.send
+
+    def send(self, content, buffers=None):
+        with self.lock:
+            if content.get("frame"):
+                data = bytes(buffers[0])
+                n = int.from_bytes(data[:4], "little")
+                self.frames.append(json.loads(data[4 : 4 + n])["seq"])
+                self.most_unacknowledged = max(self.most_unacknowledged, len(self.frames) - self.acked)
+            elif "text" in content:
+                self.texts.append((content["view"], json.loads(content["text"])))
+            elif content.get("gone"):
+                self.gone.append(content["view"])
+
+    def errors(self):
+        with self.lock:
+            return [t for _, t in self.texts if t.get("type") == "error"]
+
+
+def _until(what, condition, seconds=60):
+    end = time.monotonic() + seconds
+    while not condition():
+        assert time.monotonic() < end, f"not within {seconds} s: {what}"
+        time.sleep(0.01)
+
+
+def test_a_page_not_heard_from_is_closed_so_reloads_do_not_use_up_the_pages(ball):
+    pytest.importorskip("anywidget")
+    w = volray.view(ball, size=32)
+    page = _Page(w)
+    w._HEARTBEAT_S = 0.05
+    w._TIMEOUT_S = 0.3
+    # Twelve reloads, more than the eight pages a widget renders at once:
+    # each page opens, then is never heard from again (a reload sends no
+    # close); each silent page's renderer is closed.
+    for i in range(12):
+        w._on_message(w, {"view": f"reload-{i}", "open": True}, [])
+        _until("the hello", lambda: len(page.texts) == i + 1)
+        _until("the silent page closed", lambda: w.pages == 0, seconds=30)
+    assert page.errors() == []
+    # A live page says so and stays open past the timeout.
+    w._on_message(w, {"view": "live", "open": True}, [])
+    end = time.monotonic() + 4 * w._TIMEOUT_S
+    while time.monotonic() < end:
+        w._on_message(w, {"view": "live", "alive": True}, [])
+        time.sleep(w._HEARTBEAT_S)
+    assert w.pages == 1
+    # Closed by its page (the output cleared): gone at once.
+    w._on_message(w, {"view": "live", "close": True}, [])
+    assert w.pages == 0
+    # A page closed while silent (its browser tab hidden) is told so, and
+    # opens again keeping its view: no second hello.
+    w._on_message(w, {"view": "live", "alive": True}, [])
+    assert page.gone == ["live"]
+    hellos = len(page.texts)
+    w._on_message(w, {"view": "live", "open": True, "resume": True}, [])
+    assert w.pages == 1
+    time.sleep(0.2)
+    assert len(page.texts) == hellos
+    w.close()
+    assert w.pages == 0
+
+
+def test_a_page_is_given_at_most_two_frames_unacknowledged_their_bytes_held(ball):
+    pytest.importorskip("anywidget")
+    w = volray.view(ball, size=64)
+    page = _Page(w)
+    w._on_message(w, {"view": "p", "open": True}, [])
+    _until("the hello", lambda: len(page.texts) == 1)
+    state = page.texts[0][1]["start"]
+    idle = w._host.held()
+
+    def ask_for(seq):
+        state["azimuth"] = seq
+        text = json.dumps({"type": "view", "seq": seq, "quality": "full", "state": state})
+        w._on_message(w, {"view": "p", "text": text}, [])
+
+    ask_for(1)
+    _until("a frame", lambda: len(page.frames) == 1)
+    ask_for(2)
+    _until("a second frame", lambda: len(page.frames) == 2)
+    # The page acknowledges none: the newer views wait in the kernel.
+    for seq in range(3, 8):
+        ask_for(seq)
+    time.sleep(1.0)
+    assert len(page.frames) == 2 and w._tabs["p"].in_flight == 2
+    assert w._host.held() > idle
+    tab = w._tabs["p"]
+
+    def ack():
+        with page.lock:
+            page.acked += 1
+        w._on_message(w, {"view": "p", "ack": True}, [])
+
+    # Each acknowledgement lets one more go, until the latest view's.
+    while 7 not in page.frames:
+        ack()
+        _until("a frame after an acknowledgement", lambda: len(page.frames) == page.acked + 2)
+    assert page.frames[:2] == [1, 2] and page.frames[-1] == 7, page.frames
+    ack()
+    ack()
+    assert tab.in_flight == 0
+    assert page.most_unacknowledged == 2
+    assert page.errors() == []
+    assert w._host.held() == idle
+    w.close()

@@ -26,9 +26,11 @@
 //! | `mailbox.rs` | the single-slot mailbox: stale requests dropped, never queued; the stop flag of the frame a newer request supersedes |
 //! | `session.rs` | a tab's renderer thread: reserve, render (stoppable), encode, send |
 //! | `ledger.rs` | the memory limit shared by every tab: the volume, each tab's renderer, each frame in flight |
+//! | `pyramid.rs`, `levels.rs` | a multiscale volume served level by level; the levels read whole, shared by the tabs, read outside the cache's lock |
 //! | `reproduce.rs` | [`Reproduce`]: the caller turns a state into settings and a command |
 //! | `hello.rs` | the page's first message: histogram, colours, the start |
-//! | `link.rs` | [`Host`]: the viewer without a server, its tabs' messages carried by the caller (the Jupyter widget) |
+//! | `link.rs` | [`Host`]: the viewer without a server, its tabs' messages carried by the caller (the Jupyter widget), the frames a page has not acknowledged bounded |
+//! | `watch.rs` | [`Watch`]: a volume its owner changes between frames (a numpy array), asked for before each frame |
 //! | `options.rs` | a state as volray-options' [`volray_options::Options`], for front ends that render from options (Python) |
 //! | `encode.rs` | JPEG and PNG, quantised as `volray render` writes PNGs |
 //! | `stats.rs` | counters for `/api/status` |
@@ -42,6 +44,7 @@ mod coarse;
 mod encode;
 mod hello;
 mod ledger;
+mod levels;
 mod link;
 mod mailbox;
 mod options;
@@ -54,10 +57,11 @@ mod session;
 mod state;
 mod stats;
 mod token;
+mod watch;
 
 pub use hello::Start;
 pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
-pub use link::{Host, Message, Tab};
+pub use link::{Host, MAX_IN_FLIGHT, Message, Tab};
 pub use options::{OptionsStart, start_state, state_options};
 pub use page::embedded_html;
 pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello};
@@ -71,6 +75,7 @@ pub use state::{
 };
 pub use stats::Snapshot;
 pub use token::{NoRandomness, Token};
+pub use watch::Watch;
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -169,7 +174,7 @@ impl Viewer {
                 let [x, y, z] = self.volume.dims();
                 let what = format!("level {level} ({x}x{y}x{z}) read whole");
                 let held = ledger.reserve(&what, costs.volume)?;
-                let levels = pyramid::Levels::new(pyramid);
+                let levels = levels::Levels::new(pyramid);
                 let kept = levels.keep(level, Arc::unwrap_or_clone(self.volume), held);
                 let nothing = ledger.reserve("nothing", 0)?;
                 (nothing, Some(Arc::new(levels)), Arc::new(kept))
@@ -191,6 +196,7 @@ impl Viewer {
             time: self.time.map(Arc::new),
             figure: Arc::new(self.figure),
             copy_above: coarse::COARSE_ABOVE,
+            watch: None,
         };
         Ok(Host {
             hello,

@@ -10,6 +10,15 @@
 //! files the page's requests in the tab's single-slot mailbox, its
 //! thread renders the latest, and [`Tab::next`] hands back each message
 //! for the page, the first being the [`Host::hello`].
+//!
+//! A socket slows the renderer when the page reads slowly; the caller's
+//! connection (the notebook's comm) takes whatever it is given. So the
+//! page acknowledges each frame ([`Tab::ack`]) and at most
+//! [`MAX_IN_FLIGHT`] frames are handed over unacknowledged: the next
+//! waits in [`Tab::next`], and the renderer behind it, while the page's
+//! newer requests replace each other in the mailbox. A frame's message
+//! bytes stay reserved in the ledger until it is acknowledged (or the
+//! tab closes).
 
 use crate::ledger::Reservation;
 use crate::mailbox::Mailbox;
@@ -17,8 +26,14 @@ use crate::protocol::Request;
 use crate::server;
 use crate::session::{self, Outgoing, Shared, SpawnError};
 use crate::state::ViewState;
-use std::sync::{Arc, Mutex};
+use crate::watch::Watch;
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
 use tokio::sync::mpsc;
+
+/// The most frames a page holds unacknowledged.
+pub const MAX_IN_FLIGHT: usize = 2;
 
 /// A viewer whose tabs' messages the caller carries ([`crate::Viewer::host`]).
 pub struct Host {
@@ -44,6 +59,12 @@ pub struct Tab {
     /// The renderer's messages, the hello first; `None` once read.
     out: Mutex<mpsc::Receiver<Outgoing>>,
     hello: Mutex<Option<String>>,
+    /// The frames handed over and not acknowledged, oldest first: their
+    /// messages' bytes held in the ledger.
+    in_flight: Mutex<VecDeque<Reservation>>,
+    /// Notified when a frame is acknowledged or the tab closes.
+    room: Condvar,
+    closed: AtomicBool,
 }
 
 impl Host {
@@ -63,7 +84,22 @@ impl Host {
             mailbox,
             out: Mutex::new(out_rx),
             hello: Mutex::new(Some(self.hello.clone())),
+            in_flight: Mutex::new(VecDeque::new()),
+            room: Condvar::new(),
+            closed: AtomicBool::new(false),
         })
+    }
+
+    /// Asks `watch` for the volume before each frame of every tab opened
+    /// from now on (`watch.rs`).
+    pub fn watch(&mut self, watch: Arc<dyn Watch>) {
+        self.shared.watch = Some(watch);
+    }
+
+    /// The bytes the ledger holds now: the volume, the tabs' renderers,
+    /// the frames rendering and those not yet acknowledged.
+    pub fn held(&self) -> u128 {
+        self.shared.ledger.held()
     }
 
     /// The bytes held for the volume.
@@ -82,24 +118,56 @@ impl Tab {
     }
 
     /// The next message for the page, waiting for it: the hello first,
-    /// then frames and errors as the renderer makes them; `None` once
-    /// the tab is closed and its renderer has ended. Not to be called
-    /// from within an async runtime.
+    /// then frames and errors as the renderer makes them, a frame only
+    /// once fewer than [`MAX_IN_FLIGHT`] are unacknowledged; `None` once
+    /// the tab is closed (and its renderer has ended, unless it closed
+    /// while a frame waited for room). Not to be called from within an
+    /// async runtime.
     pub fn next(&self) -> Option<Message> {
         if let Some(hello) = lock(&self.hello).take() {
             return Some(Message::Text(hello));
         }
-        // A frame's bytes stay reserved until it is handed over.
+        // A frame's bytes stay reserved until it is acknowledged.
         match lock(&self.out).blocking_recv()? {
-            Outgoing::Frame(bytes, _reserved) => Some(Message::Frame(bytes)),
+            Outgoing::Frame(bytes, reserved) => {
+                let mut in_flight = lock(&self.in_flight);
+                while in_flight.len() >= MAX_IN_FLIGHT && !self.is_closed() {
+                    in_flight = (self.room.wait(in_flight)).unwrap_or_else(|e| e.into_inner());
+                }
+                if self.is_closed() {
+                    return None;
+                }
+                in_flight.push_back(reserved);
+                Some(Message::Frame(bytes))
+            }
             Outgoing::Text(text) => Some(Message::Text(text)),
         }
     }
 
+    /// The page has the oldest frame handed over: its bytes are given
+    /// back, and the next frame may go. Nothing where none is in flight.
+    pub fn ack(&self) {
+        lock(&self.in_flight).pop_front();
+        self.room.notify_all();
+    }
+
+    /// The frames handed over and not acknowledged.
+    pub fn in_flight(&self) -> usize {
+        lock(&self.in_flight).len()
+    }
+
     /// Stops the frame being rendered, if any, and ends the renderer:
-    /// [`Tab::next`] then returns `None` once the renderer is gone.
+    /// [`Tab::next`] then returns `None`. The frames in flight are let go
+    /// of.
     pub fn close(&self) {
+        self.closed.store(true, Ordering::SeqCst);
         self.mailbox.close();
+        lock(&self.in_flight).clear();
+        self.room.notify_all();
+    }
+
+    fn is_closed(&self) -> bool {
+        self.closed.load(Ordering::SeqCst)
     }
 }
 

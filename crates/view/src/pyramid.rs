@@ -16,21 +16,21 @@
 //!   [`volray_lazy::PIECE_BUDGET`]), stopped between pieces by a newer
 //!   request.
 //!
-//! A level read whole is held behind an `Arc` (its samples as outside
-//! bytes, so that each tab's renderer of it shares them) together with
-//! its reservation in the server's ledger: the bytes are given back when
-//! the last renderer of the level and the cache have let go of it.
+//! The levels read whole are held by `levels.rs` ([`crate::levels::Levels`]).
+//!
+//! Every frame of a pyramid, draft or still, is framed on the box of the
+//! still's level ([`Pyramid::framed`]), whichever level it shows: a
+//! level's box is its first and last grid points', which sit half a
+//! voxel of that level inside the finer level's (OME-Zarr's translation,
+//! `zarr/write.rs`), so that a coarse level framed on its own box is
+//! drawn 1–3 % larger, and the picture would jump when the still
+//! replaces the drafts.
 
-use crate::ledger::{Ledger, Overdrawn, Reservation};
-use bytemuck::cast_slice;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
 use volray_core::camera::CameraError;
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
-use volray_core::{
-    External, ExternalBytes, MemoryBound, NonFinite, RenderSettings, Sample, Samples, Store,
-    Volume, VolumeSource,
-};
+use volray_core::{MemoryBound, NonFinite, RenderSettings, VolumeSource};
 
 /// A level read whole for the frames while the view moves may take, with
 /// its frame, at most this fraction (1/4) of the memory limit.
@@ -54,16 +54,6 @@ pub enum PyramidError {
     Empty,
     #[error("--level {0}: the image has {1} levels, 0 the finest")]
     NoSuchLevel(usize, usize),
-}
-
-/// Why a level could not be read whole.
-#[derive(Debug, thiserror::Error)]
-pub enum LevelError {
-    #[error("{0}")]
-    Memory(#[from] Overdrawn),
-    /// The source's one-line message.
-    #[error("{0}")]
-    Read(String),
 }
 
 impl Pyramid {
@@ -137,6 +127,17 @@ impl Pyramid {
             Some(n) => Ok(n),
             None => self.auto_level(settings),
         }
+    }
+
+    /// `settings` framed on the box of level `still` (the camera's own
+    /// box where it names one), for a frame of any level: drafts of a
+    /// coarser level then put the volume's edges where the still puts
+    /// them (within half a voxel of the coarser level), and the still is
+    /// the frame `volray render --level N` renders of its level.
+    pub fn framed(&self, settings: &RenderSettings, still: usize) -> RenderSettings {
+        let mut framed = settings.clone();
+        framed.camera.bounds = Some(framed.camera.framed_bounds(self.grid(still).bounds()));
+        framed
     }
 
     /// The level a draft frame of `draft` shows, when the still shows
@@ -218,151 +219,4 @@ impl Pyramid {
         let voxels: u128 = source.grid().dims.iter().map(|&n| n as u128).product();
         voxels * source.voxel_bytes() as u128
     }
-}
-
-/// The levels read whole, shared by every tab: the last
-/// [`CACHED_LEVELS`] used.
-pub struct Levels {
-    pub pyramid: Pyramid,
-    /// Level and volume, the most recently used last.
-    cache: Mutex<Vec<(usize, Volume)>>,
-}
-
-impl Levels {
-    pub fn new(pyramid: Pyramid) -> Levels {
-        Levels {
-            pyramid,
-            cache: Mutex::new(Vec::new()),
-        }
-    }
-
-    fn lock(&self) -> MutexGuard<'_, Vec<(usize, Volume)>> {
-        self.cache.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// Whether level `level` is held whole now.
-    pub fn is_held(&self, level: usize) -> bool {
-        self.lock().iter().any(|(l, _)| *l == level)
-    }
-
-    /// Keeps `volume` as level `level`, its bytes held by `reserved`.
-    pub fn keep(&self, level: usize, volume: Volume, reserved: Reservation) -> Volume {
-        let volume = shared(volume, reserved);
-        let mut cache = self.lock();
-        cache.retain(|(l, _)| *l != level);
-        cache.push((level, volume.clone()));
-        let over = cache.len().saturating_sub(CACHED_LEVELS);
-        cache.drain(..over);
-        volume
-    }
-
-    /// Level `level` whole: from the cache, or read (its bytes reserved
-    /// from `ledger` first, the least recently used levels let go of
-    /// where they do not fit). Tabs reading at once wait for each other.
-    pub fn whole(&self, level: usize, ledger: &Arc<Ledger>) -> Result<Volume, LevelError> {
-        let mut cache = self.lock();
-        if let Some(i) = cache.iter().position(|(l, _)| *l == level) {
-            let entry = cache.remove(i);
-            let volume = entry.1.clone();
-            cache.push(entry);
-            return Ok(volume);
-        }
-        let pyramid = &self.pyramid;
-        let [x, y, z] = pyramid.grid(level).dims;
-        let what = format!("level {level} ({x}x{y}x{z}) read whole");
-        let bytes = pyramid.volume_bytes(level);
-        let reserved = loop {
-            match ledger.reserve(&what, bytes) {
-                Ok(r) => break r,
-                // Let go of the least recently used level, and try again
-                // (its bytes come back once no tab renders it either).
-                Err(e) if cache.is_empty() => return Err(e.into()),
-                Err(_) => {
-                    cache.remove(0);
-                }
-            }
-        };
-        let dims = pyramid.grid(level).dims;
-        let mut volume = pyramid
-            .source(level)
-            .read_box([0; 3], dims)
-            .map_err(LevelError::Read)?;
-        volume.set_labels(pyramid.labels);
-        let volume = shared(volume, reserved);
-        cache.push((level, volume.clone()));
-        let over = cache.len().saturating_sub(CACHED_LEVELS);
-        cache.drain(..over);
-        Ok(volume)
-    }
-}
-
-/// Samples read whole, and their bytes' reservation: given back when the
-/// last volume sharing them is dropped.
-#[derive(Debug)]
-struct Held {
-    samples: Owned,
-    _reserved: Reservation,
-}
-
-#[derive(Debug)]
-enum Owned {
-    U8(Vec<u8>),
-    I8(Vec<i8>),
-    U16(Vec<u16>),
-    I16(Vec<i16>),
-    F32(Vec<f32>),
-}
-
-impl ExternalBytes for Held {
-    fn bytes(&self) -> &[u8] {
-        match &self.samples {
-            Owned::U8(v) => v,
-            Owned::I8(v) => cast_slice(v),
-            Owned::U16(v) => cast_slice(v),
-            Owned::I16(v) => cast_slice(v),
-            Owned::F32(v) => cast_slice(v),
-        }
-    }
-
-    fn verify(&self) -> Result<(), String> {
-        // Memory of our own: nothing can change it underneath.
-        Ok(())
-    }
-}
-
-/// `volume` with its samples behind an `Arc`, held with `reserved`:
-/// clones share them. A volume whose samples are already outside bytes
-/// is returned as it is (and `reserved` given back).
-pub fn shared(volume: Volume, reserved: Reservation) -> Volume {
-    let (dims, spacing, origin, labels) = (
-        volume.dims(),
-        volume.spacing(),
-        volume.origin(),
-        volume.is_labels(),
-    );
-    let samples = match volume.into_samples() {
-        Samples::U8(Store::Owned(v)) => Samples::U8(held(v, Owned::U8, reserved)),
-        Samples::I8(Store::Owned(v)) => Samples::I8(held(v, Owned::I8, reserved)),
-        Samples::U16(Store::Owned(v)) => Samples::U16(held(v, Owned::U16, reserved)),
-        Samples::I16(Store::Owned(v)) => Samples::I16(held(v, Owned::I16, reserved)),
-        Samples::F32(Store::Owned(v)) => Samples::F32(held(v, Owned::F32, reserved)),
-        external => external,
-    };
-    let mut volume = Volume::from_samples(dims, samples)
-        .and_then(|v| v.with_spacing(spacing))
-        .and_then(|v| v.with_origin(origin))
-        .expect("the grid of a volume that was valid");
-    volume.set_labels(labels);
-    volume
-}
-
-/// The samples `v` behind an `Arc` with `reserved`, as outside bytes.
-fn held<T: Sample>(v: Vec<T>, wrap: fn(Vec<T>) -> Owned, reserved: Reservation) -> Store<T> {
-    let len = v.len();
-    let held: Arc<dyn ExternalBytes> = Arc::new(Held {
-        samples: wrap(v),
-        _reserved: reserved,
-    });
-    // A vector of the samples' own type: aligned, and `len` of them.
-    Store::External(External::new(held, 0, len).expect("a vector's own samples"))
 }

@@ -27,15 +27,16 @@
 use crate::coarse;
 use crate::encode::{self, DRAFT_QUALITY};
 use crate::ledger::{Costs, Ledger, Overdrawn, Reservation};
+use crate::levels::{LevelError, Levels};
 use crate::mailbox::Mailbox;
 use crate::protocol::{
     Basis, DRAFT_SCALE_RANGE, FrameHeader, LevelShown, Quality, Request, ServerMessage,
     frame_message,
 };
-use crate::pyramid::{LevelError, Levels};
 use crate::reproduce::{Refusal, Reproduce};
 use crate::state::Figure;
 use crate::stats::Stats;
+use crate::watch::Watch;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -85,6 +86,9 @@ pub struct Shared {
     /// axis, is drafted from a coarse copy (`coarse.rs`,
     /// [`coarse::COARSE_ABOVE`]).
     pub copy_above: usize,
+    /// Where the volume may change between frames: asked for it before
+    /// each frame (`watch.rs`; a whole volume without a time axis).
+    pub watch: Option<Arc<dyn Watch>>,
 }
 
 /// What a frame's annotations (`ViewState::figure`) need to know of the
@@ -157,6 +161,9 @@ enum FrameError {
     /// A time point that could not be read, or is not served.
     #[error("{0}")]
     Time(String),
+    /// The volume as its owner has it now could not be read.
+    #[error("{0}")]
+    Watch(String),
 }
 
 impl From<volray_core::camera::CameraError> for FrameError {
@@ -195,6 +202,7 @@ pub fn spawn(
     let non_finite = shared.non_finite;
     let cache_budget = shared.cache_budget;
     let copy_above = shared.copy_above;
+    let watch = shared.watch.clone();
     std::thread::Builder::new()
         .name("view-render".into())
         .spawn(move || {
@@ -244,6 +252,8 @@ pub fn spawn(
                 last_still_ms: None,
                 figure: &figure,
                 copy_above,
+                watch: watch.as_deref(),
+                generation: 0,
             };
             while let Some(request) = mailbox.take() {
                 if request.probe.is_some() {
@@ -348,6 +358,10 @@ struct Tab<'a> {
     figure: &'a FigureContext,
     /// See [`Shared::copy_above`].
     copy_above: usize,
+    /// See [`Shared::watch`], and the generation of the volume this tab
+    /// renders.
+    watch: Option<&'a dyn Watch>,
+    generation: u64,
 }
 
 /// A tab's coarse copy of its volume for the drafts (`coarse.rs`), made
@@ -463,6 +477,27 @@ impl Tab<'_> {
         copy.renderer(&cx, renderer, &reproduction.settings, self.copy_above);
     }
 
+    /// The volume as its owner has it now, where it is watched: a new
+    /// renderer (and no drafts' copy yet) where it changed since the last
+    /// frame.
+    fn watched(&mut self) -> Result<(), FrameError> {
+        let (Some(watch), None, Source::Whole { renderer, copy, .. }) =
+            (self.watch, self.time, &mut self.source)
+        else {
+            return Ok(());
+        };
+        let Some((generation, volume)) =
+            watch.current(self.generation).map_err(FrameError::Watch)?
+        else {
+            return Ok(());
+        };
+        let budget = renderer.cache_budget();
+        *renderer = Renderer::owning(volume, self.costs.non_finite())?.with_cache_budget(budget);
+        *copy = DraftCopy::NotYet;
+        self.generation = generation;
+        Ok(())
+    }
+
     /// A quick draft of the still `request` asks for, where the last still
     /// took longer than [`SLOW_STILL_MS`]: its scale aims at [`QUICK_MS`]
     /// (the time goes with the pixels, the square of the scale).
@@ -568,6 +603,7 @@ impl Tab<'_> {
                 "the figure's annotations are not drawn on a multiscale volume's levels yet".into(),
             )));
         }
+        self.watched()?;
         let mut drawn = match &mut self.source {
             Source::Whole {
                 renderer,
@@ -756,7 +792,8 @@ struct LevelTab {
 impl LevelTab {
     /// A frame of `settings` (the full-size frame's `full`): a draft from
     /// a coarse level held whole, a still from the level it needs, whole
-    /// if it fits what the memory limit has left, else in pieces.
+    /// if it fits what the memory limit has left, else in pieces; either
+    /// framed on the still's level's box.
     fn draw(
         &mut self,
         cx: &Context,
@@ -796,10 +833,13 @@ impl LevelTab {
                 (still, need <= free)
             }
         };
+        // Whichever level it shows, the frame is framed as the still
+        // (`Pyramid::framed`): no jump when the still replaces the drafts.
+        let framed = pyramid.framed(settings, still);
         let (image, shown, reserved, message_bytes) = if whole {
-            self.whole(cx, level, settings)?
+            self.whole(cx, level, &framed)?
         } else {
-            self.pieces(cx, level, settings)?
+            self.pieces(cx, level, &framed)?
         };
         Ok(Drawn {
             image,
@@ -1005,6 +1045,12 @@ fn basis_of(view: &View) -> Basis {
 }
 
 #[cfg(test)]
+mod level_tests;
+
+#[cfg(test)]
+mod link_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::mailbox::Slot;
@@ -1023,7 +1069,7 @@ mod tests {
     /// being reproduced, after its request was taken and before its
     /// frame is rendered: what a page does during a frame, without a race.
     #[derive(Default)]
-    struct Plain {
+    pub(super) struct Plain {
         meanwhile: std::sync::Mutex<Option<(f64, Meanwhile)>>,
     }
 
@@ -1058,7 +1104,7 @@ mod tests {
 
     /// A view of 17³ voxels with `reproduce`, a memory limit and a most
     /// tabs.
-    fn shared_with(reproduce: Arc<Plain>, limit: u128, max_sessions: usize) -> Shared {
+    pub(super) fn shared_with(reproduce: Arc<Plain>, limit: u128, max_sessions: usize) -> Shared {
         let n = 17;
         let h = 2.0 / (n - 1) as f64;
         let volume = Volume::from_fn([n, n, n], DVec3::splat(h), DVec3::splat(-1.0), |p| {
@@ -1088,11 +1134,12 @@ mod tests {
             time: None,
             figure: Arc::new(FigureContext::default()),
             copy_above: usize::MAX,
+            watch: None,
         }
     }
 
     /// A view request for a `side`² frame at `azimuth`.
-    fn request(seq: u64, quality: Quality, side: usize, azimuth: f64) -> Request {
+    pub(super) fn request(seq: u64, quality: Quality, side: usize, azimuth: f64) -> Request {
         let mut state = sample();
         (state.width, state.height, state.azimuth) = (side, side, azimuth);
         Request {
@@ -1104,7 +1151,7 @@ mod tests {
         }
     }
 
-    fn header(message: &[u8]) -> serde_json::Value {
+    pub(super) fn header(message: &[u8]) -> serde_json::Value {
         let n = u32::from_le_bytes(message[..4].try_into().unwrap()) as usize;
         serde_json::from_slice(&message[4..4 + n]).unwrap()
     }
@@ -1303,7 +1350,7 @@ mod tests {
     }
 
     /// Every box read from a pyramid's levels: (level, lo, hi).
-    type Reads = Arc<std::sync::Mutex<Vec<(usize, [usize; 3], [usize; 3])>>>;
+    pub(super) type Reads = Arc<std::sync::Mutex<Vec<(usize, [usize; 3], [usize; 3])>>>;
 
     /// A level that records every box read from it.
     struct Counted {

@@ -7,12 +7,21 @@ behind JupyterHub's proxy prefix and over SSH as the notebook does. Each
 output showing the widget is a page with its own renderer thread in the
 kernel; frames are rendered on the kernel's CPU cores, JPEG while the view
 moves and PNG once it stops, as ``volray view`` renders them.
+
+A page acknowledges each frame it is given: at most a few go
+unacknowledged (``volray_view::MAX_IN_FLIGHT``), the next waiting in the
+kernel, so that a slow connection slows the renderer instead of filling
+the comm. A page also says it is alive every ``_HEARTBEAT_S`` seconds: a
+page not heard from for ``_TIMEOUT_S`` (reloaded, or its browser tab
+closed, which sends no message) has its renderer closed, so that reloads
+do not use up the pages a widget may open.
 """
 
 from __future__ import annotations
 
 import json
 import threading
+import time
 from pathlib import Path
 from typing import Any, Dict, Optional
 
@@ -42,16 +51,29 @@ class Viewer(anywidget.AnyWidget):
     _esm = Path(__file__).parent / "_widget.js"
     _page = traitlets.Unicode("").tag(sync=True)
     height = traitlets.Int(560).tag(sync=True)
+    # How often a page says it is alive, and how long the kernel waits
+    # before closing the renderer of a page it has not heard from.
+    _HEARTBEAT_S = 2.0
+    _TIMEOUT_S = 10.0
+    _heartbeat_ms = traitlets.Int(int(_HEARTBEAT_S * 1000)).tag(sync=True)
 
     def __init__(self, host: _ViewHost, height: int = 560, **kwargs: Any) -> None:
         if isinstance(height, bool) or not isinstance(height, int):
             raise TypeError("height: expected an int (pixels)")
         if not 100 <= height <= _MAX_HEIGHT:
             raise ValueError(f"height: {height} pixels is not in 100 to {_MAX_HEIGHT}")
-        super().__init__(_page=host.page, height=height, **kwargs)
+        super().__init__(
+            _page=host.page,
+            height=height,
+            _heartbeat_ms=int(self._HEARTBEAT_S * 1000),
+            **kwargs,
+        )
         self._host = host
         self._tabs: Dict[str, Any] = {}
+        # When each page was last heard from (time.monotonic()).
+        self._seen: Dict[str, float] = {}
         self._lock = threading.Lock()
+        self._reaping = False
         self.on_msg(self._on_message)
 
     # ---------------------------------------------------------- read back
@@ -90,12 +112,33 @@ class Viewer(anywidget.AnyWidget):
 
     # ---------------------------------------------------------- the pages
 
+    @property
+    def pages(self) -> int:
+        """How many pages have a renderer open in the kernel."""
+        with self._lock:
+            return len(self._tabs)
+
     def _on_message(self, _widget: Any, content: Any, _buffers: Any) -> None:
         if not isinstance(content, dict) or not isinstance(content.get("view"), str):
             return
         view = content["view"][:64]
+        with self._lock:
+            if view in self._tabs:
+                self._seen[view] = time.monotonic()
         if content.get("open"):
-            self._open(view)
+            self._open(view, resume=content.get("resume") is True)
+        elif content.get("ack"):
+            with self._lock:
+                tab = self._tabs.get(view)
+            if tab is not None:
+                tab.ack()
+        elif content.get("alive"):
+            with self._lock:
+                known = view in self._tabs
+            if not known:
+                # Closed while the page was silent (a browser throttles a
+                # hidden page's timers): it opens again, keeping its view.
+                self.send({"view": view, "gone": True})
         elif isinstance(content.get("text"), str):
             with self._lock:
                 tab = self._tabs.get(view)
@@ -107,8 +150,9 @@ class Viewer(anywidget.AnyWidget):
         elif content.get("close"):
             self._close(view)
 
-    def _open(self, view: str) -> None:
+    def _open(self, view: str, resume: bool = False) -> None:
         self._close(view)
+        self._reap()
         try:
             tab = self._host.open()
         except RuntimeError as e:
@@ -118,18 +162,49 @@ class Viewer(anywidget.AnyWidget):
             return
         with self._lock:
             self._tabs[view] = tab
+            self._seen[view] = time.monotonic()
+            start_reaper = not self._reaping
+            self._reaping = True
         threading.Thread(
-            target=self._pump, args=(view, tab), name=f"volray-view-{view}", daemon=True
+            target=self._pump,
+            args=(view, tab, resume),
+            name=f"volray-view-{view}",
+            daemon=True,
         ).start()
+        if start_reaper:
+            threading.Thread(target=self._reaper, name="volray-view-reaper", daemon=True).start()
 
-    def _pump(self, view: str, tab: Any) -> None:
-        """Sends the tab's messages to its page until the tab closes."""
+    def _reap(self) -> None:
+        """Closes the renderers of the pages not heard from for
+        ``_TIMEOUT_S`` seconds."""
+        now = time.monotonic()
+        with self._lock:
+            silent = [v for v in self._tabs if now - self._seen.get(v, now) > self._TIMEOUT_S]
+        for view in silent:
+            self._close(view)
+
+    def _reaper(self) -> None:
+        """Reaps silent pages while any page is open."""
+        while True:
+            time.sleep(min(self._HEARTBEAT_S, self._TIMEOUT_S / 2))
+            self._reap()
+            with self._lock:
+                if not self._tabs:
+                    self._reaping = False
+                    return
+
+    def _pump(self, view: str, tab: Any, resume: bool = False) -> None:
+        """Sends the tab's messages to its page until the tab closes (a
+        resumed page keeps its view: its new hello is not sent)."""
         try:
             while True:
                 message = tab.next()
                 if message is None:
                     break
                 is_frame, data = message
+                if resume and not is_frame:
+                    resume = False
+                    continue
                 if is_frame:
                     self.send({"view": view, "frame": True}, buffers=[data])
                 else:
@@ -139,10 +214,12 @@ class Viewer(anywidget.AnyWidget):
             with self._lock:
                 if self._tabs.get(view) is tab:
                     del self._tabs[view]
+                    self._seen.pop(view, None)
 
     def _close(self, view: str) -> None:
         with self._lock:
             tab = self._tabs.pop(view, None)
+            self._seen.pop(view, None)
         if tab is not None:
             tab.close()
 
@@ -154,6 +231,7 @@ class Viewer(anywidget.AnyWidget):
             with lock:
                 tabs = list(self._tabs.values())
                 self._tabs.clear()
+                self._seen.clear()
         for tab in tabs:
             tab.close()
         super().close()

@@ -6,6 +6,14 @@
 // showing it) is a page of its own with its own renderer, named `view`.
 // The page takes the notebook's colours (JupyterLab's and Notebook 7's
 // --jp-* variables) and follows a change of theme.
+//
+// Each frame is acknowledged ({view, ack}) once handed to the page: the
+// kernel sends the next only while few are unacknowledged. Every
+// `_heartbeat_ms` the view says it is alive ({view, alive}): a reloaded
+// or closed browser tab sends no close, and the kernel closes the
+// renderer of a view it no longer hears from. A view the kernel closed
+// while it was silent (a hidden tab's timers are throttled) is told so
+// ({view, gone}) and opens again, keeping what the page shows.
 
 const THEME = {
   "--bg": "--jp-layout-color2",
@@ -46,11 +54,13 @@ function render({ model, el }) {
   const toPage = (message, transfer) => {
     if (iframe.contentWindow) iframe.contentWindow.postMessage(message, "*", transfer || []);
   };
+  let opened = false; // the page asked for its renderer
   const onPage = (event) => {
     if (event.source !== iframe.contentWindow || !event.data) return;
     const m = event.data;
     if (m.volray === "open") {
       toPage(theme(el));
+      opened = true;
       model.send({ view, open: true });
     } else if (m.volray === "text" && typeof m.text === "string") {
       model.send({ view, text: m.text });
@@ -65,7 +75,11 @@ function render({ model, el }) {
       const b = buffers[0];
       const bytes = new Uint8Array(b.buffer, b.byteOffset, b.byteLength).slice();
       toPage({ volray: "frame", data: bytes.buffer }, [bytes.buffer]);
+      model.send({ view, ack: true });
+    } else if (content.gone && opened) {
+      model.send({ view, open: true, resume: true });
     } else if (content.closed) {
+      opened = false;
       toPage({ volray: "closed" });
     }
   };
@@ -76,8 +90,12 @@ function render({ model, el }) {
   const observer = new MutationObserver(() => toPage(theme(el)));
   observer.observe(document.body, { attributes: true, attributeFilter: ["data-jp-theme-name", "data-jp-theme-light"] });
   iframe.srcdoc = model.get("_page");
+  const heartbeat = setInterval(() => {
+    if (opened) model.send({ view, alive: true });
+  }, model.get("_heartbeat_ms") || 2000);
 
   return () => {
+    clearInterval(heartbeat);
     observer.disconnect();
     window.removeEventListener("message", onPage);
     model.off("msg:custom", onKernel);
