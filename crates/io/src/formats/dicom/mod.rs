@@ -43,6 +43,7 @@
 //! ([`prescan`]), and before the volume is allocated every file's pixel
 //! data is checked to be able to hold what its header declares.
 
+mod caught;
 mod codecs;
 mod header;
 mod jpegls;
