@@ -511,7 +511,7 @@ pub(crate) fn check_in_file(
         return Err(IoError::invalid(
             path,
             format!(
-                "NetCDF: variable {} of shape {:?} needs the file's bytes up to {end}, but the file has {}: truncated, or a header that declares more than the file holds",
+                "NetCDF: variable {} of shape {:?}: its data end at byte {end}, past the end of the file ({} bytes): truncated, or a header that declares more than the file holds",
                 var.name,
                 header.shape(var),
                 header.len
