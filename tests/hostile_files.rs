@@ -3,7 +3,12 @@
 //! dimensions, non-finite spacings, unknown types, wrong magic numbers and
 //! compressed streams cut short, all made at test time from the valid
 //! fixtures in `crates/io/tests/fixtures` (written by each format's own
-//! tools), and Zarr stores written here by hand.
+//! tools), and Zarr stores written here by hand. `hostile_files/readers.rs`
+//! covers the readers added since (NetCDF-3, MINC1, NetCDF-4, FITS,
+//! MGH/MGZ, each compressed DICOM transfer syntax, raw) and, for every
+//! reader, a small header declaring gigabytes while the memory limit is
+//! set out of the way, so that only the reader's own checks stand
+//! between the lie and the allocation.
 //!
 //! Each case runs `volray info FILE` (some also `volray render FILE -o
 //! out.png`) as a child process under `ulimit -v` (a lying header must not
@@ -13,6 +18,9 @@
 //! panic, and nothing left in the output directory. Mutations that may
 //! still leave a valid file (random bit flips, edits the format tolerates)
 //! only assert exit 0 or 1, never a crash, with the same hygiene.
+
+#[path = "hostile_files/readers.rs"]
+mod readers;
 
 use std::collections::BTreeMap;
 use std::fs;
@@ -59,6 +67,9 @@ struct Case {
     expect: Expect,
     /// Also run `volray render INPUT -o out.png`.
     render: bool,
+    /// Flags after the input (`--max-memory 1T`: a lying header must be
+    /// caught by the file's size, not by the memory limit).
+    args: Vec<String>,
 }
 
 /// The cases of one format, built from its valid files.
@@ -90,7 +101,19 @@ impl Cases {
             input: input.to_string(),
             expect,
             render,
+            args: Vec::new(),
         });
+    }
+
+    /// The last case, also rendered.
+    fn rendered(&mut self) {
+        self.list.last_mut().expect("a case").render = true;
+    }
+
+    /// The last case, run with `args` after the input.
+    fn with_args(&mut self, args: &[&str]) {
+        let case = self.list.last_mut().expect("a case");
+        case.args = args.iter().map(|a| a.to_string()).collect();
     }
 
     /// Truncations of `bytes` in the middle of the header, at its end, in
@@ -1625,6 +1648,7 @@ fn run_case(case: &Case, root: &Path, index: usize, render: bool) -> Result<(), 
     } else {
         args.extend(["info".into(), input.clone()]);
     }
+    args.extend(case.args.iter().cloned());
     let stdout = fs::File::create(dir.join("stdout")).unwrap();
     let stderr = fs::File::create(dir.join("stderr")).unwrap();
     let mut child = Command::new("sh")
@@ -1711,7 +1735,7 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         flat_cases(),
         zarr_cases(),
     ];
-    for g in groups {
+    for g in groups.into_iter().chain(readers::all()) {
         all.extend(g.list);
     }
     // Each run: (case index, render?).
@@ -1786,6 +1810,7 @@ fn the_harness_tells_valid_files_from_refused_ones() {
         input: "v.npy".into(),
         expect: Expect::Either,
         render: true,
+        args: Vec::new(),
     };
     assert_eq!(run_case(&valid, root.path(), 0, false), Ok(()));
     assert_eq!(run_case(&valid, root.path(), 1, true), Ok(()));

@@ -76,3 +76,18 @@ fn dicom_deflated_element_before_pixel_data_is_checked() {
         "{message}"
     );
 }
+
+/// A 1094-byte DICOM file in JPEG-LS Lossless (a CharLS-encoded 16 x 12
+/// frame) whose scan header (SOS) declares a length of 65535 bytes, far
+/// past the frame's end. The decoder sliced the stream at that offset
+/// unchecked: a panic, caught, but printed with a backtrace before the
+/// one-line error (issue 41). The decoder now refuses the length.
+#[test]
+fn dicom_jpegls_scan_header_length_past_the_stream() {
+    let path = finding("dicom", "jpegls_sos_length_past_end.dcm");
+    let message = refusal(&path, VolumeFormat::Dicom, None, None);
+    assert!(
+        message.contains("JPEG-LS") && message.contains("past the stream's end"),
+        "{message}"
+    );
+}

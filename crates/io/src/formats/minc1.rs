@@ -18,7 +18,9 @@ use std::path::Path;
 
 use crate::error::IoError;
 use crate::formats::minc::{Scaling, geometry, spatial_split, valid_range_of};
-use crate::formats::netcdf::{self, Header, NcType, is_text, read_values, small_values};
+use crate::formats::netcdf::{
+    self, Header, NcType, check_in_file, is_text, read_values, small_values,
+};
 use crate::shared::cf::Value;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::limits::check_frame_dims;
@@ -206,8 +208,10 @@ pub(crate) fn read_parsed(
         ));
     }
 
-    let mut data = vec![0f32; voxels];
+    // The frame must lie in the file before it is allocated.
     let base = frame * voxels;
+    check_in_file(path, &header, image, (base + voxels - 1) as u64)?;
+    let mut data = vec![0f32; voxels];
     read_values(
         path,
         &mut file,

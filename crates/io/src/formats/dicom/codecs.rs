@@ -18,14 +18,20 @@
 //! to more samples than the header declares. Both decoders can still panic
 //! on some corrupt streams (jpeg-decoder's `info` on an unexpected
 //! component count, arithmetic in openjp2's tier-1 decoder): each call is
-//! wrapped in [`guarded`](crate::shared::panics::guarded), so a corrupt codestream is a one-line
-//! error naming the file and frame, never a crash.
+//! run through [`panics::guarded`] (the panic caught, its message kept off
+//! standard error), so a corrupt codestream is a one-line error naming
+//! the file and frame, never a crash or a backtrace. volray's own JPEG-LS
+//! decoder is caught too, but not kept quiet: a panic there is a bug.
 //!
 //! JPEG-LS is decoded by volray's own [`jpegls`] (dicom-pixeldata's adapter
 //! needs the C++ CharLS, built with CMake).
 //!
 //! Not decoded: 12-bit DCT JPEG (JPEG Extended, process 4: `jpeg-decoder`
 //! reads 8-bit DCT only), refused by name.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use crate::shared::panics;
 
 use super::header::ImageFormat;
 use super::jpegls;
@@ -296,13 +302,13 @@ pub(super) fn decode_frames(
                         h.process
                     ));
                 }
-                let samples = guarded(f, "JPEG", || jpeg(&stream, pixels))?;
+                let samples = guarded(f, "JPEG", true, || jpeg(&stream, pixels))?;
                 push(samples, format, out);
             }
             Codec::Jpeg2000 => {
                 let h = j2k_header(&stream).map_err(|e| format!("frame {f}: {e}"))?;
                 check_header(&h, format, f, "JPEG 2000")?;
-                let samples = guarded(f, "JPEG 2000", || j2k(&stream, format))?;
+                let samples = guarded(f, "JPEG 2000", true, || j2k(&stream, format))?;
                 push(samples, format, out);
             }
             Codec::JpegLs => {
@@ -314,7 +320,7 @@ pub(super) fn decode_frames(
                         h.process
                     ));
                 }
-                let samples = guarded(f, "JPEG-LS", || {
+                let samples = guarded(f, "JPEG-LS", false, || {
                     jpegls::decode(&stream, pixels).map(Samples::U16)
                 })?;
                 push(samples, format, out);
@@ -339,19 +345,25 @@ enum Samples {
     I32(Vec<i32>),
 }
 
-/// Runs a decoder, turning a panic inside it into an error: the decoders
-/// are third-party code that may panic on corrupt input.
+/// Runs a decoder, turning a panic inside it into an error: third-party
+/// decoders may panic on corrupt input, and run `quiet` (nothing printed).
 fn guarded(
     frame: usize,
     codec: &str,
+    quiet: bool,
     decode: impl FnOnce() -> Result<Samples, String>,
 ) -> Result<Samples, String> {
-    match crate::shared::panics::guarded(decode) {
-        Ok(Ok(s)) => Ok(s),
-        Ok(Err(e)) => Err(format!(
+    let result = if quiet {
+        panics::guarded(decode).ok()
+    } else {
+        catch_unwind(AssertUnwindSafe(decode)).ok()
+    };
+    match result {
+        Some(Ok(s)) => Ok(s),
+        Some(Err(e)) => Err(format!(
             "the {codec} stream of frame {frame} is corrupt: {e}"
         )),
-        Err(_) => Err(format!(
+        None => Err(format!(
             "the {codec} decoder failed on frame {frame} (a corrupt stream)"
         )),
     }
@@ -453,12 +465,12 @@ mod tests {
 
     #[test]
     fn a_panicking_decoder_is_one_error() {
-        let err = guarded(2, "JPEG", || panic!("index out of bounds")).err();
+        let err = guarded(2, "JPEG", true, || panic!("index out of bounds")).err();
         assert_eq!(
             err.as_deref(),
             Some("the JPEG decoder failed on frame 2 (a corrupt stream)")
         );
-        let err = guarded(0, "JPEG 2000", || Err("bad marker".into())).err();
+        let err = guarded(0, "JPEG 2000", true, || Err("bad marker".into())).err();
         assert_eq!(
             err.as_deref(),
             Some("the JPEG 2000 stream of frame 0 is corrupt: bad marker")

@@ -11,6 +11,7 @@ use dicom_dictionary_std::{StandardDataDictionary, tags};
 use dicom_object::{DefaultDicomObject, InMemDicomObject, OpenFileOptions, Tag};
 use volray_core::glam::DVec3;
 
+use crate::shared::panics::guarded;
 use super::prescan::{PixelData, Prescan, prescan};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_exact_at};
@@ -221,17 +222,18 @@ fn extend_to(
 /// checked; `head_only` stops before the pixel data. A panic inside the
 /// parser becomes an error.
 pub(super) fn parse(bytes: &[u8], head_only: bool) -> Result<DefaultDicomObject, String> {
-    let result = crate::shared::panics::guarded(|| {
+    let result = guarded(|| {
         let mut options = OpenFileOptions::new();
         if head_only {
             options = options.read_until(tags::FLOAT_PIXEL_DATA);
         }
         options.from_reader(bytes)
-    });
+    })
+    .ok();
     match result {
-        Ok(Ok(obj)) => Ok(obj),
-        Ok(Err(e)) => Err(format!("cannot parse: {e}")),
-        Err(_) => Err("the DICOM parser failed on this file".into()),
+        Some(Ok(obj)) => Ok(obj),
+        Some(Err(e)) => Err(format!("cannot parse: {e}")),
+        None => Err("the DICOM parser failed on this file".into()),
     }
 }
 

@@ -25,7 +25,16 @@ pub(super) fn decode(stream: &[u8], max_samples: usize) -> Result<Vec<u16>, Stri
     if h.width.saturating_mul(h.height) > max_samples {
         return Err(format!("{}x{} is larger than the image", h.width, h.height));
     }
-    let mut d = Decoder::new(&h, &stream[h.scan..])?;
+    // SOS's length field places the scan data; a corrupt one points past
+    // the stream.
+    let data = stream.get(h.scan..).ok_or_else(|| {
+        format!(
+            "the scan header's length puts the scan data at byte {}, past the stream's end ({} bytes)",
+            h.scan,
+            stream.len()
+        )
+    })?;
+    let mut d = Decoder::new(&h, data)?;
     d.run()
 }
 
@@ -202,13 +211,15 @@ struct Decoder<'a> {
     limit: i32,
     reset: i32,
     t: [i32; 3],
-    // Regular contexts (A.2.1): 365 of them.
-    a: Vec<i32>,
+    // Regular contexts (A.2.1): 365 of them. A and Ra sum error
+    // magnitudes over up to RESET samples (65535 in an LSE segment), so
+    // they are wider than the rest.
+    a: Vec<i64>,
     b: Vec<i32>,
     c: Vec<i32>,
     n: Vec<i32>,
     // Run interruption contexts 365 (RItype 0) and 366 (RItype 1).
-    ra: [i32; 2],
+    ra: [i64; 2],
     rn: [i32; 2],
     rnn: [i32; 2],
     run_index: usize,
@@ -280,11 +291,11 @@ impl<'a> Decoder<'a> {
             limit,
             reset,
             t,
-            a: vec![a0; 365],
+            a: vec![i64::from(a0); 365],
             b: vec![0; 365],
             c: vec![0; 365],
             n: vec![1; 365],
-            ra: [a0; 2],
+            ra: [i64::from(a0); 2],
             rn: [1; 2],
             rnn: [0; 2],
             run_index: 0,
@@ -332,7 +343,9 @@ impl<'a> Decoder<'a> {
         self.clamp(v)
     }
 
-    /// A limited-length Golomb code (A.5.3).
+    /// A limited-length Golomb code (A.5.3). The value is below 2^22
+    /// (LIMIT is at most 64, k at most 16), so errors times 2·NEAR + 1
+    /// stay well inside `i32`.
     fn golomb(&mut self, k: u32, limit: i32) -> Result<i32, String> {
         let escape = limit - self.qbpp as i32 - 1;
         let q = self.bits.zeros(escape)?;
@@ -386,7 +399,7 @@ impl<'a> Decoder<'a> {
         };
         let px = self.clamp(px + sign * self.c[ctx]);
         let mut k = 0;
-        while (self.n[ctx] << k) < self.a[ctx] {
+        while (i64::from(self.n[ctx]) << k) < self.a[ctx] {
             k += 1;
             if k > 24 {
                 return Err("a context out of range".into());
@@ -409,7 +422,7 @@ impl<'a> Decoder<'a> {
             &mut self.c[ctx],
             &mut self.n[ctx],
         );
-        *a += err.abs();
+        *a += i64::from(err.abs());
         *b += err * (2 * self.near + 1);
         if *n == self.reset {
             *a >>= 1;
@@ -469,9 +482,9 @@ impl<'a> Decoder<'a> {
         // Run interruption sample.
         let rb = prev[end];
         let ri = usize::from((ra - rb).abs() <= self.near);
-        let temp = self.ra[ri] + (self.rn[ri] >> 1) * ri as i32;
+        let temp = self.ra[ri] + i64::from(self.rn[ri] >> 1) * ri as i64;
         let mut k = 0;
-        while (self.rn[ri] << k) < temp {
+        while (i64::from(self.rn[ri]) << k) < temp {
             k += 1;
             if k > 24 {
                 return Err("a context out of range".into());
@@ -490,7 +503,7 @@ impl<'a> Decoder<'a> {
         if err < 0 {
             self.rnn[ri] += 1;
         }
-        self.ra[ri] += (em + 1 - ri as i32) >> 1;
+        self.ra[ri] += i64::from((em + 1 - ri as i32) >> 1);
         if self.rn[ri] == self.reset {
             self.ra[ri] >>= 1;
             self.rn[ri] >>= 1;
@@ -540,6 +553,17 @@ mod tests {
                 .unwrap_err()
                 .contains("larger than the image")
         );
+    }
+
+    #[test]
+    fn a_scan_header_length_past_the_stream_is_an_error() {
+        // SOS's length 0xFF00 puts the scan data far past the stream's end
+        // (issue 41: this sliced out of bounds, a panic).
+        let mut s = stream(1, &[], 0, &[0xFC]);
+        let sos = s.windows(2).position(|w| w == [0xFF, 0xDA]).unwrap();
+        s[sos + 2] = 0xFF;
+        let err = decode(&s, 6).unwrap_err();
+        assert!(err.contains("past the stream's end"), "{err}");
     }
 
     #[test]

@@ -13,6 +13,7 @@ use dicom_pixeldata::PixelDecoder;
 
 use volray_core::SampleType;
 
+use crate::shared::panics::guarded;
 use super::codecs::{self, Codec};
 use super::header::{ImageFormat, Plane};
 use crate::dtype::Stored;
@@ -66,10 +67,13 @@ pub(super) fn decode(
     if let Some(codec) = Codec::of(syntax) {
         return decode_encapsulated(path, obj, format, frames, codec).map(Frames::Int);
     }
-    let result = crate::shared::panics::guarded(|| obj.decode_pixel_data());
+    if syntax == RLE_LOSSLESS {
+        check_rle(path, obj, format)?;
+    }
+    let result = guarded(|| obj.decode_pixel_data()).ok();
     let decoded = match result {
-        Ok(Ok(d)) => d,
-        Ok(Err(e)) => {
+        Some(Ok(d)) => d,
+        Some(Err(e)) => {
             // The error's sources say why ("Could not decode pixel data"
             // alone does not).
             let mut reason = e.to_string();
@@ -86,7 +90,7 @@ pub(super) fn decode(
                 ),
             ));
         }
-        Err(_) => {
+        None => {
             return Err(IoError::invalid(
                 path,
                 "the DICOM pixel data decoder failed on this file",
@@ -156,6 +160,63 @@ fn decode_encapsulated(
         .map_err(|_| fail(format!("cannot allocate {bytes} bytes")))?;
     codecs::decode_frames(codec, &split, format, &mut out).map_err(fail)?;
     Ok(out)
+}
+
+/// The transfer syntax of RLE Lossless (PS3.5 A.4.2, Annex G).
+const RLE_LOSSLESS: &str = "1.2.840.10008.1.2.5";
+
+/// Checks the RLE header of each fragment (one frame each, PS3.5 A.4.2)
+/// before `dicom-pixeldata` decodes them: it trusts the header (a garbled
+/// segment count made it allocate 6 GB, and some offsets made it panic).
+/// The header (G.5) is 16 little-endian `u32`s: the number of segments,
+/// one per byte of a sample (G.2: most significant first; one sample a
+/// pixel here), then each segment's offset, the first 64, increasing,
+/// inside the fragment.
+fn check_rle(path: &Path, obj: &DefaultDicomObject, format: &ImageFormat) -> Result<(), IoError> {
+    let fail = |reason: String| {
+        IoError::invalid(
+            path,
+            format!("cannot decode the pixel data (RLE Lossless, {RLE_LOSSLESS}): {reason}"),
+        )
+    };
+    let fragments = obj
+        .get(tags::PIXEL_DATA)
+        .and_then(|e| e.value().fragments())
+        .ok_or_else(|| fail("PixelData (7FE0,0010) is not encapsulated (no fragments)".into()))?;
+    let segments = format.sample_bytes();
+    for (f, fragment) in fragments.iter().enumerate() {
+        let word = |i: usize| {
+            fragment
+                .get(4 * i..4 * i + 4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        };
+        let Some(n) = word(0) else {
+            return Err(fail(format!(
+                "fragment {f} of {} bytes is shorter than the 64-byte RLE header",
+                fragment.len()
+            )));
+        };
+        if n != segments || fragment.len() < 64 {
+            return Err(fail(format!(
+                "fragment {f} ({} bytes) declares {n} RLE segment(s), but one {}-bit sample a pixel takes {segments}",
+                fragment.len(),
+                format.bits_allocated
+            )));
+        }
+        let mut previous = 63;
+        for s in 1..=n {
+            let offset = word(s).unwrap_or(0);
+            if offset <= previous || offset >= fragment.len() || (s == 1 && offset != 64) {
+                return Err(fail(format!(
+                    "fragment {f}: RLE segment {} starts at byte {offset}, which is not after the header and the segment before it, inside the fragment's {} bytes",
+                    s - 1,
+                    fragment.len()
+                )));
+            }
+            previous = offset;
+        }
+    }
+    Ok(())
 }
 
 fn short(path: &Path, have: usize, want: usize, format: &ImageFormat, frames: usize) -> IoError {

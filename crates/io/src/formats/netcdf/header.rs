@@ -482,6 +482,45 @@ impl Parser<'_> {
     }
 }
 
+/// The byte offset of C-order element `idx` of `var` (across records for
+/// a record variable: record `r`'s part lies at `begin + r · recsize`), in
+/// `u128` so that no lying header can wrap it.
+fn element_offset(header: &Header, var: &Var, idx: u64) -> u128 {
+    let size = u128::from(var.ty.size());
+    if var.record {
+        let per_record = (header.var_bytes(var).unwrap_or(0) / var.ty.size()).max(1);
+        let (r, k) = (idx / per_record, idx % per_record);
+        u128::from(var.begin) + u128::from(r) * u128::from(header.recsize) + u128::from(k) * size
+    } else {
+        u128::from(var.begin) + u128::from(idx) * size
+    }
+}
+
+/// Checks that the elements of `var` up to C-order element `last` lie in
+/// the file, before a reader allocates room for them: a header of 100
+/// bytes may declare a 2048³ variable (offsets grow with the element, so
+/// the last one is the one to check).
+pub(crate) fn check_in_file(
+    path: &Path,
+    header: &Header,
+    var: &Var,
+    last: u64,
+) -> Result<(), IoError> {
+    let end = element_offset(header, var, last) + u128::from(var.ty.size());
+    if end > u128::from(header.len) {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "NetCDF: variable {} of shape {:?}: its data end at byte {end}, past the end of the file ({} bytes): truncated, or a header that declares more than the file holds",
+                var.name,
+                header.shape(var),
+                header.len
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Reads `count` values of `var` from C-order element `first` on, in
 /// the file `header` describes, decoded to `f64` and handed to `sink`
 /// with their place (0 for the first); the elements may span records.
@@ -507,17 +546,11 @@ pub(crate) fn read_values(
         let idx = first + done as u64;
         // A run: to the end of the record (record variables) or of what
         // is wanted.
-        let (offset, in_run) = if var.record {
-            let (r, k) = (idx / per_record, idx % per_record);
-            let off = u128::from(var.begin)
-                + u128::from(r) * u128::from(header.recsize)
-                + u128::from(k) * u128::from(size);
-            (off, per_record - k)
+        let offset = element_offset(header, var, idx);
+        let in_run = if var.record {
+            per_record - idx % per_record
         } else {
-            (
-                u128::from(var.begin) + u128::from(idx) * u128::from(size),
-                u64::MAX,
-            )
+            u64::MAX
         };
         let n = in_run.min((count - done) as u64).min(1 << 16) as usize;
         let bytes = n as u64 * size;

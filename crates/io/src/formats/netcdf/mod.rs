@@ -42,7 +42,7 @@ use crate::shared::input::open_input;
 use crate::shared::limits::check_frame_size;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
-pub(crate) use header::{Header, NcType, Var, read_values};
+pub(crate) use header::{Header, NcType, Var, check_in_file, read_values};
 
 /// Reads the NetCDF file at `path`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
@@ -214,8 +214,8 @@ fn read_cf(
 
     // The slab: the frame along the frame dimension, every other
     // non-spatial dimension (length 1) at 0; C order keeps the spatial
-    // dimensions in the variable's order, the last fastest.
-    let mut data = vec![0f32; voxels];
+    // dimensions in the variable's order, the last fastest. Its last
+    // element must lie in the file before the volume is allocated.
     let (outer, inner, along) = match layout.frame_dim {
         Some(f) => (
             shape[..f].iter().product::<u64>(),
@@ -224,6 +224,9 @@ fn read_cf(
         ),
         None => (1, voxels as u64, 1),
     };
+    let last = ((outer - 1) * along + layout.frame as u64) * inner + inner - 1;
+    check_in_file(path, &header, nc, last)?;
+    let mut data = vec![0f32; voxels];
     let mut at = 0usize;
     for o in 0..outer {
         let first = (o * along + layout.frame as u64) * inner;

@@ -170,6 +170,7 @@ pub(crate) fn open_array(dir: &Path, max_memory: u64) -> Result<(ZarrArray, Zarr
     let not_readable = |e| zarr_error(dir, "not a readable Zarr array", e);
     let array = Array::open(store.clone(), "/").map_err(not_readable)?;
     let ty = ZarrType::of(dir, &array)?;
+    check_shape(dir, array.shape())?;
     check_subchunks(dir, &array)?;
     let decoder = match array.metadata() {
         ArrayMetadata::V2(v2)
@@ -188,6 +189,26 @@ pub(crate) fn open_array(dir: &Path, max_memory: u64) -> Result<(ZarrArray, Zarr
         _ => None,
     };
     Ok((ZarrArray { array, decoder }, ty))
+}
+
+/// Refuses a shape whose voxels cannot be counted in a `usize` with room
+/// for 16 bytes each: a lying header (bad input), refused when the array
+/// is opened, before any box of it is planned (issue 41: a 2^40-cube
+/// overflowed the streamed renderer's box arithmetic).
+fn check_shape(dir: &Path, shape: &[u64]) -> Result<(), IoError> {
+    let voxels = shape
+        .iter()
+        .try_fold(1u128, |n, &d| n.checked_mul(u128::from(d)));
+    match voxels {
+        Some(n) if n <= (usize::MAX / 16) as u128 => Ok(()),
+        _ => Err(IoError::invalid(
+            dir,
+            format!(
+                "shape {shape:?}: {} voxels, more than this machine can address",
+                voxels.map_or_else(|| "over 3.4e38".to_string(), |n| n.to_string())
+            ),
+        )),
+    }
 }
 
 /// Refuses a sharded array whose subchunks do not tile its shards (zarrs
