@@ -156,7 +156,14 @@ fn openexr_keeps_the_bare_frame_and_bad_lengths_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("out.exr");
     let bare = dir.path().join("bare.exr");
-    let base = ["render", "hydrogen:6,2,1", "--size", "32", "--colormap", "magma"];
+    let base = [
+        "render",
+        "hydrogen:6,2,1",
+        "--size",
+        "32",
+        "--colormap",
+        "magma",
+    ];
     let run = volray(&[&base[..], &["-o", bare.to_str().unwrap()]].concat());
     assert!(run.status.success(), "{}", stderr(&run));
     let bare = std::fs::read(&bare).unwrap();
@@ -177,7 +184,10 @@ fn openexr_keeps_the_bare_frame_and_bad_lengths_are_refused() {
         assert_eq!(message.lines().count(), 1, "{message}");
         // The frame's values as rendered, byte for byte: the figure is
         // drawn into 8- and 16-bit pictures only.
-        assert!(std::fs::read(&exr).unwrap() == bare, "{flags:?} changed the EXR");
+        assert!(
+            std::fs::read(&exr).unwrap() == bare,
+            "{flags:?} changed the EXR"
+        );
     }
     let gif = dir.path().join("out.gif");
     let run = volray(&[

@@ -124,7 +124,12 @@ fn netcdf3_cases() -> Cases {
     let var_x = 4 + 44 + find(&bytes[44..], name_x).expect("variable x");
     let plain = put(&bytes, var_x, b"q");
     let lie = nc3_with_dim(&nc3_with_dim(&plain, "z", 1 << 20), "y", 1024);
-    c.one(&format!("{f}: z 2^20, y 1024 (20 GiB)"), f, lie, Expect::Bad);
+    c.one(
+        &format!("{f}: z 2^20, y 1024 (20 GiB)"),
+        f,
+        lie,
+        Expect::Bad,
+    );
     c.with_args(FILE_MUST_REFUSE);
     c.one(
         &format!("{f}: z 2^31"),
@@ -339,8 +344,16 @@ fn fits_cases() -> Cases {
             let (a, b) = naxis(3, "-5");
             (a, b, Expect::Bad)
         },
-        (fits_card("BITPIX", "-32"), fits_card("BITPIX", "12"), Expect::Bad),
-        (fits_card("NAXIS", "3"), fits_card("NAXIS", "999"), Expect::Bad),
+        (
+            fits_card("BITPIX", "-32"),
+            fits_card("BITPIX", "12"),
+            Expect::Bad,
+        ),
+        (
+            fits_card("NAXIS", "3"),
+            fits_card("NAXIS", "999"),
+            Expect::Bad,
+        ),
         ("SIMPLE  =".into(), "SIMPLX  =".into(), Expect::Bad),
     ];
     c.edits(f, &bytes, &edits);
@@ -366,7 +379,11 @@ fn fits_cases() -> Cases {
     c.one(
         &format!("{f}: ZNAXIS3 2^40"),
         f,
-        replace(&bytes, &fits_card(key, "5"), &fits_card(key, "1099511627776")),
+        replace(
+            &bytes,
+            &fits_card(key, "5"),
+            &fits_card(key, "1099511627776"),
+        ),
         Expect::Bad,
     );
     c.with_args(FILE_MUST_REFUSE);
@@ -419,15 +436,26 @@ fn mgh_cases() -> Cases {
     // header; optional tags (which may be cut) after the data.
     let f = "f32.mgh";
     let bytes = fixture(&format!("mgh/{f}"));
-    assert_eq!(&bytes[..24], [[0, 0, 0, 1], be32(12), be32(10), be32(8), be32(2), be32(3)].concat());
+    assert_eq!(
+        &bytes[..24],
+        [[0, 0, 0, 1], be32(12), be32(10), be32(8), be32(2), be32(3)].concat()
+    );
     c.truncations(f, &bytes, 284, Expect::Bad, Expect::Either);
     let dims = |w: u32, h: u32, d: u32| put(&bytes, 4, &[be32(w), be32(h), be32(d)].concat());
-    c.one(&format!("{f}: 1024^3"), f, dims(1024, 1024, 1024), Expect::Bad);
+    c.one(
+        &format!("{f}: 1024^3"),
+        f,
+        dims(1024, 1024, 1024),
+        Expect::Bad,
+    );
     c.with_args(FILE_MUST_REFUSE);
     for (what, b) in [
         ("width 0", dims(0, 10, 8)),
         ("width -1", dims(u32::MAX, 10, 8)),
-        ("2^31 - 1 cubed", dims(0x7fff_ffff, 0x7fff_ffff, 0x7fff_ffff)),
+        (
+            "2^31 - 1 cubed",
+            dims(0x7fff_ffff, 0x7fff_ffff, 0x7fff_ffff),
+        ),
         ("2^31 - 1 frames", put(&bytes, 16, &be32(0x7fff_ffff))),
         ("type 99", put(&bytes, 20, &be32(99))),
         ("version 9", put(&bytes, 0, &be32(9))),
@@ -536,7 +564,11 @@ fn dicom_codec_cases() -> Cases {
         c.one(
             &name("codestream middle garbled"),
             f,
-            put(&bytes, mid, &[0xff, 0x00, 0xff, 0xd9, 0x13, 0x37, 0xff, 0xff]),
+            put(
+                &bytes,
+                mid,
+                &[0xff, 0x00, 0xff, 0xd9, 0x13, 0x37, 0xff, 0xff],
+            ),
             Expect::Either,
         );
         for k in 0..6 {
@@ -544,7 +576,12 @@ fn dicom_codec_cases() -> Cases {
             let mut b = bytes.clone();
             b[at] ^= 0x5a;
             b[at + 1] = 0xff;
-            c.one(&name(&format!("bytes {at}-{} flipped", at + 1)), f, b, Expect::Either);
+            c.one(
+                &name(&format!("bytes {at}-{} flipped", at + 1)),
+                f,
+                b,
+                Expect::Either,
+            );
         }
         let stream = &bytes[start..];
         if dir.starts_with("jpeg") {
@@ -653,14 +690,28 @@ fn raw_cases() -> Cases {
         &mut c,
         "--dims 1024^3 of a 240-byte file",
         data.clone(),
-        &["--dims", "1024,1024,1024", "--dtype", "f32", "--max-memory", "1T"],
+        &[
+            "--dims",
+            "1024,1024,1024",
+            "--dtype",
+            "f32",
+            "--max-memory",
+            "1T",
+        ],
         Expect::Bad,
     );
     raw(
         &mut c,
         "--dims 2^21 cubed",
         data.clone(),
-        &["--dims", "2097152,2097152,2097152", "--dtype", "u8", "--max-memory", "1T"],
+        &[
+            "--dims",
+            "2097152,2097152,2097152",
+            "--dtype",
+            "u8",
+            "--max-memory",
+            "1T",
+        ],
         Expect::Bad,
     );
     raw(
@@ -696,7 +747,8 @@ fn zarr_size_cases() -> Cases {
     let mut c = Cases::new("zarr sizes");
     let huge = 1u64 << 40;
     let bytes = json!([{"name": "bytes", "configuration": {"endian": "little"}}]);
-    let v3 = |shape: serde_json::Value, chunk: serde_json::Value| zarr_v3(shape, chunk, bytes.clone());
+    let v3 =
+        |shape: serde_json::Value, chunk: serde_json::Value| zarr_v3(shape, chunk, bytes.clone());
     let zarray = |shape: serde_json::Value, chunks: serde_json::Value| {
         json!({
             "zarr_format": 2, "shape": shape, "chunks": chunks, "dtype": "<u2",
@@ -717,7 +769,10 @@ fn zarr_size_cases() -> Cases {
     let stores: Vec<(&str, Vec<(&str, Vec<u8>)>)> = vec![
         (
             "v3 shape 2^40 cubed in 64^3 chunks",
-            vec![("zarr.json", v3(json!([huge, huge, huge]), json!([64, 64, 64])))],
+            vec![(
+                "zarr.json",
+                v3(json!([huge, huge, huge]), json!([64, 64, 64])),
+            )],
         ),
         (
             "v3 shape 2^40 x 2^40 x 1",
@@ -729,13 +784,19 @@ fn zarr_size_cases() -> Cases {
         ),
         (
             "v2 shape 2^40 cubed",
-            vec![(".zarray", zarray(json!([huge, huge, huge]), json!([64, 64, 64])))],
+            vec![(
+                ".zarray",
+                zarray(json!([huge, huge, huge]), json!([64, 64, 64])),
+            )],
         ),
         (
             "OME-Zarr level 2^40 cubed",
             vec![
                 ("zarr.json", ome),
-                ("0/zarr.json", v3(json!([huge, huge, huge]), json!([64, 64, 64]))),
+                (
+                    "0/zarr.json",
+                    v3(json!([huge, huge, huge]), json!([64, 64, 64])),
+                ),
             ],
         ),
     ];
@@ -770,16 +831,33 @@ fn lying_cases() -> Cases {
     let at = dict.find("'shape': (").unwrap() + "'shape': ".len();
     let end = at + dict[at..].find(')').unwrap() + 1;
     let dict = format!("{}(1024, 1024, 1024){}", &dict[..at], &dict[end..]);
-    lie(&mut c, "c_f4.npy: shape 1024^3", "c_f4.npy", npy(dict.trim_end(), &bytes[10 + hlen..]));
+    lie(
+        &mut c,
+        "c_f4.npy: shape 1024^3",
+        "c_f4.npy",
+        npy(dict.trim_end(), &bytes[10 + hlen..]),
+    );
     // NRRD, attached and detached.
     let f = "f32_lps.nrrd";
     let bytes = fixture(&format!("nrrd/{f}"));
-    lie(&mut c, &format!("{f}: sizes 1024^3"), f, replace(&bytes, "sizes: 4 3 5", "sizes: 1024 1024 1024"));
+    lie(
+        &mut c,
+        &format!("{f}: sizes 1024^3"),
+        f,
+        replace(&bytes, "sizes: 4 3 5", "sizes: 1024 1024 1024"),
+    );
     let (h, r) = ("f64_be.nhdr", "f64_be.raw");
     c.many(
         &format!("{h}: sizes 1024^3"),
         vec![
-            (h.into(), replace(&fixture(&format!("nrrd/{h}")), "sizes: 4 3 5", "sizes: 1024 1024 1024")),
+            (
+                h.into(),
+                replace(
+                    &fixture(&format!("nrrd/{h}")),
+                    "sizes: 4 3 5",
+                    "sizes: 1024 1024 1024",
+                ),
+            ),
             (r.into(), fixture(&format!("nrrd/{r}"))),
         ],
         h,
@@ -793,16 +871,31 @@ fn lying_cases() -> Cases {
         .find(|l| l.starts_with("sizes: "))
         .expect("sizes")
         .to_string();
-    lie(&mut c, &format!("{f}: (text) sizes 1024^3"), f, replace(&bytes, &sizes, "sizes: 1024 1024 1024"));
+    lie(
+        &mut c,
+        &format!("{f}: (text) sizes 1024^3"),
+        f,
+        replace(&bytes, &sizes, "sizes: 1024 1024 1024"),
+    );
     // MetaImage, local and detached.
     let f = "f32.mha";
     let bytes = fixture(&format!("metaimage/{f}"));
-    lie(&mut c, &format!("{f}: DimSize 1024^3"), f, replace(&bytes, "DimSize = 4 3 5", "DimSize = 1024 1024 1024"));
+    lie(
+        &mut c,
+        &format!("{f}: DimSize 1024^3"),
+        f,
+        replace(&bytes, "DimSize = 4 3 5", "DimSize = 1024 1024 1024"),
+    );
     // NIfTI-1: dim[1..3] (int16 at 42) 1024; and Analyze's pair.
     let f = "f32.nii";
     let bytes = fixture(&format!("nifti/{f}"));
     let dims: Vec<u8> = [1024i16; 3].iter().flat_map(|d| d.to_le_bytes()).collect();
-    lie(&mut c, &format!("{f}: dim 1024^3"), f, put(&bytes, 42, &dims));
+    lie(
+        &mut c,
+        &format!("{f}: dim 1024^3"),
+        f,
+        put(&bytes, 42, &dims),
+    );
     let (h, i) = ("pair.hdr", "pair.img");
     c.many(
         &format!("{h}: dim 1024^3"),
@@ -817,13 +910,21 @@ fn lying_cases() -> Cases {
     // VTK legacy, binary and ASCII; VTK XML, inline binary, appended raw, ASCII.
     for f in ["legacy_f32.vtk", "legacy_f32_ascii.vtk"] {
         let bytes = fixture(&format!("vtk/{f}"));
-        let b = replace(&replace(&bytes, "DIMENSIONS 4 3 5", "DIMENSIONS 1024 1024 1024"), "POINT_DATA 60", "POINT_DATA 1073741824");
+        let b = replace(
+            &replace(&bytes, "DIMENSIONS 4 3 5", "DIMENSIONS 1024 1024 1024"),
+            "POINT_DATA 60",
+            "POINT_DATA 1073741824",
+        );
         lie(&mut c, &format!("{f}: DIMENSIONS 1024^3"), f, b);
     }
     for f in ["vti_binary.vti", "vti_appended_raw.vti", "vti_ascii.vti"] {
         let bytes = fixture(&format!("vtk/{f}"));
         let b = replace(
-            &replace(&bytes, "WholeExtent=\"0 3 0 2 0 4\"", "WholeExtent=\"0 1023 0 1023 0 1023\""),
+            &replace(
+                &bytes,
+                "WholeExtent=\"0 3 0 2 0 4\"",
+                "WholeExtent=\"0 1023 0 1023 0 1023\"",
+            ),
             "Extent=\"0 3 0 2 0 4\"",
             "Extent=\"0 1023 0 1023 0 1023\"",
         );
@@ -833,15 +934,30 @@ fn lying_cases() -> Cases {
     let f = "mode2_f32.mrc";
     let bytes = fixture(&format!("mrc/{f}"));
     let dims: Vec<u8> = [1024i32; 3].iter().flat_map(|d| d.to_le_bytes()).collect();
-    lie(&mut c, &format!("{f}: NX NY NZ 1024^3"), f, put(&bytes, 0, &dims));
+    lie(
+        &mut c,
+        &format!("{f}: NX NY NZ 1024^3"),
+        f,
+        put(&bytes, 0, &dims),
+    );
     // Gaussian cube and CHGCAR: text, at least two bytes a value.
     let f = "ramp_bohr.cube";
     let bytes = fixture(&format!("cube/{f}"));
-    let b = set_token(&set_token(&set_token(&bytes, 3, 0, "1024"), 4, 0, "1024"), 5, 0, "1024");
+    let b = set_token(
+        &set_token(&set_token(&bytes, 3, 0, "1024"), 4, 0, "1024"),
+        5,
+        0,
+        "1024",
+    );
     lie(&mut c, &format!("{f}: 1024^3 points"), f, b);
     let f = "CHGCAR_ortho";
     let bytes = fixture(&format!("chgcar/{f}"));
-    lie(&mut c, &format!("{f}: grid 1024^3"), f, replace(&bytes, "    4    3    5", " 1024 1024 1024"));
+    lie(
+        &mut c,
+        &format!("{f}: grid 1024^3"),
+        f,
+        replace(&bytes, "    4    3    5", " 1024 1024 1024"),
+    );
     // TIFF: the first page 60000 x 60000 (its strips far too short).
     let f = "plain_i32.tif";
     let bytes = fixture(&format!("tiff/{f}"));
@@ -863,7 +979,10 @@ fn lying_cases() -> Cases {
     let bytes = fixture(&format!("hdf5/{f}"));
     c.many(
         &format!("{f}: /fields/density 1024^3"),
-        vec![(f.into(), replace_all(&bytes, &h5_dims(&[4, 3, 5]), &h5_dims(&[1024, 1024, 1024])))],
+        vec![(
+            f.into(),
+            replace_all(&bytes, &h5_dims(&[4, 3, 5]), &h5_dims(&[1024, 1024, 1024])),
+        )],
         &format!("{f}:/fields/density"),
         Expect::Bad,
     );

@@ -11,10 +11,10 @@ use dicom_dictionary_std::{StandardDataDictionary, tags};
 use dicom_object::{DefaultDicomObject, InMemDicomObject, OpenFileOptions, Tag};
 use volray_core::glam::DVec3;
 
-use crate::shared::panics::guarded;
 use super::prescan::{PixelData, Prescan, prescan};
 use crate::error::IoError;
 use crate::shared::input::{open_input, read_exact_at};
+use crate::shared::panics::guarded;
 
 /// Header bytes read at first; doubled until the pixel data is reached.
 const FIRST_READ: usize = 64 << 10;

@@ -13,11 +13,11 @@ use dicom_pixeldata::PixelDecoder;
 
 use volray_core::SampleType;
 
-use crate::shared::panics::guarded;
 use super::codecs::{self, Codec};
 use super::header::{ImageFormat, Plane};
 use crate::dtype::Stored;
 use crate::error::IoError;
+use crate::shared::panics::guarded;
 use crate::shared::rescale::{integer_type, rescaled_range};
 
 /// The decoded frames of one file.
