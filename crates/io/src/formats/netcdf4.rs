@@ -26,8 +26,10 @@
 //!
 //! Box by box ([`open_lazy`], through `hdf5_lazy.rs`): the same axes,
 //! spacing, origin and values, each box read from the chunks or rows it
-//! covers. Along a decreasing coordinate (latitude from north to south,
-//! pressure levels from the ground up) each box is read from the file's
+//! covers. Along a coordinate that runs backward in the volume (latitude
+//! from north to south; a vertical one that points down, placed at
+//! z = −value by `cf.rs`, stored from the top down: pressure from 100 hPa
+//! to 1000, ocean depth from the surface) each box is read from the file's
 //! mirrored range and flipped, so that it is the box of the volume the
 //! eager reader flips whole.
 //!
