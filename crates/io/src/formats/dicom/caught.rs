@@ -46,7 +46,10 @@ mod tests {
         let none: Option<()> = quietly(|| panic!("a corrupt stream"));
         assert_eq!(none, None);
         // Nested: the inner call leaves the outer one quiet.
-        assert_eq!(quietly(|| quietly(|| 1).map(|v| v + QUIET.with(Cell::get) as i32)), Some(Some(2)));
+        assert_eq!(
+            quietly(|| quietly(|| 1).map(|v| v + QUIET.with(Cell::get) as i32)),
+            Some(Some(2))
+        );
         assert!(!QUIET.with(Cell::get));
     }
 }
