@@ -8,6 +8,9 @@ use super::*;
 
 // ----------------------------------------------------------------- Zarr
 
+/// A store's files: (path in `s.zarr`, bytes).
+type Store<'a> = Vec<(&'a str, Vec<u8>)>;
+
 /// Zarr stores declaring more than can be addressed: bad input (exit 1),
 /// by `info` and by `render` (which reads a chunked store in pieces).
 pub(super) fn zarr_size_cases() -> Cases {
@@ -34,7 +37,7 @@ pub(super) fn zarr_size_cases() -> Cases {
     })
     .to_string()
     .into_bytes();
-    let stores: Vec<(&str, Vec<(&str, Vec<u8>)>)> = vec![
+    let stores: Vec<(&str, Store)> = vec![
         (
             "v3 shape 2^40 cubed in 64^3 chunks",
             vec![(
