@@ -267,5 +267,26 @@ pub(super) fn cases() -> Cases {
         Expect::Bad,
     );
     c.with_args(LIMIT_MUST_REFUSE);
+    // Compressed payloads whose header declares 4 GiB, with the memory
+    // limit out of the way: the reader grows the volume as the stream
+    // inflates (nothing in the header says the stream is short), so it
+    // must find the stream's end, not allocate the declaration.
+    let f = "u8_gzip.nrrd";
+    let bytes = fixture(&format!("nrrd/{f}"));
+    let b = replace(&bytes, "sizes: 4 3 5", "sizes: 2048 2048 1024");
+    lie(&mut c, &format!("{f}: sizes 2048 2048 1024 (gzip)"), f, b);
+    let f = "i16_zlib.mha";
+    let bytes = fixture(&format!("metaimage/{f}"));
+    let b = replace(&bytes, "DimSize = 4 3 5", "DimSize = 2048 1024 1024");
+    lie(&mut c, &format!("{f}: DimSize 2048 1024 1024 (zlib)"), f, b);
+    let f = "f32.nii.gz";
+    let plain = gunzip(&fixture(&format!("nifti/{f}")));
+    let dims: Vec<u8> = [1024i16; 3].iter().flat_map(|d| d.to_le_bytes()).collect();
+    lie(
+        &mut c,
+        &format!("{f}: dim 1024^3 (gzip)"),
+        f,
+        gzip(&put(&plain, 42, &dims)),
+    );
     c
 }
