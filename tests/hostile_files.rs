@@ -19,6 +19,10 @@
 //! still leave a valid file (random bit flips, edits the format tolerates)
 //! only assert exit 0 or 1, never a crash, with the same hygiene.
 
+#[path = "hostile_files/encoded_dicom.rs"]
+mod encoded_dicom;
+#[path = "hostile_files/lying.rs"]
+mod lying;
 #[path = "hostile_files/readers.rs"]
 mod readers;
 

@@ -1,7 +1,7 @@
 //! The readers the first cases of `hostile_files.rs` left out (NetCDF-3,
-//! MINC1, NetCDF-4, FITS, MGH/MGZ, DICOM in each compressed transfer
-//! syntax, raw), and for every reader a header that lies about its size
-//! without tripping the memory limit (issue 41).
+//! MINC1, NetCDF-4, FITS, MGH/MGZ, raw; DICOM in each compressed transfer
+//! syntax in `encoded_dicom.rs`), and for every reader a header that lies
+//! about its size without tripping the memory limit (`lying.rs`; issue 41).
 //!
 //! A lie about an uncompressed volume runs with `--max-memory 1T`, so
 //! that only the reader's check of the file's length stands between the
@@ -15,9 +15,9 @@ use super::*;
 
 /// The flags of a lie about an uncompressed volume: only the file's
 /// length may refuse it.
-const FILE_MUST_REFUSE: &[&str] = &["--max-memory", "1T"];
+pub(super) const FILE_MUST_REFUSE: &[&str] = &["--max-memory", "1T"];
 /// The flags of a lie about compressed data: the memory limit refuses it.
-const LIMIT_MUST_REFUSE: &[&str] = &["--max-memory", "1G"];
+pub(super) const LIMIT_MUST_REFUSE: &[&str] = &["--max-memory", "1G"];
 
 /// Every case of this module.
 pub(super) fn all() -> Vec<Cases> {
@@ -27,10 +27,10 @@ pub(super) fn all() -> Vec<Cases> {
         netcdf4_cases(),
         fits_cases(),
         mgh_cases(),
-        dicom_codec_cases(),
+        super::encoded_dicom::cases(),
         raw_cases(),
-        zarr_size_cases(),
-        lying_cases(),
+        super::lying::zarr_size_cases(),
+        super::lying::cases(),
     ]
 }
 
@@ -39,7 +39,7 @@ fn be32(v: u32) -> [u8; 4] {
 }
 
 /// `bytes` with every `from` replaced by `to`; there must be one.
-fn replace_all(bytes: &[u8], from: &[u8], to: &[u8]) -> Vec<u8> {
+pub(super) fn replace_all(bytes: &[u8], from: &[u8], to: &[u8]) -> Vec<u8> {
     assert!(find(bytes, from).is_some(), "{from:?} not in the fixture");
     let mut out = Vec::with_capacity(bytes.len());
     let mut at = 0;
@@ -57,7 +57,7 @@ fn replace_all(bytes: &[u8], from: &[u8], to: &[u8]) -> Vec<u8> {
 
 /// Dimensions as an HDF5 dataspace message stores them: 8-byte
 /// little-endian lengths.
-fn h5_dims(dims: &[u64]) -> Vec<u8> {
+pub(super) fn h5_dims(dims: &[u64]) -> Vec<u8> {
     dims.iter().flat_map(|d| d.to_le_bytes()).collect()
 }
 
@@ -495,188 +495,6 @@ fn mgh_cases() -> Cases {
     c
 }
 
-// ------------------------------------------------------- DICOM, encoded
-
-/// The first fragment of the encapsulated pixel data of `bytes` (after
-/// the Basic Offset Table item): the offset of its item's length field.
-fn first_fragment(bytes: &[u8]) -> usize {
-    let pixel = find(bytes, &[0xe0, 0x7f, 0x10, 0x00]).expect("pixel data");
-    let item = [0xfe, 0xff, 0x00, 0xe0];
-    let table = pixel + find(&bytes[pixel..], &item).expect("offset table item");
-    let table_len = u32::from_le_bytes(bytes[table + 4..table + 8].try_into().unwrap()) as usize;
-    let fragment = table + 8 + table_len;
-    assert_eq!(bytes[fragment..fragment + 4], item, "a fragment item");
-    fragment + 4
-}
-
-fn dicom_codec_cases() -> Cases {
-    let mut c = Cases::new("dicom-codecs");
-    // One file of each encapsulated transfer syntax volray decodes.
-    for (dir, f) in [
-        ("jpeg_baseline", "jpe0.dcm"),
-        ("jpeg_extended_8bit", "jpe0.dcm"),
-        ("jpeg_lossless", "jpe0.dcm"),
-        ("jpeg_sv1", "jpe0.dcm"),
-        ("jpegls", "jpe0.dcm"),
-        ("jpegls_near", "jpe0.dcm"),
-        ("j2k_lossless", "j2k0.dcm"),
-        ("j2k_lossy", "j2k0.dcm"),
-        ("rle", "r0.dcm"),
-    ] {
-        let bytes = fixture(&format!("dicom/{dir}/{f}"));
-        let name = |what: &str| format!("{dir}/{f}: {what}");
-        let len_at = first_fragment(&bytes);
-        let start = len_at + 4;
-        let n = bytes.len();
-        c.one(
-            &name("cut in the pixel data"),
-            f,
-            bytes[..(start + n) / 2].to_vec(),
-            Expect::Bad,
-        );
-        c.one(
-            &name("cut after the fragment's item tag"),
-            f,
-            bytes[..start].to_vec(),
-            Expect::Bad,
-        );
-        c.one(
-            &name("fragment length 2^31 - 2"),
-            f,
-            put(&bytes, len_at, &0x7fff_fffeu32.to_le_bytes()),
-            Expect::Bad,
-        );
-        c.one(
-            &name("fragment length 2"),
-            f,
-            put(&bytes, len_at, &2u32.to_le_bytes()),
-            Expect::Bad,
-        );
-        // The codestream's opening bytes garbled, then its middle: a
-        // decoder error, or (lossy codes have no checksum) other pixels.
-        c.one(
-            &name("codestream start garbled"),
-            f,
-            put(&bytes, start, &[0x5a; 12]),
-            Expect::Bad,
-        );
-        let mid = (start + n) / 2;
-        c.one(
-            &name("codestream middle garbled"),
-            f,
-            put(
-                &bytes,
-                mid,
-                &[0xff, 0x00, 0xff, 0xd9, 0x13, 0x37, 0xff, 0xff],
-            ),
-            Expect::Either,
-        );
-        for k in 0..6 {
-            let at = start + k * (n - start) / 6;
-            let mut b = bytes.clone();
-            b[at] ^= 0x5a;
-            b[at + 1] = 0xff;
-            c.one(
-                &name(&format!("bytes {at}-{} flipped", at + 1)),
-                f,
-                b,
-                Expect::Either,
-            );
-        }
-        let stream = &bytes[start..];
-        if dir.starts_with("jpeg") {
-            // The first SOF's height (Y) made 65535 and 0.
-            let sof = (0..stream.len() - 1)
-                .find(|&i| stream[i] == 0xff && matches!(stream[i + 1], 0xc0..=0xc3 | 0xf7))
-                .expect("a SOF marker");
-            for y in [0xffffu16, 0] {
-                c.one(
-                    &name(&format!("frame header height {y}")),
-                    f,
-                    put(&bytes, start + sof + 5, &y.to_be_bytes()),
-                    Expect::Bad,
-                );
-            }
-            let sos = find(stream, &[0xff, 0xda]).expect("a SOS marker");
-            // The issue's report: a JPEG-LS scan header whose length puts
-            // the scan data past the stream's end.
-            c.one(
-                &name("scan header length 65535"),
-                f,
-                put(&bytes, start + sos + 2, &[0xff, 0xff]),
-                Expect::Bad,
-            );
-            c.one(
-                &name("scan header length 0"),
-                f,
-                put(&bytes, start + sos + 2, &[0, 0]),
-                Expect::Bad,
-            );
-        }
-        if dir.starts_with("jpegls") {
-            // An LSE segment (preset parameters) before the scan: MAXVAL
-            // 65535, T1..T3 65535, RESET 65535.
-            let sos = start + find(stream, &[0xff, 0xda]).expect("a SOS marker");
-            // A fill byte first keeps the fragment's length even.
-            let lse = [
-                0xff, 0xff, 0xf8, 0, 13, 1, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff,
-                0xff,
-            ];
-            let mut b = [&bytes[..sos], &lse[..], &bytes[sos..]].concat();
-            // The fragment and the pixel data grew by the segment.
-            let grow = |b: &mut Vec<u8>, at: usize| {
-                let v = u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
-                if v != u32::MAX {
-                    b[at..at + 4].copy_from_slice(&(v + lse.len() as u32).to_le_bytes());
-                }
-            };
-            grow(&mut b, len_at);
-            c.one(&name("extreme LSE preset parameters"), f, b, Expect::Either);
-        }
-        if dir.starts_with("j2k") {
-            // SIZ: Xsiz and Ysiz (bytes 8..16 after SOC) made 2^32 - 1.
-            let siz = find(stream, &[0xff, 0x4f, 0xff, 0x51]).expect("SOC SIZ");
-            c.one(
-                &name("SIZ 2^32 - 1 square"),
-                f,
-                put(&bytes, start + siz + 8, &[0xff; 8]),
-                Expect::Bad,
-            );
-            c.one(
-                &name("SIZ 0 components"),
-                f,
-                put(&bytes, start + siz + 40, &[0, 0]),
-                Expect::Bad,
-            );
-        }
-        if dir == "rle" {
-            // The RLE header: a segment count and 15 offsets (PS3.5 G.5).
-            for (what, header) in [
-                ("15 segments far past the end", {
-                    let mut h = rle_count(15);
-                    h.extend((0..15).flat_map(|_| 0x7fff_fff0u32.to_le_bytes()));
-                    h
-                }),
-                ("offsets decreasing", {
-                    let mut h = rle_count(2);
-                    h.extend(64u32.to_le_bytes());
-                    h.extend(32u32.to_le_bytes());
-                    h.resize(64, 0);
-                    h
-                }),
-                ("99 segments", rle_count(99)),
-            ] {
-                c.one(&name(what), f, put(&bytes, start, &header), Expect::Bad);
-            }
-        }
-    }
-    c
-}
-
-fn rle_count(n: u32) -> Vec<u8> {
-    n.to_le_bytes().to_vec()
-}
-
 // ------------------------------------------------------------------ raw
 
 fn raw_cases() -> Cases {
@@ -735,266 +553,5 @@ fn raw_cases() -> Cases {
         &["--dims", "4,6,10", "--dtype", "u8"],
         Expect::Either,
     );
-    c
-}
-
-// ----------------------------------------------------------------- Zarr
-
-/// Zarr stores declaring more than can be addressed: bad input (exit 1),
-/// by `info` and by `render` (which reads a chunked store in pieces).
-fn zarr_size_cases() -> Cases {
-    use serde_json::json;
-    let mut c = Cases::new("zarr sizes");
-    let huge = 1u64 << 40;
-    let bytes = json!([{"name": "bytes", "configuration": {"endian": "little"}}]);
-    let v3 =
-        |shape: serde_json::Value, chunk: serde_json::Value| zarr_v3(shape, chunk, bytes.clone());
-    let zarray = |shape: serde_json::Value, chunks: serde_json::Value| {
-        json!({
-            "zarr_format": 2, "shape": shape, "chunks": chunks, "dtype": "<u2",
-            "compressor": null, "fill_value": 0, "order": "C", "filters": null,
-        })
-        .to_string()
-        .into_bytes()
-    };
-    let ome = json!({
-        "zarr_format": 3, "node_type": "group",
-        "attributes": {"ome": {"version": "0.5", "multiscales": [{
-            "axes": ["z", "y", "x"],
-            "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1, 1, 1]}]}],
-        }]}},
-    })
-    .to_string()
-    .into_bytes();
-    let stores: Vec<(&str, Vec<(&str, Vec<u8>)>)> = vec![
-        (
-            "v3 shape 2^40 cubed in 64^3 chunks",
-            vec![(
-                "zarr.json",
-                v3(json!([huge, huge, huge]), json!([64, 64, 64])),
-            )],
-        ),
-        (
-            "v3 shape 2^40 x 2^40 x 1",
-            vec![("zarr.json", v3(json!([1, huge, huge]), json!([1, 64, 64])))],
-        ),
-        (
-            "v3 shape 2^63 x 2 x 2",
-            vec![("zarr.json", v3(json!([1u64 << 63, 2, 2]), json!([1, 2, 2])))],
-        ),
-        (
-            "v2 shape 2^40 cubed",
-            vec![(
-                ".zarray",
-                zarray(json!([huge, huge, huge]), json!([64, 64, 64])),
-            )],
-        ),
-        (
-            "OME-Zarr level 2^40 cubed",
-            vec![
-                ("zarr.json", ome),
-                (
-                    "0/zarr.json",
-                    v3(json!([huge, huge, huge]), json!([64, 64, 64])),
-                ),
-            ],
-        ),
-    ];
-    for (what, files) in stores {
-        let files = files
-            .into_iter()
-            .map(|(f, b)| (format!("s.zarr/{f}"), b))
-            .collect();
-        c.many(what, files, "s.zarr", Expect::Bad);
-        c.rendered();
-    }
-    c
-}
-
-// --------------------------------------------------- lies, every reader
-
-/// A one-file case that must be refused by the file's length alone.
-fn lie(c: &mut Cases, name: &str, file: &str, bytes: Vec<u8>) {
-    c.one(name, file, bytes, Expect::Bad);
-    c.with_args(FILE_MUST_REFUSE);
-}
-
-/// Each reader's header declaring 1024^3 or more of uncompressed data in
-/// a file of a few hundred bytes, with `--max-memory 1T`: the file's
-/// length must refuse it before anything is allocated.
-fn lying_cases() -> Cases {
-    let mut c = Cases::new("lying sizes");
-    // NumPy.
-    let bytes = fixture("c_f4.npy");
-    let hlen = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let dict = String::from_utf8(bytes[10..10 + hlen].to_vec()).unwrap();
-    let at = dict.find("'shape': (").unwrap() + "'shape': ".len();
-    let end = at + dict[at..].find(')').unwrap() + 1;
-    let dict = format!("{}(1024, 1024, 1024){}", &dict[..at], &dict[end..]);
-    lie(
-        &mut c,
-        "c_f4.npy: shape 1024^3",
-        "c_f4.npy",
-        npy(dict.trim_end(), &bytes[10 + hlen..]),
-    );
-    // NRRD, attached and detached.
-    let f = "f32_lps.nrrd";
-    let bytes = fixture(&format!("nrrd/{f}"));
-    lie(
-        &mut c,
-        &format!("{f}: sizes 1024^3"),
-        f,
-        replace(&bytes, "sizes: 4 3 5", "sizes: 1024 1024 1024"),
-    );
-    let (h, r) = ("f64_be.nhdr", "f64_be.raw");
-    c.many(
-        &format!("{h}: sizes 1024^3"),
-        vec![
-            (
-                h.into(),
-                replace(
-                    &fixture(&format!("nrrd/{h}")),
-                    "sizes: 4 3 5",
-                    "sizes: 1024 1024 1024",
-                ),
-            ),
-            (r.into(), fixture(&format!("nrrd/{r}"))),
-        ],
-        h,
-        Expect::Bad,
-    );
-    c.with_args(FILE_MUST_REFUSE);
-    let f = "u16_ascii.nrrd";
-    let bytes = fixture(&format!("nrrd/{f}"));
-    let sizes = String::from_utf8_lossy(&bytes)
-        .lines()
-        .find(|l| l.starts_with("sizes: "))
-        .expect("sizes")
-        .to_string();
-    lie(
-        &mut c,
-        &format!("{f}: (text) sizes 1024^3"),
-        f,
-        replace(&bytes, &sizes, "sizes: 1024 1024 1024"),
-    );
-    // MetaImage, local and detached.
-    let f = "f32.mha";
-    let bytes = fixture(&format!("metaimage/{f}"));
-    lie(
-        &mut c,
-        &format!("{f}: DimSize 1024^3"),
-        f,
-        replace(&bytes, "DimSize = 4 3 5", "DimSize = 1024 1024 1024"),
-    );
-    // NIfTI-1: dim[1..3] (int16 at 42) 1024; and Analyze's pair.
-    let f = "f32.nii";
-    let bytes = fixture(&format!("nifti/{f}"));
-    let dims: Vec<u8> = [1024i16; 3].iter().flat_map(|d| d.to_le_bytes()).collect();
-    lie(
-        &mut c,
-        &format!("{f}: dim 1024^3"),
-        f,
-        put(&bytes, 42, &dims),
-    );
-    let (h, i) = ("pair.hdr", "pair.img");
-    c.many(
-        &format!("{h}: dim 1024^3"),
-        vec![
-            (h.into(), put(&fixture(&format!("nifti/{h}")), 42, &dims)),
-            (i.into(), fixture(&format!("nifti/{i}"))),
-        ],
-        h,
-        Expect::Bad,
-    );
-    c.with_args(FILE_MUST_REFUSE);
-    // VTK legacy, binary and ASCII; VTK XML, inline binary, appended raw, ASCII.
-    for f in ["legacy_f32.vtk", "legacy_f32_ascii.vtk"] {
-        let bytes = fixture(&format!("vtk/{f}"));
-        let b = replace(
-            &replace(&bytes, "DIMENSIONS 4 3 5", "DIMENSIONS 1024 1024 1024"),
-            "POINT_DATA 60",
-            "POINT_DATA 1073741824",
-        );
-        lie(&mut c, &format!("{f}: DIMENSIONS 1024^3"), f, b);
-    }
-    for f in ["vti_binary.vti", "vti_appended_raw.vti", "vti_ascii.vti"] {
-        let bytes = fixture(&format!("vtk/{f}"));
-        let b = replace(
-            &replace(
-                &bytes,
-                "WholeExtent=\"0 3 0 2 0 4\"",
-                "WholeExtent=\"0 1023 0 1023 0 1023\"",
-            ),
-            "Extent=\"0 3 0 2 0 4\"",
-            "Extent=\"0 1023 0 1023 0 1023\"",
-        );
-        lie(&mut c, &format!("{f}: extent 1024^3"), f, b);
-    }
-    // MRC: NX NY NZ (int32 at 0).
-    let f = "mode2_f32.mrc";
-    let bytes = fixture(&format!("mrc/{f}"));
-    let dims: Vec<u8> = [1024i32; 3].iter().flat_map(|d| d.to_le_bytes()).collect();
-    lie(
-        &mut c,
-        &format!("{f}: NX NY NZ 1024^3"),
-        f,
-        put(&bytes, 0, &dims),
-    );
-    // Gaussian cube and CHGCAR: text, at least two bytes a value.
-    let f = "ramp_bohr.cube";
-    let bytes = fixture(&format!("cube/{f}"));
-    let b = set_token(
-        &set_token(&set_token(&bytes, 3, 0, "1024"), 4, 0, "1024"),
-        5,
-        0,
-        "1024",
-    );
-    lie(&mut c, &format!("{f}: 1024^3 points"), f, b);
-    let f = "CHGCAR_ortho";
-    let bytes = fixture(&format!("chgcar/{f}"));
-    lie(
-        &mut c,
-        &format!("{f}: grid 1024^3"),
-        f,
-        replace(&bytes, "    4    3    5", " 1024 1024 1024"),
-    );
-    // TIFF: the first page 60000 x 60000 (its strips far too short).
-    let f = "plain_i32.tif";
-    let bytes = fixture(&format!("tiff/{f}"));
-    let mut b = bytes.clone();
-    for tag in [256, 257] {
-        let (at, is_long) = tiff_entry(&b, tag);
-        let little = &b[..2] == b"II";
-        let value = match (is_long, little) {
-            (true, true) => 60000u32.to_le_bytes().to_vec(),
-            (true, false) => 60000u32.to_be_bytes().to_vec(),
-            (false, true) => 60000u16.to_le_bytes().to_vec(),
-            (false, false) => 60000u16.to_be_bytes().to_vec(),
-        };
-        b = put(&b, at, &value);
-    }
-    lie(&mut c, &format!("{f}: 60000 x 60000 pages"), f, b);
-    // HDF5 and MINC2: the dataspace of the volume made 1024^3.
-    let f = "one.h5";
-    let bytes = fixture(&format!("hdf5/{f}"));
-    c.many(
-        &format!("{f}: /fields/density 1024^3"),
-        vec![(
-            f.into(),
-            replace_all(&bytes, &h5_dims(&[4, 3, 5]), &h5_dims(&[1024, 1024, 1024])),
-        )],
-        &format!("{f}:/fields/density"),
-        Expect::Bad,
-    );
-    c.with_args(FILE_MUST_REFUSE);
-    let f = "ramp_i16.mnc";
-    let bytes = fixture(&format!("minc/{f}"));
-    c.one(
-        &format!("{f}: image 1024^3"),
-        f,
-        replace_all(&bytes, &h5_dims(&[3, 4, 5]), &h5_dims(&[1024, 1024, 1024])),
-        Expect::Bad,
-    );
-    c.with_args(LIMIT_MUST_REFUSE);
     c
 }

@@ -91,3 +91,19 @@ fn dicom_jpegls_scan_header_length_past_the_stream() {
         "{message}"
     );
 }
+
+/// A 950-byte DICOM file in RLE Lossless (16 x 12, 16 bits) whose RLE
+/// header's first 12 bytes are garbled: 1 515 870 810 segments, offsets
+/// to match. `dicom-pixeldata` trusted the header and allocated 6 GB (an
+/// abort under `ulimit -v`, found by tests/hostile_files.rs; other
+/// segment counts made it panic). Each fragment's RLE header is now
+/// checked first (issue 41).
+#[test]
+fn dicom_rle_header_with_a_garbled_segment_count() {
+    let path = finding("dicom", "rle_header_garbled.dcm");
+    let message = refusal(&path, VolumeFormat::Dicom, None, None);
+    assert!(
+        message.contains("declares 1515870810 RLE segment(s)"),
+        "{message}"
+    );
+}
