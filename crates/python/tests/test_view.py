@@ -357,6 +357,14 @@ def test_a_page_not_heard_from_is_closed_so_reloads_do_not_use_up_the_pages(ball
         w._on_message(w, {"view": "live", "alive": True}, [])
         time.sleep(w._HEARTBEAT_S)
     assert w.pages == 1
+    # While a cell runs the kernel reads no page's messages: a page is not
+    # closed then, and is given the timeout again once the cell ends.
+    w._cell_starts()
+    time.sleep(4 * w._TIMEOUT_S)
+    assert w.pages == 1
+    w._cell_ends()
+    assert w.pages == 1
+    w._on_message(w, {"view": "live", "alive": True}, [])
     # Closed by its page (the output cleared): gone at once.
     w._on_message(w, {"view": "live", "close": True}, [])
     assert w.pages == 0

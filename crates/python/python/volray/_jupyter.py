@@ -14,7 +14,9 @@ kernel, so that a slow connection slows the renderer instead of filling
 the comm. A page also says it is alive every ``_HEARTBEAT_S`` seconds: a
 page not heard from for ``_TIMEOUT_S`` (reloaded, or its browser tab
 closed, which sends no message) has its renderer closed, so that reloads
-do not use up the pages a widget may open.
+do not use up the pages a widget may open. While a cell runs the kernel
+reads no message of any page, so no page is closed then, and each is
+given ``_TIMEOUT_S`` again once the cell ends.
 """
 
 from __future__ import annotations
@@ -74,7 +76,19 @@ class Viewer(anywidget.AnyWidget):
         self._seen: Dict[str, float] = {}
         self._lock = threading.Lock()
         self._reaping = False
+        self._busy = False  # a cell runs: the pages' messages wait
         self.on_msg(self._on_message)
+        self._shell = None
+        try:
+            from IPython import get_ipython
+
+            shell = get_ipython()
+        except ImportError:  # pragma: no cover - anywidget needs IPython
+            shell = None
+        if shell is not None and hasattr(shell, "events"):
+            shell.events.register("pre_run_cell", self._cell_starts)
+            shell.events.register("post_run_cell", self._cell_ends)
+            self._shell = shell
 
     # ---------------------------------------------------------- read back
 
@@ -174,11 +188,26 @@ class Viewer(anywidget.AnyWidget):
         if start_reaper:
             threading.Thread(target=self._reaper, name="volray-view-reaper", daemon=True).start()
 
-    def _reap(self) -> None:
-        """Closes the renderers of the pages not heard from for
-        ``_TIMEOUT_S`` seconds."""
+    def _cell_starts(self, _info: Any = None) -> None:
+        with self._lock:
+            self._busy = True
+
+    def _cell_ends(self, _result: Any = None) -> None:
+        """The kernel reads the pages' messages again: each page is given
+        ``_TIMEOUT_S`` from now."""
         now = time.monotonic()
         with self._lock:
+            self._busy = False
+            for view in self._seen:
+                self._seen[view] = now
+
+    def _reap(self) -> None:
+        """Closes the renderers of the pages not heard from for
+        ``_TIMEOUT_S`` seconds (none while a cell runs)."""
+        now = time.monotonic()
+        with self._lock:
+            if self._busy:
+                return
             silent = [v for v in self._tabs if now - self._seen.get(v, now) > self._TIMEOUT_S]
         for view in silent:
             self._close(view)
@@ -234,6 +263,14 @@ class Viewer(anywidget.AnyWidget):
                 self._seen.clear()
         for tab in tabs:
             tab.close()
+        shell = getattr(self, "_shell", None)
+        if shell is not None:
+            for event, callback in [("pre_run_cell", self._cell_starts), ("post_run_cell", self._cell_ends)]:
+                try:
+                    shell.events.unregister(event, callback)
+                except ValueError:  # pragma: no cover - unregistered already
+                    pass
+            self._shell = None
         super().close()
 
 
