@@ -169,12 +169,11 @@ fn channels_at_a_time_point_are_each_channel_alone_at_it_summed() {
             })
             .collect();
         for (i, p) in all.rgb.iter().enumerate() {
-            for k in 0..3 {
+            for (k, &got) in p.iter().enumerate() {
                 let sum: u32 = alone.iter().map(|a| u32::from(a.rgb[i][k])).sum();
                 assert!(
-                    u32::from(p[k]).abs_diff(sum.min(255)) <= 2,
-                    "{input}: pixel {i} channel {k}: {} vs {sum}",
-                    p[k]
+                    u32::from(got).abs_diff(sum.min(255)) <= 2,
+                    "{input}: pixel {i} channel {k}: {got} vs {sum}"
                 );
             }
         }

@@ -68,7 +68,7 @@ pub struct InputArgs {
 
     /// Which channel, from 0, of a file that holds several: an OME-Zarr
     /// image's or HDF5 dataset's `c` axis, a hyperstack's or OME-TIFF's
-    /// channels, a 5-D NIfTI's components (dim[5]), an NRRD's or
+    /// channels, a 5-D NIfTI's components (`dim[5]`), an NRRD's or
     /// MetaImage's vector components; --frame picks the time point
     /// [default: 0].
     #[arg(long, value_name = "N")]
