@@ -40,7 +40,7 @@ use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
 use volray_core::scene::{Look, Mix, SceneSettings};
 use volray_core::{Camera, Image, NonFinite, RenderSettings, Volume};
-use volray_distributed::frame::{Distributed, FrameError, RankTimes, Source, agree};
+use volray_distributed::frame::{Distributed, Failure, FrameError, RankTimes, Source, agree};
 use volray_distributed::kd::Decomposition;
 use volray_distributed::mpi::Mpi;
 use volray_distributed::scene::DistributedScene;
@@ -99,7 +99,7 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
     } else {
         Ok(())
     };
-    agree(&mpi, checked.map(|_| Vec::new()).map_err(|e| e.to_string()))
+    agree(&mpi, checked.map(|_| Vec::new()).map_err(|e| failed(&e)))
         .map_err(|e| failure(&args.view, "", e))?;
     if let Some(which) = &args.scene.channels {
         let image = channels(args, which, &mpi, settings)?;
@@ -167,7 +167,7 @@ fn channels(
         bytes.push(u8::from(axis == ChannelAxis::Channel));
         bytes
     });
-    let all = agree(mpi, told.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
+    let all = agree(mpi, told.map_err(|e| failed(&e))).map_err(|e| failure(view, &spec, e))?;
     let word = |b: &[u8]| u32::from_le_bytes(b[..4].try_into().expect("four bytes")) as usize;
     let (count, axis) = (
         word(&all[0]),
@@ -420,8 +420,22 @@ fn from_volume(
 fn failure(view: &ViewArgs, name: &str, e: FrameError) -> CliError {
     match e {
         FrameError::Render(e) => render_failure(view, name, e),
-        FrameError::Rank { rank, message } => CliError::io(format!("rank {rank}: {message}")),
+        FrameError::Rank {
+            rank,
+            message,
+            bad_input: true,
+        } => CliError::input(format!("rank {rank}: {message}")),
+        FrameError::Rank { rank, message, .. } => CliError::io(format!("rank {rank}: {message}")),
         e => CliError::io(e.to_string()),
+    }
+}
+
+/// A rank's error as the ranks agree on it, its exit code kept: a
+/// corrupt file is bad input (1) on every rank, as in one process.
+fn failed(e: &CliError) -> Failure {
+    Failure {
+        message: e.to_string(),
+        bad_input: e.code == 1,
     }
 }
 
@@ -588,7 +602,7 @@ impl CliSource {
             let status = opened
                 .as_ref()
                 .map(|lazy| vec![u8::from(lazy.is_some())])
-                .map_err(|e| e.to_string());
+                .map_err(failed);
             let all = agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
             if all.iter().all(|m| m.first() == Some(&1)) {
                 let lazy = opened.ok().flatten().expect("agreed");
@@ -597,7 +611,8 @@ impl CliSource {
                 let stored = lazy.source.sample_type();
                 source.chunked = Some(lazy.source);
                 let fits = source.check_piece(mpi, Route::Chunked { stored });
-                agree(mpi, fits.map(|_| Vec::new())).map_err(|e| failure(view, &spec, e))?;
+                agree(mpi, fits.map(|_| Vec::new()).map_err(Failure::bad_input))
+                    .map_err(|e| failure(view, &spec, e))?;
                 source.agree_log_floor(mpi, view)?;
                 return Ok(source);
             }
@@ -616,8 +631,7 @@ impl CliSource {
                 .as_ref()
                 .map_or_else(Vec::new, |i| Header::of(i).to_bytes())
         });
-        let all =
-            agree(mpi, header.map_err(|e| e.to_string())).map_err(|e| failure(view, &spec, e))?;
+        let all = agree(mpi, header.map_err(failed)).map_err(|e| failure(view, &spec, e))?;
         let header = Header::parse(&all[0]);
         source.grid = header.grid;
         if header.nan_is_empty {
@@ -637,17 +651,15 @@ impl CliSource {
         if let (true, Ok(Some(input))) = (fits.is_ok() && !header.local, &first) {
             fits = source.check_scatter(mpi, &input.volume);
         }
-        agree(mpi, fits.map(|_| Vec::new())).map_err(|e| failure(view, &spec, e))?;
+        agree(mpi, fits.map(|_| Vec::new()).map_err(Failure::bad_input))
+            .map_err(|e| failure(view, &spec, e))?;
         if header.local {
             // Every rank maps the file itself.
             let input = match first {
                 Ok(Some(input)) => Ok(input),
                 _ => load(),
             };
-            let status = input
-                .as_ref()
-                .map(|_| Vec::new())
-                .map_err(|e| e.to_string());
+            let status = input.as_ref().map(|_| Vec::new()).map_err(failed);
             agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
             let input = input.expect("agreed");
             source.reorientation = input.file.and_then(|(_, info)| info.reorientation);
@@ -701,10 +713,7 @@ impl CliSource {
                 .map(|v| (n, v))
                 .map_err(CliError::from)
         });
-        let status = probe
-            .as_ref()
-            .map(|_| Vec::new())
-            .map_err(|e| e.to_string());
+        let status = probe.as_ref().map(|_| Vec::new()).map_err(failed);
         agree(mpi, status).map_err(|e| failure(view, &spec, e))?;
         let (n, corner) = probe.expect("agreed");
         self.grid = GridFrame {
@@ -714,7 +723,8 @@ impl CliSource {
         };
         self.generate = Some(spec.clone());
         let fits = self.check_piece(mpi, Route::Generated);
-        agree(mpi, fits.map(|_| Vec::new())).map_err(|e| failure(view, &spec, e))?;
+        agree(mpi, fits.map(|_| Vec::new()).map_err(Failure::bad_input))
+            .map_err(|e| failure(view, &spec, e))?;
         self.agree_log_floor(mpi, view)
     }
 

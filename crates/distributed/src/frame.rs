@@ -29,9 +29,14 @@ pub use volray_core::VolumeSource as Source;
 /// Why a distributed frame failed: the same on every rank.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FrameError {
-    /// A rank failed (the lowest-numbered rank that did), with its message.
+    /// A rank failed (the lowest-numbered rank that did), with its
+    /// message, and whether its input was at fault ([`Failure`]).
     #[error("rank {rank}: {message}")]
-    Rank { rank: usize, message: String },
+    Rank {
+        rank: usize,
+        message: String,
+        bad_input: bool,
+    },
     /// Rendering refused the settings (every rank refuses alike).
     #[error(transparent)]
     Render(#[from] RenderError),
@@ -127,31 +132,70 @@ pub struct Distributed<'t, T: Transport + ?Sized> {
     max_gradient: Option<f32>,
 }
 
+/// A rank's failed step, as every rank learns it: what it says, and
+/// whether the input was at fault (a corrupt or lying file, refused
+/// settings: the command line's exit 1) rather than the system (a read
+/// that failed: exit 2). A bare message is the latter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    pub message: String,
+    pub bad_input: bool,
+}
+
+impl Failure {
+    /// The input was at fault.
+    pub fn bad_input(message: impl Into<String>) -> Self {
+        Failure {
+            message: message.into(),
+            bad_input: true,
+        }
+    }
+}
+
+impl From<String> for Failure {
+    fn from(message: String) -> Self {
+        Failure {
+            message,
+            bad_input: false,
+        }
+    }
+}
+
+/// The first byte of a rank's status in [`agree`].
+const OK: u8 = 0;
+const FAILED: u8 = 1;
+const BAD_INPUT: u8 = 2;
+
 /// Every rank's outcome of a step (its bytes), or the first failure, on
 /// every rank: what each rank does after a step that may fail on one.
-pub fn agree<T: Transport + ?Sized>(
+pub fn agree<T: Transport + ?Sized, E: Into<Failure>>(
     transport: &T,
-    outcome: Result<Vec<u8>, String>,
+    outcome: Result<Vec<u8>, E>,
 ) -> Result<Vec<Vec<u8>>, FrameError> {
-    let message = match &outcome {
-        Ok(bytes) => [&[0u8][..], bytes].concat(),
-        Err(e) => [&[1u8][..], e.as_bytes()].concat(),
+    let message = match outcome.map_err(Into::into) {
+        Ok(bytes) => [&[OK][..], &bytes].concat(),
+        Err(f) => {
+            let status = if f.bad_input { BAD_INPUT } else { FAILED };
+            [&[status][..], f.message.as_bytes()].concat()
+        }
     };
     let all = transport.all_gather(&message)?;
     let mut out = Vec::with_capacity(all.len());
     for (rank, m) in all.into_iter().enumerate() {
         match m.split_first() {
-            Some((0, body)) => out.push(body.to_vec()),
-            Some((_, body)) => {
+            Some((&OK, body)) => out.push(body.to_vec()),
+            Some((&status, body)) => {
                 return Err(FrameError::Rank {
                     rank,
                     message: String::from_utf8_lossy(body).into_owned(),
+                    bad_input: status == BAD_INPUT,
                 });
             }
             None => {
                 return Err(FrameError::Rank {
                     rank,
                     message: "sent an empty status".into(),
+                    bad_input: false,
                 });
             }
         }
@@ -353,10 +397,10 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             .as_ref()
             .map(|_| Vec::new())
             .map_err(|e| e.to_string());
-        if let Err(FrameError::Rank { rank, message }) = agree(self.transport, status) {
+        if let Err(e @ FrameError::Rank { .. }) = agree(self.transport, status) {
             return Err(match rendered {
                 Err(e) => FrameError::Render(e),
-                Ok(_) => FrameError::Rank { rank, message },
+                Ok(_) => e,
             });
         }
         let mut times = self.held.times;

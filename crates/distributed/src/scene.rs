@@ -53,6 +53,7 @@ fn check_grids<T: Transport + ?Sized>(
                     first: grids[0].dims,
                 }
                 .to_string(),
+                bad_input: true,
             });
         }
     }
@@ -120,6 +121,7 @@ impl<'t, T: Transport + ?Sized> DistributedScene<'t, T> {
             return Err(FrameError::Rank {
                 rank: 0,
                 message: SceneFrameError::Mix.to_string(),
+                bad_input: true,
             });
         }
         let mut looks = request.looks.clone();
@@ -157,10 +159,10 @@ impl<'t, T: Transport + ?Sized> DistributedScene<'t, T> {
             .map(|_| Vec::new())
             .map_err(|e| e.to_string());
         let (transport, plan) = self.volumes[0].plan();
-        if let Err(FrameError::Rank { rank, message }) = agree(transport, status) {
+        if let Err(e @ FrameError::Rank { .. }) = agree(transport, status) {
             return Err(match rendered {
                 Err(e) => FrameError::Render(e),
-                Ok(_) => FrameError::Rank { rank, message },
+                Ok(_) => e,
             });
         }
         let mut times = self.volumes[0].read_times();

@@ -99,7 +99,7 @@ fn a_rank_that_cannot_read_its_piece_fails_every_rank_with_its_error() {
     for e in &errors {
         assert_eq!(e, &errors[0]);
     }
-    let FrameError::Rank { rank, message } = &errors[0] else {
+    let FrameError::Rank { rank, message, .. } = &errors[0] else {
         panic!("{:?}", errors[0])
     };
     assert_eq!(*rank, 2, "the first rank whose box starts past x = 0");

@@ -374,16 +374,20 @@ fn rounded_positions_are_read_at_the_mean_gap_with_a_note() {
     }
     assert_note(
         &l,
-        "slice gaps vary from 1.1 to 1.2 mm, at most 0.06 mm off their mean 1.16 mm, within the tolerance of 0.1116 mm (1 % of the mean gap plus 0.1 mm for positions written to 1 decimal(s)): read at the mean gap",
+        "slice gaps vary from 1.1 to 1.2 mm around their mean 1.16 mm; the largest deviation is the gap of 1.1 mm between mr3.dcm and mr4.dcm, 0.06 mm (5.17 % of the mean) off it, within the tolerance of 0.158 mm (5 % of the mean gap plus 0.1 mm for positions written to 1 decimal(s)): read at the mean gap",
     );
 }
 
 #[test]
-fn a_gap_beyond_the_tolerance_is_refused_naming_it() {
-    // z = 0, 2, 4, 5.94, 7.94, 9.94: the gap 4 -> 5.94 is 3 % short.
-    let msg = refused(&fixture("uneven"), &ReadOptions::default());
-    assert!(
-        msg.contains("slice gaps are uneven: 1.94 mm (between mr2.dcm and mr3.dcm) to 2 mm (between mr0.dcm and mr1.dcm), mean 1.988 mm; the gap of 1.94 mm between mr2.dcm and mr3.dcm is 0.048 mm off the mean, beyond the tolerance of 0.02988 mm (1 % of the mean gap plus 0.01 mm for positions written to 2 decimal(s))"),
-        "{msg}"
+fn a_gap_three_percent_short_is_read_at_the_mean_gap_naming_it() {
+    // z = 0, 2, 4, 5.94, 7.94, 9.94: the gap 4 -> 5.94 is 3 % short,
+    // within the 5 % a scanner's rounding may leave (a 20 % gap is
+    // refused: tests/dicom.rs).
+    let l = load("uneven");
+    assert_eq!(l.volume.dims()[2], 6);
+    assert!((l.volume.spacing().z - 9.94 / 5.0).abs() < 1e-12);
+    assert_note(
+        &l,
+        "the largest deviation is the gap of 1.94 mm between mr2.dcm and mr3.dcm",
     );
 }

@@ -181,7 +181,7 @@ fn every_box_read_box_by_box_equals_the_eager_read() {
         ("zyx_gzip", 1, "deflate"),
         ("labels", 1, "chunks of shape"),
         ("ilastik", 2, "chunks of shape"),
-        ("tczyx", 4, "row windows"),
+        ("tczyx", 4, "chunks of shape"), // fletcher32: decoded per chunk
         ("yxz", 1, "contiguous"),
         ("cf_names", 1, "contiguous"),
     ] {

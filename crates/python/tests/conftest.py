@@ -4,6 +4,7 @@ numpy and pytest."""
 
 import os
 import shutil
+import signal
 import struct
 import subprocess
 import zlib
@@ -13,6 +14,12 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[3]
+
+# The Ctrl-C tests simulate SIGINT (PyErr_SetInterrupt), which Python
+# ignores where SIGINT was ignored when it started: a shell's background
+# job (`cargo test ... &`, nohup) starts so. Python's own handler, as in
+# a terminal, whoever started the tests.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def volray_binary():
