@@ -305,7 +305,10 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             owned_max_gradient(v, self.held.offset, self.held.piece_owned)
         });
         self.held.max_gradient = local;
-        let all = agree(self.transport, Ok(local.to_le_bytes().to_vec()))?;
+        let all = agree(
+            self.transport,
+            Ok::<_, Failure>(local.to_le_bytes().to_vec()),
+        )?;
         let g = (all.iter())
             .filter_map(|m| m.as_slice().try_into().ok().map(f32::from_le_bytes))
             .fold(0.0f32, f32::max);
@@ -459,7 +462,7 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             }
             out
         });
-        let all = agree(self.transport, Ok(bytes))?;
+        let all = agree(self.transport, Ok::<_, Failure>(bytes))?;
         let mut whole: Option<Histogram> = None;
         for m in all.iter().filter(|m| m.len() == 16 + 8 * bins.max(1)) {
             let word = |i: usize| m[8 * i..8 * i + 8].try_into().unwrap();
@@ -502,7 +505,7 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             Err(LabelError::NotInteger(v)) => [&[2u8][..], &v.to_le_bytes()].concat(),
             Err(_) => vec![1u8],
         };
-        let all = agree(self.transport, Ok(bytes))?;
+        let all = agree(self.transport, Ok::<_, Failure>(bytes))?;
         let mut union = std::collections::BTreeSet::new();
         let mut too_many = false;
         for m in &all {

@@ -228,9 +228,10 @@ impl Chunked {
     /// than a piece is lighter in pieces (their frames never take more
     /// than a piece's budget), and was faster too. The 2048³ OME-Zarr
     /// pyramid's 1024² image at `--level auto` took 37.3 s and 3.27 GiB
-    /// read whole under the default limit, 8.3 s and 0.62 GiB in pieces:
-    /// the pieces' reads and renders overlap, and empty chunks are never
-    /// read.
+    /// read whole under the default limit, and 8.3 s and 0.62 GiB in
+    /// pieces of this same budget when `--max-memory 1.5G` forced them
+    /// (issue 41's measurement, before this rule made pieces the default
+    /// there; not measured again since).
     pub fn plan(
         &self,
         settings: &RenderSettings,
