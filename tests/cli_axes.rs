@@ -14,9 +14,8 @@
 mod common;
 
 use std::path::Path;
-use std::process::Command;
 
-use common::{Picture, pyenv_with, stderr, stdout, volray};
+use common::{Picture, stderr, stdout, volray};
 
 const WRITE: &str = r#"
 import sys
@@ -46,18 +45,11 @@ np.save(out + "/one.npy", a[1, 2].transpose(2, 1, 0))  # a[x, y, z]
 
 /// The files, or `None` where the writers are missing outside CI.
 fn files() -> Option<tempfile::TempDir> {
-    let python = pyenv_with(&["numpy", "tifffile", "h5py", "nibabel"])?;
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(&python)
-        .args(["-W", "ignore", "-c", WRITE, dir.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(dir)
+    common::written_by_python(
+        &["numpy", "tifffile", "h5py", "nibabel"],
+        &["-W", "ignore"],
+        WRITE,
+    )
 }
 
 /// The three files, as INPUT.

@@ -10,9 +10,7 @@
 
 mod common;
 
-use std::process::Command;
-
-use common::{Picture, pyenv_with, render};
+use common::{Picture, render};
 
 /// Two blobs over a ramp, u16, a[x, y, z] of (48, 40, 36) in 16³ chunks
 /// (deflate and shuffle), as `vol.h5:/data` and as `vol.nc:/rho` (f32).
@@ -57,18 +55,7 @@ with netCDF4.Dataset(sys.argv[1] + "/latdown.nc", "w", format="NETCDF4") as nc:
 /// The directory holding the files, or `None` where the writers are
 /// missing outside CI.
 fn files() -> Option<tempfile::TempDir> {
-    let python = pyenv_with(&["h5py", "netCDF4", "numpy"])?;
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(&python)
-        .args(["-c", WRITE, dir.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(dir)
+    common::written_by_python(&["h5py", "netCDF4", "numpy"], &[], WRITE)
 }
 
 const LOOK: [&str; 6] = ["--preset", "mr", "--range", "0,32000", "--size", "40x36"];

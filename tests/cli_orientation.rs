@@ -13,9 +13,7 @@
 
 mod common;
 
-use std::process::Command;
-
-use common::{Picture, pyenv_with, render, stdout, volray};
+use common::{Picture, render, stdout, volray};
 
 /// Pressure levels 1000, 900, … 200 hPa (the ground first, `positive =
 /// "down"`) over lat −80 … 80 and lon 0 … 160 by 20 degrees; ocean depth
@@ -53,18 +51,7 @@ with netCDF4.Dataset(sys.argv[1] + "/ocean.nc", "w", format="NETCDF4") as nc:
 "#;
 
 fn files() -> Option<tempfile::TempDir> {
-    let python = pyenv_with(&["netCDF4", "numpy"])?;
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(&python)
-        .args(["-c", WRITE, dir.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(dir)
+    common::written_by_python(&["netCDF4", "numpy"], &[], WRITE)
 }
 
 /// An opacity ramp (0 at the lowest value, 1 at the highest), grey, no

@@ -95,6 +95,32 @@ impl Cases {
         self.many(name, vec![(file.to_string(), bytes)], file, expect);
     }
 
+    /// An HDF5 file (HDF5, NetCDF-4, MINC2) `file` cut short four ways
+    /// (empty, at 100 bytes, in the middle, one byte short) and with its
+    /// signature garbled, `input` naming what to read of it.
+    fn cut_and_unsigned(&mut self, file: &str, input: &str, bytes: &[u8]) {
+        let n = bytes.len();
+        for (what, at) in [
+            ("empty", 0),
+            ("cut at 100 bytes", 100),
+            ("cut in the middle", n / 2),
+            ("one byte short", n - 1),
+        ] {
+            self.many(
+                &format!("{file}: {what}"),
+                vec![(file.into(), bytes[..at].to_vec())],
+                input,
+                Expect::Bad,
+            );
+        }
+        self.many(
+            &format!("{file}: wrong magic"),
+            vec![(file.into(), put(bytes, 1, b"XDF"))],
+            input,
+            Expect::Bad,
+        );
+    }
+
     /// A case of several files, `input` naming the one to read.
     fn many(&mut self, name: &str, files: Vec<(String, Vec<u8>)>, input: &str, expect: Expect) {
         let render = self.list.len().is_multiple_of(4);
@@ -1307,26 +1333,8 @@ fn hdf5_cases() -> Cases {
     let f = "one.h5";
     let bytes = fixture(&format!("hdf5/{f}"));
     let input = format!("{f}:/fields/density");
+    c.cut_and_unsigned(f, &input, &bytes);
     let n = bytes.len();
-    for (what, at) in [
-        ("empty", 0),
-        ("cut at 100 bytes", 100),
-        ("cut in the middle", n / 2),
-        ("one byte short", n - 1),
-    ] {
-        c.many(
-            &format!("{f}: {what}"),
-            vec![(f.into(), bytes[..at].to_vec())],
-            &input,
-            Expect::Bad,
-        );
-    }
-    c.many(
-        &format!("{f}: wrong magic"),
-        vec![(f.into(), put(&bytes, 1, b"XDF"))],
-        &input,
-        Expect::Bad,
-    );
     // Bit flips through the metadata (superblock, object headers, heaps,
     // B-trees) of the pure-Rust reader: read or refused, never a crash.
     c.flips(f, &bytes, n / 2, 24, 5);
@@ -1381,26 +1389,8 @@ fn minc_cases() -> Cases {
     let mut c = Cases::new("minc");
     for f in ["ramp_i16.mnc", "series_u8.mnc"] {
         let bytes = fixture(&format!("minc/{f}"));
+        c.cut_and_unsigned(f, f, &bytes);
         let n = bytes.len();
-        for (what, at) in [
-            ("empty", 0),
-            ("cut at 100 bytes", 100),
-            ("cut in the middle", n / 2),
-            ("one byte short", n - 1),
-        ] {
-            c.one(
-                &format!("{f}: {what}"),
-                f,
-                bytes[..at].to_vec(),
-                Expect::Bad,
-            );
-        }
-        c.one(
-            &format!("{f}: wrong magic"),
-            f,
-            put(&bytes, 1, b"XDF"),
-            Expect::Bad,
-        );
         // Names the reader looks up, made unknown: a dimension nobody
         // declared, the image's dataset gone.
         c.one(

@@ -43,6 +43,29 @@ pub fn pyenv_with(modules: &[&str]) -> Option<PathBuf> {
     Some(python)
 }
 
+/// A new directory holding the files `script` writes with `target/pyenv`'s
+/// python (`python FLAGS -c SCRIPT DIR`), asserting it succeeds; `None`
+/// where that python lacks one of `modules` outside CI ([`pyenv_with`]).
+pub fn written_by_python(
+    modules: &[&str],
+    flags: &[&str],
+    script: &str,
+) -> Option<tempfile::TempDir> {
+    let python = pyenv_with(modules)?;
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(&python)
+        .args(flags)
+        .args(["-c", script, dir.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(dir)
+}
+
 /// `volray render ARGS -o OUT`, asserting success; its stderr (the notes).
 pub fn render(args: &[&str], out: &Path) -> String {
     let all = [&["render"], args, &["-o", out.to_str().unwrap()]].concat();
