@@ -2,11 +2,13 @@
 match) and a small PNG decoder, so that the tests need nothing beyond
 numpy and pytest."""
 
+import importlib
 import os
 import shutil
 import signal
 import struct
 import subprocess
+import sys
 import zlib
 from pathlib import Path
 
@@ -20,6 +22,22 @@ REPO = Path(__file__).resolve().parents[3]
 # job (`cargo test ... &`, nohup) starts so. Python's own handler, as in
 # a terminal, whoever started the tests.
 signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def written_by(tmp_path_factory, script, modules, what):
+    """A new directory holding the files `script` (a path under the
+    repository) writes with this python; skipped where one of `modules`
+    is missing, except under CI=true, where that is a failure."""
+    try:
+        for module in modules:
+            importlib.import_module(module)
+    except ImportError:
+        if os.environ.get("CI") == "true":
+            raise
+        pytest.skip(f"{what} missing (.ci/run installs them)")
+    out = tmp_path_factory.mktemp(Path(script).parent.name)
+    subprocess.run([sys.executable, str(REPO / script), str(out)], check=True)
+    return out
 
 
 def volray_binary():

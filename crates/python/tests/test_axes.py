@@ -5,30 +5,23 @@ The files are written at test time by crates/io/tests/axes/write_files.py
 (tifffile, h5py, nibabel, pynrrd, which .ci/run installs in
 target/pyenv): every volume holds x + 10y + 100z + 1000c + 10000t."""
 
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import volray
 
-from conftest import REPO
+from conftest import written_by
 
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
-    try:
-        import h5py, nibabel, nrrd, tifffile  # noqa: F401, E401
-    except ImportError:
-        if os.environ.get("CI") == "true":
-            raise
-        pytest.skip("tifffile, h5py, nibabel or pynrrd missing (.ci/run installs them)")
-    out = tmp_path_factory.mktemp("axes")
-    script = REPO / "crates/io/tests/axes/write_files.py"
-    subprocess.run([sys.executable, str(script), str(out)], check=True)
-    return out
+    return written_by(
+        tmp_path_factory,
+        "crates/io/tests/axes/write_files.py",
+        ["h5py", "nibabel", "nrrd", "tifffile"],
+        "tifffile, h5py, nibabel or pynrrd",
+    )
 
 
 def expected(t, c):

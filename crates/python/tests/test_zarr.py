@@ -5,31 +5,23 @@ they raise. The stores are written at test time by
 crates/io/tests/zarr/write_stores.py (zarr-python and ome-zarr-py, which
 .ci/run installs in target/pyenv)."""
 
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import volray
 
-from conftest import REPO
+from conftest import written_by
 
 
 @pytest.fixture(scope="module")
 def stores(tmp_path_factory):
-    try:
-        import ome_zarr  # noqa: F401
-        import zarr  # noqa: F401
-    except ImportError:
-        if os.environ.get("CI") == "true":
-            raise
-        pytest.skip("zarr and ome-zarr are not installed (.ci/run installs them)")
-    out = tmp_path_factory.mktemp("stores")
-    script = REPO / "crates/io/tests/zarr/write_stores.py"
-    subprocess.run([sys.executable, str(script), str(out)], check=True)
-    return out
+    return written_by(
+        tmp_path_factory,
+        "crates/io/tests/zarr/write_stores.py",
+        ["ome_zarr", "zarr"],
+        "zarr or ome-zarr",
+    )
 
 
 @pytest.mark.parametrize("name", ["ome04", "ome05"])
