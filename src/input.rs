@@ -11,7 +11,7 @@ use volray_io::{
 use volray_options::level::LevelChoice;
 
 /// What `volray render` shows when given no input.
-pub const DEMO: &str = "blobs:64";
+pub const DEMO: &str = "fractal:129,seed=1,dim=3.7,sigma=1,ramp=0.3,threshold=0.5869113206863403";
 
 /// A loaded volume and how to name it in messages.
 pub struct Input {

@@ -13,7 +13,9 @@ use volray_options::level::LevelChoice;
 pub struct InputArgs {
     /// A volume file or a built-in source spec such as
     /// `marschner-lobb:41`, `blobs:64`, `sphere:64,radius=0.7`, `torus`
-    /// (see `volray-data`); default: the demo volume `blobs:64`.
+    /// (see `volray-data`); default: the demo volume, the paper's fractal
+    /// cloud of Figure 2a (`render` without INPUT draws it in the demo's
+    /// look when no look flag is given).
     /// A file whose name is a source's name needs a path, e.g. `./sphere`.
     pub input: Option<String>,
 

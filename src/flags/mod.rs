@@ -22,6 +22,7 @@ mod animation;
 mod bench;
 mod camera;
 mod convert;
+pub mod demo;
 mod figure;
 mod generate;
 mod info;
@@ -53,7 +54,8 @@ pub use view::ViewArgs;
 pub use viewer::ViewerArgs;
 
 use clap::error::ErrorKind;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
+use std::ffi::OsString;
 use std::process::ExitCode;
 
 #[derive(Debug, Parser)]
@@ -103,7 +105,24 @@ pub enum Command {
 /// without the usage block) and the exit code to end with: 0 for help and
 /// the version, 1 otherwise.
 pub fn parse() -> Result<Cli, ExitCode> {
-    Cli::try_parse().map_err(|e| match e.kind() {
+    let argv: Vec<OsString> = std::env::args_os().collect();
+    let matches = Cli::command()
+        .try_get_matches_from(&argv)
+        .map_err(refused)?;
+    let demo = matches
+        .subcommand_matches("render")
+        .and_then(|render| demo::words(&argv, render));
+    let cli = Cli::try_parse_from(demo.as_ref().unwrap_or(&argv)).map_err(refused)?;
+    if demo.is_some() {
+        eprintln!("{}", demo::note());
+    }
+    Ok(cli)
+}
+
+/// The exit code of a command line clap refused or answered (help, the
+/// version), its text printed.
+fn refused(e: clap::Error) -> ExitCode {
+    match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
             let _ = e.print();
             ExitCode::SUCCESS
@@ -116,7 +135,7 @@ pub fn parse() -> Result<Cli, ExitCode> {
             eprintln!("volray: {}", parse::one_line_error(&e));
             ExitCode::from(1)
         }
-    })
+    }
 }
 
 #[cfg(test)]
