@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Renders the same frames with two volray binaries and checks that the
 # files are byte-identical: the paper's figures (volray paper), the peers'
-# six workloads as 16-bit PNGs, and a frame of every fast path (perspective,
+# six workloads as 16-bit PNGs, a frame of every fast path (perspective,
 # projections, post-classification, iso, gradient opacity, crop, clip,
-# jitter) as 16-bit PNGs. For refactorings that must not change a pixel.
+# jitter), figures (colour bars, scale bar, axes, outline, titles) and
+# scenes (overlays) as 16-bit PNGs. For refactorings that must not change
+# a pixel.
 #
 #   scripts/same-images.sh OLD_VOLRAY NEW_VOLRAY [PEERS_VOLUMES_DIR]
 #
@@ -24,7 +26,7 @@ mkdir -p "$work/old" "$work/new"
 
 # name|arguments of `volray render` (16-bit PNG output added below).
 cases=(
-  "demo|"
+  "blobs-default|blobs:64"
   "ml-default|marschner-lobb:41 --size 200"
   "hydrogen-621|hydrogen:6,2,1 --view 150,150,500 --colormap magma --size 160"
   "fractal-129-step|fractal:129,seed=2 --step 0.5 --colormap inferno --size 240"
@@ -43,6 +45,10 @@ cases=(
   "crop-clip-post|blobs:64 --crop -1,1,-1,0.2,-1,1 --clip 0,0,0,1,1,0 --jitter --post-classification --size 160"
   "lights|torus --light 1,2,3 --light-color 1,0.8,0.6 --ambient 0.2 --diffuse 0.5,0.6,0.7 --specular 0.4 --shininess 7.5 --background 0.1,0.2,0.3 --size 160"
   "log-range|hydrogen:4,2,0 --log --range 1e-9,1e-3 --colormap inferno --size 160"
+  "figure|hydrogen:4,2,0 --colormap magma --colorbar --scale-bar --axes --outline --title Orbital --label a --size 200"
+  "figure-left-log|hydrogen:4,2,0 --log --colorbar left --units counts --size 200x160"
+  "scene-overlay-additive|blobs:48 --overlay sphere:48,radius=0.5:colormap=magma --mix additive --size 160"
+  "scene-overlay-perspective|fractal:65 --overlay torus:40:colormap=viridis --perspective 40 --azimuth 20 --size 160"
 )
 
 if [ -n "$peers" ]; then
