@@ -64,11 +64,13 @@ pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
 pub use link::{Host, MAX_IN_FLIGHT, Message, Tab};
 pub use options::{OptionsStart, start_state, state_options};
 pub use page::embedded_html;
-pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello};
+pub use protocol::{
+    Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello, draft_side,
+};
 pub use pyramid::{CACHED_LEVELS, DRAFT_SHARE, Pyramid, PyramidError};
 pub use reproduce::{Refusal, Reproduce, Reproduction, SceneLooks};
 pub use server::{ServeError, Server, Stopper};
-pub use session::{FigureContext, ReadTimePoint, SpawnError, TimePoints, draft_side};
+pub use session::{FigureContext, ReadTimePoint, SpawnError, TimePoints};
 pub use state::{
     BlendMode, ColorBarSide, Figure, LayerState, Lighting, MAX_SIDE, START_COLOURS, STEP_RANGE,
     StateError, ViewState, WHITE, ZOOM_RANGE, solid_colour,
