@@ -11,7 +11,7 @@
 //!  page (assets/) ──WebSocket: the whole ViewState, JSON──► server.rs ─► mailbox.rs (one slot:
 //!    ▲  drag: "draft"; mouse-up: "full"                                  │  the latest request)
 //!    │                                                                  ▼
-//!    └──── binary: FrameHeader + JPEG (draft) or PNG (full) ◄── session/: the tab's thread, 
+//!    └──── binary: FrameHeader + JPEG (draft) or PNG (full) ◄── session/: the tab's thread,
 //!          (protocol.rs)                               encode.rs     its own Renderer;
 //!                                                                  Reproduce: state → settings
 //!                                                                  and the `volray render` line

@@ -368,6 +368,22 @@ mod tests {
     use super::*;
     use crate::state::tests::sample;
 
+    #[test]
+    fn a_probe_is_filed_in_its_own_slot_and_the_waiting_view_is_kept() {
+        let mailbox = Mailbox::default();
+        let view =
+            serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": sample()});
+        let filed = file(&mailbox, &view.to_string()).unwrap();
+        assert_eq!(filed, Some(sample()), "a view gives back its state");
+        let probe =
+            serde_json::json!({"type": "probe", "seq": 2, "x": 3, "y": 4, "state": sample()});
+        assert_eq!(file(&mailbox, &probe.to_string()).unwrap(), None);
+        // The probe is answered first, then the view it did not replace.
+        assert_eq!(mailbox.waiting(), 2);
+        assert_eq!(mailbox.take().map(|r| r.seq), Some(2));
+        assert_eq!(mailbox.take().map(|r| r.seq), Some(1));
+    }
+
     fn view(quality: &str) -> String {
         serde_json::json!({
             "type": "view", "seq": 5, "quality": quality, "state": sample()
