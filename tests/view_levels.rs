@@ -3,7 +3,7 @@
 //! moves and which when still, and refuses a level the file lacks or a
 //! `--level auto` on a file of one level. (What the frames read, level by
 //! level and piece by piece, is tested on a session in
-//! `crates/view/src/session.rs`.)
+//! `crates/view/src/session/level_tests.rs`.)
 
 mod common;
 

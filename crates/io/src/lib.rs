@@ -46,7 +46,7 @@
 //! | MINC2 `.mnc` | `formats/minc.rs` | on the HDF5 layer; dimorder, steps, starts, direction cosines; image-min/max scaling as nibabel |
 //! | Zarr v2/v3, OME-Zarr 0.4/0.5 (a directory) | `formats/zarr/` | through `zarrs` (blosc, zstd, gzip, sharding, fill values); known by `zarr.json`/`.zarray`/`.zgroup`; levels ([`ReadOptions::level`]), time points, channels ([`ReadOptions::channel`]) |
 //! | NetCDF-3 `.nc`, `.cdf` (CDF-1, CDF-2, CDF-5) | `formats/netcdf/` | own bounds-checked parser; record dimension; CF conventions (`shared/cf.rs`): axes, coordinate variables, units, packing, fill values; `--frame` (time), `--array` (variable) |
-//! | MINC1 `.mnc` (NetCDF-3) | `formats/minc1.rs` | on the NetCDF-3 layer with MINC2's geometry and scaling; signtype |
+//! | MINC1 `.mnc` (NetCDF-3) | `formats/minc1.rs` | on the NetCDF-3 layer (`netcdf/header.rs`) with MINC2's geometry and scaling (`formats/minc_common.rs`); signtype |
 //! | FITS `.fits`, `.fits.gz` | `formats/fits/` | own parser; BITPIX 8 … −64, BSCALE/BZERO, BLANK as NaN; linear WCS (world spacing when the axes share a unit, else pixel coordinates); image HDUs and a 4th axis as frames, `--array EXTNAME` |
 //! | FreeSurfer MGH `.mgh`, `.mgz` | `formats/mgh/` | big-endian; nibabel's get_affine (Mdc, delta, Pxyz_c); frames; gzip streamed; known by content too |
 //! | Analyze 7.5 `.hdr`/`.img` | `formats/nifti/` | a NIfTI-1 pair without magic; nibabel's affine (x flipped, centre or SPM originator); known by content |

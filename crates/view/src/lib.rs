@@ -11,7 +11,7 @@
 //!  page (assets/) ──WebSocket: the whole ViewState, JSON──► server.rs ─► mailbox.rs (one slot:
 //!    ▲  drag: "draft"; mouse-up: "full"                                  │  the latest request)
 //!    │                                                                  ▼
-//!    └──── binary: FrameHeader + JPEG (draft) or PNG (full) ◄── session.rs: the tab's thread,
+//!    └──── binary: FrameHeader + JPEG (draft) or PNG (full) ◄── session/: the tab's thread,
 //!          (protocol.rs)                               encode.rs     its own Renderer;
 //!                                                                  Reproduce: state → settings
 //!                                                                  and the `volray render` line
@@ -24,7 +24,7 @@
 //! | `state.rs` | [`ViewState`]: what the page's controls set, and its bounds |
 //! | `protocol.rs` | the messages both ways, parsed and checked |
 //! | `mailbox.rs` | the single-slot mailbox: stale requests dropped, never queued; the stop flag of the frame a newer request supersedes |
-//! | `session.rs` | a tab's renderer thread: reserve, render (stoppable), encode, send |
+//! | `session/` | a tab's renderer thread: reserve, render (stoppable), encode, send; `mod.rs` its life in order, then one file per concern (`frame.rs`, `render.rs`, `drafts.rs`, `levels.rs`, `pieces.rs`, `time.rs`, `figure.rs`, `probe.rs`) |
 //! | `ledger.rs` | the memory limit shared by every tab: the volume, each tab's renderer, each frame in flight |
 //! | `pyramid.rs`, `levels.rs` | a multiscale volume served level by level; the levels read whole, shared by the tabs, read outside the cache's lock |
 //! | `reproduce.rs` | [`Reproduce`]: the caller turns a state into settings and a command |
@@ -64,11 +64,13 @@ pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};
 pub use link::{Host, MAX_IN_FLIGHT, Message, Tab};
 pub use options::{OptionsStart, start_state, state_options};
 pub use page::embedded_html;
-pub use protocol::{Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello};
+pub use protocol::{
+    Basis, FrameHeader, Hello, LevelShown, Quality, ServerMessage, VolumeHello, draft_side,
+};
 pub use pyramid::{CACHED_LEVELS, DRAFT_SHARE, Pyramid, PyramidError};
 pub use reproduce::{Refusal, Reproduce, Reproduction, SceneLooks};
 pub use server::{ServeError, Server, Stopper};
-pub use session::{FigureContext, ReadTimePoint, SpawnError, TimePoints, draft_side};
+pub use session::{FigureContext, ReadTimePoint, SpawnError, TimePoints};
 pub use state::{
     BlendMode, ColorBarSide, Figure, LayerState, Lighting, MAX_SIDE, START_COLOURS, STEP_RANGE,
     StateError, ViewState, WHITE, ZOOM_RANGE, solid_colour,

@@ -22,8 +22,7 @@
 
 use crate::ledger::Reservation;
 use crate::mailbox::Mailbox;
-use crate::protocol::Request;
-use crate::server;
+use crate::protocol::{self, Request};
 use crate::session::{self, Outgoing, Shared, SpawnError};
 use crate::state::ViewState;
 use crate::watch::Watch;
@@ -114,7 +113,7 @@ impl Tab {
     /// a save, `Err` with the JSON error message for the page where it is
     /// refused (malformed, out of bounds).
     pub fn receive(&self, text: &str) -> Result<Option<ViewState>, String> {
-        server::file(&self.mailbox, text).map_err(|e| e.to_json())
+        protocol::file(&self.mailbox, text).map_err(|e| e.to_json())
     }
 
     /// The next message for the page, waiting for it: the hello first,

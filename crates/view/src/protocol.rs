@@ -21,6 +21,7 @@
 //! frame: a 4-byte little-endian length, a JSON [`FrameHeader`] of that
 //! length, then the image file.
 
+use crate::mailbox::{Mailbox, Slot};
 use crate::state::{Lighting, StateError, ViewState};
 use serde::{Deserialize, Serialize};
 
@@ -89,6 +90,11 @@ pub const DRAFT_SCALE_RANGE: (f64, f64) = (1.0 / 16.0, 1.0);
 
 /// A draft's scale when the page names none: half size.
 pub const DRAFT_SCALE: f64 = 0.5;
+
+/// A draft frame's side: half the full frame's, at least one pixel.
+pub fn draft_side(full: usize) -> usize {
+    full.div_ceil(2)
+}
 
 /// A message refused: not JSON of a known shape, or out of bounds.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -334,10 +340,49 @@ impl ServerMessage {
     }
 }
 
+/// Files a request from a page in its slot, giving back its state where
+/// it asks for a view ("draft" or "full"); or says why it was refused.
+pub(crate) fn file(
+    mailbox: &Mailbox<Request>,
+    text: &str,
+) -> Result<Option<ViewState>, ServerMessage> {
+    match parse(text) {
+        Ok(request) => {
+            let (slot, view) = match request.quality {
+                _ if request.probe.is_some() => (Slot::Probe, None),
+                Quality::Save => (Slot::Save, None),
+                Quality::Draft | Quality::Full => (Slot::Latest, Some(request.state.clone())),
+            };
+            mailbox.put(slot, request);
+            Ok(view)
+        }
+        Err(e) => Err(ServerMessage::Error {
+            seq: MessageError::seq_of(text),
+            message: e.to_string(),
+        }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::state::tests::sample;
+
+    #[test]
+    fn a_probe_is_filed_in_its_own_slot_and_the_waiting_view_is_kept() {
+        let mailbox = Mailbox::default();
+        let view =
+            serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": sample()});
+        let filed = file(&mailbox, &view.to_string()).unwrap();
+        assert_eq!(filed, Some(sample()), "a view gives back its state");
+        let probe =
+            serde_json::json!({"type": "probe", "seq": 2, "x": 3, "y": 4, "state": sample()});
+        assert_eq!(file(&mailbox, &probe.to_string()).unwrap(), None);
+        // The probe is answered first, then the view it did not replace.
+        assert_eq!(mailbox.waiting(), 2);
+        assert_eq!(mailbox.take().map(|r| r.seq), Some(2));
+        assert_eq!(mailbox.take().map(|r| r.seq), Some(1));
+    }
 
     fn view(quality: &str) -> String {
         serde_json::json!({

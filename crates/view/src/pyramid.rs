@@ -169,8 +169,8 @@ impl Pyramid {
     ) -> Result<Option<usize>, CameraError> {
         let still = self.still_level(settings)?;
         let draft = RenderSettings {
-            width: crate::session::draft_side(settings.width),
-            height: crate::session::draft_side(settings.height),
+            width: crate::protocol::draft_side(settings.width),
+            height: crate::protocol::draft_side(settings.height),
             ..settings.clone()
         };
         self.draft_level(&draft, still, non_finite, limit)

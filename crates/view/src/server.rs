@@ -8,11 +8,10 @@
 
 use crate::ledger::Reservation;
 use crate::link::Host;
-use crate::mailbox::{Mailbox, Slot};
+use crate::mailbox::Mailbox;
 use crate::page;
-use crate::protocol::{self, MAX_MESSAGE_BYTES, MessageError, Quality, Request, ServerMessage};
+use crate::protocol::{MAX_MESSAGE_BYTES, Request, ServerMessage, file};
 use crate::session::{self, Outgoing, Shared};
-use crate::state::ViewState;
 use crate::token::Token;
 use axum::Router;
 use axum::body::Body;
@@ -319,29 +318,6 @@ async fn serve_tab(app: Arc<App>, mut socket: WebSocket) {
 /// Files a request from the page, or says why it was refused.
 fn receive(mailbox: &Mailbox<Request>, text: &str) -> Option<ServerMessage> {
     file(mailbox, text).err()
-}
-
-/// Files a request from a page in its slot, giving back its state where
-/// it asks for a view ("draft" or "full"); or says why it was refused.
-pub(crate) fn file(
-    mailbox: &Mailbox<Request>,
-    text: &str,
-) -> Result<Option<ViewState>, ServerMessage> {
-    match protocol::parse(text) {
-        Ok(request) => {
-            let (slot, view) = match request.quality {
-                _ if request.probe.is_some() => (Slot::Probe, None),
-                Quality::Save => (Slot::Save, None),
-                Quality::Draft | Quality::Full => (Slot::Latest, Some(request.state.clone())),
-            };
-            mailbox.put(slot, request);
-            Ok(view)
-        }
-        Err(e) => Err(ServerMessage::Error {
-            seq: MessageError::seq_of(text),
-            message: e.to_string(),
-        }),
-    }
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! MINC1 (`.mnc` whose magic is `CDF`): NetCDF-3 files in libminc's
 //! layout, read on the NetCDF-3 layer (`formats/netcdf/`) with MINC2's
-//! semantics (`formats/minc.rs`: [`spatial_split`], [`geometry`],
+//! semantics (`formats/minc_common.rs`: [`spatial_split`], [`geometry`],
 //! [`Scaling`]), matching nibabel's `Minc1File`.
 //!
 //! - The image is the variable `image`; its dimensions name its axes,
@@ -17,9 +17,9 @@
 use std::path::Path;
 
 use crate::error::IoError;
-use crate::formats::minc::{Scaling, geometry, spatial_split, valid_range_of};
-use crate::formats::netcdf::{
-    self, Header, NcType, check_in_file, is_text, read_values, small_values,
+use crate::formats::minc_common::{Scaling, geometry, scale_slices, spatial_split, valid_range_of};
+use crate::formats::netcdf::header::{
+    self, Header, NcType, check_in_file, read_values, small_values,
 };
 use crate::shared::cf::Value;
 use crate::shared::geometry::grid_to_volume;
@@ -41,7 +41,7 @@ pub(crate) fn is_minc1(header: &Header) -> bool {
 
 /// Reads the MINC1 file at `path`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let (file, header) = netcdf::open(path)?;
+    let (file, header) = header::open(path)?;
     read_parsed(path, opts, file, header)
 }
 
@@ -166,15 +166,14 @@ pub(crate) fn read_parsed(
                         Value::Text(_) => None,
                     });
                     let (lo, hi) = valid_range_of(given.clone(), type_range).map_err(what)?;
-                    let dims_of = |v: &netcdf::Var| -> Vec<String> {
+                    let dims_of = |v: &header::Var| -> Vec<String> {
                         v.dims
                             .iter()
                             .map(|&d| header.dims[d].name.clone())
                             .collect()
                     };
                     let (min_order, max_order) = (dims_of(min_var), dims_of(max_var));
-                    crate::formats::minc::scale_slices(&min_order, &max_order, &order, &shape)
-                        .map_err(what)?;
+                    scale_slices(&min_order, &max_order, &order, &shape).map_err(what)?;
                     let limit = total as u64;
                     let min = small_values(path, &mut file, &header, min_var, None, limit)?;
                     let max = small_values(path, &mut file, &header, max_var, None, limit)?;
@@ -236,4 +235,9 @@ pub(crate) fn read_parsed(
         format: VolumeFormat::Minc,
         info,
     })
+}
+
+/// Whether `value` is the text `want` (MINC's fixed-width words).
+fn is_text(value: Option<&Value>, want: &str) -> bool {
+    matches!(value, Some(Value::Text(t)) if t.trim_end_matches(['\0', ' ']) == want)
 }

@@ -25,6 +25,7 @@ pub(crate) mod metaimage;
 pub(crate) mod mgh;
 pub(crate) mod minc;
 pub(crate) mod minc1;
+pub(crate) mod minc_common;
 pub(crate) mod mrc;
 pub(crate) mod netcdf;
 pub(crate) mod netcdf4;

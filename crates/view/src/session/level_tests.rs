@@ -1,17 +1,24 @@
 //! A pyramid's tabs together: a level read whole by one tab keeps no
 //! other tab waiting (`levels.rs`), two tabs needing one level read it
 //! once, and a draft of a coarse level is framed as the still
-//! (`Pyramid::framed`).
+//! (`Pyramid::framed`); and a pyramid's tab alone: its drafts from a
+//! coarser level held whole, its still from the level auto chooses, in
+//! pieces where it does not fit what the limit has left (`pieces.rs`),
+//! and a still in pieces superseded before it starts reading nothing.
 
-use super::tests::{Plain, Reads, header, request, shared_with};
+use super::levels::LevelTab;
+use super::pieces::Pieces;
+use super::render::Context;
+use super::tests::{Plain, header, one_frame, pixels, request, shared_with};
 use super::*;
 use crate::mailbox::Slot;
 use crate::pyramid::{DRAFT_SHARE, Pyramid};
 use std::sync::Mutex;
+use std::sync::atomic::AtomicBool;
 use std::sync::mpsc as std_mpsc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use volray_core::glam::DVec3;
-use volray_core::{Blend, VolumeSource};
+use volray_core::{Blend, Image, RenderSettings, VolumeSource};
 
 /// Long enough for any frame here on a busy machine; reached only when
 /// a tab waits for what it should not wait for.
@@ -255,7 +262,7 @@ fn a_draft_of_a_coarse_level_is_framed_as_the_still_so_the_picture_does_not_jump
         let mut tab = LevelTab {
             levels: Arc::clone(&levels),
             renderers: Vec::new(),
-            streamed: None,
+            streamed: Pieces::default(),
         };
         tab.draw(&cx, quality, &settings, &settings).unwrap()
     };
@@ -279,4 +286,246 @@ fn a_draft_of_a_coarse_level_is_framed_as_the_still_so_the_picture_does_not_jump
 fn read_whole(pyramid: &Pyramid, level: usize) -> Volume {
     let dims = pyramid.grid(level).dims;
     pyramid.source(level).read_box([0; 3], dims).unwrap()
+}
+
+/// Every box read from a pyramid's levels: (level, lo, hi).
+type Reads = Arc<std::sync::Mutex<Vec<(usize, [usize; 3], [usize; 3])>>>;
+
+/// A level that records every box read from it.
+struct Counted {
+    level: usize,
+    source: Arc<dyn volray_core::VolumeSource>,
+    reads: Reads,
+}
+
+impl volray_core::VolumeSource for Counted {
+    fn grid(&self) -> volray_core::sampling::grid::GridFrame {
+        self.source.grid()
+    }
+    fn sample_type(&self) -> volray_core::SampleType {
+        self.source.sample_type()
+    }
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        self.reads.lock().unwrap().push((self.level, lo, hi));
+        self.source.read_box(lo, hi)
+    }
+}
+
+/// A 64³ OME-Zarr pyramid of 16³ chunks (levels 64³, 32³, 16³): its
+/// directory and path.
+fn pyramid_file() -> (tempfile::TempDir, std::path::PathBuf) {
+    use volray_io::{OmeZarrOptions, write_ome_zarr};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("blob.ome.zarr");
+    let volume = Volume::from_fn([64; 3], DVec3::ONE, DVec3::ZERO, |p| {
+        let d = (p - DVec3::new(30.0, 34.0, 28.0)).length();
+        ((1.0 - d / 26.0).max(0.0) * (1.0 + 0.3 * (p.x * 0.4).sin())) as f32
+    })
+    .unwrap();
+    let options = OmeZarrOptions {
+        chunk: 16,
+        shard: 32,
+        ..OmeZarrOptions::default()
+    };
+    write_ome_zarr(&path, &volume, &options).unwrap();
+    (dir, path)
+}
+
+/// Level `level` of `path` read whole, as `volray render --level N`
+/// reads it.
+fn read_level(path: &std::path::Path, level: usize) -> Volume {
+    let opts = volray_io::ReadOptions {
+        level: Some(level),
+        ..volray_io::ReadOptions::default()
+    };
+    volray_io::read(path, &opts).unwrap().volume
+}
+
+/// A server of the pyramid at `path` under `limit` bytes, its stills
+/// at `still` (`None`: auto), and the log of what its levels read.
+fn pyramid_shared(path: &std::path::Path, limit: u128, still: Option<usize>) -> (Shared, Reads) {
+    let reads = Reads::default();
+    let sources = (0..3)
+        .map(|level| {
+            let opts = volray_io::ReadOptions {
+                level: Some(level),
+                ..volray_io::ReadOptions::default()
+            };
+            let lazy = volray_io::open_lazy(path, &opts).unwrap().unwrap();
+            Arc::new(Counted {
+                level,
+                source: lazy.source,
+                reads: Arc::clone(&reads),
+            }) as Arc<dyn volray_core::VolumeSource>
+        })
+        .collect();
+    let pyramid = crate::pyramid::Pyramid::new(sources, still).unwrap();
+    let mut shared = shared_with(Arc::new(Plain::default()), limit, 1);
+    // No brick caches: what a level's renderer holds is its frame's.
+    shared.cache_budget = 0;
+    let start = RenderSettings::default();
+    shared.costs = Costs::new(&shared.volume, &start, NonFinite::Refuse, 0);
+    shared.levels = Some(Arc::new(Levels::new(pyramid)));
+    (shared, reads)
+}
+
+#[test]
+fn a_pyramids_drafts_show_a_coarser_level_held_whole_and_its_still_the_level_auto_chooses() {
+    let (_dir, path) = pyramid_file();
+    let (shared, reads) = pyramid_shared(&path, 1 << 30, None);
+    let pyramid = &shared.levels.as_ref().unwrap().pyramid;
+    let full = RenderSettings {
+        width: 64,
+        height: 64,
+        ..RenderSettings::default()
+    };
+    let draft = RenderSettings {
+        width: 32,
+        height: 32,
+        ..full.clone()
+    };
+    let still = pyramid.auto_level(&full).unwrap();
+    let coarse = pyramid.auto_level(&draft).unwrap();
+    assert!(coarse > still, "draft {coarse}, still {still}");
+    let mailbox = Arc::new(Mailbox::default());
+    let (tx, mut rx) = mpsc::channel(1);
+    spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+
+    // A drag: the coarse level, read whole once, then held.
+    let (h, _) = one_frame(&mailbox, &mut rx, request(1, Quality::Draft, 64, 30.0));
+    assert_eq!(h["level"]["index"], coarse);
+    assert_eq!(h["level"]["count"], 3);
+    assert_eq!(
+        (h["level"]["pieces"].as_u64(), h["level"]["read"].as_u64()),
+        (Some(1), Some(1))
+    );
+    let dims = pyramid.grid(coarse).dims;
+    assert_eq!(*reads.lock().unwrap(), [(coarse, [0; 3], dims)]);
+    let (h, _) = one_frame(&mailbox, &mut rx, request(2, Quality::Draft, 64, 40.0));
+    assert_eq!(
+        (h["level"]["index"].as_u64(), h["level"]["read"].as_u64()),
+        (Some(coarse as u64), Some(0))
+    );
+    assert_eq!(reads.lock().unwrap().len(), 1, "a drag reads nothing more");
+
+    // Still: the level auto chooses, whole: the frame `volray render
+    // --level N` renders of it, byte for byte.
+    let (h, png) = one_frame(&mailbox, &mut rx, request(3, Quality::Full, 64, 40.0));
+    assert_eq!(h["level"]["index"], still);
+    assert_eq!(h["level"]["pieces"], 1);
+    let dims = pyramid.grid(still).dims;
+    assert_eq!(reads.lock().unwrap()[1..], [(still, [0; 3], dims)]);
+    let volume = read_level(&path, still);
+    let mut settings = full.clone();
+    settings.camera.azimuth = 40.0;
+    let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    assert_eq!(png, encode::png(&reference, &mut Vec::new()).unwrap());
+    mailbox.close();
+    assert!(rx.blocking_recv().is_none());
+    drop(shared.levels);
+    assert_eq!(shared.ledger.held(), 0, "every level's bytes given back");
+}
+
+#[test]
+fn a_still_beyond_the_memory_left_is_rendered_in_pieces_never_read_whole_within_a_level() {
+    let (_dir, path) = pyramid_file();
+    let full = RenderSettings {
+        width: 64,
+        height: 64,
+        ..RenderSettings::default()
+    };
+    // Level 0's still does not fit: what reading it whole takes, less
+    // a byte; the drafts' level fits a quarter of that.
+    let (probe, _) = pyramid_shared(&path, u128::MAX, Some(0));
+    let pyramid = &probe.levels.as_ref().unwrap().pyramid;
+    let nf = NonFinite::Refuse;
+    let whole = pyramid.whole_bytes(0, &full, nf) + probe.costs.pieces_frame(&full).0;
+    let limit = whole - 1;
+    let draft = RenderSettings {
+        width: 32,
+        height: 32,
+        ..full.clone()
+    };
+    let coarse = pyramid.draft_level(&draft, 0, nf, limit).unwrap().unwrap();
+    assert!(coarse > 0);
+    let (shared, reads) = pyramid_shared(&path, limit, Some(0));
+    let mailbox = Arc::new(Mailbox::default());
+    let (tx, mut rx) = mpsc::channel(1);
+    spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+    let (h, _) = one_frame(&mailbox, &mut rx, request(1, Quality::Draft, 64, 20.0));
+    assert_eq!(h["level"]["index"], coarse);
+    let (h, png) = one_frame(&mailbox, &mut rx, request(2, Quality::Full, 64, 20.0));
+    assert_eq!(h["level"]["index"], 0);
+    let pieces = h["level"]["pieces"].as_u64().unwrap();
+    assert!(pieces > 1, "{h}");
+    // Level 0 was never read whole; no level read whole was larger
+    // than the limit allows.
+    let log = reads.lock().unwrap().clone();
+    assert!(log.iter().any(|(l, ..)| *l == 0));
+    for (level, lo, hi) in log {
+        let dims = pyramid.grid(level).dims;
+        assert!(
+            level != 0 || (lo, hi) != ([0; 3], dims),
+            "level 0 read whole"
+        );
+        if (lo, hi) == ([0; 3], dims) {
+            assert!(pyramid.volume_bytes(level) <= limit / crate::pyramid::DRAFT_SHARE);
+        }
+    }
+    // Within a level (1/255) of level 0 rendered whole.
+    let volume = read_level(&path, 0);
+    let mut settings = full.clone();
+    settings.camera.azimuth = 20.0;
+    let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let expected = pixels(&encode::png(&reference, &mut Vec::new()).unwrap());
+    let got = pixels(&png);
+    assert_eq!(got.len(), expected.len());
+    let worst = got
+        .iter()
+        .zip(&expected)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "{worst}/255");
+    mailbox.close();
+    assert!(rx.blocking_recv().is_none());
+    assert!(shared.ledger.held() <= limit);
+}
+
+#[test]
+fn a_still_in_pieces_superseded_before_it_starts_reads_nothing_and_the_newer_frame_is_sent() {
+    let (_dir, path) = pyramid_file();
+    let (probe, _) = pyramid_shared(&path, u128::MAX, Some(0));
+    let full = RenderSettings {
+        width: 64,
+        height: 64,
+        ..RenderSettings::default()
+    };
+    let pyramid = &probe.levels.as_ref().unwrap().pyramid;
+    let limit = pyramid.whole_bytes(0, &full, NonFinite::Refuse) - 1;
+    let plain = Arc::new(Plain::default());
+    let (mut shared, reads) = pyramid_shared(&path, limit, Some(0));
+    shared.reproduce = Arc::clone(&plain) as Arc<dyn Reproduce>;
+    let mailbox = Arc::new(Mailbox::default());
+    let page = Arc::clone(&mailbox);
+    *plain.meanwhile.lock().unwrap() = Some((
+        1.0,
+        Box::new(move || page.put(Slot::Latest, request(2, Quality::Draft, 64, 2.0))),
+    ));
+    mailbox.put(Slot::Latest, request(1, Quality::Full, 64, 1.0));
+    let (tx, mut rx) = mpsc::channel(1);
+    spawn(&shared, Arc::clone(&mailbox), tx).unwrap();
+    let Some(Outgoing::Frame(message, _)) = rx.blocking_recv() else {
+        panic!("no frame")
+    };
+    let h = header(&message);
+    assert_eq!(h["seq"], 2);
+    assert!(h["level"]["index"].as_u64().unwrap() > 0);
+    assert_eq!(shared.stats.stopped(), 1);
+    // Only the draft's level was read: the still stopped before its
+    // first piece.
+    let log = reads.lock().unwrap().clone();
+    assert!(log.iter().all(|(l, ..)| *l > 0), "{log:?}");
+    mailbox.close();
+    assert!(rx.blocking_recv().is_none());
 }

@@ -9,6 +9,7 @@ use crate::link::{Host, MAX_IN_FLIGHT, Message};
 use crate::watch::Watch;
 use std::sync::Mutex;
 use std::time::Duration;
+use volray_core::RenderSettings;
 use volray_core::glam::DVec3;
 
 fn host(shared: Shared) -> Host {

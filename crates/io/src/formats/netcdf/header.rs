@@ -20,12 +20,18 @@
 //! Every count is checked against the bytes left in the file before
 //! anything it sizes is allocated (an element takes at least one byte,
 //! a list entry at least eight), so a lying header costs no memory.
+//!
+//! The layer both NetCDF-3 readers read on (the CF reader, `mod.rs`, and
+//! MINC1's, `formats/minc1.rs`): a file opened and its header parsed
+//! ([`open`]), a variable's values read ([`read_values`],
+//! [`small_values`]).
 
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use crate::error::IoError;
-use crate::shared::cf::Value;
+use crate::shared::cf::{Packing, Value};
+use crate::shared::input::open_input;
 
 /// A NetCDF-3 external type (`nc_type`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -576,4 +582,44 @@ pub(crate) fn read_values(
         done += n;
     }
     Ok(())
+}
+
+/// Opens and parses the NetCDF-3 file at `path`.
+pub(crate) fn open(path: &Path) -> Result<(std::fs::File, Header), IoError> {
+    let (file, len) = open_input(path)?;
+    let parse_from = file.try_clone().map_err(|e| IoError::os(path, "open", e))?;
+    let header = parse(path, parse_from, len)?;
+    Ok((file, header))
+}
+
+/// All values of the small variable `var` (a coordinate variable, a MINC
+/// scale), unpacked by `packing`; refused past `limit` values.
+pub(crate) fn small_values(
+    path: &Path,
+    file: &mut std::fs::File,
+    header: &Header,
+    var: &Var,
+    packing: Option<&Packing>,
+    limit: u64,
+) -> Result<Vec<f64>, IoError> {
+    let n = header
+        .shape(var)
+        .iter()
+        .try_fold(1u64, |a, &d| a.checked_mul(d))
+        .filter(|&n| n <= limit && n.saturating_mul(var.ty.size()) <= header.len)
+        .ok_or_else(|| {
+            IoError::invalid(
+                path,
+                format!(
+                    "NetCDF: variable {} of shape {:?} is larger than the file or than {limit} values",
+                    var.name,
+                    header.shape(var)
+                ),
+            )
+        })?;
+    let mut out = vec![0.0; n as usize];
+    read_values(path, file, header, var, 0, n as usize, &mut |i, v| {
+        out[i] = packing.map_or(v, |p| p.real(v));
+    })?;
+    Ok(out)
 }

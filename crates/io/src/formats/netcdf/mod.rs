@@ -2,7 +2,8 @@
 //! (64-bit offset) and CDF-5 (64-bit data), read with the CF conventions
 //! (`shared/cf.rs`); a NetCDF-4 file, which is HDF5, goes to the HDF5
 //! route, and a MINC1 file (NetCDF-3 in libminc's layout) to
-//! `formats/minc1.rs`.
+//! `formats/minc1.rs`, which reads it on this reader's layer
+//! (`header.rs`: the header, and the values of a variable).
 //!
 //! - The header (`header.rs`) is parsed by a small own parser rather than
 //!   the `netcdf3` crate: that crate reads a variable only whole (its
@@ -30,19 +31,18 @@
 //!   NetCDF-3 bytes, and box-by-box (lazy) reads: a variable is read
 //!   whole, a frame at a time, within `--max-memory`.
 
-mod header;
+pub(crate) mod header;
 
 use std::io::Read;
 use std::path::Path;
 
 use crate::error::IoError;
-use crate::shared::cf::{self, Packing, Value};
+use crate::shared::cf::{self, Packing};
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::input::open_input;
 use crate::shared::limits::check_frame_size;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
 
-pub(crate) use header::{Header, NcType, Var, check_in_file, read_values};
+use header::{Header, NcType, check_in_file, open, read_values, small_values};
 
 /// Reads the NetCDF file at `path`.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
@@ -78,14 +78,6 @@ pub(crate) fn is_hdf5(path: &Path) -> bool {
         && &magic == b"\x89HDF\r\n\x1a\n"
 }
 
-/// Opens and parses the NetCDF-3 file at `path`.
-pub(crate) fn open(path: &Path) -> Result<(std::fs::File, Header), IoError> {
-    let (file, len) = open_input(path)?;
-    let parse_from = file.try_clone().map_err(|e| IoError::os(path, "open", e))?;
-    let header = header::parse(path, parse_from, len)?;
-    Ok((file, header))
-}
-
 /// The variables of `header` as CF sees them.
 pub(crate) fn cf_variables(header: &Header) -> Vec<cf::Variable> {
     header
@@ -113,38 +105,6 @@ fn version_name(version: u8) -> &'static str {
         2 => "NetCDF-3 64-bit offset (CDF-2)",
         _ => "NetCDF-3 64-bit data (CDF-5)",
     }
-}
-
-/// All values of the small variable `var` (a coordinate variable, a MINC
-/// scale), unpacked by `packing`; refused past `limit` values.
-pub(crate) fn small_values(
-    path: &Path,
-    file: &mut std::fs::File,
-    header: &Header,
-    var: &Var,
-    packing: Option<&Packing>,
-    limit: u64,
-) -> Result<Vec<f64>, IoError> {
-    let n = header
-        .shape(var)
-        .iter()
-        .try_fold(1u64, |a, &d| a.checked_mul(d))
-        .filter(|&n| n <= limit && n.saturating_mul(var.ty.size()) <= header.len)
-        .ok_or_else(|| {
-            IoError::invalid(
-                path,
-                format!(
-                    "NetCDF: variable {} of shape {:?} is larger than the file or than {limit} values",
-                    var.name,
-                    header.shape(var)
-                ),
-            )
-        })?;
-    let mut out = vec![0.0; n as usize];
-    read_values(path, file, header, var, 0, n as usize, &mut |i, v| {
-        out[i] = packing.map_or(v, |p| p.real(v));
-    })?;
-    Ok(out)
 }
 
 /// Reads the CF variable of a parsed NetCDF-3 file.
@@ -256,9 +216,4 @@ fn read_cf(
         format: VolumeFormat::Netcdf,
         info,
     })
-}
-
-/// Whether `value` is the text `want` (MINC's fixed-width words).
-pub(crate) fn is_text(value: Option<&Value>, want: &str) -> bool {
-    matches!(value, Some(Value::Text(t)) if t.trim_end_matches(['\0', ' ']) == want)
 }

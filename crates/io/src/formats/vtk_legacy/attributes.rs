@@ -1,24 +1,15 @@
 //! The attribute sections of a legacy VTK file (`POINT_DATA n`,
 //! `CELL_DATA n`): each keyword's header words (`SCALARS name type`,
-//! `VECTORS`, `FIELD` arrays, ...) become an [`ArraySpec`], and the
+//! `VECTORS`, `FIELD` arrays, ...) become an [`ArraySpec`] (`values.rs`), and the
 //! [`Scan`] decodes the best candidate for the volume so far and skips
 //! every other array ([`crate::shared::vtk_arrays`] ranks them).
 
 use super::lexer::Lexer;
-use super::values::{Encoding, SampleType, array_values, parse_type};
+use super::values::{ArraySpec, Encoding, SampleType, array_values, parse_type};
 use crate::FileInfo;
 use crate::dtype::DType;
 use crate::error::IoError;
 use crate::shared::vtk_arrays::{ArrayEntry, Association, rank};
-
-/// One array's description, as its header words give it.
-pub(super) struct ArraySpec {
-    pub(super) entry: ArrayEntry,
-    pub(super) sample: SampleType,
-    pub(super) tuples: usize,
-    /// ASCII `COLOR_SCALARS`: floats in [0, 1] that stand for bytes.
-    pub(super) ascii_colour: bool,
-}
 
 /// The best array found so far and its values (`None` when it cannot be
 /// used: not a scalar, or a FIELD array of the wrong length).

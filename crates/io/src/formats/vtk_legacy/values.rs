@@ -1,16 +1,17 @@
-//! The values of a legacy VTK array: its sample types, and reading
-//! (ASCII, or BINARY big-endian) or skipping the values of one array and
-//! the `METADATA` block after it, each size checked against the rest of
-//! the file before anything is allocated.
+//! The values of a legacy VTK array: its description as its header
+//! words give it ([`ArraySpec`]), its sample types, and reading (ASCII,
+//! or BINARY big-endian) or skipping the values of one array and the
+//! `METADATA` block after it, each size checked against the rest of the
+//! file before anything is allocated.
 
 use std::path::Path;
 
-use super::attributes::ArraySpec;
 use super::lexer::Lexer;
 use crate::dtype::{DType, Endian, extend_f32};
 use crate::error::IoError;
 use crate::shared::limits::{F32_BYTES, check_memory};
 use crate::shared::mapped::{self, MapPolicy};
+use crate::shared::vtk_arrays::ArrayEntry;
 
 /// Samples decoded per read of BINARY data.
 const CHUNK_SAMPLES: usize = 1 << 16;
@@ -60,6 +61,15 @@ impl SampleType {
 pub(super) enum Encoding {
     Ascii,
     Binary,
+}
+
+/// One array's description, as its header words give it.
+pub(super) struct ArraySpec {
+    pub(super) entry: ArrayEntry,
+    pub(super) sample: SampleType,
+    pub(super) tuples: usize,
+    /// ASCII `COLOR_SCALARS`: floats in [0, 1] that stand for bytes.
+    pub(super) ascii_colour: bool,
 }
 
 /// A type name, known or refused.
