@@ -3,6 +3,9 @@
 
 use std::fmt;
 
+use volray_app::AppError;
+use volray_app::error::OverBudget;
+use volray_distributed::streamed::StreamError;
 use volray_io::{IoError, VolumeFormat, format_bytes};
 
 #[derive(Debug)]
@@ -118,6 +121,77 @@ fn naming_flags(e: &IoError) -> String {
         | IoError::NotRead { .. }
         | IoError::FlatImage { .. }
         | IoError::ImageSize { .. } => e.to_string(),
+    }
+}
+
+impl From<AppError> for CliError {
+    /// volray-app's errors worded with the flags. A render error names no
+    /// flag here: [`crate::session::app_failure`] names it where the view
+    /// flags are at hand.
+    fn from(e: AppError) -> Self {
+        match e {
+            AppError::Io(e) => e.into(),
+            AppError::Data(e) => e.into(),
+            AppError::BadValue { option, message } => {
+                CliError::input(format!("--{}: {message}", option.name()))
+            }
+            AppError::RawLayoutOnFormat { spec, format } => CliError::input(format!(
+                "{spec}: --dims, --dtype and --endian describe raw files; this is a {format} file (give --format raw to read it as raw)"
+            )),
+            AppError::RawNeedsDims { path } => CliError::input(format!(
+                "{path}: raw data needs --dims X,Y,Z (and --dtype unless it is f32)"
+            )),
+            AppError::FileOptionsOnSource { spec } => CliError::input(format!(
+                "{spec}: --dims, --dtype, --endian, --format, --frame, --array, --level and --channel apply to files only, not to built-in sources"
+            )),
+            AppError::AutoLevelNeedsStill => CliError::input(
+                "--level auto chooses the level a still image needs (volray render ... -o OUT.png): give a level number here, 0 the finest",
+            ),
+            AppError::AutoLevelOneLevel { spec } => CliError::input(format!(
+                "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
+            )),
+            AppError::AutoLevel { spec, error } => CliError::input(format!("{spec}: {error}")),
+            AppError::Log { name, message } => {
+                CliError::input(format!("--log: {name}: {message}"))
+            }
+            AppError::Spacing(e) => CliError::input(format!("--spacing: {e}")),
+            AppError::OverBudget(over) => over_budget(&over),
+            AppError::Option(e) => crate::settings::refused(e),
+            AppError::Render { name, error } => {
+                if let volray_core::RenderError::SamplesChanged(_) = error {
+                    return CliError::io(format!("{name}: {error}"));
+                }
+                CliError::input(format!("{name}: {error}"))
+            }
+            AppError::Stream { name, error } => match error {
+                StreamError::Read(message) => CliError::io(message),
+                StreamError::TooLarge(message) => CliError::input(format!(
+                    "{name}: {message}: raise --max-memory, or pick a coarser --level"
+                )),
+                StreamError::Render(error) => AppError::Render { name, error }.into(),
+            },
+        }
+    }
+}
+
+/// A frame over `--max-memory`, and the way out.
+fn over_budget(over: &OverBudget) -> CliError {
+    let [nx, ny, nz] = over.dims;
+    let (w, h) = over.size;
+    let what = format!(
+        "{}: rendering {nx}x{ny}x{nz} voxels at {w}x{h} pixels",
+        over.name
+    );
+    let (need, limit) = (format_bytes(over.need), format_bytes(over.limit));
+    match over.fast_need {
+        // The oracle is dense: say so where the default path would fit.
+        Some(fast) => CliError::input(format!(
+            "{what} on the reference path (--reference) may take up to {need}, more than --max-memory {limit}; the default path takes at most {}: leave out --reference",
+            format_bytes(fast)
+        )),
+        None => CliError::input(format!(
+            "{what} may take up to {need}, more than --max-memory {limit} (raise it, or use a smaller grid)"
+        )),
     }
 }
 

@@ -14,10 +14,11 @@
 //!   `bench/vtk.rs`), `info.rs`, `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
 //!   writes with), `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
 //!   `view/reproduce.rs`: the page's state as a `volray render` command);
-//! - what they share: `input.rs` (reading INPUT), `settings.rs` (the flags
-//!   as volray-core's `RenderSettings`), `session.rs` (loading, the
-//!   renderer, threads, progress, which flag a render error is about),
-//!   `memory.rs` (the `--max-memory` bound for rendering);
+//! - what they share: `settings.rs` (the flags as volray-core's
+//!   `RenderSettings`), `session.rs` (the flags as volray-app's input
+//!   requests and plans, the renderer within the `--max-memory` budget,
+//!   threads, progress, which flag a render error is about); volray-app
+//!   reads INPUT, plans it and budgets its frames;
 //! - the process: `error.rs` (one-line errors and their exit codes: 0
 //!   success, 1 bad input, 2 I/O, 128 + the signal when interrupted),
 //!   `output.rs` (standard output), `overwrite.rs` (never writing over an
@@ -40,16 +41,13 @@ mod figure;
 mod flags;
 mod generate;
 mod info;
-mod input;
 mod interrupt;
-mod memory;
 mod overwrite;
 mod paper;
 mod render;
 mod scene;
 mod session;
 mod settings;
-mod streamed;
 mod view;
 
 use flags::Command;

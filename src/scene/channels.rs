@@ -6,7 +6,7 @@
 use super::layer::{Budget, ChannelAxis, Layer, LayerSource, channel_axis};
 use crate::error::CliError;
 use crate::flags::{ChannelColors, Channels, InputArgs, LookArgs, SceneArgs, ViewArgs};
-use crate::input;
+use volray_app::input;
 use crate::session::load;
 use volray_core::{PiecewiseLinear, RenderSettings};
 
