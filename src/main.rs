@@ -34,14 +34,14 @@ mod output;
 mod animate;
 mod bench;
 mod convert;
-#[cfg(feature = "mpi")]
-mod distributed;
 mod error;
 mod figure;
 mod flags;
 mod generate;
 mod info;
 mod interrupt;
+#[cfg(feature = "mpi")]
+mod mpi;
 mod overwrite;
 mod paper;
 mod render;
@@ -60,10 +60,10 @@ fn main() -> ExitCode {
     };
     interrupt::install();
     #[cfg(feature = "mpi")]
-    if distributed::launched() {
+    if mpi::launched() {
         let result = match &cli.command {
-            Command::Render(args) => Some(distributed::render(args)),
-            Command::Bench(args) => Some(distributed::bench(args)),
+            Command::Render(args) => Some(mpi::render(args)),
+            Command::Bench(args) => Some(mpi::bench(args)),
             _ => None,
         };
         if let Some(result) = result {

@@ -15,6 +15,7 @@ use volray_app::input::Input;
 use volray_app::memory::{Budget, png_bytes};
 use volray_app::plan::{Chosen, Frames, Plan, StreamedInput};
 use volray_core::{RenderError, RenderSettings, Renderer};
+use volray_distributed::frame::FrameError;
 use volray_distributed::streamed::{StreamError, StreamTimes};
 use volray_io::format_bytes;
 
@@ -25,13 +26,22 @@ pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
 
 /// volray-app's error as the CLI's, a render error naming its flag.
 pub fn app_failure(view: &ViewArgs, e: AppError) -> CliError {
+    app_failure_of(view, &e)
+}
+
+/// [`app_failure`] of an error kept (a rank's, told to the others).
+pub fn app_failure_of(view: &ViewArgs, e: &AppError) -> CliError {
     match e {
         AppError::Render { name, error }
         | AppError::Stream {
             name,
             error: StreamError::Render(error),
-        } => render_failure(view, &name, error),
-        e => e.into(),
+        }
+        | AppError::Frame {
+            name,
+            error: FrameError::Render(error),
+        } => render_failure(view, name, error.clone()),
+        e => crate::error::word(e),
     }
 }
 

@@ -5,6 +5,7 @@
 //! command line's `--dims`, Python's `dims=`) by matching the variants.
 
 use volray_core::{CameraError, RenderError, VolumeError};
+use volray_distributed::frame::FrameError;
 use volray_distributed::streamed::StreamError;
 use volray_io::{IoError, format_bytes};
 use volray_options::OptionError;
@@ -119,4 +120,40 @@ pub enum AppError {
     /// The spacing given is not positive and finite.
     #[error("spacing: {0}")]
     Spacing(VolumeError),
+    /// A distributed step failed (the same on every rank).
+    #[error("{name}: {error}")]
+    Frame { name: String, error: FrameError },
+    /// A rank's piece would not fit the memory limit (per rank).
+    #[error(
+        "{name}: this rank's piece, {}x{}x{} voxels with its ghost layers, needs {} to read and render, over the memory limit {}: run on more ranks",
+        dims[0], dims[1], dims[2], format_bytes(*need), format_bytes(u128::from(*limit))
+    )]
+    PieceOverBudget {
+        name: String,
+        dims: [usize; 3],
+        need: u128,
+        limit: u64,
+    },
+    /// Rank 0 could not hold the volume it reads (or generates, if
+    /// `generated`) whole with the pieces it sends.
+    #[error(
+        "{name}: rank 0 reads the volume whole to send each rank its piece: the volume ({}) with the pieces it cuts needs {}, over the memory limit {}",
+        format_bytes(*volume), format_bytes(*need), format_bytes(u128::from(*limit))
+    )]
+    ScatterOverBudget {
+        name: String,
+        generated: bool,
+        volume: u128,
+        need: u128,
+        limit: u64,
+    },
+    /// Channels along the time points of a file, with one time point picked.
+    #[error(
+        "{spec}: its channels are its time points (one channel); a frame picks one: give one of them"
+    )]
+    ChannelsAndFrame { spec: String },
+    /// A front end's own refusal, carried through (its words; whether the
+    /// input was at fault).
+    #[error("{message}")]
+    Refused { message: String, bad_input: bool },
 }

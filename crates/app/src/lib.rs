@@ -25,6 +25,9 @@
 //!   (`level auto`) in pieces ([`plan::Plan`]);
 //! - [`memory`]: the memory budget ([`memory::cache_budget`]: the
 //!   refusal of a frame over the limit, and what the caches may take);
+//! - `distributed` (feature `mpi`): `mpirun -np N` renders: the input
+//!   split among the ranks, each rank's budget, the frame composited on
+//!   rank 0, the times;
 //! - [`error`]: [`AppError`], typed, one line naming the file, which each
 //!   front end words in its own syntax.
 //!
@@ -52,6 +55,8 @@
 //! # Ok::<(), volray_app::AppError>(())
 //! ```
 
+#[cfg(feature = "mpi")]
+pub mod distributed;
 pub mod error;
 pub mod input;
 pub mod memory;

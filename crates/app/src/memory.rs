@@ -53,6 +53,35 @@ pub struct Budget {
     pub samples_count: bool,
 }
 
+/// What rendering a frame of `volume` with `settings` may take with no
+/// brick cache, non-finite values handled as `mode` says: volray-core's
+/// bound, with what the front end adds, less the volume's samples where
+/// they do not count ([`Budget`]).
+pub fn frame_bytes(
+    volume: &Volume,
+    settings: &RenderSettings,
+    mode: NonFinite,
+    budget: &Budget,
+) -> u128 {
+    let bound = MemoryBound::new(
+        volume.dims(),
+        volume.spacing(),
+        volume.sample_type(),
+        settings,
+        mode,
+        0,
+    );
+    // A volume mapped from its file is the page cache's, not ours: only
+    // what the renderer adds counts.
+    let samples = (volume.len() * volume.sample_type().bytes()) as u128;
+    let mapped = if budget.samples_count && !volume.samples().is_external() {
+        0
+    } else {
+        samples
+    };
+    bound.total() + budget.extra - mapped
+}
+
 /// The budget of the brick caches for rendering `volume` (named `name`)
 /// with `settings`, non-finite values handled as `mode` says: the
 /// library's default ([`DEFAULT_CACHE_BUDGET`]), or what is left under
@@ -67,19 +96,7 @@ pub fn cache_budget(
     budget: Budget,
 ) -> Result<usize, AppError> {
     let limit = u128::from(budget.limit);
-    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
-    // A volume mapped from its file is the page cache's, not ours: only
-    // what the renderer adds counts.
-    let samples = (volume.len() * volume.sample_type().bytes()) as u128;
-    let mapped = if budget.samples_count && !volume.samples().is_external() {
-        0
-    } else {
-        samples
-    };
-    let bytes = |settings: &RenderSettings| {
-        MemoryBound::new(grid.0, grid.1, grid.2, settings, mode, 0).total() + budget.extra
-            - mapped
-    };
+    let bytes = |settings: &RenderSettings| frame_bytes(volume, settings, mode, &budget);
     let need = bytes(settings);
     if need > limit {
         // The oracle is dense: say so where the default path would fit.
