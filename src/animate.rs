@@ -26,8 +26,8 @@ use crate::render::OutputKind;
 use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note,
 };
-use volray_app::plan::Plan;
 use rayon::ThreadPool;
+use volray_app::plan::Plan;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
 use volray_io::Animation;
@@ -49,14 +49,15 @@ pub fn turntable(
     let input_args = match crate::session::plan(&args.input, &args.view, &first)? {
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
-            let base = &(streamed.settings_from_volume(&crate::settings::look(&args.view.look), base.clone()))
-                .map_err(|e| app_failure(&args.view, e))?;
+            let base = &(streamed
+                .settings_from_volume(&crate::settings::look(&args.view.look), base.clone()))
+            .map_err(|e| app_failure(&args.view, e))?;
             let mut writer = Writer::new(args, base, frames)?;
             let mut last = None;
             for i in 0..frames {
                 let frame = turntable_frame(base, i, frames);
-                let (image, times) =
-                    pool.install(|| streamed.render(&frame, &|_| {}))
+                let (image, times) = pool
+                    .install(|| streamed.render(&frame, &|_| {}))
                     .map_err(|e| app_failure(&args.view, e))?;
                 writer.push(&image)?;
                 last = Some(times);
@@ -133,7 +134,11 @@ pub fn time_points(
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
-    let spec = args.input.input.as_deref().unwrap_or(volray_app::input::DEMO);
+    let spec = args
+        .input
+        .input
+        .as_deref()
+        .unwrap_or(volray_app::input::DEMO);
     let refuse = |why: String| Err(CliError::input(format!("--frames: {spec}: {why}")));
     if volray_data::is_source_spec(spec) {
         return refuse("a built-in source has one time point: give a file holding several".into());

@@ -15,8 +15,8 @@
 
 use crate::error::CliError;
 use crate::flags::ConvertArgs;
-use volray_app::input;
 use std::path::Path;
+use volray_app::input;
 use volray_core::Volume;
 use volray_io::{OmeZarrOptions, OmeZarrWritten, ZarrVersion, format_bytes};
 

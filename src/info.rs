@@ -2,8 +2,8 @@
 
 use crate::error::CliError;
 use crate::flags::InfoArgs;
-use volray_app::input::{self, Described};
 use serde_json::{Value, json};
+use volray_app::input::{self, Described};
 use volray_core::Histogram;
 use volray_core::transfer::labels;
 use volray_io::{FileInfo, FlatImage};

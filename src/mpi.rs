@@ -14,6 +14,7 @@ use volray_app::AppError;
 use volray_app::distributed::{self, Job, Mpi};
 use volray_core::RenderSettings;
 use volray_distributed::frame::Failure;
+use volray_distributed::transport::Transport;
 
 /// Whether this process runs under an MPI launcher, and so renders as one
 /// rank of a distributed run.
@@ -58,7 +59,11 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
     // Rank 0 writes the file: it alone checks where.
     let checked = if mpi.rank() == 0 {
         render::check_output(&args.out.output).and_then(|_| {
-            let spec = args.input.input.as_deref().unwrap_or(volray_app::input::DEMO);
+            let spec = args
+                .input
+                .input
+                .as_deref()
+                .unwrap_or(volray_app::input::DEMO);
             crate::overwrite::refuse_overwriting_inputs(
                 &render::output_files(args, kind, 1),
                 &[spec.to_string()],

@@ -6,13 +6,13 @@
 use crate::animate;
 use crate::error::CliError;
 use crate::flags::RenderArgs;
-use volray_app::input;
 use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note, thread_pool,
 };
 use crate::settings::settings;
-use volray_app::plan::Plan;
 use std::path::{Path, PathBuf};
+use volray_app::input;
+use volray_app::plan::Plan;
 use volray_core::RenderSettings;
 use volray_io::{Animation, AnimationKind, BitDepth};
 
@@ -85,12 +85,13 @@ fn still(
     let input_args = match crate::session::plan(&args.input, &args.view, settings)? {
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
-            let settings = &(streamed.settings_from_volume(&crate::settings::look(&args.view.look), settings.clone()))
-                .map_err(|e| app_failure(&args.view, e))?;
+            let settings = &(streamed
+                .settings_from_volume(&crate::settings::look(&args.view.look), settings.clone()))
+            .map_err(|e| app_failure(&args.view, e))?;
             let bar = progress_bar((settings.width * settings.height) as u64);
-            let (image, times) =
-                pool.install(|| streamed.render(settings, &|n| bar.inc(n as u64)))
-                    .map_err(|e| app_failure(&args.view, e))?;
+            let (image, times) = pool
+                .install(|| streamed.render(settings, &|n| bar.inc(n as u64)))
+                .map_err(|e| app_failure(&args.view, e))?;
             bar.finish_and_clear();
             write_still(args, kind, &image)?;
             eprintln!("{}", streamed_note(&streamed, &times));

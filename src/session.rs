@@ -48,7 +48,11 @@ pub fn app_failure_of(view: &ViewArgs, e: &AppError) -> CliError {
 /// How INPUT is rendered for frames of `settings` (volray-app's `plan`):
 /// whole, or a chunked file's level in pieces; `--level auto` says what
 /// it chose.
-pub fn plan(args: &InputArgs, view: &ViewArgs, settings: &RenderSettings) -> Result<Plan, CliError> {
+pub fn plan(
+    args: &InputArgs,
+    view: &ViewArgs,
+    settings: &RenderSettings,
+) -> Result<Plan, CliError> {
     let request = args.request();
     let frames = Frames {
         settings,

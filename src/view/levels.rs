@@ -14,9 +14,9 @@
 
 use crate::error::CliError;
 use crate::flags::ViewerArgs;
-use volray_app::input::{self, Input};
 use std::path::Path;
 use std::sync::Arc;
+use volray_app::input::{self, Input};
 use volray_core::glam::DVec3;
 use volray_core::{NonFinite, RenderSettings, SampleType};
 use volray_io::format_bytes;

@@ -15,9 +15,9 @@
 
 use crate::error::CliError;
 use crate::flags::{Cli, Command, ViewerArgs};
-use volray_app::input;
 use crate::settings::settings_with_tf_text;
 use clap::Parser;
+use volray_app::input;
 use volray_core::glam::DVec3;
 use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, Phong, SampleType, TransferFunction};

@@ -154,7 +154,11 @@ mod tests {
         let bricked = bytes(&settings(|_| {}), refuse, dims);
         assert!((4 * voxels + 30 * voxels..4 * voxels + 40 * voxels).contains(&(bricked - frame)));
         // Post-classification: 16 bytes a voxel kept, 12 more while packing.
-        let post = bytes(&settings(|o| o.look.post_classification = true), refuse, dims);
+        let post = bytes(
+            &settings(|o| o.look.post_classification = true),
+            refuse,
+            dims,
+        );
         assert!(
             (32 * voxels + frame..32 * voxels + frame + 100_000).contains(&post),
             "{post}"

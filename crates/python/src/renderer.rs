@@ -39,15 +39,15 @@ use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use volray_annotate::figure::Annotations;
+use volray_app::AppError;
+use volray_app::memory::Budget;
 use volray_core::transfer::auto;
 use volray_core::{
-    Histogram, Image, NonFinite, RenderError, RenderSettings,
-    Renderer as CoreRenderer, Volume as CoreVolume,
+    Histogram, Image, NonFinite, RenderError, RenderSettings, Renderer as CoreRenderer,
+    Volume as CoreVolume,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
 use volray_io::{MapPolicy, ReadOptions, format_bytes};
-use volray_app::AppError;
-use volray_app::memory::Budget;
 use volray_lazy::{Chunked, Found, LookError, Plan};
 use volray_options::level::LevelChoice;
 use volray_options::{CameraOptions, LookOptions, Options};

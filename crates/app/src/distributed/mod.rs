@@ -83,7 +83,11 @@ pub fn launched() -> bool {
 
 /// Rank 0's `checked` (where it writes the frame, say), agreed by every
 /// rank before any reads: the same failure on each.
-pub fn agree_on(mpi: &Mpi, checked: Result<(), AppError>, words: Words<'_>) -> Result<(), AppError> {
+pub fn agree_on(
+    mpi: &Mpi,
+    checked: Result<(), AppError>,
+    words: Words<'_>,
+) -> Result<(), AppError> {
     agree(mpi, checked.map(|_| Vec::new()).map_err(|e| words(&e)))
         .map(|_| ())
         .map_err(|e| frame("", e))
@@ -311,4 +315,3 @@ fn from_volume(
     }
     Ok(settings)
 }
-

@@ -186,7 +186,7 @@ impl RankSource {
                 let fits = source.check_piece(mpi, Route::Chunked { stored });
                 agree(mpi, fits.map(|_| Vec::new()).map_err(|e| words(&e)))
                     .map_err(|e| frame(&spec, e))?;
-                source.agree_log_floor(mpi, words)?;
+                source.agree_log_floor(mpi)?;
                 return Ok(source);
             }
         }
@@ -224,8 +224,7 @@ impl RankSource {
         if let (true, Ok(Some(input))) = (fits.is_ok() && !header.local, &first) {
             fits = source.check_scatter(mpi, &input.volume);
         }
-        agree(mpi, fits.map(|_| Vec::new()).map_err(|e| words(&e)))
-            .map_err(|e| frame(&spec, e))?;
+        agree(mpi, fits.map(|_| Vec::new()).map_err(|e| words(&e))).map_err(|e| frame(&spec, e))?;
         if header.local {
             // Every rank maps the file itself.
             let input = match first {
@@ -237,7 +236,7 @@ impl RankSource {
             let input = input.expect("agreed");
             source.reorientation = input.file.and_then(|(_, info)| info.reorientation);
             source.whole = Some(input.volume);
-            source.agree_log_floor(mpi, words)?;
+            source.agree_log_floor(mpi)?;
             return Ok(source);
         }
         // Rank 0 sends each rank its piece.
@@ -267,7 +266,7 @@ impl RankSource {
             let bytes = mpi.receive(0).map_err(|e| frame(&spec, e.into()))?;
             source.sent = decode_piece(&bytes);
         }
-        source.agree_log_floor(mpi, words)?;
+        source.agree_log_floor(mpi)?;
         Ok(source)
     }
 
@@ -295,9 +294,8 @@ impl RankSource {
         };
         self.generate = Some(spec.clone());
         let fits = self.check_piece(mpi, Route::Generated);
-        agree(mpi, fits.map(|_| Vec::new()).map_err(|e| words(&e)))
-            .map_err(|e| frame(&spec, e))?;
-        self.agree_log_floor(mpi, words)
+        agree(mpi, fits.map(|_| Vec::new()).map_err(|e| words(&e))).map_err(|e| frame(&spec, e))?;
+        self.agree_log_floor(mpi)
     }
 
     /// This rank's held box (its owned box with its ghost layers), or
@@ -396,7 +394,7 @@ impl RankSource {
     /// For `--log`: the smallest positive value over every rank's piece
     /// (the pieces cover the volume), as one process takes it over the
     /// whole volume.
-    fn agree_log_floor(&mut self, mpi: &Mpi, words: Words<'_>) -> Result<(), AppError> {
+    fn agree_log_floor(&mut self, mpi: &Mpi) -> Result<(), AppError> {
         if !self.log {
             return Ok(());
         }

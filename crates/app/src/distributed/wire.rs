@@ -6,7 +6,12 @@ use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
 
 /// The held piece (with ghosts) of the box `lo..hi`, or `None` if empty.
-pub(super) fn held_piece(volume: &Volume, lo: [usize; 3], hi: [usize; 3], dims: [usize; 3]) -> Option<Volume> {
+pub(super) fn held_piece(
+    volume: &Volume,
+    lo: [usize; 3],
+    hi: [usize; 3],
+    dims: [usize; 3],
+) -> Option<Volume> {
     if (0..3).any(|a| lo[a] >= hi[a]) {
         return None;
     }
