@@ -138,7 +138,7 @@ impl From<AppError> for CliError {
 }
 
 /// volray-app's error worded with the flags. A render error names no
-/// flag here: [`crate::session::app_failure`] names it where the view
+/// flag here: `session::app_failure` names it where the view
 /// flags are at hand.
 pub fn word(e: &AppError) -> CliError {
     match e {
@@ -166,7 +166,8 @@ pub fn word(e: &AppError) -> CliError {
         AppError::Log { name, message } => CliError::input(format!("--log: {name}: {message}")),
         AppError::Spacing(e) => CliError::input(format!("--spacing: {e}")),
         AppError::OverBudget(over) => over_budget(over),
-        AppError::Option(e) => CliError::input(e.message(&crate::settings::Flags)),
+        // Named with the flags by `session::app_failure`.
+        AppError::Option(e) => CliError::input(e.to_string()),
         AppError::Render { name, error } => render_error(name, error),
         AppError::Stream { name, error } => match error {
             StreamError::Read(message) => CliError::io(message),

@@ -41,6 +41,7 @@ pub fn app_failure_of(view: &ViewArgs, e: &AppError) -> CliError {
             name,
             error: FrameError::Render(error),
         } => render_failure(view, name, error.clone()),
+        AppError::Option(e) => crate::settings::refused(e.clone()),
         e => crate::error::word(e),
     }
 }
@@ -122,7 +123,7 @@ pub fn progress_bar(pixels: u64) -> ProgressBar {
 
 /// The renderer of `input`'s volume, its non-finite values refused or
 /// rendered as empty space as `--nonfinite` says, refused if rendering it
-/// may need more than `--max-memory` (see `memory.rs`). A refusal is one
+/// may need more than `--max-memory` (see volray-app's `memory`). A refusal is one
 /// line naming the input and the count, and the way out.
 pub fn renderer_for<'v>(
     view: &ViewArgs,

@@ -2,8 +2,8 @@
 //! over the frames (each turned half a degree further, as `bench` does),
 //! as a table rank 0 prints.
 
+use super::job::{Job, Words, frame, from_volume};
 use super::source::RankSource;
-use super::{Job, Words, frame, from_volume};
 use crate::error::AppError;
 use std::fmt::Write;
 use std::time::Duration;

@@ -29,51 +29,31 @@
 //! function from them.
 
 //!
-//! Files: `mod.rs` (the jobs: a still, its channels, the bench; MPI
-//! started, a panic ending every rank), `source.rs` (each rank's piece),
+//! Files: `mod.rs` (a still, its channels; MPI started, a panic ending
+//! every rank), `job.rs` (what a job reads and looks like, the failures
+//! the ranks agree on), `source.rs` (each rank's piece),
 //! `wire.rs` (grids and pieces as bytes), `bench.rs` (the times' table).
 
 mod bench;
+mod job;
 mod source;
 mod wire;
 
 pub use bench::bench;
+pub use job::{Job, Words};
 
 use crate::error::AppError;
 use crate::input::{Request, Spec};
+use job::{frame, from_volume};
 use source::RankSource;
 use std::sync::atomic::{AtomicBool, Ordering};
+use volray_core::Image;
 use volray_core::scene::{Look, Mix, SceneSettings};
-use volray_core::{Image, NonFinite, RenderSettings};
-use volray_distributed::frame::{Distributed, Failure, FrameError, agree};
+use volray_distributed::frame::{Distributed, agree};
 pub use volray_distributed::mpi::Mpi;
 use volray_distributed::scene::DistributedScene;
 use volray_distributed::transport::Transport;
 use volray_io::MapPolicy;
-use volray_options::LookOptions;
-
-/// How a front end tells the other ranks this rank's failure: its own
-/// one-line wording, and whether the input was at fault (a corrupt file
-/// is bad input on every rank, as in one process).
-pub type Words<'a> = &'a dyn Fn(&AppError) -> Failure;
-
-/// What a distributed render reads and how it looks: the input, the
-/// frame's settings, the look options (`--labels`, `--log`, `--tf auto`
-/// are taken as one process takes them), and non-finite values.
-pub struct Job {
-    pub request: Request,
-    pub settings: RenderSettings,
-    pub look: LookOptions,
-    pub non_finite: NonFinite,
-}
-
-/// A failed distributed step of the input `name`: the same on every rank.
-fn frame(name: &str, error: FrameError) -> AppError {
-    AppError::Frame {
-        name: name.to_string(),
-        error,
-    }
-}
 
 /// Whether this process runs under an MPI launcher, and so renders as one
 /// rank of a distributed run.
@@ -276,42 +256,4 @@ pub fn ranked<T>(run: impl FnOnce() -> T) -> T {
         Err(_) if STARTED.load(Ordering::SeqCst) => volray_distributed::mpi::abort_world(101),
         Err(payload) => std::panic::resume_unwind(payload),
     }
-}
-
-/// `settings` with what the look options leave to the volume, as one
-/// process takes it (volray-options' `from_volume`): with `--labels`, the label
-/// transfer function of the labels every rank found, joined; otherwise
-/// `--tf auto` (the default) chosen from the whole volume's histogram,
-/// summed over the ranks' owned voxels, within the file's display window
-/// where it gives one.
-fn from_volume(
-    d: &Distributed<'_, Mpi>,
-    look: &LookOptions,
-    (name, window): (&str, Option<(f64, f64)>),
-    mut settings: RenderSettings,
-) -> Result<RenderSettings, AppError> {
-    let fail = |e| frame(name, e);
-    volray_options::file_window(look, &mut settings.transfer_function, window);
-    if look.labels {
-        let found = d
-            .labels(volray_core::transfer::labels::MAX_LABELS)
-            .map_err(fail)?;
-        let found = volray_options::labels_found(found, name).map_err(AppError::Option)?;
-        volray_options::label_transfer_function(
-            look,
-            &mut settings.transfer_function,
-            &found,
-            name,
-        )
-        .map_err(AppError::Option)?;
-        return Ok(settings);
-    }
-    if look.auto_tf()
-        && let Some(histogram) = d
-            .histogram(volray_core::transfer::auto::BINS)
-            .map_err(fail)?
-    {
-        volray_options::apply_auto(look, &mut settings.transfer_function, &histogram);
-    }
-    Ok(settings)
 }

@@ -3,8 +3,8 @@
 //! by rank 0), the `--max-memory` checks before any piece is read, and
 //! the `--log` floor the ranks agree on.
 
+use super::job::{Job, Words, frame};
 use super::wire::{decode_piece, encode_piece, grid_bytes, grid_of, held_piece, parse_grid};
-use super::{Job, Words, frame};
 use crate::error::AppError;
 use crate::input::{self, Input, Request, Spec};
 use volray_core::glam::DVec3;
