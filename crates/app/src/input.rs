@@ -252,13 +252,7 @@ pub fn read_options(
     let spec = request.spec.name();
     let path = PathBuf::from(&spec);
     let raw_flags = request.raw_flags();
-    let format = match &request.format {
-        Some(f) => Some(f.parse::<VolumeFormat>().map_err(|e| AppError::BadValue {
-            option: InputOpt::Format,
-            message: e.to_string(),
-        })?),
-        None => None,
-    };
+    let format = format_named(request.format.as_deref())?;
     // Raw layout flags on a file that names another format (`a.npy
     // --dtype u8`) are misplaced, not a raw file missing its --dims.
     if raw_flags
@@ -336,14 +330,34 @@ fn raw_options(request: &Request, path: &Path) -> Result<RawOptions, AppError> {
     let dims = request.dims.ok_or_else(|| AppError::RawNeedsDims {
         path: path.display().to_string(),
     })?;
-    let dtype = match &request.dtype {
+    let (dtype, endian) = (request.dtype.as_deref(), request.endian.as_deref());
+    raw_layout(dims, dtype, endian, request.spacing)
+}
+
+/// The format a front end names (`--format`, Python's `format=`), if any.
+pub fn format_named(name: Option<&str>) -> Result<Option<VolumeFormat>, AppError> {
+    (name.map(str::parse::<VolumeFormat>).transpose()).map_err(|e| AppError::BadValue {
+        option: InputOpt::Format,
+        message: e.to_string(),
+    })
+}
+
+/// A raw file's layout: `dims` points of `dtype` (default `f32`) in
+/// `endian` byte order (default little), `spacing` apart (default 1).
+pub fn raw_layout(
+    dims: [usize; 3],
+    dtype: Option<&str>,
+    endian: Option<&str>,
+    spacing: Option<[f64; 3]>,
+) -> Result<RawOptions, AppError> {
+    let dtype = match dtype {
         Some(d) => d.parse::<DType>().map_err(|e| AppError::BadValue {
             option: InputOpt::Dtype,
             message: e.to_string(),
         })?,
         None => DType::F32,
     };
-    let endian = match &request.endian {
+    let endian = match endian {
         Some(e) => e.parse::<Endian>().map_err(|e| AppError::BadValue {
             option: InputOpt::Endian,
             message: e.to_string(),
@@ -352,6 +366,6 @@ fn raw_options(request: &Request, path: &Path) -> Result<RawOptions, AppError> {
     };
     let mut raw = RawOptions::new(dims, dtype);
     raw.endian = endian;
-    raw.spacing = DVec3::from(request.spacing.unwrap_or([1.0; 3]));
+    raw.spacing = DVec3::from(spacing.unwrap_or([1.0; 3]));
     Ok(raw)
 }
