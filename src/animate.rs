@@ -23,9 +23,11 @@
 use crate::error::CliError;
 use crate::flags::{InputArgs, RenderArgs};
 use crate::render::OutputKind;
-use crate::session::{load, progress_bar, render_failure, renderer_for};
-use crate::streamed::Plan;
+use crate::session::{
+    app_failure, load, progress_bar, render_failure, renderer_for, streamed_note,
+};
 use rayon::ThreadPool;
+use volray_app::plan::Plan;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
 use volray_io::Animation;
@@ -44,16 +46,19 @@ pub fn turntable(
     // first frame: the framing fits the bounding sphere, so every frame
     // shows the volume at one scale.
     let first = turntable_frame(base, 0, frames);
-    let input_args = match crate::streamed::plan(&args.input, &args.view, &first)? {
+    let input_args = match crate::session::plan(&args.input, &args.view, &first)? {
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
-            let base = &streamed.settings_from_volume(&args.view, base.clone())?;
+            let base = &(streamed
+                .settings_from_volume(&crate::settings::look(&args.view.look), base.clone()))
+            .map_err(|e| app_failure(&args.view, e))?;
             let mut writer = Writer::new(args, base, frames)?;
             let mut last = None;
             for i in 0..frames {
                 let frame = turntable_frame(base, i, frames);
-                let (image, times) =
-                    pool.install(|| streamed.render(&args.view, &frame, &|_| {}))?;
+                let (image, times) = pool
+                    .install(|| streamed.render(&frame, &|_| {}))
+                    .map_err(|e| app_failure(&args.view, e))?;
                 writer.push(&image)?;
                 last = Some(times);
             }
@@ -61,11 +66,14 @@ pub fn turntable(
             // As a still says it was rendered in pieces, once for the
             // animation: the last frame's pieces and times.
             if let Some(times) = last {
-                eprintln!("{} (the last of {frames} frames)", streamed.note(&times));
+                eprintln!(
+                    "{} (the last of {frames} frames)",
+                    streamed_note(&streamed, &times)
+                );
             }
             return Ok(());
         }
-        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
+        Plan::Whole { level } => args.input.at_level(level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
     let base = &crate::render::from_volume(args, base, &mut input)?;
@@ -126,7 +134,11 @@ pub fn time_points(
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
-    let spec = args.input.input.as_deref().unwrap_or(crate::input::DEMO);
+    let spec = args
+        .input
+        .input
+        .as_deref()
+        .unwrap_or(volray_app::input::DEMO);
     let refuse = |why: String| Err(CliError::input(format!("--frames: {spec}: {why}")));
     if volray_data::is_source_spec(spec) {
         return refuse("a built-in source has one time point: give a file holding several".into());

@@ -33,7 +33,11 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         }
         None => {
             if let Some(json) = &args.json {
-                let input = args.input.input.as_deref().unwrap_or(crate::input::DEMO);
+                let input = args
+                    .input
+                    .input
+                    .as_deref()
+                    .unwrap_or(volray_app::input::DEMO);
                 let tf: Vec<&Path> = args.view.look.tf_file().into_iter().collect();
                 crate::overwrite::refuse_overwriting_inputs(
                     std::slice::from_ref(json),

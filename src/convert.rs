@@ -15,8 +15,8 @@
 
 use crate::error::CliError;
 use crate::flags::ConvertArgs;
-use crate::input;
 use std::path::Path;
+use volray_app::input;
 use volray_core::Volume;
 use volray_io::{OmeZarrOptions, OmeZarrWritten, ZarrVersion, format_bytes};
 
@@ -40,7 +40,7 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
         &[spec.to_string()],
         &[],
     )?;
-    let mut input = input::load(&args.input)?;
+    let mut input = input::load(&args.input.request())?;
     let Some(kind) = kind else {
         if args.labels {
             input.volume.set_labels(true);

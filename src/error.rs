@@ -3,6 +3,10 @@
 
 use std::fmt;
 
+use volray_app::AppError;
+use volray_app::error::OverBudget;
+use volray_distributed::frame::FrameError;
+use volray_distributed::streamed::StreamError;
 use volray_io::{IoError, VolumeFormat, format_bytes};
 
 #[derive(Debug)]
@@ -37,12 +41,18 @@ impl fmt::Display for CliError {
 
 impl From<IoError> for CliError {
     fn from(e: IoError) -> Self {
-        let message = naming_flags(&e);
-        if e.is_io_failure() {
-            CliError::io(message)
-        } else {
-            CliError::input(message)
-        }
+        io_error(&e)
+    }
+}
+
+/// A reader's error worded with the flags: an I/O failure exits 2, bad
+/// input 1.
+fn io_error(e: &IoError) -> CliError {
+    let message = naming_flags(e);
+    if e.is_io_failure() {
+        CliError::io(message)
+    } else {
+        CliError::input(message)
     }
 }
 
@@ -118,6 +128,133 @@ fn naming_flags(e: &IoError) -> String {
         | IoError::NotRead { .. }
         | IoError::FlatImage { .. }
         | IoError::ImageSize { .. } => e.to_string(),
+    }
+}
+
+impl From<AppError> for CliError {
+    fn from(e: AppError) -> Self {
+        word(&e)
+    }
+}
+
+/// volray-app's error worded with the flags. A render error names no
+/// flag here: `session::app_failure` names it where the view
+/// flags are at hand.
+pub fn word(e: &AppError) -> CliError {
+    match e {
+        AppError::Io(e) => io_error(e),
+        AppError::Data(e) => CliError::input(e.to_string()),
+        AppError::BadValue { option, message } => {
+            CliError::input(format!("--{}: {message}", option.name()))
+        }
+        AppError::RawLayoutOnFormat { spec, format } => CliError::input(format!(
+            "{spec}: --dims, --dtype and --endian describe raw files; this is a {format} file (give --format raw to read it as raw)"
+        )),
+        AppError::RawNeedsDims { path } => CliError::input(format!(
+            "{path}: raw data needs --dims X,Y,Z (and --dtype unless it is f32)"
+        )),
+        AppError::FileOptionsOnSource { spec } => CliError::input(format!(
+            "{spec}: --dims, --dtype, --endian, --format, --frame, --array, --level and --channel apply to files only, not to built-in sources"
+        )),
+        AppError::AutoLevelNeedsStill => CliError::input(
+            "--level auto chooses the level a still image needs (volray render ... -o OUT.png): give a level number here, 0 the finest",
+        ),
+        AppError::AutoLevelOneLevel { spec } => CliError::input(format!(
+            "{spec}: --level auto applies to multiscale images (OME-Zarr); this file holds one level"
+        )),
+        AppError::AutoLevel { spec, error } => CliError::input(format!("{spec}: {error}")),
+        AppError::Log { name, message } => CliError::input(format!("--log: {name}: {message}")),
+        AppError::Spacing(e) => CliError::input(format!("--spacing: {e}")),
+        AppError::OverBudget(over) => over_budget(over),
+        // Named with the flags by `session::app_failure`.
+        AppError::Option(e) => CliError::input(e.to_string()),
+        AppError::Render { name, error } => render_error(name, error),
+        AppError::Stream { name, error } => match error {
+            StreamError::Read(message) => CliError::io(message),
+            StreamError::TooLarge(message) => CliError::input(format!(
+                "{name}: {message}: raise --max-memory, or pick a coarser --level"
+            )),
+            StreamError::Render(error) => render_error(name, error),
+        },
+        // A failed distributed step: the same line on every rank.
+        AppError::Frame { name, error } => match error {
+            FrameError::Render(error) => render_error(name, error),
+            FrameError::Rank {
+                rank,
+                message,
+                bad_input: true,
+            } => CliError::input(format!("rank {rank}: {message}")),
+            FrameError::Rank { rank, message, .. } => {
+                CliError::io(format!("rank {rank}: {message}"))
+            }
+            e => CliError::io(e.to_string()),
+        },
+        AppError::PieceOverBudget {
+            name,
+            dims: [x, y, z],
+            need,
+            limit,
+        } => CliError::input(format!(
+            "{name}: this rank's piece, {x}x{y}x{z} voxels with its ghost layers, needs {} to read and render, over --max-memory {}: run on more ranks",
+            format_bytes(*need),
+            format_bytes(u128::from(*limit)),
+        )),
+        AppError::ScatterOverBudget {
+            name,
+            generated,
+            volume,
+            need,
+            limit,
+        } => {
+            let how = if *generated {
+                "generates the fractal whole"
+            } else {
+                "reads the file whole (its format cannot be read by range)"
+            };
+            CliError::input(format!(
+                "{name}: rank 0 {how} to send each rank its piece: the volume ({}) with the pieces it cuts needs {}, over --max-memory {}",
+                format_bytes(*volume),
+                format_bytes(*need),
+                format_bytes(u128::from(*limit)),
+            ))
+        }
+        AppError::ChannelsAndFrame { spec } => CliError::input(format!(
+            "--channels renders the time points of {spec} (one channel) together; --frame picks one: give one of them"
+        )),
+        AppError::Refused { message, bad_input } => CliError {
+            code: if *bad_input { 1 } else { 2 },
+            message: message.clone(),
+        },
+    }
+}
+
+/// A render error of `name` naming no flag; the samples changing under
+/// the renderer is the file's failure, not the flags'.
+fn render_error(name: &str, error: &volray_core::RenderError) -> CliError {
+    if let volray_core::RenderError::SamplesChanged(_) = error {
+        return CliError::io(format!("{name}: {error}"));
+    }
+    CliError::input(format!("{name}: {error}"))
+}
+
+/// A frame over `--max-memory`, and the way out.
+fn over_budget(over: &OverBudget) -> CliError {
+    let [nx, ny, nz] = over.dims;
+    let (w, h) = over.size;
+    let what = format!(
+        "{}: rendering {nx}x{ny}x{nz} voxels at {w}x{h} pixels",
+        over.name
+    );
+    let (need, limit) = (format_bytes(over.need), format_bytes(over.limit));
+    match over.fast_need {
+        // The oracle is dense: say so where the default path would fit.
+        Some(fast) => CliError::input(format!(
+            "{what} on the reference path (--reference) may take up to {need}, more than --max-memory {limit}; the default path takes at most {}: leave out --reference",
+            format_bytes(fast)
+        )),
+        None => CliError::input(format!(
+            "{what} may take up to {need}, more than --max-memory {limit} (raise it, or use a smaller grid)"
+        )),
     }
 }
 

@@ -6,10 +6,10 @@
 
 use crate::error::CliError;
 use crate::flags::{ColorBarSide, FigureArgs, RenderArgs, ScaleLength};
-use crate::input::Input;
 use crate::render::OutputKind;
 use volray_annotate::colorbar::Side;
 use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
+use volray_app::input::Input;
 use volray_core::glam::DVec3;
 use volray_core::{Image, RenderSettings, Renderer};
 

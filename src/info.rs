@@ -2,8 +2,8 @@
 
 use crate::error::CliError;
 use crate::flags::InfoArgs;
-use crate::input::{self, Described};
 use serde_json::{Value, json};
+use volray_app::input::{self, Described};
 use volray_core::Histogram;
 use volray_core::transfer::labels;
 use volray_io::{FileInfo, FlatImage};
@@ -20,8 +20,8 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     // statistics of a smaller level.
     let chunked = large_chunked_level(&args.input)?;
     let described = match &chunked {
-        Some((_, k)) => input::describe(&crate::streamed::at_level(&args.input, Some(*k)))?,
-        None => input::describe(&args.input)?,
+        Some((_, k)) => input::describe(&args.input.at_level(Some(*k)).request())?,
+        None => input::describe(&args.input.request())?,
     };
     let input = match described {
         Described::Volume(input) => input,
@@ -181,13 +181,7 @@ fn large_chunked_level(
         .max_memory
         .unwrap_or_else(volray_io::default_max_memory);
     let path = std::path::PathBuf::from(spec);
-    let opts = input::read_options(
-        args,
-        spec,
-        &path,
-        max_memory,
-        volray_io::MapPolicy::IfLarger,
-    )?;
+    let opts = input::read_options(&args.request(), max_memory, volray_io::MapPolicy::IfLarger)?;
     let Some(lazy) = volray_io::open_lazy(&path, &opts)? else {
         return Ok(None);
     };

@@ -14,10 +14,11 @@
 //!   `bench/vtk.rs`), `info.rs`, `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
 //!   writes with), `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
 //!   `view/reproduce.rs`: the page's state as a `volray render` command);
-//! - what they share: `input.rs` (reading INPUT), `settings.rs` (the flags
-//!   as volray-core's `RenderSettings`), `session.rs` (loading, the
-//!   renderer, threads, progress, which flag a render error is about),
-//!   `memory.rs` (the `--max-memory` bound for rendering);
+//! - what they share: `settings.rs` (the flags as volray-core's
+//!   `RenderSettings`), `session.rs` (the flags as volray-app's input
+//!   requests and plans, the renderer within the `--max-memory` budget,
+//!   threads, progress, which flag a render error is about); volray-app
+//!   reads INPUT, plans it and budgets its frames;
 //! - the process: `error.rs` (one-line errors and their exit codes: 0
 //!   success, 1 bad input, 2 I/O, 128 + the signal when interrupted),
 //!   `output.rs` (standard output), `overwrite.rs` (never writing over an
@@ -33,23 +34,20 @@ mod output;
 mod animate;
 mod bench;
 mod convert;
-#[cfg(feature = "mpi")]
-mod distributed;
 mod error;
 mod figure;
 mod flags;
 mod generate;
 mod info;
-mod input;
 mod interrupt;
-mod memory;
+#[cfg(feature = "mpi")]
+mod mpi;
 mod overwrite;
 mod paper;
 mod render;
 mod scene;
 mod session;
 mod settings;
-mod streamed;
 mod view;
 
 use flags::Command;
@@ -62,10 +60,10 @@ fn main() -> ExitCode {
     };
     interrupt::install();
     #[cfg(feature = "mpi")]
-    if distributed::launched() {
+    if mpi::launched() {
         let result = match &cli.command {
-            Command::Render(args) => Some(distributed::render(args)),
-            Command::Bench(args) => Some(distributed::bench(args)),
+            Command::Render(args) => Some(mpi::render(args)),
+            Command::Bench(args) => Some(mpi::bench(args)),
             _ => None,
         };
         if let Some(result) = result {

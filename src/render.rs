@@ -6,11 +6,13 @@
 use crate::animate;
 use crate::error::CliError;
 use crate::flags::RenderArgs;
-use crate::input;
-use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
+use crate::session::{
+    app_failure, load, progress_bar, render_failure, renderer_for, streamed_note, thread_pool,
+};
 use crate::settings::settings;
-use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
+use volray_app::input;
+use volray_app::plan::Plan;
 use volray_core::RenderSettings;
 use volray_io::{Animation, AnimationKind, BitDepth};
 
@@ -53,7 +55,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
 pub fn from_volume(
     args: &RenderArgs,
     settings: &RenderSettings,
-    input: &mut crate::input::Input,
+    input: &mut volray_app::input::Input,
 ) -> Result<RenderSettings, CliError> {
     let mut settings = settings.clone();
     crate::settings::file_window(
@@ -80,19 +82,22 @@ fn still(
     pool: &rayon::ThreadPool,
     kind: OutputKind,
 ) -> Result<(), CliError> {
-    let input_args = match crate::streamed::plan(&args.input, &args.view, settings)? {
+    let input_args = match crate::session::plan(&args.input, &args.view, settings)? {
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
-            let settings = &streamed.settings_from_volume(&args.view, settings.clone())?;
+            let settings = &(streamed
+                .settings_from_volume(&crate::settings::look(&args.view.look), settings.clone()))
+            .map_err(|e| app_failure(&args.view, e))?;
             let bar = progress_bar((settings.width * settings.height) as u64);
-            let (image, times) =
-                pool.install(|| streamed.render(&args.view, settings, &|n| bar.inc(n as u64)))?;
+            let (image, times) = pool
+                .install(|| streamed.render(settings, &|n| bar.inc(n as u64)))
+                .map_err(|e| app_failure(&args.view, e))?;
             bar.finish_and_clear();
             write_still(args, kind, &image)?;
-            eprintln!("{}", streamed.note(&times));
+            eprintln!("{}", streamed_note(&streamed, &times));
             return Ok(());
         }
-        Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
+        Plan::Whole { level } => args.input.at_level(level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
     let settings = &from_volume(args, settings, &mut input)?;

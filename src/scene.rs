@@ -23,11 +23,11 @@ pub use layer::{ChannelAxis, Layer, LayerSource, channel_axis};
 use crate::animate;
 use crate::error::CliError;
 use crate::flags::{InputArgs, MixMode, RenderArgs, SceneArgs, ViewArgs};
-use crate::input;
 use crate::render::{OutputKind, output_kind, write_still};
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
-use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
+use volray_app::input;
+use volray_app::plan::Plan;
 use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
 use volray_core::{RenderError, RenderSettings, SceneError};
 use volray_options::{LookOptions, Naming, Opt, Options, Tf};
@@ -306,12 +306,12 @@ pub fn whole_input(
     settings: &RenderSettings,
     what: &str,
 ) -> Result<InputArgs, CliError> {
-    match crate::streamed::plan(input, view, settings)? {
+    match crate::session::plan(input, view, settings)? {
         Plan::Streamed(streamed) => Err(CliError::input(format!(
             "{}: too large to read whole under --max-memory (it would be rendered in pieces from its chunks), which {what} do not support: give a coarser --level or raise --max-memory",
             streamed.name
         ))),
-        Plan::Whole { level } => Ok(crate::streamed::at_level(input, level)),
+        Plan::Whole { level } => Ok(input.at_level(level)),
     }
 }
 

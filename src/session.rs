@@ -1,26 +1,108 @@
 //! What every rendering command does around the renderer: reading the
-//! input (with `--log`), building the renderer (after the `--max-memory`
-//! check of `memory.rs`), the worker threads, the progress bar, and
-//! saying which flag a render error is about. `render.rs`, `animate.rs`,
-//! `bench.rs` and `paper.rs` share these.
+//! input (with `--log`, through volray-app's `input`), building the
+//! renderer (after the `--max-memory` check of volray-app's `memory`),
+//! the worker threads, the progress bar and the note after a frame in
+//! pieces, and saying which flag a render error is about. `render.rs`,
+//! `animate.rs`, `bench.rs` and `paper.rs` share these.
 
 use crate::error::CliError;
 use crate::flags::{InputArgs, ViewArgs};
-use crate::input::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
+use std::path::Path;
+use volray_app::AppError;
+use volray_app::input::Input;
+use volray_app::memory::{Budget, png_bytes};
+use volray_app::plan::{Chosen, Frames, Plan, StreamedInput};
 use volray_core::{RenderError, RenderSettings, Renderer};
+use volray_distributed::frame::FrameError;
+use volray_distributed::streamed::{StreamError, StreamTimes};
+use volray_io::format_bytes;
 
 /// Reads the volume `args` name and, with `--log`, takes its log10.
 pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
-    let mut input = input::load(args)?;
-    if log {
-        input.volume = input
-            .volume
-            .to_log10()
-            .map_err(|e| CliError::input(format!("--log: {}: {e}", input.name)))?;
+    Ok(volray_app::input::load_log(&args.request(), log)?)
+}
+
+/// volray-app's error as the CLI's, a render error naming its flag.
+pub fn app_failure(view: &ViewArgs, e: AppError) -> CliError {
+    app_failure_of(view, &e)
+}
+
+/// [`app_failure`] of an error kept (a rank's, told to the others).
+pub fn app_failure_of(view: &ViewArgs, e: &AppError) -> CliError {
+    match e {
+        AppError::Render { name, error }
+        | AppError::Stream {
+            name,
+            error: StreamError::Render(error),
+        }
+        | AppError::Frame {
+            name,
+            error: FrameError::Render(error),
+        } => render_failure(view, name, error.clone()),
+        AppError::Option(e) => crate::settings::refused(e.clone()),
+        e => crate::error::word(e),
     }
-    Ok(input)
+}
+
+/// How INPUT is rendered for frames of `settings` (volray-app's `plan`):
+/// whole, or a chunked file's level in pieces; `--level auto` says what
+/// it chose.
+pub fn plan(
+    args: &InputArgs,
+    view: &ViewArgs,
+    settings: &RenderSettings,
+) -> Result<Plan, CliError> {
+    let request = args.request();
+    let frames = Frames {
+        settings,
+        non_finite: view.sampling.nonfinite.into(),
+        log: view.look.log,
+        labels: view.look.labels,
+        // A 16-bit PNG quantises the frame first.
+        extra: png_bytes(settings),
+    };
+    let spec = request.spec.name();
+    volray_app::plan::plan(&request, &frames, &mut |c| say_chosen(&spec, c))
+        .map_err(|e| app_failure(view, e))
+}
+
+/// The line `--level auto` prints as it chooses.
+pub fn say_chosen(spec: &str, chosen: Chosen) {
+    let [x, y, z] = chosen.dims;
+    eprintln!(
+        "volray: {}: level {} of {} ({x}x{y}x{z}), the coarsest whose voxels are no larger than a pixel (--level auto)",
+        Path::new(spec).display(),
+        chosen.level,
+        chosen.levels
+    );
+}
+
+/// The line that says how a frame was rendered in pieces.
+pub fn streamed_note(s: &StreamedInput, times: &StreamTimes) -> String {
+    let [x, y, z] = s.streamed.grid().dims;
+    // What the level's frame went over: --max-memory, or one piece's
+    // budget beneath it.
+    let limit = format_bytes(u128::from(s.max_memory));
+    let bound = if s.over_piece_budget() {
+        let piece = format_bytes(u128::from(volray_lazy::PIECE_BUDGET));
+        format!("a piece's {piece} (under --max-memory {limit})")
+    } else {
+        format!("--max-memory {limit}")
+    };
+    format!(
+        "volray: {}: level {} ({x}x{y}x{z}) rendered in pieces, as it may take up to {} whole, over {}: {} of {} pieces read ({} voxels), {:.2} s reading, {:.2} s rendering",
+        Path::new(&s.name).display(),
+        s.level,
+        format_bytes(s.whole),
+        bound,
+        times.read_pieces,
+        times.pieces,
+        times.read_voxels,
+        times.read.as_secs_f64(),
+        times.render.as_secs_f64()
+    )
 }
 
 /// A progress bar on a terminal for work of at least 256² pixels, else a
@@ -41,16 +123,16 @@ pub fn progress_bar(pixels: u64) -> ProgressBar {
 
 /// The renderer of `input`'s volume, its non-finite values refused or
 /// rendered as empty space as `--nonfinite` says, refused if rendering it
-/// may need more than `--max-memory` (see `memory.rs`). A refusal is one
+/// may need more than `--max-memory` (see volray-app's `memory`). A refusal is one
 /// line naming the input and the count, and the way out.
 pub fn renderer_for<'v>(
     view: &ViewArgs,
     settings: &RenderSettings,
     input: &'v Input,
 ) -> Result<Renderer<'v>, CliError> {
-    let budget = crate::memory::cache_budget(view, settings, input)?;
     let (name, volume) = (&input.name, &input.volume);
     let mode = input.non_finite(view.sampling.nonfinite.into());
+    let budget = cache_budget(view, settings, input)?;
     let renderer = Renderer::with_non_finite(volume, mode).map_err(|e| match e {
         RenderError::NonFinite { .. } => CliError::input(format!(
             "{name}: {e}; use --nonfinite transparent to render them as empty space"
@@ -58,6 +140,29 @@ pub fn renderer_for<'v>(
         e => render_failure(view, name, e),
     })?;
     Ok(renderer.with_cache_budget(budget))
+}
+
+/// The brick caches' budget for rendering `input` with `settings`, non-finite
+/// values as `--nonfinite` says (volray-app's `memory`: the volume counted unless mapped, and the
+/// 16-bit PNG's pixels).
+pub fn cache_budget(
+    view: &ViewArgs,
+    settings: &RenderSettings,
+    input: &Input,
+) -> Result<usize, CliError> {
+    let mode = input.non_finite(view.sampling.nonfinite.into());
+    let budget = Budget {
+        limit: input.max_memory,
+        extra: png_bytes(settings),
+        samples_count: true,
+    };
+    Ok(volray_app::memory::cache_budget(
+        &input.volume,
+        &input.name,
+        settings,
+        mode,
+        budget,
+    )?)
 }
 
 /// A failure to render `name` as one line, naming the flag whose value

@@ -64,7 +64,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         .prepare(&settings)
         .map_err(|e| crate::session::render_failure(&args.view, &input.name, e))?;
     drop(renderer);
-    let cache_budget = crate::memory::cache_budget(&args.view, &settings, &input)?;
+    let cache_budget = crate::session::cache_budget(&args.view, &settings, &input)?;
     let non_finite = input.non_finite(args.view.sampling.nonfinite.into());
 
     let state = start_state(args, &settings);
@@ -182,7 +182,7 @@ fn figure_state(args: &crate::flags::FigureArgs) -> volray_view::Figure {
 /// takes it (`figure.rs`).
 pub fn figure_context(
     args: &ViewerArgs,
-    input: &crate::input::Input,
+    input: &volray_app::input::Input,
 ) -> volray_view::FigureContext {
     let look = &args.view.look;
     volray_view::FigureContext {

@@ -15,10 +15,10 @@ use clap::ArgMatches;
 use clap::parser::ValueSource;
 use std::ffi::OsString;
 
-/// The demo volume: Figure 2a's cloud (`crate::input::DEMO`), the
+/// The demo volume: Figure 2a's cloud (`volray_app::input::DEMO`), the
 /// threshold volray-paper's `clouds::cloud(129, 1, ..)` chooses (test
 /// below).
-pub const VOLUME: &str = crate::input::DEMO;
+pub const VOLUME: &str = volray_app::input::DEMO;
 
 /// The demo's look, after INPUT. `--range 0,0.1` is the paper's window
 /// `[f_min, f_top]`, `f_top` the level whose denser voxels hold 20 % of

@@ -1,8 +1,8 @@
 //! Where the volume comes from and how to read it: INPUT and the reading
 //! options (`--dims`, `--dtype`, `--endian`, `--spacing`, `--format`,
 //! `--frame`, `--array`, `--level`, `--channel`, `--max-memory`), which `render`, `bench` and
-//! `info` share. `input.rs` (beside `main.rs`) reads the volume they
-//! describe.
+//! `info` share. volray-app's `input` reads the volume they describe
+//! ([`InputArgs::request`]).
 
 use super::parse::{parse_dims, parse_spacing};
 use clap::Args;
@@ -88,4 +88,35 @@ pub struct InputArgs {
 /// A `--level`: `auto` or a level number.
 fn parse_level(text: &str) -> Result<LevelChoice, String> {
     text.trim().parse()
+}
+
+impl InputArgs {
+    /// INPUT and its reading flags in volray-app's plain terms.
+    pub fn request(&self) -> volray_app::input::Request {
+        volray_app::input::Request {
+            spec: volray_app::input::Spec::parse(
+                self.input.as_deref().unwrap_or(volray_app::input::DEMO),
+            ),
+            dims: self.dims,
+            dtype: self.dtype.clone(),
+            endian: self.endian.clone(),
+            spacing: self.spacing,
+            format: self.format.clone(),
+            frame: self.frame,
+            array: self.array.clone(),
+            level: self.level,
+            channel: self.channel,
+            max_memory: self.max_memory,
+        }
+    }
+
+    /// These flags reading INPUT whole at `level` (`--level auto`
+    /// resolved to a number).
+    pub fn at_level(&self, level: Option<usize>) -> InputArgs {
+        InputArgs {
+            // Unresolved (a built-in source): as given, for the reader to refuse.
+            level: level.map(LevelChoice::Index).or(self.level),
+            ..self.clone()
+        }
+    }
 }

@@ -6,8 +6,8 @@
 use super::layer::{Budget, ChannelAxis, Layer, LayerSource, channel_axis};
 use crate::error::CliError;
 use crate::flags::{ChannelColors, Channels, InputArgs, LookArgs, SceneArgs, ViewArgs};
-use crate::input;
 use crate::session::load;
+use volray_app::input;
 use volray_core::{PiecewiseLinear, RenderSettings};
 
 /// Refuses the look flags that do not apply to `--channels`, whose

@@ -5,7 +5,7 @@
 use super::OverlaySpec;
 use crate::error::CliError;
 use crate::flags::InputArgs;
-use crate::input::Input;
+use volray_app::input::Input;
 use volray_core::RenderSettings;
 use volray_core::scene::Look;
 use volray_io::FileInfo;

@@ -14,9 +14,9 @@
 
 use crate::error::CliError;
 use crate::flags::ViewerArgs;
-use crate::input::{self, Input};
 use std::path::Path;
 use std::sync::Arc;
+use volray_app::input::{self, Input};
 use volray_core::glam::DVec3;
 use volray_core::{NonFinite, RenderSettings, SampleType};
 use volray_io::format_bytes;
@@ -50,9 +50,10 @@ pub fn open(args: &ViewerArgs, settings: &RenderSettings) -> Result<Option<Opene
         }
         return Ok(None);
     }
-    let max_memory = inp.max_memory.unwrap_or_else(volray_io::default_max_memory);
-    let fixed = crate::streamed::fixed_level(inp);
-    let Some(chunked) = crate::streamed::open_chunked(inp, spec, max_memory)? else {
+    let request = inp.request();
+    let max_memory = request.max_memory();
+    let fixed = request.fixed_level();
+    let Some(chunked) = volray_app::plan::open_chunked(&request, max_memory)? else {
         return Ok(None);
     };
     let count = chunked.levels().len();

@@ -15,9 +15,9 @@
 
 use crate::error::CliError;
 use crate::flags::{Cli, Command, ViewerArgs};
-use crate::input;
 use crate::settings::settings_with_tf_text;
 use clap::Parser;
+use volray_app::input;
 use volray_core::glam::DVec3;
 use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, Phong, SampleType, TransferFunction};
@@ -518,7 +518,7 @@ impl Reproduce for CliReproduce {
         let refuse = |e: CliError| Refusal(e.message);
         let settings = settings_with_tf_text(&args.view, json.as_deref()).map_err(refuse)?;
         // The frame must fit with no brick cache (as `render` checks).
-        let need = crate::memory::render_bytes(self.grid, &settings, self.non_finite, 0);
+        let need = volray_app::memory::render_bytes(self.grid, &settings, self.non_finite, 0);
         if need > u128::from(self.max_memory) {
             return Err(Refusal(format!(
                 "a {}x{} frame may take up to {}, more than --max-memory {}",

@@ -20,11 +20,11 @@ use super::reproduce::{CliReproduce, OtherWords, SceneWords};
 use super::{MAX_TABS, serve, start_state};
 use crate::error::CliError;
 use crate::flags::{MixMode, ViewerArgs};
-use crate::input;
 use crate::scene::{ChannelAxis, Layer, LayerSource, overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use std::sync::Arc;
+use volray_app::input;
 use volray_core::scene::Mix;
 use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
 
@@ -82,7 +82,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     }
     let first = &layers[0];
     let settings = first.settings.clone();
-    let cache_budget = crate::memory::cache_budget(&args.view, &settings, &first.input)?;
+    let cache_budget = crate::session::cache_budget(&args.view, &settings, &first.input)?;
     let non_finite = first.input.non_finite(args.view.sampling.nonfinite.into());
 
     let mut state = start_state(args, &settings);

@@ -15,3 +15,51 @@
 //!
 //! A front end keeps only its syntax (flags, keywords, page messages), its
 //! output writing and its progress display.
+//!
+//! ## Modules
+//!
+//! - [`input`]: an input by spec ([`input::Spec`]: a built-in source or a
+//!   file) with its reading options ([`input::Request`]), read whole or
+//!   mapped, with `log`;
+//! - [`plan`]: how it is rendered: whole, or a chunked file's level
+//!   (`level auto`) in pieces ([`plan::Plan`]);
+//! - [`memory`]: the memory budget ([`memory::cache_budget`]: the
+//!   refusal of a frame over the limit, and what the caches may take);
+//! - `distributed` (feature `mpi`): `mpirun -np N` renders: the input
+//!   split among the ranks, each rank's budget, the frame composited on
+//!   rank 0, the times;
+//! - [`error`]: [`AppError`], typed, one line naming the file, which each
+//!   front end words in its own syntax.
+//!
+//! ```no_run
+//! use volray_app::input::{self, Request};
+//! use volray_app::memory::{self, Budget};
+//! use volray_app::plan::{self, Frames, Plan};
+//! use volray_core::{NonFinite, RenderSettings};
+//!
+//! let request = Request::of("blobs:64");
+//! let settings = RenderSettings::default();
+//! let frames = Frames {
+//!     settings: &settings,
+//!     non_finite: NonFinite::Refuse,
+//!     log: false,
+//!     labels: false,
+//!     extra: 0,
+//! };
+//! if let Plan::Whole { level } = plan::plan(&request, &frames, &mut |_| {})? {
+//!     let input = input::load(&request.at_level(level))?;
+//!     let budget = Budget { limit: input.max_memory, extra: 0, samples_count: true };
+//!     let bytes = memory::cache_budget(&input.volume, &input.name, &settings, NonFinite::Refuse, budget)?;
+//!     println!("{}: {bytes} bytes of brick caches", input.name);
+//! }
+//! # Ok::<(), volray_app::AppError>(())
+//! ```
+
+#[cfg(feature = "mpi")]
+pub mod distributed;
+pub mod error;
+pub mod input;
+pub mod memory;
+pub mod plan;
+
+pub use error::AppError;

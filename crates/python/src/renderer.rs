@@ -7,7 +7,7 @@
 //! `render_stoppable`: the work left is skipped) and raises.
 //!
 //! A lazy volume (`volume.rs`: a chunked file read from its metadata)
-//! takes volray-lazy's road, as `volray render` does (`src/streamed.rs`):
+//! takes volray-lazy's road, as `volray render` does (volray-app's `plan`):
 //! each frame picks its level (`level="auto"`: the coarsest whose voxels
 //! are no larger than a pixel's footprint; else the level asked for, or
 //! the volume's), then reads that level whole when its frame fits
@@ -17,6 +17,13 @@
 //! labels and `tf="auto"` histogram found piece by piece once). A frame
 //! in pieces stops at its next piece on Ctrl-C: `Streamed` has no stop
 //! flag within a piece, so the piece being rendered finishes first.
+//!
+//! Files: this one (the renderer, its frames, Ctrl-C), `recipe.rs` (the
+//! volume and its keywords, prepared within `max_memory`), `lazy.rs` (a
+//! lazy volume's frames).
+
+mod lazy;
+mod recipe;
 
 use crate::array::{self, ArrayBytes, Order};
 use crate::errors::{io_error, option_error, render_error, settings_error, value_error};
@@ -32,10 +39,12 @@ use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use volray_annotate::figure::Annotations;
+use volray_app::AppError;
+use volray_app::memory::Budget;
 use volray_core::transfer::auto;
 use volray_core::{
-    DEFAULT_CACHE_BUDGET, Histogram, Image, MemoryBound, NonFinite, RenderError, RenderSettings,
-    Renderer as CoreRenderer, Volume as CoreVolume,
+    Histogram, Image, NonFinite, RenderError, RenderSettings, Renderer as CoreRenderer,
+    Volume as CoreVolume,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
 use volray_io::{MapPolicy, ReadOptions, format_bytes};
@@ -173,276 +182,6 @@ pub(crate) struct Known {
     pub histogram: Option<Histogram>,
 }
 
-impl Recipe {
-    /// The bytes to digest, where the samples can change under the
-    /// renderer.
-    fn watched(&self, py: Python<'_>) -> PyResult<Option<ArrayBytes>> {
-        match &self.source {
-            Source::Volume(v) if v.get().frozen => Ok(None),
-            Source::Volume(v) => ArrayBytes::new(v.get().array(py)?, None).map(Some),
-            Source::Array { object, .. } => array::watched(object.bind(py)).map(Some),
-        }
-    }
-
-    /// The digest of the samples as they are now (on `pool`, or the
-    /// global pool; the GIL released while hashing); `None` if they are
-    /// read-only.
-    pub(crate) fn digest(
-        &self,
-        py: Python<'_>,
-        pool: Option<&rayon::ThreadPool>,
-    ) -> PyResult<Option<u64>> {
-        let Some(watched) = self.watched(py)? else {
-            return Ok(None);
-        };
-        Ok(Some(py.detach(|| match pool {
-            Some(pool) => pool.install(|| watched.digest()),
-            None => watched.digest(),
-        })))
-    }
-
-    /// The volume prepared from its samples, whose digest is `digest`:
-    /// value range, labels or histogram, non-finite values, the brick
-    /// caches' budget. Samples read in place are checked against the
-    /// digest after each frame (`ArrayBytes::verify`).
-    pub(crate) fn prepare(&self, py: Python<'_>, digest: Option<u64>) -> PyResult<Prepared> {
-        let core = match &self.source {
-            Source::Volume(v) => v.get().core_expecting(py, digest)?,
-            Source::Array {
-                object,
-                order,
-                spacing,
-                origin,
-            } => {
-                let object = object.bind(py);
-                let volume = Volume::from_array(object, *spacing, *origin, *order, false)?;
-                // Checked after each frame only where the frame reads the
-                // caller's memory; a copy is the renderer's alone.
-                let kept = ArrayBytes::new(volume.array(py)?, None)?;
-                let in_place = digest.is_some() && array::watched(object)?.same_bytes(&kept);
-                volume.core_expecting(py, digest.filter(|_| in_place))?
-            }
-        };
-        self.prepare_core(py, core, digest)
-    }
-
-    /// [`Recipe::prepare`] of the samples `core`.
-    pub(crate) fn prepare_core(
-        &self,
-        py: Python<'_>,
-        mut core: CoreVolume,
-        digest: Option<u64>,
-    ) -> PyResult<Prepared> {
-        let name = &self.name;
-        if let Some(s) = self.spacing {
-            core = core
-                .with_spacing(s.into())
-                .map_err(|e| value_error(format!("spacing: {e}")))?;
-        }
-        if let Some(o) = self.origin {
-            core = core
-                .with_origin(o.into())
-                .map_err(|e| value_error(format!("origin: {e}")))?;
-        }
-        if self.log {
-            core = py
-                .detach(|| core.to_log10())
-                .map_err(|e| value_error(format!("log=True: {name}: {e}")))?;
-        }
-        let (found_labels, histogram) = if self.labels {
-            let found = volray_options::volume_labels(&core, name).map_err(option_error)?;
-            (Some(found), None)
-        } else {
-            (None, py.detach(|| Histogram::of(&core, auto::BINS)))
-        };
-        let core = if self.labels { core.as_labels() } else { core };
-        let nonfinite = self.nonfinite;
-        let inner = py
-            .detach(|| CoreRenderer::owning(core, nonfinite))
-            .map_err(|e| render_error(e, &volray_options::CameraOptions::default(), name))?;
-        let inner = {
-            let budget = cache_budget(&inner, nonfinite, self.max_memory);
-            inner.with_cache_budget(budget)
-        };
-        Ok(Prepared {
-            inner,
-            known: Known {
-                labels: found_labels,
-                histogram,
-            },
-            digest,
-        })
-    }
-}
-
-impl Recipe {
-    /// The recipe of `volume` (an array or a `Volume`) with the
-    /// volume-level keywords of `k` (but `level`).
-    pub(crate) fn build(volume: &Bound<'_, PyAny>, k: &Keywords<'_>) -> PyResult<Self> {
-        let order = match k.take::<String>("order", "'zyx' or 'xyz'")? {
-            Some(o) => Order::parse(&o)?,
-            None => Order::Xyz,
-        };
-        let spacing = k.take::<[f64; 3]>("spacing", "three numbers (dx, dy, dz)")?;
-        let origin = k.take::<[f64; 3]>("origin", "three numbers (x, y, z)")?;
-        let labels_given = k.take::<bool>("labels", "True or False")?;
-        let (source, spacing, origin, vol_labels, name, nan_is_empty) =
-            match volume.cast::<Volume>() {
-                Ok(v) => {
-                    if k.get("order").is_some() {
-                        return Err(value_error(
-                            "order applies to numpy arrays; a volray.Volume's axes are fixed",
-                        ));
-                    }
-                    let vol = v.get();
-                    let (labels, name, nan) = (vol.labels, vol.name.clone(), vol.nan_is_empty());
-                    let source = Source::Volume(v.clone().unbind());
-                    (source, spacing, origin, labels, name, nan)
-                }
-                Err(_) => {
-                    let source = Source::Array {
-                        object: volume.clone().unbind(),
-                        order,
-                        spacing,
-                        origin,
-                    };
-                    (source, None, None, false, "volume".to_string(), false)
-                }
-            };
-        let labels = labels_given.unwrap_or(vol_labels);
-        let log = k.take::<bool>("log", "True or False")?.unwrap_or(false);
-        if labels && log {
-            return Err(value_error(
-                "labels=True conflicts with log=True: a label volume's values are names, not quantities",
-            ));
-        }
-        let requested = keywords::nonfinite(k)?;
-        let nonfinite = if nan_is_empty {
-            NonFinite::Transparent
-        } else {
-            requested
-        };
-        let max_memory = k
-            .take::<u64>("max_memory", "a number of bytes")?
-            .unwrap_or_else(volray_io::default_max_memory);
-        let window = match &source {
-            Source::Volume(v) => v.get().display_window(),
-            Source::Array { .. } => None,
-        };
-        Ok(Recipe {
-            source,
-            spacing,
-            origin,
-            labels,
-            log,
-            nonfinite,
-            max_memory,
-            name,
-            window,
-        })
-    }
-
-    /// The options and settings of a frame of this volume with the frame
-    /// keywords of `k` (its file's display window the default range).
-    pub(crate) fn settings_of(&self, k: &Keywords<'_>) -> PyResult<(Options, RenderSettings)> {
-        let options = keywords::options(k, self.look())?;
-        let mut settings =
-            volray_options::settings(&options).map_err(|e| settings_error(e, &options.camera))?;
-        volray_options::file_window(&options.look, &mut settings.transfer_function, self.window);
-        Ok((options, settings))
-    }
-
-    /// What the annotations take from the volume: its file's units and
-    /// axes, and whether it is rendered as log10.
-    pub(crate) fn facts(&self, py: Python<'_>) -> figure::Facts {
-        match &self.source {
-            Source::Volume(v) => figure::Facts::of(v.bind(py).get().file.as_ref(), self.log),
-            Source::Array { .. } => figure::Facts::of(None, self.log),
-        }
-    }
-
-    /// The chunked file a lazy volume is read from, if it is one.
-    pub(crate) fn lazy(&self) -> Option<&LazyFile> {
-        match &self.source {
-            Source::Volume(v) => v.get().lazy.as_ref(),
-            Source::Array { .. } => None,
-        }
-    }
-
-    /// Whether a spacing or origin was given with the volume (or `log`):
-    /// what applies to a level read whole, not yet to a pyramid's levels.
-    pub(crate) fn reshaped(&self) -> bool {
-        self.spacing.is_some() || self.origin.is_some() || self.log
-    }
-
-    /// The file's display window (an OME-Zarr `omero` window), if any.
-    pub(crate) fn window(&self) -> Option<(f64, f64)> {
-        self.window
-    }
-
-    /// The look options the recipe fixes (labels, log).
-    pub(crate) fn look(&self) -> LookOptions {
-        LookOptions {
-            labels: self.labels,
-            log: self.log,
-            ..LookOptions::default()
-        }
-    }
-
-    /// Puts into `settings` what `options` leave to the volume, as
-    /// volray-options' from_volume does, from what `prepared` found
-    /// once: the labels' transfer function, or the automatic one.
-    pub(crate) fn leave_to_volume(
-        &self,
-        known: &Known,
-        options: &Options,
-        settings: &mut RenderSettings,
-    ) -> PyResult<()> {
-        match (&known.labels, &known.histogram) {
-            (Some(found), _) => volray_options::label_transfer_function(
-                &options.look,
-                &mut settings.transfer_function,
-                found,
-                &self.name,
-            )
-            .map_err(option_error),
-            (None, Some(histogram)) if options.look.auto_tf() => {
-                volray_options::apply_auto(
-                    &options.look,
-                    &mut settings.transfer_function,
-                    histogram,
-                );
-                Ok(())
-            }
-            _ => Ok(()),
-        }
-    }
-
-    /// Refuses a frame that may take more than `max_memory` even with no
-    /// brick cache (the command line's rule, `src/memory.rs`).
-    pub(crate) fn check_memory(
-        &self,
-        inner: &CoreRenderer<'_>,
-        settings: &RenderSettings,
-    ) -> PyResult<()> {
-        let need = need(inner, settings, self.nonfinite);
-        let volume = inner.volume();
-        let limit = u128::from(self.max_memory);
-        if need > limit {
-            let [nx, ny, nz] = volume.dims();
-            return Err(value_error(format!(
-                "{}: rendering {nx}x{ny}x{nz} voxels at {}x{} pixels may take up to {}, more than max_memory {} (raise it, or use a smaller grid)",
-                self.name,
-                settings.width,
-                settings.height,
-                format_bytes(need),
-                format_bytes(limit),
-            )));
-        }
-        Ok(())
-    }
-}
-
 impl Renderer {
     /// The renderer of `volume` (an array or a `Volume`) with the
     /// volume-level keywords of `k`.
@@ -576,280 +315,38 @@ impl Renderer {
         }
         Ok(Frame { image })
     }
-
-    /// A frame of a lazy volume: its level, then the level whole or in
-    /// pieces, as its plan says.
-    fn lazy_frame(
-        &self,
-        py: Python<'_>,
-        lazy: &LazyRoad,
-        options: &Options,
-        mut settings: RenderSettings,
-        pool: Option<rayon::ThreadPool>,
-        what: &Annotations,
-    ) -> PyResult<Frame> {
-        let level = self.level_for(lazy, &settings, &options.camera)?;
-        let pool = pool.as_ref();
-        let name = &self.recipe.name;
-        let settings_ref = &mut settings;
-        let next = py.detach(|| -> PyResult<(Next, Option<Image>)> {
-            let mut state = lazy.state.lock().unwrap_or_else(|e| e.into_inner());
-            self.settle(lazy, &mut state, level, settings_ref)?;
-            state.settings = Some(settings_ref.clone());
-            if let Way::Whole { prepared, .. } = &state.way {
-                return Ok((Next::Whole(Arc::clone(prepared)), None));
-            }
-            let Way::Pieces {
-                streamed, found, ..
-            } = &mut state.way
-            else {
-                unreachable!("settled above")
-            };
-            figure::refuse_pieces(what, name)?;
-            lazy.stop.store(false, Ordering::SeqCst);
-            let settings = &mut *settings_ref;
-            let (rendered, interrupt) = interruptible(pool, &lazy.stop, |report| {
-                found
-                    .apply(streamed, &options.look, settings, name)
-                    .and_then(|()| streamed.render(settings, report).map_err(LookError::Stream))
-            });
-            let rendered = rendered.map_err(|panic| {
-                // What the pieces knew may be half updated: start afresh.
-                state.way = Way::None;
-                internal_error(name, &panic)
-            });
-            if let Some(e) = interrupt {
-                return Err(e);
-            }
-            let (image, _times) = rendered?.map_err(|e| match e {
-                LookError::Stream(e) => stream_error(e, &options.camera, name),
-                LookError::Refused(e) => option_error(e),
-            })?;
-            Ok((Next::Pieces, Some(image)))
-        })?;
-        match next {
-            (Next::Whole(prepared), _) => {
-                self.render_prepared(py, &prepared, options, settings, pool, what)
-            }
-            (Next::Pieces, image) => Ok(Frame {
-                image: image.expect("a frame in pieces returns its image"),
-            }),
-        }
-    }
-
-    /// The level a frame of `settings` needs: `level="auto"`'s choice
-    /// for the view, or the level asked for.
-    fn level_for(
-        &self,
-        lazy: &LazyRoad,
-        settings: &RenderSettings,
-        camera: &CameraOptions,
-    ) -> PyResult<usize> {
-        match lazy.choice {
-            LevelChoice::Index(n) => Ok(n),
-            LevelChoice::Auto => lazy_file(lazy)
-                .chunked
-                .auto_level(settings)
-                .map_err(|e| render_error(RenderError::from(e), camera, &self.recipe.name)),
-        }
-    }
-
-    /// Makes `state` ready for a frame of `settings` at `level`: the level
-    /// open, and read whole (prepared) or set to be rendered in pieces,
-    /// as volray-lazy's plan says for `max_memory`. What the last frame
-    /// kept is kept where the plan is the same. Called detached from
-    /// Python, the state locked.
-    fn settle(
-        &self,
-        lazy: &LazyRoad,
-        state: &mut LazyState,
-        level: usize,
-        settings: &RenderSettings,
-    ) -> PyResult<()> {
-        let file = lazy_file(lazy);
-        let name = &self.recipe.name;
-        if state.chunked.as_ref().map(Chunked::level) != Some(level) {
-            state.way = Way::None;
-            state.chunked = None;
-            let chunked = file.chunked.open_level(level).map_err(io_error)?;
-            state.chunked = Some(chunked.stoppable(Arc::clone(&lazy.stop)));
-        }
-        let Some(chunked) = &state.chunked else {
-            unreachable!("opened above")
-        };
-        let own = file.chunked.level();
-        let overridden =
-            self.recipe.spacing.is_some() || self.recipe.origin.is_some() || file.spacing_given;
-        let refuse_override = |how: &str| {
-            value_error(format!(
-                "{name}: spacing and origin given apply to level {own} read whole, not to level {level} {how}: leave them out (the file's own are used)"
-            ))
-        };
-        let (mode, max_memory) = (self.recipe.nonfinite, self.recipe.max_memory);
-        let plan = if self.recipe.log {
-            // The log scale's pass over the level is made once, when its
-            // pieces are first needed.
-            let level = chunked.level();
-            let need = chunked.whole_log_bytes(settings, mode);
-            if need <= u128::from(max_memory) {
-                Plan::Whole { level, need }
-            } else if matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
-                return Ok(());
-            } else {
-                if overridden {
-                    return Err(refuse_override("in pieces"));
-                }
-                let streamed = (chunked.log_pieces(mode, max_memory))
-                    .map_err(|e| value_error(format!("log=True: {name}: {e}")))?;
-                Plan::Pieces {
-                    level,
-                    need,
-                    streamed: Box::new(streamed),
-                }
-            }
-        } else {
-            chunked.plan(settings, mode, max_memory, 0)
-        };
-        match plan {
-            Plan::Whole { level, .. } => {
-                if overridden && level != own {
-                    return Err(refuse_override("read whole"));
-                }
-                if !matches!(state.way, Way::Whole { level: l, .. } if l == level) {
-                    // The last level's samples go before the next is read.
-                    state.way = Way::None;
-                    let prepared =
-                        Python::attach(|py| self.prepare_level(py, lazy, file, chunked))?;
-                    state.way = Way::Whole {
-                        level,
-                        prepared: Arc::new(prepared),
-                    };
-                }
-            }
-            Plan::Pieces {
-                level, streamed, ..
-            } => {
-                if overridden {
-                    return Err(refuse_override("in pieces"));
-                }
-                if !matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
-                    state.way = Way::Pieces {
-                        level,
-                        streamed: Box::new(streamed.with_labels(self.recipe.labels)),
-                        found: Found::default(),
-                    };
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// The level `chunked` read whole and prepared: the volume's own
-    /// samples where `data` read them already, else read from the file.
-    fn prepare_level(
-        &self,
-        py: Python<'_>,
-        lazy: &LazyRoad,
-        file: &LazyFile,
-        chunked: &Chunked,
-    ) -> PyResult<Prepared> {
-        let volume = lazy.volume.get();
-        let own = chunked.level() == file.chunked.level();
-        if own && volume.loaded(py).is_some() {
-            return self.recipe.prepare_core(py, volume.core(py)?, None);
-        }
-        let opts = ReadOptions {
-            max_memory: self.recipe.max_memory,
-            map: MapPolicy::Never,
-            ..chunked.read_options()
-        };
-        let path = chunked.path();
-        let read = py
-            .detach(|| volray_io::read(path, &opts))
-            .map_err(io_error)?;
-        let mut core = read.volume;
-        if own && file.spacing_given {
-            core = core
-                .with_spacing(volume.spacing.into())
-                .map_err(|e| value_error(format!("spacing: {e}")))?;
-        }
-        if volume.labels {
-            core = core.as_labels();
-        }
-        self.recipe.prepare_core(py, core, None)
-    }
-
-    /// A lazy volume's value range: of the level of the last frame; before
-    /// the first (or after one that failed), of the level asked for (the
-    /// volume's own with `level="auto"`, which needs a view). Read whole,
-    /// or found piece by piece (every piece read once).
-    fn lazy_value_range(&self, py: Python<'_>, lazy: &LazyRoad) -> PyResult<(f32, f32)> {
-        let (options, default, _) = self.settings_of(&Keywords::new(None, &[], "value_range")?)?;
-        let name = &self.recipe.name;
-        py.detach(|| {
-            let mut state = lazy.state.lock().unwrap_or_else(|e| e.into_inner());
-            let settings = match (&state.way, state.settings.clone()) {
-                (Way::Whole { .. } | Way::Pieces { .. }, Some(settings)) => settings,
-                _ => {
-                    // A small frame: the range does not depend on it, and
-                    // the pieces need fit no picture.
-                    let settings = RenderSettings {
-                        width: 16,
-                        height: 16,
-                        ..default
-                    };
-                    let level = match lazy.choice {
-                        LevelChoice::Index(n) => n,
-                        LevelChoice::Auto => lazy_file(lazy).chunked.level(),
-                    };
-                    self.settle(lazy, &mut state, level, &settings)?;
-                    state.settings = Some(settings.clone());
-                    settings
-                }
-            };
-            match &mut state.way {
-                Way::None => unreachable!("settled by a frame before, or above"),
-                Way::Whole { prepared, .. } => Ok(prepared.inner.value_range()),
-                Way::Pieces {
-                    streamed, found, ..
-                } => {
-                    let histogram = found
-                        .histogram(streamed, &settings)
-                        .map_err(|e| stream_error(e, &options.camera, name))?;
-                    Ok(histogram.map_or((0.0, 0.0), |h| (h.min, h.max)))
-                }
-            }
-        })
-    }
 }
 
 /// What rendering a frame of `settings` may take beyond the samples
-/// (a numpy array's are the caller's) with no brick cache.
+/// (a numpy array's are the caller's) with no brick cache (volray-app's
+/// `memory`, as the command line counts it).
 pub(crate) fn need(
     renderer: &CoreRenderer<'_>,
     settings: &RenderSettings,
     mode: NonFinite,
 ) -> u128 {
-    let volume = renderer.volume();
-    let bound = MemoryBound::new(
-        volume.dims(),
-        volume.spacing(),
-        volume.sample_type(),
-        settings,
-        mode,
-        0,
-    )
-    .total();
-    bound.saturating_sub((volume.len() * volume.sample_type().bytes()) as u128)
+    volray_app::memory::frame_bytes(renderer.volume(), settings, mode, &budget(0))
+}
+
+/// What Python's frames are held to: `max_memory`; the frame is handed
+/// over (no PNG), and the samples are the caller's.
+fn budget(max_memory: u64) -> Budget {
+    Budget {
+        limit: max_memory,
+        extra: 0,
+        samples_count: false,
+    }
 }
 
 /// The budget of the brick caches: the library's default, or what is
-/// left under `max_memory` after a default frame when that is less (the
-/// command line's rule, `src/memory.rs`; the budget changes speed, never
-/// pixels).
+/// left under `max_memory` after a default frame when that is less, 0
+/// where even that is over (volray-app's `memory::cache_budget`, which
+/// the command line calls with its frame's settings: a renderer here is
+/// prepared before its frames are asked for; the budget changes speed,
+/// never pixels).
 pub(crate) fn cache_budget(renderer: &CoreRenderer<'_>, mode: NonFinite, max_memory: u64) -> usize {
-    let need = need(renderer, &RenderSettings::default(), mode);
-    (u128::from(max_memory).saturating_sub(need)).min(DEFAULT_CACHE_BUDGET as u128) as usize
+    let (volume, default) = (renderer.volume(), RenderSettings::default());
+    volray_app::memory::cache_budget(volume, "", &default, mode, budget(max_memory)).unwrap_or(0)
 }
 
 /// A pool of `threads` workers.

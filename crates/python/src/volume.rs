@@ -16,9 +16,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::path::PathBuf;
 use volray_core::{Histogram, SampleType, Volume as CoreVolume};
-use volray_io::{
-    DType, Endian, FileInfo, MapPolicy, RawOptions, ReadOptions, VolumeFormat, format_bytes,
-};
+use volray_io::{FileInfo, MapPolicy, ReadOptions, VolumeFormat, format_bytes};
 use volray_lazy::Chunked;
 
 /// A volume: `data`, a numpy array `a[x, y, z]` (x fastest in memory),
@@ -428,22 +426,12 @@ pub fn read(
             .map_err(|e| value_error(e.to_string()))?;
         (volume, None)
     } else {
-        let format = (format.map(str::parse::<VolumeFormat>))
-            .transpose()
-            .map_err(|e| value_error(format!("format: {e}")))?;
+        // volray-app's words: `format: ...`, `dtype: ...`, `endian: ...`.
+        let app = |e: volray_app::AppError| value_error(e.to_string());
+        let format = volray_app::input::format_named(format).map_err(app)?;
         let raw = match dims {
             Some(dims) => {
-                let dtype = (dtype.map(str::parse::<DType>))
-                    .transpose()
-                    .map_err(|e| value_error(format!("dtype: {e}")))?
-                    .unwrap_or(DType::F32);
-                let mut raw = RawOptions::new(dims, dtype);
-                raw.endian = (endian.map(str::parse::<Endian>))
-                    .transpose()
-                    .map_err(|e| value_error(format!("endian: {e}")))?
-                    .unwrap_or(Endian::Little);
-                raw.spacing = spacing.unwrap_or([1.0; 3]).into();
-                Some(raw)
+                Some(volray_app::input::raw_layout(dims, dtype, endian, spacing).map_err(app)?)
             }
             None if dtype.is_some() || endian.is_some() => {
                 return Err(value_error(format!(

@@ -16,7 +16,7 @@
 //! a front end's own). Every front end (the command line, the Python
 //! module, the viewer) gets this without doing anything. A front end that
 //! must end something on a bug (`mpirun`: every rank) does so after the
-//! panic has unwound to its top (`src/distributed.rs`), never in a hook.
+//! panic has unwound to its top (volray-app's `distributed::ranked`), never in a hook.
 //!
 //! volray's own decoders (`dicom/jpegls.rs`) are not run through it: a
 //! panic there is volray's bug, and shows. A decoder that hands work to

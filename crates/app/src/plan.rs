@@ -1,0 +1,192 @@
+//! Planning an input: read whole (or mapped), or, for a chunked volume
+//! (Zarr, OME-Zarr), which level (`--level auto`) and, where that level
+//! is too large to render whole under the memory limit, rendering it
+//! piece by piece from its chunks (volray-distributed's `Streamed`),
+//! never reading it whole.
+//!
+//! The order: the file is opened from its metadata alone; `--level auto`
+//! picks the level for the picture (volray-options' `level`); the level's
+//! frame is bounded as a whole volume's would be (`memory.rs`). Within
+//! the limit it is read whole and rendered as any file is (the same
+//! pixels as `--level N`); beyond it, or beyond one piece's
+//! [`volray_lazy::PIECE_BUDGET`] (lighter and faster then), in pieces of at
+//! most that each.
+
+use crate::error::AppError;
+use crate::input::{self, Request, Spec};
+use volray_core::{Image, NonFinite, RenderSettings};
+use volray_distributed::streamed::{StreamTimes, Streamed};
+use volray_io::MapPolicy;
+use volray_lazy::{Chunked, Found, LookError, Plan as LazyPlan};
+use volray_options::LookOptions;
+use volray_options::level::LevelChoice;
+
+/// How an input is rendered.
+pub enum Plan {
+    /// Read whole (or mapped), as every file is: at this level, if any.
+    Whole { level: Option<usize> },
+    /// Rendered piece by piece from its chunks.
+    Streamed(Box<StreamedInput>),
+}
+
+/// A chunked volume rendered piece by piece.
+pub struct StreamedInput {
+    pub name: String,
+    pub streamed: Streamed,
+    /// The labels or histogram found in the level, once.
+    found: Found,
+    /// The file's display window (OME-Zarr `omero`), the default `--range`.
+    window: Option<(f64, f64)>,
+    /// The level, what it may take whole, and the limit (for the note
+    /// after a frame).
+    pub level: usize,
+    pub whole: u128,
+    pub max_memory: u64,
+}
+
+/// What `--level auto` chose, said as it is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Chosen {
+    pub level: usize,
+    /// How many levels the file has, and the chosen level's grid.
+    pub levels: usize,
+    pub dims: [usize; 3],
+}
+
+/// What a plan is for: the frames' settings, and the look options that
+/// change what is read.
+pub struct Frames<'a> {
+    pub settings: &'a RenderSettings,
+    pub non_finite: NonFinite,
+    /// Values on a log scale (`--log`), and values as labels (`--labels`).
+    pub log: bool,
+    pub labels: bool,
+    /// What the front end adds to each frame ([`crate::memory::Budget::extra`]).
+    pub extra: u128,
+}
+
+/// Decides how `request`'s input is rendered for `frames`: opens a
+/// chunked file from its metadata, picks its level (telling `chosen`
+/// what `--level auto` chose), and streams it when that level's frame
+/// would not fit the memory limit whole. Other inputs (built-in sources,
+/// formats read whole or mapped) are read whole.
+pub fn plan(
+    request: &Request,
+    frames: &Frames<'_>,
+    chosen: &mut dyn FnMut(Chosen),
+) -> Result<Plan, AppError> {
+    if matches!(request.spec, Spec::Source(_)) {
+        return Ok(Plan::Whole { level: None });
+    }
+    let spec = request.spec.name();
+    let max_memory = request.max_memory();
+    let Some(mut chunked) = open_chunked(request, max_memory)? else {
+        return Ok(Plan::Whole {
+            level: request.fixed_level(),
+        });
+    };
+    let settings = frames.settings;
+    if request.level == Some(LevelChoice::Auto) {
+        let level = (chunked.auto_level(settings)).map_err(|error| AppError::AutoLevel {
+            spec: spec.clone(),
+            error,
+        })?;
+        let levels = chunked.levels();
+        chosen(Chosen {
+            level,
+            levels: levels.len(),
+            dims: levels[level].dims,
+        });
+        chunked = chunked.at_level(level)?;
+    }
+    let (mode, extra) = (frames.non_finite, frames.extra);
+    let plan = if frames.log {
+        // The log of the level, found piece by piece after a pass over it
+        // for its smallest positive value.
+        (chunked.plan_log(settings, mode, max_memory, extra)).map_err(|message| AppError::Log {
+            name: spec.clone(),
+            message,
+        })?
+    } else {
+        chunked.plan(settings, mode, max_memory, extra)
+    };
+    match plan {
+        LazyPlan::Whole { level, .. } => Ok(Plan::Whole { level: Some(level) }),
+        LazyPlan::Pieces {
+            level,
+            need,
+            streamed,
+        } => Ok(Plan::Streamed(Box::new(StreamedInput {
+            name: spec,
+            streamed: streamed.with_labels(frames.labels),
+            found: Found::default(),
+            window: chunked.info().display_window(),
+            level,
+            whole: need,
+            max_memory,
+        }))),
+    }
+}
+
+/// Opens `request`'s file from its metadata where it is stored in
+/// chunks, at the level `level N` names (0 for `auto`, which the caller
+/// resolves); `None` for a file read whole or mapped. `level auto` on
+/// such a file is refused: it has one level.
+pub fn open_chunked(request: &Request, max_memory: u64) -> Result<Option<Chunked>, AppError> {
+    let Spec::File(path) = &request.spec else {
+        return Ok(None);
+    };
+    let numbered = Request {
+        level: request.fixed_level().map(LevelChoice::Index),
+        ..request.clone()
+    };
+    let opts = input::read_options(&numbered, max_memory, MapPolicy::IfLarger)?;
+    let chunked = Chunked::open(path, &opts)?;
+    if chunked.is_none() && request.level == Some(LevelChoice::Auto) {
+        return Err(AppError::AutoLevelOneLevel {
+            spec: request.spec.name(),
+        });
+    }
+    Ok(chunked)
+}
+
+impl StreamedInput {
+    /// `settings` with what the look options leave to the volume
+    /// (`--labels`, `--tf auto`), found piece by piece (volray-lazy's
+    /// [`Found`], which the Python module shares), within the file's
+    /// display window where the options give no range.
+    pub fn settings_from_volume(
+        &mut self,
+        look: &LookOptions,
+        mut settings: RenderSettings,
+    ) -> Result<RenderSettings, AppError> {
+        let name = self.name.clone();
+        volray_options::file_window(look, &mut settings.transfer_function, self.window);
+        let found = self
+            .found
+            .apply(&mut self.streamed, look, &mut settings, &name);
+        match found {
+            Ok(()) => Ok(settings),
+            Err(LookError::Stream(error)) => Err(AppError::Stream { name, error }),
+            Err(LookError::Refused(e)) => Err(AppError::Option(e)),
+        }
+    }
+
+    /// One frame.
+    pub fn render(
+        &mut self,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<(Image, StreamTimes), AppError> {
+        (self.streamed.render(settings, progress)).map_err(|error| AppError::Stream {
+            name: self.name.clone(),
+            error,
+        })
+    }
+
+    /// Whether the level's frame went over one piece's budget beneath the
+    /// limit ([`volray_lazy::Chunked::plan`]) rather than the limit itself.
+    pub fn over_piece_budget(&self) -> bool {
+        self.max_memory > volray_lazy::PIECE_BUDGET
+    }
+}
