@@ -72,7 +72,7 @@ pub fn plan(
 pub fn say_chosen(spec: &str, chosen: Chosen) {
     let [x, y, z] = chosen.dims;
     eprintln!(
-        "volray: {}: level {} of {} ({x}x{y}x{z}), the coarsest whose voxels are no larger than a pixel (--level auto)",
+        "volray: {}: level {} of {} ({x}x{y}x{z}), the coarsest whose voxels are no larger than a pixel (--level auto, the default for a multiscale image; --level 0 is the finest)",
         Path::new(spec).display(),
         chosen.level,
         chosen.levels

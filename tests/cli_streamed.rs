@@ -211,6 +211,36 @@ fn level_auto_takes_the_coarsest_level_no_coarser_than_a_pixel() {
 }
 
 #[test]
+fn a_multiscale_image_without_a_level_is_drawn_at_the_auto_level_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let path = image.to_str().unwrap();
+    let out = |name: &str| dir.path().join(name);
+    // 17 rows: level 1 (the test above), with no --level given.
+    let size = ["--size", "17", "--preset", "mr", "--range", "0,32000"];
+    let said = render(&[&[path], &size[..]].concat(), &out("default.png"));
+    assert!(
+        said.contains("level 1 of 3") && said.contains("the default for a multiscale image"),
+        "{said}"
+    );
+    render(
+        &[&[path, "--level", "1"], &size[..]].concat(),
+        &out("fixed.png"),
+    );
+    assert_eq!(
+        Picture::read(&out("default.png")),
+        Picture::read(&out("fixed.png"))
+    );
+    // --level 0 still draws the finest level.
+    let said = render(
+        &[&[path, "--level", "0"], &size[..]].concat(),
+        &out("finest.png"),
+    );
+    assert!(!said.contains("level 1 of 3"), "{said}");
+}
+
+#[test]
 fn a_turntable_of_a_level_over_max_memory_turns_piece_by_piece() {
     let dir = tempfile::tempdir().unwrap();
     let image = dir.path().join("img.ome.zarr");
@@ -219,10 +249,18 @@ fn a_turntable_of_a_level_over_max_memory_turns_piece_by_piece() {
     let whole = dir.path().join("whole_%02d.png");
     let pieces = dir.path().join("pieces_%02d.png");
     let turn = ["--turntable", "3"];
-    let said = render(&[&[path], &LOOK[..], &turn[..]].concat(), &whole);
+    let said = render(
+        &[&[path, "--level", "0"], &LOOK[..], &turn[..]].concat(),
+        &whole,
+    );
     assert!(!said.contains("pieces"), "{said}");
     let said = render(
-        &[&[path, "--max-memory", "100K"], &LOOK[..], &turn[..]].concat(),
+        &[
+            &[path, "--level", "0", "--max-memory", "100K"],
+            &LOOK[..],
+            &turn[..],
+        ]
+        .concat(),
         &pieces,
     );
     // Each frame was rendered from pieces: the note names them.
@@ -261,6 +299,8 @@ fn annotations_are_refused_in_pieces_in_one_line_and_drawn_whole() {
             &[
                 "render",
                 path,
+                "--level",
+                "0",
                 "--max-memory",
                 "100K",
                 "--axes",
@@ -282,7 +322,15 @@ fn annotations_are_refused_in_pieces_in_one_line_and_drawn_whole() {
         assert!(!out.exists());
         // Read whole, the same frame is annotated.
         let whole = [
-            &["render", path, "--outline", "-o", out.to_str().unwrap()][..],
+            &[
+                "render",
+                path,
+                "--level",
+                "0",
+                "--outline",
+                "-o",
+                out.to_str().unwrap(),
+            ][..],
             &LOOK[..],
             extra,
         ]

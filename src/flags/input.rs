@@ -63,8 +63,8 @@ pub struct InputArgs {
 
     /// Zarr/OME-Zarr: which resolution level of a multiscale image, 0 the
     /// finest (`volray info` lists them), or `auto` (render, view): the
-    /// coarsest level whose voxels are no larger than a pixel [default: 0;
-    /// auto in view].
+    /// coarsest level whose voxels are no larger than a pixel [default:
+    /// auto where `render` or `view` draws a multiscale image; 0 elsewhere].
     #[arg(long, value_name = "N|auto", value_parser = parse_level)]
     pub level: Option<LevelChoice>,
 

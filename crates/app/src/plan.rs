@@ -86,7 +86,15 @@ pub fn plan(
         });
     };
     let settings = frames.settings;
-    if request.level == Some(LevelChoice::Auto) {
+    // A multiscale image without a level named is drawn as `auto` would:
+    // the first picture of a 2048³ pyramid need not read 16 GiB to show
+    // 480² pixels (neuroglancer and napari pick by screen resolution too).
+    // The level is said (`chosen`), and `level 0` names the finest.
+    let auto = match request.level {
+        Some(choice) => choice == LevelChoice::Auto,
+        None => chunked.levels().len() > 1,
+    };
+    if auto {
         let level = (chunked.auto_level(settings)).map_err(|error| AppError::AutoLevel {
             spec: spec.clone(),
             error,
