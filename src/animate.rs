@@ -22,16 +22,13 @@
 
 use crate::error::CliError;
 use crate::flags::{InputArgs, RenderArgs};
-use crate::render::OutputKind;
+use crate::outfile::OutputKind;
 use crate::session::{load, progress_bar, render_failure, renderer_for};
 use crate::streamed::Plan;
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
 use volray_io::Animation;
-
-/// Frames per second when `--fps` is not given.
-pub const DEFAULT_FPS: f64 = 24.0;
 
 /// `--turntable FRAMES`: `frames` views of INPUT.
 pub fn turntable(
@@ -68,7 +65,7 @@ pub fn turntable(
         Plan::Whole { level } => crate::streamed::at_level(&args.input, level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
-    let base = &crate::render::from_volume(args, base, &mut input)?;
+    let base = &crate::settings::from_input(args, base, &mut input)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
@@ -122,7 +119,7 @@ pub fn series(
 /// them), one frame each, as a series of inputs is rendered.
 pub fn time_points(
     args: &RenderArgs,
-    kind: crate::render::OutputKind,
+    kind: OutputKind,
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
@@ -156,7 +153,7 @@ pub fn time_points(
         )));
     }
     crate::overwrite::refuse_overwriting_inputs(
-        &crate::render::output_files(args, kind, end - range.start),
+        &crate::outfile::output_files(args, kind, end - range.start),
         &[spec.to_string()],
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
     )?;
@@ -319,7 +316,7 @@ impl Writer {
             settings.width,
             settings.height,
             frames,
-            args.animation.fps.unwrap_or(DEFAULT_FPS),
+            args.animation.fps.unwrap_or(crate::outfile::DEFAULT_FPS),
         )?;
         let bar = progress_bar(pixels as u64);
         Ok(Writer { animation, bar })

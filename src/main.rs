@@ -43,6 +43,7 @@ mod info;
 mod input;
 mod interrupt;
 mod memory;
+mod outfile;
 mod overwrite;
 mod paper;
 mod render;

@@ -15,3 +15,7 @@
 //!
 //! A front end keeps only its syntax (flags, keywords, page messages), its
 //! output writing and its progress display.
+
+pub mod reproduce;
+pub mod scene;
+pub mod words;
