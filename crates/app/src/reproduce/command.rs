@@ -576,6 +576,141 @@ pub fn shell_quote(word: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::OverlaySpec;
+    use volray_view::LayerState;
+
+    /// The words of a viewer of `blobs:16` started with the defaults, and
+    /// its starting state.
+    fn start() -> (CommandWords, ViewState) {
+        let options = Options::default();
+        let settings = volray_options::settings(&options).unwrap();
+        let state = volray_view::start_state(&options, &settings);
+        let tf = settings.transfer_function.clone();
+        let words = CommandWords::new("blobs:16".into(), Vec::new(), &options, tf);
+        (words, state)
+    }
+
+    #[test]
+    fn the_starting_command_renders_input_with_the_pages_camera_to_view_png() {
+        let (words, mut state) = start();
+        state.azimuth = 30.5;
+        state.zoom = 2.0;
+        let (w, _, files) = words.words(&state).unwrap();
+        assert_eq!(w[..2], ["render", "blobs:16"]);
+        assert_eq!(w[w.len() - 2..], ["-o", OUTPUT]);
+        for pair in [["--azimuth", "30.5"], ["--zoom", "2"], ["--elevation", "0"]] {
+            assert!(w.windows(2).any(|p| p == pair), "{pair:?} in {w:?}");
+        }
+        assert!(files.is_empty(), "no scene, no overlay files");
+        // An input that reads as a flag goes after `--`.
+        let options = Options::default();
+        let tf = TransferFunction::default();
+        let dashed = CommandWords::new("-x.nrrd".into(), Vec::new(), &options, tf);
+        let (w, _, _) = dashed.words(&state).unwrap();
+        assert_eq!(w[w.len() - 2..], ["--", "-x.nrrd"]);
+        assert_eq!(w.iter().filter(|w| *w == "-x.nrrd").count(), 1);
+    }
+
+    #[test]
+    fn a_scenes_volumes_are_overlays_that_parse_back_to_their_looks() {
+        let (words, mut state) = start();
+        let settings = RenderSettings {
+            transfer_function: TransferFunction::default(),
+            opacity_ramp: (0.1, 0.6),
+            ..RenderSettings::default()
+        };
+        let look = Look::of(&settings);
+        let overlay = LayerSource::Overlay(OverlaySpec::parse("seg.nii:frame=2").unwrap());
+        let channel = LayerSource::Channel {
+            index: 1,
+            axis: ChannelAxis::Channel,
+        };
+        let first = LayerSource::Channel {
+            index: 0,
+            axis: ChannelAxis::Channel,
+        };
+        let others = vec![
+            OtherWords::of(
+                &overlay,
+                "in.tif",
+                Some(3),
+                &settings,
+                Some((0.0, 10.0)),
+                look.clone(),
+            ),
+            OtherWords::of(
+                &channel,
+                "in.tif",
+                Some(3),
+                &settings,
+                Some((-1.0, 1.0)),
+                look,
+            ),
+        ];
+        let words = words.with_scene(SceneWords {
+            first: SceneWords::first_of(&first),
+            others,
+            mix: Mix::Additive,
+        });
+        state.layers = vec![
+            LayerState {
+                visible: true,
+                window: Some([1.0, 5.5]),
+                opacity: Some(vec![[0.0, 0.0], [1.0, 0.5]]),
+                colormap: "#ff0000".into(),
+            },
+            LayerState {
+                visible: false,
+                window: None,
+                opacity: None,
+                colormap: WHITE.into(),
+            },
+        ];
+        let (w, _, files) = words.words(&state).unwrap();
+        assert!(w.windows(2).any(|p| p == ["--channel", "0"]), "{w:?}");
+        assert!(w.windows(2).any(|p| p == ["--mix", "additive"]), "{w:?}");
+        let overlays: Vec<&str> = (w.windows(2))
+            .filter(|p| p[0] == "--overlay")
+            .map(|p| p[1].as_str())
+            .collect();
+        assert_eq!(
+            overlays,
+            [
+                "seg.nii:frame=2,range=1,5.5,tf=view-tf-2.json",
+                "in.tif:channel=1,frame=3,range=-1,1,opacity=0.1,0.6,tf=view-tf-3.json,hidden",
+            ]
+        );
+        // Each parses back to the volume and look the page shows.
+        let parsed: Vec<OverlaySpec> = (overlays.iter())
+            .map(|o| OverlaySpec::parse(o).unwrap())
+            .collect();
+        assert_eq!(
+            (parsed[0].file.as_str(), parsed[0].frame, parsed[0].range),
+            ("seg.nii", Some(2), Some((1.0, 5.5)))
+        );
+        assert_eq!(
+            (parsed[1].file.as_str(), parsed[1].channel, parsed[1].frame),
+            ("in.tif", Some(1), Some(3))
+        );
+        assert_eq!(
+            (parsed[1].range, parsed[1].opacity, parsed[1].hidden),
+            (Some((-1.0, 1.0)), Some((0.1, 0.6)), true)
+        );
+        assert!(!parsed[0].hidden);
+        // Their files hold the page's opacity points and colours.
+        let names: Vec<&str> = files.iter().map(|(name, _)| name.as_str()).collect();
+        assert_eq!(names, ["view-tf-2.json", "view-tf-3.json"]);
+        let tf = TransferFunction::from_json(&files[0].1).unwrap();
+        let opacity: Vec<(f32, [f32; 1])> = tf.opacity.unwrap().points().to_vec();
+        assert_eq!(opacity, [(0.0, [0.0]), (1.0, [0.5])]);
+        let red: Vec<(f32, [f32; 3])> = tf.color.unwrap().points().to_vec();
+        assert_eq!(red, [(0.0, [1.0, 0.0, 0.0]), (1.0, [1.0, 0.0, 0.0])]);
+        let white = TransferFunction::from_json(&files[1].1).unwrap();
+        assert_eq!((white.opacity, white.color), (None, None));
+        // The state must describe the volumes the viewer shows.
+        state.layers.pop();
+        assert!(words.words(&state).unwrap_err().0.contains("1 volume(s)"));
+    }
 
     #[test]
     fn odd_words_are_quoted_for_the_shell() {

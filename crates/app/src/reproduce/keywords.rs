@@ -256,3 +256,67 @@ fn num(x: f64) -> String {
 fn num32(x: f32) -> String {
     format!("{x:?}")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use volray_core::PiecewiseLinear;
+
+    #[test]
+    fn the_call_names_only_what_differs_from_the_defaults() {
+        let mut options = Options::default();
+        options.camera.azimuth = 30.0;
+        options.look.shading = false;
+        options.look.background = [0.5; 3];
+        options.look.ambient = [0.1, 0.2, 0.3];
+        options.look.tf = Some(Tf::Function(volray_core::TransferFunction {
+            domain: Some((0.0, 0.1)),
+            opacity: Some(
+                PiecewiseLinear::new("opacity", vec![(0.0, [0.0]), (1.0, [0.5])]).unwrap(),
+            ),
+            color: volray_core::transfer::colormap::colormap("viridis"),
+        }));
+        assert_eq!(
+            call(&options, &[]),
+            "volray.render(volume, camera=volray.Camera(size=(480, 480), azimuth=30.0, \
+             elevation=0.0, zoom=1.0), tf=volray.TransferFunction(opacity=[(0.0, 0.0), \
+             (1.0, 0.5)], domain=(0.0, 0.1)).with_colormap(\"viridis\"), shading=False, \
+             ambient=(0.10000000149011612, 0.20000000298023224, 0.30000001192092896), \
+             background=0.5)"
+        );
+    }
+
+    #[test]
+    fn the_figure_is_spelled_as_its_annotation_keywords() {
+        let figure = Figure {
+            colorbar: Some(volray_view::ColorBarSide::Left),
+            scale_bar: true,
+            scale_length: Some(2.5),
+            title: Some("a \"b\"".into()),
+            ..Figure::default()
+        };
+        let w = figure_keywords(Some(None), Some("HU"), &figure);
+        let code: Vec<String> = w.iter().map(|(k, v)| format!("{k}={}", code(v))).collect();
+        assert_eq!(
+            code,
+            [
+                "level=\"auto\"",
+                "colorbar=\"left\"",
+                "units=\"HU\"",
+                "scale_bar=2.5",
+                "title=\"a \\\"b\\\"\""
+            ]
+        );
+        assert!(figure_keywords(None, Some("HU"), &Figure::default()).is_empty());
+    }
+
+    #[test]
+    fn numbers_are_written_as_python_reads_them_back() {
+        for x in [0.1 + 0.2, 1e-300, -2.5, 1e21] {
+            assert_eq!(num(x).parse::<f64>().unwrap(), x);
+        }
+        assert_eq!(num(1.0), "1.0");
+        let x = 0.1f32;
+        assert_eq!(num32(x).parse::<f32>().unwrap(), x);
+    }
+}
