@@ -30,11 +30,11 @@ use crate::error::CliError;
 use crate::flags::{BenchArgs, Channels, InputArgs, MixMode, RenderArgs, ViewArgs};
 use crate::input::{self, Input};
 use crate::render::{self, OutputKind};
-use crate::scene::{ChannelAxis, channel_axis};
 use crate::session::render_failure;
 use crate::settings::settings;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
+use volray_app::scene::{ChannelAxis, channel_axis};
 use volray_core::SampleType;
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
@@ -182,14 +182,16 @@ fn channels(
             "--channels renders the time points of {spec} (one channel) together; --frame picks one: give one of them"
         )));
     }
-    let (indices, colors) = crate::scene::channels::picked_channels(
-        args.scene.channel_colors.as_ref(),
-        which,
-        &spec,
-        count,
-    )?;
+    let (indices, colors) = crate::scene::picked(&args.scene, which, &spec, count)?;
     let sources = (indices.iter())
-        .map(|&i| CliSource::open(mpi, &axis.pick(&args.input, i), view, &settings))
+        .map(|&i| {
+            CliSource::open(
+                mpi,
+                &crate::scene::pick(axis, &args.input, i),
+                view,
+                &settings,
+            )
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let mode = sources[0].non_finite;
     let fail = |e| failure(view, &spec, e);

@@ -344,8 +344,24 @@ fn explained(budget: &Budget, e: CliError) -> CliError {
     }
 }
 
+/// The channels `which` of the `count` that `spec` holds, and their
+/// colours (`--channel-colors`, else the palette).
+pub fn picked(
+    scene: &SceneArgs,
+    which: &Channels,
+    spec: &str,
+    count: usize,
+) -> Result<(Vec<usize>, Vec<[f32; 3]>), CliError> {
+    let which = match which {
+        Channels::All => None,
+        Channels::Some(list) => Some(&list[..]),
+    };
+    let colors = scene.channel_colors.as_ref().map(|c| &c.0[..]);
+    picked_channels(colors, which, spec, count).map_err(refused)
+}
+
 /// `input` reading volume `index` along `axis`.
-fn pick(axis: ChannelAxis, input: &InputArgs, index: usize) -> InputArgs {
+pub fn pick(axis: ChannelAxis, input: &InputArgs, index: usize) -> InputArgs {
     let mut one = input.clone();
     axis.pick(&mut one.channel, &mut one.frame, index);
     one
@@ -498,12 +514,7 @@ fn read_channels(
             "--channels renders the {count} volumes of {spec} (one channel, {count} time points) together; --frame picks one: give one of them"
         )));
     }
-    let which = match which {
-        Channels::All => None,
-        Channels::Some(list) => Some(&list[..]),
-    };
-    let colors = scene.channel_colors.as_ref().map(|c| &c.0[..]);
-    let (indices, colors) = picked_channels(colors, which, spec, count).map_err(refused)?;
+    let (indices, colors) = picked(scene, which, spec, count)?;
     let mut first = Some(first);
     if !indices.contains(&0) {
         budget.remove(&first.take().expect("channel 0 read").volume);
