@@ -380,7 +380,7 @@ fn ranked(run: impl FnOnce() -> Result<(), CliError>) -> Result<(), CliError> {
 }
 
 /// `settings` with what the flags leave to the volume, as one process
-/// takes it ([`crate::render::from_volume`]): with `--labels`, the label
+/// takes it ([`crate::settings::from_input`]): with `--labels`, the label
 /// transfer function of the labels every rank found, joined; otherwise
 /// `--tf auto` (the default) chosen from the whole volume's histogram,
 /// summed over the ranks' owned voxels, within the file's display window
