@@ -22,7 +22,7 @@
 
 use crate::error::CliError;
 use crate::flags::{InputArgs, RenderArgs};
-use crate::render::OutputKind;
+use crate::outfile::OutputKind;
 use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note,
 };
@@ -31,9 +31,6 @@ use volray_app::plan::Plan;
 use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
 use volray_io::Animation;
-
-/// Frames per second when `--fps` is not given.
-pub const DEFAULT_FPS: f64 = 24.0;
 
 /// `--turntable FRAMES`: `frames` views of INPUT.
 pub fn turntable(
@@ -76,7 +73,7 @@ pub fn turntable(
         Plan::Whole { level } => args.input.at_level(level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
-    let base = &crate::render::from_volume(args, base, &mut input)?;
+    let base = &crate::settings::from_input(args, base, &mut input)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
@@ -130,7 +127,7 @@ pub fn series(
 /// them), one frame each, as a series of inputs is rendered.
 pub fn time_points(
     args: &RenderArgs,
-    kind: crate::render::OutputKind,
+    kind: OutputKind,
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
@@ -168,7 +165,7 @@ pub fn time_points(
         )));
     }
     crate::overwrite::refuse_overwriting_inputs(
-        &crate::render::output_files(args, kind, end - range.start),
+        &crate::outfile::output_files(args, kind, end - range.start),
         &[spec.to_string()],
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
     )?;
@@ -331,7 +328,7 @@ impl Writer {
             settings.width,
             settings.height,
             frames,
-            args.animation.fps.unwrap_or(DEFAULT_FPS),
+            args.animation.fps.unwrap_or(crate::outfile::DEFAULT_FPS),
         )?;
         let bar = progress_bar(pixels as u64);
         Ok(Writer { animation, bar })

@@ -6,7 +6,7 @@
 
 use crate::error::CliError;
 use crate::flags::{ColorBarSide, FigureArgs, RenderArgs, ScaleLength};
-use crate::render::OutputKind;
+use crate::outfile::OutputKind;
 use volray_annotate::colorbar::Side;
 use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
 use volray_app::input::Input;

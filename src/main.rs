@@ -42,6 +42,7 @@ mod info;
 mod interrupt;
 #[cfg(feature = "mpi")]
 mod mpi;
+mod outfile;
 mod overwrite;
 mod paper;
 mod render;

@@ -7,11 +7,11 @@
 use crate::error::CliError;
 use crate::flags::{BenchArgs, MixMode, RenderArgs, ViewArgs};
 use crate::render::{self, OutputKind};
-use crate::scene::{ChannelAxis, channel_axis};
 use crate::session::{app_failure, app_failure_of};
 use crate::settings::settings;
 use volray_app::AppError;
 use volray_app::distributed::{self, Job, Mpi};
+use volray_app::scene::{ChannelAxis, channel_axis};
 use volray_core::RenderSettings;
 use volray_distributed::frame::Failure;
 use volray_distributed::transport::Transport;
@@ -94,15 +94,7 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
                 let (count, axis) = channel_axis(info);
                 (count, axis == ChannelAxis::Channel)
             };
-            let pick = |count| {
-                crate::scene::channels::picked_channels(
-                    args.scene.channel_colors.as_ref(),
-                    which,
-                    &spec,
-                    count,
-                )
-                .map_err(refusal)
-            };
+            let pick = |count| crate::scene::picked(&args.scene, which, &spec, count).map_err(refusal);
             if job.settings.blend.is_projection() {
                 return Err(CliError::input(
                     "--channels under mpirun: the projections (--blend mip, ...) are rendered by one process",

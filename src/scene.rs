@@ -12,28 +12,38 @@
 //! shared shading. Each volume is read whole and checked against
 //! `--max-memory` on its own (`session.rs`). Plain renders never come here.
 
-pub(crate) mod channels;
-mod layer;
-
-use channels::read_channels;
-pub use channels::refuse_channel_look;
-use layer::Budget;
-pub use layer::{ChannelAxis, Layer, LayerSource, channel_axis};
-
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::{InputArgs, MixMode, RenderArgs, SceneArgs, ViewArgs};
-use crate::render::{OutputKind, output_kind, write_still};
+use crate::flags::{Channels, InputArgs, LookArgs, RenderArgs, SceneArgs, ViewArgs};
+use crate::outfile::{OutputKind, output_kind, write_still};
 use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
 use std::path::{Path, PathBuf};
-use volray_app::input;
+use volray_app::input::{self, Input};
 use volray_app::plan::Plan;
+use volray_app::scene::{
+    Budget, ChannelAxis, LayerSource, OverlaySpec, Refused, channel_axis, channel_color,
+    default_mix, picked_channels, time_range,
+};
 use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
 use volray_core::{RenderError, RenderSettings, SceneError};
-use volray_options::{LookOptions, Naming, Opt, Options, Tf};
 
-/// The overlay options, as the refusal of an unknown one lists them.
-const OVERLAY_OPTIONS: &str = "labels, colormap=NAME, preset=NAME, range=LO,HI, opacity=P,Q, tf=FILE.json, frame=N, channel=N, hidden";
+/// One volume of the picture: what was read, its settings alone (whose
+/// look becomes its [`Look`]), and where it came from.
+pub struct Layer {
+    pub input: Input,
+    pub settings: RenderSettings,
+    pub source: LayerSource,
+}
+
+impl Layer {
+    /// Its look in the picture: shown unless an overlay's `hidden`.
+    pub fn look(&self) -> Look {
+        Look {
+            visible: self.source.visible(),
+            ..Look::of(&self.settings)
+        }
+    }
+}
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
@@ -49,7 +59,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         ));
     }
     let settings = crate::settings::settings(&args.view)?;
-    crate::render::check_output(&args.out.output)?;
+    crate::outfile::check_output(&args.out.output)?;
     let overlays = overlay_specs(&args.scene)?;
     let first_spec = args.input.input.as_deref().unwrap_or(input::DEMO);
     let inputs: Vec<String> = std::iter::once(first_spec.to_string())
@@ -63,7 +73,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         )
         .collect();
     crate::overwrite::refuse_overwriting_inputs(
-        &crate::render::output_files(args, kind, 1),
+        &crate::outfile::output_files(args, kind, 1),
         &inputs,
         &tf_files,
     )?;
@@ -81,12 +91,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         "--channels and --overlay",
     )?;
     let layers = read_layers(&input_args, &args.view, &args.scene, &overlays, &settings)?;
-    let mix = match args.scene.mix {
-        Some(MixMode::Composite) => Mix::Composite,
-        Some(MixMode::Additive) => Mix::Additive,
-        None if args.scene.channels.is_some() => Mix::Additive,
-        None => Mix::Composite,
-    };
+    let mix = mix(&args.scene);
     if let Some(range) = args.scene.frames {
         let walk = TimeWalk {
             args,
@@ -195,15 +200,9 @@ impl TimeWalk<'_> {
                 )));
             }
         };
-        let end = range.end.unwrap_or(count);
-        if count < 2 || range.start >= count || end > count {
-            return Err(CliError::input(format!(
-                "--frames {}:{end}: {spec} holds {count} time point(s), numbered from 0",
-                range.start
-            )));
-        }
+        let end = time_range(range.start, range.end, count, spec).map_err(refused)?;
         let n = end - range.start;
-        let files = crate::render::output_files(args, self.kind, n);
+        let files = crate::outfile::output_files(args, self.kind, n);
         crate::overwrite::refuse_overwriting_inputs(&files, &[spec.to_string()], &[])?;
         let per_frame = self.settings.width * self.settings.height * first.len();
         let mut writer = animate::Writer::with_pixels(args, self.settings, n, n * per_frame)?;
@@ -243,9 +242,10 @@ impl TimeWalk<'_> {
             let LayerSource::Channel { index, axis } = source else {
                 unreachable!("--frames takes channels only");
             };
-            let mut one = axis.pick(&at, *index);
+            let mut one = pick(*axis, &at, *index);
             one.max_memory = budget.left();
-            let mut input = load(&one, self.args.view.look.log).map_err(|e| budget.explain(e))?;
+            let mut input =
+                load(&one, self.args.view.look.log).map_err(|e| explained(&budget, e))?;
             budget.add(&input.volume);
             input.max_memory = budget.limit;
             input.name = format!("{spec} (channel {index}, time point {t})");
@@ -318,8 +318,59 @@ pub fn whole_input(
 /// The `--overlay` specs, parsed.
 pub fn overlay_specs(scene: &SceneArgs) -> Result<Vec<OverlaySpec>, CliError> {
     (scene.overlay.iter())
-        .map(|spec| OverlaySpec::parse(spec))
+        .map(|spec| OverlaySpec::parse(spec).map_err(refused))
         .collect()
+}
+
+/// How the volumes mix: `--mix`, else additive for channels.
+pub fn mix(scene: &SceneArgs) -> Mix {
+    match scene.mix {
+        Some(crate::flags::MixMode::Composite) => Mix::Composite,
+        Some(crate::flags::MixMode::Additive) => Mix::Additive,
+        None => default_mix(scene.channels.is_some()),
+    }
+}
+
+/// A scene's refusal as an input error.
+fn refused(e: Refused) -> CliError {
+    CliError::input(e.0)
+}
+
+/// A refusal of the next volume, saying what the others hold.
+fn explained(budget: &Budget, e: CliError) -> CliError {
+    CliError {
+        message: budget.explain(&e.message),
+        ..e
+    }
+}
+
+/// The channels `which` of the `count` that `spec` holds, and their
+/// colours (`--channel-colors`, else the palette).
+pub fn picked(
+    scene: &SceneArgs,
+    which: &Channels,
+    spec: &str,
+    count: usize,
+) -> Result<(Vec<usize>, Vec<[f32; 3]>), CliError> {
+    let which = match which {
+        Channels::All => None,
+        Channels::Some(list) => Some(&list[..]),
+    };
+    let colors = scene.channel_colors.as_ref().map(|c| &c.0[..]);
+    picked_channels(colors, which, spec, count).map_err(refused)
+}
+
+/// `input` reading volume `index` along `axis`.
+pub fn pick(axis: ChannelAxis, input: &InputArgs, index: usize) -> InputArgs {
+    let mut one = input.clone();
+    axis.pick(&mut one.channel, &mut one.frame, index);
+    one
+}
+
+/// Refuses the look flags that do not apply to `--channels`, whose
+/// colours are `--channel-colors`' (render's and view's).
+pub fn refuse_channel_look(look: &LookArgs) -> Result<(), CliError> {
+    volray_app::scene::refuse_channel_look(&crate::settings::look(look)).map_err(refused)
 }
 
 /// The volumes of the picture, each read whole with its look: INPUT (read
@@ -365,8 +416,8 @@ pub fn read_layers(
         }
     };
     for (overlay, tf_text) in overlays.iter().zip(&tf_texts) {
-        let mut layer = (overlay.load(view, budget.left(), tf_text.as_deref()))
-            .map_err(|e| budget.explain(e))?;
+        let mut layer = load_overlay(overlay, view, budget.left(), tf_text.as_deref())
+            .map_err(|e| explained(&budget, e))?;
         budget.add(&layer.input.volume);
         layer.input.max_memory = budget.limit;
         let first = &layers[0].input;
@@ -425,223 +476,128 @@ fn scene_failure(view: &ViewArgs, names: &[&str], e: RenderError) -> CliError {
     }
 }
 
-/// An `--overlay FILE[:OPTIONS]`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct OverlaySpec {
-    /// As given, for messages.
-    pub spec: String,
-    pub file: String,
-    pub labels: bool,
-    pub colormap: Option<String>,
-    pub preset: Option<String>,
-    pub range: Option<(f64, f64)>,
-    pub opacity: Option<(f32, f32)>,
-    pub tf: Option<String>,
-    pub frame: Option<usize>,
-    /// OME-Zarr's `c` (as `--channel`).
-    pub channel: Option<usize>,
-    /// Placed and framed, not drawn (`Look::visible`).
-    pub hidden: bool,
-}
-
-impl OverlaySpec {
-    /// Parses `spec`: the options are after the last ':' whose remainder
-    /// reads as options (so `file.h5:/dataset` stays a file spec).
-    fn parse(spec: &str) -> Result<Self, CliError> {
-        let (file, options) = (spec.char_indices().rev())
-            .filter(|&(_, c)| c == ':')
-            .find_map(|(at, _)| option_tokens(&spec[at + 1..]).map(|o| (&spec[..at], o)))
-            .unwrap_or((spec, Vec::new()));
-        let mut parsed = OverlaySpec {
-            spec: spec.to_string(),
-            file: file.to_string(),
-            ..Default::default()
-        };
-        let refuse = |message: String| CliError::input(format!("--overlay {spec}: {message}"));
-        let mut seen: Vec<&str> = Vec::new();
-        for (name, value) in &options {
-            if seen.contains(&name.as_str()) {
-                return Err(refuse(format!("option \"{name}\" is given twice")));
-            }
-            seen.push(name);
-            let value = match (name.as_str(), value) {
-                ("labels", None) => {
-                    parsed.labels = true;
-                    continue;
-                }
-                ("hidden", None) => {
-                    parsed.hidden = true;
-                    continue;
-                }
-                ("labels" | "hidden", Some(_)) => {
-                    return Err(refuse(format!("{name} takes no value")));
-                }
-                (_, Some(v)) => v.as_str(),
-                _ => unreachable!("only labels and hidden are bare words"),
-            };
-            let bad = |e: String| refuse(format!("{name}={value}: {e}"));
-            match name.as_str() {
-                "colormap" => parsed.colormap = Some(value.to_string()),
-                "preset" => parsed.preset = Some(value.to_string()),
-                "range" => parsed.range = Some(crate::flags::parse_range(value).map_err(bad)?),
-                "opacity" => {
-                    parsed.opacity = Some(crate::flags::parse_opacity(value).map_err(bad)?)
-                }
-                "tf" => parsed.tf = Some(value.to_string()),
-                "frame" => {
-                    parsed.frame = Some(
-                        value
-                            .trim()
-                            .parse()
-                            .map_err(|_| bad("not a frame number (from 0)".to_string()))?,
-                    )
-                }
-                "channel" => {
-                    parsed.channel = Some(
-                        value
-                            .trim()
-                            .parse()
-                            .map_err(|_| bad("not a channel number (from 0)".to_string()))?,
-                    )
-                }
-                _ => {
-                    return Err(refuse(format!(
-                        "unknown option \"{name}\" ({OVERLAY_OPTIONS})"
-                    )));
-                }
-            }
-        }
-        if parsed.file.is_empty() {
-            return Err(refuse("no file before the options".to_string()));
-        }
-        Ok(parsed)
+/// The channels `which` of INPUT (read as `input_args` say: at the time
+/// point `--frame` picks), each with its look.
+fn read_channels(
+    input_args: &InputArgs,
+    view: &ViewArgs,
+    scene: &SceneArgs,
+    which: &Channels,
+    settings: &RenderSettings,
+    budget: &mut Budget,
+) -> Result<Vec<Layer>, CliError> {
+    let spec = input_args.input.as_deref().unwrap_or(input::DEMO);
+    if volray_data::is_source_spec(spec) {
+        return Err(CliError::input(format!(
+            "--channels: {spec} is a built-in source, one volume: give a file holding several channels"
+        )));
     }
-
-    /// The overlay read, with its look.
-    fn load(
-        &self,
-        view: &ViewArgs,
-        max_memory: Option<u64>,
-        tf_text: Option<&str>,
-    ) -> Result<Layer, CliError> {
-        let refuse = |e: volray_options::OptionError| {
-            CliError::input(format!(
-                "--overlay {}: {}",
-                self.spec,
-                e.message(&OverlayNaming)
-            ))
+    let log = view.look.log;
+    if input_args.channel.is_some() {
+        return Err(CliError::input(format!(
+            "--channels picks the channels of {spec}; --channel picks one: give one of them"
+        )));
+    }
+    // Channel 0 (at the time point --frame picks) tells how many the file
+    // holds; kept if asked for, else dropped before the others are read,
+    // and no longer counted against --max-memory.
+    let first = load(input_args, log)?;
+    budget.add(&first.volume);
+    let Some((_, info)) = &first.file else {
+        return Err(CliError::input(format!(
+            "--channels: {spec} is not a file holding several channels"
+        )));
+    };
+    let (count, axis) = channel_axis(info);
+    if axis == ChannelAxis::Time && input_args.frame.is_some() {
+        return Err(CliError::input(format!(
+            "--channels renders the {count} volumes of {spec} (one channel, {count} time points) together; --frame picks one: give one of them"
+        )));
+    }
+    let (indices, colors) = picked(scene, which, spec, count)?;
+    let mut first = Some(first);
+    if !indices.contains(&0) {
+        budget.remove(&first.take().expect("channel 0 read").volume);
+    }
+    let mut layers = Vec::with_capacity(indices.len());
+    for (&index, &rgb) in indices.iter().zip(&colors) {
+        let kept = if index == 0 { first.take() } else { None };
+        let mut input = match kept {
+            Some(input) => input,
+            None => {
+                let mut one = pick(axis, input_args, index);
+                one.max_memory = budget.left();
+                let mut input = load(&one, log).map_err(|e| explained(budget, e))?;
+                budget.add(&input.volume);
+                input.max_memory = budget.limit;
+                input
+            }
         };
-        let input_args = InputArgs {
-            input: Some(self.file.clone()),
-            dims: None,
-            dtype: None,
-            endian: None,
-            spacing: None,
-            format: None,
-            frame: self.frame,
-            array: None,
-            level: None,
-            channel: self.channel,
-            max_memory,
-        };
-        let mut input = load(&input_args, false).map_err(|e| CliError {
-            message: format!("--overlay: {}", e.message),
-            ..e
-        })?;
-        let (look, mut settings) = self.settings(view, tf_text)?;
-        volray_options::file_window(
-            &look,
-            &mut settings.transfer_function,
+        input.name = format!("{spec} (channel {index})");
+        let mut settings = settings.clone();
+        let tf = &mut settings.transfer_function;
+        tf.color = Some(channel_color(rgb, settings.blend.is_projection()));
+        crate::settings::file_window(
+            &view.look,
+            tf,
             input.file.as_ref().and_then(|(_, i)| i.display_window()),
         );
-        volray_options::from_volume(
-            &look,
-            &mut settings.transfer_function,
-            &mut input.volume,
-            &input.name,
-        )
-        .map_err(refuse)?;
-        Ok(Layer {
+        crate::settings::from_volume(&view.look, tf, &mut input.volume, &input.name)?;
+        layers.push(Layer {
             input,
             settings,
-            source: LayerSource::Overlay(self.clone()),
-        })
+            source: LayerSource::Channel { index, axis },
+        });
     }
-
-    /// Its options' look (with the shared flags of `view`) and settings,
-    /// before anything is chosen from its volume.
-    pub fn settings(
-        &self,
-        view: &ViewArgs,
-        tf_text: Option<&str>,
-    ) -> Result<(LookOptions, RenderSettings), CliError> {
-        let refuse = |e: volray_options::OptionError| {
-            CliError::input(format!(
-                "--overlay {}: {}",
-                self.spec,
-                e.message(&OverlayNaming)
-            ))
-        };
-        // The shared flags without the first volume's `--tf` (whose text
-        // is not read here): the overlay's look is its own options'.
-        let shared = crate::settings::options(view, Some(""))?;
-        let look = LookOptions {
-            opacity: self.opacity,
-            tf: self.tf.as_ref().map(|path| Tf::Json {
-                source: path.clone(),
-                text: tf_text.unwrap_or_default().to_string(),
-            }),
-            preset: self.preset.clone(),
-            colormap: self.colormap.clone(),
-            labels: self.labels,
-            label_opacity: None,
-            show_labels: None,
-            range: self.range,
-            iso: None,
-            iso_thickness: None,
-            log: false,
-            blend: match shared.look.blend {
-                volray_options::BlendMode::Iso => volray_options::BlendMode::Composite,
-                blend => blend,
-            },
-            ..shared.look.clone()
-        };
-        let options = Options {
-            look: look.clone(),
-            ..shared
-        };
-        let settings = volray_options::settings(&options).map_err(refuse)?;
-        Ok((look, settings))
-    }
+    Ok(layers)
 }
 
-/// The options of a remainder after ':', as (name, value) pairs: tokens
-/// split at ','; `name=value` starts an option, a bare number continues
-/// the value before (`range=0,100`), `labels` is a bare word. `None`
-/// where the remainder does not read as options.
-fn option_tokens(rest: &str) -> Option<Vec<(String, Option<String>)>> {
-    let mut options: Vec<(String, Option<String>)> = Vec::new();
-    for token in rest.split(',') {
-        let token = token.trim();
-        if let Some((name, value)) = token.split_once('=') {
-            let word = !name.is_empty()
-                && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
-            if !word {
-                return None;
-            }
-            options.push((name.to_string(), Some(value.to_string())));
-        } else if token == "labels" || token == "hidden" {
-            options.push((token.to_string(), None));
-        } else if token.parse::<f64>().is_ok()
-            && let Some((_, Some(value))) = options.last_mut()
-        {
-            value.push(',');
-            value.push_str(token);
-        } else {
-            return None;
-        }
-    }
-    Some(options)
+/// The overlay read, with its look.
+fn load_overlay(
+    overlay: &OverlaySpec,
+    view: &ViewArgs,
+    max_memory: Option<u64>,
+    tf_text: Option<&str>,
+) -> Result<Layer, CliError> {
+    let refuse = |e| refused(overlay.refused(e));
+    let input_args = InputArgs {
+        input: Some(overlay.file.clone()),
+        dims: None,
+        dtype: None,
+        endian: None,
+        spacing: None,
+        format: None,
+        frame: overlay.frame,
+        array: None,
+        level: None,
+        channel: overlay.channel,
+        max_memory,
+    };
+    let mut input = load(&input_args, false).map_err(|e| CliError {
+        message: format!("--overlay: {}", e.message),
+        ..e
+    })?;
+    // The shared flags without the first volume's `--tf` (whose text
+    // is not read here): the overlay's look is its own options'.
+    let shared = crate::settings::options(view, Some(""))?;
+    let (look, mut settings) = overlay.settings(shared, tf_text).map_err(refused)?;
+    volray_options::file_window(
+        &look,
+        &mut settings.transfer_function,
+        input.file.as_ref().and_then(|(_, i)| i.display_window()),
+    );
+    volray_options::from_volume(
+        &look,
+        &mut settings.transfer_function,
+        &mut input.volume,
+        &input.name,
+    )
+    .map_err(refuse)?;
+    Ok(Layer {
+        input,
+        settings,
+        source: LayerSource::Overlay(overlay.clone()),
+    })
 }
 
 /// Reads the `tf=` file of the overlay `spec`, refused as `--tf` is.
@@ -653,70 +609,4 @@ fn read_overlay_tf(spec: &str, path: &str) -> Result<String, CliError> {
         ),
         ..e
     })
-}
-
-/// How an overlay's options are written: `preset=`, `labels`; the shared
-/// flags as flags.
-struct OverlayNaming;
-
-impl OverlayNaming {
-    fn own(opt: Opt) -> bool {
-        matches!(
-            opt,
-            Opt::Opacity | Opt::Tf | Opt::Preset | Opt::Colormap | Opt::Labels | Opt::Range
-        )
-    }
-}
-
-impl Naming for OverlayNaming {
-    fn option(&self, opt: Opt) -> String {
-        match opt {
-            Opt::Labels => "labels".to_string(),
-            opt if Self::own(opt) => format!("{}=", opt.name()),
-            opt => format!("--{}", opt.name()),
-        }
-    }
-
-    fn with_value(&self, opt: Opt, value: &str) -> String {
-        if Self::own(opt) {
-            format!("{}={value}", opt.name())
-        } else {
-            format!("--{} {value}", opt.name())
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn parsed(spec: &str) -> OverlaySpec {
-        OverlaySpec::parse(spec).unwrap()
-    }
-
-    #[test]
-    fn overlay_options_follow_the_last_colon_that_reads_as_options() {
-        let o = parsed("seg.nii.gz:labels");
-        assert_eq!((o.file.as_str(), o.labels), ("seg.nii.gz", true));
-        let o = parsed("ct.nii:range=0,100,opacity=0,0.5,colormap=magma,frame=2");
-        assert_eq!(o.file, "ct.nii");
-        assert_eq!(o.range, Some((0.0, 100.0)));
-        assert_eq!(o.opacity, Some((0.0, 0.5)));
-        assert_eq!(o.colormap.as_deref(), Some("magma"));
-        assert_eq!(o.frame, Some(2));
-        // File specs with a ':' of their own stay whole.
-        assert_eq!(parsed("file.h5:/dataset").file, "file.h5:/dataset");
-        assert_eq!(parsed("file.nc:/var").file, "file.nc:/var");
-        let o = parsed("file.h5:/group/data:labels,preset=mr");
-        assert_eq!(o.file, "file.h5:/group/data");
-        assert_eq!(o.preset.as_deref(), Some("mr"));
-        assert_eq!(parsed("plain.nrrd").file, "plain.nrrd");
-        let message = |spec: &str| OverlaySpec::parse(spec).unwrap_err().message;
-        assert_eq!(
-            message("seg.nii.gz:color=red"),
-            format!("--overlay seg.nii.gz:color=red: unknown option \"color\" ({OVERLAY_OPTIONS})")
-        );
-        assert!(message("a.nii:range=5,1").contains("range=5,1"));
-        assert!(message("a.nii:labels,labels").contains("twice"));
-    }
 }

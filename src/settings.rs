@@ -4,7 +4,7 @@
 //! Python and the viewer; its errors worded with the flags ([`Flags`]).
 
 use crate::error::CliError;
-use crate::flags::{BlendMode, CameraArgs, LookArgs, SamplingArgs, ViewArgs};
+use crate::flags::{BlendMode, CameraArgs, LookArgs, RenderArgs, SamplingArgs, ViewArgs};
 use std::path::Path;
 use volray_core::{Histogram, RenderSettings, TransferFunction, Volume};
 use volray_options::{CameraOptions, LookOptions, Naming, Opt, OptionError, Options, Tf};
@@ -77,7 +77,8 @@ pub fn camera(cam: &CameraArgs) -> CameraOptions {
     }
 }
 
-fn sampling(sampling: &SamplingArgs) -> volray_options::SamplingOptions {
+/// The sampling flags as options.
+pub fn sampling(sampling: &SamplingArgs) -> volray_options::SamplingOptions {
     volray_options::SamplingOptions {
         step: sampling.step,
         reference: sampling.reference,
@@ -153,6 +154,32 @@ pub fn from_volume(
     name: &str,
 ) -> Result<(), CliError> {
     volray_options::from_volume(&look(look_args), transfer_function, volume, name).map_err(refused)
+}
+
+/// `settings` with what the flags leave to `input`'s volume: `--labels`
+/// or the transfer function chosen from it (`--tf auto`; see
+/// [`from_volume`]), the volume marked as labels.
+pub fn from_input(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    input: &mut volray_app::input::Input,
+) -> Result<RenderSettings, CliError> {
+    let mut settings = settings.clone();
+    file_window(
+        &args.view.look,
+        &mut settings.transfer_function,
+        input
+            .file
+            .as_ref()
+            .and_then(|(_, info)| info.display_window()),
+    );
+    from_volume(
+        &args.view.look,
+        &mut settings.transfer_function,
+        &mut input.volume,
+        &input.name,
+    )?;
+    Ok(settings)
 }
 
 /// The file's own display window (OME-Zarr `omero`) as the default

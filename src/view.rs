@@ -6,7 +6,7 @@
 //! exits 0.
 //!
 //! `view/reproduce.rs` turns the page's states into `volray render`
-//! commands and their settings; `view/browser.rs` opens the browser.
+//! commands (volray-app's words) and their settings; `view/browser.rs` opens the browser.
 
 mod browser;
 mod levels;

@@ -46,10 +46,10 @@ pub use info::InfoArgs;
 pub use input::InputArgs;
 pub use look::{BlendMode, LookArgs};
 pub use paper::{PaperArgs, PaperItem};
-pub use parse::{one_line_error, parse_opacity, parse_range};
+pub use parse::one_line_error;
 pub use render::RenderArgs;
 pub use sampling::SamplingArgs;
-pub use scene::{ChannelColors, Channels, Frames, MixMode, SceneArgs};
+pub use scene::{Channels, Frames, MixMode, SceneArgs};
 pub use view::ViewArgs;
 pub use viewer::ViewerArgs;
 

@@ -3,6 +3,9 @@
 //! after the flag's name. Also [`one_line_error`], which puts a clap error
 //! on one line.
 
+// The numbers of `LO,HI` and `P,Q`, as an overlay's options read them too.
+use volray_app::words::{finite, numbers, parse_pair};
+pub use volray_app::words::{parse_opacity, parse_range};
 use volray_core::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
 
 /// A clap error as one line: its first, with the arguments it lists on the
@@ -24,23 +27,6 @@ pub fn one_line_error(e: &clap::Error) -> String {
             format!("{head}: {}", listed.join(", "))
         }
         None => first.to_string(),
-    }
-}
-
-fn numbers<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>, String> {
-    s.split(',')
-        .map(|part| {
-            part.trim()
-                .parse::<T>()
-                .map_err(|_| format!("'{part}' is not a valid {what}"))
-        })
-        .collect()
-}
-
-fn finite(values: Vec<f64>) -> Result<Vec<f64>, String> {
-    match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(format!("{v} is not a finite number")),
-        None => Ok(values),
     }
 }
 
@@ -121,21 +107,6 @@ pub fn parse_dims(s: &str) -> Result<[usize; 3], String> {
     }
 }
 
-fn parse_pair(s: &str) -> Result<(f32, f32), String> {
-    match finite(numbers::<f64>(s, "number")?)?[..] {
-        [p, q] => Ok((p as f32, q as f32)),
-        ref v => Err(format!("expected P,Q (two numbers), got {}", v.len())),
-    }
-}
-
-/// The paper's opacity ramp `p,q`: opacities, `0 <= p < q <= 1`.
-pub fn parse_opacity(s: &str) -> Result<(f32, f32), String> {
-    match parse_pair(s)? {
-        (p, q) if 0.0 <= p && p < q && q <= 1.0 => Ok((p, q)),
-        (p, q) => Err(format!("P,Q = {p},{q} needs 0 <= p < q <= 1")),
-    }
-}
-
 /// `--step`: a positive number of voxels.
 pub fn parse_step(s: &str) -> Result<f64, String> {
     match parse_number(s)? {
@@ -162,14 +133,6 @@ pub fn parse_ao_radius(s: &str) -> Result<f64, String> {
             radii.start(),
             radii.end()
         )),
-    }
-}
-
-pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
-    match finite(numbers::<f64>(s, "number")?)?[..] {
-        [lo, hi] if lo < hi => Ok((lo, hi)),
-        [lo, hi] => Err(format!("LO {lo} must be below HI {hi}")),
-        ref v => Err(format!("expected LO,HI (two numbers), got {}", v.len())),
     }
 }
 

@@ -115,14 +115,9 @@ fn parse_channels(s: &str) -> Result<Channels, String> {
 pub fn parse_color(s: &str) -> Result<[f32; 3], String> {
     let s = s.trim();
     if let Some(hex) = s.strip_prefix('#') {
-        let byte = |i: usize| {
-            hex.get(i..i + 2)
-                .and_then(|h| u8::from_str_radix(h, 16).ok())
-        };
-        return match (hex.len(), byte(0), byte(2), byte(4)) {
-            (6, Some(r), Some(g), Some(b)) => Ok([r, g, b].map(|c| c as f32 / 255.0)),
-            _ => Err(format!("'{s}' is not a colour #rrggbb")),
-        };
+        return (volray_app::scene::hex_colour(hex))
+            .filter(|_| hex.len() == 6)
+            .ok_or_else(|| format!("'{s}' is not a colour #rrggbb"));
     }
     volray_options::colors::named(s).ok_or_else(|| {
         let names = volray_options::colors::names();

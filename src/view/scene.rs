@@ -19,13 +19,12 @@
 use super::reproduce::{CliReproduce, OtherWords, SceneWords};
 use super::{MAX_TABS, serve, start_state};
 use crate::error::CliError;
-use crate::flags::{MixMode, ViewerArgs};
-use crate::scene::{ChannelAxis, Layer, LayerSource, overlay_specs, read_layers, whole_input};
+use crate::flags::ViewerArgs;
+use crate::scene::{Layer, overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use std::sync::Arc;
 use volray_app::input;
-use volray_core::scene::Mix;
 use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
@@ -49,13 +48,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         first_args.frame = Some(frames.start);
         let first = load(&first_args, look.log)?;
         let count = first.file.as_ref().map_or(1, |(_, info)| info.time_points);
-        let end = frames.end.unwrap_or(count);
-        if count < 2 || frames.start >= count || end > count {
-            return Err(CliError::input(format!(
-                "--frames {}:{end}: {spec} holds {count} time point(s), numbered from 0",
-                frames.start
-            )));
-        }
+        let end = volray_app::scene::time_range(frames.start, frames.end, count, spec)
+            .map_err(|e| CliError::input(e.0))?;
         drop(first);
         let (read_args, log, labels) = (input_args.clone(), look.log, look.labels);
         time = Some(TimePoints {
@@ -191,60 +185,23 @@ fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
 
 /// The scene's volumes after the first as the commands write them.
 fn scene_words(args: &ViewerArgs, spec: &str, layers: &[Layer]) -> SceneWords {
-    // A channel is INPUT at the time point --frame picks (if any), the
-    // channel its axis names.
-    let time = args.input.frame;
-    let first = match layers[0].source {
-        LayerSource::Channel { index, axis } => {
-            vec![format!("--{}", axis.option()), index.to_string()]
-        }
-        _ => Vec::new(),
-    };
     let others = (layers[1..].iter())
         .map(|layer| {
-            let (file, fixed, labels) = match &layer.source {
-                LayerSource::Channel { index, axis } => {
-                    let mut fixed = vec![format!("{}={index}", axis.option())];
-                    if let (ChannelAxis::Channel, Some(t)) = (axis, time) {
-                        fixed.push(format!("frame={t}"));
-                    }
-                    (spec.to_string(), fixed, false)
-                }
-                LayerSource::Overlay(o) => {
-                    let mut fixed = Vec::new();
-                    if let Some(f) = o.frame {
-                        fixed.push(format!("frame={f}"));
-                    }
-                    if let Some(c) = o.channel {
-                        fixed.push(format!("channel={c}"));
-                    }
-                    if o.labels {
-                        fixed.push("labels".to_string());
-                    }
-                    (o.file.clone(), fixed, o.labels)
-                }
-                LayerSource::Input => unreachable!("only the first volume is INPUT"),
-            };
-            let mut start = layer.settings.transfer_function.clone();
-            if start.domain.is_none() {
-                let (lo, hi) = layer.input.volume.value_range().unwrap_or((0.0, 1.0));
-                start.domain = Some((f64::from(lo), f64::from(hi)));
-            }
-            OtherWords {
-                file,
-                fixed,
-                start,
-                ramp: layer.settings.opacity_ramp,
-                labels,
-                start_look: layer.look(),
-            }
+            let range = layer.input.volume.value_range();
+            let (source, settings) = (&layer.source, &layer.settings);
+            OtherWords::of(
+                source,
+                spec,
+                args.input.frame,
+                settings,
+                range,
+                layer.look(),
+            )
         })
         .collect();
-    let mix = match args.scene.mix {
-        Some(MixMode::Composite) => Mix::Composite,
-        Some(MixMode::Additive) => Mix::Additive,
-        None if args.scene.channels.is_some() => Mix::Additive,
-        None => Mix::Composite,
-    };
-    SceneWords { first, others, mix }
+    SceneWords {
+        first: SceneWords::first_of(&layers[0].source),
+        others,
+        mix: crate::scene::mix(&args.scene),
+    }
 }

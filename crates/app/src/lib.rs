@@ -28,6 +28,12 @@
 //! - `distributed` (feature `mpi`): `mpirun -np N` renders: the input
 //!   split among the ranks, each rank's budget, the frame composited on
 //!   rank 0, the times;
+//! - [`scene`]: several volumes in one picture: channels (each in its
+//!   colour), overlays (each with its own look), the mix, time points;
+//! - [`reproduce`]: the view's state (camera, transfer function, look) and
+//!   its two spellings: `volray render` words ([`reproduce::command`]) and
+//!   Python keywords ([`reproduce::keywords`]);
+//! - [`words`]: the number words both spellings and the flags parse;
 //! - [`error`]: [`AppError`], typed, one line naming the file, which each
 //!   front end words in its own syntax.
 //!
@@ -61,5 +67,8 @@ pub mod error;
 pub mod input;
 pub mod memory;
 pub mod plan;
+pub mod reproduce;
+pub mod scene;
+pub mod words;
 
 pub use error::AppError;

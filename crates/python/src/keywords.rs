@@ -3,10 +3,11 @@
 //! value (a tuple where the flag takes `X,Y,Z`). A keyword left out, or
 //! `None`, keeps the command line's default. Types are checked here
 //! (`TypeError` naming the keyword); ranges and combinations are checked
-//! by volray-options and volray-core, as for the command line.
+//! by volray-options and volray-core, as for the command line. `Camera`
+//! keeps the camera keywords together (`camera=`).
 
 use crate::errors::value_error;
-use crate::transfer::{Camera, TransferFunction};
+use crate::transfer::TransferFunction;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyString};
@@ -219,6 +220,67 @@ pub fn camera_from(k: &Keywords<'_>) -> PyResult<CameraOptions> {
         cam.crop = Some(([x0, y0, z0], [x1, y1, z1]));
     }
     Ok(cam)
+}
+
+/// A camera: the camera keywords of `render` kept together
+/// (`render(volume, camera=cam)`), with the same defaults.
+#[pyclass(frozen, module = "volray")]
+pub struct Camera {
+    pub options: CameraOptions,
+}
+
+#[pymethods]
+impl Camera {
+    /// `Camera(size=480, view=None, look_at=None, up=(0, 0, 1),
+    /// perspective=None, azimuth=0, elevation=0, zoom=1, clip=None,
+    /// crop=None)`.
+    #[new]
+    #[pyo3(signature = (**kwargs))]
+    fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let k = Keywords::new(kwargs, &[CAMERA], "Camera")?;
+        Ok(Camera {
+            options: camera_from(&k)?,
+        })
+    }
+
+    #[getter]
+    fn size(&self) -> (usize, usize) {
+        self.options.size
+    }
+
+    #[getter]
+    fn view(&self) -> Option<[f64; 3]> {
+        self.options.view
+    }
+
+    #[getter]
+    fn look_at(&self) -> Option<[f64; 3]> {
+        self.options.look_at
+    }
+
+    #[getter]
+    fn azimuth(&self) -> f64 {
+        self.options.azimuth
+    }
+
+    #[getter]
+    fn elevation(&self) -> f64 {
+        self.options.elevation
+    }
+
+    #[getter]
+    fn zoom(&self) -> f64 {
+        self.options.zoom
+    }
+
+    #[getter]
+    fn perspective(&self) -> Option<f64> {
+        self.options.perspective
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Camera({:?})", self.options)
+    }
 }
 
 /// `tf=`: `"auto"`, a `TransferFunction`, a dict of its JSON form, or the

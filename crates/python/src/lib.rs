@@ -17,8 +17,8 @@
 //!
 //! Where things are: `array.rs` (numpy arrays as volumes, without a copy),
 //! `volume.rs` (`Volume`, `read`), `keywords.rs` (keyword arguments to
-//! options), `renderer.rs` (`Renderer`, `render`, Ctrl-C), `frame.rs`
-//! (`Frame`), `transfer.rs` (`TransferFunction`, `Camera`), `generate.rs`
+//! options, `Camera`), `render.rs` (`render`), `renderer.rs` (`Renderer`, Ctrl-C), `frame.rs`
+//! (`Frame`), `transfer.rs` (`TransferFunction`), `generate.rs`
 //! (`hydrogen`, `fractal`), `scene.rs` (`Scene`, `render` of several
 //! volumes), `view.rs` (the viewer in a notebook: `volray.view`'s
 //! host and tabs, the widget itself in `python/volray/_jupyter.py`),
@@ -34,6 +34,7 @@ mod figure;
 mod frame;
 mod generate;
 mod keywords;
+mod render;
 mod renderer;
 mod scene;
 mod transfer;
@@ -47,10 +48,10 @@ fn _volray(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_class::<frame::Frame>()?;
     m.add_class::<transfer::TransferFunction>()?;
-    m.add_class::<transfer::Camera>()?;
+    m.add_class::<keywords::Camera>()?;
     m.add_class::<view::ViewHost>()?;
     m.add_class::<view::ViewTab>()?;
-    m.add_function(wrap_pyfunction!(renderer::render, m)?)?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(volume::read, m)?)?;
     m.add_function(wrap_pyfunction!(generate::hydrogen, m)?)?;
     m.add_function(wrap_pyfunction!(generate::fractal, m)?)?;

@@ -560,19 +560,13 @@ pub(crate) fn level_choice(k: &Keywords<'_>) -> PyResult<Option<LevelChoice>> {
         .map(|n| Some(LevelChoice::Index(n)))
 }
 
-/// `render(volume, **options) -> Frame`: one frame of `volume` (a numpy
-/// array or a `volray.Volume`) with `volray render`'s options and
-/// defaults, as keywords (see the package's documentation).
-#[pyfunction]
-#[pyo3(signature = (volume, **kwargs))]
-pub fn render(
+/// `render(volume, **options)` of one volume (`render.rs` sends a scene
+/// to `scene.rs`).
+pub fn render_one(
     py: Python<'_>,
     volume: &Bound<'_, PyAny>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Frame> {
-    if crate::scene::is_scene(volume, kwargs)? {
-        return crate::scene::render(py, volume, kwargs);
-    }
     let k = Keywords::new(kwargs, &[VOLUME, CAMERA, FRAME, FIGURE], "render")?;
     Renderer::build(py, volume, &k)?.frame(py, &k, true)
 }

@@ -27,8 +27,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
+use volray_app::scene::{channel_color, default_mix, hex_colour, mix_name, mix_of_name};
+use volray_core::RenderSettings;
 use volray_core::scene::{Look, Mix, Scene as CoreScene, SceneSettings};
-use volray_core::{PiecewiseLinear, RenderSettings};
 use volray_io::format_bytes;
 use volray_options::Options;
 use volray_options::colors::{channel_colour, named};
@@ -112,7 +113,8 @@ fn sequence<'py>(value: &Bound<'py, PyAny>) -> Option<Vec<Bound<'py, PyAny>>> {
     value.cast::<PyTuple>().ok().map(|t| t.iter().collect())
 }
 
-/// `render([a, b, ...], **kwargs)`: a scene made and rendered once.
+/// `render([a, b, ...], **kwargs)`: a scene made and rendered once
+/// (`render.rs` sends it here).
 pub fn render(
     py: Python<'_>,
     volumes: &Bound<'_, PyAny>,
@@ -196,11 +198,7 @@ impl Scene {
         let n = volumes.len();
         let looks = check_looks(py, looks, n)?;
         // Channels add up by default, as napari and the command line show them.
-        let default = match channel_axis {
-            Some(_) => Mix::Additive,
-            None => Mix::Composite,
-        };
-        let mix = parse_mix(mix, default)?;
+        let mix = parse_mix(mix, default_mix(channel_axis.is_some()))?;
         let mut layers = Vec::with_capacity(n);
         for (i, (volume, palette)) in volumes.iter().zip(palette).enumerate() {
             // The shared volume keywords, then its look's.
@@ -415,7 +413,7 @@ impl Scene {
             .palette
             .filter(|_| options.look.colormap.is_none() && !recipe.labels && tf.color.is_none()));
         if let Some(rgb) = colour {
-            tf.color = Some(colour_function(rgb, settings.blend.is_projection()));
+            tf.color = Some(channel_color(rgb, settings.blend.is_projection()));
         }
         recipe.leave_to_volume(known, &options, &mut settings)?;
         let look = Look {
@@ -424,18 +422,6 @@ impl Scene {
             ..Look::of(&settings)
         };
         Ok((options, settings, look))
-    }
-}
-
-/// The colour function of `color=`: the colour itself where samples are
-/// composited; from black to the colour over the window where the volume
-/// is projected (a constant would paint the projection flat).
-fn colour_function(rgb: [f32; 3], projection: bool) -> PiecewiseLinear<3> {
-    if projection {
-        PiecewiseLinear::new("color", vec![(0.0, [0.0; 3]), (1.0, rgb)])
-            .expect("two points in order")
-    } else {
-        PiecewiseLinear::constant(rgb)
     }
 }
 
@@ -564,20 +550,11 @@ fn parse_mix(value: Option<&Bound<'_, PyAny>>, default: Mix) -> PyResult<Mix> {
         return Ok(default);
     };
     let name: String = extract(value, "mix", "'composite' or 'additive'")?;
-    match name.as_str() {
-        "composite" => Ok(Mix::Composite),
-        "additive" => Ok(Mix::Additive),
-        _ => Err(value_error(format!(
+    mix_of_name(&name).ok_or_else(|| {
+        value_error(format!(
             "mix: unknown mix '{name}': expected 'composite' or 'additive'"
-        ))),
-    }
-}
-
-fn mix_name(mix: Mix) -> &'static str {
-    match mix {
-        Mix::Composite => "composite",
-        Mix::Additive => "additive",
-    }
+        ))
+    })
 }
 
 /// `color=`: a colour's name, `'#rrggbb'` (or `'#rgb'`), a grey level or
@@ -589,7 +566,7 @@ fn parse_color(value: &Bound<'_, PyAny>) -> PyResult<[f32; 3]> {
         if let Some(rgb) = named(&lower) {
             return Ok(rgb);
         }
-        if let Some(rgb) = lower.strip_prefix('#').and_then(hex) {
+        if let Some(rgb) = lower.strip_prefix('#').and_then(hex_colour) {
             return Ok(rgb);
         }
         let names = volray_options::colors::names();
@@ -610,26 +587,6 @@ fn parse_color(value: &Bound<'_, PyAny>) -> PyResult<[f32; 3]> {
         )));
     }
     Ok(rgb)
-}
-
-/// `rrggbb` or `rgb` in hexadecimal.
-fn hex(digits: &str) -> Option<[f32; 3]> {
-    if !digits.bytes().all(|b| b.is_ascii_hexdigit()) {
-        return None;
-    }
-    let channel = |s: &str| u8::from_str_radix(s, 16).ok().map(|v| f32::from(v) / 255.0);
-    match digits.len() {
-        6 => Some([
-            channel(&digits[0..2])?,
-            channel(&digits[2..4])?,
-            channel(&digits[4..6])?,
-        ]),
-        3 => {
-            let one = |i: usize| channel(&digits[i..=i].repeat(2));
-            Some([one(0)?, one(1)?, one(2)?])
-        }
-        _ => None,
-    }
 }
 
 #[pymethods]

@@ -1,15 +1,12 @@
-//! `TransferFunction` (volray-core's, from points, JSON or a preset) and
-//! `Camera` (the camera keywords kept together, for `camera=`).
+//! `TransferFunction`: volray-core's, from points, JSON or a preset (the
+//! camera keywords kept together, `Camera`, are `keywords.rs`').
 
 use crate::errors::value_error;
-use crate::keywords::{CAMERA, Keywords, camera_from};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use std::path::Path;
 use volray_core::transfer::{colormap, presets};
 use volray_core::{PiecewiseLinear, TransferFunction as CoreTf};
-use volray_options::CameraOptions;
 
 /// The largest JSON file read as a transfer function: a few hundred
 /// points; this bounds what a wrong path (a device, a huge file) costs.
@@ -172,66 +169,5 @@ impl TransferFunction {
             count(self.function.color.as_ref().map(|f| f.points().len())),
             self.function.domain
         )
-    }
-}
-
-/// A camera: the camera keywords of `render` kept together
-/// (`render(volume, camera=cam)`), with the same defaults.
-#[pyclass(frozen, module = "volray")]
-pub struct Camera {
-    pub options: CameraOptions,
-}
-
-#[pymethods]
-impl Camera {
-    /// `Camera(size=480, view=None, look_at=None, up=(0, 0, 1),
-    /// perspective=None, azimuth=0, elevation=0, zoom=1, clip=None,
-    /// crop=None)`.
-    #[new]
-    #[pyo3(signature = (**kwargs))]
-    fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let k = Keywords::new(kwargs, &[CAMERA], "Camera")?;
-        Ok(Camera {
-            options: camera_from(&k)?,
-        })
-    }
-
-    #[getter]
-    fn size(&self) -> (usize, usize) {
-        self.options.size
-    }
-
-    #[getter]
-    fn view(&self) -> Option<[f64; 3]> {
-        self.options.view
-    }
-
-    #[getter]
-    fn look_at(&self) -> Option<[f64; 3]> {
-        self.options.look_at
-    }
-
-    #[getter]
-    fn azimuth(&self) -> f64 {
-        self.options.azimuth
-    }
-
-    #[getter]
-    fn elevation(&self) -> f64 {
-        self.options.elevation
-    }
-
-    #[getter]
-    fn zoom(&self) -> f64 {
-        self.options.zoom
-    }
-
-    #[getter]
-    fn perspective(&self) -> Option<f64> {
-        self.options.perspective
-    }
-
-    fn __repr__(&self) -> String {
-        format!("Camera({:?})", self.options)
     }
 }

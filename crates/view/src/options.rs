@@ -10,8 +10,8 @@
 //! reproduce the frame on their own. What the page does not set comes
 //! from the options the viewer was started with, dropped where the state
 //! makes it inapplicable (lighting, shadows and opacity options under a
-//! projection or without shading), as `src/view/reproduce.rs` drops the flags for `volray
-//! view`.
+//! projection or without shading), as volray-app's command words (`crates/app/src/reproduce/command.rs`)
+//! drop the flags for `volray view`.
 
 use crate::reproduce::Refusal;
 use crate::state::{BlendMode, START_COLOURS, ViewState, WHITE, solid_colour};

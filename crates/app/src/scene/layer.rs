@@ -1,32 +1,9 @@
-//! What a volume of one picture is ([`Layer`]) and where it came from
-//! ([`LayerSource`]: INPUT, a channel of it along a [`ChannelAxis`], an
-//! overlay), and the `--max-memory` the volumes share ([`Budget`]).
+//! Where a volume of one picture came from ([`LayerSource`]: INPUT, a
+//! channel of it along a [`ChannelAxis`], an overlay), and the
+//! `--max-memory` the volumes share ([`Budget`]).
 
 use super::OverlaySpec;
-use crate::error::CliError;
-use crate::flags::InputArgs;
-use volray_app::input::Input;
-use volray_core::RenderSettings;
-use volray_core::scene::Look;
 use volray_io::FileInfo;
-
-/// One volume of the picture: what was read, its settings alone (whose
-/// look becomes its [`Look`]), and where it came from.
-pub struct Layer {
-    pub input: Input,
-    pub settings: RenderSettings,
-    pub source: LayerSource,
-}
-
-impl Layer {
-    /// Its look in the picture: shown unless an overlay's `hidden`.
-    pub fn look(&self) -> Look {
-        Look {
-            visible: !matches!(&self.source, LayerSource::Overlay(o) if o.hidden),
-            ..Look::of(&self.settings)
-        }
-    }
-}
 
 /// Where a volume of the picture came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,6 +14,14 @@ pub enum LayerSource {
     Channel { index: usize, axis: ChannelAxis },
     /// An `--overlay`.
     Overlay(OverlaySpec),
+}
+
+impl LayerSource {
+    /// Whether it is drawn: unless an overlay's `hidden` (placed and
+    /// framed all the same, `Look::visible`).
+    pub fn visible(&self) -> bool {
+        !matches!(self, LayerSource::Overlay(o) if o.hidden)
+    }
 }
 
 /// The axis of INPUT whose volumes `--channels` renders together.
@@ -61,14 +46,13 @@ impl ChannelAxis {
         }
     }
 
-    /// `input` reading volume `index` along this axis.
-    pub fn pick(self, input: &InputArgs, index: usize) -> InputArgs {
-        let mut one = input.clone();
+    /// The reader options `channel` and `frame` of an input set to read
+    /// volume `index` along this axis.
+    pub fn pick(self, channel: &mut Option<usize>, frame: &mut Option<usize>, index: usize) {
         match self {
-            ChannelAxis::Channel => one.channel = Some(index),
-            ChannelAxis::Time => one.frame = Some(index),
+            ChannelAxis::Channel => *channel = Some(index),
+            ChannelAxis::Time => *frame = Some(index),
         }
-        one
     }
 }
 
@@ -90,13 +74,14 @@ pub fn channel_axis(info: &FileInfo) -> (usize, ChannelAxis) {
 /// then checked against the whole limit on its own (`renderer_for`), not
 /// against what the others' hold: a gap, for volumes whose renderers'
 /// structures (brick caches, a cleaned copy) are large beside them.
+#[derive(Debug, Clone)]
 pub struct Budget {
-    pub(crate) limit: u64,
+    pub limit: u64,
     held: u64,
 }
 
 impl Budget {
-    pub(crate) fn new(max_memory: Option<u64>) -> Self {
+    pub fn new(max_memory: Option<u64>) -> Self {
         Budget {
             limit: max_memory.unwrap_or_else(volray_io::default_max_memory),
             held: 0,
@@ -105,7 +90,7 @@ impl Budget {
 
     /// The bytes `volume` holds in memory (none for one mapped from its
     /// file).
-    pub(crate) fn held_by(volume: &volray_core::Volume) -> u64 {
+    pub fn held_by(volume: &volray_core::Volume) -> u64 {
         if volume.samples().is_external() {
             return 0;
         }
@@ -113,33 +98,30 @@ impl Budget {
         (x * y * z * volume.sample_type().bytes()) as u64
     }
 
-    pub(crate) fn add(&mut self, volume: &volray_core::Volume) {
+    pub fn add(&mut self, volume: &volray_core::Volume) {
         self.held = self.held.saturating_add(Self::held_by(volume));
     }
 
     /// `volume`, added before, dropped.
-    pub(crate) fn remove(&mut self, volume: &volray_core::Volume) {
+    pub fn remove(&mut self, volume: &volray_core::Volume) {
         self.held = self.held.saturating_sub(Self::held_by(volume));
     }
 
     /// The limit the next volume is read under.
-    pub(crate) fn left(&self) -> Option<u64> {
+    pub fn left(&self) -> Option<u64> {
         Some(self.limit.saturating_sub(self.held))
     }
 
-    /// A refusal of the next volume, saying what the others hold.
-    pub(crate) fn explain(&self, e: CliError) -> CliError {
+    /// The message of a refusal of the next volume, saying what the
+    /// others hold.
+    pub fn explain(&self, message: &str) -> String {
         if self.held == 0 {
-            return e;
+            return message.to_string();
         }
-        CliError {
-            message: format!(
-                "{} (the volumes read before it hold {} of --max-memory {})",
-                e.message,
-                volray_io::format_bytes(u128::from(self.held)),
-                volray_io::format_bytes(u128::from(self.limit))
-            ),
-            ..e
-        }
+        format!(
+            "{message} (the volumes read before it hold {} of --max-memory {})",
+            volray_io::format_bytes(u128::from(self.held)),
+            volray_io::format_bytes(u128::from(self.limit))
+        )
     }
 }
