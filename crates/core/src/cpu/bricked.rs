@@ -49,7 +49,7 @@ use crate::cpu::lit_bricks::{Lighting, LitBricks};
 use crate::cpu::tiles::{TILE, TileBins};
 use crate::kernels::composite::{Finish, FrontToBack, PartialPixel};
 use crate::kernels::trilinear::{corners, interpolate};
-use crate::progress::Progress;
+use crate::frame::progress::Progress;
 use crate::sampling::Sampling;
 use crate::sampling::jitter;
 use glam::{DVec3, Vec4};

@@ -87,11 +87,11 @@ mod tests;
 
 use crate::camera::View;
 use crate::error::{RenderError, SceneError};
-use crate::image::Image;
+use crate::frame::image::Image;
 use crate::kernels::composite::{EMPTY, PartialPixel, over_background};
-use crate::partial::{PartialImage, PartialPixels};
-use crate::piece::Piece;
-use crate::progress::Progress;
+use crate::frame::partial::{PartialImage, PartialPixels};
+use crate::volume::piece::Piece;
+use crate::frame::progress::Progress;
 use crate::renderer::Renderer;
 use crate::sampling::Sampling;
 use crate::sampling::clipping::{ClipPlane, Clipping};
@@ -136,7 +136,7 @@ pub struct Look {
     /// `false`: not drawn (a hidden layer keeps its caches).
     pub visible: bool,
     /// The volume is this piece of a larger one, as one rank of a
-    /// distributed frame holds it ([`crate::piece`]): its whole volume's
+    /// distributed frame holds it ([`crate::volume::piece`]): its whole volume's
     /// grid, the box it owns, the whole volume's value range. The volumes
     /// of a scene of pieces are pieces of one grid, split alike (the
     /// channels of one stack); their partial images
@@ -324,7 +324,7 @@ impl<'v> Scene<'v> {
     /// of the pieces, combined front to back
     /// ([`PartialImage::combine`]) and finished over the background
     /// ([`PartialImage::finish`]), give the whole scene's frame, as for
-    /// one volume (see [`crate::piece`]). The additive mix and the
+    /// one volume (see [`crate::volume::piece`]). The additive mix and the
     /// projections, which do not combine front to back, are refused.
     pub fn render_partial(
         &self,

@@ -48,7 +48,7 @@
 //! assert_eq!(opacity.eval(1.0), [auto::MAX_OPACITY]);
 //! ```
 
-use crate::histogram::Histogram;
+use crate::volume::histogram::Histogram;
 use crate::transfer::colormap;
 use crate::transfer::function::{PiecewiseLinear, TransferFunction};
 

@@ -8,11 +8,16 @@
 //! `f32`), and read as `f32`. [`Volume::to_log10`] puts values that span
 //! decades on a log scale.
 
+pub mod histogram;
+pub mod non_finite;
+pub mod piece;
+mod sample;
 mod samples;
 mod source;
 mod store;
 
-pub use samples::{Sample, SampleType, Samples};
+pub use sample::{Sample, SampleType};
+pub use samples::Samples;
 pub use source::{VolumeSource, check_box};
 pub use store::{External, ExternalBytes, ExternalError, Store};
 

@@ -16,7 +16,7 @@ use std::marker::PhantomData;
 use std::ops::Deref;
 use std::sync::Arc;
 
-use super::samples::Sample;
+use super::sample::Sample;
 
 /// Bytes owned outside the volume, in native byte order: a mapped file.
 pub trait ExternalBytes: Send + Sync + fmt::Debug {

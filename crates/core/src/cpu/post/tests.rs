@@ -7,7 +7,7 @@ use crate::bricks::macrocells::Macrocells;
 use crate::kernels::composite::Finish;
 use crate::kernels::phong::LightGeometry;
 use crate::kernels::trilinear::{cell_of, corners, interpolate};
-use crate::progress::Progress;
+use crate::frame::progress::Progress;
 use crate::transfer::iso::IsoSurface;
 use crate::volume::Volume;
 use glam::Vec3;
@@ -60,9 +60,9 @@ fn packed_voxels_interpolate_to_the_scalar_and_the_gradient_of_the_reference() {
 
 use crate::camera::View;
 use crate::camera::{Camera, Projection};
-use crate::image::Image;
+use crate::frame::image::Image;
 use crate::kernels::gradient::gradients;
-use crate::partial::{PartialImage, PartialPixels};
+use crate::frame::partial::{PartialImage, PartialPixels};
 use crate::renderer::Renderer;
 use crate::settings::{Classification, Method, RenderSettings};
 use glam::DVec3;

@@ -1,9 +1,14 @@
 //! A frame made ready: the settings checked, the camera framed on the
 //! volume, and where every pixel's ray takes its samples.
 
+
+pub mod image;
+pub mod partial;
+pub mod progress;
+
 use crate::camera::View;
 use crate::error::{RenderError, SettingError};
-use crate::piece::Piece;
+use crate::volume::piece::Piece;
 use crate::sampling::clipping::{ClipPlane, Clipping};
 use crate::sampling::grid::GridFrame;
 use crate::sampling::{PixelSamples, Sampling};
