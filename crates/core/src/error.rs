@@ -27,7 +27,7 @@ pub enum RenderError {
     #[error("the volume changed while it was rendered: {0}")]
     SamplesChanged(String),
     /// The frame was stopped by its caller
-    /// ([`Renderer::render_stoppable`](crate::Renderer::render_stoppable)).
+    /// ([`FrameRequest::stopped_by`](crate::FrameRequest::stopped_by)).
     #[error("the frame was stopped before it was finished")]
     Stopped,
     #[error(transparent)]

@@ -7,11 +7,11 @@ use crate::camera::Camera;
 use crate::error::{ImageSide, Reflection, SettingError};
 pub use crate::kernels::blend::Blend;
 use crate::kernels::phong::Phong;
-use crate::volume::piece::Piece;
 use crate::sampling::clipping::ClipPlane;
 use crate::transfer::function::TransferFunction;
 use crate::transfer::gradient_opacity::GradientOpacity;
 use crate::transfer::iso::IsoSurface;
+use crate::volume::piece::Piece;
 use glam::DVec3;
 
 /// Largest image side, in pixels.

@@ -22,9 +22,9 @@ pub mod grid;
 pub mod jitter;
 
 use crate::camera::View;
-use crate::volume::piece::Ownership;
 use crate::sampling::clipping::Clipping;
 use crate::sampling::grid::{GridFrame, clamp_to_grid};
+use crate::volume::piece::Ownership;
 use glam::DVec3;
 
 /// The sample positions of one frame's rays.

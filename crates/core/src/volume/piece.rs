@@ -38,8 +38,8 @@
 //! `hi + 2`. A piece therefore holds voxels `lo − 2 .. hi + 3` (clamped to
 //! the grid).
 
-use crate::error::SettingError;
 pub use crate::error::Misfit;
+use crate::error::SettingError;
 use crate::sampling::grid::GridFrame;
 use glam::DVec3;
 

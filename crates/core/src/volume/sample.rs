@@ -35,7 +35,6 @@ impl SampleType {
     }
 }
 
-
 mod sealed {
     pub trait Sealed {}
     impl Sealed for u8 {}

@@ -9,7 +9,7 @@
 //! memory. What an owner of outside bytes adds is [`ExternalBytes::verify`]:
 //! a file can be truncated or rewritten under a mapping, and the renderer
 //! asks, after each frame, whether the bytes it read were still the file's
-//! (see [`crate::Renderer::render`]).
+//! (see [`crate::Render::render`]).
 
 use std::fmt;
 use std::marker::PhantomData;
