@@ -27,7 +27,7 @@ use crate::session::{load, progress_bar, render_failure, renderer_for};
 use crate::streamed::Plan;
 use rayon::ThreadPool;
 use volray_core::glam::DVec3;
-use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
+use volray_core::{Camera, Fit, FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
 use volray_io::Animation;
 
 /// Frames per second when `--fps` is not given.
@@ -331,7 +331,9 @@ impl Writer {
         renderer: &Renderer,
         settings: &RenderSettings,
     ) -> Result<Image, volray_core::RenderError> {
-        pool.install(|| renderer.render_with_progress(settings, &|n| self.bar.inc(n as u64)))
+        let report = |n: usize| self.bar.inc(n as u64);
+        pool.install(|| renderer.render(FrameRequest::new(settings).reporting(&report)))
+            .map(Rendered::image)
     }
 
     pub fn push(&mut self, image: &Image) -> Result<(), CliError> {

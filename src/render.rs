@@ -11,7 +11,7 @@ use crate::session::{load, progress_bar, render_failure, renderer_for, thread_po
 use crate::settings::settings;
 use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
-use volray_core::RenderSettings;
+use volray_core::{FrameRequest, Render, RenderSettings, Rendered};
 use volray_io::{Animation, AnimationKind, BitDepth};
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
@@ -99,7 +99,8 @@ fn still(
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let mut image = pool
-        .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
+        .install(|| renderer.render(FrameRequest::new(settings).reporting(&|n| bar.inc(n as u64))))
+        .map(Rendered::image)
         .map_err(|e| render_failure(&args.view, &input.name, e))?;
     bar.finish_and_clear();
     crate::figure::draw(args, kind, settings, &renderer, &input, &mut image)?;

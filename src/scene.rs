@@ -29,7 +29,7 @@ use crate::session::{load, progress_bar, render_failure, renderer_for, thread_po
 use crate::streamed::Plan;
 use std::path::{Path, PathBuf};
 use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
-use volray_core::{RenderError, RenderSettings, SceneError};
+use volray_core::{FrameRequest, Render, RenderError, RenderSettings, Rendered, SceneError};
 use volray_options::{LookOptions, Naming, Opt, Options, Tf};
 
 /// The overlay options, as the refusal of an unknown one lists them.
@@ -115,7 +115,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             looks: looks.clone(),
             mix,
         };
-        pool.install(|| scene.render_with_progress(&request, &|n| bar.inc(n as u64), None))
+        let report = |n: usize| bar.inc(n as u64);
+        pool.install(|| scene.render(FrameRequest::new(&request).reporting(&report)))
+            .map(Rendered::image)
             .map_err(fail)
     };
     // The first volume's colour bar and scale bar, in the view that
@@ -277,7 +279,8 @@ impl TimeWalk<'_> {
             mix: self.mix,
         };
         let mut image = (self.pool)
-            .install(|| scene.render_with_progress(&request, &|n| bar.inc(n as u64), None))
+            .install(|| scene.render(FrameRequest::new(&request).reporting(&|n| bar.inc(n as u64))))
+            .map(Rendered::image)
             .map_err(fail)?;
         let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
         let mut first = layers[0].settings.clone();

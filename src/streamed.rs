@@ -16,7 +16,7 @@ use crate::flags::{InputArgs, ViewArgs};
 use crate::input;
 use crate::session::render_failure;
 use std::path::{Path, PathBuf};
-use volray_core::{Image, NonFinite, RenderSettings};
+use volray_core::{FrameRequest, Image, NonFinite, Render, RenderSettings, Rendered};
 use volray_distributed::streamed::{StreamError, StreamTimes, Streamed};
 use volray_io::{MapPolicy, format_bytes};
 use volray_lazy::{Chunked, Found, LookError, Plan as LazyPlan};
@@ -185,7 +185,8 @@ impl StreamedInput {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<(Image, StreamTimes), CliError> {
         self.streamed
-            .render(settings, progress)
+            .render(FrameRequest::new(settings).reporting(progress))
+            .map(Rendered::image_and_times)
             .map_err(|e| self.failure(view, e))
     }
 

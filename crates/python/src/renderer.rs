@@ -4,7 +4,7 @@
 //! thread while the calling thread waits for it, asking Python for
 //! pending signals every 20 ms of the wait (a finished frame returns at
 //! once); on KeyboardInterrupt it stops the frame (volray-core's
-//! `render_stoppable`: the work left is skipped) and raises.
+//! `FrameRequest::stopped_by`: the work left is skipped) and raises.
 //!
 //! A lazy volume (`volume.rs`: a chunked file read from its metadata)
 //! takes volray-lazy's road, as `volray render` does (`src/streamed.rs`):
@@ -34,8 +34,8 @@ use std::time::Duration;
 use volray_annotate::figure::Annotations;
 use volray_core::transfer::auto;
 use volray_core::{
-    DEFAULT_CACHE_BUDGET, Histogram, Image, MemoryBound, NonFinite, RenderError, RenderSettings,
-    Renderer as CoreRenderer, Volume as CoreVolume,
+    DEFAULT_CACHE_BUDGET, FrameRequest, Histogram, Image, MemoryBound, NonFinite, Render,
+    RenderError, RenderSettings, Rendered, Renderer as CoreRenderer, Volume as CoreVolume,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
 use volray_io::{MapPolicy, ReadOptions, format_bytes};
@@ -551,7 +551,8 @@ impl Renderer {
         let settings = &settings;
         let (rendered, interrupt) = py.detach(|| {
             interruptible(pool, &stop, |report| {
-                inner.render_stoppable(settings, report, &stop)
+                let request = FrameRequest::new(settings).reporting(report);
+                inner.render(request.stopped_by(&stop)).map(Rendered::image)
             })
         });
         if let Some(e) = interrupt {
@@ -611,7 +612,12 @@ impl Renderer {
             let (rendered, interrupt) = interruptible(pool, &lazy.stop, |report| {
                 found
                     .apply(streamed, &options.look, settings, name)
-                    .and_then(|()| streamed.render(settings, report).map_err(LookError::Stream))
+                    .and_then(|()| {
+                        let request = FrameRequest::new(&*settings).reporting(report);
+                        (streamed.render(request.stopped_by(&lazy.stop)))
+                            .map(Rendered::image_and_times)
+                            .map_err(LookError::Stream)
+                    })
             });
             let rendered = rendered.map_err(|panic| {
                 // What the pieces knew may be half updated: start afresh.

@@ -28,7 +28,7 @@ use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 use volray_core::scene::{Look, Mix, Scene as CoreScene, SceneSettings};
-use volray_core::{PiecewiseLinear, RenderSettings};
+use volray_core::{FrameRequest, PiecewiseLinear, Render, RenderSettings, Rendered};
 use volray_io::format_bytes;
 use volray_options::Options;
 use volray_options::colors::{channel_colour, named};
@@ -321,7 +321,8 @@ impl Scene {
         let (scene, request) = (&built.scene, &request);
         let (rendered, interrupt) = py.detach(|| {
             interruptible(pool.as_ref(), &stop, |report| {
-                scene.render_with_progress(request, report, Some(&stop))
+                let request = FrameRequest::new(request).reporting(report);
+                scene.render(request.stopped_by(&stop)).map(Rendered::image)
             })
         });
         if let Some(e) = interrupt {

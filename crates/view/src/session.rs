@@ -7,7 +7,7 @@
 //! instead of queueing frames.
 //!
 //! A frame is rendered with the mailbox's stop flag
-//! (`Renderer::render_stoppable`): a newer request for the tab, or the
+//! (`FrameRequest::stopped_by`): a newer request for the tab, or the
 //! tab closing, stops it within a tile's work (a brick's, on the bricked
 //! path; a frame stopped before it starts is not started), and the
 //! thread goes on to
@@ -44,7 +44,10 @@ use tokio::sync::mpsc;
 use volray_annotate::figure::{Rendered, annotate_frame};
 use volray_core::camera::View;
 use volray_core::scene::{Look, Scene, SceneSettings};
-use volray_core::{Image, MemoryBound, NonFinite, RenderError, RenderSettings, Renderer, Volume};
+use volray_core::{
+    FrameRequest, Image, MemoryBound, NonFinite, Render, RenderError, RenderSettings, Renderer,
+    Volume,
+};
 use volray_distributed::streamed::{StreamError, Streamed};
 
 /// What the renderer thread sends to the tab's socket.
@@ -742,8 +745,11 @@ impl Context<'_> {
             message_bytes = m;
         }
         let reserved = self.ledger.reserve(self.what, bytes)?;
-        let image =
-            self.rendering(|| scene.render_with_progress(request, &|_| {}, Some(self.stop)))?;
+        let image = self.rendering(|| {
+            scene
+                .render(FrameRequest::new(request).stopped_by(self.stop))
+                .map(volray_core::Rendered::image)
+        })?;
         Ok(Drawn {
             image,
             basis,
@@ -756,7 +762,8 @@ impl Context<'_> {
     fn render(&self, renderer: &Renderer, settings: &RenderSettings) -> Result<Image, FrameError> {
         // A fresh frame buffer each time (not one kept across frames):
         // what a tab holds between frames is then its caches alone.
-        self.rendering(|| renderer.render_stoppable(settings, &|_| {}, self.stop))
+        let request = FrameRequest::new(settings).stopped_by(self.stop);
+        self.rendering(|| renderer.render(request).map(volray_core::Rendered::image))
     }
 
     /// `work` on the pool, counted as a frame rendering; not started
@@ -925,7 +932,8 @@ impl LevelTab {
         let rendered = {
             let _rendering = cx.stats.rendering();
             cx.pool
-                .install(|| streamed.render_stoppable(settings, &|_| {}, cx.stop))
+                .install(|| streamed.render(FrameRequest::new(settings).stopped_by(cx.stop)))
+                .map(volray_core::Rendered::image_and_times)
         };
         let [x, y, z] = pyramid.grid(level).dims;
         let (image, times) = rendered.map_err(|e| match e {
@@ -1490,8 +1498,9 @@ mod tests {
             let settings = Plain::default().reproduce(&still.state).unwrap().settings;
             let want = Renderer::new(&shared.volume)
                 .unwrap()
-                .render(&settings)
-                .unwrap();
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             let (h, png) = one_frame(&mailbox, &mut rx, still);
             assert_eq!(h["quality"], "full");
             let want = encode::png(&want, &mut Vec::new()).unwrap();
@@ -1576,7 +1585,11 @@ mod tests {
         let volume = read_level(&path, still);
         let mut settings = full.clone();
         settings.camera.azimuth = 40.0;
-        let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+        let reference = Renderer::new(&volume)
+            .unwrap()
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         assert_eq!(png, encode::png(&reference, &mut Vec::new()).unwrap());
         mailbox.close();
         assert!(rx.blocking_recv().is_none());
@@ -1634,7 +1647,11 @@ mod tests {
         let volume = read_level(&path, 0);
         let mut settings = full.clone();
         settings.camera.azimuth = 20.0;
-        let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+        let reference = Renderer::new(&volume)
+            .unwrap()
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         let expected = pixels(&encode::png(&reference, &mut Vec::new()).unwrap());
         let got = pixels(&png);
         assert_eq!(got.len(), expected.len());

@@ -114,7 +114,11 @@ fn a_volume_changed_between_frames_is_rendered_as_it_is_now() {
             height: 32,
             ..RenderSettings::default()
         };
-        let image = Renderer::new(volume).unwrap().render(&settings).unwrap();
+        let image = Renderer::new(volume)
+            .unwrap()
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         encode::png(&image, &mut Vec::new()).unwrap()
     };
     let mut host = host(shared);
