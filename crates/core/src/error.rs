@@ -34,7 +34,7 @@ pub enum RenderError {
     Scene(#[from] SceneError),
 }
 
-/// Why several volumes cannot be rendered together ([`crate::scene`]).
+/// Why several volumes cannot be rendered together (`scene`).
 /// Layers are counted from 0, the first volume being layer 0.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SceneError {

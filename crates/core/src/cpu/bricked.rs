@@ -386,7 +386,7 @@ impl CellBox {
 }
 
 /// A sample number counted from a ray's base, as the `i32` the ray caster
-/// counts in (a ray has at most [`crate::renderer::MAX_SAMPLES_PER_RAY`]
+/// counts in (a ray has at most `renderer::MAX_SAMPLES_PER_RAY`
 /// samples in the grid, and its base is near them).
 fn relative(k: i64, base: i64) -> i32 {
     (k.saturating_sub(base)).clamp(i32::MIN as i64, i32::MAX as i64) as i32
@@ -723,7 +723,7 @@ impl<A: Accumulator> RayState<A> {
 
 /// `⌈x⌉` and `⌊x⌋` for `|x| < 2³¹` without a library call (SSE2 has no
 /// rounding instruction). Sample numbers are far smaller: a ray has at most
-/// [`crate::renderer::MAX_SAMPLES_PER_RAY`] samples on either side of the
+/// `renderer::MAX_SAMPLES_PER_RAY` samples on either side of the
 /// image plane (of its base sample, in perspective, which lies level with
 /// the grid's centre).
 #[inline]
