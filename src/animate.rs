@@ -29,7 +29,7 @@ use crate::session::{
 use rayon::ThreadPool;
 use volray_app::plan::Plan;
 use volray_core::glam::DVec3;
-use volray_core::{Camera, Fit, Image, RenderSettings, Renderer};
+use volray_core::{Camera, Fit, FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
 use volray_io::Animation;
 
 /// `--turntable FRAMES`: `frames` views of INPUT.
@@ -340,7 +340,9 @@ impl Writer {
         renderer: &Renderer,
         settings: &RenderSettings,
     ) -> Result<Image, volray_core::RenderError> {
-        pool.install(|| renderer.render_with_progress(settings, &|n| self.bar.inc(n as u64)))
+        let report = |n: usize| self.bar.inc(n as u64);
+        pool.install(|| renderer.render(FrameRequest::new(settings).reporting(&report)))
+            .map(Rendered::image)
     }
 
     pub fn push(&mut self, image: &Image) -> Result<(), CliError> {

@@ -19,7 +19,9 @@ use crate::session::{load, render_failure, renderer_for, thread_pool};
 use crate::settings::settings;
 use std::path::Path;
 use std::time::{Duration, Instant};
-use volray_core::{Camera, FrameTimes, Image, Method, RenderSettings, Renderer};
+use volray_core::{
+    Camera, FrameRequest, FrameTimes, Image, Method, Render, RenderSettings, Renderer,
+};
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     match &args.peers {
@@ -102,9 +104,15 @@ pub fn time_frames(
         };
         let t0 = Instant::now();
         let parts = match settings.method {
-            Method::Fast => Some(renderer.render_into(&settings, image)?),
+            Method::Fast => {
+                let reusing = std::mem::replace(image, Image::new(0, 0, [0.0; 4]));
+                let request = FrameRequest::new(&settings).reusing(reusing);
+                let (rendered, times) = renderer.render(request)?.image_and_times();
+                *image = rendered;
+                Some(times)
+            }
             Method::Reference => {
-                *image = renderer.render(&settings)?;
+                *image = renderer.render(FrameRequest::new(&settings))?.image();
                 None
             }
         };

@@ -94,7 +94,8 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
                 let (count, axis) = channel_axis(info);
                 (count, axis == ChannelAxis::Channel)
             };
-            let pick = |count| crate::scene::picked(&args.scene, which, &spec, count).map_err(refusal);
+            let pick =
+                |count| crate::scene::picked(&args.scene, which, &spec, count).map_err(refusal);
             if job.settings.blend.is_projection() {
                 return Err(CliError::input(
                     "--channels under mpirun: the projections (--blend mip, ...) are rendered by one process",

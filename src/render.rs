@@ -7,14 +7,14 @@ use crate::animate;
 // The output file, as `distributed.rs` (MPI) takes it from here.
 use crate::error::CliError;
 use crate::flags::RenderArgs;
+pub use crate::outfile::{OutputKind, check_output, output_files, output_kind, write_still};
 use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note, thread_pool,
 };
-pub use crate::outfile::{OutputKind, check_output, output_files, output_kind, write_still};
 use crate::settings::settings;
 use volray_app::input;
 use volray_app::plan::Plan;
-use volray_core::RenderSettings;
+use volray_core::{FrameRequest, Render, RenderSettings, Rendered};
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_scene_flags_alone(args)?;
@@ -78,7 +78,8 @@ fn still(
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
     let mut image = pool
-        .install(|| renderer.render_with_progress(settings, &|n| bar.inc(n as u64)))
+        .install(|| renderer.render(FrameRequest::new(settings).reporting(&|n| bar.inc(n as u64))))
+        .map(Rendered::image)
         .map_err(|e| render_failure(&args.view, &input.name, e))?;
     bar.finish_and_clear();
     crate::figure::draw(args, kind, settings, &renderer, &input, &mut image)?;

@@ -25,7 +25,7 @@ use volray_app::scene::{
     default_mix, picked_channels, time_range,
 };
 use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
-use volray_core::{RenderError, RenderSettings, SceneError};
+use volray_core::{FrameRequest, Render, RenderError, RenderSettings, Rendered, SceneError};
 
 /// One volume of the picture: what was read, its settings alone (whose
 /// look becomes its [`Look`]), and where it came from.
@@ -120,7 +120,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             looks: looks.clone(),
             mix,
         };
-        pool.install(|| scene.render_with_progress(&request, &|n| bar.inc(n as u64), None))
+        let report = |n: usize| bar.inc(n as u64);
+        pool.install(|| scene.render(FrameRequest::new(&request).reporting(&report)))
+            .map(Rendered::image)
             .map_err(fail)
     };
     // The first volume's colour bar and scale bar, in the view that
@@ -277,7 +279,8 @@ impl TimeWalk<'_> {
             mix: self.mix,
         };
         let mut image = (self.pool)
-            .install(|| scene.render_with_progress(&request, &|n| bar.inc(n as u64), None))
+            .install(|| scene.render(FrameRequest::new(&request).reporting(&|n| bar.inc(n as u64))))
+            .map(Rendered::image)
             .map_err(fail)?;
         let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
         let mut first = layers[0].settings.clone();

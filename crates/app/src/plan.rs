@@ -14,7 +14,7 @@
 
 use crate::error::AppError;
 use crate::input::{self, Request, Spec};
-use volray_core::{Image, NonFinite, RenderSettings};
+use volray_core::{FrameRequest, Image, NonFinite, Render, RenderSettings, Rendered};
 use volray_distributed::streamed::{StreamTimes, Streamed};
 use volray_io::MapPolicy;
 use volray_lazy::{Chunked, Found, LookError, Plan as LazyPlan};
@@ -186,7 +186,11 @@ impl StreamedInput {
         settings: &RenderSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<(Image, StreamTimes), AppError> {
-        (self.streamed.render(settings, progress)).map_err(|error| AppError::Stream {
+        (self
+            .streamed
+            .render(FrameRequest::new(settings).reporting(progress)))
+        .map(Rendered::image_and_times)
+        .map_err(|error| AppError::Stream {
             name: self.name.clone(),
             error,
         })

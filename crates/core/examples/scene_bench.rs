@@ -22,6 +22,7 @@ use volray_core::scene::{Look, Mix, Scene, SceneSettings};
 use volray_core::{
     Classification, PiecewiseLinear, RenderSettings, Renderer, TransferFunction, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 /// A generator of numbers in [0, 1) from `seed`.
 fn random(seed: u64) -> impl FnMut() -> f64 {
@@ -159,31 +160,71 @@ fn main() {
         let cases: [(&str, Frame); 7] = [
             (
                 "1 channel (its renderer)",
-                Box::new(|f| drop(one.render(&settings(f)).unwrap())),
+                Box::new(|f| drop(one.render(FrameRequest::new(&settings(f))).unwrap().image())),
             ),
             (
                 "2 channels, 2nd clear",
-                Box::new(|f| drop(two_clear.render(&clear(f)).unwrap())),
+                Box::new(|f| {
+                    drop(
+                        two_clear
+                            .render(FrameRequest::new(&clear(f)))
+                            .unwrap()
+                            .image(),
+                    )
+                }),
             ),
             (
                 "2 channels, composite",
-                Box::new(|f| drop(two.render(&request(2, f, Mix::Composite)).unwrap())),
+                Box::new(|f| {
+                    drop(
+                        two.render(FrameRequest::new(&request(2, f, Mix::Composite)))
+                            .unwrap()
+                            .image(),
+                    )
+                }),
             ),
             (
                 "2 apart, composite",
-                Box::new(|f| drop(apart.render(&request(2, f, Mix::Composite)).unwrap())),
+                Box::new(|f| {
+                    drop(
+                        apart
+                            .render(FrameRequest::new(&request(2, f, Mix::Composite)))
+                            .unwrap()
+                            .image(),
+                    )
+                }),
             ),
             (
                 "2 channels, additive",
-                Box::new(|f| drop(two.render(&request(2, f, Mix::Additive)).unwrap())),
+                Box::new(|f| {
+                    drop(
+                        two.render(FrameRequest::new(&request(2, f, Mix::Additive)))
+                            .unwrap()
+                            .image(),
+                    )
+                }),
             ),
             (
                 "3 channels, composite",
-                Box::new(|f| drop(three.render(&request(3, f, Mix::Composite)).unwrap())),
+                Box::new(|f| {
+                    drop(
+                        three
+                            .render(FrameRequest::new(&request(3, f, Mix::Composite)))
+                            .unwrap()
+                            .image(),
+                    )
+                }),
             ),
             (
                 "3 channels, additive",
-                Box::new(|f| drop(three.render(&request(3, f, Mix::Additive)).unwrap())),
+                Box::new(|f| {
+                    drop(
+                        three
+                            .render(FrameRequest::new(&request(3, f, Mix::Additive)))
+                            .unwrap()
+                            .image(),
+                    )
+                }),
             ),
         ];
         let cases: Vec<_> = (cases.into_iter())

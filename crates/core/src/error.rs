@@ -27,14 +27,14 @@ pub enum RenderError {
     #[error("the volume changed while it was rendered: {0}")]
     SamplesChanged(String),
     /// The frame was stopped by its caller
-    /// ([`Renderer::render_stoppable`](crate::Renderer::render_stoppable)).
+    /// ([`FrameRequest::stopped_by`](crate::FrameRequest::stopped_by)).
     #[error("the frame was stopped before it was finished")]
     Stopped,
     #[error(transparent)]
     Scene(#[from] SceneError),
 }
 
-/// Why several volumes cannot be rendered together ([`crate::scene`]).
+/// Why several volumes cannot be rendered together (`scene`).
 /// Layers are counted from 0, the first volume being layer 0.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SceneError {
@@ -106,7 +106,7 @@ pub enum SettingError {
     #[error("crop box {lo} .. {hi} must be finite with low < high on every axis")]
     Crop { lo: DVec3, hi: DVec3 },
     #[error("{0}")]
-    Piece(Box<crate::piece::Misfit>),
+    Piece(Box<Misfit>),
     #[error("clip plane point {0} must be finite")]
     ClipPoint(DVec3),
     #[error("clip plane normal {0} must be a finite, non-zero vector")]
@@ -164,5 +164,25 @@ impl fmt::Display for Reflection {
             Reflection::Specular => "specular",
             Reflection::LightColor => "light colour",
         })
+    }
+}
+
+/// A volume that is not the piece it is said to be (see
+/// `Piece::validate`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Misfit {
+    pub whole: [usize; 3],
+    pub offset: [usize; 3],
+    pub dims: [usize; 3],
+    pub owned: ([usize; 3], [usize; 3]),
+}
+
+impl std::fmt::Display for Misfit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "a piece of {:?} voxels at {:?} of a {:?} grid, owning {:?}..{:?}, must lie in the grid with the cells it samples, at the grid's spacing",
+            self.dims, self.offset, self.whole, self.owned.0, self.owned.1
+        )
     }
 }

@@ -8,7 +8,7 @@
 //! ## The pipeline, as the default (fast) path runs
 //!
 //! ```text
-//!  Volume ──► Renderer::new ─ value range; NaN/∞ refused or masked ─────── renderer.rs, non_finite.rs
+//!  Volume ──► Renderer::new ─ value range; NaN/∞ refused or masked ─────── renderer.rs, volume/non_finite.rs
 //!    │
 //!    │ once per volume and transfer function (kept across frames)
 //!    ├─► min/max of each 8³-cell brick ──────────────────────────────────── bricks/macrocells.rs
@@ -16,7 +16,7 @@
 //!          (transfer function: transfer/classifier.rs; gradient: kernels/gradient.rs)
 //!
 //!  per frame
-//!    RenderSettings checked, camera framed, each ray's samples ─────────── frame.rs, settings.rs
+//!    RenderSettings checked, camera framed, each ray's samples ─────────── frame/, settings.rs
 //!          (camera/ ─ the view; sampling/ ─ t = (k + u)·step, crop, clip planes, jitter)
 //!    occupied bricks binned into 16² tiles, front to back ──────────────── cpu/tiles.rs
 //!    per tile, in parallel, brick by brick front to back ───────────────── cpu/bricked.rs
@@ -24,8 +24,8 @@
 //!      │    (kernels/phong.rs: two-sided Phong × material colour)
 //!      └─ each ray: trilinear sample, composite front to back, stop ───── kernels/trilinear.rs,
 //!           when T < 1/1024                                               kernels/composite.rs
-//!    ──► PartialImage: premultiplied colour and transmittance per pixel ─ partial.rs
-//!    ──► finish: over the background ──► Image ───────────────────────── image.rs
+//!    ──► PartialImage: premultiplied colour and transmittance per pixel ─ frame/partial.rs
+//!    ──► finish: over the background ──► Image ─────────────────── frame/image.rs
 //! ```
 //!
 //! The other paths share every step they can: post-classified frames
@@ -54,11 +54,15 @@
 //! | `bricks/` | the fast path's view-independent store: the brick grid, min/max macro-cells, occupied bricks |
 //! | `cpu/` | the fast path on the CPU: tiles, the lit-brick cache, the three casters |
 //! | `reference/` | the oracle: the paper's stage 1 and back-to-front compositing, every option |
-//! | `renderer.rs`, `settings.rs`, `frame.rs`, `error.rs` | the [`Renderer`] (caches, routing, timing), [`RenderSettings`], a checked and framed [`Frame`], typed errors |
-//! | `volume.rs`, `image.rs`, `partial.rs`, `memory.rs`, `non_finite.rs`, `histogram.rs` | [`Volume`], [`Image`], [`PartialImage`], [`MemoryBound`], [`NonFinite`], [`Histogram`] |
+//! | `frame/` | one frame: asked for ([`FrameRequest`], answered through the one entry [`Render::render`] with [`Rendered`]: the image or [`PartialImage`], and [`FrameTimes`]), made ready ([`Frame`]: settings checked, camera framed), its [`Progress`] and stop flag, the [`PartialImage`] and the finished [`Image`] |
+//! | `renderer.rs`, `renderer/` | the [`Renderer`] of one volume: its caches, routing to a path, timing; its depth cues |
+//! | [`scene`] | several volumes in one picture: a [`Scene`](scene::Scene) renders through the same entry |
+//! | `volume/` | the [`Volume`] and its samples, stores and sources ([`VolumeSource`]); [`NonFinite`] values, [`Histogram`]s, a [`Piece`] of a larger volume |
+//! | `settings.rs`, `error.rs`, `memory.rs` | [`RenderSettings`], typed errors, [`MemoryBound`] |
+//! | `shadows/`, [`probe`] | depth cues (shadows, ambient occlusion); what a pixel shows |
 //!
 //! ```
-//! use volray_core::{Renderer, RenderSettings, Volume, glam::DVec3};
+//! use volray_core::{FrameRequest, Render, Renderer, RenderSettings, Volume, glam::DVec3};
 //!
 //! // A ball of density 1 − r on a 32³ grid over [−1, 1]³.
 //! let n = 32;
@@ -68,7 +72,8 @@
 //! })
 //! .unwrap();
 //! let settings = RenderSettings { width: 64, height: 64, ..Default::default() };
-//! let image = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+//! let renderer = Renderer::new(&volume).unwrap();
+//! let image = renderer.render(FrameRequest::new(&settings)).unwrap().image();
 //! let centre = image.get(32, 32);
 //! let corner = image.get(0, 0);
 //! assert!(centre[0] > 0.5 && corner == [0.0, 0.0, 0.0, 0.0]);
@@ -79,15 +84,9 @@ pub mod camera;
 mod cpu;
 mod error;
 mod frame;
-mod histogram;
-mod image;
 pub mod kernels;
 mod memory;
-mod non_finite;
-mod partial;
-pub mod piece;
 pub mod probe;
-mod progress;
 mod reference;
 mod renderer;
 pub mod sampling;
@@ -102,16 +101,14 @@ pub use camera::{
 };
 pub use error::{ImageSide, Reflection, RenderError, SceneError, SettingError};
 pub use frame::Frame;
+pub use frame::image::Image;
+pub use frame::partial::{PartialImage, PartialPixels};
+pub use frame::progress::Progress;
+pub use frame::request::{FrameRequest, FrameTimes, Picture, Render, Rendered};
 pub use glam;
-pub use histogram::Histogram;
-pub use image::Image;
 pub use kernels::phong::{LightGeometry, Phong};
 pub use memory::MemoryBound;
-pub use non_finite::{NonFinite, NonFiniteMask};
-pub use partial::{PartialImage, PartialPixels};
-pub use piece::Piece;
-pub use progress::Progress;
-pub use renderer::{DEFAULT_CACHE_BUDGET, FrameTimes, Renderer};
+pub use renderer::{DEFAULT_CACHE_BUDGET, Renderer};
 pub use sampling::clipping::ClipPlane;
 pub use settings::{
     Blend, Classification, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_SAMPLES_PER_RAY, Method,
@@ -119,6 +116,10 @@ pub use settings::{
 };
 pub use transfer::function::{PiecewiseLinear, TransferFunction};
 pub use transfer::iso::IsoSurface;
+pub use volume::histogram::Histogram;
+pub use volume::non_finite::{NonFinite, NonFiniteMask};
+pub use volume::piece;
+pub use volume::piece::Piece;
 pub use volume::{
     External, ExternalBytes, ExternalError, Sample, SampleType, Samples, Store, Volume,
     VolumeError, VolumeSource, check_box, checked_point_count,

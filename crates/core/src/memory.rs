@@ -29,19 +29,20 @@
 //! empty space, the cleaned copy of the volume and its mask. A renderer
 //! that renders frames of several paths keeps each path's caches.
 
+use crate::bricks;
 use crate::bricks::BrickGrid;
 use crate::cpu::{bricked, lit_bricks, post, tiles};
+use crate::frame::image::Image;
 use crate::kernels::gradient;
 use crate::kernels::projection::Projected;
-use crate::non_finite::{self, NonFinite};
 use crate::reference::{self, stage1};
 use crate::settings::{Blend, Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
 use crate::shadows::ambient::AmbientRays;
 use crate::shadows::ambient_volume::{self, AmbientVolume};
 use crate::shadows::light_volume::{self, LightVolume};
 use crate::shadows::opacities;
+use crate::volume::non_finite::{self, NonFinite};
 use crate::volume::{SampleType, Volume};
-use crate::{bricks, image::Image};
 use glam::DVec3;
 
 /// An upper bound, in bytes, on the memory one frame of a volume takes,

@@ -34,13 +34,13 @@ use crate::cpu::tiles::TileBins;
 use crate::cpu::{bricked, post as post_cast};
 use crate::error::RenderError;
 use crate::frame::Frame;
-use crate::image::Image;
+use crate::frame::image::Image;
+use crate::frame::partial::{PartialImage, PartialPixels};
+use crate::frame::progress::Progress;
+use crate::frame::request::{FrameRequest, FrameTimes, Picture, Render, Rendered};
 use crate::kernels::composite::{Finish, PartialPixel};
 use crate::kernels::gradient::{gradients, max_magnitude};
 use crate::kernels::phong::LightGeometry;
-use crate::non_finite::{NonFinite, NonFiniteMask};
-use crate::partial::{PartialImage, PartialPixels};
-use crate::progress::Progress;
 use crate::reference;
 use crate::reference::Shader;
 use crate::reference::post::PostClassifier;
@@ -48,11 +48,11 @@ use crate::reference::stage1::{Reached, ShadedVolume, shade_and_classify};
 use crate::settings::{Blend, Classification, Method, RenderSettings, key_light};
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
+use crate::volume::non_finite::{NonFinite, NonFiniteMask};
 use depth_cues::{KeptAmbient, KeptLight};
 use std::borrow::Cow;
-use std::sync::atomic::AtomicBool;
 use std::sync::{Mutex, MutexGuard, OnceLock};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// A volume ready to render. Its value range is found once; the fast
 /// path's view-independent work (the min/max macro-cells, and the occupied
@@ -110,39 +110,6 @@ pub(crate) struct FastState {
     pub bricks: ClassifiedBricks,
     /// The frame's lit bricks, buffers reused from frame to frame.
     pub lit: LitBricks,
-}
-
-/// Where a fast frame's time went.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct FrameTimes {
-    /// Classifying the volume into bricks: zero unless the transfer
-    /// function (or the step) changed since the last frame.
-    pub classify: Duration,
-    /// Binning the occupied bricks into image tiles.
-    pub bin: Duration,
-    /// Stage 1 per frame, lighting the occupied bricks' voxels (done as the
-    /// rays first reach each brick), and stage 2, casting the rays.
-    pub cast: Duration,
-    /// Occupied bricks.
-    pub bricks: usize,
-    /// Bricks lit for the frame: those a ray sampled before it
-    /// terminated (hidden and off-screen bricks are not lit). A brick lit
-    /// more than once (for several tiles, when the cache budget does not
-    /// hold the bricks in use) counts each time.
-    pub lit: usize,
-    /// Bricks classified during the frame because the cache of classified
-    /// bricks did not hold them (counted each time, as `lit`).
-    pub classified: usize,
-    /// Bytes of classified and lit bricks the caches hold after the frame
-    /// (at most the [cache budget](Renderer::with_cache_budget)).
-    pub cached_bytes: usize,
-}
-
-impl FrameTimes {
-    /// The whole frame.
-    pub fn total(&self) -> Duration {
-        self.classify + self.bin + self.cast
-    }
 }
 
 impl<'v> Renderer<'v> {
@@ -234,104 +201,39 @@ impl<'v> Renderer<'v> {
         self.value_range
     }
 
-    /// Renders one frame.
-    pub fn render(&self, settings: &RenderSettings) -> Result<Image, RenderError> {
-        self.render_with_progress(settings, &|_| {})
-    }
-
-    /// Renders one frame, calling `progress` with the number of pixels
-    /// finished as the work proceeds (`width·height` in all).
-    pub fn render_with_progress(
-        &self,
-        settings: &RenderSettings,
-        progress: &(dyn Fn(usize) + Sync),
-    ) -> Result<Image, RenderError> {
-        let mut image = Image::new(0, 0, [0.0; 4]);
-        self.render_frame(settings, &mut image, &Progress::new(progress))?;
-        Ok(image)
-    }
-
-    /// [`Self::render_with_progress`], stopped when `stop` is set (by
-    /// another thread): the work left is skipped, within about one tile's
-    /// time (one brick's on the bricked path),
-    /// and the answer is [`RenderError::Stopped`].
-    pub fn render_stoppable(
-        &self,
-        settings: &RenderSettings,
-        progress: &(dyn Fn(usize) + Sync),
-        stop: &AtomicBool,
-    ) -> Result<Image, RenderError> {
-        let mut image = Image::new(0, 0, [0.0; 4]);
-        let progress = Progress::new(progress).stopping(stop);
-        self.render_frame(settings, &mut image, &progress)?;
-        if progress.stopped() {
-            return Err(RenderError::Stopped);
-        }
-        Ok(image)
-    }
-
-    /// Renders one frame as a partial image: premultiplied colour and
-    /// transmittance, or projected values, without the background (see
-    /// [`PartialImage`]). [`Self::finish`] makes it the frame
-    /// [`Self::render`] gives; partial images of pieces of a volume
-    /// [`combine`](PartialImage::combine) first.
-    pub fn render_partial(
-        &self,
-        settings: &RenderSettings,
-        progress: &(dyn Fn(usize) + Sync),
-    ) -> Result<PartialImage, RenderError> {
-        self.render_partial_timed(settings, progress)
-            .map(|(partial, _)| partial)
-    }
-
-    /// [`Self::render_partial`], saying where the time went (as
-    /// [`Self::render_into`] does).
-    pub fn render_partial_timed(
-        &self,
-        settings: &RenderSettings,
-        progress: &(dyn Fn(usize) + Sync),
-    ) -> Result<(PartialImage, FrameTimes), RenderError> {
-        let progress = &Progress::new(progress);
-        let frame = self.prepare(settings)?;
-        let start = Instant::now();
-        let (partial, times) = match settings.method {
-            Method::Fast => {
-                let mut partial = self.blank(settings, Vec::new());
-                let times =
-                    self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
-                (partial, times)
-            }
-            Method::Reference => {
-                let partial = self.render_reference(settings, &frame, progress);
-                let times = FrameTimes {
-                    cast: start.elapsed(),
-                    ..FrameTimes::default()
-                };
-                (partial, times)
-            }
-        };
-        verify(&self.volume)?;
-        Ok((partial, times))
-    }
-
-    /// [`Self::render_partial`] with a [`Progress`] (a scene's layers
-    /// rendered apart share their caller's), its samples verified.
-    pub(crate) fn render_partial_with(
+    /// One frame as a partial image (a scene's layers rendered apart share
+    /// their caller's `progress`), its samples verified.
+    pub(crate) fn partial_frame(
         &self,
         settings: &RenderSettings,
         progress: &Progress,
-    ) -> Result<PartialImage, RenderError> {
+    ) -> Result<(PartialImage, FrameTimes), RenderError> {
         let frame = self.prepare(settings)?;
-        let partial = match settings.method {
+        let rendered = self.partial_unverified(settings, &frame, progress);
+        verify(&self.volume)?;
+        Ok(rendered)
+    }
+
+    /// The partial image of `frame` on the path `settings` take.
+    fn partial_unverified(
+        &self,
+        settings: &RenderSettings,
+        frame: &Frame,
+        progress: &Progress,
+    ) -> (PartialImage, FrameTimes) {
+        let start = Instant::now();
+        match settings.method {
             Method::Fast => {
                 let mut partial = self.blank(settings, Vec::new());
-                self.render_fast(settings, &frame, &mut partial, Finish::Partial, progress);
-                partial
+                let times =
+                    self.render_fast(settings, frame, &mut partial, Finish::Partial, progress);
+                (partial, times)
             }
-            Method::Reference => self.render_reference(settings, &frame, progress),
-        };
-        self.verify()?;
-        Ok(partial)
+            Method::Reference => {
+                let partial = self.render_reference(settings, frame, progress);
+                (partial, FrameTimes::cast(start.elapsed()))
+            }
+        }
     }
 
     /// Whether the volume's samples were what they are meant to be while
@@ -347,66 +249,42 @@ impl<'v> Renderer<'v> {
         partial.finish(settings.background, |f| classifier.projection_colour(f))
     }
 
-    /// Renders one frame into `image` (its buffer reused when it is the
-    /// frame's size), and says where the time went. On the bricked fast
-    /// path the parts are timed; a projection, a post-classified frame, or
-    /// a frame on the reference path counts all its time as `cast`.
-    pub fn render_into(
-        &self,
-        settings: &RenderSettings,
-        image: &mut Image,
-    ) -> Result<FrameTimes, RenderError> {
-        self.render_frame(settings, image, &Progress::new(&|_| {}))
-    }
-
-    /// A whole frame into `image`'s buffer. A composited frame on a fast
-    /// path is finished by the casters, each ray over the background as
-    /// its last step ([`Finish::Over`]), with no second pass over the
-    /// pixels; the others are finished from their partial image.
-    pub(crate) fn render_frame(
-        &self,
-        settings: &RenderSettings,
-        image: &mut Image,
-        progress: &Progress,
-    ) -> Result<FrameTimes, RenderError> {
-        let times = self.render_frame_unverified(settings, image, progress)?;
-        verify(&self.volume)?;
-        Ok(times)
-    }
-
-    /// [`Self::render_frame`] before the samples it read are verified.
-    fn render_frame_unverified(
+    /// A whole frame into `image`'s buffer, its samples verified. A
+    /// composited frame on a fast path is finished by the casters, each
+    /// ray over the background as its last step ([`Finish::Over`]), with
+    /// no second pass over the pixels, in `image`'s buffer when it is
+    /// large enough; the others are finished from their partial image.
+    pub(crate) fn frame_into(
         &self,
         settings: &RenderSettings,
         image: &mut Image,
         progress: &Progress,
     ) -> Result<FrameTimes, RenderError> {
         let frame = self.prepare(settings)?;
-        let start = Instant::now();
-        let (partial, times) = match settings.method {
-            Method::Reference => (self.render_reference(settings, &frame, progress), None),
-            Method::Fast => {
+        let times = match (settings.method, settings.blend) {
+            (Method::Fast, Blend::Composite) => {
                 let buffer = std::mem::replace(image, Image::new(0, 0, [0.0; 4])).into_pixels();
                 let mut partial = self.blank(settings, buffer);
-                let finish = match settings.blend {
-                    Blend::Composite => Finish::Over(settings.background),
-                    _ => Finish::Partial,
-                };
+                let finish = Finish::Over(settings.background);
                 let times = self.render_fast(settings, &frame, &mut partial, finish, progress);
-                if finish != Finish::Partial {
-                    let pixels = partial.into_composite().expect("a composited frame");
-                    *image = Image::from_pixels(settings.width, settings.height, pixels)
-                        .expect("the frame's size");
-                    return Ok(times);
+                let pixels = partial.into_composite().expect("a composited frame");
+                *image = Image::from_pixels(settings.width, settings.height, pixels)
+                    .expect("the frame's size");
+                times
+            }
+            _ => {
+                let start = Instant::now();
+                let (partial, times) = self.partial_unverified(settings, &frame, progress);
+                *image = self.finish(settings, partial);
+                match settings.method {
+                    // All of it, the finish included.
+                    Method::Reference => FrameTimes::cast(start.elapsed()),
+                    Method::Fast => times,
                 }
-                (partial, Some(times))
             }
         };
-        *image = self.finish(settings, partial);
-        Ok(times.unwrap_or(FrameTimes {
-            cast: start.elapsed(),
-            ..FrameTimes::default()
-        }))
+        verify(&self.volume)?;
+        Ok(times)
     }
 
     /// The partial image a fast frame of `settings` is rendered into:
@@ -758,5 +636,33 @@ impl<'v> Renderer<'v> {
         times.classified = state.bricks.classified_count() - classified_before;
         times.cached_bytes = state.bricks.slot_bytes() + state.lit.bytes();
         times
+    }
+}
+
+impl Render for Renderer<'_> {
+    type Settings = RenderSettings;
+    type Times = FrameTimes;
+    type Error = RenderError;
+
+    /// One frame of this volume: finished (in the request's image buffer
+    /// where the path can reuse it) or partial, timed, stoppable.
+    fn render(&self, mut request: FrameRequest<'_>) -> Result<Rendered, RenderError> {
+        let settings = request.settings();
+        let progress = request.progress();
+        let rendered = if request.wants_partial() {
+            let (partial, times) = self.partial_frame(settings, &progress)?;
+            Rendered {
+                picture: Picture::Partial(partial),
+                times,
+            }
+        } else {
+            let mut image = request.take_buffer();
+            let times = self.frame_into(settings, &mut image, &progress)?;
+            Rendered {
+                picture: Picture::Image(image),
+                times,
+            }
+        };
+        request.answer(rendered)
     }
 }

@@ -7,11 +7,11 @@ use crate::camera::Camera;
 use crate::error::{ImageSide, Reflection, SettingError};
 pub use crate::kernels::blend::Blend;
 use crate::kernels::phong::Phong;
-use crate::piece::Piece;
 use crate::sampling::clipping::ClipPlane;
 use crate::transfer::function::TransferFunction;
 use crate::transfer::gradient_opacity::GradientOpacity;
 use crate::transfer::iso::IsoSurface;
+use crate::volume::piece::Piece;
 use glam::DVec3;
 
 /// Largest image side, in pixels.
@@ -87,7 +87,7 @@ pub struct RenderSettings {
     /// value window.
     pub gradient_opacity_max: Option<f32>,
     /// Render only this piece of a larger volume, as one rank of a
-    /// distributed render does (see [`crate::piece`]); `None` renders the
+    /// distributed render does (see [`crate::volume::piece`]); `None` renders the
     /// renderer's volume as the whole.
     pub piece: Option<Piece>,
     /// Shade with the light that reaches each point through the volume

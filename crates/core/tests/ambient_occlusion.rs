@@ -16,6 +16,7 @@ use volray_core::{
     Blend, Classification, Image, Phong, RenderError, RenderSettings, Renderer, SettingError,
     Volume,
 };
+use volray_core::{FrameRequest, Render, Rendered};
 
 /// The reference's and the fast path's occlusion of every voxel of a grid
 /// of unit opacities `alpha`, the rays' spacing apart.
@@ -213,12 +214,20 @@ fn the_fast_paths_are_within_a_level_of_the_marched_occlusion() {
                 shading,
                 ..occluded(colorful(), Some(radius))
             };
-            let fast = renderer.render(&settings).unwrap();
-            let reference = renderer.render(&on_the_reference(&settings)).unwrap();
-            let plain = (renderer.render(&on_the_reference(&RenderSettings {
-                ambient_occlusion: None,
-                ..settings.clone()
-            })))
+            let fast = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
+            let reference = renderer
+                .render(FrameRequest::new(&on_the_reference(&settings)))
+                .unwrap()
+                .image();
+            let plain = (renderer
+                .render(FrameRequest::new(&on_the_reference(&RenderSettings {
+                    ambient_occlusion: None,
+                    ..settings.clone()
+                })))
+                .map(Rendered::image))
             .unwrap();
             let diff = fast.max_abs_diff(&reference).unwrap();
             let what = format!("{:?} {classification:?} lit {shading}", volume.dims());
@@ -263,13 +272,18 @@ fn without_ambient_occlusion_nothing_is_kept_and_frames_are_as_before() {
             ..settings.clone()
         };
         let used = Renderer::new(&volume).unwrap();
-        used.render(&RenderSettings {
+        used.render(FrameRequest::new(&RenderSettings {
             ambient_occlusion: Some(4.0),
             ..settings.clone()
-        })
-        .unwrap();
-        let after = used.render(&settings).unwrap();
-        let fresh = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+        }))
+        .unwrap()
+        .image();
+        let after = used.render(FrameRequest::new(&settings)).unwrap().image();
+        let fresh = Renderer::new(&volume)
+            .unwrap()
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         assert_eq!(after.pixels(), fresh.pixels(), "{classification:?}");
     }
 }
@@ -282,9 +296,13 @@ fn a_kept_ambient_volume_is_computed_again_for_another_radius_or_transfer_functi
     let first = occluded(colorful(), Some(3.0));
     for second in [occluded(colorful(), Some(7.0)), occluded(sparse, Some(3.0))] {
         let used = Renderer::new(&volume).unwrap();
-        let before: Image = used.render(&first).unwrap();
-        let after = used.render(&second).unwrap();
-        let fresh = Renderer::new(&volume).unwrap().render(&second).unwrap();
+        let before: Image = used.render(FrameRequest::new(&first)).unwrap().image();
+        let after = used.render(FrameRequest::new(&second)).unwrap().image();
+        let fresh = Renderer::new(&volume)
+            .unwrap()
+            .render(FrameRequest::new(&second))
+            .unwrap()
+            .image();
         assert_eq!(after.pixels(), fresh.pixels());
         assert_ne!(before.pixels(), after.pixels());
     }
@@ -300,7 +318,10 @@ fn ambient_occlusion_is_refused_for_projections_pieces_odd_radii_and_scenes() {
         ambient_occlusion: Some(4.0),
         ..RenderSettings::default()
     };
-    let refused = |settings: RenderSettings| match renderer.render(&settings) {
+    let refused = |settings: RenderSettings| match renderer
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image)
+    {
         Err(RenderError::Setting(e)) => e,
         other => panic!("expected a refusal, got {:?}", other.map(|_| ())),
     };
@@ -323,11 +344,12 @@ fn ambient_occlusion_is_refused_for_projections_pieces_odd_radii_and_scenes() {
     }
     // Unlit frames take it: the colour is the ambient light's.
     renderer
-        .render(&RenderSettings {
+        .render(FrameRequest::new(&RenderSettings {
             shading: false,
             ..on.clone()
-        })
-        .unwrap();
+        }))
+        .unwrap()
+        .image();
     let layers = vec![
         Renderer::new(&volume).unwrap(),
         Renderer::new(&volume).unwrap(),
@@ -338,6 +360,6 @@ fn ambient_occlusion_is_refused_for_projections_pieces_odd_radii_and_scenes() {
         settings: on,
         mix: Mix::Composite,
     };
-    let e = scene.render(&request).unwrap_err();
+    let e = scene.render(FrameRequest::new(&request)).unwrap_err();
     assert!(e.to_string().contains("ambient occlusion"), "{e}");
 }

@@ -7,6 +7,7 @@ mod common;
 use common::{assert_within_a_level, both_paths, tf};
 use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
+use volray_core::{FrameRequest, Render, Rendered};
 use volray_core::{Image, IsoSurface, RenderError, RenderSettings, Renderer, SettingError, Volume};
 
 /// The fast and the reference image of one frame, which must agree within
@@ -71,7 +72,7 @@ fn an_iso_surface_of_a_distance_field_is_a_hollow_shell() {
         iso: None,
         ..settings.clone()
     };
-    let filled = renderer.render(&ball).unwrap();
+    let filled = renderer.render(FrameRequest::new(&ball)).unwrap().image();
     assert!(filled.get(20, 20)[3] > alpha(20, 20) + 0.2);
 
     // Other views and steps, and an anisotropic grid, on both paths.
@@ -125,9 +126,13 @@ fn changing_the_iso_surface_reclassifies() {
         }),
         ..RenderSettings::default()
     };
-    let first = shared.render(&at(0.4)).unwrap();
-    let second = shared.render(&at(0.8)).unwrap();
-    let fresh = Renderer::new(&volume).unwrap().render(&at(0.8)).unwrap();
+    let first = shared.render(FrameRequest::new(&at(0.4))).unwrap().image();
+    let second = shared.render(FrameRequest::new(&at(0.8))).unwrap().image();
+    let fresh = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&at(0.8)))
+        .unwrap()
+        .image();
     assert_eq!(second, fresh);
     assert_ne!(first, second);
 }
@@ -211,7 +216,10 @@ fn classification_settings_are_validated() {
         SettingError::GradientOpacity { lo: 0.0, hi: 1.5 },
     ];
     for (settings, want) in bad.iter().zip(want) {
-        match renderer.render(settings) {
+        match renderer
+            .render(FrameRequest::new(settings))
+            .map(Rendered::image)
+        {
             // NaN != NaN: compare the messages.
             Err(RenderError::Setting(got)) => assert_eq!(got.to_string(), want.to_string()),
             other => panic!("{settings:?}: {other:?}"),

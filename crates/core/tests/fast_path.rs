@@ -12,6 +12,7 @@ use common::{
 };
 use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
+use volray_core::{FrameRequest, Render};
 use volray_core::{Image, RenderSettings, Renderer, TransferFunction, Volume};
 
 /// The fewest pixels of opacity above 0.2 the reference must show for a
@@ -183,8 +184,7 @@ fn bricks_hidden_behind_an_opaque_surface_are_not_lit() {
             "color": [[0, 0.2, 0.6, 0.9], [1, 0.9, 0.5, 0.2]]}"#),
         ..RenderSettings::default()
     };
-    let mut image = Image::new(0, 0, [0.0; 4]);
-    let times = renderer.render_into(&settings, &mut image).unwrap();
+    let times = renderer.render(FrameRequest::new(&settings)).unwrap().times;
     // 10 × 3 × 3 bricks, all occupied; the front layer's 9 are lit (a
     // ray on a brick face may also reach the second layer).
     assert_eq!(times.bricks, 90);
@@ -197,7 +197,7 @@ fn bricks_hidden_behind_an_opaque_surface_are_not_lit() {
             "color": [[0, 0.2, 0.6, 0.9], [1, 0.9, 0.5, 0.2]]}"#),
         ..settings
     };
-    let times = renderer.render_into(&faint, &mut image).unwrap();
+    let times = renderer.render(FrameRequest::new(&faint)).unwrap().times;
     assert_eq!(times.lit, 90);
 }
 
@@ -222,8 +222,18 @@ fn classification_follows_the_transfer_function_between_frames() {
         frame(other, 1.0),
         frame(sparse_tf(), 0.5),
     ] {
-        let fresh = Renderer::new(&volume).unwrap().render(&settings).unwrap();
-        assert_eq!(renderer.render(&settings).unwrap(), fresh);
+        let fresh = Renderer::new(&volume)
+            .unwrap()
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
+        assert_eq!(
+            renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image(),
+            fresh
+        );
     }
 }
 
@@ -290,9 +300,13 @@ fn a_faint_dense_volume_beyond_the_cache_budget_is_lit_once_a_frame() {
             let tight = Renderer::new(&volume).unwrap().with_cache_budget(budget);
             let (mut want, mut got) = (Image::new(0, 0, [0.0; 4]), Image::new(0, 0, [0.0; 4]));
             for settings in &frames {
-                let all = roomy.render_into(settings, &mut want).unwrap();
+                let request = FrameRequest::new(settings).reusing(want);
+                let all;
+                (want, all) = roomy.render(request).unwrap().image_and_times();
                 assert_eq!((all.bricks, all.lit, all.classified), (bricks, bricks, 0));
-                let some = tight.render_into(settings, &mut got).unwrap();
+                let request = FrameRequest::new(settings).reusing(got);
+                let some;
+                (got, some) = tight.render(request).unwrap().image_and_times();
                 assert!(got == want, "{threads} threads");
                 assert!(some.cached_bytes <= budget);
                 // Each brick lit once; classified once where the cache

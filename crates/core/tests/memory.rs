@@ -11,6 +11,7 @@ use volray_core::{
     Blend, Classification, DEFAULT_CACHE_BUDGET, MemoryBound, Method, NonFinite, RenderSettings,
     Renderer, SampleType, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 /// The system allocator, counting the bytes held and their peak.
 struct Counting;
@@ -179,16 +180,20 @@ fn the_bound_holds_within_ten_percent_on_every_path() {
     // The thread pool's own allocations, once, before anything is counted.
     Renderer::new(&dense(9))
         .unwrap()
-        .render(&RenderSettings {
+        .render(FrameRequest::new(&RenderSettings {
             width: 8,
             height: 8,
             ..RenderSettings::default()
-        })
-        .unwrap();
+        }))
+        .unwrap()
+        .image();
     for (what, settings) in cases {
         let measured = peak_during(|| {
             let renderer = Renderer::new(&volume).unwrap();
-            let image = renderer.render(&settings).unwrap();
+            let image = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             assert!(image.pixels().iter().any(|p| p[3] > 0.5), "{what}");
         });
         let bound =
@@ -257,13 +262,19 @@ fn a_cache_budget_bounds_the_memory_and_changes_no_pixel() {
         })
         .collect();
     let unbounded = Renderer::new(&volume).unwrap();
-    let want: Vec<_> = views.iter().map(|s| unbounded.render(s).unwrap()).collect();
+    let want: Vec<_> = views
+        .iter()
+        .map(|s| unbounded.render(FrameRequest::new(s)).unwrap().image())
+        .collect();
     drop(unbounded);
     for budget in [6 << 20, 2 << 20, 0] {
         let measured = peak_during(|| {
             let renderer = Renderer::new(&volume).unwrap().with_cache_budget(budget);
             for (s, want) in views.iter().zip(&want) {
-                assert!(renderer.render(s).unwrap() == *want, "budget {budget}");
+                assert!(
+                    renderer.render(FrameRequest::new(s)).unwrap().image() == *want,
+                    "budget {budget}"
+                );
             }
         });
         let bound = MemoryBound::for_volume(&volume, &views[0], NonFinite::Refuse, budget);

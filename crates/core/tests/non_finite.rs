@@ -15,6 +15,7 @@ use volray_core::{
     Blend, Classification, ClipPlane, Image, IsoSurface, Method, NonFinite, RenderError,
     RenderSettings, Renderer, TransferFunction, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 fn transparent(volume: &Volume) -> Renderer<'_> {
     Renderer::with_non_finite(volume, NonFinite::Transparent).unwrap()
@@ -85,8 +86,18 @@ fn non_finite_values_are_refused_by_default_with_their_count() {
         height: 16,
         ..RenderSettings::default()
     };
-    let plain = Renderer::new(&finite).unwrap().render(&settings).unwrap();
-    assert!(renderer.render(&settings).unwrap() == plain);
+    let plain = Renderer::new(&finite)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
+    assert!(
+        renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image()
+            == plain
+    );
 }
 
 #[test]
@@ -138,7 +149,10 @@ fn a_non_finite_slab_in_a_uniform_medium_leaves_the_shorter_medium() {
                         Method::Reference => 1e-5,
                         Method::Fast => 1.0 / 255.0,
                     };
-                    let image = renderer.render(&settings).unwrap();
+                    let image = renderer
+                        .render(FrameRequest::new(&settings))
+                        .unwrap()
+                        .image();
                     let what = format!("{classification:?} step {step} {method:?}");
                     assert_uniform_medium(&image, light, c, bg, keep, tol, &what);
                     checked += 1;
@@ -290,15 +304,24 @@ fn fast_paths_match_the_reference_with_non_finite_regions_in_every_mode() {
                 camera,
                 ..settings.clone()
             };
-            let fast = renderer.render(&settings).unwrap();
-            let slow = renderer.render(&on_the_reference(&settings)).unwrap();
+            let fast = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
+            let slow = renderer
+                .render(FrameRequest::new(&on_the_reference(&settings)))
+                .unwrap()
+                .image();
             let diff = assert_within_a_level(&fast, &slow, &format!("{name}, {camera:?}"));
             worst = worst.max(diff);
             assert!(
                 slow.pixels().iter().any(|p| p[3] > 0.2),
                 "{name}: the image is empty"
             );
-            let plain = unmasked.render(&on_the_reference(&settings)).unwrap();
+            let plain = unmasked
+                .render(FrameRequest::new(&on_the_reference(&settings)))
+                .unwrap()
+                .image();
             changed = changed.max(plain.max_abs_diff(&slow).unwrap());
         }
         println!("{name}: masking changed the picture by {changed}");
@@ -367,18 +390,22 @@ fn projections_with_infinite_voxels_equal_those_of_the_data_cut_before_them() {
                     transfer_function: grey_unit_window(),
                     ..RenderSettings::default()
                 };
-                let got = masked.render(&settings).unwrap();
+                let got = masked.render(FrameRequest::new(&settings)).unwrap().image();
                 let want = cropped
-                    .render(&RenderSettings {
+                    .render(FrameRequest::new(&RenderSettings {
                         crop,
                         ..settings.clone()
-                    })
-                    .unwrap();
+                    }))
+                    .unwrap()
+                    .image();
                 let diff = got.max_abs_diff(&want).unwrap();
                 assert!(diff < 1e-6, "{blend:?} {camera:?} {method:?}: {diff}");
                 assert!(got.pixels().iter().filter(|p| p[3] == 1.0).count() > 200);
                 // Uncropped, the bright planes show: the cut is not vacuous.
-                let whole = cropped.render(&settings).unwrap();
+                let whole = cropped
+                    .render(FrameRequest::new(&settings))
+                    .unwrap()
+                    .image();
                 if blend == Blend::Maximum {
                     assert!(whole.max_abs_diff(&got).unwrap() > 0.1);
                 }
@@ -432,7 +459,10 @@ fn a_blob_in_a_sea_of_nan_renders_as_the_blob() {
             method,
             ..RenderSettings::default()
         };
-        let image = renderer.render(&settings).unwrap();
+        let image = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         assert!((image.get(12, 12)[0] - 1.0).abs() < 1e-6, "{method:?}");
         for row in 0..25 {
             for col in 0..25 {
@@ -462,11 +492,12 @@ fn a_blob_in_a_sea_of_nan_renders_as_the_blob() {
         };
         for classification in [Classification::Pre, Classification::Post] {
             let image = renderer
-                .render(&RenderSettings {
+                .render(FrameRequest::new(&RenderSettings {
                     classification,
                     ..settings.clone()
-                })
-                .unwrap();
+                }))
+                .unwrap()
+                .image();
             for row in 0..25 {
                 for col in 0..25 {
                     let (y, z) = line(col, row);
@@ -502,7 +533,10 @@ fn a_volume_of_nothing_but_non_finite_values_renders_the_background() {
                     background: bg,
                     ..RenderSettings::default()
                 };
-                let image = renderer.render(&settings).unwrap();
+                let image = renderer
+                    .render(FrameRequest::new(&settings))
+                    .unwrap()
+                    .image();
                 let want = Image::new(12, 12, [bg[0], bg[1], bg[2], 0.0]);
                 assert!(image == want, "{blend:?} {classification:?} {method:?}");
             }

@@ -16,6 +16,7 @@ use volray_core::{
     Blend, Classification, ClipPlane, Image, Method, RenderSettings, Renderer, TransferFunction,
     Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 /// A ball of radius `r` about `centre` with a soft edge one voxel wide.
 fn ball(n: usize, r: f64, centre: DVec3) -> Volume {
@@ -79,7 +80,10 @@ fn projections_of_a_ramp_seen_along_it_are_its_maximum_minimum_and_mean() {
                 method,
                 ..RenderSettings::default()
             };
-            let image = renderer.render(&settings).unwrap();
+            let image = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             for row in 0..8 {
                 for col in 0..12 {
                     let (y, z) = ((col as f64 + 0.5) / 2.0, 4.0 - (row as f64 + 0.5) / 2.0);
@@ -168,7 +172,10 @@ fn projections_equal_a_brute_force_pass_over_the_samples_of_oblique_and_perspect
                 method,
                 ..RenderSettings::default()
             };
-            let image = renderer.render(&settings).unwrap();
+            let image = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             let view = View::frame(&camera, volume.bounds(), 24, 20).unwrap();
             let mut hits = 0;
             for row in 0..20 {
@@ -239,7 +246,10 @@ fn fast_projections_match_the_reference_with_every_option() {
                 let in_pool = |threads| render_on_threads(&renderer, &settings, threads);
                 let (fast, fast_2) = (in_pool(1), in_pool(2));
                 assert!(fast == fast_2);
-                let slow = renderer.render(&on_the_reference(&settings)).unwrap();
+                let slow = renderer
+                    .render(FrameRequest::new(&on_the_reference(&settings)))
+                    .unwrap()
+                    .image();
                 let diff =
                     assert_within_a_level(&fast, &slow, &format!("{camera:?} {blend:?} {jitter}"));
                 worst = worst.max(diff);
@@ -304,8 +314,14 @@ fn maximum_projection_finds_single_voxels_behind_brighter_bricks() {
             camera,
             ..RenderSettings::default()
         };
-        let fast = renderer.render(&settings).unwrap();
-        let slow = renderer.render(&on_the_reference(&settings)).unwrap();
+        let fast = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
+        let slow = renderer
+            .render(FrameRequest::new(&on_the_reference(&settings)))
+            .unwrap()
+            .image();
         // f32 against f64 interpolation.
         assert!(max_diff(&fast, &slow) < 1e-5);
         // Each spot shows at (nearly) its full height where its centre
@@ -365,8 +381,14 @@ fn skipping_resumes_at_the_first_sample_past_a_skipped_brick() {
                 transfer_function: grey_unit_window(),
                 ..RenderSettings::default()
             };
-            let fast = renderer.render(&settings).unwrap();
-            let slow = renderer.render(&on_the_reference(&settings)).unwrap();
+            let fast = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
+            let slow = renderer
+                .render(FrameRequest::new(&on_the_reference(&settings)))
+                .unwrap()
+                .image();
             assert!(max_diff(&fast, &slow) < 1e-5, "{blend:?} {camera:?}");
             // The wall shows through everywhere it is seen.
             let wall = if flip { 0.1 } else { 0.9 };
@@ -446,11 +468,12 @@ fn a_clip_plane_equals_the_equivalent_crop() {
     for method in [Method::Fast, Method::Reference] {
         let with = |s: &RenderSettings| {
             renderer
-                .render(&RenderSettings {
+                .render(FrameRequest::new(&RenderSettings {
                     method,
                     ..s.clone()
-                })
+                }))
                 .unwrap()
+                .image()
         };
         let (plane, crop, whole) = (with(&clipped), with(&cropped), with(&base));
         assert!(max_diff(&plane, &crop) < 1e-6, "{method:?}");
@@ -560,11 +583,12 @@ fn jitter_is_deterministic_and_stays_close_to_the_plain_image_of_a_smooth_volume
         let (one, two, again) = (in_pool(1), in_pool(2), in_pool(2));
         assert!(one == two && two == again, "{:?}", settings.method);
         let unjittered = renderer
-            .render(&RenderSettings {
+            .render(FrameRequest::new(&RenderSettings {
                 jitter: false,
                 ..settings.clone()
-            })
-            .unwrap();
+            }))
+            .unwrap()
+            .image();
         // Moving every sample by less than a step changes the picture, but
         // only a little: the volume is smooth at the scale of a voxel.
         let (max, mean) = (max_diff(&one, &unjittered), mean_diff(&one, &unjittered));
@@ -604,7 +628,10 @@ fn post_classification_of_a_uniform_medium_has_the_closed_form_colour() {
             };
             let keep = (1.0 - alpha).powf(step * k as f64);
             let light = if shading { 0.1 } else { 1.0 };
-            let image = renderer.render(&settings).unwrap();
+            let image = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             assert_uniform_medium(&image, light, c, bg, keep, 1e-5, &format!("step {step}"));
         }
     }
@@ -632,13 +659,14 @@ fn post_and_pre_classification_agree_on_a_smooth_volume() {
     };
     let post = |s: &RenderSettings| {
         renderer
-            .render(&RenderSettings {
+            .render(FrameRequest::new(&RenderSettings {
                 classification: Classification::Post,
                 ..s.clone()
-            })
+            }))
             .unwrap()
+            .image()
     };
-    let pre = renderer.render(&linear).unwrap();
+    let pre = renderer.render(FrameRequest::new(&linear)).unwrap().image();
     assert!(max_diff(&pre, &post(&linear)) < 1e-5);
     // Lit, with a non-linear transfer function, the orders differ but not
     // by much on data this smooth.
@@ -647,7 +675,10 @@ fn post_and_pre_classification_agree_on_a_smooth_volume() {
         transfer_function: colorful(),
         ..linear
     };
-    let (pre, post) = (renderer.render(&lit).unwrap(), post(&lit));
+    let (pre, post) = (
+        renderer.render(FrameRequest::new(&lit)).unwrap().image(),
+        post(&lit),
+    );
     let (max, mean) = (max_diff(&pre, &post), mean_diff(&pre, &post));
     println!("post vs pre: {max:.4} at most, {mean:.5} on average");
     assert!(
@@ -699,7 +730,10 @@ fn perspective_shows_a_near_ball_larger_than_the_same_ball_far_away() {
         let view = View::frame(&camera, volume.bounds(), 64, 64).unwrap();
         let mut counts = Vec::new();
         for settings in [settings.clone(), on_the_reference(&settings)] {
-            let image = renderer.render(&settings).unwrap();
+            let image = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             let mut count = 0;
             for row in 0..64 {
                 for col in 0..64 {
@@ -753,7 +787,10 @@ fn bad_crops_and_clip_planes_are_refused_by_name() {
         ),
     ];
     for (settings, expect) in cases {
-        let err = renderer.render(&settings).unwrap_err().to_string();
+        let err = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains(expect), "{err}");
     }
 }

@@ -14,6 +14,7 @@ use volray_core::glam::DVec3;
 use volray_core::{
     Blend, Classification, Image, PartialImage, RenderSettings, Renderer, TransferFunction,
 };
+use volray_core::{FrameRequest, Render};
 
 fn volume() -> volray_core::Volume {
     blobs([33, 29, 25], DVec3::new(1.0, 1.2, 0.9), DVec3::ZERO)
@@ -72,14 +73,17 @@ fn a_finished_partial_image_is_the_frame_render_gives_on_every_path() {
     let volume = volume();
     let renderer = Renderer::new(&volume).unwrap();
     for (what, s) in every_path() {
-        let partial = renderer.render_partial(&s, &|_| {}).unwrap();
+        let partial = renderer
+            .render(FrameRequest::new(&s).partial())
+            .unwrap()
+            .partial();
         let finished = renderer.finish(&s, partial);
-        let frame = renderer.render(&s).unwrap();
+        let frame = renderer.render(FrameRequest::new(&s)).unwrap().image();
         assert!(finished == frame, "{what}");
-        // And `render_into`, reusing a buffer of another frame.
-        let mut reused = Image::new(7, 3, [0.5; 4]);
-        renderer.render_into(&s, &mut reused).unwrap();
-        assert!(reused == frame, "{what}: render_into");
+        // And into a reused buffer of another frame.
+        let reusing = FrameRequest::new(&s).reusing(Image::new(7, 3, [0.5; 4]));
+        let reused = renderer.render(reusing).unwrap().image();
+        assert!(reused == frame, "{what}: reusing a buffer");
         assert!(frame.pixels().iter().any(|p| p[3] > 0.5), "{what}: empty");
     }
 }
@@ -132,12 +136,15 @@ fn halves_rendered_apart_and_combined_front_to_back_give_the_whole_frame() {
                     crop: Some(crop),
                     ..whole.clone()
                 };
-                renderer.render_partial(&s, &|_| {}).unwrap()
+                renderer
+                    .render(FrameRequest::new(&s).partial())
+                    .unwrap()
+                    .partial()
             };
             let mut combined: PartialImage = piece(front);
             combined.combine(&piece(back));
             let combined = renderer.finish(&whole, combined);
-            let frame = renderer.render(&whole).unwrap();
+            let frame = renderer.render(FrameRequest::new(&whole)).unwrap().image();
             let diff = combined.max_abs_diff(&frame).unwrap();
             // The fast path stops a ray once T < 1/1024, within each half
             // for the pieces: each image is within T < 1/1024 of the exact

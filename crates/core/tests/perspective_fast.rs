@@ -13,7 +13,7 @@ use common::{
 };
 use volray_core::camera::{Camera, View};
 use volray_core::glam::DVec3;
-use volray_core::{ClipPlane, Image, RenderSettings, Renderer, Volume};
+use volray_core::{ClipPlane, FrameRequest, Image, Render, RenderSettings, Renderer, Volume};
 
 /// The fewest pixels of opacity above 0.2 the reference must show for a
 /// comparison to count.
@@ -322,10 +322,9 @@ fn perspective_frames_run_on_the_bricked_path() {
     // The frame times its parts as a bricked frame does.
     let volume = blobs([20, 20, 20], DVec3::ONE);
     let renderer = Renderer::new(&volume).unwrap();
-    let mut image = Image::new(1, 1, [0.0; 4]);
-    let times = renderer
-        .render_into(&base_settings(perspective(30.0), 1.0), &mut image)
-        .unwrap();
+    let settings = base_settings(perspective(30.0), 1.0);
+    let request = FrameRequest::new(&settings).reusing(Image::new(1, 1, [0.0; 4]));
+    let (image, times) = renderer.render(request).unwrap().image_and_times();
     assert!(times.bricks > 0);
     let view = View::frame(&perspective(30.0), volume.bounds(), 37, 29).unwrap();
     assert!(matches!(view, View::Perspective(_)));

@@ -14,6 +14,7 @@ use volray_core::sampling::grid::GridFrame;
 use volray_core::{
     Blend, Classification, ClipPlane, PartialImage, Piece, RenderSettings, Renderer, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 fn volume() -> Volume {
     blobs(
@@ -154,12 +155,12 @@ fn one_piece_owning_the_whole_grid_renders_the_whole_frame() {
     let one = Renderer::new(&v).unwrap();
     for (name, camera) in cameras() {
         let s = settings(camera);
-        let frame = whole.render(&s).unwrap();
+        let frame = whole.render(FrameRequest::new(&s)).unwrap().image();
         let with_piece = RenderSettings {
             piece: Some(piece.clone()),
             ..s
         };
-        let as_piece = one.render(&with_piece).unwrap();
+        let as_piece = one.render(FrameRequest::new(&with_piece)).unwrap().image();
         assert!(as_piece == frame, "{name}");
     }
 }
@@ -198,14 +199,14 @@ fn slabs_composited_front_to_back_give_the_whole_frame_on_every_path() {
                     ..settings(camera)
                 };
                 let s = if reference { on_the_reference(&s) } else { s };
-                let frame = whole.render(&s).unwrap();
+                let frame = whole.render(FrameRequest::new(&s)).unwrap().image();
                 let mut parts: Vec<PartialImage> = (pieces.iter().zip(&renderers))
                     .map(|((_, piece), r)| {
                         let s = RenderSettings {
                             piece: Some(piece.clone()),
                             ..s.clone()
                         };
-                        r.render_partial(&s, &|_| {}).unwrap()
+                        r.render(FrameRequest::new(&s).partial()).unwrap().partial()
                     })
                     .collect();
                 // The eye is on the +x side of every one of these views.

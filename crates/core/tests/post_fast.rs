@@ -18,6 +18,7 @@ use volray_core::glam::DVec3;
 use volray_core::{
     Classification, ClipPlane, IsoSurface, RenderSettings, Renderer, TransferFunction, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 /// `common::assert_matches` for a post-classified frame: the fast path
 /// within 1/255 per channel of the reference, which shows at least 10
@@ -338,7 +339,7 @@ fn a_uniform_medium_has_the_closed_form_colour_on_the_fast_path() {
             };
             let keep = (1.0 - alpha).powf(step * k as f64);
             let light = if shading { 0.1 } else { 1.0 };
-            let image = renderer.render(&s).unwrap();
+            let image = renderer.render(FrameRequest::new(&s)).unwrap().image();
             let what = format!("step {step}, lit {shading}");
             assert_uniform_medium(&image, light, c, bg, keep, 1e-5, &what);
         }

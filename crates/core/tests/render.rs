@@ -9,11 +9,16 @@ use common::{
 };
 use volray_core::camera::{Camera, OrthographicView};
 use volray_core::glam::DVec3;
+use volray_core::{FrameRequest, Render};
 use volray_core::{Image, Method, RenderSettings, Renderer, TransferFunction, Volume};
 
 /// `settings` rendered by a new renderer of `volume`.
 fn render(volume: &Volume, settings: &RenderSettings) -> Image {
-    Renderer::new(volume).unwrap().render(settings).unwrap()
+    Renderer::new(volume)
+        .unwrap()
+        .render(FrameRequest::new(settings))
+        .unwrap()
+        .image()
 }
 
 /// `common::blobs` on `dims` points of `spacing` from (−2, 5, 1).
@@ -420,7 +425,10 @@ fn invalid_settings_are_refused_by_name() {
         ),
     ];
     for (settings, expect) in cases {
-        let err = renderer.render(&settings).unwrap_err().to_string();
+        let err = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains(expect), "{err}");
     }
 }

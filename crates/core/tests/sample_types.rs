@@ -12,6 +12,7 @@ use volray_core::{
     Blend, Classification, IsoSurface, Method, NonFinite, RenderSettings, Renderer, SampleType,
     Samples, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 /// A smooth field with structure at every scale, as `T` values over
 /// `[lo, hi]` (rounded to whole numbers).
@@ -138,7 +139,10 @@ fn assert_renders_as_f32(typed: Volume, what: &str) {
             }),
             ..settings
         };
-        let (x, y) = (a.render(&settings).unwrap(), b.render(&settings).unwrap());
+        let (x, y) = (
+            a.render(FrameRequest::new(&settings)).unwrap().image(),
+            b.render(FrameRequest::new(&settings)).unwrap().image(),
+        );
         assert!(x == y, "{what}, {name}: differs from its f32 conversion");
         assert!(
             x.pixels().iter().any(|p| p[3] > 0.3),

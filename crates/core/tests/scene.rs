@@ -17,6 +17,7 @@ use volray_core::{
     Blend, Classification, Image, Method, PartialImage, Piece, PiecewiseLinear, RenderError,
     RenderSettings, Renderer, SceneError, TransferFunction, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 /// A ball of density `1 − r/radius` about `centre` (world units) on
 /// `dims` points of `spacing` from `origin`.
@@ -56,7 +57,7 @@ fn coloured(settings: &RenderSettings, rgb: [f32; 3]) -> Look {
 }
 
 fn render(scene: &Scene, request: &SceneSettings) -> Image {
-    scene.render(request).unwrap()
+    scene.render(FrameRequest::new(request)).unwrap().image()
 }
 
 /// The fast image of `request` against the reference's: within 1/255 per
@@ -316,7 +317,10 @@ fn a_scene_of_one_volume_renders_exactly_as_its_renderer() {
                 classification,
                 ..small(40)
             };
-            let alone = renderer.render(&settings).unwrap();
+            let alone = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             let scene = Scene::new(vec![Renderer::new(&v).unwrap()]).unwrap();
             let request = SceneSettings {
                 looks: vec![Look::of(&settings)],
@@ -344,7 +348,11 @@ fn a_transparent_or_hidden_second_channel_leaves_the_first_as_it_renders_alone()
         transfer_function: colorful(),
         ..small(40)
     };
-    let alone = Renderer::new(&a).unwrap().render(&settings).unwrap();
+    let alone = Renderer::new(&a)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     let scene = Scene::new(vec![Renderer::new(&a).unwrap(), Renderer::new(&b).unwrap()]).unwrap();
     let nothing = TransferFunction {
         opacity: Some(PiecewiseLinear::constant([0.0])),
@@ -385,7 +393,11 @@ fn the_additive_mix_sums_the_channels_colours() {
             },
             ..settings.clone()
         };
-        Renderer::new(v).unwrap().render(&s).unwrap()
+        Renderer::new(v)
+            .unwrap()
+            .render(FrameRequest::new(&s))
+            .unwrap()
+            .image()
     };
     let (ra, gb) = (alone(&a, &red), alone(&b, &green));
     let scene = Scene::new(vec![Renderer::new(&a).unwrap(), Renderer::new(&b).unwrap()]).unwrap();
@@ -620,7 +632,7 @@ fn refused_scenes_name_the_volume_and_the_problem() {
         mix: Mix::Composite,
     };
     assert_eq!(
-        scene.render(&request).err(),
+        scene.render(FrameRequest::new(&request)).err(),
         Some(RenderError::Scene(SceneError::Looks {
             layers: 2,
             looks: 1
@@ -637,7 +649,7 @@ fn refused_scenes_name_the_volume_and_the_problem() {
         settings: settings.clone(),
         mix: Mix::Composite,
     };
-    let err = scene.render(&request).unwrap_err();
+    let err = scene.render(FrameRequest::new(&request)).unwrap_err();
     assert_eq!(err.to_string(), "volume 1: opacity 1.5 must be in [0, 1]");
     let request = SceneSettings {
         looks: vec![
@@ -650,7 +662,7 @@ fn refused_scenes_name_the_volume_and_the_problem() {
         settings,
         mix: Mix::Composite,
     };
-    let err = scene.render(&request).unwrap_err();
+    let err = scene.render(FrameRequest::new(&request)).unwrap_err();
     assert!(
         err.to_string().starts_with("volume 1: opacity ramp"),
         "{err}"
@@ -755,7 +767,10 @@ fn pieces_of_a_scene_composited_front_to_back_give_the_whole_scenes_frame() {
                             looks,
                             ..request.clone()
                         };
-                        scene.render_partial(&request, &|_| {}).unwrap()
+                        scene
+                            .render(FrameRequest::new(&request).partial())
+                            .unwrap()
+                            .partial()
                     })
                     .collect();
                 let mut front = parts.pop().unwrap();
@@ -790,7 +805,7 @@ fn pieces_of_a_scene_composited_front_to_back_give_the_whole_scenes_frame() {
         settings,
         mix: Mix::Additive,
     };
-    let err = scenes[0].render(&request).unwrap_err();
+    let err = scenes[0].render(FrameRequest::new(&request)).unwrap_err();
     assert!(
         err.to_string().contains("only in the composite mix"),
         "{err}"
@@ -800,7 +815,7 @@ fn pieces_of_a_scene_composited_front_to_back_give_the_whole_scenes_frame() {
         mix: Mix::Composite,
         ..request
     };
-    let err = scenes[0].render(&request).unwrap_err();
+    let err = scenes[0].render(FrameRequest::new(&request)).unwrap_err();
     assert!(
         err.to_string().contains("every volume is a piece, or none"),
         "{err}"

@@ -14,6 +14,7 @@ use volray_core::shadows::{ShadowRay, reference_light};
 use volray_core::{
     Blend, Classification, Image, RenderError, RenderSettings, Renderer, SettingError, Volume,
 };
+use volray_core::{FrameRequest, Render, Rendered};
 
 /// A ball of radius 6 voxels centred at (20, 20, 24) over a plate filling
 /// z = 4..=6, in a 40³ grid of unit spacing: 1 inside, 0 outside.
@@ -121,7 +122,11 @@ fn in_the_shadow_the_plate_keeps_its_ambient_light_and_elsewhere_all_of_it() {
     for method in [volray_core::Method::Fast, volray_core::Method::Reference] {
         let render = |light, shadows| {
             let settings = from_above(light, shadows);
-            (renderer.render(&RenderSettings { method, ..settings })).unwrap()
+            let settings = RenderSettings { method, ..settings };
+            renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image()
         };
         // Lit from above and +x: inside the shadow, clear of the ball, the
         // plate keeps the ambient term (0.1) only; unshadowed it takes
@@ -211,14 +216,21 @@ fn the_fast_paths_are_within_two_levels_of_the_marched_shadows_on_smooth_volumes
             (DVec3::new(-1.0, 1.0, 1.0), Classification::Post, 1.0),
         ] {
             let settings = shadowed(colorful(), Some(light), classification, step);
-            let fast = renderer.render(&settings).unwrap();
-            let reference = renderer.render(&on_the_reference(&settings)).unwrap();
+            let fast = renderer
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
+            let reference = renderer
+                .render(FrameRequest::new(&on_the_reference(&settings)))
+                .unwrap()
+                .image();
             let plain = renderer
-                .render(&RenderSettings {
+                .render(FrameRequest::new(&RenderSettings {
                     shadows: false,
                     ..settings.clone()
-                })
-                .unwrap();
+                }))
+                .unwrap()
+                .image();
             let diff = fast.max_abs_diff(&reference).unwrap();
             let what = format!("{:?} light {light} {classification:?}", volume.dims());
             // Post-classified samples read the light volume between voxels,
@@ -268,8 +280,14 @@ fn where_the_sweep_is_known_to_part_from_the_march_it_stays_within_its_measured_
     for (volume, tf, light, classification, bound) in cases {
         let renderer = Renderer::new(&volume).unwrap();
         let settings = shadowed(tf, light, classification, 0.5);
-        let fast = renderer.render(&settings).unwrap();
-        let reference = renderer.render(&on_the_reference(&settings)).unwrap();
+        let fast = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
+        let reference = renderer
+            .render(FrameRequest::new(&on_the_reference(&settings)))
+            .unwrap()
+            .image();
         let diff = fast.max_abs_diff(&reference).unwrap() * 255.0;
         assert!(diff <= bound, "{:?} {light:?}: {diff}/255", volume.dims());
     }
@@ -308,13 +326,18 @@ fn without_shadows_the_light_volume_is_not_kept_and_frames_are_as_before() {
         ..RenderSettings::default()
     };
     let used = Renderer::new(&volume).unwrap();
-    used.render(&RenderSettings {
+    used.render(FrameRequest::new(&RenderSettings {
         shadows: true,
         ..settings.clone()
-    })
-    .unwrap();
-    let after = used.render(&settings).unwrap();
-    let fresh = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    }))
+    .unwrap()
+    .image();
+    let after = used.render(FrameRequest::new(&settings)).unwrap().image();
+    let fresh = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     assert_eq!(after.pixels(), fresh.pixels());
 }
 
@@ -338,7 +361,10 @@ fn shadows_are_refused_where_nothing_is_lit_or_several_volumes_meet() {
             ..shadows.clone()
         },
     ] {
-        match renderer.render(&settings) {
+        match renderer
+            .render(FrameRequest::new(&settings))
+            .map(Rendered::image)
+        {
             Err(RenderError::Setting(SettingError::Shadows(why))) => {
                 assert!(
                     why.contains("projection") || why.contains("lighting"),
@@ -359,6 +385,6 @@ fn shadows_are_refused_where_nothing_is_lit_or_several_volumes_meet() {
         settings: shadows,
         mix: Mix::Composite,
     };
-    let error = scene.render(&request).unwrap_err();
+    let error = scene.render(FrameRequest::new(&request)).unwrap_err();
     assert!(error.to_string().contains("shadows"), "{error}");
 }

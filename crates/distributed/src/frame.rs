@@ -17,8 +17,8 @@ use volray_core::kernels::gradient::{Differences, magnitude};
 use volray_core::sampling::grid::GridFrame;
 use volray_core::transfer::labels::{LabelError, labels_of};
 use volray_core::{
-    Histogram, Image, NonFinite, PartialImage, Piece, RenderError, RenderSettings, Renderer,
-    Volume, with_samples,
+    FrameRequest, Histogram, Image, NonFinite, PartialImage, Piece, Render, RenderError,
+    RenderSettings, Renderer, Volume, with_samples,
 };
 
 /// Where a rank's piece comes from: volray-core's one interface to
@@ -391,7 +391,8 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
         .map_err(RenderError::from)?;
         let viewpoint = Viewpoint::of(&view);
         let rendered = match &self.held.renderer {
-            Some(r) => r.render_partial_timed(&settings, &|_| {}).map(Some),
+            Some(r) => (r.render(FrameRequest::new(&settings).partial()))
+                .map(|r| Some(r.partial_and_times())),
             None => settings.validate().map(|_| None).map_err(RenderError::from),
         };
         // Every rank refuses the same settings alike; anything else (one

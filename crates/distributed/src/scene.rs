@@ -19,7 +19,9 @@ use std::time::Instant;
 use thiserror::Error;
 use volray_core::camera::View;
 use volray_core::scene::{Mix, Scene, SceneSettings};
-use volray_core::{Image, NonFinite, PartialImage, RenderError, Renderer};
+use volray_core::{
+    FrameRequest, Image, NonFinite, PartialImage, Render, RenderError, Rendered, Renderer,
+};
 
 /// Why several volumes cannot be rendered together across the ranks.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -146,7 +148,7 @@ impl<'t, T: Transport + ?Sized> DistributedScene<'t, T> {
                     looks,
                     ..request.clone()
                 };
-                scene.render_partial(&request, &|_| {})
+                (scene.render(FrameRequest::new(&request).partial())).map(Rendered::partial)
             }
             None => (settings.validate())
                 .map(|()| PartialImage::composite(settings.width, settings.height))

@@ -36,17 +36,24 @@
 //! A volume that fits in one piece is read once and its renderer kept
 //! across frames, exactly as rendering it whole.
 //!
+//! A frame is asked for as any renderer's ([`Render::render`]): its stop
+//! flag is checked before each piece is read (for the statistics pass
+//! too) and, passed on to each piece's frame, by volray-core's casters
+//! before each tile (each brick on the bricked path), so a frame stops
+//! within one brick's time, not one piece's; a partial frame is the
+//! pieces' partial images combined, before the background.
+//!
 //! ```
 //! use std::sync::Arc;
 //! use volray_core::glam::DVec3;
-//! use volray_core::{NonFinite, RenderSettings, Volume};
+//! use volray_core::{FrameRequest, NonFinite, Render, RenderSettings, Volume};
 //! use volray_distributed::streamed::Streamed;
 //!
 //! let volume = Volume::from_fn([40; 3], DVec3::ONE, DVec3::ZERO, |p| p.x as f32).unwrap();
 //! let settings = RenderSettings { width: 32, height: 32, ..RenderSettings::default() };
 //! // A budget of 200 kB: the 40³ volume (256 kB) is rendered in several pieces.
-//! let mut streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 200_000);
-//! let (image, times) = streamed.render(&settings, &|_| {}).unwrap();
+//! let streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 200_000);
+//! let (image, times) = streamed.render(FrameRequest::new(&settings)).unwrap().image_and_times();
 //! assert!(times.pieces > 1 && times.read_pieces <= times.pieces);
 //! assert_eq!((image.width(), image.height()), (32, 32));
 //! ```
@@ -54,7 +61,7 @@
 use crate::frame::{blank, owned_max_gradient};
 use crate::kd::{Decomposition, Viewpoint, VoxelBox};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 use volray_core::camera::View;
@@ -63,8 +70,9 @@ use volray_core::sampling::grid::GridFrame;
 use volray_core::transfer::classifier::Classifier;
 use volray_core::transfer::labels::{LabelError, labels_of};
 use volray_core::{
-    Blend, DEFAULT_CACHE_BUDGET, Histogram, Image, MemoryBound, NonFinite, PartialImage,
-    PartialPixels, Piece, RenderError, RenderSettings, Renderer, Volume, VolumeSource,
+    Blend, DEFAULT_CACHE_BUDGET, FrameRequest, Histogram, MemoryBound, NonFinite, PartialImage,
+    PartialPixels, Picture, Piece, Progress, Render, RenderError, RenderSettings, Rendered,
+    Renderer, Volume, VolumeSource,
 };
 
 /// Why a streamed frame failed.
@@ -111,173 +119,29 @@ pub struct Streamed {
     grid: GridFrame,
     non_finite: NonFinite,
     budget: u64,
-    decomposition: Decomposition,
-    known: Vec<Known>,
-    /// The renderer of the one piece, when the whole volume fits in one.
-    whole: Option<Renderer<'static>>,
+    /// What frames learn and keep: locked for a frame (frames of one
+    /// `Streamed` are rendered one at a time, as a `Renderer`'s are).
+    state: Mutex<Pieces>,
     /// Whether the pieces are read as labels.
     labels: bool,
 }
 
-impl Streamed {
-    /// Renders `source` in pieces that each fit `budget` bytes (the volume
-    /// read, the renderer's structures and the frames); its non-finite
-    /// values are handled as `non_finite` says. Reads nothing yet.
-    pub fn new(source: Arc<dyn VolumeSource>, non_finite: NonFinite, budget: u64) -> Self {
-        let grid = source.grid();
-        let labels = source.is_labels();
-        Streamed {
-            decomposition: Decomposition::new(grid.dims, 1),
-            known: vec![Known::default()],
-            source,
-            grid,
-            non_finite,
-            budget,
-            whole: None,
-            labels,
-        }
-    }
+/// The pieces of a [`Streamed`] volume and what is known of them.
+struct Pieces {
+    decomposition: Decomposition,
+    known: Vec<Known>,
+    /// The renderer of the one piece, when the whole volume fits in one.
+    whole: Option<Renderer<'static>>,
+}
 
-    /// The same, its values read as labels (a segmentation) or not.
-    pub fn with_labels(mut self, labels: bool) -> Self {
-        self.labels = labels;
-        self.whole = None;
-        self
-    }
-
-    /// The whole volume's grid.
-    pub fn grid(&self) -> GridFrame {
-        self.grid
-    }
-
-    /// The source the pieces are read from.
-    pub fn source(&self) -> &Arc<dyn VolumeSource> {
-        &self.source
-    }
-
-    /// The number of pieces the grid is split into now.
-    pub fn pieces(&self) -> usize {
+impl Pieces {
+    /// The number of pieces the grid is split into.
+    fn count(&self) -> usize {
         self.decomposition.boxes.len()
     }
 
-    /// Renders one frame: the finished image, and where its time went.
-    /// `progress` hears of pixels finished within each piece's frame.
-    pub fn render(
-        &mut self,
-        settings: &RenderSettings,
-        progress: &(dyn Fn(usize) + Sync),
-    ) -> Result<(Image, StreamTimes), StreamError> {
-        self.render_stoppable(settings, progress, &AtomicBool::new(false))
-    }
-
-    /// [`Self::render`], stopped when `stop` is set (by another thread: a
-    /// viewer whose view moved on): checked before each piece is read
-    /// (for the statistics pass too) and after each piece is rendered (and, for a volume in one piece, by
-    /// volray-core's casters before each tile); the answer is then
-    /// [`RenderError::Stopped`]. What was learnt of the pieces read so far
-    /// is kept.
-    pub fn render_stoppable(
-        &mut self,
-        settings: &RenderSettings,
-        progress: &(dyn Fn(usize) + Sync),
-        stop: &AtomicBool,
-    ) -> Result<(Image, StreamTimes), StreamError> {
-        let stopped = || -> Result<(), StreamError> {
-            if stop.load(Ordering::Relaxed) {
-                Err(StreamError::Render(RenderError::Stopped))
-            } else {
-                Ok(())
-            }
-        };
-        settings.validate().map_err(RenderError::from)?;
-        let cache = self.split_for(settings)?;
-        let mut times = StreamTimes {
-            pieces: self.pieces(),
-            ..StreamTimes::default()
-        };
-        if self.pieces() == 1 {
-            return self.render_whole(settings, cache, progress, stop, times);
-        }
-        let needs_range =
-            settings.blend.is_projection() || settings.transfer_function.domain.is_none();
-        let needs_gradient = settings.iso.is_some()
-            || (settings.gradient_opacity.is_some() && settings.gradient_opacity_max.is_none());
-        let start = Instant::now();
-        if needs_range || needs_gradient {
-            times.statistics_pieces = self.learn(needs_range, needs_gradient, stop)?;
-        }
-        times.read += start.elapsed();
-        let value_range = self.value_range().unwrap_or((0.0, 0.0));
-        let max_gradient = self.max_gradient().unwrap_or(0.0);
-        let voxel_size = self.grid.spacing.min_element() as f32;
-        let classifier = Classifier::for_frame(settings, value_range, voxel_size, || max_gradient);
-
-        let view = View::frame(
-            &settings.camera,
-            self.grid.bounds(),
-            settings.width,
-            settings.height,
-        )
-        .map_err(RenderError::from)?;
-        let viewpoint = Viewpoint::of(&view);
-        let mut image: Option<PartialImage> = None;
-        for index in self.decomposition.front_to_back(&viewpoint, &self.grid) {
-            let owned = self.decomposition.boxes[index];
-            if owned.is_empty() {
-                continue;
-            }
-            let composite = settings.blend == Blend::Composite;
-            if let Some(Some((lo, hi))) = self.known[index].range
-                && composite
-                && classifier.is_transparent_between(lo, hi)
-            {
-                continue;
-            }
-            if composite
-                && let Some(image) = &image
-                && hidden(image, &view, &self.grid, owned)
-            {
-                continue;
-            }
-            stopped()?;
-            let start = Instant::now();
-            let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
-            let volume = self.read(lo, hi)?;
-            times.read_pieces += 1;
-            times.read_voxels += volume.len() as u64;
-            let renderer = Renderer::owning(volume, self.non_finite)?.with_cache_budget(cache);
-            self.known[index].range = Some(renderer.volume().value_range());
-            times.read += start.elapsed();
-            let start = Instant::now();
-            let piece = RenderSettings {
-                piece: Some(Piece {
-                    whole: self.grid,
-                    offset: lo,
-                    owned: (owned.lo, owned.hi),
-                    value_range,
-                    max_gradient,
-                }),
-                ..settings.clone()
-            };
-            let partial = renderer.render_partial(&piece, progress)?;
-            stopped()?;
-            image = Some(match image {
-                None => partial,
-                Some(mut front) => {
-                    front.combine(&partial);
-                    front
-                }
-            });
-            times.render += start.elapsed();
-        }
-        let image = image.unwrap_or_else(|| blank(settings));
-        let image = image.finish(settings.background, |f| classifier.projection_colour(f));
-        Ok((image, times))
-    }
-
-    /// The whole volume's value range over the pieces read so far: exact
-    /// once every piece has been read (the first frame that needed it).
-    pub fn value_range(&self) -> Option<(f32, f32)> {
+    /// The whole volume's value range over the pieces read so far.
+    fn value_range(&self) -> Option<(f32, f32)> {
         if let Some(r) = &self.whole {
             return r.volume().value_range();
         }
@@ -296,6 +160,62 @@ impl Streamed {
             .filter_map(|k| k.max_gradient)
             .reduce(f32::max)
     }
+}
+
+impl Streamed {
+    /// Renders `source` in pieces that each fit `budget` bytes (the volume
+    /// read, the renderer's structures and the frames); its non-finite
+    /// values are handled as `non_finite` says. Reads nothing yet.
+    pub fn new(source: Arc<dyn VolumeSource>, non_finite: NonFinite, budget: u64) -> Self {
+        let grid = source.grid();
+        let labels = source.is_labels();
+        Streamed {
+            state: Mutex::new(Pieces {
+                decomposition: Decomposition::new(grid.dims, 1),
+                known: vec![Known::default()],
+                whole: None,
+            }),
+            source,
+            grid,
+            non_finite,
+            budget,
+            labels,
+        }
+    }
+
+    /// The same, its values read as labels (a segmentation) or not.
+    pub fn with_labels(mut self, labels: bool) -> Self {
+        self.labels = labels;
+        self.lock().whole = None;
+        self
+    }
+
+    /// The whole volume's grid.
+    pub fn grid(&self) -> GridFrame {
+        self.grid
+    }
+
+    /// The source the pieces are read from.
+    pub fn source(&self) -> &Arc<dyn VolumeSource> {
+        &self.source
+    }
+
+    /// The number of pieces the grid is split into now.
+    pub fn pieces(&self) -> usize {
+        self.lock().count()
+    }
+
+    /// The pieces, locked (a frame that panicked left them as they were
+    /// between two steps, each of which keeps them true).
+    fn lock(&self) -> MutexGuard<'_, Pieces> {
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// The whole volume's value range over the pieces read so far: exact
+    /// once every piece has been read (the first frame that needed it).
+    pub fn value_range(&self) -> Option<(f32, f32)> {
+        self.lock().value_range()
+    }
 
     /// The whole volume's histogram in `bins` bins over its value range
     /// (what `--tf auto` chooses from), counted piece by piece over each
@@ -305,21 +225,22 @@ impl Streamed {
     /// The pieces are those of frames of `settings` (histograms come
     /// before the frame whose transfer function they choose).
     pub fn histogram(
-        &mut self,
+        &self,
         settings: &RenderSettings,
         bins: usize,
     ) -> Result<Option<Histogram>, StreamError> {
-        self.split_for(settings)?;
-        self.keep_whole()?;
-        if let Some(r) = &self.whole {
+        let pieces = &mut *self.lock();
+        self.split_for(pieces, settings)?;
+        self.keep_whole(pieces)?;
+        if let Some(r) = &pieces.whole {
             return Ok(Histogram::of(r.volume(), bins));
         }
-        self.learn(true, false, &AtomicBool::new(false))?;
-        let Some(range) = self.value_range() else {
+        self.learn(pieces, true, false, &Progress::new(&|_| {}))?;
+        let Some(range) = pieces.value_range() else {
             return Ok(None);
         };
         let mut whole: Option<Histogram> = None;
-        for owned in self.decomposition.boxes.clone() {
+        for owned in pieces.decomposition.boxes.clone() {
             if owned.is_empty() {
                 continue;
             }
@@ -339,17 +260,18 @@ impl Streamed {
     /// `Ok(None)` for more than `max` distinct values.
     /// The pieces are those of frames of `settings`.
     pub fn labels(
-        &mut self,
+        &self,
         settings: &RenderSettings,
         max: usize,
     ) -> Result<Result<Option<Vec<i64>>, LabelError>, StreamError> {
-        self.split_for(settings)?;
-        self.keep_whole()?;
-        if let Some(r) = &self.whole {
+        let pieces = &mut *self.lock();
+        self.split_for(pieces, settings)?;
+        self.keep_whole(pieces)?;
+        if let Some(r) = &pieces.whole {
             return Ok(labels_of(r.volume(), max));
         }
         let mut union = std::collections::BTreeSet::new();
-        for owned in self.decomposition.boxes.clone() {
+        for owned in pieces.decomposition.boxes.clone() {
             if owned.is_empty() {
                 continue;
             }
@@ -367,10 +289,10 @@ impl Streamed {
     }
 
     /// With one piece, reads it (once) and keeps its renderer.
-    fn keep_whole(&mut self) -> Result<(), StreamError> {
-        if self.pieces() == 1 && self.whole.is_none() {
+    fn keep_whole(&self, pieces: &mut Pieces) -> Result<(), StreamError> {
+        if pieces.count() == 1 && pieces.whole.is_none() {
             let volume = self.read([0; 3], self.grid.dims)?;
-            self.whole = Some(Renderer::owning(volume, self.non_finite)?);
+            pieces.whole = Some(Renderer::owning(volume, self.non_finite)?);
         }
         Ok(())
     }
@@ -384,22 +306,23 @@ impl Streamed {
 
     /// Reads the pieces whose value range (and largest gradient, if
     /// `gradient`) is not known yet, keeping only those: the number read.
-    /// Stopped before a piece is read when `stop` is set.
+    /// Stopped before a piece is read when `progress` says so.
     fn learn(
-        &mut self,
+        &self,
+        pieces: &mut Pieces,
         range: bool,
         gradient: bool,
-        stop: &AtomicBool,
+        progress: &Progress,
     ) -> Result<usize, StreamError> {
         let mut read = 0;
-        for (index, owned) in self.decomposition.boxes.clone().into_iter().enumerate() {
-            let known = self.known[index];
+        for (index, owned) in pieces.decomposition.boxes.clone().into_iter().enumerate() {
+            let known = pieces.known[index];
             let missing =
                 (range && known.range.is_none()) || (gradient && known.max_gradient.is_none());
             if owned.is_empty() || !missing {
                 continue;
             }
-            if stop.load(Ordering::Relaxed) {
+            if progress.stopped() {
                 return Err(StreamError::Render(RenderError::Stopped));
             }
             let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
@@ -407,9 +330,9 @@ impl Streamed {
             read += 1;
             let renderer = Renderer::owning(volume, self.non_finite)?;
             let volume = renderer.volume();
-            self.known[index].range = Some(volume.value_range());
+            pieces.known[index].range = Some(volume.value_range());
             if gradient {
-                self.known[index].max_gradient =
+                pieces.known[index].max_gradient =
                     Some(owned_max_gradient(volume, lo, (owned.lo, owned.hi)));
             }
         }
@@ -417,46 +340,50 @@ impl Streamed {
     }
 
     /// A frame of the whole volume as one piece: read once, its renderer
-    /// kept.
+    /// kept; `request` goes to it as it is.
     fn render_whole(
-        &mut self,
-        settings: &RenderSettings,
+        &self,
+        pieces: &mut Pieces,
+        request: FrameRequest<'_>,
         cache: usize,
-        progress: &(dyn Fn(usize) + Sync),
-        stop: &AtomicBool,
         mut times: StreamTimes,
-    ) -> Result<(Image, StreamTimes), StreamError> {
-        if self.whole.is_none() {
+    ) -> Result<Rendered<StreamTimes>, StreamError> {
+        if pieces.whole.is_none() {
             let start = Instant::now();
-            self.keep_whole()?;
+            self.keep_whole(pieces)?;
             times.read_pieces = 1;
             times.read_voxels = self.grid.dims.iter().map(|&n| n as u64).product();
             times.read = start.elapsed();
         }
-        let renderer = self
+        let renderer = pieces
             .whole
             .take()
             .expect("read above")
             .with_cache_budget(cache);
         let start = Instant::now();
-        let image = renderer.render_stoppable(settings, progress, stop);
-        self.whole = Some(renderer);
+        let rendered = renderer.render(request);
+        pieces.whole = Some(renderer);
         times.render = start.elapsed();
-        Ok((image?, times))
+        let picture = rendered?.picture;
+        Ok(Rendered { picture, times })
     }
 
     /// Splits the grid finely enough for a frame of `settings` to fit the
     /// budget, and gives the brick caches' budget: what is left, up to
     /// the renderer's default.
-    fn split_for(&mut self, settings: &RenderSettings) -> Result<usize, StreamError> {
-        let mut n = self.pieces();
+    fn split_for(
+        &self,
+        pieces: &mut Pieces,
+        settings: &RenderSettings,
+    ) -> Result<usize, StreamError> {
+        let mut n = pieces.count();
         loop {
             let bound = self.bound(n, settings);
             if bound <= u128::from(self.budget) {
-                if n != self.pieces() {
-                    self.decomposition = Decomposition::new(self.grid.dims, n);
-                    self.known = vec![Known::default(); n];
-                    self.whole = None;
+                if n != pieces.count() {
+                    pieces.decomposition = Decomposition::new(self.grid.dims, n);
+                    pieces.known = vec![Known::default(); n];
+                    pieces.whole = None;
                 }
                 let room = u128::from(self.budget) - bound;
                 return Ok(usize::try_from(room)
@@ -490,6 +417,119 @@ impl Streamed {
         );
         let front = if n > 1 { piece.frame } else { 0 };
         piece.total() + front
+    }
+}
+
+impl Render for Streamed {
+    type Settings = RenderSettings;
+    type Times = StreamTimes;
+    type Error = StreamError;
+
+    /// One frame, piece by piece (see the module documentation): finished
+    /// or partial, and where its time went; `progress` hears of pixels
+    /// finished within each piece's frame. What was learnt of the pieces
+    /// read is kept, for a stopped frame too.
+    fn render(&self, request: FrameRequest<'_>) -> Result<Rendered<StreamTimes>, StreamError> {
+        let pieces = &mut *self.lock();
+        let (settings, progress) = (request.settings(), request.progress());
+        let stopped = || -> Result<(), StreamError> {
+            if progress.stopped() {
+                Err(StreamError::Render(RenderError::Stopped))
+            } else {
+                Ok(())
+            }
+        };
+        settings.validate().map_err(RenderError::from)?;
+        let cache = self.split_for(pieces, settings)?;
+        let mut times = StreamTimes {
+            pieces: pieces.count(),
+            ..StreamTimes::default()
+        };
+        if pieces.count() == 1 {
+            return self.render_whole(pieces, request, cache, times);
+        }
+        let needs_range =
+            settings.blend.is_projection() || settings.transfer_function.domain.is_none();
+        let needs_gradient = settings.iso.is_some()
+            || (settings.gradient_opacity.is_some() && settings.gradient_opacity_max.is_none());
+        let start = Instant::now();
+        if needs_range || needs_gradient {
+            times.statistics_pieces = self.learn(pieces, needs_range, needs_gradient, &progress)?;
+        }
+        times.read += start.elapsed();
+        let value_range = pieces.value_range().unwrap_or((0.0, 0.0));
+        let max_gradient = pieces.max_gradient().unwrap_or(0.0);
+        let voxel_size = self.grid.spacing.min_element() as f32;
+        let classifier = Classifier::for_frame(settings, value_range, voxel_size, || max_gradient);
+
+        let view = View::frame(
+            &settings.camera,
+            self.grid.bounds(),
+            settings.width,
+            settings.height,
+        )
+        .map_err(RenderError::from)?;
+        let viewpoint = Viewpoint::of(&view);
+        let mut image: Option<PartialImage> = None;
+        for index in pieces.decomposition.front_to_back(&viewpoint, &self.grid) {
+            let owned = pieces.decomposition.boxes[index];
+            if owned.is_empty() {
+                continue;
+            }
+            let composite = settings.blend == Blend::Composite;
+            if let Some(Some((lo, hi))) = pieces.known[index].range
+                && composite
+                && classifier.is_transparent_between(lo, hi)
+            {
+                continue;
+            }
+            if composite
+                && let Some(image) = &image
+                && hidden(image, &view, &self.grid, owned)
+            {
+                continue;
+            }
+            stopped()?;
+            let start = Instant::now();
+            let (lo, hi) = Piece::held((owned.lo, owned.hi), self.grid.dims);
+            let volume = self.read(lo, hi)?;
+            times.read_pieces += 1;
+            times.read_voxels += volume.len() as u64;
+            let renderer = Renderer::owning(volume, self.non_finite)?.with_cache_budget(cache);
+            pieces.known[index].range = Some(renderer.volume().value_range());
+            times.read += start.elapsed();
+            let start = Instant::now();
+            let piece = RenderSettings {
+                piece: Some(Piece {
+                    whole: self.grid,
+                    offset: lo,
+                    owned: (owned.lo, owned.hi),
+                    value_range,
+                    max_gradient,
+                }),
+                ..settings.clone()
+            };
+            // The stop flag goes with it: a piece stops within a brick.
+            let partial = renderer.render(request.for_part(&piece).partial())?;
+            let partial = partial.partial();
+            stopped()?;
+            image = Some(match image {
+                None => partial,
+                Some(mut front) => {
+                    front.combine(&partial);
+                    front
+                }
+            });
+            times.render += start.elapsed();
+        }
+        let image = image.unwrap_or_else(|| blank(settings));
+        let picture = match request.wants_partial() {
+            true => Picture::Partial(image),
+            false => Picture::Image(
+                image.finish(settings.background, |f| classifier.projection_colour(f)),
+            ),
+        };
+        Ok(request.answer(Rendered { picture, times })?)
     }
 }
 

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::sync::Mutex;
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
+use volray_core::{FrameRequest, Render, Rendered};
 use volray_core::{
     Histogram, MemoryBound, NonFinite, RenderSettings, Renderer, SampleType, TransferFunction,
     Volume, VolumeSource,
@@ -79,13 +80,19 @@ fn frames_rendered_piece_by_piece_equal_the_whole_volumes_within_a_level() {
             height: 28,
             ..settings
         };
-        let single = renderer.render(&settings).unwrap();
+        let single = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         let mut seen = Vec::new();
         for share in [1, 2, 4] {
             let budget = budget(&volume, &settings, share);
             let source = Counted::new(volume.clone());
-            let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
-            let (frame, times) = streamed.render(&settings, &|_| {}).unwrap();
+            let streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+            let (frame, times) = streamed
+                .render(FrameRequest::new(&settings))
+                .map(Rendered::image_and_times)
+                .unwrap();
             let diff = frame.max_abs_diff(&single).unwrap();
             worst = worst.max(diff);
             assert!(
@@ -129,15 +136,25 @@ fn transparent_pieces_are_not_read_once_their_range_is_known() {
         transfer_function: tf,
         ..RenderSettings::default()
     };
-    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let single = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     let source = Counted::new(volume.clone());
     let budget = budget(&volume, &settings, 10);
-    let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
-    let (first, t1) = streamed.render(&settings, &|_| {}).unwrap();
+    let streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+    let (first, t1) = streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+        .unwrap();
     // The domain is given: no pass for statistics, every piece read once.
     assert_eq!(t1.statistics_pieces, 0);
     assert_eq!(source.take().len(), t1.read_pieces);
-    let (second, t2) = streamed.render(&settings, &|_| {}).unwrap();
+    let (second, t2) = streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+        .unwrap();
     let reads = source.take();
     assert_eq!(reads.len(), t2.read_pieces);
     assert!(
@@ -178,11 +195,18 @@ fn pieces_behind_an_opaque_wall_are_not_read() {
         transfer_function: tf,
         ..RenderSettings::default()
     };
-    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let single = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     let source = Counted::new(volume.clone());
     let budget = budget(&volume, &settings, 6);
-    let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
-    let (frame, times) = streamed.render(&settings, &|_| {}).unwrap();
+    let streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+    let (frame, times) = streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+        .unwrap();
     assert!(frame.max_abs_diff(&single).unwrap() <= 1.0 / 255.0);
     let reads = source.take();
     assert!(times.pieces >= 4, "{times:?}");
@@ -197,8 +221,11 @@ fn the_histogram_counted_by_pieces_is_the_whole_volumes() {
     let volume = volume();
     let settings = small();
     let budget = budget(&volume, &settings, 6);
-    let mut streamed = Streamed::new(Arc::new(volume.clone()), NonFinite::Refuse, budget);
-    streamed.render(&settings, &|_| {}).unwrap();
+    let streamed = Streamed::new(Arc::new(volume.clone()), NonFinite::Refuse, budget);
+    streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+        .unwrap();
     assert!(streamed.pieces() > 1);
     let pieces = streamed.histogram(&settings, 64).unwrap().unwrap();
     let whole = Histogram::of(&volume, 64).unwrap();
@@ -230,8 +257,11 @@ fn a_failed_read_fails_the_frame_with_the_sources_message() {
     let volume = volume();
     let settings = small();
     let budget = budget(&volume, &settings, 6);
-    let mut streamed = Streamed::new(Arc::new(Failing(volume)), NonFinite::Refuse, budget);
-    match streamed.render(&settings, &|_| {}) {
+    let streamed = Streamed::new(Arc::new(Failing(volume)), NonFinite::Refuse, budget);
+    match streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+    {
         Err(e) => assert_eq!(
             e,
             StreamError::Read("scan.zarr: chunk c/0/0/1 is truncated".into())
@@ -244,8 +274,11 @@ fn a_failed_read_fails_the_frame_with_the_sources_message() {
 fn a_budget_too_small_for_any_piece_is_refused() {
     let volume = volume();
     let settings = RenderSettings::default();
-    let mut streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 1000);
-    match streamed.render(&settings, &|_| {}) {
+    let streamed = Streamed::new(Arc::new(volume), NonFinite::Refuse, 1000);
+    match streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+    {
         Err(StreamError::TooLarge(m)) => assert!(m.contains("does not fit 1000 bytes"), "{m}"),
         Err(e) => panic!("{e}"),
         Ok((_, times)) => panic!("rendered: {times:?}"),
@@ -273,7 +306,11 @@ fn a_label_volume_in_pieces_has_the_wholes_labels_and_frame() {
         transfer_function: transfer_function(&found, &LabelStyle::default()).unwrap(),
         ..small()
     };
-    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let single = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     let budget = budget(&volume, &settings, 5);
     // The source does not say its values are labels: the renderer of pieces is told.
     let plain = Counted::new({
@@ -281,8 +318,11 @@ fn a_label_volume_in_pieces_has_the_wholes_labels_and_frame() {
         v.set_labels(false);
         v
     });
-    let mut streamed = Streamed::new(plain, NonFinite::Refuse, budget).with_labels(true);
-    let (frame, times) = streamed.render(&settings, &|_| {}).unwrap();
+    let streamed = Streamed::new(plain, NonFinite::Refuse, budget).with_labels(true);
+    let (frame, times) = streamed
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image_and_times)
+        .unwrap();
     assert!(times.pieces > 1, "{times:?}");
     assert_eq!(
         streamed.labels(&settings, MAX_LABELS).unwrap().unwrap(),
@@ -334,21 +374,101 @@ fn a_frame_whose_stop_flag_is_set_reads_no_further_piece_and_says_stopped() {
         stop: Arc::new(AtomicBool::new(false)),
         reads: AtomicUsize::new(0),
     });
-    let mut streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
-    match streamed.render_stoppable(&settings, &|_| {}, &source.stop) {
+    let streamed = Streamed::new(source.clone(), NonFinite::Refuse, budget);
+    match streamed.render(FrameRequest::new(&settings).stopped_by(&source.stop)) {
         Err(StreamError::Render(RenderError::Stopped)) => {}
         Err(e) => panic!("{e}"),
-        Ok((_, times)) => panic!("rendered: {times:?}"),
+        Ok(rendered) => panic!("rendered: {:?}", rendered.times),
     }
     assert!(streamed.pieces() > 1);
     assert_eq!(source.reads.load(Ordering::SeqCst), 1);
     // Cleared, the same renderer finishes the frame: the whole volume's.
     source.stop.store(false, Ordering::SeqCst);
     let never = AtomicBool::new(false);
-    let (frame, times) = streamed
-        .render_stoppable(&settings, &|_| {}, &never)
-        .unwrap();
-    let whole = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let request = FrameRequest::new(&settings).stopped_by(&never);
+    let (frame, times) = streamed.render(request).unwrap().image_and_times();
+    let whole = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     assert!(frame.max_abs_diff(&whole).unwrap() <= 1.0 / 255.0);
     assert!(times.pieces > 1);
+}
+
+#[test]
+fn a_stop_set_during_a_piece_stops_that_piece_within_a_tile_and_reads_no_other() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::sync::mpsc;
+    use volray_core::RenderError;
+    let volume = volume();
+    let settings = RenderSettings {
+        transfer_function: TransferFunction {
+            domain: Some((0.0, 1.0)),
+            ..TransferFunction::default()
+        },
+        ..small()
+    };
+    let source = Counted::new(volume.clone());
+    let streamed = Streamed::new(
+        source.clone(),
+        NonFinite::Refuse,
+        budget(&volume, &settings, 6),
+    );
+    // Another thread sets the stop flag once the first tile is reported,
+    // and the report waits for it: one thread renders, so every tile
+    // after the first sees the flag.
+    let (stop, pixels) = (AtomicBool::new(false), AtomicUsize::new(0));
+    let (heard_tx, heard_rx) = mpsc::channel::<()>();
+    let (stopped_tx, stopped_rx) = mpsc::channel::<()>();
+    let (heard_tx, stopped_rx) = (Mutex::new(Some(heard_tx)), Mutex::new(stopped_rx));
+    let report = |n: usize| {
+        pixels.fetch_add(n, Ordering::SeqCst);
+        if let Some(heard) = heard_tx.lock().unwrap().take() {
+            heard.send(()).unwrap();
+            stopped_rx.lock().unwrap().recv().unwrap();
+        }
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let answer = std::thread::scope(|s| {
+        let flag = &stop;
+        s.spawn(move || {
+            // Err: the frame ended without a report.
+            if heard_rx.recv().is_ok() {
+                flag.store(true, Ordering::SeqCst);
+                stopped_tx.send(()).unwrap();
+            }
+        });
+        let request = FrameRequest::new(&settings)
+            .reporting(&report)
+            .stopped_by(&stop);
+        let answer = pool.install(|| streamed.render(request));
+        heard_tx.lock().unwrap().take();
+        answer
+    });
+    match answer {
+        Err(StreamError::Render(RenderError::Stopped)) => {}
+        Err(e) => panic!("{e}"),
+        Ok(rendered) => panic!("rendered: {:?}", rendered.times),
+    }
+    // Several pieces; one read, and of its four tiles (the first 16² pixels
+    // of 24²) the first alone rendered: the piece was stopped, not finished.
+    assert!(streamed.pieces() > 1, "{} pieces", streamed.pieces());
+    assert_eq!(source.take().len(), 1);
+    assert_eq!(pixels.load(Ordering::SeqCst), 16 * 16);
+    // Cleared, the same frame is finished: every piece's pixels reported.
+    let done = AtomicUsize::new(0);
+    let count = |n: usize| {
+        done.fetch_add(n, Ordering::SeqCst);
+    };
+    stop.store(false, Ordering::SeqCst);
+    let request = FrameRequest::new(&settings)
+        .reporting(&count)
+        .stopped_by(&stop);
+    let times = streamed.render(request).unwrap().times;
+    assert_eq!(done.load(Ordering::SeqCst), times.read_pieces * 24 * 24);
+    assert!(times.read_pieces > 1);
 }

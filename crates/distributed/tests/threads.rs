@@ -7,7 +7,7 @@
 
 use volray_core::camera::Camera;
 use volray_core::glam::DVec3;
-use volray_core::{Image, RenderSettings, Renderer, Volume};
+use volray_core::{FrameRequest, Image, Render, RenderSettings, Renderer, Volume};
 use volray_distributed::frame::{Distributed, FrameError};
 use volray_distributed::transport::Local;
 
@@ -37,7 +37,10 @@ fn one_to_eight_ranks_give_the_single_process_frame_within_a_level() {
     let renderer = Renderer::new(&volume).unwrap();
     let mut worst: f32 = 0.0;
     for (name, settings) in cases() {
-        let single = renderer.render(&settings).unwrap();
+        let single = renderer
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         assert!(
             single.pixels().iter().any(|p| p[3] > 0.3),
             "{name}: nearly empty"
@@ -142,7 +145,8 @@ fn ranks_join_their_labels_into_the_whole_volumes() {
         },
         ..RenderSettings::default()
     };
-    let single = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let single = Renderer::new(&volume).unwrap();
+    let single = single.render(FrameRequest::new(&settings)).unwrap().image();
     for ranks in [1, 3, 5] {
         let results: Vec<_> = std::thread::scope(|s| {
             let handles: Vec<_> = (Local::group(ranks).into_iter())
@@ -229,7 +233,7 @@ fn two_channels_across_one_to_five_ranks_give_the_single_process_scene_within_a_
             looks,
             mix: Mix::Composite,
         };
-        let want = single.render(&request).unwrap();
+        let want = single.render(FrameRequest::new(&request)).unwrap().image();
         for ranks in [1, 2, 3, 5] {
             let frames: Vec<Option<Image>> = std::thread::scope(|s| {
                 let handles: Vec<_> = (Local::group(ranks).into_iter())

@@ -8,6 +8,7 @@ mod common;
 
 use std::fs;
 use std::path::{Path, PathBuf};
+use volray_core::{FrameRequest, Render};
 
 use common::fixture;
 use volray_core::{RenderError, RenderSettings, Renderer};
@@ -269,7 +270,10 @@ fn a_mapped_file_truncated_before_a_frame_fails_the_frame() {
         height: 32,
         ..RenderSettings::default()
     };
-    let mapped_frame = renderer.render(&settings).unwrap();
+    let mapped_frame = renderer
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     let read_in = read(
         &p,
         &ReadOptions {
@@ -279,7 +283,11 @@ fn a_mapped_file_truncated_before_a_frame_fails_the_frame() {
     )
     .unwrap()
     .volume;
-    let in_memory = Renderer::new(&read_in).unwrap().render(&settings).unwrap();
+    let in_memory = Renderer::new(&read_in)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     assert_eq!(mapped_frame, in_memory);
     fs::OpenOptions::new()
         .write(true)
@@ -289,7 +297,7 @@ fn a_mapped_file_truncated_before_a_frame_fails_the_frame() {
         .unwrap();
     let err = Renderer::new(&volume)
         .err()
-        .or_else(|| renderer.render(&settings).err());
+        .or_else(|| renderer.render(FrameRequest::new(&settings)).err());
     match err {
         Some(RenderError::SamplesChanged(why)) => {
             assert!(why.contains(&p.display().to_string()), "{why}");

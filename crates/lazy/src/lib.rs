@@ -164,8 +164,11 @@ impl Chunked {
 
     /// The same level, its boxes refused with [`STOPPED`] once `stop` is
     /// set: a [`Streamed`] frame of it stops before its next piece, the
-    /// pieces already read kept. `Streamed` has no stop flag of its own,
-    /// and a piece is the unit it reads.
+    /// pieces already read kept. A frame's own stop flag
+    /// ([`FrameRequest::stopped_by`](volray_core::FrameRequest::stopped_by))
+    /// stops it too, within a brick; this also stops the passes over the
+    /// pieces outside a frame (histograms, labels), a piece being the
+    /// unit they read.
     pub fn stoppable(mut self, stop: Arc<AtomicBool>) -> Chunked {
         let inner = Arc::clone(&self.lazy.source);
         self.lazy.source = Arc::new(Stoppable { inner, stop });

@@ -43,6 +43,7 @@
 
 use volray_core::PiecewiseLinear;
 use volray_core::glam::DVec3;
+use volray_core::{FrameRequest, Render, Rendered};
 use volray_core::{Image, Method, Phong, RenderSettings, Renderer, TransferFunction, Volume};
 use volray_data::fractal::{FractalParams, generate};
 
@@ -196,7 +197,13 @@ pub fn render(cloud: &Cloud, style: &CloudStyle, size: usize) -> Result<Image, P
     let what = cloud.spec();
     let renderer = Renderer::new(&cloud.volume).map_err(PaperError::render(&what))?;
     renderer
-        .render(&settings(&cloud.volume, style, size, Method::Fast))
+        .render(FrameRequest::new(&settings(
+            &cloud.volume,
+            style,
+            size,
+            Method::Fast,
+        )))
+        .map(Rendered::image)
         .map_err(PaperError::render(&what))
 }
 

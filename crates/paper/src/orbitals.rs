@@ -44,6 +44,7 @@ use volray_core::glam::DVec3;
 use volray_core::{
     Camera, Fit, Image, Method, Phong, RenderSettings, Renderer, TransferFunction, Volume,
 };
+use volray_core::{FrameRequest, Render, Rendered};
 use volray_data::hydrogen::HydrogenParams;
 
 use crate::PaperError;
@@ -214,7 +215,8 @@ pub fn render_panel(
     let settings = panel_settings(&state.volume, view, size, Method::Fast);
     let renderer = Renderer::new(&state.volume).map_err(PaperError::render(&what))?;
     renderer
-        .render(&settings)
+        .render(FrameRequest::new(&settings))
+        .map(Rendered::image)
         .map_err(PaperError::render(&what))
 }
 

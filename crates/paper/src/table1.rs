@@ -24,6 +24,7 @@
 //! difference per channel is reported (the tests hold it within 1/255).
 
 use std::time::{Duration, Instant};
+use volray_core::{FrameRequest, Render, Rendered};
 
 use volray_core::{Image, Method, RenderSettings, Renderer, Volume};
 
@@ -176,7 +177,8 @@ fn timed_render(volume: &Volume, settings: &RenderSettings) -> Result<(f64, Imag
     let start = Instant::now();
     let renderer = Renderer::new(volume).map_err(PaperError::render("table 1"))?;
     let image = renderer
-        .render(settings)
+        .render(FrameRequest::new(settings))
+        .map(Rendered::image)
         .map_err(PaperError::render("table 1"))?;
     Ok((start.elapsed().as_secs_f64(), image))
 }

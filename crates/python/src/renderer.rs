@@ -4,7 +4,7 @@
 //! thread while the calling thread waits for it, asking Python for
 //! pending signals every 20 ms of the wait (a finished frame returns at
 //! once); on KeyboardInterrupt it stops the frame (volray-core's
-//! `render_stoppable`: the work left is skipped) and raises.
+//! `FrameRequest::stopped_by`: the work left is skipped) and raises.
 //!
 //! A lazy volume (`volume.rs`: a chunked file read from its metadata)
 //! takes volray-lazy's road, as `volray render` does (volray-app's `plan`):
@@ -43,8 +43,8 @@ use volray_app::AppError;
 use volray_app::memory::Budget;
 use volray_core::transfer::auto;
 use volray_core::{
-    Histogram, Image, NonFinite, RenderError, RenderSettings, Renderer as CoreRenderer,
-    Volume as CoreVolume,
+    FrameRequest, Histogram, Image, NonFinite, Render, RenderError, RenderSettings, Rendered,
+    Renderer as CoreRenderer, Volume as CoreVolume,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
 use volray_io::{MapPolicy, ReadOptions, format_bytes};
@@ -290,7 +290,8 @@ impl Renderer {
         let settings = &settings;
         let (rendered, interrupt) = py.detach(|| {
             interruptible(pool, &stop, |report| {
-                inner.render_stoppable(settings, report, &stop)
+                let request = FrameRequest::new(settings).reporting(report);
+                inner.render(request.stopped_by(&stop)).map(Rendered::image)
             })
         });
         if let Some(e) = interrupt {

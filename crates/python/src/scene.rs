@@ -30,6 +30,7 @@ use std::sync::{Arc, Mutex};
 use volray_app::scene::{channel_color, default_mix, hex_colour, mix_name, mix_of_name};
 use volray_core::RenderSettings;
 use volray_core::scene::{Look, Mix, Scene as CoreScene, SceneSettings};
+use volray_core::{FrameRequest, Render, Rendered};
 use volray_io::format_bytes;
 use volray_options::Options;
 use volray_options::colors::{channel_colour, named};
@@ -319,7 +320,8 @@ impl Scene {
         let (scene, request) = (&built.scene, &request);
         let (rendered, interrupt) = py.detach(|| {
             interruptible(pool.as_ref(), &stop, |report| {
-                scene.render_with_progress(request, report, Some(&stop))
+                let request = FrameRequest::new(request).reporting(report);
+                scene.render(request.stopped_by(&stop)).map(Rendered::image)
             })
         });
         if let Some(e) = interrupt {

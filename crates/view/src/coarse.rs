@@ -229,6 +229,7 @@ pub fn draft_settings(
 mod tests {
     use super::*;
     use volray_core::glam::DVec3;
+    use volray_core::{FrameRequest, Render};
 
     #[test]
     fn an_odd_axis_halves_with_the_quarter_half_quarter_tent() {
@@ -318,10 +319,10 @@ mod tests {
         assert!((ratio - 2.0).abs() < 1e-12);
         let whole = volray_core::Renderer::new(&volume).unwrap();
         let coarse = volray_core::Renderer::new(&copy).unwrap();
-        let want = whole.render(&settings).unwrap();
+        let want = whole.render(FrameRequest::new(&settings)).unwrap().image();
         let drafted = draft_settings(&settings, whole.value_range(), ratio, || 1.0);
-        let got = coarse.render(&drafted).unwrap();
-        let plain = coarse.render(&settings).unwrap();
+        let got = coarse.render(FrameRequest::new(&drafted)).unwrap().image();
+        let plain = coarse.render(FrameRequest::new(&settings)).unwrap().image();
         let (near, off) = (difference(&got, &want), difference(&plain, &want));
         // Measured: 0.015 with the draft settings, 0.16 without.
         assert!(

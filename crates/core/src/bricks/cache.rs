@@ -15,7 +15,7 @@
 //!
 //! A caller that knows a brick's buffer will not be asked for again (the
 //! lit bricks: once the last tile that lists a brick is done with it, see
-//! [`crate::cpu::lit_bricks`]) gives it back ([`BrickCache::release`]) to a
+//! `cpu::lit_bricks`) gives it back ([`BrickCache::release`]) to a
 //! pool, from which the next brick takes it before any is allocated or
 //! taken from another entry. The buffers then hold the bricks in use, not
 //! the first ones a frame asked for, and a budget smaller than all the

@@ -35,7 +35,7 @@
 //! so the images do not depend on the budget.
 //!
 //! All of this depends on the volume and the classifier only: the light,
-//! which follows the camera, is applied per frame by [`crate::cpu::lit_bricks`].
+//! which follows the camera, is applied per frame by `cpu::lit_bricks`.
 
 use crate::bricks::cache::{BrickCache, Budget, CacheRef};
 use crate::bricks::macrocells::Macrocells;

@@ -4,7 +4,7 @@
 //! The light follows the camera (a headlight by default), so this cannot
 //! be kept across frames; everything it reads can (see
 //! [`crate::bricks::occupied`]). It is the model of [`crate::kernels::phong`] and
-//! [`crate::reference::stage1`] on the stored normals: two-sided (the normal turned to
+//! `reference::stage1` on the stored normals: two-sided (the normal turned to
 //! face the viewer), `C = Cs·(ka + kd·max(N·L, 0) + ks·max(N·H, 0)^n)` times
 //! the material colour, clamped to [0, 1], with ambient light only where
 //! the gradient is zero (a zero normal makes every dot product zero). Every

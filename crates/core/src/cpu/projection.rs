@@ -29,12 +29,12 @@
 use crate::bricks::BRICK;
 use crate::bricks::macrocells::Macrocells;
 use crate::camera::View;
+use crate::frame::progress::Progress;
 use crate::kernels::projection::Projected;
 use crate::kernels::trilinear::sample_scalar;
-use crate::non_finite::NonFiniteMask;
-use crate::progress::Progress;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::settings::Blend;
+use crate::volume::non_finite::NonFiniteMask;
 use crate::volume::{Sample, Volume};
 use glam::Vec3;
 use rayon::prelude::*;

@@ -9,7 +9,7 @@
 //! Gradients depend on the data alone, not on the view: they are computed
 //! once per volume and kept across frames (as VTK caches its normals).
 //! Their largest magnitude, [`max_magnitude`], scales gradient-magnitude
-//! opacity and bounds Levoy's iso-surfaces (see [`crate::transfer::classifier`]).
+//! opacity and bounds Levoy's iso-surfaces (see `transfer::classifier`).
 
 use crate::volume::{Sample, Volume};
 use glam::DVec3;

@@ -1,5 +1,5 @@
 //! Mixing the samples of several volumes at one point of a ray into one
-//! sample ([`crate::scene`]'s composite mix): the opacity-weighted colour
+//! sample (`scene`'s composite mix): the opacity-weighted colour
 //! `c = Σ αᵢcᵢ / Σ αᵢ` and the opacity of the volumes together,
 //! `α = 1 − Π(1 − αᵢ)` (the light that gets through each volume's sample
 //! gets through all of them: independent absorbers, Cai and Sakas 1999).

@@ -94,9 +94,9 @@ impl Phong {
     }
 
     /// [`Self::shade`] where only the parts `reaching` of the light and of
-    /// the ambient light arrive: the light's ([`crate::shadows`]) scales
-    /// the diffuse and specular terms, the ambient light's
-    /// ([`crate::shadows::ambient`]) the ambient term.
+    /// the ambient light arrive: the light's (shadows) scales
+    /// the diffuse and specular terms, the ambient light's (ambient
+    /// occlusion) the ambient term.
     #[inline]
     pub fn shade_reached(
         &self,
@@ -131,9 +131,8 @@ impl Phong {
 }
 
 /// How much of the light and of the ambient light reaches a point, each
-/// in `[0, 1]`: the light through the volume towards it (shadows,
-/// [`crate::shadows`]) and the mean over short rays around it (ambient
-/// occlusion, [`crate::shadows::ambient`]).
+/// in `[0, 1]`: the light through the volume towards it (shadows) and
+/// the mean over short rays around it (ambient occlusion).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reaching {
     pub light: f32,

@@ -30,17 +30,17 @@ pub mod post;
 pub mod stage1;
 
 use crate::camera::View;
+use crate::frame::partial::{PartialImage, PartialPixels};
+use crate::frame::progress::Progress;
 use crate::kernels::composite::back_to_front;
 use crate::kernels::projection::Projected;
 use crate::kernels::trilinear;
-use crate::non_finite::NonFiniteMask;
-use crate::partial::{PartialImage, PartialPixels};
-use crate::progress::Progress;
 use crate::reference::post::PostClassifier;
 use crate::reference::stage1::ShadedVolume;
 use crate::sampling::Sampling;
 use crate::settings::Blend;
 use crate::volume::Volume;
+use crate::volume::non_finite::NonFiniteMask;
 use glam::DVec4;
 use rayon::prelude::*;
 

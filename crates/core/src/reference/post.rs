@@ -22,10 +22,10 @@
 use crate::kernels::gradient::gradients;
 use crate::kernels::phong::{LightGeometry, Phong, Reaching, lit_colour_reached};
 use crate::kernels::trilinear;
-use crate::non_finite::NonFiniteMask;
 use crate::shadows::ShadowRay;
 use crate::transfer::classifier::Classifier;
 use crate::volume::Volume;
+use crate::volume::non_finite::NonFiniteMask;
 use glam::{DVec3, DVec4, Vec3};
 use std::borrow::Cow;
 

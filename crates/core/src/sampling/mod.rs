@@ -22,9 +22,9 @@ pub mod grid;
 pub mod jitter;
 
 use crate::camera::View;
-use crate::piece::Ownership;
 use crate::sampling::clipping::Clipping;
 use crate::sampling::grid::{GridFrame, clamp_to_grid};
+use crate::volume::piece::Ownership;
 use glam::DVec3;
 
 /// The sample positions of one frame's rays.
@@ -38,7 +38,7 @@ pub struct Sampling {
     pub jitter: bool,
     /// Rays start at the eye (perspective): only `t ≥ 0` is sampled.
     pub from_eye: bool,
-    /// A piece of a larger volume ([`crate::piece`]): rays are bounded by
+    /// A piece of a larger volume ([`crate::volume::piece`]): rays are bounded by
     /// the whole grid, and take only the samples the piece owns.
     pub ownership: Option<Ownership>,
 }

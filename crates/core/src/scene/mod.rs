@@ -51,6 +51,7 @@
 //! ```
 //! use volray_core::glam::DVec3;
 //! use volray_core::scene::{Look, Mix, Scene, SceneSettings};
+//! use volray_core::{FrameRequest, Render};
 //! use volray_core::{PiecewiseLinear, RenderSettings, Renderer, TransferFunction, Volume};
 //!
 //! // Two channels of one 24³ grid: a ball left, a ball right.
@@ -72,7 +73,7 @@
 //! };
 //! let looks = vec![coloured([1.0, 0.0, 1.0]), coloured([0.0, 1.0, 0.0])];
 //! let request = SceneSettings { settings, looks, mix: Mix::Composite };
-//! let image = scene.render(&request).unwrap();
+//! let image = scene.render(FrameRequest::new(&request)).unwrap().image();
 //! // Seen along −x, +y is to the right: the first ball magenta, the second green.
 //! let (left, right) = (image.get(11, 24), image.get(36, 24));
 //! assert!(left[0] > 0.3 && left[1] < 0.05, "{left:?}");
@@ -87,11 +88,11 @@ mod tests;
 
 use crate::camera::View;
 use crate::error::{RenderError, SceneError};
-use crate::image::Image;
+use crate::frame::image::Image;
+use crate::frame::partial::{PartialImage, PartialPixels};
+use crate::frame::progress::Progress;
+use crate::frame::request::{FrameRequest, FrameTimes, Picture, Render, Rendered};
 use crate::kernels::composite::{EMPTY, PartialPixel, over_background};
-use crate::partial::{PartialImage, PartialPixels};
-use crate::piece::Piece;
-use crate::progress::Progress;
 use crate::renderer::Renderer;
 use crate::sampling::Sampling;
 use crate::sampling::clipping::{ClipPlane, Clipping};
@@ -99,10 +100,11 @@ use crate::sampling::grid::GridFrame;
 use crate::settings::{Classification, MAX_SAMPLES_PER_RAY, Method, RenderSettings};
 use crate::transfer::function::{PiecewiseLinear, TransferFunction};
 use crate::transfer::iso::IsoSurface;
+use crate::volume::piece::Piece;
 use crate::{SettingError, Volume};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::sync::atomic::AtomicBool;
+use std::time::Instant;
 
 /// How the samples of several volumes at one step make one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -136,11 +138,11 @@ pub struct Look {
     /// `false`: not drawn (a hidden layer keeps its caches).
     pub visible: bool,
     /// The volume is this piece of a larger one, as one rank of a
-    /// distributed frame holds it ([`crate::piece`]): its whole volume's
+    /// distributed frame holds it ([`crate::volume::piece`]): its whole volume's
     /// grid, the box it owns, the whole volume's value range. The volumes
     /// of a scene of pieces are pieces of one grid, split alike (the
     /// channels of one stack); their partial images
-    /// ([`Scene::render_partial`]) combine front to back into the whole
+    /// (a [partial](FrameRequest::partial) frame) combine front to back into the whole
     /// scene's frame.
     pub piece: Option<Piece>,
 }
@@ -258,31 +260,6 @@ impl<'v> Scene<'v> {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// Renders one frame.
-    pub fn render(&self, request: &SceneSettings) -> Result<Image, RenderError> {
-        self.render_with_progress(request, &|_| {}, None)
-    }
-
-    /// Renders one frame, calling `progress` with the pixels finished as
-    /// the work proceeds (`width·height` in all per march: once for one
-    /// march, once per volume rendered apart), stopped when `stop` is set ([`RenderError::Stopped`]).
-    pub fn render_with_progress(
-        &self,
-        request: &SceneSettings,
-        progress: &(dyn Fn(usize) + Sync),
-        stop: Option<&AtomicBool>,
-    ) -> Result<Image, RenderError> {
-        let mut report = Progress::new(progress);
-        if let Some(stop) = stop {
-            report = report.stopping(stop);
-        }
-        let image = self.render_frame(request, &report)?;
-        if report.stopped() {
-            return Err(RenderError::Stopped);
-        }
-        Ok(image)
-    }
-
     /// The box the camera frames in a frame of `request`: every volume's,
     /// or the whole grid's of a scene of pieces, whose pieces are checked
     /// to split one grid alike (the volumes' pieces: `shared.piece` is
@@ -324,12 +301,12 @@ impl<'v> Scene<'v> {
     /// of the pieces, combined front to back
     /// ([`PartialImage::combine`]) and finished over the background
     /// ([`PartialImage::finish`]), give the whole scene's frame, as for
-    /// one volume (see [`crate::piece`]). The additive mix and the
+    /// one volume (see [`crate::volume::piece`]). The additive mix and the
     /// projections, which do not combine front to back, are refused.
-    pub fn render_partial(
+    fn partial_frame(
         &self,
         request: &SceneSettings,
-        progress: &(dyn Fn(usize) + Sync),
+        progress: &Progress,
     ) -> Result<PartialImage, RenderError> {
         if request.mix == Mix::Additive || request.settings.blend.is_projection() {
             return Err(
@@ -337,14 +314,13 @@ impl<'v> Scene<'v> {
             );
         }
         let settings = self.layer_settings(request)?;
-        let progress = Progress::new(progress);
         if self.layers.len() == 1 {
-            return self.layers[0].render_partial_with(&settings[0], &progress);
+            return Ok(self.layers[0].partial_frame(&settings[0], progress)?.0);
         }
         let shown: Vec<usize> = (0..self.layers.len())
             .filter(|&i| request.looks[i].shown())
             .collect();
-        self.composite(&settings, &shown, request, &progress)
+        self.composite(&settings, &shown, request, progress)
     }
 
     /// Each layer's settings in a frame of `request`, checked.
@@ -411,7 +387,7 @@ impl<'v> Scene<'v> {
             // One volume: exactly its renderer's frame.
             let renderer = &self.layers[0];
             let mut image = Image::new(0, 0, [0.0; 4]);
-            renderer.render_frame(&settings[0], &mut image, progress)?;
+            renderer.frame_into(&settings[0], &mut image, progress)?;
             return Ok(image);
         }
         let shown: Vec<usize> = (0..self.layers.len())
@@ -452,7 +428,7 @@ impl<'v> Scene<'v> {
             let mut sum = vec![EMPTY; width * height];
             for &i in &shown {
                 let layer = &self.layers[i];
-                let partial = layer.render_partial_with(&settings[i], progress)?;
+                let (partial, _) = layer.partial_frame(&settings[i], progress)?;
                 let PartialPixels::Composite(pixels) = partial.pixels() else {
                     unreachable!("a composited frame")
                 };
@@ -568,7 +544,7 @@ impl<'v> Scene<'v> {
         let mut sum: Vec<Option<[f32; 3]>> = vec![None; width * height];
         for &i in shown {
             let layer = &self.layers[i];
-            let partial = layer.render_partial_with(&settings[i], progress)?;
+            let (partial, _) = layer.partial_frame(&settings[i], progress)?;
             let classifier = layer.classifier(&settings[i]);
             let PartialPixels::Projection { blend, pixels } = partial.pixels() else {
                 unreachable!("a projection")
@@ -589,6 +565,32 @@ impl<'v> Scene<'v> {
             })
             .collect();
         Ok(Image::from_pixels(width, height, pixels).expect("the frame's size"))
+    }
+}
+
+impl Render for Scene<'_> {
+    type Settings = SceneSettings;
+    type Times = FrameTimes;
+    type Error = RenderError;
+
+    /// One frame of the scene, its time all counted as `cast`. A partial
+    /// frame is of the composite mix only (the additive mix and the
+    /// projections do not combine front to back): with every volume a
+    /// piece of its whole ([`Look::piece`]), the partial images of the
+    /// pieces, combined front to back ([`PartialImage::combine`]) and
+    /// finished over the background ([`PartialImage::finish`]), give the
+    /// whole scene's frame, as for one volume (see [`crate::volume::piece`]).
+    /// Progress counts `width·height` pixels per march: once for one
+    /// march, once per volume rendered apart.
+    fn render(&self, request: FrameRequest<'_, SceneSettings>) -> Result<Rendered, RenderError> {
+        let start = Instant::now();
+        let (settings, progress) = (request.settings(), request.progress());
+        let picture = match request.wants_partial() {
+            true => Picture::Partial(self.partial_frame(settings, &progress)?),
+            false => Picture::Image(self.render_frame(settings, &progress)?),
+        };
+        let times = FrameTimes::cast(start.elapsed());
+        request.answer(Rendered { picture, times })
     }
 }
 

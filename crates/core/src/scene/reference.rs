@@ -10,11 +10,11 @@
 //! millionth of a step) takes nothing from it.
 
 use super::SceneFrame;
+use crate::frame::partial::{PartialImage, PartialPixels};
+use crate::frame::progress::Progress;
 use crate::kernels::composite::back_to_front;
 use crate::kernels::mix::mix_reference;
 use crate::kernels::trilinear;
-use crate::partial::{PartialImage, PartialPixels};
-use crate::progress::Progress;
 use crate::reference::post::PostClassifier;
 use crate::reference::stage1::ShadedVolume;
 use crate::renderer::Renderer;

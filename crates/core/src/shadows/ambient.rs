@@ -35,7 +35,7 @@
 //! between them, as their gradients are: post-classified samples read it
 //! so. The directions are the lattice's, not spread evenly over the
 //! sphere: from a voxel their samples are voxels, so the fast path's
-//! [`AmbientVolume`](super::ambient_volume::AmbientVolume) gets each
+//! `AmbientVolume` gets each
 //! voxel's `A` as the reference marches it (to rounding), with no
 //! interpolation error.
 //!

@@ -1,5 +1,5 @@
 //! Every voxel's opacity for the shadow rays' step, quantised: what the
-//! light volume's sweeps read ([`super::light_volume`]).
+//! light volume's sweeps read (`light_volume`).
 //!
 //! The light follows the camera unless it is fixed in the world (the
 //! camera's key light), so an orbit sweeps a new light volume every

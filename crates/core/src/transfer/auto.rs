@@ -48,9 +48,9 @@
 //! assert_eq!(opacity.eval(1.0), [auto::MAX_OPACITY]);
 //! ```
 
-use crate::histogram::Histogram;
 use crate::transfer::colormap;
 use crate::transfer::function::{PiecewiseLinear, TransferFunction};
+use crate::volume::histogram::Histogram;
 
 /// Bins of the histogram the choice is made on.
 pub const BINS: usize = 256;

@@ -206,7 +206,7 @@ impl Classifier {
     }
 
     /// The same classification for samples `step_voxels` voxels apart
-    /// (the shadow rays', [`crate::shadows`]).
+    /// (the shadow rays', `shadows`).
     pub fn with_step(&self, step_voxels: f32) -> Classifier {
         Classifier {
             step_voxels,

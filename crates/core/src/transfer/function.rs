@@ -11,7 +11,7 @@
 //! where `[lo, hi]` is `domain` when given and the volume's `[fmin, fmax]`
 //! otherwise. Outside its first and last points a function holds its end
 //! values. Opacity is per unit distance of one voxel (the paper's step);
-//! the renderer corrects it for other steps (see [`crate::transfer::classifier`]).
+//! the renderer corrects it for other steps (see `transfer::classifier`).
 //! Either function may be left out: opacity then falls back to the paper's
 //! `[p, q]` ramp, colour to white.
 

@@ -3,7 +3,7 @@
 //!
 //! M. Levoy, "Display of surfaces from volume data", *IEEE CG&A* 8(3),
 //! 1988, eq. 3: for the isovalue `f_v` with opacity `α_v` (see
-//! [`crate::transfer::classifier::Classifier::iso_alpha`]: an opacity table's value at
+//! `transfer::classifier::Classifier::iso_alpha`: an opacity table's value at
 //! `f_v`, or the ramp's top `q`) and a transition region `r` voxels thick,
 //!
 //! ```text

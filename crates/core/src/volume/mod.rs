@@ -8,11 +8,16 @@
 //! `f32`), and read as `f32`. [`Volume::to_log10`] puts values that span
 //! decades on a log scale.
 
+pub mod histogram;
+pub mod non_finite;
+pub mod piece;
+mod sample;
 mod samples;
 mod source;
 mod store;
 
-pub use samples::{Sample, SampleType, Samples};
+pub use sample::{Sample, SampleType};
+pub use samples::Samples;
 pub use source::{VolumeSource, check_box};
 pub use store::{External, ExternalBytes, ExternalError, Store};
 
@@ -137,10 +142,10 @@ impl Volume {
     /// The same grid read as labels (a segmentation): each value names a
     /// region rather than measuring something. Every path then shades with
     /// the gradient of the smoothed indicator of each voxel's own label
-    /// ([`crate::kernels::gradient`]) instead of the values' gradient,
+    /// (`kernels::gradient`) instead of the values' gradient,
     /// which between labels 1 and 5 would point at the larger number; a
     /// transfer function that is constant over each label
-    /// ([`crate::transfer::labels`]) classifies by label, pre-classified, so
+    /// (`transfer::labels`) classifies by label, pre-classified, so
     /// that no two labels' values are ever blended.
     pub fn as_labels(mut self) -> Self {
         self.labels = true;

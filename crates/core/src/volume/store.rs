@@ -9,14 +9,14 @@
 //! memory. What an owner of outside bytes adds is [`ExternalBytes::verify`]:
 //! a file can be truncated or rewritten under a mapping, and the renderer
 //! asks, after each frame, whether the bytes it read were still the file's
-//! (see [`crate::Renderer::render`]).
+//! (see [`crate::Render::render`]).
 
 use std::fmt;
 use std::marker::PhantomData;
 use std::ops::Deref;
 use std::sync::Arc;
 
-use super::samples::Sample;
+use super::sample::Sample;
 
 /// Bytes owned outside the volume, in native byte order: a mapped file.
 pub trait ExternalBytes: Send + Sync + fmt::Debug {

@@ -15,6 +15,7 @@ use volray_core::glam::DVec3;
 use volray_core::{
     ClipPlane, Image, Method, PiecewiseLinear, RenderSettings, Renderer, TransferFunction, Volume,
 };
+use volray_core::{FrameRequest, Render};
 
 // ---- the two paths ----
 
@@ -30,8 +31,14 @@ pub fn on_the_reference(settings: &RenderSettings) -> RenderSettings {
 /// frame is set for the fast path (else both would be the reference).
 pub fn both_paths(renderer: &Renderer, settings: &RenderSettings) -> (Image, Image) {
     assert_eq!(settings.method, Method::Fast);
-    let fast = renderer.render(settings).unwrap();
-    let reference = renderer.render(&on_the_reference(settings)).unwrap();
+    let fast = renderer
+        .render(FrameRequest::new(settings))
+        .unwrap()
+        .image();
+    let reference = renderer
+        .render(FrameRequest::new(&on_the_reference(settings)))
+        .unwrap()
+        .image();
     (fast, reference)
 }
 
@@ -71,7 +78,12 @@ pub fn render_on_threads(renderer: &Renderer, settings: &RenderSettings, threads
         .num_threads(threads)
         .build()
         .unwrap();
-    pool.install(|| renderer.render(settings).unwrap())
+    pool.install(|| {
+        renderer
+            .render(FrameRequest::new(settings))
+            .unwrap()
+            .image()
+    })
 }
 
 // ---- transfer functions ----

@@ -39,7 +39,12 @@ impl Renderer {
             let (rendered, interrupt) = interruptible(pool, &lazy.stop, |report| {
                 found
                     .apply(streamed, &options.look, settings, name)
-                    .and_then(|()| streamed.render(settings, report).map_err(LookError::Stream))
+                    .and_then(|()| {
+                        let request = FrameRequest::new(&*settings).reporting(report);
+                        (streamed.render(request.stopped_by(&lazy.stop)))
+                            .map(Rendered::image_and_times)
+                            .map_err(LookError::Stream)
+                    })
             });
             let rendered = rendered.map_err(|panic| {
                 // What the pieces knew may be half updated: start afresh.

@@ -153,6 +153,7 @@ mod tests {
     use crate::session::{Outgoing, spawn};
     use std::sync::Arc;
     use tokio::sync::mpsc;
+    use volray_core::{FrameRequest, Render};
 
     #[test]
     fn a_large_volumes_drafts_come_from_its_coarse_copy_and_its_still_from_the_volume() {
@@ -182,8 +183,9 @@ mod tests {
             let settings = Plain::default().reproduce(&still.state).unwrap().settings;
             let want = Renderer::new(&shared.volume)
                 .unwrap()
-                .render(&settings)
-                .unwrap();
+                .render(FrameRequest::new(&settings))
+                .unwrap()
+                .image();
             let (h, png) = one_frame(&mailbox, &mut rx, still);
             assert_eq!(h["quality"], "full");
             let want = encode::png(&want, &mut Vec::new()).unwrap();

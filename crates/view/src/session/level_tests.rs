@@ -18,7 +18,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::mpsc as std_mpsc;
 use std::time::{Duration, Instant};
 use volray_core::glam::DVec3;
-use volray_core::{Blend, Image, RenderSettings, VolumeSource};
+use volray_core::{Blend, FrameRequest, Image, Render, RenderSettings, VolumeSource};
 
 /// Long enough for any frame here on a busy machine; reached only when
 /// a tab waits for what it should not wait for.
@@ -418,7 +418,11 @@ fn a_pyramids_drafts_show_a_coarser_level_held_whole_and_its_still_the_level_aut
     let volume = read_level(&path, still);
     let mut settings = full.clone();
     settings.camera.azimuth = 40.0;
-    let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let reference = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     assert_eq!(png, encode::png(&reference, &mut Vec::new()).unwrap());
     mailbox.close();
     assert!(rx.blocking_recv().is_none());
@@ -476,7 +480,11 @@ fn a_still_beyond_the_memory_left_is_rendered_in_pieces_never_read_whole_within_
     let volume = read_level(&path, 0);
     let mut settings = full.clone();
     settings.camera.azimuth = 20.0;
-    let reference = Renderer::new(&volume).unwrap().render(&settings).unwrap();
+    let reference = Renderer::new(&volume)
+        .unwrap()
+        .render(FrameRequest::new(&settings))
+        .unwrap()
+        .image();
     let expected = pixels(&encode::png(&reference, &mut Vec::new()).unwrap());
     let got = pixels(&png);
     assert_eq!(got.len(), expected.len());

@@ -9,8 +9,8 @@ use crate::link::{Host, MAX_IN_FLIGHT, Message};
 use crate::watch::Watch;
 use std::sync::Mutex;
 use std::time::Duration;
-use volray_core::RenderSettings;
 use volray_core::glam::DVec3;
+use volray_core::{FrameRequest, Render, RenderSettings};
 
 fn host(shared: Shared) -> Host {
     let volume = shared.ledger.reserve("the volume", 0).unwrap();
@@ -115,7 +115,11 @@ fn a_volume_changed_between_frames_is_rendered_as_it_is_now() {
             height: 32,
             ..RenderSettings::default()
         };
-        let image = Renderer::new(volume).unwrap().render(&settings).unwrap();
+        let image = Renderer::new(volume)
+            .unwrap()
+            .render(FrameRequest::new(&settings))
+            .unwrap()
+            .image();
         encode::png(&image, &mut Vec::new()).unwrap()
     };
     let mut host = host(shared);

@@ -10,7 +10,7 @@ use crate::levels::LevelError;
 use crate::protocol::LevelShown;
 use crate::pyramid::Pyramid;
 use std::sync::Arc;
-use volray_core::{Image, RenderSettings};
+use volray_core::{FrameRequest, Image, Render, RenderSettings};
 use volray_distributed::streamed::{StreamError, Streamed};
 /// A level rendered piece by piece, with its budget: kept so that what
 /// it learnt of its pieces (their value ranges) serves the next still.
@@ -49,7 +49,8 @@ impl Pieces {
         let rendered = {
             let _rendering = cx.stats.rendering();
             cx.pool
-                .install(|| streamed.render_stoppable(settings, &|_| {}, cx.stop))
+                .install(|| streamed.render(FrameRequest::new(settings).stopped_by(cx.stop)))
+                .map(volray_core::Rendered::image_and_times)
         };
         let [x, y, z] = pyramid.grid(level).dims;
         let (image, times) = rendered.map_err(|e| match e {

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use volray_core::camera::View;
 use volray_core::scene::{Scene, SceneSettings};
-use volray_core::{Image, RenderError, RenderSettings, Renderer};
+use volray_core::{FrameRequest, Image, Render, RenderError, RenderSettings, Renderer};
 
 /// A frame rendered, before it is encoded.
 pub(super) struct Drawn {
@@ -77,8 +77,11 @@ impl Context<'_> {
             message_bytes = m;
         }
         let reserved = self.ledger.reserve(self.what, bytes)?;
-        let image =
-            self.rendering(|| scene.render_with_progress(request, &|_| {}, Some(self.stop)))?;
+        let image = self.rendering(|| {
+            scene
+                .render(FrameRequest::new(request).stopped_by(self.stop))
+                .map(volray_core::Rendered::image)
+        })?;
         Ok(Drawn {
             image,
             basis,
@@ -95,7 +98,8 @@ impl Context<'_> {
     ) -> Result<Image, FrameError> {
         // A fresh frame buffer each time (not one kept across frames):
         // what a tab holds between frames is then its caches alone.
-        self.rendering(|| renderer.render_stoppable(settings, &|_| {}, self.stop))
+        let request = FrameRequest::new(settings).stopped_by(self.stop);
+        self.rendering(|| renderer.render(request).map(volray_core::Rendered::image))
     }
 
     /// `work` on the pool, counted as a frame rendering; not started

@@ -12,10 +12,10 @@ use super::scene::{PostWork, Scene};
 use super::skipping::{TransparentValues, transparent_bricks, value_range};
 use crate::bricks::{BRICK, BrickGrid};
 use crate::camera::View;
+use crate::frame::progress::Progress;
 use crate::kernels::composite::{EMPTY, Finish, FrontToBack, PartialPixel};
 use crate::kernels::phong::{Reaching, lit_colour_reached};
 use crate::kernels::trilinear::{cell_of, corners, interpolate};
-use crate::progress::Progress;
 use crate::sampling::grid::clamp_to_grid;
 use crate::sampling::{PixelSamples, Sampling};
 

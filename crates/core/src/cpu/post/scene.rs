@@ -7,10 +7,10 @@ use wide::f32x4;
 
 use crate::bricks::macrocells::Macrocells;
 use crate::kernels::phong::{LightGeometry, Phong};
-use crate::non_finite::NonFiniteMask;
 use crate::shadows::ambient_volume::AmbientVolume;
 use crate::shadows::light_volume::LightVolume;
 use crate::transfer::classifier::Classifier;
+use crate::volume::non_finite::NonFiniteMask;
 use crate::volume::{Sample, Volume};
 
 /// Bytes per voxel of the packed values and gradients ([`packed_voxels`]).

@@ -4,12 +4,13 @@
 use super::scene::PostWork;
 use super::*;
 use crate::bricks::macrocells::Macrocells;
+use crate::frame::progress::Progress;
 use crate::kernels::composite::Finish;
 use crate::kernels::phong::LightGeometry;
 use crate::kernels::trilinear::{cell_of, corners, interpolate};
-use crate::progress::Progress;
 use crate::transfer::iso::IsoSurface;
 use crate::volume::Volume;
+use crate::{FrameRequest, Render};
 use glam::Vec3;
 
 #[test]
@@ -60,9 +61,9 @@ fn packed_voxels_interpolate_to_the_scalar_and_the_gradient_of_the_reference() {
 
 use crate::camera::View;
 use crate::camera::{Camera, Projection};
-use crate::image::Image;
+use crate::frame::image::Image;
+use crate::frame::partial::{PartialImage, PartialPixels};
 use crate::kernels::gradient::gradients;
-use crate::partial::{PartialImage, PartialPixels};
 use crate::renderer::Renderer;
 use crate::settings::{Classification, Method, RenderSettings};
 use glam::DVec3;
@@ -153,8 +154,14 @@ fn empty_bricks_are_skipped_and_small_features_behind_them_are_found() {
         };
         let (image, work, nominal) = post_cast_work(&renderer, &s);
         // The renderer's fast path is this very function.
-        assert!(image == renderer.render(&s).unwrap(), "{camera:?}");
-        let slow = renderer.render(&on_the_reference(&s)).unwrap();
+        assert!(
+            image == renderer.render(FrameRequest::new(&s)).unwrap().image(),
+            "{camera:?}"
+        );
+        let slow = renderer
+            .render(FrameRequest::new(&on_the_reference(&s)))
+            .unwrap()
+            .image();
         assert!(
             image.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0,
             "{camera:?}"
@@ -203,8 +210,11 @@ fn bricks_near_an_isovalue_are_visited_and_far_ones_skipped() {
         ..RenderSettings::default()
     };
     let (fast, work, nominal) = post_cast_work(&renderer, &s);
-    assert!(fast == renderer.render(&s).unwrap());
-    let slow = renderer.render(&on_the_reference(&s)).unwrap();
+    assert!(fast == renderer.render(FrameRequest::new(&s)).unwrap().image());
+    let slow = renderer
+        .render(FrameRequest::new(&on_the_reference(&s)))
+        .unwrap()
+        .image();
     assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
     assert!(slow.pixels().iter().filter(|p| p[3] > 0.3).count() >= 4);
     println!("iso: {work:?} of {nominal} nominal samples");
@@ -221,6 +231,9 @@ fn bricks_near_an_isovalue_are_visited_and_far_ones_skipped() {
     };
     let (fast, work, _) = post_cast_work(&renderer, &thick);
     assert_eq!(work.bricks_skipped, 0);
-    let slow = renderer.render(&on_the_reference(&thick)).unwrap();
+    let slow = renderer
+        .render(FrameRequest::new(&on_the_reference(&thick)))
+        .unwrap()
+        .image();
     assert!(fast.max_abs_diff(&slow).unwrap() <= 1.0 / 255.0);
 }

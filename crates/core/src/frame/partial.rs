@@ -14,7 +14,7 @@
 //! projected values to colour. Distributed and tiled renderers exchange
 //! exactly these.
 
-use crate::image::Image;
+use crate::frame::image::Image;
 use crate::kernels::composite::{EMPTY, PartialPixel, over, over_background};
 use crate::kernels::projection::Projected;
 use crate::settings::Blend;

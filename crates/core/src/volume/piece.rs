@@ -38,6 +38,7 @@
 //! `hi + 2`. A piece therefore holds voxels `lo − 2 .. hi + 3` (clamped to
 //! the grid).
 
+pub use crate::error::Misfit;
 use crate::error::SettingError;
 use crate::sampling::grid::GridFrame;
 use glam::DVec3;
@@ -135,26 +136,6 @@ impl Piece {
             whole: self.whole,
             faces,
         }
-    }
-}
-
-/// A volume that is not the piece it is said to be (see
-/// [`Piece::validate`]).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Misfit {
-    pub whole: [usize; 3],
-    pub offset: [usize; 3],
-    pub dims: [usize; 3],
-    pub owned: ([usize; 3], [usize; 3]),
-}
-
-impl std::fmt::Display for Misfit {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "a piece of {:?} voxels at {:?} of a {:?} grid, owning {:?}..{:?}, must lie in the grid with the cells it samples, at the grid's spacing",
-            self.dims, self.offset, self.whole, self.owned.0, self.owned.1
-        )
     }
 }
 

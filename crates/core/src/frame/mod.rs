@@ -1,14 +1,19 @@
 //! A frame made ready: the settings checked, the camera framed on the
 //! volume, and where every pixel's ray takes its samples.
 
+pub mod image;
+pub mod partial;
+pub mod progress;
+pub mod request;
+
 use crate::camera::View;
 use crate::error::{RenderError, SettingError};
-use crate::piece::Piece;
 use crate::sampling::clipping::{ClipPlane, Clipping};
 use crate::sampling::grid::GridFrame;
 use crate::sampling::{PixelSamples, Sampling};
 use crate::settings::{MAX_SAMPLES_PER_RAY, RenderSettings};
 use crate::volume::Volume;
+use crate::volume::piece::Piece;
 
 /// A validated, framed view of a volume.
 #[derive(Debug, Clone, PartialEq)]
