@@ -141,7 +141,7 @@ impl Start<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::tests::sample;
+    use crate::state::ViewState;
     use volray_core::TransferFunction;
 
     #[test]
@@ -157,7 +157,7 @@ mod tests {
             .unwrap(),
             ..RenderSettings::default()
         };
-        let state = sample();
+        let state = ViewState::default();
         let hello = Start {
             name: "cube",
             volume: &volume,

@@ -47,17 +47,18 @@ mod ledger;
 mod levels;
 mod link;
 mod mailbox;
-mod options;
 mod page;
 mod protocol;
 mod pyramid;
-mod reproduce;
 mod server;
 mod session;
-mod state;
 mod stats;
 mod token;
 mod watch;
+
+// The page's state and its reproduction live in volray-app (the viewer,
+// the CLI and Python share them); named here as they were.
+use volray_app::reproduce::{options, state, viewer as reproduce};
 
 pub use hello::Start;
 pub use ledger::{ENCODE_BYTES_PER_PIXEL, Overdrawn};

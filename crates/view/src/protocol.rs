@@ -366,17 +366,19 @@ pub(crate) fn file(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::tests::sample;
+    use crate::state::ViewState;
 
     #[test]
     fn a_probe_is_filed_in_its_own_slot_and_the_waiting_view_is_kept() {
         let mailbox = Mailbox::default();
-        let view =
-            serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": sample()});
+        let view = serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": ViewState::default()});
         let filed = file(&mailbox, &view.to_string()).unwrap();
-        assert_eq!(filed, Some(sample()), "a view gives back its state");
-        let probe =
-            serde_json::json!({"type": "probe", "seq": 2, "x": 3, "y": 4, "state": sample()});
+        assert_eq!(
+            filed,
+            Some(ViewState::default()),
+            "a view gives back its state"
+        );
+        let probe = serde_json::json!({"type": "probe", "seq": 2, "x": 3, "y": 4, "state": ViewState::default()});
         assert_eq!(file(&mailbox, &probe.to_string()).unwrap(), None);
         // The probe is answered first, then the view it did not replace.
         assert_eq!(mailbox.waiting(), 2);
@@ -386,7 +388,7 @@ mod tests {
 
     fn view(quality: &str) -> String {
         serde_json::json!({
-            "type": "view", "seq": 5, "quality": quality, "state": sample()
+            "type": "view", "seq": 5, "quality": quality, "state": ViewState::default()
         })
         .to_string()
     }
@@ -394,28 +396,31 @@ mod tests {
     #[test]
     fn views_and_saves_parse() {
         let r = parse(&view("draft")).unwrap();
-        assert_eq!((r.seq, r.quality, r.state), (5, Quality::Draft, sample()));
+        assert_eq!(
+            (r.seq, r.quality, r.state),
+            (5, Quality::Draft, ViewState::default())
+        );
         assert_eq!(parse(&view("full")).unwrap().quality, Quality::Full);
-        let save = serde_json::json!({"type": "save", "seq": 9, "state": sample()});
+        let save = serde_json::json!({"type": "save", "seq": 9, "state": ViewState::default()});
         let r = parse(&save.to_string()).unwrap();
         assert_eq!((r.seq, r.quality), (9, Quality::Save));
         // A draft's scale: half by default, or as the page picks it.
         assert_eq!(parse(&view("draft")).unwrap().draft_scale, DRAFT_SCALE);
         let scaled = serde_json::json!({
-            "type": "view", "seq": 5, "quality": "draft", "state": sample(), "draft_scale": 0.25
+            "type": "view", "seq": 5, "quality": "draft", "state": ViewState::default(), "draft_scale": 0.25
         });
         assert_eq!(parse(&scaled.to_string()).unwrap().draft_scale, 0.25);
         // A probe of a pixel of the full-size frame.
-        let probe = serde_json::json!({"type": "probe", "seq": 6, "x": 12.5, "y": 479.9, "state": sample()});
+        let probe = serde_json::json!({"type": "probe", "seq": 6, "x": 12.5, "y": 479.9, "state": ViewState::default()});
         let r = parse(&probe.to_string()).unwrap();
         assert_eq!((r.seq, r.probe), (6, Some([12, 479])));
     }
 
     #[test]
     fn bad_messages_are_errors_not_panics() {
-        let mut nan = serde_json::to_value(sample()).unwrap();
+        let mut nan = serde_json::to_value(ViewState::default()).unwrap();
         nan["zoom"] = serde_json::Value::Null;
-        let mut far = sample();
+        let mut far = ViewState::default();
         far.zoom = 1e9;
         let cases = [
             ("{", "malformed"),
@@ -436,7 +441,7 @@ mod tests {
             (&view("save"), "save message"),
             (&view("best"), "malformed"),
             (
-                &serde_json::json!({"type": "view", "seq": -1, "quality": "full", "state": sample()})
+                &serde_json::json!({"type": "view", "seq": -1, "quality": "full", "state": ViewState::default()})
                     .to_string(),
                 "malformed",
             ),
@@ -446,23 +451,23 @@ mod tests {
                 "zoom 1000000000 is outside",
             ),
             (
-                &serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": sample(), "x": 1})
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "full", "state": ViewState::default(), "x": 1})
                     .to_string(),
                 "malformed",
             ),
             (&"x".repeat(MAX_MESSAGE_BYTES + 1), "too long"),
             (
-                &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": sample(), "draft_scale": 0.01})
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": ViewState::default(), "draft_scale": 0.01})
                     .to_string(),
                 "draft_scale 0.01 is outside 1/16 to 1",
             ),
             (
-                &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": sample(), "draft_scale": 2})
+                &serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": ViewState::default(), "draft_scale": 2})
                     .to_string(),
                 "draft_scale 2 is outside",
             ),
             (
-                &serde_json::json!({"type": "probe", "seq": 1, "x": 480, "y": 0, "state": sample()})
+                &serde_json::json!({"type": "probe", "seq": 1, "x": 480, "y": 0, "state": ViewState::default()})
                     .to_string(),
                 "the probe's pixel (480, 0) is outside the frame",
             ),

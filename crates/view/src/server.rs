@@ -352,7 +352,7 @@ mod tests {
     #[test]
     fn requests_go_to_the_mailbox_and_bad_ones_are_answered() {
         let mailbox = Mailbox::default();
-        let state = crate::state::tests::sample();
+        let state = crate::state::ViewState::default();
         let good =
             serde_json::json!({"type": "view", "seq": 1, "quality": "draft", "state": state});
         assert!(receive(&mailbox, &good.to_string()).is_none());

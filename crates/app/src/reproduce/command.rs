@@ -11,12 +11,13 @@
 //! scene's other volumes are written as `--overlay`s with their look in
 //! full ([`SceneWords`]).
 
+use super::state::{BlendMode, START_COLOURS, ViewState, WHITE};
+use super::viewer::Refusal;
 use crate::scene::{ChannelAxis, LayerSource, mix_name};
 use volray_annotate::figure::preset_unit;
 use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, Phong, RenderSettings, TransferFunction};
 use volray_options::Options;
-use volray_view::{BlendMode, Refusal, START_COLOURS, ViewState, WHITE};
 
 /// The file the command writes and the transfer-function file it names.
 pub const OUTPUT: &str = "view.png";
@@ -436,7 +437,7 @@ impl CommandWords {
                     let colours = match layer.colormap.as_str() {
                         START_COLOURS => other.start.color.as_ref().map(|f| f.points().to_vec()),
                         WHITE => None,
-                        name => match volray_view::solid_colour(name) {
+                        name => match super::state::solid_colour(name) {
                             Some(c) => Some(vec![(0.0, c), (1.0, c)]),
                             None => {
                                 options.push(format!("colormap={name}"));
@@ -576,15 +577,15 @@ pub fn shell_quote(word: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reproduce::state::LayerState;
     use crate::scene::OverlaySpec;
-    use volray_view::LayerState;
 
     /// The words of a viewer of `blobs:16` started with the defaults, and
     /// its starting state.
     fn start() -> (CommandWords, ViewState) {
         let options = Options::default();
         let settings = volray_options::settings(&options).unwrap();
-        let state = volray_view::start_state(&options, &settings);
+        let state = crate::reproduce::options::start_state(&options, &settings);
         let tf = settings.transfer_function.clone();
         let words = CommandWords::new("blobs:16".into(), Vec::new(), &options, tf);
         (words, state)

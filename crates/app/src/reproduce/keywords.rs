@@ -5,10 +5,10 @@
 //! same value. The options are the page's state as volray-view's
 //! `state_options` reads it (the camera, one whole transfer function).
 
+use super::state::Figure;
 use std::fmt::Write;
 use volray_core::{NonFinite, Phong, RenderSettings};
 use volray_options::{BlendMode, CameraOptions, Options, Tf};
-use volray_view::Figure;
 
 /// The keywords beside the options': a chunked file's `level` (`Some(None)`
 /// for `"auto"`; `None` for a volume in memory), and the annotations
@@ -289,7 +289,7 @@ mod tests {
     #[test]
     fn the_figure_is_spelled_as_its_annotation_keywords() {
         let figure = Figure {
-            colorbar: Some(volray_view::ColorBarSide::Left),
+            colorbar: Some(crate::reproduce::state::ColorBarSide::Left),
             scale_bar: true,
             scale_length: Some(2.5),
             title: Some("a \"b\"".into()),

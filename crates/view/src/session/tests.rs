@@ -9,7 +9,6 @@ use crate::mailbox::Slot;
 use crate::protocol::Quality;
 use crate::reproduce::Reproduction;
 use crate::state::ViewState;
-use crate::state::tests::sample;
 use volray_core::RenderSettings;
 use volray_core::glam::DVec3;
 
@@ -93,7 +92,7 @@ pub(super) fn shared_with(reproduce: Arc<Plain>, limit: u128, max_sessions: usiz
 
 /// A view request for a `side`² frame at `azimuth`.
 pub(super) fn request(seq: u64, quality: Quality, side: usize, azimuth: f64) -> Request {
-    let mut state = sample();
+    let mut state = ViewState::default();
     (state.width, state.height, state.azimuth) = (side, side, azimuth);
     Request {
         seq,
@@ -116,7 +115,7 @@ fn the_latest_request_is_rendered_and_stale_ones_are_dropped() {
     let (tx, mut rx) = mpsc::channel(1);
     // A burst before the renderer starts: only the last is rendered.
     for seq in 0..1000 {
-        let mut state = sample();
+        let mut state = ViewState::default();
         state.width = 32;
         state.height = 32;
         state.azimuth = seq as f64;
@@ -155,7 +154,7 @@ fn the_latest_request_is_rendered_and_stale_ones_are_dropped() {
     assert_eq!(shared.stats.sessions(), 1);
 
     // A draft is half size, a JPEG; a refusal is an error naming the seq.
-    let mut state = sample();
+    let mut state = ViewState::default();
     state.width = 33;
     mailbox.put(
         Slot::Latest,

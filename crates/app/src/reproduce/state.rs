@@ -185,7 +185,7 @@ impl Figure {
     }
 
     /// What volray-annotate draws for this figure (the unit left to the
-    /// viewer's [`crate::FigureContext`]).
+    /// viewer's `FigureContext`, volray-view).
     pub fn annotations(&self) -> Annotations {
         Annotations {
             colorbar: self.colorbar.map(|side| match side {
@@ -466,12 +466,10 @@ fn check_opacity(points: &[[f32; 2]]) -> Result<(), StateError> {
     Ok(())
 }
 
-#[cfg(test)]
-pub(crate) mod tests {
-    use super::*;
-
-    /// A valid state: the default view of a 480² frame.
-    pub fn sample() -> ViewState {
+/// A valid state: the default view of a 480² frame (white, composited,
+/// shaded, the camera and window left to the volume).
+impl Default for ViewState {
+    fn default() -> Self {
         ViewState {
             width: 480,
             height: 480,
@@ -498,6 +496,16 @@ pub(crate) mod tests {
             ambient_occlusion: None,
             figure: Figure::default(),
         }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A valid state: the default view of a 480² frame.
+    pub fn sample() -> ViewState {
+        ViewState::default()
     }
 
     #[test]

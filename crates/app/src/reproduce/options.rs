@@ -13,8 +13,8 @@
 //! projection or without shading), as volray-app's command words (`crates/app/src/reproduce/command.rs`)
 //! drop the flags for `volray view`.
 
-use crate::reproduce::Refusal;
-use crate::state::{BlendMode, START_COLOURS, ViewState, WHITE, solid_colour};
+use super::state::{BlendMode, START_COLOURS, ViewState, WHITE, solid_colour};
+use super::viewer::Refusal;
 use volray_core::transfer::colormap;
 use volray_core::{Phong, PiecewiseLinear, Projection, RenderSettings, TransferFunction};
 use volray_options::{BlendMode as Blend, Options, Tf};
@@ -79,7 +79,7 @@ pub fn start_state(options: &Options, settings: &RenderSettings) -> ViewState {
         lighting: None,
         shadows: look.shadows,
         ambient_occlusion: look.ambient_occlusion,
-        figure: crate::state::Figure::default(),
+        figure: super::state::Figure::default(),
     }
 }
 
@@ -232,7 +232,7 @@ pub fn state_options(state: &ViewState, start: &OptionsStart) -> Result<Options,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::Lighting;
+    use crate::reproduce::state::Lighting;
 
     fn start(options: Options) -> (OptionsStart, ViewState) {
         let mut settings = volray_options::settings(&options).unwrap();

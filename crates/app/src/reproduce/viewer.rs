@@ -7,7 +7,7 @@
 //! the frame the page shows and the command it prints are the same frame
 //! by construction. This crate knows nothing of flags.
 
-use crate::state::ViewState;
+use super::state::ViewState;
 use volray_core::RenderSettings;
 use volray_core::scene::{Look, Mix};
 
