@@ -420,8 +420,10 @@ mod tests {
     fn bad_messages_are_errors_not_panics() {
         let mut nan = serde_json::to_value(ViewState::default()).unwrap();
         nan["zoom"] = serde_json::Value::Null;
-        let mut far = ViewState::default();
-        far.zoom = 1e9;
+        let far = ViewState {
+            zoom: 1e9,
+            ..ViewState::default()
+        };
         let cases = [
             ("{", "malformed"),
             ("", "malformed"),

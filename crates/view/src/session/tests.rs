@@ -115,10 +115,12 @@ fn the_latest_request_is_rendered_and_stale_ones_are_dropped() {
     let (tx, mut rx) = mpsc::channel(1);
     // A burst before the renderer starts: only the last is rendered.
     for seq in 0..1000 {
-        let mut state = ViewState::default();
-        state.width = 32;
-        state.height = 32;
-        state.azimuth = seq as f64;
+        let state = ViewState {
+            width: 32,
+            height: 32,
+            azimuth: seq as f64,
+            ..ViewState::default()
+        };
         let quality = if seq == 999 {
             Quality::Full
         } else {
@@ -154,8 +156,10 @@ fn the_latest_request_is_rendered_and_stale_ones_are_dropped() {
     assert_eq!(shared.stats.sessions(), 1);
 
     // A draft is half size, a JPEG; a refusal is an error naming the seq.
-    let mut state = ViewState::default();
-    state.width = 33;
+    let mut state = ViewState {
+        width: 33,
+        ..ViewState::default()
+    };
     mailbox.put(
         Slot::Latest,
         Request {
