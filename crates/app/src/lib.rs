@@ -33,6 +33,10 @@
 //! - [`reproduce`]: the view's state (camera, transfer function, look) and
 //!   its two spellings: `volray render` words ([`reproduce::command`]) and
 //!   Python keywords ([`reproduce::keywords`]);
+//! - [`bench`]: `volray bench`'s timed frames, their medians and `--json`
+//!   rows, and the peer benchmark's workloads (with VTK timed beside them);
+//! - [`describe`]: what a volume file holds and how volray reads it, as
+//!   `volray info` says it (lines of text, or JSON);
 //! - [`words`]: the number words both spellings and the flags parse;
 //! - [`error`]: [`AppError`], typed, one line naming the file, which each
 //!   front end words in its own syntax.
@@ -61,6 +65,8 @@
 //! # Ok::<(), volray_app::AppError>(())
 //! ```
 
+pub mod bench;
+pub mod describe;
 #[cfg(feature = "mpi")]
 pub mod distributed;
 pub mod error;
