@@ -115,7 +115,8 @@ pub fn lines(request: &Request, bins: u16, as_json: bool) -> Result<Vec<String>,
         print_stored(&mut out, i, &input.name);
     }
     outln!(out, "dims:      {nx} x {ny} x {nz} ({points} points)");
-    outln!(out,
+    outln!(
+        out,
         "in memory: {}{} ({} a voxel, {})",
         if mapped { "mapped from the file, " } else { "" },
         kept.name(),
@@ -130,32 +131,40 @@ pub fn lines(request: &Request, bins: u16, as_json: bool) -> Result<Vec<String>,
     let e = grid.extent();
     outln!(out, "extent:    {}, {}, {}{unit_suffix}", e.x, e.y, e.z);
     if let Some((k, [x, y, z])) = values_from {
-        outln!(out,
+        outln!(
+            out,
             "           values below from level {k} ({x} x {y} x {z}), block means of this one: its range lies within this level's (only the metadata of a level this large is read)"
         );
     }
     match &hist {
         None => outln!(out, "values:    no finite values"),
         Some(h) => {
-            outln!(out,
+            outln!(
+                out,
                 "values:    min {}, max {}, mean {:.6e}",
                 h.min,
                 h.max,
                 h.mean
             );
             if h.non_finite > 0 && info.is_some_and(|i| i.nan_is_empty) {
-                outln!(out,
+                outln!(
+                    out,
                     "           {} NaN: no value (outside the file's grid, or fill or blank values; see the notes), rendered as empty",
                     h.non_finite
                 );
             } else if h.non_finite > 0 {
-                outln!(out, "           {} non-finite (NaN or infinite)", h.non_finite);
+                outln!(
+                    out,
+                    "           {} non-finite (NaN or infinite)",
+                    h.non_finite
+                );
             }
             outln!(out, "histogram: ({} bins)", h.counts.len());
             let peak = h.counts.iter().copied().max().unwrap_or(1).max(1);
             for (b, &c) in h.counts.iter().enumerate() {
                 let bar = (c * 40).div_ceil(peak) as usize;
-                outln!(out,
+                outln!(
+                    out,
                     "  [{:>12.5e}, {:>12.5e}{} {:<40} {c}",
                     h.edge(b),
                     h.edge(b + 1),
@@ -167,7 +176,8 @@ pub fn lines(request: &Request, bins: u16, as_json: bool) -> Result<Vec<String>,
     }
     if let Some(found) = &labels {
         let shown: Vec<String> = found.iter().take(16).map(i64::to_string).collect();
-        outln!(out,
+        outln!(
+            out,
             "labels:    {} distinct integer values ({}{}): a segmentation? render it with --labels",
             found.len(),
             shown.join(", "),
@@ -249,7 +259,8 @@ fn describe_image(out: &mut Vec<String>, name: &str, image: &FlatImage, as_json:
     outln!(out, "input:     {name}");
     outln!(out, "format:    {}", image.format.description());
     print_stored(out, i, name);
-    outln!(out,
+    outln!(
+        out,
         "dims:      {nx} x {ny} x {nz} ({} points: an image, not a volume)",
         image.values.len()
     );
@@ -294,23 +305,27 @@ fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
     outln!(out, "stored as: {}", i.stored_type);
     let (t, c) = (i.time_points, i.channels);
     if t > 1 {
-        outln!(out,
+        outln!(
+            out,
             "time points: {t} (read: {}; --frame picks another; as an animation: volray render {name} --frames all -o OUT.gif)",
             i.time_point
         );
     }
     if c > 1 {
-        outln!(out,
+        outln!(
+            out,
             "channels:  {c} (read: {}; --channel picks another; together: volray render {name} --channels all)",
             i.channel
         );
     } else if t > 1 {
-        outln!(out,
+        outln!(
+            out,
             "channels:  1 (its {t} time points rendered together as channels: volray render {name} --channels all)"
         );
     }
     if !i.levels.is_empty() {
-        outln!(out,
+        outln!(
+            out,
             "levels:    {} (read: {}; --level picks another)",
             i.levels.len(),
             i.level
@@ -323,7 +338,8 @@ fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
         for (n, l) in i.levels.iter().enumerate() {
             let [x, y, z] = l.dims;
             let [sx, sy, sz] = l.spacing;
-            outln!(out,
+            outln!(
+                out,
                 "  {n}: {x} x {y} x {z}, spacing {sx}, {sy}, {sz}; chunks {}, shards {}; codecs {}; {} stored, {} in memory",
                 shape(&l.chunk_shape),
                 shape(&l.shard_shape),
@@ -351,10 +367,16 @@ fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
         if let Some(a) = o.active {
             parts.push(if a { "shown" } else { "hidden" }.to_string());
         }
-        outln!(out, "omero:     channel {}: {}", o.channel, parts.join(", "));
+        outln!(
+            out,
+            "omero:     channel {}: {}",
+            o.channel,
+            parts.join(", ")
+        );
     }
     if !i.arrays.is_empty() {
-        outln!(out,
+        outln!(
+            out,
             "arrays:    {} (read: {}; --array picks another)",
             i.arrays.join(", "),
             i.array.as_deref().unwrap_or("-")

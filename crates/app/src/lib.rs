@@ -33,6 +33,8 @@
 //! - [`reproduce`]: the view's state (camera, transfer function, look) and
 //!   its two spellings: `volray render` words ([`reproduce::command`]) and
 //!   Python keywords ([`reproduce::keywords`]);
+//! - [`animation`]: a turntable's views, and the window and framing the
+//!   frames of a series share;
 //! - [`bench`]: `volray bench`'s timed frames, their medians and `--json`
 //!   rows, and the peer benchmark's workloads (with VTK timed beside them);
 //! - [`describe`]: what a volume file holds and how volray reads it, as
@@ -65,6 +67,7 @@
 //! # Ok::<(), volray_app::AppError>(())
 //! ```
 
+pub mod animation;
 pub mod bench;
 pub mod describe;
 #[cfg(feature = "mpi")]

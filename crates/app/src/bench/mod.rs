@@ -18,7 +18,9 @@ pub mod vtk;
 use crate::AppError;
 use std::path::Path;
 use std::time::{Duration, Instant};
-use volray_core::{Camera, FrameRequest, FrameTimes, Image, Method, Render, RenderSettings, Renderer};
+use volray_core::{
+    Camera, FrameRequest, FrameTimes, Image, Method, Render, RenderSettings, Renderer,
+};
 
 /// One timed frame.
 #[derive(Debug, Clone, Copy)]

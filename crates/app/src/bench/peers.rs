@@ -77,8 +77,7 @@ fn load(dir: &Path, name: &str) -> Result<(Volume, Sidecar), AppError> {
             path.display()
         ))
     })?;
-    let side =
-        parse_sidecar(&text).map_err(|e| input(format!("{}: {e}", path.display())))?;
+    let side = parse_sidecar(&text).map_err(|e| input(format!("{}: {e}", path.display())))?;
     let mut raw = RawOptions::new(side.dims, side.dtype);
     raw.endian = Endian::Little;
     raw.spacing = DVec3::from(side.spacing);
@@ -338,7 +337,8 @@ fn print_row(out: &mut dyn FnMut(String), row: &Row, threads: usize) {
         row.classify_ms,
     );
     match &row.vtk {
-        Some(v) => outln!(out,
+        Some(v) => outln!(
+            out,
             "{head}; VTK {:.4} s: VTK/volray {:.2}x",
             v.median_s,
             v.median_s / row.median_s
@@ -352,12 +352,16 @@ fn print_table(out: &mut dyn FnMut(String), rows: &[Row], threads: usize) {
     outln!(out, "");
     let vtk = rows.iter().any(|r| r.vtk.is_some());
     if vtk {
-        outln!(out,
+        outln!(
+            out,
             "| dataset, window | volray median s | samples/s (nominal) | VTK fixed-point median s | VTK / volray | image vs VTK: mean abs diff (levels of 255) |"
         );
         outln!(out, "|---|---|---|---|---|---|");
     } else {
-        outln!(out, "| dataset, window | volray median s | samples/s (nominal) |");
+        outln!(
+            out,
+            "| dataset, window | volray median s | samples/s (nominal) |"
+        );
         outln!(out, "|---|---|---|");
     }
     for r in rows {
@@ -370,7 +374,8 @@ fn print_table(out: &mut dyn FnMut(String), rows: &[Row], threads: usize) {
         );
         let volray = format!("{:.4} | {:.3e}", r.median_s, nominal(r) / r.median_s);
         match &r.vtk {
-            Some(v) => outln!(out,
+            Some(v) => outln!(
+                out,
                 "| {name} | {volray} | {:.4} | {:.2} | {:.2} (means {:.1} vs {:.1}) |",
                 v.median_s,
                 v.median_s / r.median_s,

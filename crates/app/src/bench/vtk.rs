@@ -93,8 +93,7 @@ impl Harness {
             )));
         }
         let scratch = std::env::temp_dir().join(format!("volray-bench-{}", std::process::id()));
-        std::fs::create_dir_all(&scratch)
-            .map_err(|e| io(format!("{}: {e}", scratch.display())))?;
+        std::fs::create_dir_all(&scratch).map_err(|e| io(format!("{}: {e}", scratch.display())))?;
         Ok(Harness {
             python,
             dir,
@@ -136,8 +135,8 @@ impl Harness {
                 "vtk_bench.py failed on {dataset}:{window}: {last}"
             )));
         }
-        let text = std::fs::read_to_string(&json)
-            .map_err(|e| io(format!("{}: {e}", json.display())))?;
+        let text =
+            std::fs::read_to_string(&json).map_err(|e| io(format!("{}: {e}", json.display())))?;
         let bad = || io(format!("{}: not vtk_bench.py's results", json.display()));
         let value: serde_json::Value = serde_json::from_str(&text).map_err(|_| bad())?;
         let result = &value["results"][0];
