@@ -361,7 +361,7 @@ pub fn read_layers(
 /// error as `load`'s, an overlay's after `--overlay:`, saying what the
 /// volumes read before it hold.
 fn layer_failure(e: LayerError) -> CliError {
-    let error = match e.failure {
+    let error = match *e.failure {
         Failure::Read(e) => CliError::from(e),
         Failure::OverlayRead(e) => {
             let e = CliError::from(e);

@@ -52,14 +52,15 @@ pub enum Failure {
 /// they left it ([`Budget::explain`] says what they hold).
 #[derive(Debug)]
 pub struct LayerError {
-    pub failure: Failure,
+    /// Boxed: a reader's error is large beside the layers returned.
+    pub failure: Box<Failure>,
     pub after: Option<Budget>,
 }
 
 impl From<Failure> for LayerError {
     fn from(failure: Failure) -> Self {
         LayerError {
-            failure,
+            failure: Box::new(failure),
             after: None,
         }
     }
