@@ -35,7 +35,7 @@
 //!   Python keywords ([`reproduce::keywords`]);
 //! - [`animation`]: a turntable's views, and the window and framing the
 //!   frames of a series share;
-//! - [`bench`]: `volray bench`'s timed frames, their medians and `--json`
+//! - [`bench`](mod@bench): `volray bench`'s timed frames, their medians and `--json`
 //!   rows, and the peer benchmark's workloads (with VTK timed beside them);
 //! - [`describe`]: what a volume file holds and how volray reads it, as
 //!   `volray info` says it (lines of text, or JSON);

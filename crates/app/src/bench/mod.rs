@@ -35,7 +35,7 @@ pub struct Timed {
 /// was idle (while the volume was read, or while VTK ran) comes back to
 /// full speed only after some tens of milliseconds of work; VTK's harness
 /// gets that while Python imports VTK.
-const WARM_UP: Duration = Duration::from_millis(250);
+pub const WARM_UP: Duration = Duration::from_millis(250);
 
 /// Renders the warm-up view (`base`'s camera) until [`WARM_UP`] has passed,
 /// then `frames` timed frames each turned half a degree further about the
