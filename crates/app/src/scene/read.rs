@@ -318,3 +318,79 @@ fn load_overlay(
         source: LayerSource::Overlay(overlay.clone()),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The volumes of `request` (its channels if `channels`) and `overlays`.
+    fn read(
+        request: &str,
+        channels: bool,
+        overlays: &[OverlaySpec],
+    ) -> Result<Vec<Layer>, LayerError> {
+        let request = Request::of(request);
+        let shared = Options::default();
+        let first = First {
+            request: &request,
+            log: false,
+            look: &shared.look,
+        };
+        let pick = ChannelPick {
+            which: None,
+            colors: None,
+        };
+        let tf_texts = vec![None; overlays.len()];
+        let overlays = Overlays {
+            specs: overlays,
+            tf_texts: &tf_texts,
+            shared: &shared,
+        };
+        read_layers(
+            &first,
+            channels.then_some(pick),
+            &overlays,
+            &RenderSettings::default(),
+        )
+    }
+
+    #[test]
+    fn a_built_in_source_is_read_with_its_look_and_its_channels_are_refused() {
+        let layers = read("blobs:16", false, &[]).unwrap();
+        assert_eq!(layers.len(), 1);
+        assert_eq!(layers[0].source, LayerSource::Input);
+        assert_eq!(layers[0].input.volume.dims(), [16; 3]);
+        let e = read("blobs:16", true, &[]).err().unwrap();
+        match *e.failure {
+            Failure::Refused(Refused(m)) => assert_eq!(
+                m,
+                "--channels: blobs:16 is a built-in source, one volume: give a file holding several channels"
+            ),
+            other => panic!("{other:?}"),
+        }
+        assert!(e.after.is_none());
+    }
+
+    #[test]
+    fn an_overlay_the_reader_refuses_says_what_the_volumes_before_it_hold() {
+        let dir = tempfile::tempdir().unwrap();
+        let junk = dir.path().join("junk.txt");
+        std::fs::write(&junk, "not a volume").unwrap();
+        let spec = OverlaySpec::parse(junk.to_str().unwrap()).unwrap();
+        let e = read("blobs:16", false, &[spec]).err().unwrap();
+        assert!(
+            matches!(*e.failure, Failure::OverlayRead(AppError::Io(_))),
+            "{:?}",
+            e.failure
+        );
+        // blobs:16 is held in memory: 16³ f32 samples.
+        let budget = e.after.expect("read after the first volume");
+        assert!(
+            budget
+                .explain("refused")
+                .starts_with("refused (the volumes read before it hold 16 KiB of --max-memory"),
+            "{}",
+            budget.explain("refused")
+        );
+    }
+}
