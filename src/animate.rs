@@ -6,7 +6,7 @@
 //! - A **turntable** orbits the view point about the up vector, frame `i`
 //!   of `n` at azimuth `--azimuth + 360·i/n`. The orthographic window (or
 //!   the perspective eye's distance) fits the bounding sphere rather than
-//!   the box ([`Fit::Sphere`]), so the object keeps its scale as it turns
+//!   the box ([`Fit::Sphere`](volray_core::Fit::Sphere)), so the object keeps its scale as it turns
 //!   instead of breathing with its box's outline.
 //! - A **series** renders several volumes, one frame each, as they are
 //!   given: the paper's "repeat the calculation for various unit-cell
@@ -27,9 +27,10 @@ use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note,
 };
 use rayon::ThreadPool;
+use volray_app::animation::Extent;
+pub use volray_app::animation::turntable_frame;
 use volray_app::plan::Plan;
-use volray_core::glam::DVec3;
-use volray_core::{Camera, Fit, FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
+use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
 use volray_io::Animation;
 
 /// `--turntable FRAMES`: `frames` views of INPUT.
@@ -93,18 +94,6 @@ pub fn turntable(
         writer.push(&image)?;
     }
     writer.finish()
-}
-
-/// The settings of frame `i` of an `n`-frame turntable of `base`.
-pub fn turntable_frame(base: &RenderSettings, i: usize, n: usize) -> RenderSettings {
-    RenderSettings {
-        camera: Camera {
-            azimuth: base.camera.azimuth + 360.0 * i as f64 / n as f64,
-            fit: Fit::Sphere,
-            ..base.camera
-        },
-        ..base.clone()
-    }
 }
 
 /// Several inputs: one frame per volume in `specs`, in order.
@@ -252,52 +241,6 @@ fn series_of(
     writer.finish()
 }
 
-/// The value range, the bounds and (for gradient opacity) the largest
-/// gradient magnitude of the volumes seen so far.
-#[derive(Debug, Default, Clone, Copy, PartialEq)]
-struct Extent {
-    range: Option<(f32, f32)>,
-    bounds: Option<(DVec3, DVec3)>,
-    max_gradient: f32,
-}
-
-impl Extent {
-    fn add(&mut self, (lo, hi): (f32, f32), (min, max): (DVec3, DVec3)) {
-        self.range = Some(match self.range {
-            Some((a, b)) => (a.min(lo), b.max(hi)),
-            None => (lo, hi),
-        });
-        self.bounds = Some(match self.bounds {
-            Some((a, b)) => (a.min(min), b.max(max)),
-            None => (min, max),
-        });
-    }
-
-    /// `base` with one value window and one framed box for every volume:
-    /// the window is the union of the ranges unless the transfer function
-    /// fixes one (`--range`, `--tf`, a CT preset); the box is the union of
-    /// the bounds; gradient opacity is relative to the largest gradient. Volumes that are all the same constant keep no window
-    /// (each one's own range is then that constant).
-    fn fix(&self, base: &RenderSettings) -> RenderSettings {
-        let mut settings = base.clone();
-        if settings.transfer_function.domain.is_none()
-            && let Some((lo, hi)) = self.range
-            && lo < hi
-        {
-            settings.transfer_function.domain = Some((lo as f64, hi as f64));
-        }
-        if settings.camera.bounds.is_none() {
-            settings.camera.bounds = self.bounds;
-        }
-        // Gradient opacity relative to the steepest volume of all, so that
-        // one gradient magnitude gets one opacity in every frame.
-        if settings.gradient_opacity.is_some() && self.max_gradient > 0.0 {
-            settings.gradient_opacity_max = Some(self.max_gradient);
-        }
-        settings
-    }
-}
-
 /// The animation being written, with its progress bar.
 pub struct Writer {
     animation: Animation,
@@ -353,69 +296,5 @@ impl Writer {
         self.bar.finish_and_clear();
         self.animation.finish()?;
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn turntable_frames_turn_by_equal_steps_from_the_given_azimuth() {
-        let base = RenderSettings {
-            camera: Camera {
-                azimuth: 10.0,
-                elevation: 20.0,
-                ..Camera::default()
-            },
-            ..RenderSettings::default()
-        };
-        let azimuths: Vec<f64> = (0..4)
-            .map(|i| turntable_frame(&base, i, 4).camera.azimuth)
-            .collect();
-        assert_eq!(azimuths, [10.0, 100.0, 190.0, 280.0]);
-        let frame = turntable_frame(&base, 3, 4);
-        assert_eq!(frame.camera.fit, Fit::Sphere);
-        assert_eq!(frame.camera.elevation, 20.0);
-        assert_eq!(
-            RenderSettings {
-                camera: base.camera,
-                ..frame.clone()
-            },
-            base
-        );
-    }
-
-    #[test]
-    fn a_series_shares_the_union_of_ranges_and_bounds() {
-        let mut extent = Extent::default();
-        extent.add((0.0, 2.0), (DVec3::ZERO, DVec3::ONE));
-        extent.add(
-            (-1.0, 1.5),
-            (DVec3::new(0.5, -1.0, 0.0), DVec3::new(3.0, 0.5, 1.0)),
-        );
-        let fixed = extent.fix(&RenderSettings::default());
-        assert_eq!(fixed.transfer_function.domain, Some((-1.0, 2.0)));
-        assert_eq!(
-            fixed.camera.bounds,
-            Some((DVec3::new(0.0, -1.0, 0.0), DVec3::new(3.0, 1.0, 1.0)))
-        );
-        // A window the user gave stays.
-        let mut given = RenderSettings::default();
-        given.transfer_function.domain = Some((0.0, 10.0));
-        assert_eq!(
-            extent.fix(&given).transfer_function.domain,
-            Some((0.0, 10.0))
-        );
-        // Constant volumes all alike keep no window.
-        let mut flat = Extent::default();
-        flat.add((3.0, 3.0), (DVec3::ZERO, DVec3::ONE));
-        flat.add((3.0, 3.0), (DVec3::ZERO, DVec3::ONE));
-        assert_eq!(
-            flat.fix(&RenderSettings::default())
-                .transfer_function
-                .domain,
-            None
-        );
     }
 }

@@ -1,27 +1,16 @@
 //! `volray bench`: time whole frames, of one volume or of the peer
-//! benchmark's workloads (`--peers`, see [`peers`]).
-//!
-//! A frame is everything after the volume is in memory: classification
-//! (done on the first frame and kept while the transfer function stays the
-//! same, as VTK keeps its normals), lighting the voxels for this view,
-//! binning the bricks into tiles and casting the rays into the frame
-//! buffer; PNG encoding is not timed. One warm-up view (rendered for at
-//! least a quarter of a second, untimed, so that the CPU is awake), then
-//! `--frames` timed ones, each turned a further half degree about the up
-//! axis so that no view-dependent work is reused.
-
-mod peers;
-mod vtk;
+//! benchmark's workloads (`--peers`): the flags, and the tables printed.
+//! How frames are timed, and the peers' workloads, are
+//! `volray_app::bench`'s.
 
 use crate::error::CliError;
 use crate::flags::BenchArgs;
 use crate::session::{load, render_failure, renderer_for, thread_pool};
 use crate::settings::settings;
 use std::path::Path;
-use std::time::{Duration, Instant};
-use volray_core::{
-    Camera, FrameRequest, FrameTimes, Image, Method, Render, RenderSettings, Renderer,
-};
+use volray_app::bench::peers::{self, Peers};
+use volray_app::bench::{JsonRow, Timed, median, ms, time_frames, write_json};
+use volray_core::Method;
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     match &args.peers {
@@ -31,7 +20,21 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
                     "{input}: --peers times the peers' volumes; give INPUT or --peers, not both"
                 )));
             }
-            peers::run(args, dir)
+            let pool = thread_pool(args.view.threads)?;
+            let peers = Peers {
+                dir,
+                cases: args.cases.as_ref().map(|c| c.0.clone()),
+                frames: args.frames,
+                shadows: args.view.look.shadows,
+                ambient_occlusion: args.view.look.ambient_occlusion,
+                vs_vtk: args.vs_vtk,
+                python: args.peers_python.as_deref(),
+            };
+            let rows = peers::run(&peers, &pool, &mut |line| outln!("{line}"))?;
+            if let Some(path) = &args.json {
+                write_json(path, &rows)?;
+            }
+            Ok(())
         }
         None => {
             if let Some(json) = &args.json {
@@ -63,127 +66,6 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             one_volume(args)
         }
     }
-}
-
-/// One timed frame.
-#[derive(Debug, Clone, Copy)]
-pub struct Timed {
-    /// Wall time of the whole frame, seconds.
-    pub wall: f64,
-    /// The fast path's breakdown (`None` on the reference path).
-    pub parts: Option<FrameTimes>,
-}
-
-/// The least time the warm-up view is rendered for, untimed. A CPU that
-/// was idle (while the volume was read, or while VTK ran) comes back to
-/// full speed only after some tens of milliseconds of work; VTK's harness
-/// gets that while Python imports VTK.
-const WARM_UP: Duration = Duration::from_millis(250);
-
-/// Renders the warm-up view (`base`'s camera) until [`WARM_UP`] has passed,
-/// then `frames` timed frames each turned half a degree further about the
-/// up axis, calling `report` after the first warm-up frame (frame 0, which
-/// includes the classification) and after each timed one. Returns the
-/// warm-up image and the timed frames.
-pub fn time_frames(
-    renderer: &Renderer,
-    base: &RenderSettings,
-    frames: u32,
-    mut report: impl FnMut(u32, &Timed),
-) -> Result<(Image, Vec<Timed>), volray_core::RenderError> {
-    let mut image = Image::new(base.width, base.height, [0.0; 4]);
-    let render = |frame: u32, image: &mut Image| {
-        // Orbit about the up axis through the view reference (VTK's
-        // azimuth), for either projection and with or without --view.
-        let settings = RenderSettings {
-            camera: Camera {
-                azimuth: base.camera.azimuth + 0.5 * frame as f64,
-                ..base.camera
-            },
-            ..base.clone()
-        };
-        let t0 = Instant::now();
-        let parts = match settings.method {
-            Method::Fast => {
-                let reusing = std::mem::replace(image, Image::new(0, 0, [0.0; 4]));
-                let request = FrameRequest::new(&settings).reusing(reusing);
-                let (rendered, times) = renderer.render(request)?.image_and_times();
-                *image = rendered;
-                Some(times)
-            }
-            Method::Reference => {
-                *image = renderer.render(FrameRequest::new(&settings))?.image();
-                None
-            }
-        };
-        Ok::<_, volray_core::RenderError>(Timed {
-            wall: t0.elapsed().as_secs_f64(),
-            parts,
-        })
-    };
-    let start = Instant::now();
-    report(0, &render(0, &mut image)?);
-    let warm = image.clone();
-    while start.elapsed() < WARM_UP {
-        render(0, &mut image)?;
-    }
-    let mut timed = Vec::new();
-    for frame in 1..=frames {
-        let t = render(frame, &mut image)?;
-        report(frame, &t);
-        timed.push(t);
-    }
-    Ok((warm, timed))
-}
-
-/// The median of `values` (the mean of the middle two for an even count).
-pub fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
-}
-
-/// Milliseconds of one part of a frame, for the tables.
-fn ms(d: std::time::Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-/// One row of `--json`.
-pub struct JsonRow {
-    pub dataset: String,
-    pub window: usize,
-    pub threads: usize,
-    pub median_s: f64,
-    /// VTK's median on the same workload, when it ran.
-    pub vtk_median_s: Option<f64>,
-}
-
-/// Writes `rows` to `path` as a JSON list, atomically.
-pub fn write_json(path: &Path, rows: &[JsonRow]) -> Result<(), CliError> {
-    let list: Vec<serde_json::Value> = rows
-        .iter()
-        .map(|r| {
-            let mut v = serde_json::json!({
-                "dataset": r.dataset,
-                "window": r.window,
-                "threads": r.threads,
-                "median_s": r.median_s,
-            });
-            if let Some(vtk) = r.vtk_median_s {
-                v["vtk_median_s"] = vtk.into();
-            }
-            v
-        })
-        .collect();
-    let text = serde_json::to_string_pretty(&list).expect("plain values serialise");
-    volray_io::write_atomically(path, |w| writeln!(w, "{text}"))?;
-    Ok(())
 }
 
 /// `volray bench INPUT`: the frames of one volume.

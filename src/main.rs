@@ -10,8 +10,8 @@
 //! - one module per subcommand: `render.rs` (one still image, and the
 //!   checks before any work) with `animate.rs` (turntables, series and
 //!   `--frames`) and `scene.rs` (several volumes in one picture:
-//!   `--channels`, `--overlay`), `bench.rs` (with `bench/peers.rs` and
-//!   `bench/vtk.rs`), `info.rs`, `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
+//!   `--channels`, `--overlay`), `bench.rs`, `info.rs` (their timing,
+//!   reading and describing are volray-app's), `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
 //!   writes with), `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
 //!   `view/reproduce.rs`: the page's state as a `volray render` command);
 //! - what they share: `settings.rs` (the flags as volray-core's

@@ -11,39 +11,23 @@
 //! `colormap=`, `preset=`, `range=`, `opacity=`, `tf=`, `frame=`) with the
 //! shared shading. Each volume is read whole and checked against
 //! `--max-memory` on its own (`session.rs`). Plain renders never come here.
+//! The volumes are read by `volray_app::scene` (`read.rs`); here are the
+//! flags, the refusals worded with them, and the frames written.
 
 use crate::animate;
 use crate::error::CliError;
 use crate::flags::{Channels, InputArgs, LookArgs, RenderArgs, SceneArgs, ViewArgs};
 use crate::outfile::{OutputKind, output_kind, write_still};
-use crate::session::{load, progress_bar, render_failure, renderer_for, thread_pool};
+use crate::session::{progress_bar, render_failure, renderer_for, thread_pool};
 use std::path::{Path, PathBuf};
-use volray_app::input::{self, Input};
+use volray_app::input;
 use volray_app::plan::Plan;
 use volray_app::scene::{
-    Budget, ChannelAxis, LayerSource, OverlaySpec, Refused, channel_axis, channel_color,
-    default_mix, picked_channels, time_range,
+    self, ChannelAxis, ChannelPick, Failure, First, Layer, LayerError, LayerSource, OverlaySpec,
+    Overlays, Refused, channel_axis, channels_at, default_mix, time_range,
 };
-use volray_core::scene::{Look, Mix, Scene, SceneSettings, overlaps};
+use volray_core::scene::{Look, Mix, Scene, SceneSettings};
 use volray_core::{FrameRequest, Render, RenderError, RenderSettings, Rendered, SceneError};
-
-/// One volume of the picture: what was read, its settings alone (whose
-/// look becomes its [`Look`]), and where it came from.
-pub struct Layer {
-    pub input: Input,
-    pub settings: RenderSettings,
-    pub source: LayerSource,
-}
-
-impl Layer {
-    /// Its look in the picture: shown unless an overlay's `hidden`.
-    pub fn look(&self) -> Look {
-        Look {
-            visible: self.source.visible(),
-            ..Look::of(&self.settings)
-        }
-    }
-}
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
@@ -217,47 +201,14 @@ impl TimeWalk<'_> {
         for t in range.start..end {
             let now = match layers.take() {
                 Some(first) => first,
-                None => self.read_at(input_args, t, &looks)?,
+                None => channels_at(&input_args.request(), args.view.look.log, t, &looks)
+                    .map_err(layer_failure)?,
             };
             let image = self.picture(&now, &writer.bar)?;
             drop(now);
             writer.push(&image)?;
         }
         writer.finish()
-    }
-
-    /// The channels of `looks` at time point `t`, each with its look.
-    fn read_at(
-        &self,
-        input_args: &InputArgs,
-        t: usize,
-        looks: &[(LayerSource, RenderSettings)],
-    ) -> Result<Vec<Layer>, CliError> {
-        let spec = input_args.input.as_deref().unwrap_or(input::DEMO);
-        let at = InputArgs {
-            frame: Some(t),
-            ..input_args.clone()
-        };
-        let mut budget = Budget::new(at.max_memory);
-        let mut layers = Vec::with_capacity(looks.len());
-        for (source, settings) in looks {
-            let LayerSource::Channel { index, axis } = source else {
-                unreachable!("--frames takes channels only");
-            };
-            let mut one = pick(*axis, &at, *index);
-            one.max_memory = budget.left();
-            let mut input =
-                load(&one, self.args.view.look.log).map_err(|e| explained(&budget, e))?;
-            budget.add(&input.volume);
-            input.max_memory = budget.limit;
-            input.name = format!("{spec} (channel {index}, time point {t})");
-            layers.push(Layer {
-                input,
-                settings: settings.clone(),
-                source: source.clone(),
-            });
-        }
-        Ok(layers)
     }
 
     /// One frame of `layers`, annotated as the first volume's.
@@ -339,16 +290,10 @@ fn refused(e: Refused) -> CliError {
     CliError::input(e.0)
 }
 
-/// A refusal of the next volume, saying what the others hold.
-fn explained(budget: &Budget, e: CliError) -> CliError {
-    CliError {
-        message: budget.explain(&e.message),
-        ..e
-    }
-}
-
 /// The channels `which` of the `count` that `spec` holds, and their
-/// colours (`--channel-colors`, else the palette).
+/// colours (`--channel-colors`, else the palette): `mpirun`'s
+/// `--channels` (one process reads them through `read_layers`).
+#[cfg(feature = "mpi")]
 pub fn picked(
     scene: &SceneArgs,
     which: &Channels,
@@ -360,14 +305,7 @@ pub fn picked(
         Channels::Some(list) => Some(&list[..]),
     };
     let colors = scene.channel_colors.as_ref().map(|c| &c.0[..]);
-    picked_channels(colors, which, spec, count).map_err(refused)
-}
-
-/// `input` reading volume `index` along `axis`.
-pub fn pick(axis: ChannelAxis, input: &InputArgs, index: usize) -> InputArgs {
-    let mut one = input.clone();
-    axis.pick(&mut one.channel, &mut one.frame, index);
-    one
+    volray_app::scene::picked_channels(colors, which, spec, count).map_err(refused)
 }
 
 /// Refuses the look flags that do not apply to `--channels`, whose
@@ -376,9 +314,9 @@ pub fn refuse_channel_look(look: &LookArgs) -> Result<(), CliError> {
     volray_app::scene::refuse_channel_look(&crate::settings::look(look)).map_err(refused)
 }
 
-/// The volumes of the picture, each read whole with its look: INPUT (read
-/// as `input_args` say) or its `--channels`, then each overlay, refused
-/// where an overlay does not meet the first volume.
+/// The volumes of the picture, each read whole with its look
+/// (`volray_app::scene::read_layers`): INPUT (read as `input_args` say)
+/// or its `--channels`, then each overlay.
 pub fn read_layers(
     input_args: &InputArgs,
     view: &ViewArgs,
@@ -393,47 +331,55 @@ pub fn read_layers(
                 .transpose()
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut budget = Budget::new(input_args.max_memory);
-    let mut layers = match &scene.channels {
-        Some(which) => read_channels(input_args, view, scene, which, settings, &mut budget)?,
-        None => {
-            let mut input = load(input_args, view.look.log)?;
-            budget.add(&input.volume);
-            let mut settings = settings.clone();
-            crate::settings::file_window(
-                &view.look,
-                &mut settings.transfer_function,
-                (input.file.as_ref()).and_then(|(_, info)| info.display_window()),
-            );
-            crate::settings::from_volume(
-                &view.look,
-                &mut settings.transfer_function,
-                &mut input.volume,
-                &input.name,
-            )?;
-            vec![Layer {
-                input,
-                settings,
-                source: LayerSource::Input,
-            }]
-        }
+    let request = input_args.request();
+    let look = crate::settings::look(&view.look);
+    let first = First {
+        request: &request,
+        log: view.look.log,
+        look: &look,
     };
-    for (overlay, tf_text) in overlays.iter().zip(&tf_texts) {
-        let mut layer = load_overlay(overlay, view, budget.left(), tf_text.as_deref())
-            .map_err(|e| explained(&budget, e))?;
-        budget.add(&layer.input.volume);
-        layer.input.max_memory = budget.limit;
-        let first = &layers[0].input;
-        if !overlaps(&layer.input.volume, &first.volume) {
-            let ((a, b), (c, d)) = (layer.input.volume.bounds(), first.volume.bounds());
-            return Err(CliError::input(format!(
-                "--overlay {}: its box ({a} .. {b}) does not meet the box of {} ({c} .. {d}): check its origin and spacing",
-                overlay.spec, first.name
-            )));
+    let colors = scene.channel_colors.as_ref().map(|c| &c.0[..]);
+    let channels = scene.channels.as_ref().map(|which| ChannelPick {
+        which: match which {
+            Channels::All => None,
+            Channels::Some(list) => Some(&list[..]),
+        },
+        colors,
+    });
+    // The shared flags without the first volume's `--tf` (whose text
+    // is not read here): an overlay's look is its own options'.
+    let shared = crate::settings::options(view, Some(""))?;
+    let overlays = Overlays {
+        specs: overlays,
+        tf_texts: &tf_texts,
+        shared: &shared,
+    };
+    scene::read_layers(&first, channels, &overlays, settings).map_err(layer_failure)
+}
+
+/// A volume of the picture refused, worded with the flags: the reader's
+/// error as `load`'s, an overlay's after `--overlay:`, saying what the
+/// volumes read before it hold.
+fn layer_failure(e: LayerError) -> CliError {
+    let error = match *e.failure {
+        Failure::Read(e) => CliError::from(e),
+        Failure::OverlayRead(e) => {
+            let e = CliError::from(e);
+            CliError {
+                message: format!("--overlay: {}", e.message),
+                ..e
+            }
         }
-        layers.push(layer);
+        Failure::Option(e) => crate::settings::refused(e),
+        Failure::Refused(e) => refused(e),
+    };
+    match e.after {
+        Some(budget) => CliError {
+            message: budget.explain(&error.message),
+            ..error
+        },
+        None => error,
     }
-    Ok(layers)
 }
 
 /// The refusals of what several volumes in one picture do not take.
@@ -477,130 +423,6 @@ fn scene_failure(view: &ViewArgs, names: &[&str], e: RenderError) -> CliError {
         }
         e => render_failure(view, names[0], e),
     }
-}
-
-/// The channels `which` of INPUT (read as `input_args` say: at the time
-/// point `--frame` picks), each with its look.
-fn read_channels(
-    input_args: &InputArgs,
-    view: &ViewArgs,
-    scene: &SceneArgs,
-    which: &Channels,
-    settings: &RenderSettings,
-    budget: &mut Budget,
-) -> Result<Vec<Layer>, CliError> {
-    let spec = input_args.input.as_deref().unwrap_or(input::DEMO);
-    if volray_data::is_source_spec(spec) {
-        return Err(CliError::input(format!(
-            "--channels: {spec} is a built-in source, one volume: give a file holding several channels"
-        )));
-    }
-    let log = view.look.log;
-    if input_args.channel.is_some() {
-        return Err(CliError::input(format!(
-            "--channels picks the channels of {spec}; --channel picks one: give one of them"
-        )));
-    }
-    // Channel 0 (at the time point --frame picks) tells how many the file
-    // holds; kept if asked for, else dropped before the others are read,
-    // and no longer counted against --max-memory.
-    let first = load(input_args, log)?;
-    budget.add(&first.volume);
-    let Some((_, info)) = &first.file else {
-        return Err(CliError::input(format!(
-            "--channels: {spec} is not a file holding several channels"
-        )));
-    };
-    let (count, axis) = channel_axis(info);
-    if axis == ChannelAxis::Time && input_args.frame.is_some() {
-        return Err(CliError::input(format!(
-            "--channels renders the {count} volumes of {spec} (one channel, {count} time points) together; --frame picks one: give one of them"
-        )));
-    }
-    let (indices, colors) = picked(scene, which, spec, count)?;
-    let mut first = Some(first);
-    if !indices.contains(&0) {
-        budget.remove(&first.take().expect("channel 0 read").volume);
-    }
-    let mut layers = Vec::with_capacity(indices.len());
-    for (&index, &rgb) in indices.iter().zip(&colors) {
-        let kept = if index == 0 { first.take() } else { None };
-        let mut input = match kept {
-            Some(input) => input,
-            None => {
-                let mut one = pick(axis, input_args, index);
-                one.max_memory = budget.left();
-                let mut input = load(&one, log).map_err(|e| explained(budget, e))?;
-                budget.add(&input.volume);
-                input.max_memory = budget.limit;
-                input
-            }
-        };
-        input.name = format!("{spec} (channel {index})");
-        let mut settings = settings.clone();
-        let tf = &mut settings.transfer_function;
-        tf.color = Some(channel_color(rgb, settings.blend.is_projection()));
-        crate::settings::file_window(
-            &view.look,
-            tf,
-            input.file.as_ref().and_then(|(_, i)| i.display_window()),
-        );
-        crate::settings::from_volume(&view.look, tf, &mut input.volume, &input.name)?;
-        layers.push(Layer {
-            input,
-            settings,
-            source: LayerSource::Channel { index, axis },
-        });
-    }
-    Ok(layers)
-}
-
-/// The overlay read, with its look.
-fn load_overlay(
-    overlay: &OverlaySpec,
-    view: &ViewArgs,
-    max_memory: Option<u64>,
-    tf_text: Option<&str>,
-) -> Result<Layer, CliError> {
-    let refuse = |e| refused(overlay.refused(e));
-    let input_args = InputArgs {
-        input: Some(overlay.file.clone()),
-        dims: None,
-        dtype: None,
-        endian: None,
-        spacing: None,
-        format: None,
-        frame: overlay.frame,
-        array: None,
-        level: None,
-        channel: overlay.channel,
-        max_memory,
-    };
-    let mut input = load(&input_args, false).map_err(|e| CliError {
-        message: format!("--overlay: {}", e.message),
-        ..e
-    })?;
-    // The shared flags without the first volume's `--tf` (whose text
-    // is not read here): the overlay's look is its own options'.
-    let shared = crate::settings::options(view, Some(""))?;
-    let (look, mut settings) = overlay.settings(shared, tf_text).map_err(refused)?;
-    volray_options::file_window(
-        &look,
-        &mut settings.transfer_function,
-        input.file.as_ref().and_then(|(_, i)| i.display_window()),
-    );
-    volray_options::from_volume(
-        &look,
-        &mut settings.transfer_function,
-        &mut input.volume,
-        &input.name,
-    )
-    .map_err(refuse)?;
-    Ok(Layer {
-        input,
-        settings,
-        source: LayerSource::Overlay(overlay.clone()),
-    })
 }
 
 /// Reads the `tf=` file of the overlay `spec`, refused as `--tf` is.

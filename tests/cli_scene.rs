@@ -483,6 +483,24 @@ fn bad_channels_and_overlays_are_refused_in_one_line_naming_the_option() {
         "{e}"
     );
 
+    // The reader's refusal of an overlay, after the option that names it.
+    let junk = d.join("junk.txt");
+    std::fs::write(&junk, "not a volume").unwrap();
+    let junk = junk.to_str().unwrap();
+    let e = refused(d, &[&file, "--overlay", junk]);
+    assert!(
+        e.starts_with(&format!(
+            "volray: error: --overlay: {junk}: unknown volume format"
+        )) && e.contains("name the format with --format (the volumes read before it hold"),
+        "{e}"
+    );
+
+    let e = refused(d, &["blobs:16", "--channels", "all"]);
+    assert!(
+        e.contains("--channels: blobs:16 is a built-in source, one volume"),
+        "{e}"
+    );
+
     let e = refused(d, &[&file, "--overlay", &format!("{one}:preset=bones")]);
     assert!(
         e.contains("--overlay") && e.contains("preset=") && e.contains("bones"),

@@ -20,11 +20,12 @@ use super::reproduce::{CliReproduce, OtherWords, SceneWords};
 use super::{MAX_TABS, serve, start_state};
 use crate::error::CliError;
 use crate::flags::ViewerArgs;
-use crate::scene::{Layer, overlay_specs, read_layers, whole_input};
+use crate::scene::{overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use std::sync::Arc;
 use volray_app::input;
+use volray_app::scene::Layer;
 use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {

@@ -33,6 +33,12 @@
 //! - [`reproduce`]: the view's state (camera, transfer function, look) and
 //!   its two spellings: `volray render` words ([`reproduce::command`]) and
 //!   Python keywords ([`reproduce::keywords`]);
+//! - [`animation`]: a turntable's views, and the window and framing the
+//!   frames of a series share;
+//! - [`bench`](mod@bench): `volray bench`'s timed frames, their medians and `--json`
+//!   rows, and the peer benchmark's workloads (with VTK timed beside them);
+//! - [`describe`]: what a volume file holds and how volray reads it, as
+//!   `volray info` says it (lines of text, or JSON);
 //! - [`words`]: the number words both spellings and the flags parse;
 //! - [`error`]: [`AppError`], typed, one line naming the file, which each
 //!   front end words in its own syntax.
@@ -61,6 +67,9 @@
 //! # Ok::<(), volray_app::AppError>(())
 //! ```
 
+pub mod animation;
+pub mod bench;
+pub mod describe;
 #[cfg(feature = "mpi")]
 pub mod distributed;
 pub mod error;

@@ -5,22 +5,29 @@
 //! (`--mix`, `mix=`), a file's time points (`--frames`), and the memory
 //! limit the volumes share.
 //!
-//! Plain types and one-line refusals ([`Refused`]) only: each front end
-//! reads the volumes (the command line through its session, the Python
-//! module from arrays) and spells the refusals as its own errors.
+//! Plain types and typed refusals ([`Refused`], [`LayerError`]) only:
+//! the command line's volumes are read here (`read.rs`), the Python
+//! module's come from arrays; each front end spells the refusals as its
+//! own errors.
 //!
 //! - `layer.rs`: where a volume came from ([`LayerSource`], [`ChannelAxis`])
 //!   and the shared `--max-memory` ([`Budget`]);
 //! - `channels.rs`: which channels, in which colours;
-//! - `overlay.rs`: an `--overlay`'s spec, look and settings.
+//! - `overlay.rs`: an `--overlay`'s spec, look and settings;
+//! - `read.rs`: the volumes read, each whole with its look ([`Layer`]),
+//!   the refusals typed ([`LayerError`]) for each front end to word.
 
 mod channels;
 mod layer;
 mod overlay;
+mod read;
 
 pub use channels::{channel_color, picked_channels, refuse_channel_look};
 pub use layer::{Budget, ChannelAxis, LayerSource, channel_axis};
 pub use overlay::{OVERLAY_OPTIONS, OverlayNaming, OverlaySpec};
+pub use read::{
+    ChannelPick, Failure, First, Layer, LayerError, Overlays, channels_at, pick, read_layers,
+};
 
 use volray_core::scene::Mix;
 

@@ -7,7 +7,8 @@
 //! number of frames after its warm-up, as the peers report it; its image is
 //! the one `vtk_bench.py` writes for that case.
 
-use crate::error::CliError;
+use super::{input, io};
+use crate::AppError;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use volray_core::Image;
@@ -46,8 +47,8 @@ pub struct VtkRun {
 impl Harness {
     /// The harness around the volumes in `volumes` (its parent directory),
     /// with `python` or the peers' venv.
-    pub fn find(volumes: &Path, python: Option<&Path>) -> Result<Self, CliError> {
-        let fail = |what: String| CliError::input(format!("--vs-vtk: {what}"));
+    pub fn find(volumes: &Path, python: Option<&Path>) -> Result<Self, AppError> {
+        let fail = |what: String| input(format!("--vs-vtk: {what}"));
         // The parent of DIR as given (DIR itself may be a link).
         let given = std::path::absolute(volumes)
             .map_err(|e| fail(format!("{}: {e}", volumes.display())))?;
@@ -92,8 +93,7 @@ impl Harness {
             )));
         }
         let scratch = std::env::temp_dir().join(format!("volray-bench-{}", std::process::id()));
-        std::fs::create_dir_all(&scratch)
-            .map_err(|e| CliError::io(format!("{}: {e}", scratch.display())))?;
+        std::fs::create_dir_all(&scratch).map_err(|e| io(format!("{}: {e}", scratch.display())))?;
         Ok(Harness {
             python,
             dir,
@@ -108,7 +108,7 @@ impl Harness {
         window: usize,
         threads: usize,
         frames: u32,
-    ) -> Result<VtkRun, CliError> {
+    ) -> Result<VtkRun, AppError> {
         let json = self.scratch.join(format!("vtk_{dataset}_{window}.json"));
         let output = Command::new(&self.python)
             .arg(self.dir.join("vtk_bench.py"))
@@ -123,7 +123,7 @@ impl Harness {
             .args(["--wait-quiet", "0", "--json"])
             .arg(&json)
             .output()
-            .map_err(|e| CliError::io(format!("{}: {e}", self.python.display())))?;
+            .map_err(|e| io(format!("{}: {e}", self.python.display())))?;
         if !output.status.success() {
             let err = String::from_utf8_lossy(&output.stderr);
             let last = err
@@ -131,13 +131,13 @@ impl Harness {
                 .rev()
                 .find(|l| !l.trim().is_empty())
                 .unwrap_or("");
-            return Err(CliError::io(format!(
+            return Err(io(format!(
                 "vtk_bench.py failed on {dataset}:{window}: {last}"
             )));
         }
-        let text = std::fs::read_to_string(&json)
-            .map_err(|e| CliError::io(format!("{}: {e}", json.display())))?;
-        let bad = || CliError::io(format!("{}: not vtk_bench.py's results", json.display()));
+        let text =
+            std::fs::read_to_string(&json).map_err(|e| io(format!("{}: {e}", json.display())))?;
+        let bad = || io(format!("{}: not vtk_bench.py's results", json.display()));
         let value: serde_json::Value = serde_json::from_str(&text).map_err(|_| bad())?;
         let result = &value["results"][0];
         let median_s = result["median_s"].as_f64().ok_or_else(bad)?;
@@ -158,7 +158,7 @@ impl Harness {
         image: &Image,
         dataset: &str,
         window: usize,
-    ) -> Result<VtkRun, CliError> {
+    ) -> Result<VtkRun, AppError> {
         let ours = self.scratch.join(format!("volray_{dataset}_{window}.png"));
         volray_io::write_png(&ours, image, BitDepth::Eight)?;
         let output = Command::new(&self.python)
@@ -166,7 +166,7 @@ impl Harness {
             .arg(&ours)
             .arg(&run.png)
             .output()
-            .map_err(|e| CliError::io(format!("{}: {e}", self.python.display())))?;
+            .map_err(|e| io(format!("{}: {e}", self.python.display())))?;
         let text = String::from_utf8_lossy(&output.stdout);
         let numbers: Vec<f64> = text
             .split_whitespace()
@@ -179,7 +179,7 @@ impl Harness {
                 mean_vtk: b,
                 ..run
             }),
-            _ => Err(CliError::io(format!(
+            _ => Err(io(format!(
                 "comparing with {}: {}",
                 run.png.display(),
                 String::from_utf8_lossy(&output.stderr).trim()

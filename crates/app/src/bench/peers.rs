@@ -22,10 +22,8 @@
 //!   samples/s is nominal, `W²·(n − 1)/0.5` per frame over the median.
 
 use super::vtk::Harness;
-use super::{JsonRow, Timed, median, ms, time_frames, write_json};
-use crate::error::CliError;
-use crate::flags::BenchArgs;
-use crate::session::thread_pool;
+use super::{JsonRow, Timed, input, io, median, ms, time_frames};
+use crate::AppError;
 use std::path::Path;
 use volray_core::PiecewiseLinear;
 use volray_core::glam::DVec3;
@@ -41,6 +39,13 @@ pub const CASES: [(&str, usize); 6] = [
     ("fractal_257", 480),
     ("fractal_257", 1024),
 ];
+
+/// Gives `out` a line, formatted as `format!` does.
+macro_rules! outln {
+    ($out:expr, $($arg:tt)*) => {
+        $out(format!($($arg)*))
+    };
+}
 
 /// The sample step, in voxels.
 pub const STEP: f64 = 0.5;
@@ -64,23 +69,22 @@ struct Sidecar {
 }
 
 /// Reads `DIR/<name>.json` and the raw volume it describes.
-fn load(dir: &Path, name: &str) -> Result<(Volume, Sidecar), CliError> {
+fn load(dir: &Path, name: &str) -> Result<(Volume, Sidecar), AppError> {
     let path = dir.join(format!("{name}.json"));
     let text = std::fs::read_to_string(&path).map_err(|e| {
-        CliError::io(format!(
+        io(format!(
             "{}: cannot read the sidecar: {e} (make the volumes with the peers' make_volumes.py)",
             path.display()
         ))
     })?;
-    let side =
-        parse_sidecar(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let side = parse_sidecar(&text).map_err(|e| input(format!("{}: {e}", path.display())))?;
     let mut raw = RawOptions::new(side.dims, side.dtype);
     raw.endian = Endian::Little;
     raw.spacing = DVec3::from(side.spacing);
     let raw_path = dir.join(format!("{name}.raw"));
     let volume = volray_io::read_volume(&raw_path, Some(&raw))?
         .with_origin(DVec3::from(side.origin))
-        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        .map_err(|e| input(format!("{}: {e}", path.display())))?;
     Ok((volume, side))
 }
 
@@ -205,19 +209,44 @@ struct Row {
     vtk: Option<super::vtk::VtkRun>,
 }
 
-pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
-    let pool = thread_pool(args.view.threads)?;
+/// What `volray bench --peers DIR` times, as its flags say.
+pub struct Peers<'a> {
+    /// DIR: the peers' volumes and their sidecars.
+    pub dir: &'a Path,
+    /// The workloads (dataset, window); `None` for all of [`CASES`].
+    pub cases: Option<Vec<(String, usize)>>,
+    /// Timed frames after the warm-up.
+    pub frames: u32,
+    /// The look's shadows and ambient occlusion, over the peers' shading.
+    pub shadows: bool,
+    pub ambient_occlusion: Option<f64>,
+    /// VTK timed on each workload too (`--vs-vtk`), by this Python (else
+    /// the peers' venv's).
+    pub vs_vtk: bool,
+    pub python: Option<&'a Path>,
+}
+
+/// Times each workload of `args` on `pool`, VTK first where asked,
+/// giving `out` each line of the report (a heading, a line a workload, the
+/// closing table) as it comes; returns the `--json` rows.
+pub fn run(
+    args: &Peers<'_>,
+    pool: &rayon::ThreadPool,
+    out: &mut dyn FnMut(String),
+) -> Result<Vec<JsonRow>, AppError> {
+    let dir = args.dir;
     let threads = pool.current_num_threads();
     let harness = if args.vs_vtk {
-        Some(Harness::find(dir, args.peers_python.as_deref())?)
+        Some(Harness::find(dir, args.python)?)
     } else {
         None
     };
     let cases: Vec<(String, usize)> = match &args.cases {
-        Some(cases) => cases.0.clone(),
+        Some(cases) => cases.clone(),
         None => CASES.iter().map(|(d, w)| (d.to_string(), *w)).collect(),
     };
     outln!(
+        out,
         "volray bench --peers {}: {} workloads, {threads} threads, 1 warm-up + {} timed frames each, turned 0.5° apart",
         dir.display(),
         cases.len(),
@@ -228,11 +257,11 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
         let dataset = dataset.as_str();
         let (volume, side) = load(dir, dataset)?;
         let settings = RenderSettings {
-            shadows: args.view.look.shadows,
-            ambient_occlusion: args.view.look.ambient_occlusion,
+            shadows: args.shadows,
+            ambient_occlusion: args.ambient_occlusion,
             ..workload(&volume, (side.min, side.max), window)
         };
-        let fail = |e: volray_core::RenderError| CliError::input(format!("{dataset}: {e}"));
+        let fail = |e: volray_core::RenderError| input(format!("{dataset}: {e}"));
         // VTK first, then volray: each sees the machine as the other left it.
         let vtk = match &harness {
             Some(h) => Some(h.run(dataset, window, threads, args.frames)?),
@@ -273,24 +302,20 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), CliError> {
                 _ => None,
             },
         };
-        print_row(&row, threads);
+        print_row(out, &row, threads);
         rows.push(row);
     }
-    print_table(&rows, threads);
-    if let Some(path) = &args.json {
-        let json: Vec<JsonRow> = rows
-            .iter()
-            .map(|r| JsonRow {
-                dataset: r.dataset.clone(),
-                window: r.window,
-                threads,
-                median_s: r.median_s,
-                vtk_median_s: r.vtk.as_ref().map(|v| v.median_s),
-            })
-            .collect();
-        write_json(path, &json)?;
-    }
-    Ok(())
+    print_table(out, &rows, threads);
+    Ok(rows
+        .iter()
+        .map(|r| JsonRow {
+            dataset: r.dataset.clone(),
+            window: r.window,
+            threads,
+            median_s: r.median_s,
+            vtk_median_s: r.vtk.as_ref().map(|v| v.median_s),
+        })
+        .collect())
 }
 
 /// Nominal samples per frame: `W²` rays of `(n − 1)/step` samples (point
@@ -299,7 +324,7 @@ fn nominal(row: &Row) -> f64 {
     (row.window * row.window) as f64 * (row.dims[0] - 1) as f64 / STEP
 }
 
-fn print_row(row: &Row, threads: usize) {
+fn print_row(out: &mut dyn FnMut(String), row: &Row, threads: usize) {
     let [bin, cast] = row.parts;
     let head = format!(
         "  {:<13} {:>5}² t={threads}: median {:.4} s, {:.3e} samples/s (bin {bin:.2} + shade and cast {cast:.2} ms; {} bricks, {} lit a frame, classified once in {:.1} ms)",
@@ -313,26 +338,31 @@ fn print_row(row: &Row, threads: usize) {
     );
     match &row.vtk {
         Some(v) => outln!(
+            out,
             "{head}; VTK {:.4} s: VTK/volray {:.2}x",
             v.median_s,
             v.median_s / row.median_s
         ),
-        None => outln!("{head}"),
+        None => outln!(out, "{head}"),
     }
 }
 
 /// The closing table, in Markdown.
-fn print_table(rows: &[Row], threads: usize) {
-    outln!();
+fn print_table(out: &mut dyn FnMut(String), rows: &[Row], threads: usize) {
+    outln!(out, "");
     let vtk = rows.iter().any(|r| r.vtk.is_some());
     if vtk {
         outln!(
+            out,
             "| dataset, window | volray median s | samples/s (nominal) | VTK fixed-point median s | VTK / volray | image vs VTK: mean abs diff (levels of 255) |"
         );
-        outln!("|---|---|---|---|---|---|");
+        outln!(out, "|---|---|---|---|---|---|");
     } else {
-        outln!("| dataset, window | volray median s | samples/s (nominal) |");
-        outln!("|---|---|---|");
+        outln!(
+            out,
+            "| dataset, window | volray median s | samples/s (nominal) |"
+        );
+        outln!(out, "|---|---|---|");
     }
     for r in rows {
         let name = format!(
@@ -345,6 +375,7 @@ fn print_table(rows: &[Row], threads: usize) {
         let volray = format!("{:.4} | {:.3e}", r.median_s, nominal(r) / r.median_s);
         match &r.vtk {
             Some(v) => outln!(
+                out,
                 "| {name} | {volray} | {:.4} | {:.2} | {:.2} (means {:.1} vs {:.1}) |",
                 v.median_s,
                 v.median_s / r.median_s,
@@ -352,7 +383,7 @@ fn print_table(rows: &[Row], threads: usize) {
                 v.mean_volray,
                 v.mean_vtk
             ),
-            None => outln!("| {name} | {volray} |"),
+            None => outln!(out, "| {name} | {volray} |"),
         }
     }
 }
