@@ -5,6 +5,7 @@ use std::fmt;
 
 use volray_app::AppError;
 use volray_app::error::OverBudget;
+use volray_core::SourceError;
 use volray_distributed::frame::FrameError;
 use volray_distributed::streamed::StreamError;
 use volray_io::{IoError, VolumeFormat, format_bytes};
@@ -170,7 +171,7 @@ pub fn word(e: &AppError) -> CliError {
         AppError::Option(e) => CliError::input(e.to_string()),
         AppError::Render { name, error } => render_error(name, error),
         AppError::Stream { name, error } => match error {
-            StreamError::Read(message) => CliError::io(message),
+            StreamError::Read(error) => CliError::from(error.clone()),
             StreamError::TooLarge(message) => CliError::input(format!(
                 "{name}: {message}: raise --max-memory, or pick a coarser --level"
             )),
@@ -255,6 +256,17 @@ fn over_budget(over: &OverBudget) -> CliError {
         None => CliError::input(format!(
             "{what} may take up to {need}, more than --max-memory {limit} (raise it, or use a smaller grid)"
         )),
+    }
+}
+
+/// A box of a source that could not be read: an I/O failure exits 2,
+/// bad data (a corrupt or lying chunk) and the rest 1.
+impl From<SourceError> for CliError {
+    fn from(e: SourceError) -> Self {
+        match e.is_io_failure() {
+            true => CliError::io(e.message),
+            false => CliError::input(e.message),
+        }
     }
 }
 

@@ -407,3 +407,59 @@ fn an_omero_window_is_the_default_range_in_pieces_as_whole() {
     // A window the picture shows: another range is another picture.
     assert!(pieces.max_diff(&Picture::read(&out("o.png"))) > 16);
 }
+
+/// `volray render` of the image's level 0 in pieces (`--max-memory
+/// 100K`) to `out`: its exit code and its stderr.
+fn render_in_pieces(image: &Path, out: &Path) -> (Option<i32>, String) {
+    let args = [
+        &["render", image.to_str().unwrap(), "--level", "0"][..],
+        &["--max-memory", "100K", "-o", out.to_str().unwrap()],
+        &LOOK[..],
+    ]
+    .concat();
+    let run = volray(&args);
+    (run.status.code(), stderr(&run))
+}
+
+#[test]
+fn a_corrupt_chunk_read_piece_by_piece_is_bad_input_and_an_unreadable_one_an_io_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img.ome.zarr");
+    write_image(&image);
+    let out = dir.path().join("out.png");
+    let level = image.join("0").display().to_string();
+    let chunk = image.join("0/c/1/1/1");
+    let bytes = fs::read(&chunk).unwrap();
+    // The chunk's bytes at fault (cut short, or empty): bad input, exit
+    // 1, one line naming the level's array and the chunk.
+    for (what, data) in [("cut short", &bytes[..bytes.len() / 2]), ("empty", &[][..])] {
+        fs::write(&chunk, data).unwrap();
+        let (code, said) = render_in_pieces(&image, &out);
+        assert_eq!(code, Some(1), "{what}: {said}");
+        assert_eq!(said.lines().count(), 1, "{what}: {said}");
+        assert!(
+            said.contains(&format!("error: {level}: ")),
+            "{what}: {said}"
+        );
+        assert!(
+            said.contains("cannot read Zarr chunks: c/1/1/1"),
+            "{what}: {said}"
+        );
+        assert!(!said.contains("panicked"), "{what}: {said}");
+    }
+    // A directory where the chunk's file should be: the system cannot
+    // read it, an I/O failure, exit 2.
+    fs::remove_file(&chunk).unwrap();
+    fs::create_dir(&chunk).unwrap();
+    let (code, said) = render_in_pieces(&image, &out);
+    assert_eq!(code, Some(2), "{said}");
+    assert_eq!(said.lines().count(), 1, "{said}");
+    assert!(said.contains(&format!("error: {level}: ")), "{said}");
+    assert!(!said.contains("panicked"), "{said}");
+    // Restored, the same command renders.
+    fs::remove_dir(&chunk).unwrap();
+    fs::write(&chunk, &bytes).unwrap();
+    let (code, said) = render_in_pieces(&image, &out);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(said.contains("in pieces"), "{said}");
+}

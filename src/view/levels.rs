@@ -119,7 +119,7 @@ impl Opened {
         let dims = self.pyramid.grid(self.start).dims;
         let volume = (self.pyramid.source(self.start))
             .read_box([0; 3], dims)
-            .map_err(CliError::io)?;
+            .map_err(CliError::from)?;
         Ok(Input {
             volume,
             name: self.spec.clone(),

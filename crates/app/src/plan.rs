@@ -15,7 +15,7 @@
 use crate::error::AppError;
 use crate::input::{self, Request, Spec};
 use volray_core::{FrameRequest, Image, NonFinite, Render, RenderSettings, Rendered};
-use volray_distributed::streamed::{StreamTimes, Streamed};
+use volray_distributed::streamed::{StreamError, StreamTimes, Streamed};
 use volray_io::MapPolicy;
 use volray_lazy::{Chunked, Found, LookError, Plan as LazyPlan};
 use volray_options::LookOptions;
@@ -111,9 +111,19 @@ pub fn plan(
     let plan = if frames.log {
         // The log of the level, found piece by piece after a pass over it
         // for its smallest positive value.
-        (chunked.plan_log(settings, mode, max_memory, extra)).map_err(|message| AppError::Log {
-            name: spec.clone(),
-            message,
+        // A slab the system failed to read is a read's failure; bad data
+        // (or no positive value) is --log's.
+        (chunked.plan_log(settings, mode, max_memory, extra)).map_err(|error| {
+            match error.is_io_failure() {
+                true => AppError::Stream {
+                    name: spec.clone(),
+                    error: StreamError::Read(error),
+                },
+                false => AppError::Log {
+                    name: spec.clone(),
+                    message: error.message,
+                },
+            }
         })?
     } else {
         chunked.plan(settings, mode, max_memory, extra)

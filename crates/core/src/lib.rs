@@ -121,6 +121,6 @@ pub use volume::non_finite::{NonFinite, NonFiniteMask};
 pub use volume::piece;
 pub use volume::piece::Piece;
 pub use volume::{
-    External, ExternalBytes, ExternalError, Sample, SampleType, Samples, Store, Volume,
-    VolumeError, VolumeSource, check_box, checked_point_count,
+    External, ExternalBytes, ExternalError, Sample, SampleType, Samples, SourceError,
+    SourceErrorKind, Store, Volume, VolumeError, VolumeSource, check_box, checked_point_count,
 };

@@ -18,7 +18,7 @@ use volray_core::sampling::grid::GridFrame;
 use volray_core::transfer::labels::{LabelError, labels_of};
 use volray_core::{
     FrameRequest, Histogram, Image, NonFinite, PartialImage, Piece, Render, RenderError,
-    RenderSettings, Renderer, Volume, with_samples,
+    RenderSettings, Renderer, SourceError, Volume, with_samples,
 };
 
 /// Where a rank's piece comes from: volray-core's one interface to
@@ -161,6 +161,17 @@ impl From<String> for Failure {
     }
 }
 
+/// A piece that could not be read: bad input unless the system failed
+/// to read it.
+impl From<SourceError> for Failure {
+    fn from(e: SourceError) -> Self {
+        Failure {
+            bad_input: !e.is_io_failure(),
+            message: e.message,
+        }
+    }
+}
+
 /// The first byte of a rank's status in [`agree`].
 const OK: u8 = 0;
 const FAILED: u8 = 1;
@@ -224,8 +235,10 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
             Ok(None)
         } else {
             (source.read_box(lo, hi))
+                .map_err(Failure::from)
                 .and_then(|v| {
-                    Renderer::owning(v, non_finite).map_err(|e| format!("its piece: {e}"))
+                    (Renderer::owning(v, non_finite))
+                        .map_err(|e| Failure::from(format!("its piece: {e}")))
                 })
                 .map(Some)
         };

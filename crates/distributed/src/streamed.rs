@@ -72,15 +72,16 @@ use volray_core::transfer::labels::{LabelError, labels_of};
 use volray_core::{
     Blend, DEFAULT_CACHE_BUDGET, FrameRequest, Histogram, MemoryBound, NonFinite, PartialImage,
     PartialPixels, Picture, Piece, Progress, Render, RenderError, RenderSettings, Rendered,
-    Renderer, Volume, VolumeSource,
+    Renderer, SourceError, Volume, VolumeSource,
 };
 
 /// Why a streamed frame failed.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum StreamError {
-    /// A piece could not be read (the source's one-line message).
+    /// A piece could not be read: the source's one-line message, and
+    /// whether the data or the system was at fault.
     #[error("{0}")]
-    Read(String),
+    Read(SourceError),
     /// Even the smallest pieces do not fit the memory budget.
     #[error("{0}")]
     TooLarge(String),

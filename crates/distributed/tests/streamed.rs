@@ -44,7 +44,7 @@ impl VolumeSource for Counted {
     fn sample_type(&self) -> SampleType {
         self.volume.sample_type()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         self.reads.lock().unwrap().push((lo, hi));
         self.volume.read_box(lo, hi)
     }
@@ -244,9 +244,11 @@ impl VolumeSource for Failing {
     fn sample_type(&self) -> SampleType {
         self.0.sample_type()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         if lo[0] > 0 {
-            return Err("scan.zarr: chunk c/0/0/1 is truncated".into());
+            return Err(volray_core::SourceError::bad_data(
+                "scan.zarr: chunk c/0/0/1 is truncated",
+            ));
         }
         self.0.read_box(lo, hi)
     }
@@ -264,7 +266,9 @@ fn a_failed_read_fails_the_frame_with_the_sources_message() {
     {
         Err(e) => assert_eq!(
             e,
-            StreamError::Read("scan.zarr: chunk c/0/0/1 is truncated".into())
+            StreamError::Read(volray_core::SourceError::bad_data(
+                "scan.zarr: chunk c/0/0/1 is truncated"
+            ))
         ),
         Ok((_, times)) => panic!("rendered: {times:?}"),
     }
@@ -348,7 +352,7 @@ impl VolumeSource for StopsAfterARead {
     fn sample_type(&self) -> SampleType {
         self.volume.sample_type()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         use std::sync::atomic::Ordering;
         self.reads.fetch_add(1, Ordering::SeqCst);
         self.stop.store(true, Ordering::SeqCst);

@@ -66,7 +66,8 @@ fn the_same_rank_count_gives_the_same_frame_bit_for_bit() {
 }
 
 /// A source whose read fails on one box.
-struct Failing(Volume);
+/// A source whose boxes past x = 0 fail with an error of its kind.
+struct Failing(Volume, volray_core::SourceErrorKind);
 
 impl volray_distributed::frame::Source for Failing {
     fn grid(&self) -> volray_core::sampling::grid::GridFrame {
@@ -75,18 +76,42 @@ impl volray_distributed::frame::Source for Failing {
     fn sample_type(&self) -> volray_core::SampleType {
         self.0.sample_type()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         if lo[0] > 0 {
-            return Err("scan.raw: unexpected end of file at byte 4096".into());
+            return Err(volray_core::SourceError::new(
+                self.1,
+                "scan.raw: unexpected end of file at byte 4096",
+            ));
         }
         self.0.read_box(lo, hi)
     }
 }
 
 #[test]
-fn a_rank_that_cannot_read_its_piece_fails_every_rank_with_its_error() {
-    let source = Failing(volume());
-    let errors: Vec<FrameError> = std::thread::scope(|s| {
+fn a_rank_that_cannot_read_its_piece_fails_every_rank_with_its_error_and_its_kind() {
+    use volray_core::SourceErrorKind::{BadData, Io};
+    for (kind, bad_input) in [(BadData, true), (Io, false)] {
+        let errors = failures(Failing(volume(), kind));
+        for e in &errors {
+            assert_eq!(e, &errors[0]);
+        }
+        let FrameError::Rank {
+            rank,
+            message,
+            bad_input: said,
+        } = &errors[0]
+        else {
+            panic!("{:?}", errors[0])
+        };
+        assert_eq!(*rank, 2, "the first rank whose box starts past x = 0");
+        assert!(message.contains("scan.raw"), "{message}");
+        assert_eq!(*said, bad_input, "{kind:?}");
+    }
+}
+
+/// Every rank's error reading `source` in 4 ranks.
+fn failures(source: Failing) -> Vec<FrameError> {
+    std::thread::scope(|s| {
         let handles: Vec<_> = (Local::group(4).into_iter())
             .map(|t| {
                 let source = &source;
@@ -98,15 +123,7 @@ fn a_rank_that_cannot_read_its_piece_fails_every_rank_with_its_error() {
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()
-    });
-    for e in &errors {
-        assert_eq!(e, &errors[0]);
-    }
-    let FrameError::Rank { rank, message, .. } = &errors[0] else {
-        panic!("{:?}", errors[0])
-    };
-    assert_eq!(*rank, 2, "the first rank whose box starts past x = 0");
-    assert!(message.contains("scan.raw"), "{message}");
+    })
 }
 
 /// A label volume: every rank's labels, joined, are the whole volume's

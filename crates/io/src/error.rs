@@ -19,7 +19,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
-use volray_core::VolumeError;
+use volray_core::{SourceError, SourceErrorKind, VolumeError};
 
 #[cfg(doc)]
 use crate::ReadOptions;
@@ -391,6 +391,21 @@ impl IoError {
     }
 }
 
+/// A reader's error as a box read's (a lazy reader's
+/// [`VolumeSource::read_box`](volray_core::VolumeSource::read_box)): the
+/// same line, an I/O failure kept apart from bad data and from the
+/// memory limit.
+impl From<IoError> for SourceError {
+    fn from(e: IoError) -> Self {
+        let kind = match &e {
+            IoError::OverMemoryLimit { .. } => SourceErrorKind::OverMemory,
+            e if e.is_io_failure() => SourceErrorKind::Io,
+            _ => SourceErrorKind::BadData,
+        };
+        SourceError::new(kind, e.to_string())
+    }
+}
+
 /// `text` with its control characters escaped (`\n`, `\u{1b}`): one line.
 fn one_line(text: impl Into<String>) -> String {
     let text: String = text.into();
@@ -481,6 +496,29 @@ mod tests {
         let plain = IoError::invalid(Path::new("f"), "x \"y\" é");
         assert_eq!(plain.to_string(), "f: x \"y\" é");
         assert!(!plain.is_io_failure());
+    }
+
+    #[test]
+    fn a_box_read_keeps_the_line_and_whether_the_system_failed() {
+        let cases = [
+            (
+                IoError::os(Path::new("c/0"), "read", io::Error::other("boom")),
+                SourceErrorKind::Io,
+            ),
+            (
+                IoError::invalid(Path::new("s.zarr"), "chunk cut"),
+                SourceErrorKind::BadData,
+            ),
+            (
+                IoError::over_memory_limit(Path::new("s.zarr"), "Zarr box", 10),
+                SourceErrorKind::OverMemory,
+            ),
+        ];
+        for (e, kind) in cases {
+            let line = e.to_string();
+            let s = SourceError::from(e);
+            assert_eq!((s.kind, s.message), (kind, line));
+        }
     }
 
     #[test]

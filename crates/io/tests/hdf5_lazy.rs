@@ -23,7 +23,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use volray_core::{Volume, VolumeSource};
+use volray_core::{SourceErrorKind, Volume, VolumeSource};
 use volray_io::{IoError, Lazy, ReadOptions, VolumeFormat, open_lazy, read};
 
 /// The directory the writers filled, or `None` (with the reason printed)
@@ -325,6 +325,8 @@ fn a_chunk_failing_its_fletcher32_checksum_is_refused_naming_file_dataset_and_ch
         );
     }
     let err = l.source.read_box([15, 0, 15], [17, 2, 17]).unwrap_err();
+    assert_eq!(err.kind, SourceErrorKind::BadData, "{err}");
+    let err = err.message;
     assert!(
         err.starts_with(&file.display().to_string())
             && err.contains("HDF5 dataset \"/v\": the chunk at offset [16, 0, 16] fails its Fletcher-32 checksum (stored 0x")
@@ -466,6 +468,8 @@ fn a_box_reads_only_the_chunks_it_touches() {
         );
     }
     let err = l.source.read_box([15, 15, 15], [17, 17, 17]).unwrap_err();
+    assert_eq!(err.kind, SourceErrorKind::BadData, "{err}");
+    let err = err.message;
     assert!(
         err.starts_with(&dir.join("one_bad_chunk.h5").display().to_string())
             && err.contains(
@@ -492,7 +496,11 @@ fn a_box_is_held_to_max_memory_and_not_the_whole_volume() {
     let got = l.source.read_box([3, 4, 5], [30, 20, 15]).unwrap();
     assert!(got == VolumeSource::read_box(&expected, [3, 4, 5], [30, 20, 15]).unwrap());
     let err = l.source.read_box([0, 0, 0], [37, 29, 23]).unwrap_err();
-    assert!(err.contains("exceed the memory limit of 16 KiB"), "{err}");
+    assert_eq!(err.kind, SourceErrorKind::OverMemory, "{err}");
+    assert!(
+        err.message.contains("exceed the memory limit of 16 KiB"),
+        "{err}"
+    );
     // Contiguous data: its scratch is one x row (29·23·4 bytes).
     let spec = PathBuf::from(format!(
         "{}:/contiguous_f32",
@@ -514,7 +522,9 @@ fn refused(path: &Path, read_box: bool) -> String {
         Err(e) => e.to_string(),
         Ok(Some(l)) if read_box => {
             let dims = l.source.grid().dims;
-            l.source.read_box([0; 3], dims).unwrap_err()
+            let err = l.source.read_box([0; 3], dims).unwrap_err();
+            assert!(!err.is_io_failure(), "{err}");
+            err.message
         }
         Ok(_) => panic!("{} opened", path.display()),
     };

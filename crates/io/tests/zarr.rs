@@ -16,6 +16,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use volray_core::SourceErrorKind;
 use volray_core::glam::DVec3;
 use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, open_lazy, read};
 
@@ -204,7 +205,11 @@ fn every_box_read_lazily_equals_the_same_box_of_the_level_read_whole() {
         }
         assert!(boxes >= 8, "{name}: {boxes} boxes");
         let e = source.read_box([0; 3], [d[0] + 1, d[1], d[2]]).unwrap_err();
-        assert!(e.contains(name) && e.contains("inside the"), "{e}");
+        assert_eq!(e.kind, SourceErrorKind::OutsideGrid, "{e}");
+        assert!(
+            e.message.contains(name) && e.message.contains("inside the"),
+            "{e}"
+        );
     }
     // Formats read whole or mapped are not opened lazily.
     let npy = dir.join("v2_gzip.npy");

@@ -25,6 +25,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use serde_json::{Value, json};
+use volray_core::SourceErrorKind;
 use volray_io::{IoError, Loaded, ReadOptions, open_lazy, read};
 use zarrs::array::Array;
 use zarrs::filesystem::FilesystemStore;
@@ -901,6 +902,8 @@ fn lazy_boxes_of_shards_with_lying_indexes_are_refused() {
         ),
     ] {
         let err = read_box(&shard(&values, Some(index)), [0, 0, 0], [2, 2, 2]).expect_err(what);
+        assert_eq!(err.kind, SourceErrorKind::BadData, "{what}: {err}");
+        let err = err.message;
         assert!(!err.contains('\n'), "{what}: {err}");
         assert!(err.contains("s.zarr"), "{what}: {err}");
         assert!(
@@ -910,7 +913,8 @@ fn lazy_boxes_of_shards_with_lying_indexes_are_refused() {
     }
     // A shard too short for its index.
     let err = read_box(&good[..40], [0, 0, 0], [2, 2, 2]).expect_err("cut shard");
-    assert!(err.contains("past its end"), "{err}");
+    assert_eq!(err.kind, SourceErrorKind::BadData, "{err}");
+    assert!(err.message.contains("past its end"), "{err}");
 }
 
 #[test]

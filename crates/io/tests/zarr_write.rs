@@ -152,7 +152,7 @@ impl VolumeSource for Recording {
     fn is_labels(&self) -> bool {
         self.volume.is_labels()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         let n = (0..3).map(|a| hi[a] - lo[a]).product::<usize>();
         let mut largest = self.largest.lock().unwrap();
         *largest = (*largest).max(n);
@@ -356,9 +356,15 @@ fn a_source_that_fails_leaves_no_store() {
         fn sample_type(&self) -> SampleType {
             self.0.sample_type()
         }
-        fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+        fn read_box(
+            &self,
+            lo: [usize; 3],
+            hi: [usize; 3],
+        ) -> Result<Volume, volray_core::SourceError> {
             if lo[0] > 0 {
-                return Err("disk.raw: cannot read: input/output error".into());
+                return Err(volray_core::SourceError::io(
+                    "disk.raw: cannot read: input/output error",
+                ));
             }
             self.0.read_box(lo, hi)
         }

@@ -63,7 +63,8 @@ use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
 use volray_core::transfer::{auto, labels::MAX_LABELS};
 use volray_core::{
-    Histogram, MemoryBound, NonFinite, RenderSettings, SampleType, Volume, VolumeSource,
+    Histogram, MemoryBound, NonFinite, RenderSettings, SampleType, SourceError, SourceErrorKind,
+    Volume, VolumeSource,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
 use volray_io::{FileInfo, IoError, Lazy, LevelInfo, ReadOptions, VolumeFormat};
@@ -265,7 +266,7 @@ impl Chunked {
         non_finite: NonFinite,
         max_memory: u64,
         extra: u128,
-    ) -> Result<Plan, String> {
+    ) -> Result<Plan, SourceError> {
         let level = self.level();
         let need = self.whole_log_bytes(settings, non_finite) + extra;
         if need <= u128::from(max_memory.min(PIECE_BUDGET)) {
@@ -300,15 +301,20 @@ impl Chunked {
     /// which holds a piece's samples, their `f32` copy and their log at
     /// once: at most 2.5 times the `f32` piece the pieces' bound counts,
     /// so the pieces get a third of the budget.
-    pub fn log_pieces(&self, non_finite: NonFinite, max_memory: u64) -> Result<Streamed, String> {
+    pub fn log_pieces(
+        &self,
+        non_finite: NonFinite,
+        max_memory: u64,
+    ) -> Result<Streamed, SourceError> {
         let budget = max_memory.min(PIECE_BUDGET);
         let source = Log10Source::over(Arc::clone(self.source()), budget)?;
         Ok(Streamed::new(Arc::new(source), non_finite, budget / 3))
     }
 }
 
-/// The error of a box read once the stop flag of [`Chunked::stoppable`]
-/// is set (a [`StreamError::Read`]).
+/// The message of a box read once the stop flag of [`Chunked::stoppable`]
+/// is set (a [`StreamError::Read`] of kind
+/// [`SourceErrorKind::Stopped`]).
 pub const STOPPED: &str = "stopped";
 
 /// A source whose reads fail with [`STOPPED`] once `stop` is set.
@@ -330,9 +336,9 @@ impl VolumeSource for Stoppable {
         self.inner.is_labels()
     }
 
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
         if self.stop.load(Ordering::Relaxed) {
-            return Err(STOPPED.to_string());
+            return Err(SourceError::new(SourceErrorKind::Stopped, STOPPED));
         }
         self.inner.read_box(lo, hi)
     }

@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use volray_core::sampling::grid::GridFrame;
-use volray_core::{SampleType, Volume, VolumeSource};
+use volray_core::{SampleType, SourceError, Volume, VolumeSource};
 
 /// A level's boxes as the log10 of its values, values `<= 0` at the log
 /// of the level's smallest positive value.
@@ -19,9 +19,10 @@ pub struct Log10Source {
 impl Log10Source {
     /// `inner` on a log scale, its smallest positive value found in slabs
     /// of z whose samples, read and converted, take at most `budget`
-    /// bytes. An error if a slab cannot be read, or if no value is
-    /// positive (as a volume read whole would be refused).
-    pub fn over(inner: Arc<dyn VolumeSource>, budget: u64) -> Result<Log10Source, String> {
+    /// bytes. An error if a slab cannot be read (the slab's error), or if
+    /// no value is positive (bad data, as a volume read whole would be
+    /// refused).
+    pub fn over(inner: Arc<dyn VolumeSource>, budget: u64) -> Result<Log10Source, SourceError> {
         let [nx, ny, nz] = inner.grid().dims;
         // A slab read holds its samples and their f32 copy.
         let per_z = (nx * ny * (inner.voxel_bytes() + 4)) as u64;
@@ -41,7 +42,9 @@ impl Log10Source {
             z = hi;
         }
         if smallest == f32::INFINITY {
-            return Err("a log scale needs a positive value, and the volume has none".into());
+            return Err(SourceError::bad_data(
+                "a log scale needs a positive value, and the volume has none",
+            ));
         }
         Ok(Log10Source { inner, smallest })
     }
@@ -61,7 +64,7 @@ impl VolumeSource for Log10Source {
         SampleType::F32
     }
 
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
         Ok(self.inner.read_box(lo, hi)?.to_log10_above(self.smallest))
     }
 }
@@ -103,6 +106,6 @@ mod tests {
     fn a_level_without_a_positive_value_is_refused() {
         let whole = Volume::new([4, 4, 4], vec![-1.0; 64]).unwrap();
         let refused = Log10Source::over(Arc::new(whole), 1 << 20).err();
-        assert!(refused.is_some_and(|e| e.contains("the volume has none")));
+        assert!(refused.is_some_and(|e| e.message.contains("the volume has none")));
     }
 }

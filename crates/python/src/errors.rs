@@ -42,6 +42,16 @@ pub fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
 }
 
+/// A box of a chunked file that could not be read: `OSError` where the
+/// system failed to read it, `ValueError` for bad data (a corrupt or
+/// lying chunk) and the rest, as for a file read whole.
+pub fn source_error(e: volray_core::SourceError) -> PyErr {
+    match e.is_io_failure() {
+        true => PyOSError::new_err(e.message),
+        false => value_error(e.message),
+    }
+}
+
 pub fn option_error(e: OptionError) -> PyErr {
     value_error(e.message(&Keywords))
 }

@@ -26,12 +26,13 @@ mod lazy;
 mod recipe;
 
 use crate::array::{self, ArrayBytes, Order};
-use crate::errors::{io_error, option_error, render_error, settings_error, value_error};
+use crate::errors::{
+    io_error, option_error, render_error, settings_error, source_error, value_error,
+};
 use crate::figure::{self, FIGURE};
 use crate::frame::Frame;
 use crate::keywords::{self, CAMERA, FRAME, Keywords, VOLUME};
 use crate::volume::{LazyFile, Volume};
-use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -518,7 +519,7 @@ fn lazy_file(lazy: &LazyRoad) -> &LazyFile {
 /// A frame in pieces that failed, as the Python exception.
 fn stream_error(e: StreamError, camera: &CameraOptions, name: &str) -> PyErr {
     match e {
-        StreamError::Read(message) => PyOSError::new_err(message),
+        StreamError::Read(e) => source_error(e),
         StreamError::TooLarge(message) => value_error(format!(
             "{name}: {message}: raise max_memory, or pick a coarser level"
         )),

@@ -21,7 +21,7 @@
 //! at most [`volray_view::MAX_IN_FLIGHT`] go unacknowledged, their bytes
 //! held in the memory limit's ledger.
 
-use crate::errors::{Keywords as Names, value_error};
+use crate::errors::{Keywords as Names, source_error, value_error};
 use crate::figure::{self, FIGURE};
 use crate::keywords::{self, CAMERA, Camera, FRAME, Keywords, VOLUME};
 use crate::renderer::{Recipe, cache_budget, check_level, level_choice, level_in_memory, pool};
@@ -139,7 +139,7 @@ impl ViewHost {
                 let dims = opened.pyramid.grid(opened.start).dims;
                 let source = Arc::clone(opened.pyramid.source(opened.start));
                 let core = (py.detach(|| source.read_box([0; 3], dims)))
-                    .map_err(|e| PyOSError::new_err(format!("{name}: {e}")))?;
+                    .map_err(|e| source_error(e.prefixed(&name)))?;
                 (recipe.prepare_core(py, core, None)?, Some(opened))
             }
         };

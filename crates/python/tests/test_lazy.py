@@ -126,6 +126,23 @@ def test_data_of_a_lazy_volume_whose_chunks_went_bad_raises_naming_the_file(stor
         v.data
 
 
+def test_a_frame_in_pieces_over_a_corrupt_chunk_is_a_value_error_and_over_an_unreadable_one_an_os_error(store):
+    path, _ = store
+    args = dict(size=SIZE, azimuth=30, elevation=20, tf="auto")
+    chunk = sorted(chunk_files(path / "s0"))[0]
+    with open(chunk, "wb") as out:
+        out.write(b"not a zstd frame at all")
+    with pytest.raises(ValueError, match=str(path)) as bad:
+        volray.Renderer(volray.read(path), max_memory=PIECES).render(**args)
+    assert "\n" not in str(bad.value)
+    # A directory where the chunk's file should be: the system cannot read it.
+    os.remove(chunk)
+    os.mkdir(chunk)
+    with pytest.raises(OSError, match="not a regular file") as unreadable:
+        volray.Renderer(volray.read(path), max_memory=PIECES).render(**args)
+    assert str(path) in str(unreadable.value)
+
+
 def test_data_over_max_memory_is_refused_before_reading_with_the_coarser_level_that_fits(store):
     path, _ = store
     # Level 0 takes 1 MiB as float32, level 1 128 KiB, level 2 16 KiB.

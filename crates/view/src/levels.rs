@@ -23,9 +23,9 @@ use volray_core::{External, ExternalBytes, Sample, Samples, Store, Volume};
 pub enum LevelError {
     #[error("{0}")]
     Memory(#[from] Overdrawn),
-    /// The source's one-line message.
+    /// The source's one-line message, and its kind.
     #[error("{0}")]
-    Read(String),
+    Read(volray_core::SourceError),
 }
 
 /// The levels read whole, shared by every tab.

@@ -9,7 +9,7 @@ use crate::error::AppError;
 use crate::input::{self, Input, Request, Spec};
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
-use volray_core::{NonFinite, RenderSettings, SampleType, Volume};
+use volray_core::{NonFinite, RenderSettings, SampleType, SourceError, Volume};
 use volray_distributed::frame::{Source, agree};
 use volray_distributed::kd::Decomposition;
 use volray_distributed::mpi::Mpi;
@@ -420,20 +420,23 @@ impl RankSource {
     /// The voxels `lo..hi` as read or generated, before `--log` (their
     /// size checked by [`RankSource::check_piece`] when the source was
     /// opened).
-    fn raw_piece(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn raw_piece(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
         if let Some(spec) = &self.generate {
-            return volray_data::generate_box(spec, lo, hi).map_err(|e| e.to_string());
+            return volray_data::generate_box(spec, lo, hi)
+                .map_err(|e| SourceError::bad_data(e.to_string()));
         }
         if let Some(chunked) = &self.chunked {
             return chunked.read_box(lo, hi);
         }
         match (&self.whole, &self.reorientation, &self.sent) {
-            (Some(file), Some(r), _) => {
-                (r.sub_box(file, lo, hi)).map_err(|e| format!("{}: its piece: {e}", self.name))
-            }
+            (Some(file), Some(r), _) => (r.sub_box(file, lo, hi))
+                .map_err(|e| SourceError::bad_data(format!("{}: its piece: {e}", self.name))),
             (Some(whole), None, _) => Ok(whole.sub_box(lo, hi)),
             (None, _, Some(sent)) => Ok(sent.clone()),
-            (None, _, None) => Err(format!("{}: rank 0 sent no piece", self.name)),
+            (None, _, None) => Err(SourceError::io(format!(
+                "{}: rank 0 sent no piece",
+                self.name
+            ))),
         }
     }
 }
@@ -459,7 +462,7 @@ impl Source for RankSource {
         self.labels
     }
 
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
         let piece = self.raw_piece(lo, hi)?;
         let mut piece = match self.log_floor {
             Some(smallest) => piece.to_log10_above(smallest),

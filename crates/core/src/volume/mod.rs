@@ -18,7 +18,7 @@ mod store;
 
 pub use sample::{Sample, SampleType};
 pub use samples::Samples;
-pub use source::{VolumeSource, check_box};
+pub use source::{SourceError, SourceErrorKind, VolumeSource, check_box};
 pub use store::{External, ExternalBytes, ExternalError, Store};
 
 use glam::DVec3;

@@ -55,7 +55,7 @@ use std::sync::{Arc, Mutex};
 
 use hdf5_pure::Layout;
 use volray_core::sampling::grid::GridFrame;
-use volray_core::{SampleType, Volume, VolumeSource, check_box};
+use volray_core::{SampleType, SourceError, Volume, VolumeSource, check_box};
 
 use super::hdf5::{Found, Opened};
 use super::hdf5_axes::{Placement, each_index};
@@ -611,9 +611,9 @@ impl VolumeSource for H5Source {
         self.stored
     }
 
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
-        check_box(self.grid.dims, lo, hi).map_err(|e| format!("{}: {e}", self.path.display()))?;
-        self.read(lo, hi).map_err(|e| e.to_string())
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
+        check_box(self.grid.dims, lo, hi).map_err(|e| e.prefixed(self.path.display()))?;
+        Ok(self.read(lo, hi)?)
     }
 }
 

@@ -132,8 +132,12 @@ impl Renderer {
                 if overridden {
                     return Err(refuse_override("in pieces"));
                 }
-                let streamed = (chunked.log_pieces(mode, max_memory))
-                    .map_err(|e| value_error(format!("log=True: {name}: {e}")))?;
+                let streamed = (chunked.log_pieces(mode, max_memory)).map_err(|e| {
+                    match e.is_io_failure() {
+                        true => source_error(e),
+                        false => value_error(format!("log=True: {name}: {e}")),
+                    }
+                })?;
                 Plan::Pieces {
                     level,
                     need,

@@ -47,7 +47,7 @@ impl VolumeSource for Gated {
     fn sample_type(&self) -> volray_core::SampleType {
         self.source.sample_type()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         self.reads.lock().unwrap().push((self.level, lo, hi));
         if let Some(gate) = self.gate.as_ref().filter(|_| hi == self.grid().dims) {
             gate.entered.send(()).unwrap();
@@ -305,7 +305,7 @@ impl volray_core::VolumeSource for Counted {
     fn sample_type(&self) -> volray_core::SampleType {
         self.source.sample_type()
     }
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, volray_core::SourceError> {
         self.reads.lock().unwrap().push((self.level, lo, hi));
         self.source.read_box(lo, hi)
     }

@@ -20,16 +20,18 @@ use std::sync::Arc;
 use unsafe_cell_slice::UnsafeCellSlice;
 use volray_core::Samples;
 use zarrs::array::codec::BloscCodec;
+use zarrs::array::codec::api::CodecError;
 use zarrs::array::data_type::{
     Float32DataType, Float64DataType, Int8DataType, Int16DataType, Int32DataType, Int64DataType,
     UInt8DataType, UInt16DataType, UInt32DataType, UInt64DataType,
 };
 use zarrs::array::{
-    Array, ArrayBytesFixedDisjointView, ArrayMetadata, ArrayShardedExt, ArraySubset,
+    Array, ArrayBytesFixedDisjointView, ArrayError, ArrayMetadata, ArrayShardedExt, ArraySubset,
 };
 use zarrs::convert::array_metadata_v2_to_v3;
 use zarrs::filesystem::FilesystemStore;
 use zarrs::plugin::ExtensionAliasesV2;
+use zarrs::storage::StorageError;
 
 use super::guard::{self, CheckedStore};
 use crate::IoError;
@@ -324,8 +326,29 @@ fn elements<T: bytemuck::Pod>(
     .map_err(|e| zarr_error(path, "Zarr box", e))?;
     array
         .retrieve_array_subset_into(subset, (&mut view).into())
-        .map_err(|e| zarr_error(path, "cannot read Zarr chunks", e))?;
+        .map_err(|e| match os_error(&e) {
+            // The same line either way; the system's failure told apart
+            // from the chunks' bytes (the command line's exit 2, not 1).
+            Some(os) => IoError::os(
+                path,
+                "read Zarr chunks",
+                std::io::Error::new(os.kind(), os.to_string()),
+            ),
+            None => zarr_error(path, "cannot read Zarr chunks", e),
+        })?;
     Ok(values)
+}
+
+/// The operating system's error under a failed read of chunks, where the
+/// system failed (a chunk file that cannot be opened or read), and `None`
+/// where the bytes did (cut, garbled, refused by `guard.rs`).
+fn os_error(e: &ArrayError) -> Option<&std::io::Error> {
+    match e {
+        ArrayError::StorageError(StorageError::IOError(os))
+        | ArrayError::CodecError(CodecError::IOError(os))
+        | ArrayError::CodecError(CodecError::StorageError(StorageError::IOError(os))) => Some(os),
+        _ => None,
+    }
 }
 
 fn widen<T: Copy>(values: Vec<T>, to_f32: impl Fn(T) -> f32) -> Samples {

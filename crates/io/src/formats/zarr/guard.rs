@@ -693,6 +693,14 @@ impl ReadableStorageTraits for CheckedStore {
         let Some(size) = self.inner.size_key(key)? else {
             return Ok(None);
         };
+        // A directory where a chunk's file should be: the system cannot
+        // read it (an I/O failure, as a file read whole that is not a
+        // file), not bytes to decode.
+        if !self.inner.key_to_fspath(key).is_file() {
+            return Err(StorageError::IOError(Arc::new(std::io::Error::other(
+                format!("{key}: not a regular file"),
+            ))));
+        }
         let name = key.as_str().rsplit('/').next().unwrap_or_default();
         let limit = if MARKERS.contains(&name) {
             MAX_METADATA_BYTES.min(self.max_read)

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
-use volray_core::{SampleType, Volume, VolumeSource, check_box};
+use volray_core::{SampleType, SourceError, Volume, VolumeSource, check_box};
 
 use super::chunks::{ZarrArray, ZarrType, read_box};
 use crate::{IoError, LevelInfo};
@@ -116,9 +116,8 @@ impl VolumeSource for ZarrLevel {
         }
     }
 
-    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, String> {
-        check_box(self.grid.dims, lo, hi).map_err(|e| format!("{}: {e}", self.path.display()))?;
-        self.read(self.start.clone(), lo, hi)
-            .map_err(|e| e.to_string())
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
+        check_box(self.grid.dims, lo, hi).map_err(|e| e.prefixed(self.path.display()))?;
+        Ok(self.read(self.start.clone(), lo, hi)?)
     }
 }
