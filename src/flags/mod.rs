@@ -54,7 +54,7 @@ pub use view::ViewArgs;
 pub use viewer::ViewerArgs;
 
 use clap::error::ErrorKind;
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::ffi::OsString;
 use std::process::ExitCode;
 
@@ -112,10 +112,13 @@ pub fn parse() -> Result<Cli, ExitCode> {
     let demo = matches
         .subcommand_matches("render")
         .and_then(|render| demo::words(&argv, render));
-    let cli = Cli::try_parse_from(demo.as_ref().unwrap_or(&argv)).map_err(refused)?;
-    if demo.is_some() {
-        eprintln!("{}", demo::note());
-    }
+    // The command line is parsed once; only the demo's is parsed again,
+    // with its words.
+    let Some(words) = demo else {
+        return Cli::from_arg_matches(&matches).map_err(refused);
+    };
+    let cli = Cli::try_parse_from(&words).map_err(refused)?;
+    eprintln!("{}", demo::note());
     Ok(cli)
 }
 
