@@ -164,7 +164,7 @@ fn plain_stacks_of_every_sample_type() {
             l.info
                 .notes
                 .iter()
-                .any(|n| n.contains("no ImageJ metadata")),
+                .any(|n| n.contains("the resolution tags name no unit")),
             "{name}: {:?}",
             l.info.notes
         );

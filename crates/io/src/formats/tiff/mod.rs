@@ -28,12 +28,14 @@
 //! and the spacing from `PhysicalSizeX`/`Y`/`Z` and their units, converted
 //! to one unit. ImageJ metadata, where present, is read first, as before.
 //!
-//! Without either the spacing is 1 (the resolution tags of a plain TIFF
-//! describe print size, not voxel size) and the origin is 0.
+//! Without either, the resolution tags give the spacing where they name
+//! a physical unit and are not a print default (`resolution.rs`, with z
+//! taken equal to x), else it is 1; the origin is 0.
 
 mod imagej;
 mod ome;
 mod page;
+mod resolution;
 
 use std::io::BufReader;
 use std::path::Path;
@@ -47,6 +49,7 @@ use self::ome::{Ome, is_ome};
 use self::page::{
     Sample, compression_name, find_ascii, find_f64, header_fields, page_info, tiff_error,
 };
+use self::resolution::spacing_from_tags;
 use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
@@ -78,6 +81,14 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let description = find_ascii(&mut decoder, Tag::ImageDescription);
     let x_resolution = find_f64(&mut decoder, Tag::XResolution);
     let y_resolution = find_f64(&mut decoder, Tag::YResolution);
+    // A SHORT of 1, 2 or 3: anything else is named in the note.
+    let resolution_unit = find_f64(&mut decoder, Tag::ResolutionUnit).map(|u| {
+        if (0.0..=65535.0).contains(&u) {
+            u as u16
+        } else {
+            u16::MAX
+        }
+    });
     let mut pages = Vec::new();
     loop {
         let ifd = pages.len();
@@ -283,11 +294,9 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         }
         None if ome.is_some() => {}
         None => {
-            if x_resolution.is_some() || y_resolution.is_some() {
-                info.notes.push(
-                    "no ImageJ metadata: spacing 1, 1, 1; XResolution/YResolution (print size) ignored"
-                        .into(),
-                );
+            let tags = [x_resolution, y_resolution];
+            if let Some(s) = spacing_from_tags(tags, resolution_unit, &mut info) {
+                spacing = s;
             }
         }
     }
