@@ -28,6 +28,7 @@ pub(crate) mod hdf5;
 pub(crate) mod input;
 pub(crate) mod limits;
 pub(crate) mod mapped;
+pub(crate) mod matlab;
 pub mod panics;
 pub(crate) mod payload;
 pub(crate) mod periodic_cell;

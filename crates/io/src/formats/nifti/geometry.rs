@@ -1,12 +1,14 @@
 //! Where a NIfTI volume lies in the world: the sform, else the qform
 //! quaternion, else `pixdim` alone (nifti1.h methods 3, 2 and 1), and the
-//! length unit of `xyzt_units`.
+//! length unit of `xyzt_units`; an Analyze 7.5 grid's from SPM's `.mat`
+//! beside it (`spm.rs`), else as nibabel places a header without one.
 
 use std::path::Path;
 
 use volray_core::glam::{DMat3, DVec3};
 
 use super::header::Header;
+use super::spm::spm_geometry;
 use crate::FileInfo;
 use crate::error::IoError;
 
@@ -17,6 +19,9 @@ pub(super) fn geometry(
     info: &mut FileInfo,
 ) -> Result<([DVec3; 3], DVec3), IoError> {
     if let Some(originator) = h.analyze {
+        if let Some(geometry) = spm_geometry(path, info)? {
+            return Ok(geometry);
+        }
         return analyze_geometry(path, h, originator, info);
     }
     if h.sform_code > 0 {

@@ -47,6 +47,7 @@ mod data;
 mod geometry;
 mod header;
 mod source;
+mod spm;
 
 use std::path::Path;
 
