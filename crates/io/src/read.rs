@@ -403,7 +403,7 @@ fn has_channels(format: VolumeFormat) -> bool {
     use VolumeFormat as F;
     matches!(
         format,
-        F::Tiff | F::Hdf5 | F::Nifti | F::Zarr | F::Nrrd | F::MetaImage
+        F::Tiff | F::Hdf5 | F::Nifti | F::Zarr | F::Nrrd | F::MetaImage | F::Vtkhdf
     )
 }
 
@@ -467,13 +467,14 @@ fn open_lazy_as(
                 info,
             }))
         }
-        VolumeFormat::Hdf5 => Ok(crate::formats::hdf5_lazy::open(path, opts)?.map(
-            |(source, info)| Lazy {
-                source: Arc::new(source),
-                format,
-                info,
-            },
-        )),
+        VolumeFormat::Hdf5 | VolumeFormat::Vtkhdf => Ok(crate::formats::hdf5_lazy::open(
+            path, opts,
+        )?
+        .map(|(source, info)| Lazy {
+            source: Arc::new(source),
+            format,
+            info,
+        })),
         // A NetCDF-4 variable (HDF5 underneath) with its CF geometry and
         // packing; a NetCDF-3 variable is read whole.
         VolumeFormat::Netcdf if crate::formats::netcdf::is_netcdf4(path) => Ok(
@@ -487,8 +488,23 @@ fn open_lazy_as(
     }
 }
 
-/// The format to read `path` as: see [`read`].
+/// The format to read `path` as: see [`read`]. An HDF5 file (by name or
+/// content, not named with `:/dataset`) holding a `/VTKHDF` group is
+/// VTKHDF.
 fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
+    let format = detect_by_name_or_content(path, opts)?;
+    if format == VolumeFormat::Hdf5
+        && opts.format.is_none()
+        && split_hdf5_path(path).is_none()
+        && crate::formats::vtkhdf::is_vtkhdf(path)
+    {
+        return Ok(VolumeFormat::Vtkhdf);
+    }
+    Ok(format)
+}
+
+/// [`detect`] but for VTKHDF.
+fn detect_by_name_or_content(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
     if let Some(format) = opts.format {
         return Ok(format);
     }

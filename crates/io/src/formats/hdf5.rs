@@ -27,7 +27,8 @@
 //! dataset's shape and storage are checked against the file's length
 //! before anything is read, and samples are read in slabs of the first
 //! axis, so the scratch memory beside the volume stays small. A file
-//! holding MINC2's layout (`/minc-2.0`) is MINC2's (`formats/minc.rs`).
+//! holding MINC2's layout (`/minc-2.0`) is MINC2's (`formats/minc.rs`);
+//! one holding a `/VTKHDF` group is VTKHDF (`formats/vtkhdf.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -162,6 +163,9 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let root = h5.file.root();
     if dataset_path.is_none() && h5.file.group("minc-2.0").is_ok() {
         return Ok(Found::Minc(file_path));
+    }
+    if dataset_path.is_none() && h5.file.group(super::vtkhdf::ROOT).is_ok() {
+        return super::vtkhdf::open(file_path, h5, opts).map(|o| Found::Dataset(Box::new(o)));
     }
 
     let (name, dataset) = match &dataset_path {

@@ -37,6 +37,7 @@ pub(crate) mod raw;
 pub(crate) mod tiff;
 pub(crate) mod vti;
 pub(crate) mod vtk_legacy;
+pub(crate) mod vtkhdf;
 pub(crate) mod zarr;
 
 use std::fmt;
@@ -94,6 +95,9 @@ pub enum VolumeFormat {
     /// Analyze 7.5 `.hdr`/`.img` pairs (no NIfTI magic), read by the
     /// NIfTI reader.
     Analyze,
+    /// VTKHDF image data (`.vtkhdf`, or an HDF5 file with a `/VTKHDF`
+    /// group): VTK's own HDF5 format.
+    Vtkhdf,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -465,6 +469,21 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: nifti::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Vtkhdf,
+        name: "vtkhdf",
+        description: "VTKHDF image data",
+        extensions: &["vtkhdf"],
+        name_stems: &[],
+        known_as: ".vtkhdf (or an HDF5 file with a /VTKHDF group)",
+        // HDF5's signature: an HDF5 file is told by its /VTKHDF group
+        // (`read.rs`'s `detect`).
+        magic: Magic::NONE,
+        frames: false,
+        arrays: true,
+        levels: false,
+        read: vtkhdf::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -748,13 +767,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .vtkhdf (or an HDF5 file with a /VTKHDF group)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, vtkhdf"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 19);
+        assert_eq!(VolumeFormat::ALL.len(), 20);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
