@@ -403,7 +403,7 @@ fn has_channels(format: VolumeFormat) -> bool {
     use VolumeFormat as F;
     matches!(
         format,
-        F::Tiff | F::Hdf5 | F::Nifti | F::Zarr | F::Nrrd | F::MetaImage | F::Vtkhdf
+        F::Tiff | F::Hdf5 | F::Nifti | F::Zarr | F::Nrrd | F::MetaImage | F::Vtkhdf | F::Bdv
     )
 }
 
@@ -475,6 +475,14 @@ fn open_lazy_as(
             format,
             info,
         })),
+        VolumeFormat::Bdv => {
+            let (source, info) = crate::formats::bdv::open_lazy(path, opts)?;
+            Ok(Some(Lazy {
+                source,
+                format,
+                info,
+            }))
+        }
         // A NetCDF-4 variable (HDF5 underneath) with its CF geometry and
         // packing; a NetCDF-3 variable is read whole.
         VolumeFormat::Netcdf if crate::formats::netcdf::is_netcdf4(path) => Ok(
@@ -490,7 +498,7 @@ fn open_lazy_as(
 
 /// The format to read `path` as: see [`read`]. An HDF5 file (by name or
 /// content, not named with `:/dataset`) holding a `/VTKHDF` group is
-/// VTKHDF.
+/// VTKHDF; one holding BigDataViewer's groups is BigDataViewer's.
 fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
     let format = detect_by_name_or_content(path, opts)?;
     if format == VolumeFormat::Hdf5
@@ -499,6 +507,13 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
         && crate::formats::vtkhdf::is_vtkhdf(path)
     {
         return Ok(VolumeFormat::Vtkhdf);
+    }
+    if format == VolumeFormat::Hdf5
+        && opts.format.is_none()
+        && split_hdf5_path(path).is_none()
+        && crate::formats::bdv::is_bdv_h5(path)
+    {
+        return Ok(VolumeFormat::Bdv);
     }
     Ok(format)
 }

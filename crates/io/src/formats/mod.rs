@@ -14,6 +14,7 @@
 //! [`IoError::UnknownFormat`], which reader options apply and the reader
 //! itself all come from the row.
 
+pub(crate) mod bdv;
 pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
@@ -98,6 +99,9 @@ pub enum VolumeFormat {
     /// VTKHDF image data (`.vtkhdf`, or an HDF5 file with a `/VTKHDF`
     /// group): VTK's own HDF5 format.
     Vtkhdf,
+    /// BigDataViewer HDF5: a SpimData `dataset.xml` and its `.h5` (or
+    /// the `.h5` alone), levels, view setups and time points.
+    Bdv,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -484,6 +488,24 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: vtkhdf::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Bdv,
+        name: "bdv",
+        description: "BigDataViewer HDF5",
+        extensions: &[],
+        name_stems: &[],
+        known_as: "dataset.xml (BigDataViewer, or its .h5)",
+        // The XML by its root element; the .h5 by its groups
+        // (`read.rs`'s `detect`).
+        magic: Magic {
+            text: Some(bdv::sniff),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: true,
+        read: bdv::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -767,13 +789,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .vtkhdf (or an HDF5 file with a /VTKHDF group)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .vtkhdf (or an HDF5 file with a /VTKHDF group), dataset.xml (BigDataViewer, or its .h5)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, vtkhdf"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, vtkhdf, bdv"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 20);
+        assert_eq!(VolumeFormat::ALL.len(), 21);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
