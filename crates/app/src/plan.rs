@@ -107,26 +107,8 @@ pub fn plan(
         });
         chunked = chunked.at_level(level)?;
     }
-    let (mode, extra) = (frames.non_finite, frames.extra);
-    let plan = if frames.log {
-        // The log of the level, found piece by piece after a pass over it
-        // for its smallest positive value.
-        // A slab the system failed to read is a read's failure; bad data
-        // (or no positive value) is --log's.
-        (chunked.plan_log(settings, mode, max_memory, extra)).map_err(|error| {
-            match error.is_io_failure() {
-                true => AppError::Stream {
-                    name: spec.clone(),
-                    error: StreamError::Read(error),
-                },
-                false => AppError::Log {
-                    name: spec.clone(),
-                    message: error.message,
-                },
-            }
-        })?
-    } else {
-        chunked.plan(settings, mode, max_memory, extra)
+    let Some(plan) = plan_level(&chunked, &spec, frames, max_memory, false)? else {
+        unreachable!("a plan is made where none is kept")
     };
     match plan {
         LazyPlan::Whole { level, .. } => Ok(Plan::Whole { level: Some(level) }),
@@ -144,6 +126,45 @@ pub fn plan(
             max_memory,
         }))),
     }
+}
+
+/// How `chunked`'s level (of the input `name`) is rendered for `frames`
+/// under `max_memory`: volray-lazy's plan, whole or in pieces, or with
+/// `log` its plan of the level's log10 (in pieces after a pass over the
+/// level for its smallest positive value). `kept`: the front end renders
+/// this level in pieces already (Python's `Renderer` keeps them from
+/// frame to frame, with what it found in them): `None` where the plan is
+/// pieces again, with no second pass over the level.
+pub fn plan_level(
+    chunked: &Chunked,
+    name: &str,
+    frames: &Frames<'_>,
+    max_memory: u64,
+    kept: bool,
+) -> Result<Option<LazyPlan>, AppError> {
+    let (settings, mode, extra) = (frames.settings, frames.non_finite, frames.extra);
+    if !frames.log {
+        let plan = chunked.plan(settings, mode, max_memory, extra);
+        return Ok((!(kept && matches!(plan, LazyPlan::Pieces { .. }))).then_some(plan));
+    }
+    // `plan_log`'s rule, asked before its pass over the level.
+    let whole = chunked.whole_log_bytes(settings, mode) + extra;
+    if kept && whole > u128::from(max_memory.min(volray_lazy::PIECE_BUDGET)) {
+        return Ok(None);
+    }
+    // A slab the system failed to read is a read's failure; bad data
+    // (or no positive value) is --log's.
+    let plan = chunked.plan_log(settings, mode, max_memory, extra);
+    plan.map(Some).map_err(|error| match error.is_io_failure() {
+        true => AppError::Stream {
+            name: name.to_string(),
+            error: StreamError::Read(error),
+        },
+        false => AppError::Log {
+            name: name.to_string(),
+            message: error.message,
+        },
+    })
 }
 
 /// Opens `request`'s file from its metadata where it is stored in

@@ -5,6 +5,7 @@
 
 use pyo3::PyErr;
 use pyo3::exceptions::{PyOSError, PyValueError};
+use volray_app::AppError;
 use volray_io::IoError;
 use volray_options::{CameraOptions, Naming, Opt, OptionError};
 
@@ -76,6 +77,28 @@ pub fn io_error(e: IoError) -> PyErr {
         PyOSError::new_err(e.to_string())
     } else {
         value_error(e.to_string())
+    }
+}
+
+/// volray-app's error opening, planning or budgeting an input, in its
+/// one-line words: the reader's failures as [`io_error`] maps them
+/// (`OSError` where the system failed), a piece's read as
+/// [`source_error`] does, the rest (bad input, bad options) `ValueError`.
+/// A `log=True` refusal names the keyword as Python spells it.
+pub fn app_error(e: AppError) -> PyErr {
+    use volray_distributed::streamed::StreamError;
+    match e {
+        AppError::Io(e) => io_error(e),
+        AppError::Stream {
+            error: StreamError::Read(e),
+            ..
+        } => source_error(e),
+        AppError::Log { name, message } => value_error(format!("log=True: {name}: {message}")),
+        AppError::Refused {
+            message,
+            bad_input: false,
+        } => PyOSError::new_err(message),
+        other => value_error(other.to_string()),
     }
 }
 

@@ -27,7 +27,7 @@ mod recipe;
 
 use crate::array::{self, ArrayBytes, Order};
 use crate::errors::{
-    io_error, option_error, render_error, settings_error, source_error, value_error,
+    app_error, io_error, option_error, render_error, settings_error, source_error, value_error,
 };
 use crate::figure::{self, FIGURE};
 use crate::frame::Frame;
@@ -42,13 +42,14 @@ use std::time::Duration;
 use volray_annotate::figure::Annotations;
 use volray_app::AppError;
 use volray_app::memory::Budget;
+use volray_app::plan::{self, Frames};
 use volray_core::transfer::auto;
 use volray_core::{
     FrameRequest, Histogram, Image, NonFinite, Render, RenderError, RenderSettings, Rendered,
     Renderer as CoreRenderer, Volume as CoreVolume,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
-use volray_io::{MapPolicy, ReadOptions, format_bytes};
+use volray_io::format_bytes;
 use volray_lazy::{Chunked, Found, LookError, Plan};
 use volray_options::level::LevelChoice;
 use volray_options::{CameraOptions, LookOptions, Options};
@@ -218,29 +219,50 @@ impl Renderer {
             return Err(level_in_memory(&recipe.name));
         }
         let digest = recipe.digest(py, None)?;
-        let prepared = recipe.prepare(py, digest)?;
+        // The caches' budget for the frame `k` asks (`render`), or a
+        // default one (`Renderer`): a later frame that leaves less room
+        // prepares the volume again (`current`).
+        let (_, first) = recipe.settings_of(k)?;
+        let prepared = recipe.prepare(py, digest, &first)?;
         Ok(Renderer {
             recipe,
             road: Road::Memory(Mutex::new(Arc::new(prepared))),
         })
     }
 
-    /// The volume prepared from the samples as they are now: the last
-    /// one, or (the samples changed since) a new one.
+    /// The volume prepared from the samples as they are now, for a frame
+    /// of `settings` (if one is to be rendered): the last one, or (the
+    /// samples changed since, or its brick caches may take more than the
+    /// frame leaves them under `max_memory`) a new one.
     fn current(
         &self,
         py: Python<'_>,
         memory: &Mutex<Arc<Prepared>>,
         pool: Option<&rayon::ThreadPool>,
+        settings: Option<&RenderSettings>,
     ) -> PyResult<Arc<Prepared>> {
         // The lock is held only to clone or replace the `Arc`, never
         // across a call that waits for the GIL or another thread.
         let last = Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner()));
         let digest = self.recipe.digest(py, pool)?;
-        if digest == last.digest {
+        let (mode, max_memory) = (self.recipe.nonfinite, self.recipe.max_memory);
+        let fits = settings.is_none_or(|s| last.fits(s, mode, max_memory));
+        if digest == last.digest && fits {
             return Ok(last);
         }
-        let fresh = Arc::new(self.recipe.prepare(py, digest)?);
+        let settings = match settings {
+            Some(settings) => settings,
+            None => {
+                &self
+                    .recipe
+                    .settings_of(&Keywords::new(None, &[], "Renderer")?)?
+                    .1
+            }
+        };
+        // The last one's caches go before the new one is made, unless a
+        // frame of another thread still holds it.
+        drop(last);
+        let fresh = Arc::new(self.recipe.prepare(py, digest, settings)?);
         *memory.lock().unwrap_or_else(|e| e.into_inner()) = Arc::clone(&fresh);
         Ok(fresh)
     }
@@ -267,7 +289,7 @@ impl Renderer {
         };
         let prepared = match fresh {
             true => Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner())),
-            false => self.current(py, memory, pool.as_ref())?,
+            false => self.current(py, memory, pool.as_ref(), Some(&settings))?,
         };
         self.render_prepared(py, &prepared, &options, settings, pool.as_ref(), &what)
     }
@@ -340,15 +362,40 @@ fn budget(max_memory: u64) -> Budget {
     }
 }
 
-/// The budget of the brick caches: the library's default, or what is
-/// left under `max_memory` after a default frame when that is less, 0
-/// where even that is over (volray-app's `memory::cache_budget`, which
-/// the command line calls with its frame's settings: a renderer here is
-/// prepared before its frames are asked for; the budget changes speed,
-/// never pixels).
-pub(crate) fn cache_budget(renderer: &CoreRenderer<'_>, mode: NonFinite, max_memory: u64) -> usize {
-    let (volume, default) = (renderer.volume(), RenderSettings::default());
-    volray_app::memory::cache_budget(volume, "", &default, mode, budget(max_memory)).unwrap_or(0)
+/// The budget of the brick caches for frames of `settings`: the
+/// library's default, or what is left under `max_memory` after such a
+/// frame when that is less, 0 where even that is over (volray-app's
+/// `memory::cache_budget`, as the command line budgets its frame). The
+/// budget changes speed, never pixels.
+///
+/// Core fixes a renderer's budget when it is built, and a Python
+/// renderer is built before its frames are asked for: with the first
+/// frame's settings for `render`, the defaults for `Renderer`. A frame
+/// that leaves the caches less than that budget (a larger image,
+/// `post_classification`, shadows: [`Prepared::fits`]) has the volume
+/// prepared again with the smaller one, which the frames after keep (it
+/// never grows back: each frame stays within `max_memory`, and the
+/// volume is prepared again at most once per smaller budget).
+pub(crate) fn cache_budget(
+    renderer: &CoreRenderer<'_>,
+    settings: &RenderSettings,
+    mode: NonFinite,
+    max_memory: u64,
+) -> usize {
+    let volume = renderer.volume();
+    volray_app::memory::cache_budget(volume, "", settings, mode, budget(max_memory)).unwrap_or(0)
+}
+
+impl Prepared {
+    /// Whether a frame of `settings` leaves this volume's brick caches
+    /// their budget under `max_memory` (see [`cache_budget`]); a frame
+    /// over the limit whatever the caches is refused, not prepared for.
+    pub(crate) fn fits(&self, settings: &RenderSettings, mode: NonFinite, max_memory: u64) -> bool {
+        let volume = self.inner.volume();
+        let room = volray_app::memory::cache_budget(volume, "", settings, mode, budget(max_memory));
+        room.ok()
+            .is_none_or(|room| room >= self.inner.cache_budget())
+    }
 }
 
 /// A pool of `threads` workers.
@@ -388,7 +435,7 @@ impl Renderer {
     #[getter]
     fn value_range(&self, py: Python<'_>) -> PyResult<(f32, f32)> {
         match &self.road {
-            Road::Memory(memory) => Ok(self.current(py, memory, None)?.inner.value_range()),
+            Road::Memory(memory) => Ok(self.current(py, memory, None, None)?.inner.value_range()),
             Road::Lazy(lazy) => self.lazy_value_range(py, lazy),
         }
     }
@@ -426,6 +473,25 @@ impl Renderer {
                 Way::Pieces { streamed, .. } => Some(streamed.pieces()),
             },
         )
+    }
+
+    /// For tests: the byte budget of the brick caches the last frame
+    /// rendered with (of the volume as prepared now; `None` for a lazy
+    /// volume before its first frame or rendered in pieces).
+    #[getter]
+    fn _cache_budget(&self, py: Python<'_>) -> Option<usize> {
+        let prepared = match &self.road {
+            Road::Memory(memory) => Arc::clone(&memory.lock().unwrap_or_else(|e| e.into_inner())),
+            Road::Lazy(lazy) => {
+                py.detach(
+                    || match &lazy.state.lock().unwrap_or_else(|e| e.into_inner()).way {
+                        Way::Whole { prepared, .. } => Some(Arc::clone(prepared)),
+                        Way::None | Way::Pieces { .. } => None,
+                    },
+                )?
+            }
+        };
+        Some(prepared.inner.cache_budget())
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {

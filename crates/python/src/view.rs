@@ -21,13 +21,13 @@
 //! at most [`volray_view::MAX_IN_FLIGHT`] go unacknowledged, their bytes
 //! held in the memory limit's ledger.
 
-use crate::errors::{Keywords as Names, source_error, value_error};
+use crate::errors::{Keywords as Names, io_error, source_error, value_error};
 use crate::figure::{self, FIGURE};
 use crate::keywords::{self, CAMERA, Camera, FRAME, Keywords, VOLUME};
 use crate::renderer::{Recipe, cache_budget, check_level, level_choice, level_in_memory, pool};
 use crate::transfer::TransferFunction;
 use crate::volume::LazyFile;
-use pyo3::exceptions::{PyOSError, PyRuntimeError};
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::sync::{Arc, Mutex};
@@ -132,7 +132,7 @@ impl ViewHost {
                     return Err(level_in_memory(&name));
                 }
                 digest = recipe.digest(py, None)?;
-                (recipe.prepare(py, digest)?, None)
+                (recipe.prepare(py, digest, &settings)?, None)
             }
             Some(file) => {
                 let opened = open_levels(py, &recipe, file, level, &settings)?;
@@ -140,7 +140,10 @@ impl ViewHost {
                 let source = Arc::clone(opened.pyramid.source(opened.start));
                 let core = (py.detach(|| source.read_box([0; 3], dims)))
                     .map_err(|e| source_error(e.prefixed(&name)))?;
-                (recipe.prepare_core(py, core, None)?, Some(opened))
+                (
+                    recipe.prepare_core(py, core, None, &settings)?,
+                    Some(opened),
+                )
             }
         };
         if levels.is_some() && what.any() {
@@ -152,7 +155,8 @@ impl ViewHost {
         recipe.leave_to_volume(&prepared.known, &options, &mut settings)?;
         recipe.check_memory(&prepared.inner, &settings)?;
         let non_finite = recipe.nonfinite;
-        let cache_budget = cache_budget(&prepared.inner, non_finite, recipe.max_memory);
+        // The starting view's, as `volray view` budgets its first frame.
+        let cache_budget = cache_budget(&prepared.inner, &settings, non_finite, recipe.max_memory);
         let volume = Arc::new(prepared.inner.volume().clone());
         drop(prepared);
         let mut state = volray_view::start_state(&options, &settings);
@@ -336,7 +340,10 @@ impl Watch for Watcher {
                 (last.digest, last.generation)
             };
             if digest != known {
-                let prepared = self.recipe.prepare(py, digest).map_err(failed)?;
+                // Only the samples are taken (the viewer's renderers keep
+                // their own budget): any settings do.
+                let default = RenderSettings::default();
+                let prepared = (self.recipe.prepare(py, digest, &default)).map_err(failed)?;
                 let mut last = lock(&self.last);
                 if last.digest != digest {
                     *last = Watched {
@@ -406,7 +413,7 @@ fn open_levels(
             .map(|l| Ok(Arc::clone(file.chunked.open_level(l)?.source())))
             .collect::<Result<Vec<_>, volray_io::IoError>>()
     });
-    let sources = sources.map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let sources = sources.map_err(io_error)?;
     let pyramid = Pyramid::new(sources, fixed).map_err(|e| value_error(format!("{name}: {e}")))?;
     let limit = u128::from(recipe.max_memory);
     let start = pyramid

@@ -9,15 +9,19 @@
 //! or piece by piece (`renderer.rs`).
 
 use crate::array::{self, Order};
-use crate::errors::{io_error, value_error};
+use crate::errors::{app_error, value_error};
 use numpy::{PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::path::PathBuf;
+use volray_app::AppError;
+use volray_app::input::{self, Request, Spec};
+use volray_app::plan;
 use volray_core::{Histogram, SampleType, Volume as CoreVolume};
-use volray_io::{FileInfo, MapPolicy, ReadOptions, VolumeFormat, format_bytes};
+use volray_io::{FileInfo, MapPolicy, VolumeFormat, format_bytes};
 use volray_lazy::Chunked;
+use volray_options::level::LevelChoice;
 
 /// A volume: `data`, a numpy array `a[x, y, z]` (x fastest in memory),
 /// and where its voxels lie, `spacing` and `origin` in `(x, y, z)`.
@@ -58,11 +62,30 @@ pub struct Volume {
 /// A level of a chunked file, opened from its metadata.
 pub struct LazyFile {
     pub chunked: Chunked,
+    /// What `read` was asked (volray-app's request, its level the one
+    /// open): a level is read whole as the command line reads it.
+    pub request: Request,
     /// `read`'s `max_memory`: what reading the level whole may take.
     pub max_memory: u64,
     /// Whether `read` was given a spacing (which holds for this level
     /// only).
     pub spacing_given: bool,
+}
+
+impl LazyFile {
+    /// Level `level` of the file read whole into memory (never mapped:
+    /// the samples move into numpy or a renderer), within `max_memory`,
+    /// as volray-app reads any input; `read`'s spacing applies to its
+    /// own level only.
+    pub fn read_level(&self, level: usize, max_memory: u64) -> Result<CoreVolume, AppError> {
+        let own = level == self.chunked.level();
+        let request = Request {
+            spacing: self.request.spacing.filter(|_| own),
+            max_memory: Some(max_memory),
+            ..self.request.at_level(Some(level))
+        };
+        Ok(input::load_with(&request, MapPolicy::Never)?.volume)
+    }
 }
 
 impl Volume {
@@ -134,16 +157,10 @@ impl Volume {
                 format_bytes(u128::from(lazy.max_memory)),
             )));
         }
-        let opts = ReadOptions {
-            max_memory: lazy.max_memory,
-            map: MapPolicy::Never,
-            ..chunked.read_options()
-        };
-        let path = chunked.path();
-        let loaded = py
-            .detach(|| volray_io::read(path, &opts))
-            .map_err(io_error)?;
-        let volume = loaded.volume;
+        let level = chunked.level();
+        let volume = py
+            .detach(|| lazy.read_level(level, lazy.max_memory))
+            .map_err(app_error)?;
         if volume.dims() != [x, y, z] || volume.sample_type() != self.sample {
             let [a, b, c] = volume.dims();
             return Err(PyErr::new::<pyo3::exceptions::PyOSError, _>(format!(
@@ -413,56 +430,37 @@ pub fn read(
     max_memory: Option<u64>,
 ) -> PyResult<Volume> {
     let spec = path.to_string_lossy().to_string();
-    let max_memory = max_memory.unwrap_or_else(volray_io::default_max_memory);
     let level = read_level(&spec, level)?;
-    let (volume, file) = if volray_data::is_source_spec(&spec) {
-        if level.is_some() || channel.is_some() {
-            return Err(value_error(format!(
-                "{spec}: level and channel pick a level and a channel of a file, not of a built-in source"
-            )));
-        }
-        let volume = py
-            .detach(|| volray_data::generate(&spec))
-            .map_err(|e| value_error(e.to_string()))?;
-        (volume, None)
-    } else {
-        // volray-app's words: `format: ...`, `dtype: ...`, `endian: ...`.
-        let app = |e: volray_app::AppError| value_error(e.to_string());
-        let format = volray_app::input::format_named(format).map_err(app)?;
-        let raw = match dims {
-            Some(dims) => {
-                Some(volray_app::input::raw_layout(dims, dtype, endian, spacing).map_err(app)?)
-            }
-            None if dtype.is_some() || endian.is_some() => {
-                return Err(value_error(format!(
-                    "{spec}: dtype and endian describe a raw file: give dims too"
-                )));
-            }
-            None => None,
-        };
-        let opts = ReadOptions {
-            format,
-            raw,
-            frame,
-            array,
-            level,
-            channel,
-            max_memory,
-            // The samples move into a numpy array, which owns its memory.
-            map: MapPolicy::Never,
-        };
-        let chunked = py
-            .detach(|| Chunked::open(&path, &opts))
-            .map_err(io_error)?;
-        if let Some(chunked) = chunked {
-            return Ok(lazy_volume(chunked, spec, spacing, max_memory));
-        }
-        let loaded = py
-            .detach(|| volray_io::read(&path, &opts))
-            .map_err(io_error)?;
-        (loaded.volume, Some((loaded.format, loaded.info)))
+    // Opened as the command line opens its INPUT (volray-app): a
+    // built-in source's spec or a file, the same options refused the
+    // same way, in volray-app's words.
+    let request = Request {
+        spec: Spec::parse(&spec),
+        dims,
+        dtype: dtype.map(String::from),
+        endian: endian.map(String::from),
+        spacing,
+        format: format.map(String::from),
+        frame,
+        array,
+        level: level.map(LevelChoice::Index),
+        channel,
+        max_memory,
     };
-    let spacing = spacing.unwrap_or(volume.spacing().to_array());
+    let max_memory = request.max_memory();
+    let chunked = py
+        .detach(|| plan::open_chunked(&request, max_memory))
+        .map_err(app_error)?;
+    if let Some(chunked) = chunked {
+        return Ok(lazy_volume(chunked, request));
+    }
+    // The samples move into a numpy array, which owns its memory: never
+    // mapped from the file.
+    let loaded = py
+        .detach(|| input::load_with(&request, MapPolicy::Never))
+        .map_err(app_error)?;
+    let (volume, file) = (loaded.volume, loaded.file);
+    let spacing = volume.spacing().to_array();
     let origin = volume.origin().to_array();
     let labels = volume.is_labels();
     let sample = volume.sample_type();
@@ -499,27 +497,24 @@ fn read_level(spec: &str, level: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u
 
 /// The volume of a chunked file's level, from its metadata: no sample
 /// read.
-fn lazy_volume(
-    chunked: Chunked,
-    name: String,
-    spacing: Option<[f64; 3]>,
-    max_memory: u64,
-) -> Volume {
+fn lazy_volume(chunked: Chunked, request: Request) -> Volume {
     let source = chunked.source();
     let grid = source.grid();
+    let spacing = request.spacing;
     Volume {
         data: PyOnceLock::new(),
         sample: source.sample_type(),
         spacing: spacing.unwrap_or(grid.spacing.to_array()),
         origin: grid.origin.to_array(),
         labels: source.is_labels(),
-        name,
+        name: request.spec.name(),
         frozen: true,
         file: Some((chunked.format(), chunked.info().clone())),
         lazy: Some(LazyFile {
             chunked,
-            max_memory,
+            max_memory: request.max_memory(),
             spacing_given: spacing.is_some(),
+            request,
         }),
     }
 }

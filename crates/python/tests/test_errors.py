@@ -80,6 +80,57 @@ def test_files_that_cannot_be_read_raise_os_or_value_errors(tmp_path):
         volray.read(_big(tmp_path), max_memory=1000)
 
 
+def test_read_refuses_what_the_command_line_refuses_in_its_words(tmp_path):
+    # volray-app's rules for an input, Python's read and `volray render` alike.
+    np.save(tmp_path / "a.npy", ball())
+    with pytest.raises(ValueError, match="a.npy: dims, dtype and endian describe raw files; this is a NumPy .npy file"):
+        volray.read(tmp_path / "a.npy", dims=(24, 24, 24))
+    raw = tmp_path / "a.raw"
+    raw.write_bytes(bytes(8))
+    with pytest.raises(ValueError, match="a.raw: raw data needs dims"):
+        volray.read(raw, dtype="u8")
+    with pytest.raises(ValueError, match="sphere:8: .* apply to files only"):
+        volray.read("sphere:8", frame=0)
+    with pytest.raises(ValueError, match="spacing"):
+        volray.read("sphere:8", spacing=(0, 1, 1))
+    # A built-in source is checked against max_memory before it is made.
+    with pytest.raises(ValueError, match="blobs:200: points per side 200 200 200 .* exceed the memory limit"):
+        volray.read("blobs:200", max_memory=1000)
+    sphere = volray.read("sphere:8", spacing=(2, 1, 0.5))
+    assert sphere.spacing == (2.0, 1.0, 0.5) and sphere.dims == (8, 8, 8)
+    assert np.array_equal(sphere.data, volray.read("sphere:8").data)
+
+
+def test_a_frame_that_needs_more_memory_shrinks_the_brick_caches_to_fit():
+    # The caches get what max_memory leaves after the frame being
+    # rendered, as the command line budgets them; the pixels are the same.
+    a = ball()
+    limit = 64 << 20
+    r = volray.Renderer(a, max_memory=limit)
+    small = r.render(size=32)
+    first = r._cache_budget
+    assert 0 < first < limit
+    big = r.render(size=(520, 500))
+    after_big = r._cache_budget
+    # 16 bytes a pixel more than the default 480x480 frame's.
+    assert first - after_big >= 16 * (520 * 500 - 480 * 480)
+    shadowed = r.render(size=(520, 500), shadows=True)
+    # Shadows keep a light volume of 2 bytes a voxel.
+    assert after_big - r._cache_budget >= 2 * 24**3
+    # What a renderer made for that frame first gets; never more again.
+    fresh = volray.Renderer(a, max_memory=limit)
+    fresh.render(size=(520, 500), shadows=True)
+    assert fresh._cache_budget == r._cache_budget
+    budget = r._cache_budget
+    again = r.render(size=32)
+    assert r._cache_budget == budget
+    roomy = volray.Renderer(a)
+    frames = [(small, {"size": 32}), (big, {"size": (520, 500)}), (again, {"size": 32}),
+              (shadowed, {"size": (520, 500), "shadows": True})]
+    for frame, keywords in frames:
+        assert np.array_equal(np.asarray(frame), np.asarray(roomy.render(**keywords)))
+
+
 def _big(tmp_path):
     path = tmp_path / "big.npy"
     np.save(path, np.zeros((32, 32, 32), np.float32))

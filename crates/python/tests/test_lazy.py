@@ -285,6 +285,24 @@ def test_level_is_refused_for_a_volume_in_memory_and_out_of_range(store):
         volray.Renderer(volray.read(path), level="coarse")
 
 
+def test_a_level_read_whole_budgets_its_brick_caches_for_each_frame(store):
+    # As a volume in memory: what max_memory leaves after the frame being
+    # rendered; a frame that leaves less has the level prepared again.
+    path, _ = store
+    limit = 64 << 20
+    renderer = volray.Renderer(volray.read(path), level=0, max_memory=limit)
+    small = renderer.render(size=SIZE)
+    budget = renderer._cache_budget
+    assert renderer.pieces == 1 and 0 < budget < limit
+    large = renderer.render(size=(300, 200))
+    # 16 bytes a pixel more.
+    assert budget - renderer._cache_budget >= 16 * (300 * 200 - SIZE * SIZE)
+    assert renderer.pieces == 1 and renderer.level == 0
+    whole = in_memory(volray.read(path))
+    assert np.array_equal(np.asarray(small), np.asarray(volray.render(whole, size=SIZE)))
+    assert np.array_equal(np.asarray(large), np.asarray(volray.render(whole, size=(300, 200))))
+
+
 def test_log_is_taken_whole_and_in_pieces_on_the_whole_levels_scale(store, cli_image):
     path, _ = store
     frame = volray.render(volray.read(path), log=True, size=SIZE)

@@ -119,44 +119,39 @@ impl Renderer {
             ))
         };
         let (mode, max_memory) = (self.recipe.nonfinite, self.recipe.max_memory);
-        let plan = if self.recipe.log {
-            // The log scale's pass over the level is made once, when its
-            // pieces are first needed.
-            let level = chunked.level();
-            let need = chunked.whole_log_bytes(settings, mode);
-            if need <= u128::from(max_memory) {
-                Plan::Whole { level, need }
-            } else if matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
-                return Ok(());
-            } else {
-                if overridden {
-                    return Err(refuse_override("in pieces"));
-                }
-                let streamed = (chunked.log_pieces(mode, max_memory)).map_err(|e| {
-                    match e.is_io_failure() {
-                        true => source_error(e),
-                        false => value_error(format!("log=True: {name}: {e}")),
-                    }
-                })?;
-                Plan::Pieces {
-                    level,
-                    need,
-                    streamed: Box::new(streamed),
-                }
-            }
-        } else {
-            chunked.plan(settings, mode, max_memory, 0)
+        // volray-app's plan of the level, as `volray render` plans it: the
+        // pieces of this level kept from the last frame, where it is
+        // pieces again (with log=True, no second pass over the level).
+        let frames = Frames {
+            settings,
+            non_finite: mode,
+            log: self.recipe.log,
+            labels: self.recipe.labels,
+            extra: 0,
+        };
+        let kept = matches!(state.way, Way::Pieces { level: l, .. } if l == level);
+        let planned = plan::plan_level(chunked, name, &frames, max_memory, kept);
+        let Some(plan) = planned.map_err(app_error)? else {
+            return Ok(());
         };
         match plan {
             Plan::Whole { level, .. } => {
                 if overridden && level != own {
                     return Err(refuse_override("read whole"));
                 }
-                if !matches!(state.way, Way::Whole { level: l, .. } if l == level) {
+                // Kept while its caches' budget fits this frame (see
+                // `cache_budget`).
+                let kept = match &state.way {
+                    Way::Whole { level: l, prepared } if *l == level => {
+                        prepared.fits(settings, mode, max_memory)
+                    }
+                    _ => false,
+                };
+                if !kept {
                     // The last level's samples go before the next is read.
                     state.way = Way::None;
                     let prepared =
-                        Python::attach(|py| self.prepare_level(py, lazy, file, chunked))?;
+                        Python::attach(|py| self.prepare_level(py, lazy, file, chunked, settings))?;
                     state.way = Way::Whole {
                         level,
                         prepared: Arc::new(prepared),
@@ -181,39 +176,31 @@ impl Renderer {
         Ok(())
     }
 
-    /// The level `chunked` read whole and prepared: the volume's own
-    /// samples where `data` read them already, else read from the file.
+    /// The level `chunked` read whole and prepared for frames of
+    /// `settings`: the volume's own samples where `data` read them
+    /// already, else read from the file (volray-app's reading, as
+    /// `volray render` reads a level that fits).
     pub(super) fn prepare_level(
         &self,
         py: Python<'_>,
         lazy: &LazyRoad,
         file: &LazyFile,
         chunked: &Chunked,
+        settings: &RenderSettings,
     ) -> PyResult<Prepared> {
         let volume = lazy.volume.get();
-        let own = chunked.level() == file.chunked.level();
-        if own && volume.loaded(py).is_some() {
-            return self.recipe.prepare_core(py, volume.core(py)?, None);
+        let level = chunked.level();
+        if level == file.chunked.level() && volume.loaded(py).is_some() {
+            return (self.recipe).prepare_core(py, volume.core(py)?, None, settings);
         }
-        let opts = ReadOptions {
-            max_memory: self.recipe.max_memory,
-            map: MapPolicy::Never,
-            ..chunked.read_options()
-        };
-        let path = chunked.path();
-        let read = py
-            .detach(|| volray_io::read(path, &opts))
-            .map_err(io_error)?;
-        let mut core = read.volume;
-        if own && file.spacing_given {
-            core = core
-                .with_spacing(volume.spacing.into())
-                .map_err(|e| value_error(format!("spacing: {e}")))?;
-        }
+        let max_memory = self.recipe.max_memory;
+        let mut core = py
+            .detach(|| file.read_level(level, max_memory))
+            .map_err(app_error)?;
         if volume.labels {
             core = core.as_labels();
         }
-        self.recipe.prepare_core(py, core, None)
+        self.recipe.prepare_core(py, core, None, settings)
     }
 
     /// A lazy volume's value range: of the level of the last frame; before

@@ -35,9 +35,14 @@ impl Recipe {
 
     /// The volume prepared from its samples, whose digest is `digest`:
     /// value range, labels or histogram, non-finite values, the brick
-    /// caches' budget. Samples read in place are checked against the
-    /// digest after each frame (`ArrayBytes::verify`).
-    pub(crate) fn prepare(&self, py: Python<'_>, digest: Option<u64>) -> PyResult<Prepared> {
+    /// caches' budget for frames of `settings`. Samples read in place are
+    /// checked against the digest after each frame (`ArrayBytes::verify`).
+    pub(crate) fn prepare(
+        &self,
+        py: Python<'_>,
+        digest: Option<u64>,
+        settings: &RenderSettings,
+    ) -> PyResult<Prepared> {
         let core = match &self.source {
             Source::Volume(v) => v.get().core_expecting(py, digest)?,
             Source::Array {
@@ -55,7 +60,7 @@ impl Recipe {
                 volume.core_expecting(py, digest.filter(|_| in_place))?
             }
         };
-        self.prepare_core(py, core, digest)
+        self.prepare_core(py, core, digest, settings)
     }
 
     /// [`Recipe::prepare`] of the samples `core`.
@@ -64,6 +69,7 @@ impl Recipe {
         py: Python<'_>,
         mut core: CoreVolume,
         digest: Option<u64>,
+        settings: &RenderSettings,
     ) -> PyResult<Prepared> {
         let name = &self.name;
         if let Some(s) = self.spacing {
@@ -93,7 +99,7 @@ impl Recipe {
             .detach(|| CoreRenderer::owning(core, nonfinite))
             .map_err(|e| render_error(e, &volray_options::CameraOptions::default(), name))?;
         let inner = {
-            let budget = cache_budget(&inner, nonfinite, self.max_memory);
+            let budget = cache_budget(&inner, settings, nonfinite, self.max_memory);
             inner.with_cache_budget(budget)
         };
         Ok(Prepared {
