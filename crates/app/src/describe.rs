@@ -296,7 +296,10 @@ fn with_bytes_stored(info: &FileInfo) -> FileInfo {
 /// A level's stored bytes as `volray info` says them.
 fn stored(l: &volray_io::LevelInfo) -> String {
     l.bytes_stored.map_or_else(
-        || format!("over {COUNTED_FILES} chunk files (not counted)"),
+        || match l.dir.is_dir() {
+            true => format!("over {COUNTED_FILES} chunk files (not counted)"),
+            false => "bytes in the file not counted".into(),
+        },
         |b| volray_io::format_bytes(u128::from(b)),
     )
 }

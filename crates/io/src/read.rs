@@ -257,7 +257,7 @@ pub struct LevelInfo {
     pub shard_shape: Option<Vec<u64>>,
     /// The codecs, in order, e.g. `bytes, zstd` or `blosc (lz4)`.
     pub codecs: String,
-    /// The level's directory.
+    /// The level's directory (the file, for a level inside one file).
     pub dir: PathBuf,
     /// The bytes the level's chunk files take on disk, where counted:
     /// opening a level does not count them (a level of 64³ chunks of a
@@ -280,6 +280,10 @@ impl LevelInfo {
     /// `volray info`, and would take minutes on a level of millions of
     /// chunks). Hard-linked files count once for each name.
     pub fn count_bytes_stored(&self, max_files: usize) -> Option<u64> {
+        // A level inside one file (BigDataViewer's HDF5) is not counted.
+        if !self.dir.is_dir() {
+            return None;
+        }
         crate::formats::zarr::stored_bytes(&self.dir, max_files)
     }
 }

@@ -271,7 +271,7 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<(Opened, Option<RealValue>), 
                 Some(vec![c[2] as u64, c[1] as u64, c[0] as u64])
             }),
             shard_shape: None,
-            codecs: String::new(),
+            codecs: "HDF5 chunks".into(),
             dir: d.h5_path.clone(),
             bytes_stored: None,
             bytes_in_memory: shape.iter().product::<usize>() as u64 * bytes,
