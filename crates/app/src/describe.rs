@@ -298,7 +298,7 @@ fn stored(l: &volray_io::LevelInfo) -> String {
     l.bytes_stored.map_or_else(
         || match l.dir.is_dir() {
             true => format!("over {COUNTED_FILES} chunk files (not counted)"),
-            false => "bytes in the file not counted".into(),
+            false => "an uncounted share of the file".into(),
         },
         |b| volray_io::format_bytes(u128::from(b)),
     )
