@@ -132,6 +132,7 @@ pub use dtype::{
 };
 pub use error::IoError;
 pub use formats::VolumeFormat;
+pub use formats::dicom::directory_files as dicom_directory_files;
 pub use formats::npy::{read_npy, write_npy};
 pub use formats::nrrd::write_nrrd;
 pub use formats::raw::{RawOptions, read_raw, write_raw};
@@ -142,8 +143,8 @@ pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
 pub use read::{
-    FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, open_lazy, read,
-    read_volume, split_hdf5_path, world_axis_names,
+    FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, Segment, open_lazy,
+    read, read_volume, split_hdf5_path, world_axis_names,
 };
 pub use shared::compress::{Compression, inflate_exact};
 pub use shared::geometry::{Reorientation, grid_to_volume};
