@@ -12,10 +12,10 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{assert_frame_out_of_range, assert_note, error_about, frame, refused};
+use common::{assert_frame_out_of_range, assert_note, frame, refused};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
-use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
     common::fixture("dicom", name)
@@ -485,7 +485,7 @@ fn inconsistent_directories_are_refused() {
     let msg = refused(&dir, &ReadOptions::default());
     assert!(
         msg.contains(
-            "no DICOM image files in this directory (skipped 1 file(s) not DICOM (notes.txt))"
+            "no DICOM image files in this directory or its subfolders (skipped 1 file(s) not DICOM (notes.txt))"
         ),
         "{msg}"
     );
