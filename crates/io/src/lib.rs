@@ -37,7 +37,7 @@
 //! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames; 5-D components as frames; sheared sform resampled, NaN outside ([`FileInfo::nan_is_empty`]) |
 //! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib, LZ4, LZMA; Direction; pieces |
-//! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
+//! | DICOM directory (a DICOMDIR's file-set, subfolders) or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); the largest of several, or one named; enhanced multi-frame; RT dose; Segmentations as label volumes; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
 //! | TIFF stacks `.tif` | `formats/tiff/` | pages are z; ImageJ spacing; hyperstack frames; OME-XML page order, physical sizes and units |
 //! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`); axes named by `axes`, `axistags`, `DIMENSION_LABELS`, dimension scales (`hdf5_axes.rs`), else `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
 //! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled; known by content too |

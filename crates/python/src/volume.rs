@@ -381,7 +381,7 @@ impl Volume {
 
 /// `read(path, *, format=None, frame=None, array=None, level=None,
 /// channel=None, dims=None, dtype=None, endian=None, spacing=None,
-/// max_memory=None)`: the volume
+/// max_memory=None, series=None)`: the volume
 /// in a file of any format volray reads (or a built-in source such as
 /// `"hydrogen:4,2,1"`), its samples moved into a numpy array without a
 /// copy, read-only (`volume.data.copy()` is a writeable copy). `frame`
@@ -390,13 +390,16 @@ impl Volume {
 /// `c`, a 5-D NIfTI's `dim[4]` and `dim[5]`; the command line's
 /// `--frame` and `--channel`; 0 by default); `level` a level of an
 /// OME-Zarr image. `dims`, `dtype` and `endian` describe a raw file.
+/// `series` picks a series of a DICOM directory or DICOMDIR: its number
+/// in the list the file's notes give (from 1) or its SeriesInstanceUID
+/// (default: the largest; the command line's `--series`).
 ///
 /// A chunked file (Zarr, OME-Zarr) is read lazily: the volume comes from
 /// the metadata alone, `volume.data` reads the level when first asked
 /// for, and `render(volume, level="auto")` picks the level each view
 /// needs (`level="auto"` here cannot know the view, and is refused).
 #[pyfunction]
-#[pyo3(signature = (path, *, format=None, frame=None, array=None, level=None, channel=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
+#[pyo3(signature = (path, *, format=None, frame=None, array=None, level=None, channel=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None, series=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn read(
     py: Python<'_>,
@@ -411,14 +414,17 @@ pub fn read(
     endian: Option<&str>,
     spacing: Option<[f64; 3]>,
     max_memory: Option<u64>,
+    series: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Volume> {
     let spec = path.to_string_lossy().to_string();
+    // A number (from 1) or a UID, as an int or a str.
+    let series = series.map(|s| s.str().map(|s| s.to_string())).transpose()?;
     let max_memory = max_memory.unwrap_or_else(volray_io::default_max_memory);
     let level = read_level(&spec, level)?;
     let (volume, file) = if volray_data::is_source_spec(&spec) {
-        if level.is_some() || channel.is_some() {
+        if level.is_some() || channel.is_some() || series.is_some() {
             return Err(value_error(format!(
-                "{spec}: level and channel pick a level and a channel of a file, not of a built-in source"
+                "{spec}: level, channel and series pick a level, a channel and a series of a file, not of a built-in source"
             )));
         }
         let volume = py
@@ -450,6 +456,7 @@ pub fn read(
             max_memory,
             // The samples move into a numpy array, which owns its memory.
             map: MapPolicy::Never,
+            series,
         };
         let chunked = py
             .detach(|| Chunked::open(&path, &opts))
