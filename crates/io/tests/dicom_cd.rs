@@ -196,12 +196,15 @@ fn set_u32(bytes: &mut [u8], at: usize, value: u32) {
     bytes[at..at + 4].copy_from_slice(&value.to_le_bytes());
 }
 
+/// A change of a DICOMDIR's bytes.
+type Edit = Box<dyn FnOnce(&mut Vec<u8>)>;
+
 #[test]
 fn malformed_dicomdirs_are_refused_in_one_line_naming_the_dicomdir() {
     if fixtures().is_none() {
         return;
     }
-    let cases: Vec<(&str, Box<dyn FnOnce(&mut Vec<u8>)>)> = vec![
+    let cases: Vec<(&str, Edit)> = vec![
         (
             "past the end of its container",
             Box::new(|b: &mut Vec<u8>| {
