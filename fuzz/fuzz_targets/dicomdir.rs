@@ -17,7 +17,7 @@ macro_rules! image {
     ($path:literal) => {
         (
             $path,
-            &include_bytes!(concat!("../../crates/io/tests/fixtures/dicom/cd/", $path))[..],
+            include_bytes!(concat!("../../crates/io/tests/fixtures/dicom/cd/", $path)) as &[u8],
         )
     };
 }
