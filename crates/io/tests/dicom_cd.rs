@@ -340,6 +340,27 @@ fn a_segmentation_is_a_label_volume_on_its_source_series_grid() {
 }
 
 #[test]
+fn a_fractional_segmentation_paints_where_the_fraction_exceeds_one_half() {
+    let Some(dir) = fixtures() else { return };
+    let seg = load(&dir.join("seg_fractional.dcm"), &ReadOptions::default());
+    let v = &seg.volume;
+    assert_eq!(v.dims(), [4, 3, 5]);
+    for z in 0..5 {
+        for y in 0..3 {
+            for x in 0..4 {
+                let want = match (x, y) {
+                    (0, _) => 1.0,
+                    (3, 2) => 2.0,
+                    _ => 0.0,
+                };
+                assert_eq!(v.get(x, y, z), want, "({x}, {y}, {z})");
+            }
+        }
+    }
+    assert_note(&seg, "exceeds half of MaximumFractionalValue 200");
+}
+
+#[test]
 fn a_segmentation_with_a_short_pixel_data_or_no_segment_is_refused_in_one_line() {
     let Some(dir) = fixtures() else { return };
     let bytes = fs::read(dir.join("seg.dcm")).unwrap();

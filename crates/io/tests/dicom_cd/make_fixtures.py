@@ -17,6 +17,9 @@ folder named on the command line, with pydicom and highdicom:
              and 1 <= z <= 3, 3 "corner" at (3, 2, 4); colours red, blue
              and (128, 64, 200); every frame kept
     seg_omitted.dcm  the same, empty frames left out (highdicom's default)
+    seg_fractional.dcm  FRACTIONAL (MaximumFractionalValue 200): segment 1
+             0.75 where x = 0 and 0.25 where x = 1, segment 2 1.0 at
+             (3, 2, z)
 """
 
 import os
@@ -159,3 +162,26 @@ for name, omit in [("seg.dcm", False), ("seg_omitted.dcm", True)]:
         omit_empty_frames=omit,
     )
     seg.save_as(f"{out}/{name}")
+
+# FRACTIONAL: segment 1 at 0.75 where x = 0 and 0.25 where x = 1 (below
+# one half: not in the segment), segment 2 at 1.0 at (3, 2, z).
+fraction = np.zeros((5, 3, 4, 2), dtype=np.float32)
+fraction[:, :, 0, 0] = 0.75
+fraction[:, :, 1, 0] = 0.25
+fraction[:, 2, 3, 1] = 1.0
+seg = hd.seg.Segmentation(
+    source_images=a,
+    pixel_array=fraction,
+    segmentation_type=hd.seg.SegmentationTypeValues.FRACTIONAL,
+    segment_descriptions=descriptions[:2],
+    series_instance_uid=ROOT + ".5",
+    series_number=11,
+    sop_instance_uid=ROOT + ".5.1",
+    instance_number=1,
+    manufacturer="volray tests",
+    manufacturer_model_name="fixtures",
+    software_versions="1",
+    device_serial_number="1",
+    max_fractional_value=200,
+)
+seg.save_as(f"{out}/seg_fractional.dcm")
