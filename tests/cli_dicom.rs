@@ -72,6 +72,8 @@ fn a_segmentation_renders_as_labels_and_info_names_its_segments() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["segments"][1]["name"], "vessel");
     assert_eq!(v["segments"][1]["color"], "0000FF");
+    // --labels takes the segments' colours: "bone" red and "vessel" blue,
+    // which neither palette colour of labels 1 and 2 (orange, green) is.
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("seg.png");
     let out = volray(&[
@@ -79,11 +81,40 @@ fn a_segmentation_renders_as_labels_and_info_names_its_segments() {
         SEG,
         "--labels",
         "--size",
-        "32",
+        "48",
         "-o",
         png.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    let pixels = rgb_pixels(&png);
+    // The vessel is one voxel column at the grid's edge, seen partly
+    // mixed with the red: more blue than red and green is enough.
+    let bluish = |&[r, g, b]: &[u8; 3]| b > 40 && b > r.max(g).saturating_add(10);
+    let reddish = |&[r, g, b]: &[u8; 3]| r > 40 && u16::from(r) > 2 * u16::from(g.max(b));
+    assert!(
+        pixels.iter().any(bluish),
+        "no blue pixel: the file's colours unused"
+    );
+    assert!(
+        pixels.iter().any(reddish),
+        "no red pixel: the file's colours unused"
+    );
+}
+
+/// The RGB pixels of an 8-bit PNG.
+fn rgb_pixels(path: &std::path::Path) -> Vec<[u8; 3]> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(
+        (info.color_type, info.bit_depth),
+        (png::ColorType::Rgb, png::BitDepth::Eight)
+    );
+    buf[..info.buffer_size()]
+        .chunks(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect()
 }
 
 #[test]

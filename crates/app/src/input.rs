@@ -139,6 +139,18 @@ impl Input {
     }
 }
 
+/// The colours the file of `input` gives its labels (a DICOM
+/// Segmentation's segment colours), `(label, sRGB 0..1)`, for the look's
+/// `label_colours`; none for other inputs.
+pub fn label_colours(input: &Input) -> Vec<(i64, [f32; 3])> {
+    let Some((_, info)) = &input.file else {
+        return Vec::new();
+    };
+    (info.segments.iter())
+        .filter_map(|s| Some((s.label, s.colour?.map(|c| f32::from(c) / 255.0))))
+        .collect()
+}
+
 /// What `volray info` describes: a volume, or a file holding one image
 /// (a single slice, a 2-D image) that `render` refuses.
 pub enum Described {
