@@ -27,7 +27,7 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom dicomdir tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
@@ -72,6 +72,11 @@ for t in $targets; do
         add dicom 08 "$fix"/dicom/single.dcm "$fix"/dicom/enhanced_ct.dcm
         add dicom 02 "$fix"/dicom/enhanced_4d.dcm
         add dicom 08 "$fix"/dicom/jpeg_split.dcm "$fix"/dicom/j2k_split.dcm "$fix"/dicom/jpegls_frames.dcm
+        ;;
+    dicomdir)
+        add dicomdir 00 "$fix"/dicom/cd/DICOMDIR
+        add dicomdir 01 "$fix"/dicom/cd/DICOMDIR
+        add dicomdir 06 "$fix"/dicom/cd/DICOMDIR
         ;;
     tiff)
         add tiff 00 "$fix"/tiff/*.tif

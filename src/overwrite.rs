@@ -4,7 +4,8 @@
 //! `a.png`), not by name.
 //!
 //! The files a command reads are its input files (every volume of a
-//! series, and each file of a DICOM directory), the detached data files a
+//! series, and each file of a DICOM directory: its DICOMDIR and every file
+//! that lists, or every file of its subfolders), the detached data files a
 //! `.nhdr` or `.mhd` header names (one name or a `LIST`; numbered
 //! `%d` patterns are not expanded), and `--tf`.
 
@@ -66,13 +67,26 @@ fn input_path(spec: &str) -> PathBuf {
 }
 
 /// The files reading `path` touches: the file itself, the files of a
-/// directory (DICOM), and a text header's detached data files.
+/// directory (DICOM: every series it may read, volray-io's walk), and a
+/// text header's detached data files.
 fn files_read(path: &Path) -> Vec<PathBuf> {
     let mut files = vec![path.to_path_buf()];
     if path.is_dir() {
         if let Ok(entries) = fs::read_dir(path) {
             files.extend(entries.flatten().map(|e| e.path()));
         }
+        files.extend(volray_io::dicom_directory_files(path));
+        return files;
+    }
+    let is_dicomdir = (path.file_name().and_then(|n| n.to_str()))
+        .is_some_and(|n| n.eq_ignore_ascii_case("DICOMDIR"));
+    if is_dicomdir && let Some(dir) = path.parent() {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        files.extend(volray_io::dicom_directory_files(dir));
         return files;
     }
     let ext = path

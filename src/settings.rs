@@ -105,6 +105,7 @@ pub fn look(look: &LookArgs) -> LookOptions {
         labels: look.labels,
         label_opacity: look.label_opacity.clone().map(|l| l.0),
         show_labels: look.show_labels.clone().map(|l| l.0),
+        label_colours: Vec::new(),
         range: look.range,
         ambient: look.ambient,
         diffuse: look.diffuse,
@@ -173,12 +174,17 @@ pub fn from_input(
             .as_ref()
             .and_then(|(_, info)| info.display_window()),
     );
-    from_volume(
-        &args.view.look,
+    // The colours the file gives its labels (a DICOM Segmentation's
+    // segments), for --labels.
+    let mut look = look(&args.view.look);
+    look.label_colours = volray_app::input::label_colours(input);
+    volray_options::from_volume(
+        &look,
         &mut settings.transfer_function,
         &mut input.volume,
         &input.name,
-    )?;
+    )
+    .map_err(refused)?;
     Ok(settings)
 }
 

@@ -19,6 +19,8 @@
 //! still leave a valid file (random bit flips, edits the format tolerates)
 //! only assert exit 0 or 1, never a crash, with the same hygiene.
 
+#[path = "hostile_files/dicomdir.rs"]
+mod dicomdir;
 #[path = "hostile_files/encoded_dicom.rs"]
 mod encoded_dicom;
 #[path = "hostile_files/lying.rs"]
@@ -1720,6 +1722,7 @@ fn malformed_files_are_refused_cleanly_under_a_memory_limit() {
         vtk_cases(),
         vti_cases(),
         dicom_cases(),
+        dicomdir::cases(),
         tiff_cases(),
         cube_cases(),
         mrc_cases(),

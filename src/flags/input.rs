@@ -1,6 +1,6 @@
 //! Where the volume comes from and how to read it: INPUT and the reading
 //! options (`--dims`, `--dtype`, `--endian`, `--spacing`, `--format`,
-//! `--frame`, `--array`, `--level`, `--channel`, `--max-memory`), which `render`, `bench` and
+//! `--frame`, `--series`, `--array`, `--level`, `--channel`, `--max-memory`), which `render`, `bench` and
 //! `info` share. volray-app's `input` reads the volume they describe
 //! ([`InputArgs::request`]).
 
@@ -56,6 +56,14 @@ pub struct InputArgs {
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub frame: Option<usize>,
 
+    /// DICOM: which series of a directory or DICOMDIR (a CD or DVD):
+    /// its number in the list `volray info` shows, from 1, or its
+    /// SeriesInstanceUID [default: the largest, with a note naming the
+    /// others].
+    // Its own id: `render`'s MORE volumes are `series` already.
+    #[arg(long = "series", id = "dicom_series", value_name = "N|UID")]
+    pub series: Option<String>,
+
     /// Which named array of a VTK file (.vtk, .vti) [default: the active
     /// scalars, else the first array].
     #[arg(long, value_name = "NAME")]
@@ -103,6 +111,7 @@ impl InputArgs {
             spacing: self.spacing,
             format: self.format.clone(),
             frame: self.frame,
+            series: self.series.clone(),
             array: self.array.clone(),
             level: self.level,
             channel: self.channel,

@@ -175,6 +175,7 @@ fn reading(inp: &InputArgs) -> Vec<String> {
     reading.opt("--spacing", inp.spacing.map(v3));
     reading.opt("--format", inp.format.clone());
     reading.opt("--frame", inp.frame.map(|f| f.to_string()));
+    reading.opt("--series", inp.series.clone());
     reading.opt("--array", inp.array.clone());
     reading.opt("--channel", inp.channel.map(|c| c.to_string()));
     reading.opt("--max-memory", inp.max_memory.map(|m| m.to_string()));

@@ -377,6 +377,21 @@ fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
             parts.join(", ")
         );
     }
+    if !i.segments.is_empty() {
+        let segments: Vec<String> = (i.segments.iter())
+            .map(|s| {
+                let colour = (s.colour)
+                    .map(|[r, g, b]| format!(" #{r:02X}{g:02X}{b:02X}"))
+                    .unwrap_or_default();
+                format!("{} \"{}\"{colour}", s.label, s.name)
+            })
+            .collect();
+        outln!(
+            out,
+            "segments:  {} (label value, name, colour; --labels renders them)",
+            segments.join(", ")
+        );
+    }
     if !i.arrays.is_empty() {
         outln!(
             out,
@@ -416,6 +431,16 @@ fn add_file_json(out: &mut Value, i: &FileInfo) {
     out["channel"] = json!(i.channel);
     out["arrays"] = json!(i.arrays);
     out["array"] = json!(i.array);
+    // A segmentation's segments: label value, name, sRGB colour `RRGGBB`.
+    out["segments"] = json!(
+        (i.segments.iter())
+            .map(|s| json!({
+                "label": s.label,
+                "name": s.name,
+                "color": s.colour.map(|[r, g, b]| format!("{r:02X}{g:02X}{b:02X}")),
+            }))
+            .collect::<Vec<_>>()
+    );
     out["header"] = json!(
         i.header
             .iter()

@@ -87,7 +87,7 @@ pub enum AppError {
     RawNeedsDims { path: String },
     /// File options given for a built-in source.
     #[error(
-        "{spec}: dims, dtype, endian, format, frame, array, level and channel apply to files only, not to built-in sources"
+        "{spec}: dims, dtype, endian, format, frame, array, level, channel and series apply to files only, not to built-in sources"
     )]
     FileOptionsOnSource { spec: String },
     /// `level auto` where no still image picks the level.

@@ -67,6 +67,8 @@ pub struct Request {
     /// The format, whatever the file's name and content say.
     pub format: Option<String>,
     pub frame: Option<usize>,
+    /// Which series of a DICOM directory: its number (from 1) or UID.
+    pub series: Option<String>,
     pub array: Option<String>,
     pub level: Option<LevelChoice>,
     pub channel: Option<usize>,
@@ -135,6 +137,18 @@ impl Input {
             _ => requested,
         }
     }
+}
+
+/// The colours the file of `input` gives its labels (a DICOM
+/// Segmentation's segment colours), `(label, sRGB 0..1)`, for the look's
+/// `label_colours`; none for other inputs.
+pub fn label_colours(input: &Input) -> Vec<(i64, [f32; 3])> {
+    let Some((_, info)) = &input.file else {
+        return Vec::new();
+    };
+    (info.segments.iter())
+        .filter_map(|s| Some((s.label, s.colour?.map(|c| f32::from(c) / 255.0))))
+        .collect()
 }
 
 /// What `volray info` describes: a volume, or a file holding one image
@@ -282,6 +296,7 @@ pub fn read_options(
         // A volume over --max-memory is mapped from its file where its
         // format allows (volray-io's MapPolicy), refused otherwise.
         map,
+        series: request.series.clone(),
     })
 }
 
@@ -291,7 +306,10 @@ pub fn read_options(
 /// checked before it is generated.
 pub fn source_grid(request: &Request) -> Result<usize, AppError> {
     let spec = request.spec.name();
-    let file_flags = request.format.is_some() || request.frame.is_some() || request.array.is_some();
+    let file_flags = request.format.is_some()
+        || request.frame.is_some()
+        || request.array.is_some()
+        || request.series.is_some();
     let zarr_flags = request.level.is_some() || request.channel.is_some();
     if request.raw_flags() || file_flags || zarr_flags {
         return Err(AppError::FileOptionsOnSource { spec });

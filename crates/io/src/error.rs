@@ -339,19 +339,6 @@ impl IoError {
         }
     }
 
-    /// [`IoError::FrameNeeded`].
-    pub(crate) fn frame_needed(
-        path: &Path,
-        held: impl Into<String>,
-        choices: impl Into<String>,
-    ) -> Self {
-        IoError::FrameNeeded {
-            path: path.to_path_buf(),
-            held: one_line(held),
-            choices: one_line(choices),
-        }
-    }
-
     /// [`IoError::NoSuchArray`].
     pub(crate) fn no_such_array(path: &Path, name: &str, held: impl Into<String>) -> Self {
         IoError::NoSuchArray {

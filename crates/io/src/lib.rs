@@ -37,7 +37,7 @@
 //! | NIfTI-1/2 `.nii`, `.nii.gz`, `.hdr`/`.img` | `formats/nifti/` | scl_slope/inter; sform, else qform, else pixdim (RAS+ mm); 4-D frames; 5-D components as frames; sheared sform resampled, NaN outside ([`FileInfo::nan_is_empty`]) |
 //! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib, LZ4, LZMA; Direction; pieces |
-//! | DICOM directory or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); enhanced multi-frame; RT dose; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
+//! | DICOM directory (a DICOMDIR's file-set, subfolders) or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); the largest of several, or one named; enhanced multi-frame; RT dose; Segmentations as label volumes; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
 //! | TIFF stacks `.tif` | `formats/tiff/` | pages are z; ImageJ spacing; hyperstack frames; OME-XML page order, physical sizes and units |
 //! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`); axes named by `axes`, `axistags`, `DIMENSION_LABELS`, dimension scales (`hdf5_axes.rs`), else `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
 //! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled; known by content too |
@@ -132,6 +132,7 @@ pub use dtype::{
 };
 pub use error::IoError;
 pub use formats::VolumeFormat;
+pub use formats::dicom::directory_files as dicom_directory_files;
 pub use formats::npy::{read_npy, write_npy};
 pub use formats::nrrd::write_nrrd;
 pub use formats::raw::{RawOptions, read_raw, write_raw};
@@ -142,8 +143,8 @@ pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
 pub use read::{
-    FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, open_lazy, read,
-    read_volume, split_hdf5_path, world_axis_names,
+    FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, Segment, open_lazy,
+    read, read_volume, split_hdf5_path, world_axis_names,
 };
 pub use shared::compress::{Compression, inflate_exact};
 pub use shared::geometry::{Reorientation, grid_to_volume};

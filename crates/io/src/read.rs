@@ -60,6 +60,10 @@ pub struct ReadOptions {
     /// uncompressed, contiguous and in a type and byte order it keeps (see
     /// [`MapPolicy`]).
     pub map: MapPolicy,
+    /// Which series of a DICOM directory or DICOMDIR: its number in the
+    /// list the reader gives (from 1, in the order of SeriesNumber and
+    /// SeriesInstanceUID) or its SeriesInstanceUID. Default: the largest.
+    pub series: Option<String>,
 }
 
 impl Default for ReadOptions {
@@ -73,6 +77,7 @@ impl Default for ReadOptions {
             channel: None,
             max_memory: default_max_memory(),
             map: MapPolicy::IfLarger,
+            series: None,
         }
     }
 }
@@ -174,6 +179,21 @@ pub struct FileInfo {
     pub level: usize,
     /// The OME-Zarr `omero` rendering hints of the channel read, if any.
     pub omero: Option<OmeroChannel>,
+    /// The segments of a label volume whose file names them (a DICOM
+    /// Segmentation): each label value's name and colour.
+    pub segments: Vec<Segment>,
+}
+
+/// One segment of a label volume: the label value that marks it, its
+/// name and its recommended display colour, as the file gives them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Segment {
+    /// The label value (a DICOM SegmentNumber).
+    pub label: i64,
+    /// Its name (SegmentLabel), empty if none.
+    pub name: String,
+    /// Its colour, sRGB 0..255 (from RecommendedDisplayCIELabValue).
+    pub colour: Option<[u8; 3]>,
 }
 
 /// An OME-Zarr image's `omero` rendering hints for one channel: what its
@@ -389,6 +409,15 @@ fn check_options(path: &Path, format: VolumeFormat, opts: &ReadOptions) -> Resul
             path,
             channel,
             format!("{} files hold one channel (channel 0)", spec.description),
+        ));
+    }
+    if opts.series.is_some() && format != VolumeFormat::Dicom {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "series selection applies to DICOM directories and DICOMDIRs only, not to {} files",
+                spec.description
+            ),
         ));
     }
     if opts.array.is_some() && !spec.arrays {

@@ -12,10 +12,10 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{assert_frame_out_of_range, assert_note, error_about, frame, refused};
+use common::{assert_frame_out_of_range, assert_note, frame, refused};
 use volray_core::Volume;
 use volray_core::glam::DVec3;
-use volray_io::{IoError, Loaded, ReadOptions, VolumeFormat, read};
+use volray_io::{Loaded, ReadOptions, VolumeFormat, read};
 
 fn fixture(name: &str) -> PathBuf {
     common::fixture("dicom", name)
@@ -162,30 +162,23 @@ fn sagittal_series_is_reordered_to_world_axes() {
 }
 
 #[test]
-fn several_series_are_listed_then_picked_by_frame() {
-    let err = error_about(
-        &fixture("two_series"),
-        &ReadOptions::default(),
-        &fixture("two_series"),
+fn of_several_series_the_largest_is_read_then_others_picked_by_frame() {
+    // Series are listed by SeriesNumber: B (1) is 1 (frame 0), A (2) is 2.
+    let a = load("two_series", &ReadOptions::default());
+    check(&a.volume, 3, |v| v as f32, &UNIT);
+    assert_eq!((a.info.frames, a.info.frame), (2, 1));
+    assert_note(
+        &a,
+        "2 series; read the largest, 2: SeriesNumber 2, CT \"series A\", 3 file(s), 4 x 3, UID ",
     );
-    assert!(
-        matches!(&err, IoError::FrameNeeded { held, .. } if held == "directory holds 2 DICOM series"),
-        "{err}"
+    assert_note(
+        &a,
+        "the others: 1: SeriesNumber 1, CT \"series B\", 2 file(s)",
     );
-    let msg = err.to_string();
-    assert!(
-        msg.contains("directory holds 2 DICOM series; choose one by its frame number: 0: SeriesNumber 1, CT \"series B\", 2 file(s), UID "),
-        "{msg}"
-    );
-    assert!(
-        msg.contains("; 1: SeriesNumber 2, CT \"series A\", 3 file(s)"),
-        "{msg}"
-    );
-    // Series are numbered by SeriesNumber: B (1) is 0, A (2) is 1.
     let b = load("two_series", &frame(0));
     check(&b.volume, 2, |v| (v + 7) as f32, &UNIT);
     assert_eq!((b.info.frames, b.info.frame), (2, 0));
-    assert_note(&b, "series 0 of 2 read");
+    assert_note(&b, "series 1 of 2 read (frame 0)");
     let a = load("two_series", &frame(1));
     check(&a.volume, 3, |v| v as f32, &UNIT);
     let err = read(&fixture("two_series"), &frame(2)).unwrap_err();
@@ -492,7 +485,7 @@ fn inconsistent_directories_are_refused() {
     let msg = refused(&dir, &ReadOptions::default());
     assert!(
         msg.contains(
-            "no DICOM image files in this directory (skipped 1 file(s) not DICOM (notes.txt))"
+            "no DICOM image files in this directory or its subfolders (skipped 1 file(s) not DICOM (notes.txt))"
         ),
         "{msg}"
     );

@@ -134,6 +134,10 @@ pub struct LookOptions {
     pub label_opacity: Option<Vec<(i64, f32)>>,
     /// Only these labels shown (`--show-labels`).
     pub show_labels: Option<Vec<i64>>,
+    /// The colours the file gives its labels (a DICOM Segmentation's
+    /// segments), `(label, sRGB 0..1)`: used by `labels` in place of the
+    /// palette's.
+    pub label_colours: Vec<(i64, [f32; 3])>,
     /// The value window the transfer function spans, in the data's units
     /// (`--range`).
     pub range: Option<(f64, f64)>,
@@ -185,6 +189,7 @@ impl Default for LookOptions {
             labels: false,
             label_opacity: None,
             show_labels: None,
+            label_colours: Vec::new(),
             range: None,
             ambient: lit.ambient,
             diffuse: lit.diffuse,

@@ -103,6 +103,7 @@ pub fn label_transfer_function(
             let style = labels::LabelStyle {
                 opacity: look.label_opacity.clone().unwrap_or_default(),
                 shown: look.show_labels.clone(),
+                colours: look.label_colours.clone(),
             };
             *transfer_function = labels::transfer_function(found, &style).map_err(|e| {
                 let opts: &'static [Opt] = match e {

@@ -398,7 +398,7 @@ impl Volume {
 
 /// `read(path, *, format=None, frame=None, array=None, level=None,
 /// channel=None, dims=None, dtype=None, endian=None, spacing=None,
-/// max_memory=None)`: the volume
+/// max_memory=None, series=None)`: the volume
 /// in a file of any format volray reads (or a built-in source such as
 /// `"hydrogen:4,2,1"`), its samples moved into a numpy array without a
 /// copy, read-only (`volume.data.copy()` is a writeable copy). `frame`
@@ -407,13 +407,16 @@ impl Volume {
 /// `c`, a 5-D NIfTI's `dim[4]` and `dim[5]`; the command line's
 /// `--frame` and `--channel`; 0 by default); `level` a level of an
 /// OME-Zarr image. `dims`, `dtype` and `endian` describe a raw file.
+/// `series` picks a series of a DICOM directory or DICOMDIR: its number
+/// in the list the file's notes give (from 1) or its SeriesInstanceUID
+/// (default: the largest; the command line's `--series`).
 ///
 /// A chunked file (Zarr, OME-Zarr) is read lazily: the volume comes from
 /// the metadata alone, `volume.data` reads the level when first asked
 /// for, and `render(volume, level="auto")` picks the level each view
 /// needs (`level="auto"` here cannot know the view, and is refused).
 #[pyfunction]
-#[pyo3(signature = (path, *, format=None, frame=None, array=None, level=None, channel=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None))]
+#[pyo3(signature = (path, *, format=None, frame=None, array=None, level=None, channel=None, dims=None, dtype=None, endian=None, spacing=None, max_memory=None, series=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn read(
     py: Python<'_>,
@@ -428,9 +431,12 @@ pub fn read(
     endian: Option<&str>,
     spacing: Option<[f64; 3]>,
     max_memory: Option<u64>,
+    series: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Volume> {
     let spec = path.to_string_lossy().to_string();
     let level = read_level(&spec, level)?;
+    // A number (from 1) or a UID, as an int or a str.
+    let series = series.map(|s| s.str().map(|s| s.to_string())).transpose()?;
     // Opened as the command line opens its INPUT (volray-app): a
     // built-in source's spec or a file, the same options refused the
     // same way, in volray-app's words.
@@ -445,6 +451,7 @@ pub fn read(
         array,
         level: level.map(LevelChoice::Index),
         channel,
+        series,
         max_memory,
     };
     let max_memory = request.max_memory();

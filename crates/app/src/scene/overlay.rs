@@ -122,6 +122,8 @@ impl OverlaySpec {
             labels: self.labels,
             label_opacity: None,
             show_labels: None,
+            // The first volume's file's colours are not the overlay's.
+            label_colours: Vec::new(),
             range: self.range,
             iso: None,
             iso_thickness: None,

@@ -83,8 +83,8 @@ pub enum LabelError {
     Absent(i64, String),
 }
 
-/// How the labels look: opacities other than [`DEFAULT_OPACITY`], and
-/// which labels are shown.
+/// How the labels look: opacities other than [`DEFAULT_OPACITY`], which
+/// labels are shown, and colours other than [`PALETTE`]'s.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LabelStyle {
     /// `(label, opacity)` pairs (the CLI's `--label-opacity L:A,...`).
@@ -92,6 +92,9 @@ pub struct LabelStyle {
     /// Only these labels are shown (`--show-labels 1,3,5`); `None`: all
     /// but 0.
     pub shown: Option<Vec<i64>>,
+    /// `(label, colour)` pairs the file gives (a DICOM Segmentation's
+    /// segment colours); other labels take [`colour_of`]'s.
+    pub colours: Vec<(i64, [f32; 3])>,
 }
 
 impl LabelStyle {
@@ -107,6 +110,13 @@ impl LabelStyle {
         (self.opacity.iter().rev())
             .find(|(l, _)| *l == label)
             .map_or(DEFAULT_OPACITY, |(_, a)| *a)
+    }
+
+    /// The colour of `label`: the one given, else [`colour_of`]'s.
+    pub fn colour(&self, label: i64) -> [f32; 3] {
+        (self.colours.iter())
+            .find(|(l, _)| *l == label)
+            .map_or_else(|| colour_of(label), |(_, c)| *c)
     }
 
     /// Refuses a style that names a label `labels` does not hold.
@@ -235,7 +245,7 @@ pub fn transfer_function(
         };
         let a = style.opacity_of(label);
         opacity.extend([(from, [a]), (to, [a])]);
-        let c = colour_of(label);
+        let c = style.colour(label);
         colour.extend([(from, c), (to, c)]);
     }
     Ok(TransferFunction {
@@ -275,10 +285,22 @@ mod tests {
     }
 
     #[test]
+    fn colours_a_file_gives_replace_the_palettes_for_those_labels_only() {
+        let style = LabelStyle {
+            colours: vec![(2, [0.0, 0.0, 1.0])],
+            ..LabelStyle::default()
+        };
+        let tf = transfer_function(&[0, 1, 2], &style).unwrap();
+        assert_eq!(at(&tf, 2.0).1, [0.0, 0.0, 1.0]);
+        assert_eq!(at(&tf, 1.0).1, PALETTE[1]);
+    }
+
+    #[test]
     fn shown_labels_and_opacities_are_as_the_style_says() {
         let style = LabelStyle {
             opacity: vec![(3, 0.25)],
             shown: Some(vec![0, 3]),
+            ..LabelStyle::default()
         };
         let tf = transfer_function(&[0, 1, 3], &style).unwrap();
         // Shown explicitly, 0 is opaque; 1 is hidden; 3 has its own.
@@ -288,6 +310,7 @@ mod tests {
         let absent = LabelStyle {
             opacity: vec![(4, 0.5)],
             shown: None,
+            ..LabelStyle::default()
         };
         assert_eq!(
             transfer_function(&[0, 1, 3], &absent),

@@ -129,6 +129,8 @@ pub(super) struct FileHeader {
     pub path: PathBuf,
     pub file_len: u64,
     pub transfer_syntax: String,
+    /// SOPClassUID (or the file meta's MediaStorageSOPClassUID).
+    pub sop_class: String,
     pub series_uid: String,
     pub series_number: Option<i64>,
     pub series_description: String,
@@ -255,6 +257,8 @@ fn extract(
         path: path.to_path_buf(),
         file_len: 0,
         transfer_syntax: obj.meta().transfer_syntax().to_string(),
+        sop_class: text(obj, tags::SOP_CLASS_UID)
+            .unwrap_or_else(|| obj.meta().media_storage_sop_class_uid().to_string()),
         series_uid: text(obj, tags::SERIES_INSTANCE_UID).unwrap_or_default(),
         series_number: int(obj, tags::SERIES_NUMBER),
         series_description: text(obj, tags::SERIES_DESCRIPTION).unwrap_or_default(),

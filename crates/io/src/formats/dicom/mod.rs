@@ -1,11 +1,16 @@
-//! DICOM volumes: a directory of single-slice files (CT, MR, ...) or one
-//! multi-frame file (enhanced CT/MR, RT dose).
+//! DICOM volumes: a directory of single-slice files (CT, MR, ...), a
+//! file-set with a DICOMDIR (a CD or DVD export), or one multi-frame file
+//! (enhanced CT/MR, RT dose, a Segmentation read as labels: [`seg`]).
 //!
-//! A directory: every file in it that parses as DICOM and holds pixel data
-//! is read (others are skipped and counted in a note; subdirectories are
-//! not searched); the files are grouped by SeriesInstanceUID. Several
-//! series are refused with a list, unless `--frame N` picks series N in
-//! the order of (SeriesNumber, SeriesInstanceUID). The slices are sorted
+//! A directory: with a `DICOMDIR`, the files its directory records list
+//! ([`dicomdir`]); without, every file in it and its subfolders (bounded
+//! depth and count, each folder once) that parses as DICOM and holds pixel
+//! data (others are skipped and counted in a note). The files are grouped
+//! by SeriesInstanceUID and listed in the order of (SeriesNumber,
+//! SeriesInstanceUID); the series read is the one named by number or UID
+//! (`ReadOptions::series`), else by `--frame N` (from 0), else the largest,
+//! with a note naming the others ([`series`]). A `DICOMDIR` named as the
+//! input reads its file-set. The slices are sorted
 //! along their normal by ImagePositionPatient ([`stack`]); they must share
 //! Rows, Columns, sample layout, orientation and PixelSpacing, and be
 //! equally spaced: every gap within 1 % of the mean gap plus what rounding
@@ -44,15 +49,16 @@
 //! data is checked to be able to hold what its header declares.
 
 mod codecs;
+mod dicomdir;
 mod header;
 mod jpegls;
 mod pixels;
 mod prescan;
+mod seg;
+mod series;
 mod stack;
 
-use std::collections::BTreeMap;
-use std::fs;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use volray_core::glam::DVec3;
 use volray_core::{Sample, Samples};
@@ -66,10 +72,6 @@ use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
 use crate::shared::limits::check_volume_size;
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
-
-/// A directory with more entries than this is refused before any is read
-/// (a CT series has hundreds to a few thousand slices).
-const MAX_DIRECTORY_ENTRIES: usize = 100_000;
 
 /// Encapsulated (compressed) pixel data may decode to at most this many
 /// times the file's length (or [`SMALL_FILE_ALLOWANCE`]): RLE inflates at
@@ -85,7 +87,14 @@ const LISTED: usize = 5;
 /// multi-frame file.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     if path.is_dir() {
-        read_directory(path, opts)
+        read_directory(path, None, opts)
+    } else if is_dicomdir(path) {
+        let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+        read_directory(
+            dir.unwrap_or(Path::new(".")),
+            Some(path.to_path_buf()),
+            opts,
+        )
     } else {
         let header = match read_header(path) {
             Ok(Some(h)) => h,
@@ -104,6 +113,48 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     }
 }
 
+/// Whether `path` is named as a DICOMDIR is (`DICOMDIR`, any case, or
+/// an ISO 9660 `DICOMDIR;1`).
+fn is_dicomdir(path: &Path) -> bool {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.eq_ignore_ascii_case("DICOMDIR") || n.eq_ignore_ascii_case("DICOMDIR;1"))
+}
+
+/// Every file reading the DICOM directory `dir` might open (see
+/// [`series`]): for the overwrite check of the command line.
+pub fn directory_files(dir: &Path) -> Vec<PathBuf> {
+    series::files_read(dir)
+}
+
+/// The headers of the files a DICOMDIR lists for one series; a file that
+/// is not DICOM or holds no pixel data is refused by name.
+fn dicomdir_headers(files: &[PathBuf]) -> Result<Vec<FileHeader>, IoError> {
+    let mut headers = Vec::with_capacity(files.len());
+    for p in files {
+        match read_header(p) {
+            Ok(Some(h)) if h.pixel_data.is_some() => headers.push(h),
+            Ok(Some(_)) => {
+                return Err(IoError::invalid(
+                    p,
+                    "listed by the DICOMDIR as an image of the series, but holds no pixel data",
+                ));
+            }
+            Ok(None) => {
+                return Err(IoError::invalid(
+                    p,
+                    "listed by the DICOMDIR but not a DICOM file: no DICM magic at byte 128",
+                ));
+            }
+            Err(HeaderError::Io(e)) => return Err(e),
+            Err(HeaderError::Bad(reason)) => {
+                return Err(IoError::invalid(p, format!("DICOM: {reason}")));
+            }
+        }
+    }
+    Ok(headers)
+}
+
 /// Reads the volume `volume` (default 0) of the multi-frame file whose
 /// header is `header`. `info` may carry notes from a directory scan.
 fn read_multiframe(
@@ -113,6 +164,9 @@ fn read_multiframe(
     max_memory: u64,
     mut info: FileInfo,
 ) -> Result<Loaded, IoError> {
+    if header.sop_class == seg::SEGMENTATION {
+        return seg::read(path, header, max_memory, info);
+    }
     let format = header
         .format
         .clone()
@@ -219,118 +273,60 @@ fn read_single_slice(
     }
 }
 
-/// Reads the series in directory `dir` (see the module documentation).
-fn read_directory(dir: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let mut entries = Vec::new();
-    let listing = fs::read_dir(dir).map_err(|e| IoError::os(dir, "read directory", e))?;
-    for entry in listing {
-        let entry = entry.map_err(|e| IoError::os(dir, "read directory", e))?;
-        entries.push(entry.path());
-        if entries.len() > MAX_DIRECTORY_ENTRIES {
-            return Err(IoError::invalid(
-                dir,
-                format!(
-                    "directory holds more than {MAX_DIRECTORY_ENTRIES} entries: too many for one DICOM series"
-                ),
-            ));
-        }
-    }
-    entries.sort();
-
-    let mut images: Vec<FileHeader> = Vec::new();
-    let mut not_dicom = Vec::new();
-    let mut unreadable = Vec::new();
-    let mut no_pixels = Vec::new();
-    let mut subdirectories = 0;
-    for p in &entries {
-        let name = file_name(p);
-        if p.is_dir() {
-            subdirectories += 1;
-            continue;
-        }
-        match read_header(p) {
-            Ok(None) => not_dicom.push(name),
-            Ok(Some(h)) if h.pixel_data.is_none() => no_pixels.push(name),
-            Ok(Some(h)) => images.push(h),
-            Err(HeaderError::Bad(reason)) => unreadable.push(format!("{name}: {reason}")),
-            Err(HeaderError::Io(e)) => return Err(e),
-        }
-    }
-    let mut skipped = Vec::new();
-    if !not_dicom.is_empty() {
-        skipped.push(format!(
-            "{} file(s) not DICOM ({})",
-            not_dicom.len(),
-            list(&not_dicom, |s| s.clone())
-        ));
-    }
-    if !no_pixels.is_empty() {
-        skipped.push(format!(
-            "{} DICOM file(s) without pixel data ({})",
-            no_pixels.len(),
-            list(&no_pixels, |s| s.clone())
-        ));
-    }
-    if !unreadable.is_empty() {
-        skipped.push(format!(
-            "{} unreadable DICOM file(s) ({})",
-            unreadable.len(),
-            list(&unreadable, |s| s.clone())
-        ));
-    }
-    if subdirectories > 0 {
-        skipped.push(format!("{subdirectories} subdirectory(ies) not searched"));
-    }
-    let skipped = (!skipped.is_empty()).then(|| format!("skipped {}", skipped.join("; ")));
+/// Reads the series in directory `dir` (see the module documentation and
+/// [`series`]); `dicomdir` is its DICOMDIR when named as the input.
+fn read_directory(
+    dir: &Path,
+    dicomdir: Option<PathBuf>,
+    opts: &ReadOptions,
+) -> Result<Loaded, IoError> {
+    let dicomdir = dicomdir.or_else(|| series::dicomdir_in(dir));
+    let listing = series::list_series(dir, dicomdir)?;
+    let skipped = listing.skipped.clone();
     // Errors about the series carry what was skipped: a skipped file may
     // be the reason.
     let with_skips = |reason: String| match &skipped {
         Some(s) => IoError::invalid(dir, format!("{reason} ({s})")),
         None => IoError::invalid(dir, reason),
     };
-    if images.is_empty() {
-        return Err(with_skips("no DICOM image files in this directory".into()));
-    }
-
-    let mut by_series: BTreeMap<(i64, String), Vec<FileHeader>> = BTreeMap::new();
-    for h in images {
-        let key = (h.series_number.unwrap_or(i64::MAX), h.series_uid.clone());
-        by_series.entry(key).or_default().push(h);
-    }
-    let series: Vec<Vec<FileHeader>> = by_series.into_values().collect();
-    if series.len() > 1 && opts.frame.is_none() {
-        let listed: Vec<String> = series
-            .iter()
-            .enumerate()
-            .map(|(i, files)| describe_series(i, files))
-            .collect();
-        return Err(IoError::frame_needed(
-            dir,
-            format!("directory holds {} DICOM series", series.len()),
-            listed.join("; "),
+    if listing.series.is_empty() {
+        return Err(with_skips(
+            "no DICOM image files in this directory or its subfolders".into(),
         ));
     }
-    let count = series.len();
-    let s = pick(dir, opts.frame, count, "series")?;
-    let mut files = series.into_iter().nth(s).expect("picked in range");
+    let count = listing.series.len();
+    let (s, note) = series::choose(dir, &listing.series, opts)?;
+    let found = listing.series.into_iter().nth(s).expect("chosen in range");
+    let mut files = if found.headers.len() == found.files.len() {
+        found.headers
+    } else {
+        dicomdir_headers(&found.files)?
+    };
     let mut info = FileInfo::new("");
     info.frames = count;
     info.frame = s;
+    if let Some(d) = &listing.dicomdir {
+        info.notes.push(format!(
+            "read through {} ({count} series listed)",
+            d.display()
+        ));
+    }
     if let Some(note) = skipped.clone() {
         info.notes.push(note);
     }
-    if count > 1 {
-        info.notes.push(format!(
-            "series {s} of {count} read: {}",
-            describe_series(s, &files)
-        ));
+    if let Some(note) = note {
+        info.notes.push(note);
     }
 
-    if files.iter().any(|h| h.frames > 1) {
+    if files
+        .iter()
+        .any(|h| h.frames > 1 || h.sop_class == seg::SEGMENTATION)
+    {
         if files.len() == 1 {
             let header = files.pop().expect("one file");
             let path = header.path.clone();
             let volume = if count == 1 { opts.frame } else { None };
+
             let mut loaded =
                 read_multiframe(&path, header, volume, opts.max_memory, FileInfo::new(""))?;
             if count > 1 {
@@ -595,29 +591,6 @@ fn pick(path: &Path, frame: Option<usize>, count: usize, what: &str) -> Result<u
         ));
     }
     Ok(n)
-}
-
-fn describe_series(index: usize, files: &[FileHeader]) -> String {
-    let h = &files[0];
-    let number = h
-        .series_number
-        .map(|n| format!("SeriesNumber {n}, "))
-        .unwrap_or_default();
-    let description = if h.series_description.is_empty() {
-        String::new()
-    } else {
-        format!(" \"{}\"", h.series_description)
-    };
-    format!(
-        "{index}: {number}{}{description}, {} file(s), UID {}",
-        if h.modality.is_empty() {
-            "?"
-        } else {
-            &h.modality
-        },
-        files.len(),
-        h.series_uid
-    )
 }
 
 fn file_name(path: &Path) -> String {
