@@ -232,3 +232,43 @@ fn damaged_copies_of_every_fixture_never_panic() {
         }
     }
 }
+
+#[test]
+fn the_committed_libver_latest_fixture_holds_the_values_of_many_h5() {
+    // make_hdf5_fixtures.py: latest.h5 holds many.h5's u8, u32, gzip_u16
+    // and series under a version 2 B-tree (filtered and not), a fixed
+    // array with layout message 5 and an extensible array; v = x + 10y +
+    // 100z at a[x, y, z] of (4, 3, 5). No writer needed: this runs
+    // everywhere.
+    let v = |x: usize, y: usize, z: usize| (x + 10 * y + 100 * z) as f64;
+    let cases: [(&str, Option<usize>, &dyn Fn(usize, usize, usize) -> f64); 5] = [
+        ("u8", None, &|x, y, z| (x + 2 * y + 6 * z) as f64),
+        ("u32", None, &|x, y, z| f64::from((v(x, y, z) + 3e9) as f32)),
+        ("gzip_u16", None, &v),
+        ("series", Some(0), &v),
+        ("series", Some(2), &|x, y, z| v(x, y, z) + 2000.0),
+    ];
+    for (name, frame, want) in cases {
+        let path = PathBuf::from(format!(
+            "{}:/{name}",
+            common::fixture("hdf5", "latest.h5").display()
+        ));
+        let o = common::with_frame(frame);
+        let whole = read(&path, &o).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(whole.volume.dims(), [4, 3, 5], "{name}");
+        for z in 0..5 {
+            for y in 0..3 {
+                for x in 0..4 {
+                    assert_eq!(
+                        f64::from(whole.volume.get(x, y, z)),
+                        want(x, y, z),
+                        "{name} {frame:?} at ({x}, {y}, {z})"
+                    );
+                }
+            }
+        }
+        let l = open_lazy(&path, &o).unwrap().unwrap();
+        let b = l.source.read_box([1, 1, 2], [4, 3, 5]).unwrap();
+        assert!(b == VolumeSource::read_box(&whole.volume, [1, 1, 2], [4, 3, 5]).unwrap());
+    }
+}

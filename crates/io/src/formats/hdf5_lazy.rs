@@ -186,7 +186,7 @@ pub(crate) fn from_opened(
         Ok(Layout::Chunked {
             index: ChunkIndex::BTreeV2,
             ..
-        }) => Err("its chunk index is a version 2 B-tree".to_string()),
+        }) => Err("hdf5-pure 0.47 cannot read a version 2 B-tree chunk index".to_string()),
         Ok(layout) => Ok(layout),
         Err(e) => Err(
             match e.to_string().split("invalid data layout version: ").nth(1) {
