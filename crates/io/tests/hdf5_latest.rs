@@ -233,6 +233,9 @@ fn damaged_copies_of_every_fixture_never_panic() {
     }
 }
 
+/// A fixture's value at (x, y, z).
+type Formula = dyn Fn(usize, usize, usize) -> f64;
+
 #[test]
 fn the_committed_libver_latest_fixture_holds_the_values_of_many_h5() {
     // make_hdf5_fixtures.py: latest.h5 holds many.h5's u8, u32, gzip_u16
@@ -240,8 +243,10 @@ fn the_committed_libver_latest_fixture_holds_the_values_of_many_h5() {
     // array with layout message 5 and an extensible array; v = x + 10y +
     // 100z at a[x, y, z] of (4, 3, 5). No writer needed: this runs
     // everywhere.
-    let v = |x: usize, y: usize, z: usize| (x + 10 * y + 100 * z) as f64;
-    let cases: [(&str, Option<usize>, &dyn Fn(usize, usize, usize) -> f64); 5] = [
+    fn v(x: usize, y: usize, z: usize) -> f64 {
+        (x + 10 * y + 100 * z) as f64
+    }
+    let cases: [(&str, Option<usize>, &Formula); 5] = [
         ("u8", None, &|x, y, z| (x + 2 * y + 6 * z) as f64),
         ("u32", None, &|x, y, z| f64::from((v(x, y, z) + 3e9) as f32)),
         ("gzip_u16", None, &v),

@@ -247,7 +247,7 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let coordinates = |l: &Listed| l.attrs.iter().any(|(n, _)| n == "_Netcdf4Coordinates");
     let old_style: Vec<String> = listed
         .iter()
-        .filter(|l| !coordinates(l) && !(l.scale && l.shape.len() == 1))
+        .filter(|l| !(coordinates(l) || (l.scale && l.shape.len() == 1)))
         .map(|l| l.name.clone())
         .collect();
     let mut referenced: Vec<(String, Vec<String>)> = Vec::new();
