@@ -10,8 +10,9 @@
 //! NetCDF-4 file as netCDF-C before `_Netcdf4Dimid` wrote it: its
 //! dimensions through `DIMENSION_LIST`'s references, with the coordinates
 //! netCDF4 (netCDF-C) reads. Then hostile files: a version 2 B-tree whose
-//! record count lies, byte flips over every fixture: one-line errors, no
-//! panic.
+//! record counts lie or whose node points at itself, a layout message of
+//! an unknown index type or cut short, byte flips over every fixture:
+//! one-line errors naming the file, the cause and `h5repack`, no panic.
 //!
 //! The writers run in `target/pyenv` (h5py, netCDF4 and numpy, which
 //! `.ci/run` installs); without them these tests fail under `CI=true` and
@@ -203,6 +204,24 @@ fn a_version_2_b_tree_whose_records_lie_or_loop_is_refused_in_one_line() {
         &spec(dir, "btree_total_lies.h5", "v"),
         &dir.join("btree.npy"),
     );
+}
+
+#[test]
+fn a_damaged_layout_message_is_refused_in_one_line_naming_the_cause_and_h5repack() {
+    let Some(dir) = files() else { return };
+    for (file, cause) in [
+        ("layout_index_type.h5", "unsupported chunk indexing type 9"),
+        ("layout_cut.h5", "unexpected end of data"),
+    ] {
+        for err in refused(&spec(dir, file, "v")) {
+            assert!(
+                err.contains("HDF5 dataset \"/v\": its layout message is of version 5 (HDF5 2.0), which hdf5-pure 0.47 cannot read, and hdf5-reader cannot open it: ")
+                    && err.contains(cause)
+                    && err.contains("h5repack --low=0 --high=1"),
+                "{err}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -10,7 +10,8 @@ dimensions only in the DIMENSION_LIST references of HDF5's dimension
 scales), checked by netCDF4 (netCDF-C) to have the dimensions and
 coordinates the tests expect. Then hostile copies: a version 2 B-tree
 header whose record count lies, its checksum recomputed so that only
-the count is wrong.
+the count is wrong; a layout message damaged inside an intact object
+header.
 """
 
 import sys
@@ -162,13 +163,19 @@ assert (node, record, depth, in_root) == (2048, 44, 1, 1), (node, record, depth,
 assert good[root : root + 4] == b"BTIN"
 
 
-def patched(edits, checksummed):
+def patched_at(good, edits, checksummed):
+    """`good` with each (offset, bytes) of `edits` written, then each
+    (start, stop) range's lookup3 checksum written at stop."""
     raw = bytearray(good)
     for offset, value in edits:
         raw[offset : offset + len(value)] = value
     for start, stop in checksummed:
         raw[stop : stop + 4] = lookup3(bytes(raw[start:stop])).to_bytes(4, "little")
     return bytes(raw)
+
+
+def patched(edits, checksummed):
+    return patched_at(good, edits, checksummed)
 
 
 # The total record count says 2^40: it counts, it allocates nothing.
@@ -190,3 +197,36 @@ assert lookup3(good[root : root + body]) == int.from_bytes(
 (out / "btree_loop.h5").write_bytes(
     patched([(child, root.to_bytes(8, "little"))], [(root, root + body)])
 )
+
+# A layout message of version 5 damaged inside an intact object header
+# (its checksum recomputed): its chunk index type 9, which no version
+# defines; and its size cut to 4 bytes, the message ending inside its
+# chunk dimensions.
+with h5py.File(out / "layout.h5", "w", libver="latest") as f:
+    f.create_dataset("v", data=field("f4"), chunks=(8, 8, 8), compression="gzip")
+good = (out / "layout.h5").read_bytes()
+hits = [i for i in range(len(good) - 6) if good[i] == 8 and good[i + 4 : i + 6] == b"\x05\x02"]
+assert len(hits) == 1, hits
+msg = hits[0]  # type 1, size 2, flags 1, then the message: 5, 2, flags,
+size = int.from_bytes(good[msg + 1 : msg + 3], "little")
+body = msg + 4  # dimensionality, dimension size width, dimensions...
+ndims, width = good[body + 3], good[body + 4]
+index_type = body + 5 + ndims * width
+assert good[index_type] == 3, good[index_type]  # a fixed array
+oh = good.rfind(b"OHDR", 0, msg)
+flags = good[oh + 5]
+at = oh + 6 + (16 if flags & 0x20 else 0) + (4 if flags & 0x10 else 0)
+width0 = 1 << (flags & 3)
+chunk0 = int.from_bytes(good[at : at + width0], "little")
+start = at + width0
+assert start <= msg < start + chunk0
+assert lookup3(good[oh : start + chunk0]) == int.from_bytes(
+    good[start + chunk0 : start + chunk0 + 4], "little"
+)
+(out / "layout_index_type.h5").write_bytes(
+    patched_at(good, [(index_type, b"\x09")], [(oh, start + chunk0)])
+)
+(out / "layout_cut.h5").write_bytes(
+    patched_at(good, [(msg + 1, (4).to_bytes(2, "little"))], [(oh, start + chunk0)])
+)
+assert size > 4
