@@ -94,6 +94,8 @@ for t in $targets; do
         # The control byte's high nibble picks the dataset (fuzz_targets/hdf5.rs).
         add hdf5 00 "$fix"/hdf5/one.h5
         for c in 10 20 30 40 50 60 70 72 80 90; do add hdf5 $c "$fix"/hdf5/many.h5; done
+        # HDF5 2.0's chunk indexes (through hdf5-reader), whole and box by box.
+        for c in 10 18 30 38 60 68 70 79; do add hdf5 $c "$fix"/hdf5/latest.h5; done
         ;;
     minc)
         add minc 00 "$fix"/minc/*.mnc

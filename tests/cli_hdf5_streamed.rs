@@ -3,7 +3,9 @@
 //! each piece read from the chunks it touches (`volray_io::open_lazy`),
 //! the same picture as the dataset read whole, within 1/255. Also one
 //! frame of an LZF-compressed (t, z, y, x) series, and a NetCDF-4 variable
-//! along a decreasing latitude (ERA5's order), each flipped box by box. The files
+//! along a decreasing latitude (ERA5's order), each flipped box by box; and
+//! the dataset as HDF5 2.0 writes it (`libver='latest'`, a version 2 B-tree
+//! chunk index), the same picture as the older file's. The files
 //! are written here by h5py and netCDF4 in `target/pyenv` (which `.ci/run`
 //! installs); without them these tests fail under `CI=true` and are
 //! skipped elsewhere.
@@ -25,6 +27,11 @@ def blob(c, r):
 v = (30000 * blob((16, 14, 12), 6) + 20000 * blob((32, 26, 24), 5) + 40 * z).astype("<u2")
 with h5py.File(sys.argv[1] + "/vol.h5", "w") as f:
     f.create_dataset("data", data=v, chunks=(16, 16, 16), compression="gzip", shuffle=True)
+# The same as HDF5 2.0 writes it with libver="latest" and two unlimited
+# axes: layout message 5, a version 2 B-tree chunk index (hdf5-reader's).
+with h5py.File(sys.argv[1] + "/latest.h5", "w", libver="latest") as f:
+    f.create_dataset("data", data=v, chunks=(16, 16, 16), compression="gzip", shuffle=True,
+                     maxshape=(None, None, 36))
 with netCDF4.Dataset(sys.argv[1] + "/vol.nc", "w", format="NETCDF4") as nc:
     for name, n in zip("xyz", v.shape):
         nc.createDimension(name, n)
@@ -87,6 +94,32 @@ fn a_chunked_hdf5_dataset_over_max_memory_renders_piece_by_piece_as_it_would_who
         let diff = Picture::read(&pieces).max_diff(&Picture::read(&whole));
         assert!(diff <= 1, "{spec} --tf auto: {diff}");
     }
+}
+
+#[test]
+fn a_dataset_hdf5_2_writes_renders_whole_and_in_pieces_as_the_same_data_written_for_older_readers()
+{
+    let Some(dir) = files() else { return };
+    let d = dir.path();
+    let input = format!("{}/latest.h5:/data", d.display());
+    let older = format!("{}/vol.h5:/data", d.display());
+    let (whole, pieces, before) = (
+        d.join("l_whole.png"),
+        d.join("l_pieces.png"),
+        d.join("old.png"),
+    );
+    render(&[&[older.as_str()], &LOOK[..]].concat(), &before);
+    let said = render(&[&[input.as_str()], &LOOK[..]].concat(), &whole);
+    assert!(!said.contains("pieces"), "{said}");
+    let said = render(
+        &[&[input.as_str(), "--max-memory", "100K"], &LOOK[..]].concat(),
+        &pieces,
+    );
+    assert!(said.contains("in pieces"), "{said}");
+    let picture = Picture::read(&before);
+    assert!(picture.rgb.iter().any(|p| *p != picture.rgb[0]), "blank");
+    assert_eq!(Picture::read(&whole).max_diff(&picture), 0);
+    assert!(Picture::read(&pieces).max_diff(&picture) <= 1);
 }
 
 #[test]

@@ -1340,6 +1340,26 @@ fn hdf5_cases() -> Cases {
     // Bit flips through the metadata (superblock, object headers, heaps,
     // B-trees) of the pure-Rust reader: read or refused, never a crash.
     c.flips(f, &bytes, n / 2, 24, 5);
+    // HDF5 2.0's chunk indexes (libver='latest'): /u8 under a version 2
+    // B-tree and a layout message of version 5, which hdf5-pure cannot
+    // read and hdf5-reader walks; cut short, and bit-flipped anywhere.
+    let f = "latest.h5";
+    let bytes = fixture(&format!("hdf5/{f}"));
+    let input = format!("{f}:/u8");
+    c.cut_and_unsigned(f, &input, &bytes);
+    let mut rng = 43;
+    for _ in 0..24 {
+        let r = xorshift(&mut rng);
+        let at = (r % bytes.len() as u64) as usize;
+        let mut b = bytes.clone();
+        b[at] ^= 1 << ((r >> 32) % 8);
+        c.many(
+            &format!("{input}: byte {at} flipped"),
+            vec![(f.into(), b)],
+            &input,
+            Expect::Either,
+        );
+    }
     c
 }
 

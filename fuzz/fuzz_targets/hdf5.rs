@@ -1,4 +1,7 @@
-//! Fuzzes the HDF5 reader (pure Rust, hdf5-pure).
+//! Fuzzes the HDF5 reader (pure Rust, hdf5-pure; hdf5-reader for the
+//! chunk indexes hdf5-pure cannot read: the seed `latest.h5` holds
+//! `/u8`, `/u32`, `/gzip_u16` and `/series` under a version 2 B-tree, a
+//! fixed array with layout message 5 and an extensible array).
 //! The first byte chooses `--frame` (bits 0-2), a lazy read of a box of
 //! half the dataset (bit 3: the chunk index, the chunks a box touches,
 //! contiguous rows; `open_lazy`) rather than the whole, and the dataset

@@ -39,7 +39,7 @@
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib, LZ4, LZMA; Direction; pieces |
 //! | DICOM directory (a DICOMDIR's file-set, subfolders) or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); the largest of several, or one named; enhanced multi-frame; RT dose; Segmentations as label volumes; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
 //! | TIFF stacks `.tif` | `formats/tiff/` | pages are z; ImageJ spacing; hyperstack frames; OME-XML page order, physical sizes and units |
-//! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`); axes named by `axes`, `axistags`, `DIMENSION_LABELS`, dimension scales (`hdf5_axes.rs`), else `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
+//! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`; `hdf5-reader` for the chunk indexes of HDF5 2.0 and the version 2 B-tree); axes named by `axes`, `axistags`, `DIMENSION_LABELS`, dimension scales (`hdf5_axes.rs`), else `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
 //! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled; known by content too |
 //! | CCP4/MRC `.map`, `.mrc` | `formats/mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin; skewed: a whole cell resampled periodically, a part (or more) over its box, NaN outside ([`FileInfo::nan_is_empty`]) |
 //! | VASP CHGCAR/CHG | `formats/chgcar/` | divided by the cell volume; periodic plane added; spin blocks as frames; known by content too |
@@ -74,6 +74,9 @@
 //! data; `shared/periodic_cell.rs` resamples skewed periodic cells (and
 //! the boxes of skewed maps that are not one cell); `shared/hdf5.rs` opens
 //! HDF5 files and reads their attributes and datasets (HDF5, MINC2);
+//! `shared/hdf5_index.rs` lists through `hdf5-reader` the chunk indexes
+//! `hdf5-pure` cannot read (HDF5 2.0's layout message 5, the version 2
+//! B-tree) and follows `DIMENSION_LIST` references (NetCDF-4);
 //! `shared/vtk_arrays.rs` chooses the array of a VTK file.
 //!
 //! The axes beside space are one model for every reader (`axes.rs`):

@@ -7,8 +7,11 @@
 //!
 //! How a box is read depends on the dataset's storage:
 //! - **chunked**, its chunks enumerated from the chunk index (B-tree v1,
-//!   fixed array, extensible array, implicit, single chunk, not a B-tree
-//!   v2, which `hdf5-pure` 0.47 cannot read at all), unfiltered or
+//!   fixed array, extensible array, implicit, single chunk by `hdf5-pure`;
+//!   a version 2 B-tree, and any index under a layout message of version
+//!   5 (HDF5 2.0), which `hdf5-pure` 0.47 cannot read, by `hdf5-reader`:
+//!   `shared/hdf5_index.rs`, the eager reader then reading the whole
+//!   volume as one box here), unfiltered or
 //!   filtered by deflate, shuffle, Fletcher-32 (checked) and LZF
 //!   (`hdf5_lazy/chunks.rs`): each chunk the box touches is read from its
 //!   file address, decoded (to exactly its decoded size, no more), and its
@@ -53,7 +56,7 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use hdf5_pure::Layout;
+use hdf5_pure::{ChunkIndex, Dataset, Layout};
 use volray_core::sampling::grid::GridFrame;
 use volray_core::{SampleType, SourceError, Volume, VolumeSource, check_box};
 
@@ -61,6 +64,7 @@ use super::hdf5::{Found, Opened};
 use super::hdf5_axes::{Placement, each_index};
 use crate::dtype::{Stored, read_as_stored};
 use crate::shared::hdf5::{self as h5, check_stored, slab_rows, slab_samples};
+use crate::shared::hdf5_index::{self, Listed, REPACK};
 use crate::shared::limits::{check_held, format_bytes};
 use crate::{FileInfo, IoError, ReadOptions};
 use chunks::{Chunks, Indexed, StoredChunk};
@@ -176,10 +180,40 @@ pub(crate) fn from_opened(
     }
     let element = dataset.datatype().ok().as_ref().and_then(Element::of);
     let total = shape.iter().product::<usize>() as u64 * sample.size as u64;
-    let layout = dataset
-        .layout()
-        .map_err(|e| fail(format!("unreadable layout: {e}")))?;
+    // What hdf5-pure cannot read (a layout message of version 5, a version
+    // 2 B-tree chunk index) is indexed through hdf5-reader instead.
+    let layout = match dataset.layout() {
+        Ok(Layout::Chunked {
+            index: ChunkIndex::BTreeV2,
+            ..
+        }) => Err("hdf5-pure 0.47 cannot read a version 2 B-tree chunk index".to_string()),
+        Ok(layout) => Ok(layout),
+        Err(e) => Err(
+            match e.to_string().split("invalid data layout version: ").nth(1) {
+                Some(v) => format!(
+                    "its layout message is of version {v} (HDF5 2.0), which hdf5-pure 0.47 cannot read"
+                ),
+                None => format!("hdf5-pure 0.47 cannot read its layout message ({e})"),
+            },
+        ),
+    };
     let storage = match (element, layout) {
+        (_, Err(why)) => {
+            let (storage, note) = beyond_hdf5_pure(
+                &file_path,
+                &name,
+                &dataset,
+                element,
+                &shape,
+                sample.size,
+                h5.len,
+                opts.max_memory,
+                &why,
+            )
+            .map_err(fail)?;
+            info.notes.push(note);
+            storage
+        }
         (None, _) => Storage::Rows {
             reason: format!(
                 "its type ({}) is not a whole-byte integer or IEEE float",
@@ -188,10 +222,10 @@ pub(crate) fn from_opened(
         },
         (
             Some(_),
-            Layout::Contiguous {
+            Ok(Layout::Contiguous {
                 address: Some(address),
                 size,
-            },
+            }),
         ) => {
             let end = address.checked_add(size).filter(|&e| e <= h5.len);
             if end.is_none() {
@@ -208,30 +242,46 @@ pub(crate) fn from_opened(
             }
             Storage::Contiguous { address }
         }
-        (Some(_), Layout::Chunked { chunk_shape, index }) => match chunks::index(
-            &dataset,
-            &shape,
-            chunk_shape,
-            index,
-            sample.size,
-            h5.len,
-            opts.max_memory,
-        )
-        .map_err(fail)?
-        {
-            Indexed::Chunks(c) => Storage::Chunks(c),
-            Indexed::Rows(reason) => Storage::Rows { reason },
-        },
-        (Some(_), Layout::Contiguous { address: None, .. }) => Storage::Fill(
+        (Some(_), Ok(Layout::Chunked { chunk_shape, .. })) => {
+            let listed = || {
+                let chunks = dataset
+                    .chunks()
+                    .map_err(|e| format!("unreadable chunk index: {e}"))?;
+                Ok(chunks
+                    .into_iter()
+                    .map(|c| Listed {
+                        offset: c.offset,
+                        address: c.address,
+                        size: c.storage_size,
+                        mask: c.filter_mask,
+                    })
+                    .collect())
+            };
+            match chunks::index(
+                &dataset,
+                &shape,
+                chunk_shape,
+                listed,
+                sample.size,
+                h5.len,
+                opts.max_memory,
+            )
+            .map_err(fail)?
+            {
+                Indexed::Chunks(c) => Storage::Chunks(c),
+                Indexed::Rows(reason) => Storage::Rows { reason },
+            }
+        }
+        (Some(_), Ok(Layout::Contiguous { address: None, .. })) => Storage::Fill(
             dataset
                 .fill_value::<f64>()
                 .map_err(|e| fail(format!("unreadable fill value: {e}")))?
                 .unwrap_or(0.0),
         ),
-        (Some(_), Layout::Compact { .. }) => Storage::Rows {
+        (Some(_), Ok(Layout::Compact { .. })) => Storage::Rows {
             reason: "its data is compact (held in its header)".into(),
         },
-        (Some(_), other) => Storage::Rows {
+        (Some(_), Ok(other)) => Storage::Rows {
             reason: format!("its layout is {other}"),
         },
     };
@@ -290,7 +340,86 @@ pub(crate) fn from_opened(
     ))
 }
 
+/// The storage of a dataset `hdf5-pure` cannot index (`why`: its layout
+/// message, or its chunk index), from the chunk index `hdf5-reader` lists
+/// (`shared/hdf5_index.rs`), with the note that says so; refused, naming
+/// the cause and `h5repack`, where its chunks need a decoder only
+/// `hdf5-pure` has, or it is not chunked.
+#[allow(clippy::too_many_arguments)]
+fn beyond_hdf5_pure(
+    path: &Path,
+    name: &str,
+    dataset: &Dataset,
+    element: Option<Element>,
+    shape: &[usize],
+    sample_size: usize,
+    file_len: u64,
+    max_memory: u64,
+    why: &str,
+) -> Result<(Storage, String), String> {
+    if element.is_none() {
+        return Err(format!(
+            "{why}, and its type is one only hdf5-pure decodes: {REPACK}"
+        ));
+    }
+    let Some(list) = hdf5_index::chunk_list(path, name, sample_size)
+        .map_err(|e| format!("{why}, and {e}: {REPACK}"))?
+    else {
+        return Err(format!("{why}, and it is not chunked: {REPACK}"));
+    };
+    let kind = list.kind;
+    let chunks = list.chunks;
+    match chunks::index(
+        dataset,
+        shape,
+        list.chunk_shape,
+        || Ok(chunks),
+        sample_size,
+        file_len,
+        max_memory,
+    )? {
+        Indexed::Chunks(c) => Ok((
+            Storage::Chunks(c),
+            format!(
+                "{why}: its chunk index ({kind}) listed through hdf5-reader, its chunks read and decoded here"
+            ),
+        )),
+        Indexed::Rows(reason) => Err(format!("{why}, and {reason}: {REPACK}")),
+    }
+}
+
+/// Whether `hdf5-pure` cannot read `dataset`'s samples itself (a layout
+/// message of version 5, a version 2 B-tree chunk index): the eager
+/// reader then reads the whole volume through the source of boxes.
+pub(crate) fn beyond_pure(dataset: &Dataset) -> bool {
+    matches!(
+        dataset.layout(),
+        Err(_)
+            | Ok(Layout::Chunked {
+                index: ChunkIndex::BTreeV2,
+                ..
+            })
+    )
+}
+
 impl H5Source {
+    /// The whole volume, each stored value through `real` where given
+    /// (then kept as `f32`): the eager reader's read of a dataset
+    /// [`beyond_pure`]. Held to `--max-memory` as a box is.
+    pub(crate) fn whole(
+        &self,
+        real: Option<&dyn Fn(f64) -> f64>,
+    ) -> Result<volray_core::Samples, IoError> {
+        let hi = self.grid.dims;
+        let kept = if real.is_some() {
+            SampleType::F32
+        } else {
+            self.stored
+        };
+        self.check_box([0; 3], hi, kept)?;
+        read_as_stored!(kept, |T| self.samples::<T>([0; 3], hi, real))
+    }
+
     fn fail(&self, reason: String) -> IoError {
         IoError::invalid(
             &self.path,
@@ -319,11 +448,11 @@ impl H5Source {
         }
     }
 
-    /// The box `lo..hi` (x, y, z).
-    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, IoError> {
-        let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
-        let voxels = dims.iter().product::<usize>();
-        let peak = voxels as u128 * self.stored.bytes() as u128 + self.scratch();
+    /// Checks that the box `lo..hi` as `kept`, beside the scratch to read
+    /// it, fits `--max-memory`.
+    fn check_box(&self, lo: [usize; 3], hi: [usize; 3], kept: SampleType) -> Result<(), IoError> {
+        let voxels = (0..3).map(|a| hi[a] - lo[a]).product::<usize>();
+        let peak = voxels as u128 * kept.bytes() as u128 + self.scratch();
         check_held(
             &self.path,
             &format!("box {lo:?}..{hi:?} of HDF5 dataset \"{}\"", self.name),
@@ -332,24 +461,31 @@ impl H5Source {
             &format!(
                 "{} as {} and the scratch to read it",
                 format_bytes(peak),
-                self.stored.name()
+                kept.name()
             ),
             self.max_memory,
-        )?;
+        )
+    }
+
+    /// The box `lo..hi` (x, y, z).
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, IoError> {
+        let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
+        self.check_box(lo, hi, self.stored)?;
         // The file's range of the box: mirrored along a flipped axis.
         let n = self.grid.dims;
         let file_lo: [usize; 3] =
             std::array::from_fn(|a| if self.flip[a] { n[a] - hi[a] } else { lo[a] });
         let file_hi: [usize; 3] =
             std::array::from_fn(|a| if self.flip[a] { n[a] - lo[a] } else { hi[a] });
-        let samples = read_as_stored!(self.stored, |T| self.samples::<T>(file_lo, file_hi).map(
-            |mut v| {
+        let real = self.real.as_deref().map(|f| f as &dyn Fn(f64) -> f64);
+        let samples = read_as_stored!(self.stored, |T| self
+            .samples::<T>(file_lo, file_hi, real)
+            .map(|mut v| {
                 for a in (0..3).filter(|&a| self.flip[a]) {
                     flip_axis(&mut v, dims, a);
                 }
                 v
-            }
-        ))?;
+            }))?;
         let origin = self.grid.origin
             + volray_core::glam::DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64)
                 * self.grid.spacing;
@@ -360,7 +496,12 @@ impl H5Source {
     }
 
     /// The box's samples, x fastest.
-    fn samples<T: Stored>(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Vec<T>, IoError> {
+    fn samples<T: Stored>(
+        &self,
+        lo: [usize; 3],
+        hi: [usize; 3],
+        real: Option<&dyn Fn(f64) -> f64>,
+    ) -> Result<Vec<T>, IoError> {
         let dims: [usize; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
         let mut out = vec![T::default(); dims.iter().product()];
         let (dlo, dhi) = self.placement.dataset_box(lo, hi);
@@ -370,7 +511,6 @@ impl H5Source {
             hi: dhi,
         };
         // The value as the eager reader keeps it, at its place in the box.
-        let real = self.real.as_deref();
         let mut put = |at: usize, v: f64| {
             let v = real.map_or(v, |f| f(v));
             out[at] = T::from_f64(f64::from(v as f32));

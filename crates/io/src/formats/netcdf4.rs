@@ -8,11 +8,13 @@
 //! dimension-only scales (`NAME` "This is a netCDF dimension but not a
 //! netCDF variable"); a variable's dimension names come from its
 //! `_Netcdf4Coordinates` (one dimension id per axis) and the scales'
-//! `_Netcdf4Dimid` (`hdf5_axes.rs`: `hdf5-pure` 0.47 cannot follow the
-//! `DIMENSION_LIST` object references HDF5's own API attaches); a
-//! coordinate variable (a scale) has its own name as dimension. A variable
-//! without `_Netcdf4Coordinates` (files of other writers) gets no names,
-//! and CF places its axes by position (the last x).
+//! `_Netcdf4Dimid`; without them (files of netCDF-C before 4.1, and of
+//! other writers), from the `DIMENSION_LIST` object references HDF5's
+//! own API attaches, which `hdf5-pure` 0.47 cannot follow and
+//! `hdf5-reader` does (`shared/hdf5_index.rs`: each reference an object
+//! header's address, matched to the scales' own); a coordinate variable
+//! (a scale) has its own name as dimension. A variable with neither gets
+//! no names, and CF places its axes by position (the last x).
 //!
 //! Then, through `cf.rs`: the variable is the one `file.nc:/var` or
 //! `--array` names, else the only data variable of three spatial
@@ -51,6 +53,7 @@ use crate::shared::cf::{self, Packing, Value, Variable};
 use crate::shared::hdf5::{
     self as h5, NumericType, check_filters, numbers, numeric_type, read_small, sorted_attrs, text,
 };
+use crate::shared::hdf5_index;
 use crate::{FileInfo, IoError, Loaded, ReadOptions, VolumeFormat, split_hdf5_path};
 
 /// The `NAME` netCDF-C gives a dimension that has no coordinate variable.
@@ -180,6 +183,9 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let mut listed: Vec<Listed> = Vec::new();
     let mut dimensions: Vec<(String, u64, bool)> = Vec::new();
     let mut dimids: Vec<(f64, String)> = Vec::new();
+    // The scales' absolute paths, for DIMENSION_LIST's references.
+    let mut scale_paths: Vec<String> = Vec::new();
+    let mut info_notes: Vec<String> = Vec::new();
     for name in &datasets {
         let Ok(ds) = dataset_in(&group, name) else {
             continue;
@@ -189,6 +195,7 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
         let scale = attr("CLASS").and_then(text).as_deref() == Some("DIMENSION_SCALE");
         if scale {
             note_dimid(&mut dimids, name, attr("_Netcdf4Dimid"));
+            scale_paths.push(format!("{prefix}/{name}"));
         }
         let Ok(shape) = ds.shape() else { continue };
         if scale {
@@ -229,7 +236,34 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
             let Ok(attrs) = ds.attrs() else { continue };
             if attrs.get("CLASS").and_then(text).as_deref() == Some("DIMENSION_SCALE") {
                 note_dimid(&mut dimids, name, attrs.get("_Netcdf4Dimid"));
+                scale_paths.push(format!("{}/{name}", above.trim_end_matches('/')));
             }
+        }
+    }
+    // Variables without _Netcdf4Coordinates (netCDF-C before 4.1 wrote
+    // none): their dimensions from the DIMENSION_LIST references to the
+    // scales, followed through hdf5-reader (hdf5-pure cannot), the file
+    // opened once for all of them.
+    let coordinates = |l: &Listed| l.attrs.iter().any(|(n, _)| n == "_Netcdf4Coordinates");
+    let old_style: Vec<String> = listed
+        .iter()
+        .filter(|l| !(coordinates(l) || (l.scale && l.shape.len() == 1)))
+        .map(|l| l.name.clone())
+        .collect();
+    let mut referenced: Vec<(String, Vec<String>)> = Vec::new();
+    if !old_style.is_empty() && !scale_paths.is_empty() {
+        let full: Vec<String> = old_style.iter().map(|n| format!("{prefix}/{n}")).collect();
+        match hdf5_index::dimension_lists(&file_path, &full, &scale_paths) {
+            Ok(lists) => {
+                for (name, dims) in old_style.iter().zip(lists) {
+                    if let Some(dims) = dims {
+                        referenced.push((name.clone(), dims));
+                    }
+                }
+            }
+            Err(e) => info_notes.push(format!(
+                "DIMENSION_LIST not followed ({e}): axes by position"
+            )),
         }
     }
     let mut vars: Vec<Variable> = Vec::new();
@@ -242,6 +276,12 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
                 ids.iter()
                     .map(|id| dimids.iter().find(|(i, _)| i == id).map(|(_, n)| n.clone()))
                     .collect::<Option<Vec<String>>>()
+            })
+            .or_else(|| {
+                referenced
+                    .iter()
+                    .find(|(n, _)| *n == l.name)
+                    .map(|(_, d)| d.clone())
             })
             .filter(|d| d.len() == l.shape.len());
         let dims = match named {
@@ -300,16 +340,22 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     cf::describe(&dimensions, &globals, &vars, &var, &layout, &mut info);
     info.frames = layout.frames;
     info.frame = layout.frame;
+    let source = if referenced.iter().any(|(n, _)| *n == var.name) {
+        "the DIMENSION_LIST references to its dimension scales (a file of netCDF-C before _Netcdf4Coordinates)"
+    } else {
+        "_Netcdf4Coordinates and the dimension scales' _Netcdf4Dimid"
+    };
     info.notes.push(format!(
-        "NetCDF-4 variable {full} read through the HDF5 layer, dimensions ({}) from _Netcdf4Coordinates and the dimension scales' _Netcdf4Dimid",
+        "NetCDF-4 variable {full} read through the HDF5 layer, dimensions ({}) from {source}",
         var.dims.join(", ")
     ));
     if !unnamed.is_empty() {
         info.notes.push(format!(
-            "no _Netcdf4Coordinates on {}: dimension names unknown (hdf5-pure cannot follow DIMENSION_LIST), axes by position",
+            "no _Netcdf4Coordinates or DIMENSION_LIST naming its scales on {}: dimension names unknown, axes by position",
             unnamed.join(", ")
         ));
     }
+    info.notes.append(&mut info_notes);
     let mut coordinate = |c: &Variable| -> Result<Vec<f64>, IoError> {
         let ds = dataset_in(&group, &c.name)
             .map_err(|e| fail(format!("coordinate variable {}: {e}", c.name)))?;

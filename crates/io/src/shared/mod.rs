@@ -10,6 +10,7 @@
 //! | `sigbus.rs` | a mapped file truncated under the renderer: an error, not a crash | `mapped.rs` |
 //! | `limits.rs` | the memory limit and the size checks before allocating | every reader |
 //! | `hdf5.rs` | HDF5 files opened, attributes read, numeric datasets read in slabs (pure Rust) | HDF5, MINC2 |
+//! | `hdf5_index.rs` | what hdf5-pure cannot read, through hdf5-reader: layout version 5 and version 2 B-tree chunk indexes, `DIMENSION_LIST` references | HDF5, NetCDF-4 |
 //! | `geometry.rs` | a file's grid (origin, step vectors) → the axis-aligned volume | every reader with geometry |
 //! | `text_header.rs` | header lines and field values | NRRD, MetaImage |
 //! | `payload/` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
@@ -25,6 +26,7 @@ pub(crate) mod cf;
 pub(crate) mod compress;
 pub(crate) mod geometry;
 pub(crate) mod hdf5;
+pub(crate) mod hdf5_index;
 pub(crate) mod input;
 pub(crate) mod limits;
 pub(crate) mod mapped;

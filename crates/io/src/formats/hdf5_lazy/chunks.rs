@@ -1,6 +1,7 @@
 //! The chunks of a chunked HDF5 dataset as the box-by-box reader reads
 //! them: the chunk index enumerated once (`hdf5-pure`'s `Dataset::chunks`,
-//! which reads the index and no data), each entry checked against the
+//! which reads the index and no data; `hdf5-reader`'s walk of an index
+//! `hdf5-pure` cannot read, `shared/hdf5_index.rs`), each entry checked against the
 //! chunk grid and the file's end; the filter pipeline recognised; and each
 //! chunk a box touches decoded here, the filters undone in the reverse of
 //! their order in the pipeline (the HDF5 format's "Filter Pipeline
@@ -22,10 +23,11 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use hdf5_pure::{ChunkIndex, Dataset};
+use hdf5_pure::Dataset;
 
 use crate::IoError;
 use crate::shared::compress::{Compression, inflate_exact};
+use crate::shared::hdf5_index::Listed;
 use crate::shared::limits::format_bytes;
 
 /// HDF5's registered filter numbers decoded here (H5Zpublic.h; 32000 is
@@ -89,14 +91,16 @@ pub(super) enum Indexed {
     Rows(String),
 }
 
-/// The chunks of a chunked dataset of `shape` (see the module docs), or
-/// the row windows where this module cannot decode them; `Err` for an
-/// index no reader can use or a chunk that cannot fit `max_memory`.
+/// The chunks of a chunked dataset of `shape` (see the module docs), as
+/// `listed` gives them (`hdf5-pure`'s enumeration, or `hdf5-reader`'s for
+/// an index `hdf5-pure` cannot read: `shared/hdf5_index.rs`), or the row
+/// windows where this module cannot decode them; `Err` for an index no
+/// reader can use or a chunk that cannot fit `max_memory`.
 pub(super) fn index(
     dataset: &Dataset,
     shape: &[usize],
     chunk_shape: Vec<u64>,
-    index: ChunkIndex,
+    listed: impl FnOnce() -> Result<Vec<Listed>, String>,
     sample_size: usize,
     file_len: u64,
     max_memory: u64,
@@ -141,17 +145,7 @@ pub(super) fn index(
             }
         });
     }
-    if index == ChunkIndex::BTreeV2 {
-        // Nor does it read one whole or by rows: the eager reader refuses
-        // it too ("a version 2 B-tree chunk index cannot be enumerated").
-        return Err(
-            "its chunks are indexed by a version 2 B-tree (several unlimited dimensions), which hdf5-pure 0.47 cannot read: rewrite it with fixed dimensions (h5repack -l CHUNK=...)"
-                .into(),
-        );
-    }
-    let listed = dataset
-        .chunks()
-        .map_err(|e| format!("unreadable chunk index: {e}"))?;
+    let listed = listed()?;
     let expected = shape
         .iter()
         .zip(&chunk)
@@ -176,20 +170,20 @@ pub(super) fn index(
                 c.offset
             ));
         }
-        let end = c.address.checked_add(c.storage_size);
-        if end.is_none_or(|e| e > file_len) || c.storage_size == 0 {
+        let end = c.address.checked_add(c.size);
+        if end.is_none_or(|e| e > file_len) || c.size == 0 {
             return Err(format!(
                 "the chunk at offset {:?} is stored at byte {} ({} bytes), past the end of the {file_len}-byte file",
-                c.offset, c.address, c.storage_size
+                c.offset, c.address, c.size
             ));
         }
-        if c.storage_size > most {
+        if c.size > most {
             return Err(format!(
                 "the chunk at offset {:?} is stored in {} bytes, more than a chunk of {bytes} bytes can take",
-                c.offset, c.storage_size
+                c.offset, c.size
             ));
         }
-        largest = largest.max(c.storage_size as usize);
+        largest = largest.max(c.size as usize);
         let at: Vec<usize> = c
             .offset
             .iter()
@@ -200,8 +194,8 @@ pub(super) fn index(
             at,
             StoredChunk {
                 address: c.address,
-                size: c.storage_size,
-                mask: c.filter_mask,
+                size: c.size,
+                mask: c.mask,
             },
         );
         if old.is_some() {
