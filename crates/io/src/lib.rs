@@ -38,7 +38,7 @@
 //! | legacy VTK `.vtk` | `formats/vtk_legacy/` | STRUCTURED_POINTS, ASCII and binary; point and cell data |
 //! | VTK XML `.vti` | `formats/vti/` | ascii, base64, appended, zlib, LZ4, LZMA; Direction; pieces |
 //! | DICOM directory (a DICOMDIR's file-set, subfolders) or `.dcm` | `formats/dicom/` | series sorted along the slice normal (LPS mm); the largest of several, or one named; enhanced multi-frame; RT dose; Segmentations as label volumes; RLE, JPEG, JPEG-LS and JPEG 2000 pixel data |
-//! | TIFF stacks `.tif` | `formats/tiff/` | pages are z; ImageJ spacing; hyperstack frames; OME-XML page order, physical sizes and units |
+//! | TIFF stacks `.tif` | `formats/tiff/` | pages are z; ImageJ spacing; hyperstack frames; OME-XML page order, physical sizes and units; else the resolution tags in cm or inch (`tiff/resolution.rs`) |
 //! | HDF5 `file.h5:/dataset` | `formats/hdf5.rs` | pure Rust (`hdf5-pure`; `hdf5-reader` for the chunk indexes of HDF5 2.0 and the version 2 B-tree); axes named by `axes`, `axistags`, `DIMENSION_LABELS`, dimension scales (`hdf5_axes.rs`), else `a[x, y, z]`, `a[t, x, y, z]`; chunked, deflate, shuffle |
 //! | Gaussian cube `.cube` | `formats/cube.rs` | bohr or Å; orbitals as frames; skewed cells resampled; known by content too |
 //! | CCP4/MRC `.map`, `.mrc` | `formats/mrc.rs` | modes 0, 1, 2, 6, 12; MAPC/R/S; origin; skewed: a whole cell resampled periodically, a part (or more) over its box, NaN outside ([`FileInfo::nan_is_empty`]) |
@@ -49,7 +49,9 @@
 //! | MINC1 `.mnc` (NetCDF-3) | `formats/minc1.rs` | on the NetCDF-3 layer (`netcdf/header.rs`) with MINC2's geometry and scaling (`formats/minc_common.rs`); signtype |
 //! | FITS `.fits`, `.fits.gz` | `formats/fits/` | own parser; BITPIX 8 … −64, BSCALE/BZERO, BLANK as NaN; linear WCS (world spacing when the axes share a unit, else pixel coordinates); image HDUs and a 4th axis as frames, `--array EXTNAME` |
 //! | FreeSurfer MGH `.mgh`, `.mgz` | `formats/mgh/` | big-endian; nibabel's get_affine (Mdc, delta, Pxyz_c); frames; gzip streamed; known by content too |
-//! | Analyze 7.5 `.hdr`/`.img` | `formats/nifti/` | a NIfTI-1 pair without magic; nibabel's affine (x flipped, centre or SPM originator); known by content |
+//! | Analyze 7.5 `.hdr`/`.img` | `formats/nifti/` | a NIfTI-1 pair without magic; SPM's `.mat` beside it (`nifti/spm.rs`, MATLAB files by `shared/matlab.rs`), else nibabel's affine (x flipped, centre or SPM originator); known by content |
+//! | VTKHDF `.vtkhdf` (or an HDF5 file with `/VTKHDF`) | `formats/vtkhdf.rs` | ImageData: extent, origin, spacing; point and cell arrays (`--array`), components (`--channel`); read through `hdf5.rs` and `hdf5_lazy.rs` |
+//! | BigDataViewer `dataset.xml` (or its `.h5`) | `formats/bdv/` | SpimData XML (`xml.rs`); setups as channels, time points, levels as OME-Zarr's ([`ReadOptions::level`]); voxel size and registration; int16 as unsigned |
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is
