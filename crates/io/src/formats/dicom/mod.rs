@@ -121,8 +121,9 @@ fn is_dicomdir(path: &Path) -> bool {
         .is_some_and(|n| n.eq_ignore_ascii_case("DICOMDIR") || n.eq_ignore_ascii_case("DICOMDIR;1"))
 }
 
-/// Every file reading the DICOM directory `dir` might open (see
-/// [`series`]): for the overwrite check of the command line.
+/// Every file reading the DICOM directory `dir` might open (its
+/// subfolders' files, or those its DICOMDIR lists): for the overwrite
+/// check of the command line.
 pub fn directory_files(dir: &Path) -> Vec<PathBuf> {
     series::files_read(dir)
 }
