@@ -24,10 +24,10 @@ use crate::error::CliError;
 use crate::flags::{InputArgs, RenderArgs};
 use crate::outfile::OutputKind;
 use crate::session::{
-    app_failure, load, progress_bar, render_failure, renderer_for, streamed_note,
+    app_failure, load, progress_bar, render_failure, renderer_failure, renderer_for, streamed_note,
 };
 use rayon::ThreadPool;
-use volray_app::animation::Extent;
+use volray_app::animation::series_settings;
 pub use volray_app::animation::turntable_frame;
 use volray_app::plan::Plan;
 use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
@@ -153,7 +153,7 @@ pub fn time_points(
             "--frames {given}: {spec} holds {count} time points, numbered from 0"
         )));
     }
-    crate::overwrite::refuse_overwriting_inputs(
+    volray_app::reads::refuse_overwriting_inputs(
         &crate::outfile::output_files(args, kind, end - range.start),
         &[spec.to_string()],
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
@@ -175,44 +175,13 @@ fn series_of(
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
-    // Pass 1: the value range and bounds of all the volumes together, and
-    // the first volume's histogram, should the transfer function be chosen
-    // from it.
+    // Pass 1: one window, framing and transfer function for all.
     let look = &args.view.look;
-    let mut extent = Extent::default();
-    let mut first = None;
-    let mut labels = std::collections::BTreeSet::new();
-    for one in inputs {
-        let input = load(one, args.view.look.log)?;
-        if first.is_none() && look.auto_tf() {
-            first = volray_core::Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
-        }
-        if look.labels {
-            labels.extend(crate::settings::volume_labels(&input.volume, &input.name)?);
-        }
-        let renderer = renderer_for(&args.view, base, &input)?;
-        extent.add(renderer.value_range(), input.volume.bounds());
-        if base.gradient_opacity.is_some() {
-            let max = pool.install(|| renderer.max_gradient());
-            extent.max_gradient = extent.max_gradient.max(max);
-        }
-    }
-    let mut settings = extent.fix(base);
-    if look.labels {
-        // The labels of every volume, so that a label has one colour.
-        let found: Vec<i64> = labels.into_iter().collect();
-        let names = format!("{} volumes", inputs.len());
-        crate::settings::label_transfer_function(
-            look,
-            &mut settings.transfer_function,
-            &found,
-            &names,
-        )?;
-    }
-    if let Some(histogram) = &first {
-        // Chosen from the first volume, over the window of them all.
-        crate::settings::apply_auto(look, &mut settings.transfer_function, histogram);
-    }
+    let requests: Vec<_> = inputs.iter().map(InputArgs::request).collect();
+    let non_finite = args.view.sampling.nonfinite.into();
+    let options = crate::settings::look(look);
+    let settings = series_settings(&requests, base, &options, non_finite, pool)
+        .map_err(|e| renderer_failure(&args.view, e))?;
 
     // Pass 2: render each.
     let mut writer = Writer::new(args, &settings, inputs.len())?;

@@ -43,7 +43,6 @@ mod interrupt;
 #[cfg(feature = "mpi")]
 mod mpi;
 mod outfile;
-mod overwrite;
 mod paper;
 mod render;
 mod scene;

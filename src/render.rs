@@ -31,7 +31,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let settings = settings(&args.view)?;
     check_output(&args.out.output)?;
-    crate::overwrite::refuse_overwriting_inputs(
+    volray_app::reads::refuse_overwriting_inputs(
         &output_files(args, kind, specs.len()),
         &specs,
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),

@@ -6,7 +6,7 @@
 use crate::error::CliError;
 use crate::flags::{BlendMode, CameraArgs, LookArgs, RenderArgs, SamplingArgs, ViewArgs};
 use std::path::Path;
-use volray_core::{Histogram, RenderSettings, TransferFunction, Volume};
+use volray_core::{RenderSettings, TransferFunction, Volume};
 use volray_options::{CameraOptions, LookOptions, Naming, Opt, OptionError, Options, Tf};
 
 /// How the command line writes an option: `--look-at`, `--no-shading`,
@@ -190,33 +190,6 @@ pub fn file_window(
     window: Option<(f64, f64)>,
 ) {
     volray_options::file_window(&look(look_args), transfer_function, window);
-}
-
-/// The labels of `volume` (`name`), refused as `--labels` would be.
-pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, CliError> {
-    volray_options::volume_labels(volume, name).map_err(refused)
-}
-
-/// With `--labels`, the transfer function of `found` (the labels of the
-/// volumes `name`), as `--label-opacity` and `--show-labels` say.
-pub fn label_transfer_function(
-    look_args: &LookArgs,
-    transfer_function: &mut TransferFunction,
-    found: &[i64],
-    name: &str,
-) -> Result<(), CliError> {
-    volray_options::label_transfer_function(&look(look_args), transfer_function, found, name)
-        .map_err(refused)
-}
-
-/// The transfer function chosen from values whose statistics are
-/// `histogram` (a series chooses from its first volume's).
-pub fn apply_auto(
-    look_args: &LookArgs,
-    transfer_function: &mut TransferFunction,
-    histogram: &Histogram,
-) {
-    volray_options::apply_auto(&look(look_args), transfer_function, histogram)
 }
 
 /// The largest `--tf` file read: a transfer function is a few hundred
