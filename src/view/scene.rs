@@ -17,16 +17,15 @@
 //! the one its slider asks for, as `--frame T`.
 
 use super::reproduce::{CliReproduce, OtherWords, SceneWords};
-use super::{MAX_TABS, serve, start_state};
+use super::{launch, serve};
 use crate::error::CliError;
 use crate::flags::ViewerArgs;
 use crate::scene::{overlay_specs, read_layers, whole_input};
-use crate::session::{load, renderer_for, thread_pool};
+use crate::session::{load, renderer_for};
 use crate::settings::{read_tf_file, settings_with_tf_text};
-use std::sync::Arc;
 use volray_app::input;
 use volray_app::scene::Layer;
-use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
+use volray_view::{LayerState, START_COLOURS, TimePoints, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
@@ -77,28 +76,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     }
     let first = &layers[0];
     let settings = first.settings.clone();
-    let cache_budget = crate::session::cache_budget(&args.view, &settings, &first.input)?;
     let non_finite = first.input.non_finite(args.view.sampling.nonfinite.into());
-
-    let mut state = start_state(args, &settings);
-    state.time = time.as_ref().map(|t| t.start);
-    state.layers = (layers[1..].iter())
-        .map(|l| LayerState {
-            visible: l.look().visible,
-            window: None,
-            opacity: None,
-            colormap: if l.settings.transfer_function.color.is_some() {
-                START_COLOURS.to_string()
-            } else {
-                WHITE.to_string()
-            },
-        })
-        .collect();
-    state.check().map_err(|e| {
-        CliError::input(format!(
-            "the starting view is beyond the viewer's bounds: {e}"
-        ))
-    })?;
     let volume = &first.input.volume;
     let grid = (volume.dims(), volume.spacing(), volume.sample_type());
     // The first volume's transfer function, as its command names it.
@@ -110,42 +88,27 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     if args.scene.is_scene() {
         reproduce = reproduce.with_scene(scene_words(args, spec, &layers));
     }
-    reproduce
-        .reproduce(&state)
-        .map_err(|e| CliError::input(format!("{}: {e}", first.input.name)))?;
-    let others: Vec<_> = (layers[1..].iter())
-        .map(|l| (l.input.name.as_str(), &l.input.volume, &l.settings))
+    let mut layers = layers.into_iter();
+    let first = layers.next().expect("the first volume");
+    let mut launch = launch(args, first.input, settings, reproduce)?;
+    launch.state.time = time.as_ref().map(|t| t.start);
+    launch.state.layers = (layers.as_slice().iter())
+        .map(|l| LayerState {
+            visible: l.look().visible,
+            window: None,
+            opacity: None,
+            colormap: if l.settings.transfer_function.color.is_some() {
+                START_COLOURS.to_string()
+            } else {
+                WHITE.to_string()
+            },
+        })
         .collect();
-    let mut hello = Start {
-        name: &first.input.name,
-        volume,
-        log: look.log,
-        state: &state,
-        settings: &settings,
-        others,
-        time: time.as_ref().map(|t| t.range),
-    }
-    .hello();
-    hello.fit = args.view.camera.size.is_none();
-    let pool = thread_pool(args.view.threads)?;
-    let figure = super::figure_context(args, &first.input);
-    let max_memory = u128::from(first.input.max_memory);
-    let mut volumes = layers.into_iter().map(|l| Arc::new(l.input.volume));
-    let viewer = Viewer {
-        volume: volumes.next().expect("the first volume"),
-        non_finite,
-        cache_budget,
-        max_memory,
-        hello,
-        reproduce: Arc::new(reproduce),
-        pool: Arc::new(pool),
-        max_sessions: MAX_TABS,
-        levels: None,
-        others: volumes.collect(),
-        time,
-        figure,
-    };
-    serve(args, viewer)
+    launch.others = layers
+        .map(|l| (l.input.name, l.input.volume, l.settings))
+        .collect();
+    launch.time = time;
+    serve(args, launch)
 }
 
 /// What `render` refuses of several volumes in one picture, and what
