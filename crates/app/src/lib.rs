@@ -41,6 +41,8 @@
 //!   OME-Zarr), and what was written, in words;
 //! - [`describe`]: what a volume file holds and how volray reads it, as
 //!   `volray info` says it (lines of text, or JSON);
+//! - [`look`]: what the look options leave to an input's volume (its
+//!   file's window, labels, `tf auto`);
 //! - [`renderer`]: a volume's renderer within the memory budget, as the
 //!   command line renders its frames;
 //! - [`reads`]: the files an input reads (a DICOM directory's, a
@@ -81,6 +83,7 @@ pub mod describe;
 pub mod distributed;
 pub mod error;
 pub mod input;
+pub mod look;
 pub mod memory;
 pub mod plan;
 pub mod reads;
