@@ -69,6 +69,7 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
                 &[spec.to_string()],
                 &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
             )
+            .map_err(CliError::from)
         })
     } else {
         Ok(())
