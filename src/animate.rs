@@ -7,7 +7,9 @@
 //!   of `n` at azimuth `--azimuth + 360·i/n`. The orthographic window (or
 //!   the perspective eye's distance) fits the bounding sphere rather than
 //!   the box ([`Fit::Sphere`](volray_core::Fit::Sphere)), so the object keeps its scale as it turns
-//!   instead of breathing with its box's outline.
+//!   instead of breathing with its box's outline. Each frame's view is
+//!   volray-app's (`animation::Views`, of which a turntable is one); here
+//!   the frames are rendered, annotated and written.
 //! - A **series** renders several volumes, one frame each, as they are
 //!   given: the paper's "repeat the calculation for various unit-cell
 //!   parameters and see". Every frame has the same transfer function (the
@@ -15,7 +17,8 @@
 //!   framing (the box around all the volumes), so the frames differ only
 //!   where the data do. The volumes are read one at a time, twice (first
 //!   for their ranges and bounds, then to render), so a long series never
-//!   has to fit in memory.
+//!   has to fit in memory. The first pass is volray-app's
+//!   (`animation::series_settings`).
 //! - **Time points** (`--frames`) are a series of one file's frames
 //!   (`--frame 0, 1, ...`: a 4-D NIfTI's volumes, an OME-Zarr image's
 //!   `t`, NetCDF time), read and rendered as a series of files is.
@@ -27,23 +30,24 @@ use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_failure, renderer_for, streamed_note,
 };
 use rayon::ThreadPool;
-use volray_app::animation::series_settings;
-pub use volray_app::animation::turntable_frame;
+use volray_app::animation::{Views, series_settings};
 use volray_app::plan::Plan;
 use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
 use volray_io::Animation;
 
-/// `--turntable FRAMES`: `frames` views of INPUT.
-pub fn turntable(
+/// The views `views` of INPUT (`--turntable FRAMES`: volray-app's
+/// `Turntable`), one frame each.
+pub fn views(
     args: &RenderArgs,
     base: &RenderSettings,
     pool: &ThreadPool,
-    frames: usize,
+    views: &dyn Views,
 ) -> Result<(), CliError> {
     // The level and the road (whole or in pieces) are chosen for the
-    // first frame: the framing fits the bounding sphere, so every frame
-    // shows the volume at one scale.
-    let first = turntable_frame(base, 0, frames);
+    // first frame: a turntable's framing fits the bounding sphere, so
+    // every frame shows the volume at one scale.
+    let frames = views.frames();
+    let first = views.frame(base, 0);
     let input_args = match crate::session::plan(&args.input, &args.view, &first)? {
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
@@ -53,7 +57,7 @@ pub fn turntable(
             let mut writer = Writer::new(args, base, frames)?;
             let mut last = None;
             for i in 0..frames {
-                let frame = turntable_frame(base, i, frames);
+                let frame = views.frame(base, i);
                 let (image, times) = pool
                     .install(|| streamed.render(&frame, &|_| {}))
                     .map_err(|e| app_failure(&args.view, e))?;
@@ -79,7 +83,7 @@ pub fn turntable(
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
     for i in 0..frames {
-        let frame = turntable_frame(base, i, frames);
+        let frame = views.frame(base, i);
         let mut image = writer.render(pool, &renderer, &frame).map_err(fail)?;
         // Annotated in the frame's own view: the triad turns, the outline
         // and a perspective scale bar follow it.

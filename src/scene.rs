@@ -20,6 +20,7 @@ use crate::flags::{Channels, InputArgs, LookArgs, RenderArgs, SceneArgs, ViewArg
 use crate::outfile::{OutputKind, output_kind, write_still};
 use crate::session::{progress_bar, render_failure, renderer_for, thread_pool};
 use std::path::{Path, PathBuf};
+use volray_app::animation::{Turntable, Views};
 use volray_app::input;
 use volray_app::plan::Plan;
 use volray_app::scene::{
@@ -65,7 +66,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
 
     // The first input: whole (a chunked one at the level asked for).
     let first_frame = match args.animation.turntable {
-        Some(n) => animate::turntable_frame(&settings, 0, n as usize),
+        Some(n) => Turntable(n as usize).frame(&settings, 0),
         None => settings.clone(),
     };
     let input_args = whole_input(
@@ -91,10 +92,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let per_frame = settings.width * settings.height * if apart { layers.len() } else { 1 };
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(n)) => {
-            let n = n as usize;
+            let views = Turntable(n as usize);
+            let n = views.frames();
             let mut writer = animate::Writer::with_pixels(args, &settings, n, n * per_frame)?;
             for i in 0..n {
-                let turned = animate::turntable_frame(&settings, i, n);
+                let turned = views.frame(&settings, i);
                 let camera = turned.camera;
                 let image = pictures.picture(&scene, &layers, turned, camera, &writer.bar)?;
                 writer.push(&image)?;

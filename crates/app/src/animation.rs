@@ -12,6 +12,32 @@ use volray_core::glam::DVec3;
 use volray_core::{Camera, Fit, Histogram, NonFinite, RenderSettings};
 use volray_options::LookOptions;
 
+/// The views of an animation of one picture: how many frames, and the
+/// settings of each from the settings the options describe. The front
+/// end renders and writes frame after frame; the level (and whether the
+/// volume is rendered in pieces) is chosen for the first. A turntable is
+/// one ([`Turntable`]); a camera path through keyframes would be another.
+pub trait Views {
+    /// The number of frames.
+    fn frames(&self) -> usize;
+    /// The settings of frame `i` (of [`Views::frames`]) of `base`.
+    fn frame(&self, base: &RenderSettings, i: usize) -> RenderSettings;
+}
+
+/// A turntable of so many frames: [`turntable_frame`]'s views.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Turntable(pub usize);
+
+impl Views for Turntable {
+    fn frames(&self) -> usize {
+        self.0
+    }
+
+    fn frame(&self, base: &RenderSettings, i: usize) -> RenderSettings {
+        turntable_frame(base, i, self.0)
+    }
+}
+
 /// The settings of frame `i` of an `n`-frame turntable of `base`.
 pub fn turntable_frame(base: &RenderSettings, i: usize, n: usize) -> RenderSettings {
     RenderSettings {
@@ -141,6 +167,8 @@ mod tests {
             .collect();
         assert_eq!(azimuths, [10.0, 100.0, 190.0, 280.0]);
         let frame = turntable_frame(&base, 3, 4);
+        assert_eq!(Turntable(4).frames(), 4);
+        assert_eq!(Turntable(4).frame(&base, 3), frame);
         assert_eq!(frame.camera.fit, Fit::Sphere);
         assert_eq!(frame.camera.elevation, 20.0);
         assert_eq!(
