@@ -16,7 +16,7 @@
 //! function serve every time point, as a series' do), and each tab reads
 //! the one its slider asks for, as `--frame T`.
 
-use super::reproduce::{CliReproduce, OtherWords, SceneWords};
+use super::reproduce::{CliReproduce, SceneWords};
 use super::{launch, serve};
 use crate::error::CliError;
 use crate::flags::ViewerArgs;
@@ -24,7 +24,6 @@ use crate::scene::{overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use volray_app::input;
-use volray_app::scene::Layer;
 use volray_view::{LayerState, START_COLOURS, TimePoints, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
@@ -86,7 +85,9 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         reproduce = reproduce.with_time();
     }
     if args.scene.is_scene() {
-        reproduce = reproduce.with_scene(scene_words(args, spec, &layers));
+        let mix = crate::scene::mix(&args.scene);
+        let words = SceneWords::of(spec, args.input.frame, &layers, mix);
+        reproduce = reproduce.with_scene(words);
     }
     let mut layers = layers.into_iter();
     let first = layers.next().expect("the first volume");
@@ -145,27 +146,4 @@ fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
         )));
     }
     Ok(())
-}
-
-/// The scene's volumes after the first as the commands write them.
-fn scene_words(args: &ViewerArgs, spec: &str, layers: &[Layer]) -> SceneWords {
-    let others = (layers[1..].iter())
-        .map(|layer| {
-            let range = layer.input.volume.value_range();
-            let (source, settings) = (&layer.source, &layer.settings);
-            OtherWords::of(
-                source,
-                spec,
-                args.input.frame,
-                settings,
-                range,
-                layer.look(),
-            )
-        })
-        .collect();
-    SceneWords {
-        first: SceneWords::first_of(&layers[0].source),
-        others,
-        mix: crate::scene::mix(&args.scene),
-    }
 }
