@@ -33,8 +33,9 @@
 //! - [`reproduce`]: the view's state (camera, transfer function, look) and
 //!   its two spellings: `volray render` words ([`reproduce::command`]) and
 //!   Python keywords ([`reproduce::keywords`]);
-//! - [`animation`]: a turntable's views, and the window and framing the
-//!   frames of a series share;
+//! - [`animation`]: an animation's views ([`animation::Views`]: a
+//!   turntable's, or any per-frame camera path), and the window and
+//!   framing the frames of a series share (its first pass);
 //! - [`bench`](mod@bench): `volray bench`'s timed frames, their medians and `--json`
 //!   rows, and the peer benchmark's workloads (with VTK timed beside them);
 //! - [`convert`]: a volume written back as a file (NRRD, `.npy`, raw,
