@@ -7,7 +7,9 @@
 //!   of `n` at azimuth `--azimuth + 360·i/n`. The orthographic window (or
 //!   the perspective eye's distance) fits the bounding sphere rather than
 //!   the box ([`Fit::Sphere`](volray_core::Fit::Sphere)), so the object keeps its scale as it turns
-//!   instead of breathing with its box's outline.
+//!   instead of breathing with its box's outline. Each frame's view is
+//!   volray-app's (`animation::Views`, of which a turntable is one); here
+//!   the frames are rendered, annotated and written.
 //! - A **series** renders several volumes, one frame each, as they are
 //!   given: the paper's "repeat the calculation for various unit-cell
 //!   parameters and see". Every frame has the same transfer function (the
@@ -15,7 +17,8 @@
 //!   framing (the box around all the volumes), so the frames differ only
 //!   where the data do. The volumes are read one at a time, twice (first
 //!   for their ranges and bounds, then to render), so a long series never
-//!   has to fit in memory.
+//!   has to fit in memory. The first pass is volray-app's
+//!   (`animation::series_settings`).
 //! - **Time points** (`--frames`) are a series of one file's frames
 //!   (`--frame 0, 1, ...`: a 4-D NIfTI's volumes, an OME-Zarr image's
 //!   `t`, NetCDF time), read and rendered as a series of files is.
@@ -24,26 +27,27 @@ use crate::error::CliError;
 use crate::flags::{InputArgs, RenderArgs};
 use crate::outfile::OutputKind;
 use crate::session::{
-    app_failure, load, progress_bar, render_failure, renderer_for, streamed_note,
+    app_failure, load, progress_bar, render_failure, renderer_failure, renderer_for, streamed_note,
 };
 use rayon::ThreadPool;
-use volray_app::animation::Extent;
-pub use volray_app::animation::turntable_frame;
+use volray_app::animation::{Views, series_settings};
 use volray_app::plan::Plan;
 use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
 use volray_io::Animation;
 
-/// `--turntable FRAMES`: `frames` views of INPUT.
-pub fn turntable(
+/// The views `views` of INPUT (`--turntable FRAMES`: volray-app's
+/// `Turntable`), one frame each.
+pub fn views(
     args: &RenderArgs,
     base: &RenderSettings,
     pool: &ThreadPool,
-    frames: usize,
+    views: &dyn Views,
 ) -> Result<(), CliError> {
     // The level and the road (whole or in pieces) are chosen for the
-    // first frame: the framing fits the bounding sphere, so every frame
-    // shows the volume at one scale.
-    let first = turntable_frame(base, 0, frames);
+    // first frame: a turntable's framing fits the bounding sphere, so
+    // every frame shows the volume at one scale.
+    let frames = views.frames();
+    let first = views.frame(base, 0);
     let input_args = match crate::session::plan(&args.input, &args.view, &first)? {
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
@@ -53,7 +57,7 @@ pub fn turntable(
             let mut writer = Writer::new(args, base, frames)?;
             let mut last = None;
             for i in 0..frames {
-                let frame = turntable_frame(base, i, frames);
+                let frame = views.frame(base, i);
                 let (image, times) = pool
                     .install(|| streamed.render(&frame, &|_| {}))
                     .map_err(|e| app_failure(&args.view, e))?;
@@ -79,7 +83,7 @@ pub fn turntable(
     let renderer = renderer_for(&args.view, base, &input)?;
     let mut writer = Writer::new(args, base, frames)?;
     for i in 0..frames {
-        let frame = turntable_frame(base, i, frames);
+        let frame = views.frame(base, i);
         let mut image = writer.render(pool, &renderer, &frame).map_err(fail)?;
         // Annotated in the frame's own view: the triad turns, the outline
         // and a perspective scale bar follow it.
@@ -153,7 +157,7 @@ pub fn time_points(
             "--frames {given}: {spec} holds {count} time points, numbered from 0"
         )));
     }
-    crate::overwrite::refuse_overwriting_inputs(
+    volray_app::reads::refuse_overwriting_inputs(
         &crate::outfile::output_files(args, kind, end - range.start),
         &[spec.to_string()],
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
@@ -175,44 +179,13 @@ fn series_of(
     base: &RenderSettings,
     pool: &ThreadPool,
 ) -> Result<(), CliError> {
-    // Pass 1: the value range and bounds of all the volumes together, and
-    // the first volume's histogram, should the transfer function be chosen
-    // from it.
+    // Pass 1: one window, framing and transfer function for all.
     let look = &args.view.look;
-    let mut extent = Extent::default();
-    let mut first = None;
-    let mut labels = std::collections::BTreeSet::new();
-    for one in inputs {
-        let input = load(one, args.view.look.log)?;
-        if first.is_none() && look.auto_tf() {
-            first = volray_core::Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
-        }
-        if look.labels {
-            labels.extend(crate::settings::volume_labels(&input.volume, &input.name)?);
-        }
-        let renderer = renderer_for(&args.view, base, &input)?;
-        extent.add(renderer.value_range(), input.volume.bounds());
-        if base.gradient_opacity.is_some() {
-            let max = pool.install(|| renderer.max_gradient());
-            extent.max_gradient = extent.max_gradient.max(max);
-        }
-    }
-    let mut settings = extent.fix(base);
-    if look.labels {
-        // The labels of every volume, so that a label has one colour.
-        let found: Vec<i64> = labels.into_iter().collect();
-        let names = format!("{} volumes", inputs.len());
-        crate::settings::label_transfer_function(
-            look,
-            &mut settings.transfer_function,
-            &found,
-            &names,
-        )?;
-    }
-    if let Some(histogram) = &first {
-        // Chosen from the first volume, over the window of them all.
-        crate::settings::apply_auto(look, &mut settings.transfer_function, histogram);
-    }
+    let requests: Vec<_> = inputs.iter().map(InputArgs::request).collect();
+    let non_finite = args.view.sampling.nonfinite.into();
+    let options = crate::settings::look(look);
+    let settings = series_settings(&requests, base, &options, non_finite, pool)
+        .map_err(|e| renderer_failure(&args.view, e))?;
 
     // Pass 2: render each.
     let mut writer = Writer::new(args, &settings, inputs.len())?;

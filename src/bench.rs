@@ -44,7 +44,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
                     .as_deref()
                     .unwrap_or(volray_app::input::DEMO);
                 let tf: Vec<&Path> = args.view.look.tf_file().into_iter().collect();
-                crate::overwrite::refuse_overwriting_inputs(
+                volray_app::reads::refuse_overwriting_inputs(
                     std::slice::from_ref(json),
                     &[input.to_string()],
                     &tf,

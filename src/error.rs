@@ -270,6 +270,13 @@ impl From<SourceError> for CliError {
     }
 }
 
+/// An output that is one of the inputs (volray-app's `reads`).
+impl From<volray_app::reads::Overwrites> for CliError {
+    fn from(e: volray_app::reads::Overwrites) -> Self {
+        CliError::input(e.to_string())
+    }
+}
+
 impl From<volray_data::DataError> for CliError {
     fn from(e: volray_data::DataError) -> Self {
         CliError::input(e.to_string())

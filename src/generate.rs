@@ -3,8 +3,6 @@
 
 use crate::error::CliError;
 use crate::flags::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
-use std::path::Path;
-use volray_core::Volume;
 use volray_data::DataError;
 use volray_data::fractal::FractalParams;
 use volray_data::hydrogen::HydrogenParams;
@@ -24,7 +22,7 @@ pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
             &f.output,
         ),
     };
-    write(&volume, output)?;
+    crate::convert::write(&volume, output)?;
     let [nx, ny, nz] = volume.dims();
     let s = volume.spacing();
     let o = volume.origin();
@@ -175,10 +173,4 @@ pub fn fractal_params(a: &FractalArgs) -> FractalParams {
         raw_field: a.raw_field,
         random_additions: a.random_additions,
     }
-}
-
-/// Writes `volume` in the format `path`'s extension names: `.npy`, `.raw`
-/// (little-endian f32, x fastest) or `.nrrd` (with spacing and origin).
-fn write(volume: &Volume, path: &Path) -> Result<(), CliError> {
-    crate::convert::write_volume(volume, path, crate::convert::OutputFormat::of(path)?)
 }

@@ -1,6 +1,9 @@
-//! `volray`: the command line. It parses arguments and calls the libraries:
-//! `volray-io` and `volray-data` for the input, `volray-core` to render,
-//! `volray-io` again for the PNG.
+//! `volray`: the command line: flags, output writing and progress
+//! display. It parses arguments and calls the libraries: `volray-app` for
+//! what the front ends share (the input, its plan, the memory budget,
+//! scenes, animations, the files an input reads, volumes written back),
+//! `volray-core` to render, `volray-io` for the images, `volray-view` to
+//! serve the browser viewer.
 //!
 //! Where things are:
 //!
@@ -9,20 +12,22 @@
 //!   parses the command line and lists them all;
 //! - one module per subcommand: `render.rs` (one still image, and the
 //!   checks before any work) with `animate.rs` (turntables, series and
-//!   `--frames`) and `scene.rs` (several volumes in one picture:
-//!   `--channels`, `--overlay`), `bench.rs`, `info.rs` (their timing,
-//!   reading and describing are volray-app's), `convert.rs` (a volume to NRRD, `.npy` or raw, also what `generate`
-//!   writes with), `generate.rs`, `paper.rs`, `view.rs` (the browser viewer, with
-//!   `view/reproduce.rs`: the page's state as a `volray render` command);
-//! - what they share: `settings.rs` (the flags as volray-core's
-//!   `RenderSettings`), `session.rs` (the flags as volray-app's input
-//!   requests and plans, the renderer within the `--max-memory` budget,
-//!   threads, progress, which flag a render error is about); volray-app
-//!   reads INPUT, plans it and budgets its frames;
+//!   `--frames`, written frame by frame) and `scene.rs` (several volumes in
+//!   one picture: `--channels`, `--overlay`), `bench.rs`, `info.rs` (their
+//!   timing, reading and describing are volray-app's), `convert.rs` (the
+//!   flags of volray-app's `convert`, also what `generate` writes with),
+//!   `generate.rs`, `paper.rs`, `view.rs` (the flags as volray-view's
+//!   `open` and `Launch`, with `view/reproduce.rs`: the page's state as a
+//!   `volray render` command; `view/scene.rs`; `view/browser.rs`);
+//! - what they share: `settings.rs` (the flags as volray-options'
+//!   `Options` and volray-core's `RenderSettings`), `session.rs` (the
+//!   flags as volray-app's input requests, plans and renderers within the
+//!   `--max-memory` budget, threads, progress, which flag a render error
+//!   is about), `outfile.rs` and `figure.rs` (the output file, the
+//!   annotations);
 //! - the process: `error.rs` (one-line errors and their exit codes: 0
 //!   success, 1 bad input, 2 I/O, 128 + the signal when interrupted),
-//!   `output.rs` (standard output), `overwrite.rs` (never writing over an
-//!   input), `interrupt.rs` (Ctrl-C and friends).
+//!   `output.rs` (standard output), `interrupt.rs` (Ctrl-C and friends).
 //!
 //! This file only dispatches: parse, catch signals, run the subcommand,
 //! print its error on one line and exit with its code.
@@ -43,7 +48,6 @@ mod interrupt;
 #[cfg(feature = "mpi")]
 mod mpi;
 mod outfile;
-mod overwrite;
 mod paper;
 mod render;
 mod scene;

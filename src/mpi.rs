@@ -64,11 +64,12 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
                 .input
                 .as_deref()
                 .unwrap_or(volray_app::input::DEMO);
-            crate::overwrite::refuse_overwriting_inputs(
+            volray_app::reads::refuse_overwriting_inputs(
                 &render::output_files(args, kind, 1),
                 &[spec.to_string()],
                 &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
             )
+            .map_err(CliError::from)
         })
     } else {
         Ok(())

@@ -114,7 +114,7 @@ pub fn output_files(args: &RenderArgs, kind: OutputKind, inputs: usize) -> Vec<P
 }
 
 /// Refuses, before any work, an output that cannot be written where it is
-/// asked for (overwriting an input is refused by `overwrite.rs`).
+/// asked for (overwriting an input is refused by volray-app's `reads`).
 pub fn check_output(output: &Path) -> Result<(), CliError> {
     let dir = match output.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,

@@ -12,6 +12,7 @@ use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note, thread_pool,
 };
 use crate::settings::settings;
+use volray_app::animation::Turntable;
 use volray_app::input;
 use volray_app::plan::Plan;
 use volray_core::{FrameRequest, Render, RenderSettings, Rendered};
@@ -31,7 +32,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let settings = settings(&args.view)?;
     check_output(&args.out.output)?;
-    crate::overwrite::refuse_overwriting_inputs(
+    volray_app::reads::refuse_overwriting_inputs(
         &output_files(args, kind, specs.len()),
         &specs,
         &args.view.look.tf_file().into_iter().collect::<Vec<_>>(),
@@ -39,7 +40,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let pool = thread_pool(args.view.threads)?;
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(frames)) => {
-            animate::turntable(args, &settings, &pool, frames as usize)
+            animate::views(args, &settings, &pool, &Turntable(frames as usize))
         }
         (OutputKind::Animation, None) if args.scene.frames.is_some() => {
             animate::time_points(args, kind, &settings, &pool)

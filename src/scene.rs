@@ -20,13 +20,14 @@ use crate::flags::{Channels, InputArgs, LookArgs, RenderArgs, SceneArgs, ViewArg
 use crate::outfile::{OutputKind, output_kind, write_still};
 use crate::session::{progress_bar, render_failure, renderer_for, thread_pool};
 use std::path::{Path, PathBuf};
+use volray_app::animation::{Turntable, Views};
 use volray_app::input;
 use volray_app::plan::Plan;
 use volray_app::scene::{
     self, ChannelAxis, ChannelPick, Failure, First, Layer, LayerError, LayerSource, OverlaySpec,
     Overlays, Refused, channel_axis, channels_at, default_mix, time_range,
 };
-use volray_core::scene::{Look, Mix, Scene, SceneSettings};
+use volray_core::scene::{Mix, Scene, SceneSettings};
 use volray_core::{FrameRequest, Render, RenderError, RenderSettings, Rendered, SceneError};
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
@@ -56,7 +57,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                 .filter_map(|o| o.tf.as_deref().map(Path::new)),
         )
         .collect();
-    crate::overwrite::refuse_overwriting_inputs(
+    volray_app::reads::refuse_overwriting_inputs(
         &crate::outfile::output_files(args, kind, 1),
         &inputs,
         &tf_files,
@@ -65,7 +66,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
 
     // The first input: whole (a chunked one at the level asked for).
     let first_frame = match args.animation.turntable {
-        Some(n) => animate::turntable_frame(&settings, 0, n as usize),
+        Some(n) => Turntable(n as usize).frame(&settings, 0),
         None => settings.clone(),
     };
     let input_args = whole_input(
@@ -75,101 +76,111 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         "--channels and --overlay",
     )?;
     let layers = read_layers(&input_args, &args.view, &args.scene, &overlays, &settings)?;
-    let mix = mix(&args.scene);
+    let pictures = Pictures {
+        args,
+        kind,
+        pool: &pool,
+        mix: mix(&args.scene),
+    };
     if let Some(range) = args.scene.frames {
-        let walk = TimeWalk {
-            args,
-            kind,
-            settings: &settings,
-            pool: &pool,
-            mix,
-        };
-        return walk.run(&input_args, layers, range);
+        return pictures.time_walk(&input_args, layers, &settings, range);
     }
-
-    let names: Vec<&str> = layers.iter().map(|l| l.input.name.as_str()).collect();
-    let renderers = (layers.iter())
-        .map(|l| renderer_for(&args.view, &l.settings, &l.input))
-        .collect::<Result<Vec<_>, _>>()?;
-    let fail = |e: RenderError| scene_failure(&args.view, &names, e);
-    let scene = Scene::new(renderers).map_err(|e| fail(RenderError::Scene(e)))?;
-    let looks: Vec<Look> = layers.iter().map(Layer::look).collect();
+    let scene = pictures.scene(&layers)?;
     // The progress bar counts each volume rendered apart (the additive
     // mix, the projections).
-    let apart = mix == Mix::Additive || settings.blend.is_projection();
+    let apart = pictures.mix == Mix::Additive || settings.blend.is_projection();
     let per_frame = settings.width * settings.height * if apart { layers.len() } else { 1 };
-    let frame = |settings: RenderSettings, bar: &indicatif::ProgressBar| {
-        let request = SceneSettings {
-            settings,
-            looks: looks.clone(),
-            mix,
-        };
-        let report = |n: usize| bar.inc(n as u64);
-        pool.install(|| scene.render(FrameRequest::new(&request).reporting(&report)))
-            .map(Rendered::image)
-            .map_err(fail)
-    };
-    // The first volume's colour bar and scale bar, in the view that
-    // frames every volume (`camera`: the frame's), and the box of each
-    // volume for --outline.
-    let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
-    let annotate = |camera: volray_core::Camera, image: &mut volray_core::Image| {
-        let mut first = layers[0].settings.clone();
-        first.camera = camera;
-        first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
-        let renderer = &scene.layers()[0];
-        crate::figure::draw_framed(
-            args,
-            kind,
-            &first,
-            renderer,
-            &layers[0].input,
-            &boxes,
-            renderer.volume().bounds(),
-            image,
-        )
-    };
     match (kind, args.animation.turntable) {
         (OutputKind::Animation, Some(n)) => {
-            let n = n as usize;
+            let views = Turntable(n as usize);
+            let n = views.frames();
             let mut writer = animate::Writer::with_pixels(args, &settings, n, n * per_frame)?;
             for i in 0..n {
-                let turned = animate::turntable_frame(&settings, i, n);
+                let turned = views.frame(&settings, i);
                 let camera = turned.camera;
-                let mut image = frame(turned, &writer.bar)?;
-                annotate(camera, &mut image)?;
+                let image = pictures.picture(&scene, &layers, turned, camera, &writer.bar)?;
                 writer.push(&image)?;
             }
             writer.finish()
         }
         (kind, _) => {
             let bar = progress_bar(per_frame as u64);
-            let mut image = frame(settings.clone(), &bar)?;
+            let camera = layers[0].settings.camera;
+            let image = pictures.picture(&scene, &layers, settings.clone(), camera, &bar)?;
             bar.finish_and_clear();
-            annotate(layers[0].settings.camera, &mut image)?;
             write_still(args, kind, &image)
         }
     }
 }
 
-/// `--channels` with `--frames`: the channels at each time point of the
-/// range, one frame each, every channel with the look (transfer function,
-/// window) it has at the first, as a series of inputs has one transfer
-/// function; each time point's volumes read after the last one's are
-/// dropped.
-struct TimeWalk<'a> {
+/// The frames of a picture of several volumes: its scene, each frame
+/// rendered and annotated as the first volume's.
+struct Pictures<'a> {
     args: &'a RenderArgs,
     kind: OutputKind,
-    settings: &'a RenderSettings,
     pool: &'a rayon::ThreadPool,
     mix: Mix,
 }
 
-impl TimeWalk<'_> {
-    fn run(
+impl Pictures<'_> {
+    /// The scene of `layers`, each volume's renderer within `--max-memory`.
+    fn scene<'v>(&self, layers: &'v [Layer]) -> Result<Scene<'v>, CliError> {
+        let view = &self.args.view;
+        let renderers = (layers.iter())
+            .map(|l| renderer_for(view, &l.settings, &l.input))
+            .collect::<Result<Vec<_>, _>>()?;
+        Scene::new(renderers).map_err(|e| scene_failure(view, layers, RenderError::Scene(e)))
+    }
+
+    /// One frame of `scene` (of `layers`) with `settings`, annotated as
+    /// the first volume's in the view that frames every volume (`camera`:
+    /// the frame's), with the box of each volume for `--outline`.
+    fn picture(
+        &self,
+        scene: &Scene,
+        layers: &[Layer],
+        settings: RenderSettings,
+        camera: volray_core::Camera,
+        bar: &indicatif::ProgressBar,
+    ) -> Result<volray_core::Image, CliError> {
+        let request = SceneSettings {
+            settings,
+            looks: layers.iter().map(Layer::look).collect(),
+            mix: self.mix,
+        };
+        let report = |n: usize| bar.inc(n as u64);
+        let mut image = (self.pool)
+            .install(|| scene.render(FrameRequest::new(&request).reporting(&report)))
+            .map(Rendered::image)
+            .map_err(|e| scene_failure(&self.args.view, layers, e))?;
+        let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
+        let mut first = layers[0].settings.clone();
+        first.camera = camera;
+        first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
+        let renderer = &scene.layers()[0];
+        crate::figure::draw_framed(
+            self.args,
+            self.kind,
+            &first,
+            renderer,
+            &layers[0].input,
+            &boxes,
+            renderer.volume().bounds(),
+            &mut image,
+        )?;
+        Ok(image)
+    }
+
+    /// `--channels` with `--frames`: the channels at each time point of
+    /// the range, one frame each, every channel with the look (transfer
+    /// function, window) it has at the first, as a series of inputs has
+    /// one transfer function; each time point's volumes read after the
+    /// last one's are dropped.
+    fn time_walk(
         &self,
         input_args: &InputArgs,
         first: Vec<Layer>,
+        settings: &RenderSettings,
         range: crate::flags::Frames,
     ) -> Result<(), CliError> {
         let args = self.args;
@@ -189,9 +200,9 @@ impl TimeWalk<'_> {
         let end = time_range(range.start, range.end, count, spec).map_err(refused)?;
         let n = end - range.start;
         let files = crate::outfile::output_files(args, self.kind, n);
-        crate::overwrite::refuse_overwriting_inputs(&files, &[spec.to_string()], &[])?;
-        let per_frame = self.settings.width * self.settings.height * first.len();
-        let mut writer = animate::Writer::with_pixels(args, self.settings, n, n * per_frame)?;
+        volray_app::reads::refuse_overwriting_inputs(&files, &[spec.to_string()], &[])?;
+        let per_frame = settings.width * settings.height * first.len();
+        let mut writer = animate::Writer::with_pixels(args, settings, n, n * per_frame)?;
         // The looks of time point 0, read first; its volumes rendered if
         // the range starts there, else dropped now.
         let looks: Vec<(LayerSource, RenderSettings)> = (first.iter())
@@ -204,50 +215,14 @@ impl TimeWalk<'_> {
                 None => channels_at(&input_args.request(), args.view.look.log, t, &looks)
                     .map_err(layer_failure)?,
             };
-            let image = self.picture(&now, &writer.bar)?;
+            let scene = self.scene(&now)?;
+            let camera = now[0].settings.camera;
+            let image = self.picture(&scene, &now, settings.clone(), camera, &writer.bar)?;
+            drop(scene);
             drop(now);
             writer.push(&image)?;
         }
         writer.finish()
-    }
-
-    /// One frame of `layers`, annotated as the first volume's.
-    fn picture(
-        &self,
-        layers: &[Layer],
-        bar: &indicatif::ProgressBar,
-    ) -> Result<volray_core::Image, CliError> {
-        let view = &self.args.view;
-        let names: Vec<&str> = layers.iter().map(|l| l.input.name.as_str()).collect();
-        let renderers = (layers.iter())
-            .map(|l| renderer_for(view, &l.settings, &l.input))
-            .collect::<Result<Vec<_>, _>>()?;
-        let fail = |e: RenderError| scene_failure(view, &names, e);
-        let scene = Scene::new(renderers).map_err(|e| fail(RenderError::Scene(e)))?;
-        let request = SceneSettings {
-            settings: self.settings.clone(),
-            looks: layers.iter().map(Layer::look).collect(),
-            mix: self.mix,
-        };
-        let mut image = (self.pool)
-            .install(|| scene.render(FrameRequest::new(&request).reporting(&|n| bar.inc(n as u64))))
-            .map(Rendered::image)
-            .map_err(fail)?;
-        let boxes: Vec<_> = scene.layers().iter().map(|r| r.volume().bounds()).collect();
-        let mut first = layers[0].settings.clone();
-        first.camera.bounds = Some(first.camera.framed_bounds(scene.bounds()));
-        let renderer = &scene.layers()[0];
-        crate::figure::draw_framed(
-            self.args,
-            self.kind,
-            &first,
-            renderer,
-            &layers[0].input,
-            &boxes,
-            renderer.volume().bounds(),
-            &mut image,
-        )?;
-        Ok(image)
     }
 }
 
@@ -416,12 +391,13 @@ fn refuse_unsupported(args: &RenderArgs) -> Result<(), CliError> {
 }
 
 /// A scene's render error as one line, naming the volume it is about.
-fn scene_failure(view: &ViewArgs, names: &[&str], e: RenderError) -> CliError {
+fn scene_failure(view: &ViewArgs, layers: &[Layer], e: RenderError) -> CliError {
+    let name = |i: usize| layers.get(i).unwrap_or(&layers[0]).input.name.as_str();
     match e {
         RenderError::Scene(SceneError::Layer { layer, error }) => {
-            render_failure(view, names.get(layer).unwrap_or(&names[0]), *error)
+            render_failure(view, name(layer), *error)
         }
-        e => render_failure(view, names[0], e),
+        e => render_failure(view, name(0), e),
     }
 }
 

@@ -12,7 +12,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 use volray_app::AppError;
 use volray_app::input::Input;
-use volray_app::memory::{Budget, png_bytes};
+use volray_app::memory::png_bytes;
 use volray_app::plan::{Chosen, Frames, Plan, StreamedInput};
 use volray_core::{RenderError, RenderSettings, Renderer};
 use volray_distributed::frame::FrameError;
@@ -121,47 +121,43 @@ pub fn progress_bar(pixels: u64) -> ProgressBar {
     }
 }
 
-/// The renderer of `input`'s volume, its non-finite values refused or
-/// rendered as empty space as `--nonfinite` says, refused if rendering it
-/// may need more than `--max-memory` (see volray-app's `memory`). A refusal is one
-/// line naming the input and the count, and the way out.
+/// The renderer of `input`'s volume (volray-app's `renderer`), refused
+/// if rendering it may need more than `--max-memory`, or for its
+/// non-finite values as `--nonfinite` says: one line naming the input
+/// and the count, and the way out.
 pub fn renderer_for<'v>(
     view: &ViewArgs,
     settings: &RenderSettings,
     input: &'v Input,
 ) -> Result<Renderer<'v>, CliError> {
-    let (name, volume) = (&input.name, &input.volume);
-    let mode = input.non_finite(view.sampling.nonfinite.into());
-    let budget = cache_budget(view, settings, input)?;
-    let renderer = Renderer::with_non_finite(volume, mode).map_err(|e| match e {
-        RenderError::NonFinite { .. } => CliError::input(format!(
-            "{name}: {e}; use --nonfinite transparent to render them as empty space"
-        )),
-        e => render_failure(view, name, e),
-    })?;
-    Ok(renderer.with_cache_budget(budget))
+    volray_app::renderer::renderer_for(input, settings, view.sampling.nonfinite.into())
+        .map_err(|e| renderer_failure(view, e))
 }
 
-/// The brick caches' budget for rendering `input` with `settings`, non-finite
-/// values as `--nonfinite` says (volray-app's `memory`: the volume counted unless mapped, and the
-/// 16-bit PNG's pixels).
+/// volray-app's refusal of a renderer worded with the flags: non-finite
+/// values name `--nonfinite`.
+pub fn renderer_failure(view: &ViewArgs, e: AppError) -> CliError {
+    match e {
+        AppError::Render {
+            name,
+            error: e @ RenderError::NonFinite { .. },
+        } => CliError::input(format!(
+            "{name}: {e}; use --nonfinite transparent to render them as empty space"
+        )),
+        e => app_failure(view, e),
+    }
+}
+
+/// The brick caches' budget for rendering `input` with `settings`,
+/// non-finite values as `--nonfinite` says (volray-app's `renderer`).
 pub fn cache_budget(
     view: &ViewArgs,
     settings: &RenderSettings,
     input: &Input,
 ) -> Result<usize, CliError> {
-    let mode = input.non_finite(view.sampling.nonfinite.into());
-    let budget = Budget {
-        limit: input.max_memory,
-        extra: png_bytes(settings),
-        samples_count: true,
-    };
-    Ok(volray_app::memory::cache_budget(
-        &input.volume,
-        &input.name,
-        settings,
-        mode,
-        budget,
+    let non_finite = view.sampling.nonfinite.into();
+    Ok(volray_app::renderer::cache_budget(
+        input, settings, non_finite,
     )?)
 }
 

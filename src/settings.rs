@@ -6,7 +6,7 @@
 use crate::error::CliError;
 use crate::flags::{BlendMode, CameraArgs, LookArgs, RenderArgs, SamplingArgs, ViewArgs};
 use std::path::Path;
-use volray_core::{Histogram, RenderSettings, TransferFunction, Volume};
+use volray_core::{RenderSettings, TransferFunction, Volume};
 use volray_options::{CameraOptions, LookOptions, Naming, Opt, OptionError, Options, Tf};
 
 /// How the command line writes an option: `--look-at`, `--no-shading`,
@@ -157,103 +157,31 @@ pub fn from_volume(
     volray_options::from_volume(&look(look_args), transfer_function, volume, name).map_err(refused)
 }
 
-/// `settings` with what the flags leave to `input`'s volume: `--labels`
-/// or the transfer function chosen from it (`--tf auto`; see
-/// [`from_volume`]), the volume marked as labels.
+/// `settings` with what the flags leave to `input`'s volume (volray-app's
+/// `look`): the file's display window as the default `--range`, then
+/// `--labels` or the transfer function chosen from it (`--tf auto`), the
+/// volume marked as labels.
 pub fn from_input(
     args: &RenderArgs,
     settings: &RenderSettings,
     input: &mut volray_app::input::Input,
 ) -> Result<RenderSettings, CliError> {
     let mut settings = settings.clone();
-    file_window(
-        &args.view.look,
-        &mut settings.transfer_function,
-        input
-            .file
-            .as_ref()
-            .and_then(|(_, info)| info.display_window()),
-    );
-    // The colours the file gives its labels (a DICOM Segmentation's
-    // segments), for --labels.
-    let mut look = look(&args.view.look);
-    look.label_colours = volray_app::input::label_colours(input);
-    volray_options::from_volume(
-        &look,
-        &mut settings.transfer_function,
-        &mut input.volume,
-        &input.name,
-    )
-    .map_err(refused)?;
+    let tf = &mut settings.transfer_function;
+    volray_app::look::leave_to_volume(&look(&args.view.look), tf, input).map_err(refused)?;
     Ok(settings)
 }
 
-/// The file's own display window (OME-Zarr `omero`) as the default
-/// `--range` (volray-options' [`file_window`](volray_options::file_window)).
-pub fn file_window(
-    look_args: &LookArgs,
-    transfer_function: &mut TransferFunction,
-    window: Option<(f64, f64)>,
-) {
-    volray_options::file_window(&look(look_args), transfer_function, window);
-}
-
-/// The labels of `volume` (`name`), refused as `--labels` would be.
-pub fn volume_labels(volume: &Volume, name: &str) -> Result<Vec<i64>, CliError> {
-    volray_options::volume_labels(volume, name).map_err(refused)
-}
-
-/// With `--labels`, the transfer function of `found` (the labels of the
-/// volumes `name`), as `--label-opacity` and `--show-labels` say.
-pub fn label_transfer_function(
-    look_args: &LookArgs,
-    transfer_function: &mut TransferFunction,
-    found: &[i64],
-    name: &str,
-) -> Result<(), CliError> {
-    volray_options::label_transfer_function(&look(look_args), transfer_function, found, name)
-        .map_err(refused)
-}
-
-/// The transfer function chosen from values whose statistics are
-/// `histogram` (a series chooses from its first volume's).
-pub fn apply_auto(
-    look_args: &LookArgs,
-    transfer_function: &mut TransferFunction,
-    histogram: &Histogram,
-) {
-    volray_options::apply_auto(&look(look_args), transfer_function, histogram)
-}
-
-/// The largest `--tf` file read: a transfer function is a few hundred
-/// points; this bounds what a wrong path (a device, a huge file) costs.
-const TF_MAX_BYTES: u64 = 16 << 20;
-
-/// Reads a `--tf` file: a regular file of at most [`TF_MAX_BYTES`].
+/// Reads a `--tf` file (volray-app's `look`: a regular file of UTF-8
+/// text, bounded).
 pub fn read_tf_file(path: &Path) -> Result<String, CliError> {
-    use std::io::Read;
-    let name = path.display();
-    let meta = std::fs::metadata(path)
-        .map_err(|e| CliError::io(format!("--tf {name}: cannot read: {e}")))?;
-    if !meta.is_file() {
-        return Err(CliError::input(format!("--tf {name}: not a regular file")));
-    }
-    if meta.len() > TF_MAX_BYTES {
-        return Err(CliError::input(format!(
-            "--tf {name}: {} bytes is too large for a transfer function (at most {TF_MAX_BYTES})",
-            meta.len()
-        )));
-    }
-    let mut text = String::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(TF_MAX_BYTES).read_to_string(&mut text))
-        .map_err(|e| match e.kind() {
-            std::io::ErrorKind::InvalidData => CliError::input(format!(
-                "--tf {name}: not UTF-8 text (a JSON file is expected)"
-            )),
-            _ => CliError::io(format!("--tf {name}: cannot read: {e}")),
-        })?;
-    Ok(text)
+    volray_app::look::read_tf_file(path).map_err(|e| {
+        let message = format!("--tf {}: {e}", path.display());
+        match e.is_io_failure() {
+            true => CliError::io(message),
+            false => CliError::input(message),
+        }
+    })
 }
 
 #[cfg(test)]

@@ -9,7 +9,6 @@
 //! commands (volray-app's words) and their settings; `view/browser.rs` opens the browser.
 
 mod browser;
-mod levels;
 mod reproduce;
 mod scene;
 
@@ -19,9 +18,15 @@ use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{from_volume, named_transfer_function, read_tf_file, settings_with_tf_text};
 use reproduce::CliReproduce;
 use std::net::SocketAddr;
+use std::path::Path;
 use std::sync::Arc;
+use volray_app::input::{self, Input};
 use volray_core::RenderSettings;
-use volray_view::{Reproduce, Start, ViewState, Viewer};
+use volray_io::format_bytes;
+use volray_options::level::LevelChoice;
+use volray_view::launch::Launch;
+use volray_view::open::{OpenError, Opened};
+use volray_view::{DRAFT_SHARE, ViewState};
 
 /// The most tabs rendering at once, whatever the memory allows (the
 /// memory itself is held to `--max-memory` by the viewer's ledger:
@@ -37,10 +42,20 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let mut settings = settings_with_tf_text(&args.view, tf_text.as_deref())?;
     let mut named = named_transfer_function(look, tf_text.as_deref())?;
     // A chunked file is opened from its metadata, and only the level the
-    // first drafts show is read (`view/levels.rs`).
-    let pyramid = levels::open(args, &settings)?;
+    // first drafts show is read (volray-view's `open`).
+    let pyramid = open_levels(args, &settings)?;
     let mut input = match &pyramid {
-        Some(p) => p.start_input(args)?,
+        Some(p) => Input {
+            volume: p.start_volume()?,
+            name: args
+                .input
+                .input
+                .as_deref()
+                .unwrap_or(input::DEMO)
+                .to_string(),
+            file: None,
+            max_memory: args.input.request().max_memory(),
+        },
         None => load(&args.input, look.log)?,
     };
     // A transfer function chosen from the volume (`--tf auto`, `--labels`)
@@ -64,15 +79,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         .prepare(&settings)
         .map_err(|e| crate::session::render_failure(&args.view, &input.name, e))?;
     drop(renderer);
-    let cache_budget = crate::session::cache_budget(&args.view, &settings, &input)?;
     let non_finite = input.non_finite(args.view.sampling.nonfinite.into());
-
-    let state = start_state(args, &settings);
-    state.check().map_err(|e| {
-        CliError::input(format!(
-            "the starting view is beyond the viewer's bounds: {e}"
-        ))
-    })?;
     let volume = &input.volume;
     let grid = match &pyramid {
         // The frames' memory is checked against the level each renders.
@@ -80,46 +87,49 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         None => (volume.dims(), volume.spacing(), volume.sample_type()),
     };
     let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory)
-        .with_level(levels::level_word(args, pyramid.as_ref()));
-    reproduce
-        .reproduce(&state)
-        .map_err(|e| CliError::input(format!("{}: {e}", input.name)))?;
-    let mut hello = Start {
-        name: &input.name,
-        volume,
-        log: look.log,
-        state: &state,
-        settings: &settings,
+        .with_level(level_word(args, pyramid.as_ref()));
+    let mut launch = launch(args, input, settings, reproduce)?;
+    launch.levels = pyramid;
+    serve(args, launch)
+}
+
+/// The viewer of `input` with `settings` as the flags start it, its
+/// commands `reproduce`'s: one volume, no time axis, no levels, the
+/// starting state the flags'.
+fn launch(
+    args: &ViewerArgs,
+    input: Input,
+    settings: RenderSettings,
+    reproduce: CliReproduce,
+) -> Result<Launch, CliError> {
+    let cache_budget = crate::session::cache_budget(&args.view, &settings, &input)?;
+    let non_finite = input.non_finite(args.view.sampling.nonfinite.into());
+    let figure = figure_context(args, &input);
+    Ok(Launch {
+        name: input.name,
+        volume: input.volume,
+        log: args.view.look.log,
+        state: start_state(args, &settings),
+        settings,
         others: Vec::new(),
         time: None,
-    }
-    .hello();
-    if let Some(p) = &pyramid {
-        p.describe(&mut hello);
-    }
-    hello.fit = args.view.camera.size.is_none();
-    let pool = thread_pool(args.view.threads)?;
-    let labels = input.volume.is_labels();
-    let figure = figure_context(args, &input);
-    let viewer = Viewer {
-        volume: Arc::new(input.volume),
+        levels: None,
+        fit: args.view.camera.size.is_none(),
         non_finite,
         cache_budget,
         max_memory: u128::from(input.max_memory),
-        hello,
         reproduce: Arc::new(reproduce),
-        pool: Arc::new(pool),
+        pool: thread_pool(args.view.threads)?,
         max_sessions: MAX_TABS,
-        levels: pyramid.map(|p| p.into_levels(labels)),
-        others: Vec::new(),
-        time: None,
         figure,
-    };
-    serve(args, viewer)
+    })
 }
 
-/// Serves `viewer` as `args` say until Ctrl-C or SIGTERM.
-fn serve(args: &ViewerArgs, viewer: Viewer) -> Result<(), CliError> {
+/// Serves `launch` as `args` say until Ctrl-C or SIGTERM.
+fn serve(args: &ViewerArgs, launch: Launch) -> Result<(), CliError> {
+    let viewer = launch
+        .viewer()
+        .map_err(|e| CliError::input(e.to_string()))?;
     let addr = SocketAddr::new(args.bind, args.port);
     let server = viewer.bind(addr).map_err(|e| CliError::io(e.to_string()))?;
     let url = server
@@ -190,5 +200,69 @@ pub fn figure_context(
         value_unit: volray_annotate::figure::preset_unit(look.preset.as_deref()).map(String::from),
         length_unit: (input.file.as_ref()).and_then(|(_, info)| info.length_unit.clone()),
         axis_names: crate::figure::axis_names(input).map(String::from),
+    }
+}
+
+/// Opens INPUT level by level (volray-view's `open`) when it is a chunked
+/// file and neither `--log` nor `--spacing` is given (volray-view's
+/// levels are not taken to log10 or respaced yet); `None` for any other
+/// input, read whole. `settings` are the starting view's.
+fn open_levels(args: &ViewerArgs, settings: &RenderSettings) -> Result<Option<Opened>, CliError> {
+    let inp = &args.input;
+    let spec = inp.input.as_deref().unwrap_or(input::DEMO);
+    if volray_data::is_source_spec(spec) {
+        return Ok(None);
+    }
+    if args.view.look.log || inp.spacing.is_some() {
+        if inp.level == Some(LevelChoice::Auto) {
+            return Err(CliError::input(format!(
+                "{spec}: --level auto: the viewer reads a multiscale image's levels as its frames need them, but not yet with --log or --spacing: give a level number, 0 the finest"
+            )));
+        }
+        return Ok(None);
+    }
+    let request = inp.request();
+    let max_memory = request.max_memory();
+    let Some(chunked) = volray_app::plan::open_chunked(&request, max_memory)? else {
+        return Ok(None);
+    };
+    let fixed = request.fixed_level();
+    let non_finite = args.view.sampling.nonfinite.into();
+    let opened = volray_view::open::open_levels(&chunked, fixed, settings, non_finite, max_memory.into())
+        .map_err(|e| match e {
+            OpenError::Read(e) => CliError::from(e),
+            OpenError::CoarsestTooLarge { dims: [x, y, z], need, limit } => CliError::input(format!(
+                "{spec}: its coarsest level ({x}x{y}x{z}) may take up to {} to render whole, more than the 1/{DRAFT_SHARE} of --max-memory {} the viewer gives the frames while the view moves: raise --max-memory",
+                format_bytes(need),
+                format_bytes(limit)
+            )),
+            e => CliError::input(format!("{spec}: {e}")),
+        })?;
+    let count = opened.pyramid.len();
+    let [x, y, z] = opened.pyramid.grid(opened.start).dims;
+    let when_still = match fixed {
+        Some(n) => format!("level {n}"),
+        None => format!(
+            "the level each still needs (--level auto; {} for the start)",
+            opened.still
+        ),
+    };
+    eprintln!(
+        "volray: {}: {count} level{}; the view shows level {} ({x}x{y}x{z}) while it moves, {when_still} when still",
+        Path::new(spec).display(),
+        if count == 1 { "" } else { "s" },
+        opened.start
+    );
+    Ok(Some(opened))
+}
+
+/// The `--level` word of the commands the page shows: the level the
+/// stills show (`auto` for a multiscale image opened level by level
+/// without `--level`), or the `--level N` given.
+fn level_word(args: &ViewerArgs, opened: Option<&Opened>) -> Option<String> {
+    match (args.input.level, opened) {
+        (Some(LevelChoice::Index(n)), _) => Some(n.to_string()),
+        (_, Some(o)) if o.pyramid.len() > 1 => Some("auto".to_string()),
+        _ => None,
     }
 }

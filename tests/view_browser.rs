@@ -523,7 +523,18 @@ fn a_bind_beyond_loopback_warns_and_a_bad_start_is_refused() {
     let out = common::volray(&["view", "blobs:16", "--zoom", "0.0001", "--no-browser"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
-        common::stderr(&out).contains("zoom"),
+        common::stderr(&out).contains(
+            "the starting view is beyond the viewer's bounds: zoom 0.0001 is outside 0.001 to 1000"
+        ),
+        "{}",
+        common::stderr(&out)
+    );
+    let out = common::volray(&["view", "blobs:16", "--size", "5000", "--no-browser"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        common::stderr(&out).contains(
+            "the starting view is beyond the viewer's bounds: width 5000 is outside 1 to 4096"
+        ),
         "{}",
         common::stderr(&out)
     );

@@ -70,3 +70,38 @@ fn a_level_the_file_lacks_and_auto_on_a_file_of_one_level_are_refused() {
         common::stderr(&out)
     );
 }
+
+#[test]
+fn a_pyramid_whose_coarsest_drafts_overrun_the_memory_or_auto_with_log_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = pyramid(dir.path());
+    // The 48³ level's draft frame takes more than a quarter of 600 KiB.
+    let args = ["view", &path, "--max-memory", "600000", "--no-browser"];
+    let out = common::volray(&args);
+    assert_eq!(out.status.code(), Some(1));
+    let err = common::stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("b.ome.zarr: its coarsest level (48x48x48) may take up to ")
+            && err.contains(
+                "more than the 1/4 of --max-memory 586 KiB the viewer gives the frames while the view moves: raise --max-memory"
+            ),
+        "{err}"
+    );
+    for flag in [&["--log"][..], &["--spacing", "1,1,2"]] {
+        let args = [
+            &["view", &path, "--level", "auto", "--no-browser"][..],
+            flag,
+        ]
+        .concat();
+        let out = common::volray(&args);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(
+            common::stderr(&out).contains(
+                "--level auto: the viewer reads a multiscale image's levels as its frames need them, but not yet with --log or --spacing"
+            ),
+            "{}",
+            common::stderr(&out)
+        );
+    }
+}

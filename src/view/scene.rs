@@ -16,17 +16,15 @@
 //! function serve every time point, as a series' do), and each tab reads
 //! the one its slider asks for, as `--frame T`.
 
-use super::reproduce::{CliReproduce, OtherWords, SceneWords};
-use super::{MAX_TABS, serve, start_state};
+use super::reproduce::{CliReproduce, SceneWords};
+use super::{launch, serve};
 use crate::error::CliError;
 use crate::flags::ViewerArgs;
 use crate::scene::{overlay_specs, read_layers, whole_input};
-use crate::session::{load, renderer_for, thread_pool};
+use crate::session::{load, renderer_for};
 use crate::settings::{read_tf_file, settings_with_tf_text};
-use std::sync::Arc;
 use volray_app::input;
-use volray_app::scene::Layer;
-use volray_view::{LayerState, Reproduce, START_COLOURS, Start, TimePoints, Viewer, WHITE};
+use volray_view::{LayerState, START_COLOURS, TimePoints, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
@@ -77,12 +75,25 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     }
     let first = &layers[0];
     let settings = first.settings.clone();
-    let cache_budget = crate::session::cache_budget(&args.view, &settings, &first.input)?;
     let non_finite = first.input.non_finite(args.view.sampling.nonfinite.into());
-
-    let mut state = start_state(args, &settings);
-    state.time = time.as_ref().map(|t| t.start);
-    state.layers = (layers[1..].iter())
+    let volume = &first.input.volume;
+    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
+    // The first volume's transfer function, as its command names it.
+    let named = settings.transfer_function.clone();
+    let mut reproduce = CliReproduce::new(args, named, grid, non_finite, first.input.max_memory);
+    if time.is_some() {
+        reproduce = reproduce.with_time();
+    }
+    if args.scene.is_scene() {
+        let mix = crate::scene::mix(&args.scene);
+        let words = SceneWords::of(spec, args.input.frame, &layers, mix);
+        reproduce = reproduce.with_scene(words);
+    }
+    let mut layers = layers.into_iter();
+    let first = layers.next().expect("the first volume");
+    let mut launch = launch(args, first.input, settings, reproduce)?;
+    launch.state.time = time.as_ref().map(|t| t.start);
+    launch.state.layers = (layers.as_slice().iter())
         .map(|l| LayerState {
             visible: l.look().visible,
             window: None,
@@ -94,58 +105,11 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
             },
         })
         .collect();
-    state.check().map_err(|e| {
-        CliError::input(format!(
-            "the starting view is beyond the viewer's bounds: {e}"
-        ))
-    })?;
-    let volume = &first.input.volume;
-    let grid = (volume.dims(), volume.spacing(), volume.sample_type());
-    // The first volume's transfer function, as its command names it.
-    let named = settings.transfer_function.clone();
-    let mut reproduce = CliReproduce::new(args, named, grid, non_finite, first.input.max_memory);
-    if time.is_some() {
-        reproduce = reproduce.with_time();
-    }
-    if args.scene.is_scene() {
-        reproduce = reproduce.with_scene(scene_words(args, spec, &layers));
-    }
-    reproduce
-        .reproduce(&state)
-        .map_err(|e| CliError::input(format!("{}: {e}", first.input.name)))?;
-    let others: Vec<_> = (layers[1..].iter())
-        .map(|l| (l.input.name.as_str(), &l.input.volume, &l.settings))
+    launch.others = layers
+        .map(|l| (l.input.name, l.input.volume, l.settings))
         .collect();
-    let mut hello = Start {
-        name: &first.input.name,
-        volume,
-        log: look.log,
-        state: &state,
-        settings: &settings,
-        others,
-        time: time.as_ref().map(|t| t.range),
-    }
-    .hello();
-    hello.fit = args.view.camera.size.is_none();
-    let pool = thread_pool(args.view.threads)?;
-    let figure = super::figure_context(args, &first.input);
-    let max_memory = u128::from(first.input.max_memory);
-    let mut volumes = layers.into_iter().map(|l| Arc::new(l.input.volume));
-    let viewer = Viewer {
-        volume: volumes.next().expect("the first volume"),
-        non_finite,
-        cache_budget,
-        max_memory,
-        hello,
-        reproduce: Arc::new(reproduce),
-        pool: Arc::new(pool),
-        max_sessions: MAX_TABS,
-        levels: None,
-        others: volumes.collect(),
-        time,
-        figure,
-    };
-    serve(args, viewer)
+    launch.time = time;
+    serve(args, launch)
 }
 
 /// What `render` refuses of several volumes in one picture, and what
@@ -182,27 +146,4 @@ fn refuse_unsupported(args: &ViewerArgs) -> Result<(), CliError> {
         )));
     }
     Ok(())
-}
-
-/// The scene's volumes after the first as the commands write them.
-fn scene_words(args: &ViewerArgs, spec: &str, layers: &[Layer]) -> SceneWords {
-    let others = (layers[1..].iter())
-        .map(|layer| {
-            let range = layer.input.volume.value_range();
-            let (source, settings) = (&layer.source, &layer.settings);
-            OtherWords::of(
-                source,
-                spec,
-                args.input.frame,
-                settings,
-                range,
-                layer.look(),
-            )
-        })
-        .collect();
-    SceneWords {
-        first: SceneWords::first_of(&layers[0].source),
-        others,
-        mix: crate::scene::mix(&args.scene),
-    }
 }

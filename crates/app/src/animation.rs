@@ -3,11 +3,40 @@
 //! `azimuth + 360·i/n`, framed to the bounding sphere ([`Fit::Sphere`]) so
 //! that the object keeps its scale as it turns), and the one transfer
 //! function and framing every frame of a **series** (several volumes, or a
-//! file's time points) shares ([`Extent`]). The front end reads the
-//! volumes, renders and writes the frames.
+//! file's time points) shares ([`Extent`], read from every volume by
+//! [`series_settings`]). The front end renders and writes the frames.
 
+use crate::AppError;
+use crate::input::{self, Request};
 use volray_core::glam::DVec3;
-use volray_core::{Camera, Fit, RenderSettings};
+use volray_core::{Camera, Fit, Histogram, NonFinite, RenderSettings};
+use volray_options::LookOptions;
+
+/// The views of an animation of one picture: how many frames, and the
+/// settings of each from the settings the options describe. The front
+/// end renders and writes frame after frame; the level (and whether the
+/// volume is rendered in pieces) is chosen for the first. A turntable is
+/// one ([`Turntable`]); a camera path through keyframes would be another.
+pub trait Views {
+    /// The number of frames.
+    fn frames(&self) -> usize;
+    /// The settings of frame `i` (of [`Views::frames`]) of `base`.
+    fn frame(&self, base: &RenderSettings, i: usize) -> RenderSettings;
+}
+
+/// A turntable of so many frames: [`turntable_frame`]'s views.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Turntable(pub usize);
+
+impl Views for Turntable {
+    fn frames(&self) -> usize {
+        self.0
+    }
+
+    fn frame(&self, base: &RenderSettings, i: usize) -> RenderSettings {
+        turntable_frame(base, i, self.0)
+    }
+}
 
 /// The settings of frame `i` of an `n`-frame turntable of `base`.
 pub fn turntable_frame(base: &RenderSettings, i: usize, n: usize) -> RenderSettings {
@@ -69,6 +98,56 @@ impl Extent {
     }
 }
 
+/// The settings every frame of a series shares, from a first pass over
+/// its volumes (`inputs`, each read in turn and dropped, so that a long
+/// series never has to fit in memory; the frames read them again): one
+/// value window and one framed box for all ([`Extent::fix`]); with
+/// `labels`, the labels of every volume, so that a label has one colour;
+/// with `tf auto`, the transfer function chosen from the first volume's
+/// histogram over the window of them all. `base` is the settings the
+/// options describe; `look` the options, `non_finite` how non-finite
+/// values are rendered.
+pub fn series_settings(
+    inputs: &[Request],
+    base: &RenderSettings,
+    look: &LookOptions,
+    non_finite: NonFinite,
+    pool: &rayon::ThreadPool,
+) -> Result<RenderSettings, AppError> {
+    let mut extent = Extent::default();
+    let mut first = None;
+    let mut labels = std::collections::BTreeSet::new();
+    for one in inputs {
+        let input = input::load_log(one, look.log)?;
+        if first.is_none() && look.auto_tf() {
+            first = Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
+        }
+        if look.labels {
+            let found = volray_options::volume_labels(&input.volume, &input.name);
+            labels.extend(found.map_err(AppError::Option)?);
+        }
+        let renderer = crate::renderer::renderer_for(&input, base, non_finite)?;
+        extent.add(renderer.value_range(), input.volume.bounds());
+        if base.gradient_opacity.is_some() {
+            let max = pool.install(|| renderer.max_gradient());
+            extent.max_gradient = extent.max_gradient.max(max);
+        }
+    }
+    let mut settings = extent.fix(base);
+    let tf = &mut settings.transfer_function;
+    if look.labels {
+        let found: Vec<i64> = labels.into_iter().collect();
+        let names = format!("{} volumes", inputs.len());
+        volray_options::label_transfer_function(look, tf, &found, &names)
+            .map_err(AppError::Option)?;
+    }
+    if let Some(histogram) = &first {
+        // Chosen from the first volume, over the window of them all.
+        volray_options::apply_auto(look, tf, histogram);
+    }
+    Ok(settings)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -88,6 +167,8 @@ mod tests {
             .collect();
         assert_eq!(azimuths, [10.0, 100.0, 190.0, 280.0]);
         let frame = turntable_frame(&base, 3, 4);
+        assert_eq!(Turntable(4).frames(), 4);
+        assert_eq!(Turntable(4).frame(&base, 3), frame);
         assert_eq!(frame.camera.fit, Fit::Sphere);
         assert_eq!(frame.camera.elevation, 20.0);
         assert_eq!(

@@ -33,12 +33,21 @@
 //! - [`reproduce`]: the view's state (camera, transfer function, look) and
 //!   its two spellings: `volray render` words ([`reproduce::command`]) and
 //!   Python keywords ([`reproduce::keywords`]);
-//! - [`animation`]: a turntable's views, and the window and framing the
-//!   frames of a series share;
+//! - [`animation`]: an animation's views ([`animation::Views`]: a
+//!   turntable's, or any per-frame camera path), and the window and
+//!   framing the frames of a series share (its first pass);
 //! - [`bench`](mod@bench): `volray bench`'s timed frames, their medians and `--json`
 //!   rows, and the peer benchmark's workloads (with VTK timed beside them);
+//! - [`convert`]: a volume written back as a file (NRRD, `.npy`, raw,
+//!   OME-Zarr), and what was written, in words;
 //! - [`describe`]: what a volume file holds and how volray reads it, as
 //!   `volray info` says it (lines of text, or JSON);
+//! - [`look`]: what the look options leave to an input's volume (its
+//!   file's window, labels, `tf auto`);
+//! - [`renderer`]: a volume's renderer within the memory budget, as the
+//!   command line renders its frames;
+//! - [`reads`]: the files an input reads (a DICOM directory's, a
+//!   header's detached data), and the refusal of an output that is one;
 //! - [`words`]: the number words both spellings and the flags parse;
 //! - [`error`]: [`AppError`], typed, one line naming the file, which each
 //!   front end words in its own syntax.
@@ -69,13 +78,17 @@
 
 pub mod animation;
 pub mod bench;
+pub mod convert;
 pub mod describe;
 #[cfg(feature = "mpi")]
 pub mod distributed;
 pub mod error;
 pub mod input;
+pub mod look;
 pub mod memory;
 pub mod plan;
+pub mod reads;
+pub mod renderer;
 pub mod reproduce;
 pub mod scene;
 pub mod words;

@@ -26,6 +26,8 @@
 //! | `mailbox.rs` | the single-slot mailbox: stale requests dropped, never queued; the stop flag of the frame a newer request supersedes |
 //! | `session/` | a tab's renderer thread: reserve, render (stoppable), encode, send; `mod.rs` its life in order, then one file per concern (`frame.rs`, `render.rs`, `drafts.rs`, `levels.rs`, `pieces.rs`, `time.rs`, `figure.rs`, `probe.rs`) |
 //! | `ledger.rs` | the memory limit shared by every tab: the volume, each tab's renderer, each frame in flight |
+//! | `launch.rs` | [`launch::Launch`]: a viewer started from the volumes its front end read: the starting state checked and reproduced, the first message, the [`Viewer`] |
+//! | `open.rs` | a chunked file opened level by level: its [`Pyramid`], the level read first |
 //! | `pyramid.rs`, `levels.rs` | a multiscale volume served level by level; the levels read whole, shared by the tabs, read outside the cache's lock |
 //! | `reproduce.rs` | [`Reproduce`]: the caller turns a state into settings and a command |
 //! | `hello.rs` | the page's first message: histogram, colours, the start |
@@ -43,10 +45,12 @@
 mod coarse;
 mod encode;
 mod hello;
+pub mod launch;
 mod ledger;
 mod levels;
 mod link;
 mod mailbox;
+pub mod open;
 mod page;
 mod protocol;
 mod pyramid;

@@ -13,7 +13,7 @@
 
 use super::state::{BlendMode, START_COLOURS, ViewState, WHITE};
 use super::viewer::Refusal;
-use crate::scene::{ChannelAxis, LayerSource, mix_name};
+use crate::scene::{ChannelAxis, Layer, LayerSource, mix_name};
 use volray_annotate::figure::preset_unit;
 use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, Phong, RenderSettings, TransferFunction};
@@ -100,6 +100,24 @@ pub struct OtherWords {
 }
 
 impl SceneWords {
+    /// The words of the picture of `layers` (read from INPUT, `spec`, at
+    /// the time point `--frame` picks, `time`), mixed as `mix` says:
+    /// the first volume's channel, every other volume's options.
+    pub fn of(spec: &str, time: Option<usize>, layers: &[Layer], mix: Mix) -> Self {
+        let others = (layers[1..].iter())
+            .map(|layer| {
+                let range = layer.input.volume.value_range();
+                let (source, settings) = (&layer.source, &layer.settings);
+                OtherWords::of(source, spec, time, settings, range, layer.look())
+            })
+            .collect();
+        SceneWords {
+            first: SceneWords::first_of(&layers[0].source),
+            others,
+            mix,
+        }
+    }
+
     /// What picks the first volume of a scene that came from `source`:
     /// its channel's `--channel K` or `--frame K`.
     pub fn first_of(source: &LayerSource) -> Vec<String> {

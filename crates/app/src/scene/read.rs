@@ -12,6 +12,7 @@
 use super::{Budget, ChannelAxis, LayerSource, OverlaySpec, Refused, channel_axis, channel_color};
 use crate::AppError;
 use crate::input::{self, Input, Request};
+use crate::look::leave_to_volume;
 use volray_core::RenderSettings;
 use volray_core::scene::{Look, overlaps};
 use volray_options::{LookOptions, OptionError, Options};
@@ -127,18 +128,8 @@ pub fn read_layers(
             let mut input = input::load_log(first.request, first.log).map_err(Failure::Read)?;
             budget.add(&input.volume);
             let mut settings = settings.clone();
-            volray_options::file_window(
-                first.look,
-                &mut settings.transfer_function,
-                (input.file.as_ref()).and_then(|(_, info)| info.display_window()),
-            );
-            volray_options::from_volume(
-                first.look,
-                &mut settings.transfer_function,
-                &mut input.volume,
-                &input.name,
-            )
-            .map_err(Failure::Option)?;
+            leave_to_volume(first.look, &mut settings.transfer_function, &mut input)
+                .map_err(Failure::Option)?;
             vec![Layer {
                 input,
                 settings,
@@ -230,13 +221,7 @@ fn read_channels(
         let mut settings = settings.clone();
         let tf = &mut settings.transfer_function;
         tf.color = Some(channel_color(rgb, settings.blend.is_projection()));
-        volray_options::file_window(
-            first.look,
-            tf,
-            input.file.as_ref().and_then(|(_, i)| i.display_window()),
-        );
-        volray_options::from_volume(first.look, tf, &mut input.volume, &input.name)
-            .map_err(Failure::Option)?;
+        leave_to_volume(first.look, tf, &mut input).map_err(Failure::Option)?;
         layers.push(Layer {
             input,
             settings,
@@ -300,18 +285,7 @@ fn load_overlay(
     // (whose text is not read here): the overlay's look is its own
     // options'.
     let (look, mut settings) = overlay.settings(shared.clone(), tf_text)?;
-    volray_options::file_window(
-        &look,
-        &mut settings.transfer_function,
-        input.file.as_ref().and_then(|(_, i)| i.display_window()),
-    );
-    volray_options::from_volume(
-        &look,
-        &mut settings.transfer_function,
-        &mut input.volume,
-        &input.name,
-    )
-    .map_err(refuse)?;
+    leave_to_volume(&look, &mut settings.transfer_function, &mut input).map_err(refuse)?;
     Ok(Layer {
         input,
         settings,

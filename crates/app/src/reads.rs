@@ -1,26 +1,41 @@
-//! volray never writes to its inputs: before any work, each output path is
-//! compared with every file the command will read, by identity (device and
-//! inode on Unix, so hard links and symbolic links count, and `./a.png` is
-//! `a.png`), not by name.
+//! The files an input reads, so that volray never writes to its inputs:
+//! before any work, each output path is compared with every file the
+//! command will read, by identity (device and inode on Unix, so hard
+//! links and symbolic links count, and `./a.png` is `a.png`), not by name.
 //!
-//! The files a command reads are its input files (every volume of a
-//! series, and each file of a DICOM directory: its DICOMDIR and every file
-//! that lists, or every file of its subfolders), the detached data files a
-//! `.nhdr` or `.mhd` header names (one name or a `LIST`; numbered
-//! `%d` patterns are not expanded), and `--tf`.
+//! The files an input spec reads ([`files_read`]) are its file (every
+//! volume of a series is a spec of its own), each file of a DICOM
+//! directory (its DICOMDIR and every file that lists, or every file of
+//! its subfolders), and the detached data files a `.nhdr` or `.mhd` header names
+//! (one name or a `LIST`; numbered `%d` patterns are not expanded); a
+//! front end adds its own plain input files (`--tf`).
 
-use crate::error::CliError;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-/// Refuses, with exit code 1, any of `outputs` that is one of the files
-/// `inputs` (specs as given on the command line: built-in sources are
-/// skipped) or `others` (plain input files) name.
+/// An output that is one of the files read: bad input, refused before
+/// any work. Its message names the output, and the input where it is
+/// another name for it.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}: the output is {}; refusing to overwrite it", output.display(), match input {
+    None => "the input file".to_string(),
+    Some(input) => format!("the input file {}", input.display()),
+})]
+pub struct Overwrites {
+    pub output: PathBuf,
+    /// The input by the name it was given, where that is not the
+    /// output's.
+    pub input: Option<PathBuf>,
+}
+
+/// Refuses any of `outputs` that is one of the files `inputs` (specs as
+/// given: built-in sources are skipped) or `others` (plain input files)
+/// name.
 pub fn refuse_overwriting_inputs(
     outputs: &[PathBuf],
     inputs: &[String],
     others: &[&Path],
-) -> Result<(), CliError> {
+) -> Result<(), Overwrites> {
     // Outputs that do not exist yet cannot be inputs; most runs stop here.
     let existing: Vec<(&PathBuf, Identity)> = outputs
         .iter()
@@ -40,15 +55,10 @@ pub fn refuse_overwriting_inputs(
             continue;
         };
         if let Some((output, _)) = existing.iter().find(|(_, o)| *o == id) {
-            let what = if input == output.as_path() {
-                "the input file".to_string()
-            } else {
-                format!("the input file {}", input.display())
-            };
-            return Err(CliError::input(format!(
-                "{}: the output is {what}; refusing to overwrite it",
-                output.display()
-            )));
+            return Err(Overwrites {
+                output: output.to_path_buf(),
+                input: (input != output.as_path()).then(|| input.clone()),
+            });
         }
     }
     Ok(())
@@ -69,7 +79,7 @@ fn input_path(spec: &str) -> PathBuf {
 /// The files reading `path` touches: the file itself, the files of a
 /// directory (DICOM: every series it may read, volray-io's walk), and a
 /// text header's detached data files.
-fn files_read(path: &Path) -> Vec<PathBuf> {
+pub fn files_read(path: &Path) -> Vec<PathBuf> {
     let mut files = vec![path.to_path_buf()];
     if path.is_dir() {
         if let Ok(entries) = fs::read_dir(path) {
@@ -220,15 +230,29 @@ mod tests {
         let link = dir.path().join("link.png");
         fs::hard_link(&input, &link).unwrap();
         for output in [dotted, link] {
-            let err =
-                refuse_overwriting_inputs(&[output], std::slice::from_ref(&spec), &[]).unwrap_err();
-            assert_eq!(err.code, 1);
-            assert!(err.message.contains("refusing to overwrite"), "{err}");
+            let err = refuse_overwriting_inputs(
+                std::slice::from_ref(&output),
+                std::slice::from_ref(&spec),
+                &[],
+            )
+            .unwrap_err();
+            assert_eq!(err.output, output);
+            assert_eq!(err.input.as_ref(), Some(&input));
+            assert!(err.to_string().ends_with(&format!(
+                ": the output is the input file {}; refusing to overwrite it",
+                input.display()
+            )));
         }
-        // A plain input file such as --tf.
+        // A plain input file such as --tf, by its own name.
         let err =
             refuse_overwriting_inputs(std::slice::from_ref(&other), &[], &[&other]).unwrap_err();
-        assert_eq!(err.code, 1);
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "{}: the output is the input file; refusing to overwrite it",
+                other.display()
+            )
+        );
         // A built-in source names no file, even when one has its name.
         fs::write(dir.path().join("blobs:8"), b"x").unwrap();
         assert!(refuse_overwriting_inputs(&[other], &["blobs:8".to_string()], &[]).is_ok());
