@@ -8,29 +8,17 @@ use std::path::Path;
 use volray_core::transfer::{colormap, presets};
 use volray_core::{PiecewiseLinear, TransferFunction as CoreTf};
 
-/// The largest JSON file read as a transfer function: a few hundred
-/// points; this bounds what a wrong path (a device, a huge file) costs.
-const JSON_MAX_BYTES: u64 = 16 << 20;
-
 /// The text of the transfer-function file `path`.
 pub fn read_json(path: &Path) -> PyResult<String> {
-    let name = path.display();
-    let meta = std::fs::metadata(path)
-        .map_err(|e| PyOSError::new_err(format!("tf {name}: cannot read: {e}")))?;
-    if !meta.is_file() {
-        return Err(value_error(format!("tf {name}: not a regular file")));
-    }
-    if meta.len() > JSON_MAX_BYTES {
-        return Err(value_error(format!(
-            "tf {name}: {} bytes is too large for a transfer function (at most {JSON_MAX_BYTES})",
-            meta.len()
-        )));
-    }
-    std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::InvalidData => value_error(format!(
-            "tf {name}: not UTF-8 text (a JSON file is expected)"
-        )),
-        _ => PyOSError::new_err(format!("tf {name}: cannot read: {e}")),
+    // The command line's check and read (volray-app's `read_tf_file`),
+    // its refusals as Python's exceptions.
+    volray_app::look::read_tf_file(path).map_err(|e| {
+        let text = format!("tf {}: {e}", path.display());
+        if e.is_io_failure() {
+            PyOSError::new_err(text)
+        } else {
+            value_error(text)
+        }
     })
 }
 

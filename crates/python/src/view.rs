@@ -408,25 +408,27 @@ fn open_levels(
         }
         Some(LevelChoice::Auto) | None => None,
     };
-    let sources = py.detach(|| {
-        (0..count)
-            .map(|l| Ok(Arc::clone(file.chunked.open_level(l)?.source())))
-            .collect::<Result<Vec<_>, volray_io::IoError>>()
-    });
-    let sources = sources.map_err(io_error)?;
-    let pyramid = Pyramid::new(sources, fixed).map_err(|e| value_error(format!("{name}: {e}")))?;
+    // Opened as `volray view` opens it (volray-view's `open_levels`), the
+    // refusals worded here.
     let limit = u128::from(recipe.max_memory);
-    let start = pyramid
-        .first_draft_level(settings, recipe.nonfinite, limit)
-        .map_err(|e| value_error(format!("{name}: {e}")))?;
-    let Some(start) = start else {
-        let [x, y, z] = pyramid.grid(count - 1).dims;
-        return Err(value_error(format!(
+    let opened = py.detach(|| {
+        volray_view::open::open_levels(&file.chunked, fixed, settings, recipe.nonfinite, limit)
+    });
+    use volray_view::open::OpenError;
+    match opened {
+        Ok(o) => Ok(Opened {
+            pyramid: o.pyramid,
+            start: o.start,
+        }),
+        Err(OpenError::Read(e)) => Err(io_error(e)),
+        Err(OpenError::CoarsestTooLarge {
+            dims: [x, y, z], ..
+        }) => Err(value_error(format!(
             "{name}: its coarsest level ({x}x{y}x{z}) takes more than the 1/{DRAFT_SHARE} of max_memory {} the viewer gives the frames while the view moves: raise max_memory",
             volray_io::format_bytes(limit)
-        )));
-    };
-    Ok(Opened { pyramid, start })
+        ))),
+        Err(e) => Err(value_error(format!("{name}: {e}"))),
+    }
 }
 
 #[pymethods]
