@@ -286,6 +286,13 @@ impl IoError {
     }
 
     pub(crate) fn os(path: &Path, action: &'static str, error: io::Error) -> Self {
+        // A compressed file's decoder found its stream corrupt: bad input
+        // (shared/packed.rs), not the system's failure.
+        if let Some(corrupt) =
+            (error.get_ref()).and_then(|e| e.downcast_ref::<crate::shared::packed::CorruptStream>())
+        {
+            return IoError::invalid(path, corrupt.to_string());
+        }
         IoError::Os {
             path: path.to_path_buf(),
             action,

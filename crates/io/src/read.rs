@@ -533,9 +533,43 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
     if let Some(refusal) = not_read::refuse_file(path, &head) {
         return Err(refusal);
     }
-    VolumeFormat::sniff(&head).ok_or_else(|| IoError::UnknownFormat {
-        path: path.to_path_buf(),
-    })
+    // A compressed file is known by what it decompresses to, read from
+    // the file (a bzip2 stream shows nothing before its first block).
+    let inside = crate::shared::packed::unpack_file_head(path, &head);
+    let format = (inside.as_deref().and_then(VolumeFormat::sniff))
+        .or_else(|| VolumeFormat::sniff(&head))
+        .ok_or_else(|| IoError::UnknownFormat {
+            path: path.to_path_buf(),
+        })?;
+    refuse_packed(path, &head, inside.as_deref(), format)?;
+    Ok(format)
+}
+
+/// Refuses a file found to be `format` inside gzip, bzip2 or xz where its
+/// reader reads the format uncompressed only, naming the way round.
+fn refuse_packed(
+    path: &Path,
+    head: &[u8],
+    inside: Option<&[u8]>,
+    format: VolumeFormat,
+) -> Result<(), IoError> {
+    use crate::shared::packed::{Packing, reads_packed};
+    let Some(packing) = Packing::of(head) else {
+        return Ok(());
+    };
+    let inside = inside.and_then(VolumeFormat::sniff);
+    if reads_packed(format) || inside != Some(format) {
+        return Ok(());
+    }
+    Err(IoError::invalid(
+        path,
+        format!(
+            "a {}-compressed {} file, which volray reads uncompressed only: decompress it first ({} FILE)",
+            packing.name(),
+            format.description(),
+            packing.tool()
+        ),
+    ))
 }
 
 /// Most directory entries looked at for Zarr or N5 stores inside a

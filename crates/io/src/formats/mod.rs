@@ -562,10 +562,11 @@ impl VolumeFormat {
     /// number (`head` should hold at least the first 1024 bytes, or the
     /// whole file if shorter).
     pub fn sniff(head: &[u8]) -> Option<Self> {
-        // A gzip file (.nii.gz, .mgz) is known by what it inflates to; a
-        // gzip file that shows nothing is still taken for a .nii.gz.
-        if head.starts_with(b"\x1f\x8b")
-            && let Some(format) = Self::sniff_plain(&inflate_head(head))
+        // A gzip file (.nii.gz, .mgz, .cube.gz), or a bzip2 or xz one, is
+        // known by what it decompresses to (shared/packed.rs); a gzip file
+        // that shows nothing is still taken for a .nii.gz.
+        if let Some(unpacked) = crate::shared::packed::unpack_head(head)
+            && let Some(format) = Self::sniff_plain(&unpacked)
         {
             return Some(format);
         }
@@ -596,24 +597,6 @@ impl VolumeFormat {
         })?;
         Some(spec.format)
     }
-}
-
-/// The first bytes (at most 1024) that the gzip stream starting `head`
-/// inflates to, as far as `head` goes; empty if it is no gzip stream.
-fn inflate_head(head: &[u8]) -> Vec<u8> {
-    use std::io::Read;
-    let mut out = Vec::with_capacity(1024);
-    let mut decoder = flate2::read::MultiGzDecoder::new(head).take(1024);
-    let mut buf = [0u8; 256];
-    // A stream cut short by `head`'s end fails after yielding what it
-    // could: keep that.
-    while let Ok(n) = decoder.read(&mut buf) {
-        if n == 0 {
-            break;
-        }
-        out.extend_from_slice(&buf[..n]);
-    }
-    out
 }
 
 impl fmt::Display for VolumeFormat {
