@@ -50,6 +50,12 @@
 //! | FITS `.fits`, `.fits.gz` | `formats/fits/` | own parser; BITPIX 8 … −64, BSCALE/BZERO, BLANK as NaN; linear WCS (world spacing when the axes share a unit, else pixel coordinates); image HDUs and a 4th axis as frames, `--array EXTNAME` |
 //! | FreeSurfer MGH `.mgh`, `.mgz` | `formats/mgh/` | big-endian; nibabel's get_affine (Mdc, delta, Pxyz_c); frames; gzip streamed; known by content too |
 //! | Analyze 7.5 `.hdr`/`.img` | `formats/nifti/` | a NIfTI-1 pair without magic; nibabel's affine (x flipped, centre or SPM originator); known by content |
+//! | OpenDX `.dx` | `formats/opendx.rs` | APBS, VMD, PyMOL, GridDataFormats; text values (data follows); deltas placed exactly, rotated kept in the grid's axes, skewed resampled over the box; known by content too |
+//! | XSF/BXSF `.xsf`, `.bxsf` | `formats/xsf.rs` | XCrySDen, Quantum ESPRESSO, ASE, VESTA; DATAGRID_3D grids as arrays (`--array`), BANDGRID_3D bands as frames; general (periodic) grids, skewed cells resampled; known by content too |
+//! | gOpenMol `.plt` | `formats/plt.rs` | binary, either byte order; min..max inclusive (gOpenMol, VMD); known by content too |
+//!
+//! The text formats (cube, CHGCAR, legacy VTK, OpenDX, XSF) and gOpenMol
+//! are also read inside gzip, bzip2 or xz, known by content (`shared/packed.rs`).
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is

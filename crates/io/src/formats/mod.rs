@@ -33,10 +33,13 @@ pub(crate) mod nifti;
 pub(crate) mod not_read;
 pub(crate) mod npy;
 pub(crate) mod nrrd;
+pub(crate) mod opendx;
+pub(crate) mod plt;
 pub(crate) mod raw;
 pub(crate) mod tiff;
 pub(crate) mod vti;
 pub(crate) mod vtk_legacy;
+pub(crate) mod xsf;
 pub(crate) mod zarr;
 
 use std::fmt;
@@ -94,6 +97,12 @@ pub enum VolumeFormat {
     /// Analyze 7.5 `.hdr`/`.img` pairs (no NIfTI magic), read by the
     /// NIfTI reader.
     Analyze,
+    /// OpenDX scalar fields (`.dx`): APBS, VMD, PyMOL, GridDataFormats.
+    Dx,
+    /// XCrySDen XSF and BXSF data and band grids (`.xsf`, `.bxsf`).
+    Xsf,
+    /// gOpenMol plot files (`.plt`), binary.
+    Plt,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -465,6 +474,55 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: nifti::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Dx,
+        name: "dx",
+        description: "OpenDX field",
+        extensions: &["dx"],
+        name_stems: &[],
+        known_as: ".dx",
+        magic: Magic {
+            text: Some(opendx::sniff_text),
+            ..Magic::NONE
+        },
+        frames: false,
+        arrays: false,
+        levels: false,
+        read: opendx::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Xsf,
+        name: "xsf",
+        description: "XCrySDen XSF grid",
+        extensions: &["xsf", "bxsf"],
+        name_stems: &[],
+        known_as: ".xsf/.bxsf",
+        magic: Magic {
+            text: Some(xsf::sniff_text),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: true,
+        levels: false,
+        read: xsf::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Plt,
+        name: "plt",
+        description: "gOpenMol plt grid",
+        extensions: &["plt"],
+        name_stems: &[],
+        known_as: ".plt (gOpenMol)",
+        // Rank 3 in either byte order and plausible fields (`plt::sniff`).
+        magic: Magic {
+            binary: Some(plt::sniff),
+            ..Magic::NONE
+        },
+        frames: false,
+        arrays: false,
+        levels: false,
+        read: plt::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -731,13 +789,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 19);
+        assert_eq!(VolumeFormat::ALL.len(), 22);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

@@ -126,7 +126,7 @@ pub(crate) fn reads_packed(format: VolumeFormat) -> bool {
     use VolumeFormat as F;
     matches!(
         format,
-        F::Nifti | F::Mgh | F::Fits | F::Cube | F::Chgcar | F::VtkLegacy
+        F::Nifti | F::Mgh | F::Fits | F::Cube | F::Chgcar | F::VtkLegacy | F::Dx | F::Xsf | F::Plt
     )
 }
 
