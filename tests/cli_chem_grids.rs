@@ -1,5 +1,6 @@
 //! The chemistry grids volray reads beside cube and CHGCAR (OpenDX, XSF,
-//! gOpenMol plt) and text formats behind gzip, bzip2 or xz: `volray info`
+//! gOpenMol plt), NumPy `.npz` archives, and text formats behind gzip,
+//! bzip2 or xz: `volray info`
 //! names the format and geometry, and `volray render` with no options
 //! draws a picture that is not blank. The files are small ones made here
 //! after each format's layout (crates/io/tests/chem_grids.rs checks the
@@ -10,7 +11,7 @@ mod common;
 use std::io::Write;
 use std::path::Path;
 
-use common::{Picture, render, stderr, stdout, volray};
+use common::{Picture, render, stderr, stdout, volray, written_by_python};
 
 /// A ball of density on an n³ grid, x fastest: exp(-r²/4), r in voxels
 /// from the centre.
@@ -136,4 +137,28 @@ fn a_compressed_file_of_a_format_read_plain_only_is_refused_in_one_line() {
     let err = stderr(&out);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("a gzip-compressed MetaImage file, which volray reads uncompressed only: decompress it first (gunzip -k FILE)"), "{err}");
+}
+
+#[test]
+fn a_numpy_npz_archive_renders_with_no_options() {
+    let script = "import sys, numpy as np\n\
+i, j, k = np.indices((9, 8, 7))\n\
+r2 = (i - 4) ** 2 + (j - 3.5) ** 2 + (k - 3) ** 2\n\
+np.savez_compressed(sys.argv[1] + '/ball.npz', ball=np.exp(-r2 / 4.0).astype(np.float32), other=np.zeros((2, 2, 2)))\n";
+    let Some(dir) = written_by_python(&["numpy"], &[], script) else {
+        return;
+    };
+    let path = dir.path().join("ball.npz");
+    let v = info(&path);
+    assert_eq!(v["format"], "NumPy .npz");
+    assert_eq!(v["dims"], serde_json::json!([9, 8, 7]));
+    let png = dir.path().join("ball.png");
+    render(&[path.to_str().unwrap(), "--size", "32"], &png);
+    let picture = Picture::read(&png);
+    assert!(picture.rgb.iter().any(|p| *p != picture.rgb[0]), "blank");
+    let text = stdout(&volray(&["info", path.to_str().unwrap()]));
+    assert!(
+        text.contains("array \"ball\" (the first) of the 2 the archive holds"),
+        "{text}"
+    );
 }

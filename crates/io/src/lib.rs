@@ -53,6 +53,7 @@
 //! | OpenDX `.dx` | `formats/opendx.rs` | APBS, VMD, PyMOL, GridDataFormats; text values (data follows); deltas placed exactly, rotated kept in the grid's axes, skewed resampled over the box; known by content too |
 //! | XSF/BXSF `.xsf`, `.bxsf` | `formats/xsf.rs` | XCrySDen, Quantum ESPRESSO, ASE, VESTA; DATAGRID_3D grids as arrays (`--array`), BANDGRID_3D bands as frames; general (periodic) grids, skewed cells resampled; known by content too |
 //! | gOpenMol `.plt` | `formats/plt.rs` | binary, either byte order; min..max inclusive (gOpenMol, VMD); known by content too |
+//! | NumPy `.npz` | `formats/npz.rs` | `numpy.savez` (stored) and `savez_compressed` (deflated) archives through the `zip` crate; each array as `.npy`; `--array NAME`, the first by default |
 //!
 //! The text formats (cube, CHGCAR, legacy VTK, OpenDX, XSF) and gOpenMol
 //! are also read inside gzip, bzip2 or xz, known by content (`shared/packed.rs`).

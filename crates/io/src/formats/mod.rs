@@ -32,6 +32,7 @@ pub(crate) mod netcdf4;
 pub(crate) mod nifti;
 pub(crate) mod not_read;
 pub(crate) mod npy;
+pub(crate) mod npz;
 pub(crate) mod nrrd;
 pub(crate) mod opendx;
 pub(crate) mod plt;
@@ -103,6 +104,8 @@ pub enum VolumeFormat {
     Xsf,
     /// gOpenMol plot files (`.plt`), binary.
     Plt,
+    /// NumPy `.npz` archives (`numpy.savez`, `savez_compressed`).
+    Npz,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -523,6 +526,21 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: plt::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Npz,
+        name: "npz",
+        description: "NumPy .npz",
+        extensions: &["npz"],
+        name_stems: &[],
+        known_as: ".npz",
+        // A zip file's first local header: other zip-based files (a .docx)
+        // are sent here too and refused as holding no .npy arrays.
+        magic: Magic::strong(&[(0, b"PK\x03\x04")]),
+        frames: false,
+        arrays: true,
+        levels: false,
+        read: npz::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -789,13 +807,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol), .npz"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt, npz"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 22);
+        assert_eq!(VolumeFormat::ALL.len(), 23);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
