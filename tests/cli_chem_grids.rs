@@ -1,5 +1,5 @@
 //! The chemistry grids volray reads beside cube and CHGCAR (OpenDX, XSF,
-//! gOpenMol plt), NumPy `.npz` archives, and text formats behind gzip,
+//! gOpenMol plt), NumPy `.npz` archives, GIPL images, and text formats behind gzip,
 //! bzip2 or xz: `volray info`
 //! names the format and geometry, and `volray render` with no options
 //! draws a picture that is not blank. The files are small ones made here
@@ -161,4 +161,25 @@ np.savez_compressed(sys.argv[1] + '/ball.npz', ball=np.exp(-r2 / 4.0).astype(np.
         text.contains("array \"ball\" (the first) of the 2 the archive holds"),
         "{text}"
     );
+}
+
+#[test]
+fn a_gipl_image_from_simpleitk_renders_with_no_options() {
+    let script = "import sys, numpy as np, SimpleITK as sitk\n\
+k, j, i = np.indices((7, 8, 9))\n\
+r2 = (i - 4) ** 2 + (j - 3.5) ** 2 + (k - 3) ** 2\n\
+image = sitk.GetImageFromArray((1000 * np.exp(-r2 / 4.0)).astype(np.int16))\n\
+image.SetSpacing((1.0, 1.0, 1.5))\n\
+sitk.WriteImage(image, sys.argv[1] + '/ball.gipl')\n";
+    let Some(dir) = written_by_python(&["numpy", "SimpleITK"], &[], script) else {
+        return;
+    };
+    let path = dir.path().join("ball.gipl");
+    let v = info(&path);
+    assert_eq!(v["format"], "GIPL image");
+    assert_eq!(v["dims"], serde_json::json!([9, 8, 7]));
+    let png = dir.path().join("ball.png");
+    render(&[path.to_str().unwrap(), "--size", "32"], &png);
+    let picture = Picture::read(&png);
+    assert!(picture.rgb.iter().any(|p| *p != picture.rgb[0]), "blank");
 }

@@ -54,6 +54,7 @@
 //! | XSF/BXSF `.xsf`, `.bxsf` | `formats/xsf.rs` | XCrySDen, Quantum ESPRESSO, ASE, VESTA; DATAGRID_3D grids as arrays (`--array`), BANDGRID_3D bands as frames; general (periodic) grids, skewed cells resampled; known by content too |
 //! | gOpenMol `.plt` | `formats/plt.rs` | binary, either byte order; min..max inclusive (gOpenMol, VMD); known by content too |
 //! | NumPy `.npz` | `formats/npz.rs` | `numpy.savez` (stored) and `savez_compressed` (deflated) archives through the `zip` crate; each array as `.npy`; `--array NAME`, the first by default |
+//! | GIPL `.gipl`, `.gipl.gz` | `formats/gipl.rs` | ITK's layout: big-endian, i8 … f64; pixdim, origin (no direction: world axes); a 4th axis as frames; known by its magic |
 //!
 //! The text formats (cube, CHGCAR, legacy VTK, OpenDX, XSF) and gOpenMol
 //! are also read inside gzip, bzip2 or xz, known by content (`shared/packed.rs`).

@@ -294,7 +294,7 @@ fn lying_and_broken_opendx_files_are_refused_in_one_line() {
     );
     refuse_text(
         "nan.dx",
-        format!("object 1 class gridpositions counts 2 2 2\norigin 0 nan 0\n").as_bytes(),
+        b"object 1 class gridpositions counts 2 2 2\norigin 0 nan 0\n",
         "origin",
     );
 }

@@ -18,6 +18,7 @@ pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
 pub(crate) mod fits;
+pub(crate) mod gipl;
 pub(crate) mod hdf5;
 pub(crate) mod hdf5_axes;
 pub(crate) mod hdf5_lazy;
@@ -106,6 +107,8 @@ pub enum VolumeFormat {
     Plt,
     /// NumPy `.npz` archives (`numpy.savez`, `savez_compressed`).
     Npz,
+    /// GIPL images (`.gipl`, `.gipl.gz`): ITK, SimpleITK.
+    Gipl,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -541,6 +544,20 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: npz::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Gipl,
+        name: "gipl",
+        description: "GIPL image",
+        extensions: &["gipl", "gipl.gz"],
+        name_stems: &[],
+        known_as: ".gipl",
+        // ITK's two magic numbers at byte 252 (`gipl::MAGIC`).
+        magic: Magic::strong(&[(252, b"\xef\xff\xe9\xb0"), (252, b"\x2a\xe3\x89\xb8")]),
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: gipl::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -807,13 +824,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol), .npz"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol), .npz, .gipl"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt, npz"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt, npz, gipl"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 23);
+        assert_eq!(VolumeFormat::ALL.len(), 24);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 
