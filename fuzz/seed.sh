@@ -3,7 +3,7 @@
 # readers' test fixtures (crates/io/tests/fixtures/) and the committed
 # hand-made seeds (fuzz/seeds/<target>/; dx, xsf and plt: files written by
 # crates/io/tests/chem_grids/write_files.py, npz and gipl: by
-# crates/io/tests/npz/ and gipl/write_files.py). Targets whose reader takes
+# crates/io/tests/npz/ and gipl/write_files.py; mrtrix: after its documented layout). Targets whose reader takes
 # --frame/--array read a control byte before the file (see fuzz/src/lib.rs):
 # fixtures get 0x00 (defaults) and, where they hold several volumes or need
 # a detached header's name, the byte that picks that.
@@ -29,11 +29,11 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh dx xsf plt npz gipl"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh dx xsf plt npz gipl mrtrix"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
-    dx | plt | gipl) add $t 00 "$here"/seeds/$t/* ;;
+    dx | plt | gipl | mrtrix) add $t 00 "$here"/seeds/$t/* ;;
     npz)
         add npz 00 "$here"/seeds/npz/*
         add npz 20 "$here"/seeds/npz/named.npz

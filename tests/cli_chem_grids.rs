@@ -1,5 +1,5 @@
 //! The chemistry grids volray reads beside cube and CHGCAR (OpenDX, XSF,
-//! gOpenMol plt), NumPy `.npz` archives, GIPL images, and text formats behind gzip,
+//! gOpenMol plt), NumPy `.npz` archives, GIPL and MRtrix images, and text formats behind gzip,
 //! bzip2 or xz: `volray info`
 //! names the format and geometry, and `volray render` with no options
 //! draws a picture that is not blank. The files are small ones made here
@@ -72,6 +72,16 @@ fn plt(n: usize) -> Vec<u8> {
     out
 }
 
+fn mif(n: usize) -> Vec<u8> {
+    let mut out = format!(
+        "mrtrix image\ndim: {n},{n},{n}\nvox: 1,1,1\nlayout: +0,+1,+2\ndatatype: Float32LE\nfile: . 128\nEND\n"
+    )
+    .into_bytes();
+    out.resize(128, 0);
+    out.extend(ball(n).iter().flat_map(|f| f.to_le_bytes()));
+    out
+}
+
 fn gzip(bytes: &[u8]) -> Vec<u8> {
     let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
     e.write_all(bytes).unwrap();
@@ -89,7 +99,8 @@ fn info(path: &Path) -> serde_json::Value {
 fn opendx_xsf_plt_and_compressed_text_render_with_no_options() {
     let dir = tempfile::tempdir().unwrap();
     let cube = std::fs::read("crates/io/tests/fixtures/cube/ramp_bohr.cube").unwrap();
-    let cases: [(&str, Vec<u8>, &str, [usize; 3]); 6] = [
+    let cases: [(&str, Vec<u8>, &str, [usize; 3]); 7] = [
+        ("ball.mif", mif(9), "MRtrix image", [9, 9, 9]),
         ("ball.dx", dx(9), "OpenDX field", [9, 9, 9]),
         ("ball.xsf", xsf(9), "XCrySDen XSF grid", [9, 9, 9]),
         ("ball.plt", plt(9), "gOpenMol plt grid", [9, 9, 9]),

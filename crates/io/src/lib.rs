@@ -55,9 +55,10 @@
 //! | gOpenMol `.plt` | `formats/plt.rs` | binary, either byte order; min..max inclusive (gOpenMol, VMD); known by content too |
 //! | NumPy `.npz` | `formats/npz.rs` | `numpy.savez` (stored) and `savez_compressed` (deflated) archives through the `zip` crate; each array as `.npy`; `--array NAME`, the first by default |
 //! | GIPL `.gipl`, `.gipl.gz` | `formats/gipl.rs` | ITK's layout: big-endian, i8 … f64; pixdim, origin (no direction: world axes); a 4th axis as frames; known by its magic |
+//! | MRtrix `.mif`, `.mih`, `.mif.gz` | `formats/mrtrix.rs` | MRtrix3's header: dim, vox, layout (ranks and reversed axes), datatype, transform (scanner RAS mm), scaling; a 4th axis as frames; known by content too |
 //!
-//! The text formats (cube, CHGCAR, legacy VTK, OpenDX, XSF) and gOpenMol
-//! are also read inside gzip, bzip2 or xz, known by content (`shared/packed.rs`).
+//! The text formats (cube, CHGCAR, legacy VTK, OpenDX, XSF), gOpenMol, GIPL
+//! and MRtrix are also read inside gzip, bzip2 or xz, known by content (`shared/packed.rs`).
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is

@@ -28,6 +28,7 @@ pub(crate) mod minc;
 pub(crate) mod minc1;
 pub(crate) mod minc_common;
 pub(crate) mod mrc;
+pub(crate) mod mrtrix;
 pub(crate) mod netcdf;
 pub(crate) mod netcdf4;
 pub(crate) mod nifti;
@@ -109,6 +110,8 @@ pub enum VolumeFormat {
     Npz,
     /// GIPL images (`.gipl`, `.gipl.gz`): ITK, SimpleITK.
     Gipl,
+    /// MRtrix images (`.mif`, `.mih`, `.mif.gz`).
+    Mrtrix,
 }
 
 /// Everything volray knows about one format besides its reader's code.
@@ -558,6 +561,22 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         levels: false,
         read: gipl::read,
     },
+    FormatSpec {
+        format: VolumeFormat::Mrtrix,
+        name: "mrtrix",
+        description: "MRtrix image",
+        extensions: &["mif", "mih", "mif.gz"],
+        name_stems: &[],
+        known_as: ".mif/.mih",
+        magic: Magic {
+            text: Some(mrtrix::sniff_text),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: mrtrix::read,
+    },
 ];
 
 // Row i describes variant i, so `spec` can index the table.
@@ -824,13 +843,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol), .npz, .gipl"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol), .npz, .gipl, .mif/.mih"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt, npz, gipl"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt, npz, gipl, mrtrix"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 24);
+        assert_eq!(VolumeFormat::ALL.len(), 25);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

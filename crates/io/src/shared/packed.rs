@@ -1,7 +1,7 @@
 //! Files behind gzip, bzip2 or xz (`.cube.gz`, `CHGCAR.bz2`, `grid.dx.xz`),
 //! known by their first bytes, not their names, and read as the stream
 //! they decompress to: the text formats (cube, CHGCAR, legacy VTK, OpenDX,
-//! XSF), gOpenMol `.plt` and GIPL take their input through [`open_unpacked`],
+//! XSF), gOpenMol `.plt`, GIPL and MRtrix take their input through [`open_unpacked`],
 //! which hands a plain file through unchanged.
 //!
 //! Nothing is decompressed whole: the readers stream numbers out of the
