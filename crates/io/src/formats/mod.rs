@@ -13,6 +13,9 @@
 //! of names `--format` accepts, the list of known kinds in
 //! [`IoError::UnknownFormat`], which reader options apply and the reader
 //! itself all come from the row.
+//!
+//! The file runs past 800 lines because the table is one row per format
+//! (25), kept beside the enum it indexes and the detection that reads it.
 
 pub(crate) mod chgcar;
 pub(crate) mod cube;
