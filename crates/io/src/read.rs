@@ -545,6 +545,26 @@ fn detect(path: &Path, opts: &ReadOptions) -> Result<VolumeFormat, IoError> {
     Ok(format)
 }
 
+/// Whether `format`'s reader reads its files inside gzip (and bzip2 and
+/// xz where it streams through `shared/packed.rs`); the others are refused
+/// by name of the compression when found inside one (below).
+fn reads_packed(format: VolumeFormat) -> bool {
+    use VolumeFormat as F;
+    matches!(
+        format,
+        F::Nifti
+            | F::Mgh
+            | F::Fits
+            | F::Cube
+            | F::Chgcar
+            | F::VtkLegacy
+            | F::Dx
+            | F::Xsf
+            | F::Plt
+            | F::Gipl
+    )
+}
+
 /// Refuses a file found to be `format` inside gzip, bzip2 or xz where its
 /// reader reads the format uncompressed only, naming the way round.
 fn refuse_packed(
@@ -553,7 +573,7 @@ fn refuse_packed(
     inside: Option<&[u8]>,
     format: VolumeFormat,
 ) -> Result<(), IoError> {
-    use crate::shared::packed::{Packing, reads_packed};
+    use crate::shared::packed::Packing;
     let Some(packing) = Packing::of(head) else {
         return Ok(());
     };

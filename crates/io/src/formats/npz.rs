@@ -21,11 +21,10 @@ use std::path::Path;
 use zip::result::ZipError;
 use zip::{CompressionMethod, ZipArchive};
 
-use crate::error::IoError;
+use crate::error::{CorruptStream, IoError};
 use crate::formats::npy;
 use crate::shared::compress::MAX_DEFLATE_RATIO;
 use crate::shared::input::open_input;
-use crate::shared::packed::CorruptStream;
 use crate::{Loaded, ReadOptions, VolumeFormat};
 
 /// Reads the `.npz` archive at `path` (see the module docs).

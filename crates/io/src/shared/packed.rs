@@ -16,10 +16,9 @@
 //! costs time in proportion to its decompressed size, never memory.
 //!
 //! Corrupt streams are bad input, not a failure of the system: the
-//! decoders' errors come out as [`CorruptStream`], which
+//! decoders' errors come out as `CorruptStream` (error.rs), which
 //! [`IoError::os`](crate::IoError) words as an invalid file.
 
-use std::fmt;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom};
 use std::num::NonZeroUsize;
@@ -28,8 +27,7 @@ use std::path::Path;
 use bzip2::read::MultiBzDecoder;
 use flate2::read::MultiGzDecoder;
 
-use crate::error::IoError;
-use crate::formats::VolumeFormat;
+use crate::error::{CorruptStream, IoError};
 use crate::shared::compress::{MAX_BZIP2_RATIO, MAX_DEFLATE_RATIO, MAX_XZ_DICT};
 use crate::shared::input::open_input;
 
@@ -103,40 +101,6 @@ impl Packing {
             )),
         }
     }
-}
-
-/// A decoder's complaint about its stream: the file is corrupt (bad
-/// input), not unreadable. Carried inside an [`io::Error`] of kind
-/// `InvalidData`, which [`IoError::os`] turns into an invalid-file error.
-#[derive(Debug)]
-pub(crate) struct CorruptStream(pub String);
-
-impl fmt::Display for CorruptStream {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for CorruptStream {}
-
-/// Whether `format`'s reader reads its files inside gzip (and bzip2 and
-/// xz where it streams through [`open_unpacked`]); the others are refused
-/// by name of the compression when found inside one (`read.rs`).
-pub(crate) fn reads_packed(format: VolumeFormat) -> bool {
-    use VolumeFormat as F;
-    matches!(
-        format,
-        F::Nifti
-            | F::Mgh
-            | F::Fits
-            | F::Cube
-            | F::Chgcar
-            | F::VtkLegacy
-            | F::Dx
-            | F::Xsf
-            | F::Plt
-            | F::Gipl
-    )
 }
 
 /// A file opened for streaming: its bytes, or the bytes it decompresses to.
