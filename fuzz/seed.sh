@@ -1,7 +1,9 @@
 #!/bin/sh
 # Builds the fuzzing corpora (fuzz/corpus/<target>/, not committed) from the
 # readers' test fixtures (crates/io/tests/fixtures/) and the committed
-# hand-made seeds (fuzz/seeds/<target>/). Targets whose reader takes
+# hand-made seeds (fuzz/seeds/<target>/; dx, xsf and plt: files written by
+# crates/io/tests/chem_grids/write_files.py, npz and gipl: by
+# crates/io/tests/npz/ and gipl/write_files.py; mrtrix: after its documented layout). Targets whose reader takes
 # --frame/--array read a control byte before the file (see fuzz/src/lib.rs):
 # fixtures get 0x00 (defaults) and, where they hold several volumes or need
 # a detached header's name, the byte that picks that.
@@ -27,10 +29,19 @@ add() {
     done
 }
 
-targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom dicomdir tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh"}
+targets=${*:-"raw npy nrrd metaimage nifti vtk vti dicom dicomdir tiff cube mrc chgcar hdf5 minc zarr netcdf fits mgh dx xsf plt npz gipl mrtrix"}
 for t in $targets; do
     case $t in
     raw) add raw none "$here"/seeds/raw/* ;;
+    dx | plt | gipl | mrtrix) add $t 00 "$here"/seeds/$t/* ;;
+    npz)
+        add npz 00 "$here"/seeds/npz/*
+        add npz 20 "$here"/seeds/npz/named.npz
+        ;;
+    xsf)
+        add xsf 00 "$here"/seeds/xsf/*
+        add xsf 02 "$here"/seeds/xsf/fermi.bxsf
+        ;;
     npy) add npy none "$fix"/*.npy ;;
     mrc) add mrc none "$fix"/mrc/* ;;
     nrrd)

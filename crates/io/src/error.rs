@@ -286,6 +286,11 @@ impl IoError {
     }
 
     pub(crate) fn os(path: &Path, action: &'static str, error: io::Error) -> Self {
+        // A compressed file's decoder found its stream corrupt: bad input
+        // (shared/packed.rs), not the system's failure.
+        if let Some(corrupt) = (error.get_ref()).and_then(|e| e.downcast_ref::<CorruptStream>()) {
+            return IoError::invalid(path, corrupt.to_string());
+        }
         IoError::Os {
             path: path.to_path_buf(),
             action,
@@ -409,6 +414,21 @@ fn one_line(text: impl Into<String>) -> String {
         })
         .collect()
 }
+
+/// A decoder's complaint about its stream: the file is corrupt (bad
+/// input), not unreadable. Carried inside an [`io::Error`] of kind
+/// `InvalidData`, which [`IoError::os`] turns into an invalid-file error
+/// (shared/packed.rs's decoders, an `.npz` member's).
+#[derive(Debug)]
+pub(crate) struct CorruptStream(pub String);
+
+impl std::fmt::Display for CorruptStream {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for CorruptStream {}
 
 #[cfg(test)]
 mod tests {

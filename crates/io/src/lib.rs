@@ -52,6 +52,15 @@
 //! | Analyze 7.5 `.hdr`/`.img` | `formats/nifti/` | a NIfTI-1 pair without magic; SPM's `.mat` beside it (`nifti/spm.rs`, MATLAB files by `shared/matlab.rs`), else nibabel's affine (x flipped, centre or SPM originator); known by content |
 //! | VTKHDF `.vtkhdf` (or an HDF5 file with `/VTKHDF`) | `formats/vtkhdf.rs` | ImageData: extent, origin, spacing; point and cell arrays (`--array`), components (`--channel`); read through `hdf5.rs` and `hdf5_lazy.rs` |
 //! | BigDataViewer `dataset.xml` (or its `.h5`) | `formats/bdv/` | SpimData XML (`xml.rs`); setups as channels, time points, levels as OME-Zarr's ([`ReadOptions::level`]); voxel size and registration; int16 as unsigned |
+//! | OpenDX `.dx` | `formats/opendx.rs` | APBS, VMD, PyMOL, GridDataFormats; text values (data follows); deltas placed exactly, rotated kept in the grid's axes, skewed resampled over the box; known by content too |
+//! | XSF/BXSF `.xsf`, `.bxsf` | `formats/xsf.rs` | XCrySDen, Quantum ESPRESSO, ASE, VESTA; DATAGRID_3D grids as arrays (`--array`), BANDGRID_3D bands as frames; general (periodic) grids, skewed cells resampled; known by content too |
+//! | gOpenMol `.plt` | `formats/plt.rs` | binary, either byte order; min..max inclusive (gOpenMol, VMD); known by content too |
+//! | NumPy `.npz` | `formats/npz.rs` | `numpy.savez` (stored) and `savez_compressed` (deflated) archives through the `zip` crate; each array as `.npy`; `--array NAME`, the first by default |
+//! | GIPL `.gipl`, `.gipl.gz` | `formats/gipl.rs` | ITK's layout: big-endian, i8 … f64; pixdim, origin (no direction: world axes); a 4th axis as frames; known by its magic |
+//! | MRtrix `.mif`, `.mih`, `.mif.gz` | `formats/mrtrix.rs` | MRtrix3's header: dim, vox, layout (ranks and reversed axes), datatype, transform (scanner RAS mm), scaling; a 4th axis as frames; known by content too |
+//!
+//! The text formats (cube, CHGCAR, legacy VTK, OpenDX, XSF), gOpenMol, GIPL
+//! and MRtrix are also read inside gzip, bzip2 or xz, known by content (`shared/packed.rs`).
 //!
 //! A file that holds one image rather than a volume (a single DICOM
 //! slice, a 2-D NRRD, NIfTI, MetaImage or HDF5 image, a one-page TIFF) is

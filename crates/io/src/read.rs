@@ -597,9 +597,63 @@ fn detect_by_name_or_content(path: &Path, opts: &ReadOptions) -> Result<VolumeFo
     if let Some(refusal) = not_read::refuse_file(path, &head) {
         return Err(refusal);
     }
-    VolumeFormat::sniff(&head).ok_or_else(|| IoError::UnknownFormat {
-        path: path.to_path_buf(),
-    })
+    // A compressed file is known by what it decompresses to, read from
+    // the file (a bzip2 stream shows nothing before its first block).
+    let inside = crate::shared::packed::unpack_file_head(path, &head);
+    let format = (inside.as_deref().and_then(VolumeFormat::sniff))
+        .or_else(|| VolumeFormat::sniff(&head))
+        .ok_or_else(|| IoError::UnknownFormat {
+            path: path.to_path_buf(),
+        })?;
+    refuse_packed(path, &head, inside.as_deref(), format)?;
+    Ok(format)
+}
+
+/// Whether `format`'s reader reads its files inside gzip (and bzip2 and
+/// xz where it streams through `shared/packed.rs`); the others are refused
+/// by name of the compression when found inside one (below).
+fn reads_packed(format: VolumeFormat) -> bool {
+    use VolumeFormat as F;
+    matches!(
+        format,
+        F::Nifti
+            | F::Mgh
+            | F::Fits
+            | F::Cube
+            | F::Chgcar
+            | F::VtkLegacy
+            | F::Dx
+            | F::Xsf
+            | F::Plt
+            | F::Gipl
+    )
+}
+
+/// Refuses a file found to be `format` inside gzip, bzip2 or xz where its
+/// reader reads the format uncompressed only, naming the way round.
+fn refuse_packed(
+    path: &Path,
+    head: &[u8],
+    inside: Option<&[u8]>,
+    format: VolumeFormat,
+) -> Result<(), IoError> {
+    use crate::shared::packed::Packing;
+    let Some(packing) = Packing::of(head) else {
+        return Ok(());
+    };
+    let inside = inside.and_then(VolumeFormat::sniff);
+    if reads_packed(format) || inside != Some(format) {
+        return Ok(());
+    }
+    Err(IoError::invalid(
+        path,
+        format!(
+            "a {}-compressed {} file, which volray reads uncompressed only: decompress it first ({} FILE)",
+            packing.name(),
+            format.description(),
+            packing.tool()
+        ),
+    ))
 }
 
 /// Most directory entries looked at for Zarr or N5 stores inside a

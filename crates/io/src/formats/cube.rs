@@ -25,15 +25,14 @@
 //! Skewed axes (crystal cells written by periodic codes) are resampled as
 //! one periodic cell (see [`crate::shared::periodic_cell`]).
 
-use std::io::BufReader;
 use std::path::Path;
 
 use volray_core::glam::DVec3;
 
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::input::open_input;
 use crate::shared::limits::{F32_BYTES, check_dims};
+use crate::shared::packed::open_unpacked;
 use crate::shared::periodic_cell;
 use crate::shared::text_reader::{TextReader, all_numbers, integer, number, whole_lines};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -72,9 +71,12 @@ pub(crate) fn sniff_text(text: &str) -> bool {
 
 /// Reads the cube file at `path` (see the module docs).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let (file, file_len) = open_input(path)?;
-    let mut r = TextReader::new(path, BufReader::new(file));
+    let opened = open_unpacked(path)?;
     let mut info = FileInfo::new("decimal text");
+    info.notes.extend(opened.note());
+    let file_len = opened.len;
+    let size = opened.size_phrase();
+    let mut r = TextReader::new(path, opened.reader);
     let invalid = |reason: String| IoError::invalid(path, reason);
 
     for n in 1..=2 {
@@ -232,7 +234,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         })?;
         if m > file_len / 2 {
             return Err(r.error(format!(
-                "orbital count (DSET_IDS) {m} is more than a {file_len}-byte file can list"
+                "orbital count (DSET_IDS) {m} is more than a {size} can list"
             )));
         }
         orbitals.reserve(m as usize);
@@ -268,7 +270,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         (Some(p), Some(t)) if (t as u64) <= file_len / 2 + 1 => (p, t),
         _ => {
             return Err(invalid(format!(
-                "the header declares {}x{}x{} points with {per_point} value(s) each, more than a {file_len}-byte file can hold",
+                "the header declares {}x{}x{} points with {per_point} value(s) each, more than a {size} can hold",
                 counts[0], counts[1], counts[2]
             )));
         }

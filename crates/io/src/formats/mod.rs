@@ -13,12 +13,16 @@
 //! of names `--format` accepts, the list of known kinds in
 //! [`IoError::UnknownFormat`], which reader options apply and the reader
 //! itself all come from the row.
+//!
+//! The file runs past 800 lines because the table is one row per format
+//! (25), kept beside the enum it indexes and the detection that reads it.
 
 pub(crate) mod bdv;
 pub(crate) mod chgcar;
 pub(crate) mod cube;
 pub(crate) mod dicom;
 pub(crate) mod fits;
+pub(crate) mod gipl;
 pub(crate) mod hdf5;
 pub(crate) mod hdf5_axes;
 pub(crate) mod hdf5_lazy;
@@ -28,17 +32,22 @@ pub(crate) mod minc;
 pub(crate) mod minc1;
 pub(crate) mod minc_common;
 pub(crate) mod mrc;
+pub(crate) mod mrtrix;
 pub(crate) mod netcdf;
 pub(crate) mod netcdf4;
 pub(crate) mod nifti;
 pub(crate) mod not_read;
 pub(crate) mod npy;
+pub(crate) mod npz;
 pub(crate) mod nrrd;
+pub(crate) mod opendx;
+pub(crate) mod plt;
 pub(crate) mod raw;
 pub(crate) mod tiff;
 pub(crate) mod vti;
 pub(crate) mod vtk_legacy;
 pub(crate) mod vtkhdf;
+pub(crate) mod xsf;
 pub(crate) mod zarr;
 
 use std::fmt;
@@ -96,6 +105,18 @@ pub enum VolumeFormat {
     /// Analyze 7.5 `.hdr`/`.img` pairs (no NIfTI magic), read by the
     /// NIfTI reader.
     Analyze,
+    /// OpenDX scalar fields (`.dx`): APBS, VMD, PyMOL, GridDataFormats.
+    Dx,
+    /// XCrySDen XSF and BXSF data and band grids (`.xsf`, `.bxsf`).
+    Xsf,
+    /// gOpenMol plot files (`.plt`), binary.
+    Plt,
+    /// NumPy `.npz` archives (`numpy.savez`, `savez_compressed`).
+    Npz,
+    /// GIPL images (`.gipl`, `.gipl.gz`): ITK, SimpleITK.
+    Gipl,
+    /// MRtrix images (`.mif`, `.mih`, `.mif.gz`).
+    Mrtrix,
     /// VTKHDF image data (`.vtkhdf`, or an HDF5 file with a `/VTKHDF`
     /// group): VTK's own HDF5 format.
     Vtkhdf,
@@ -474,6 +495,100 @@ pub(crate) const FORMATS: &[FormatSpec] = &[
         read: nifti::read,
     },
     FormatSpec {
+        format: VolumeFormat::Dx,
+        name: "dx",
+        description: "OpenDX field",
+        extensions: &["dx"],
+        name_stems: &[],
+        known_as: ".dx",
+        magic: Magic {
+            text: Some(opendx::sniff_text),
+            ..Magic::NONE
+        },
+        frames: false,
+        arrays: false,
+        levels: false,
+        read: opendx::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Xsf,
+        name: "xsf",
+        description: "XCrySDen XSF grid",
+        extensions: &["xsf", "bxsf"],
+        name_stems: &[],
+        known_as: ".xsf/.bxsf",
+        magic: Magic {
+            text: Some(xsf::sniff_text),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: true,
+        levels: false,
+        read: xsf::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Plt,
+        name: "plt",
+        description: "gOpenMol plt grid",
+        extensions: &["plt"],
+        name_stems: &[],
+        known_as: ".plt (gOpenMol)",
+        // Rank 3 in either byte order and plausible fields (`plt::sniff`).
+        magic: Magic {
+            binary: Some(plt::sniff),
+            ..Magic::NONE
+        },
+        frames: false,
+        arrays: false,
+        levels: false,
+        read: plt::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Npz,
+        name: "npz",
+        description: "NumPy .npz",
+        extensions: &["npz"],
+        name_stems: &[],
+        known_as: ".npz",
+        // A zip file's first local header: other zip-based files (a .docx)
+        // are sent here too and refused as holding no .npy arrays.
+        magic: Magic::strong(&[(0, b"PK\x03\x04")]),
+        frames: false,
+        arrays: true,
+        levels: false,
+        read: npz::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Gipl,
+        name: "gipl",
+        description: "GIPL image",
+        extensions: &["gipl", "gipl.gz"],
+        name_stems: &[],
+        known_as: ".gipl",
+        // ITK's two magic numbers at byte 252 (`gipl::MAGIC`).
+        magic: Magic::strong(&[(252, b"\xef\xff\xe9\xb0"), (252, b"\x2a\xe3\x89\xb8")]),
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: gipl::read,
+    },
+    FormatSpec {
+        format: VolumeFormat::Mrtrix,
+        name: "mrtrix",
+        description: "MRtrix image",
+        extensions: &["mif", "mih", "mif.gz"],
+        name_stems: &[],
+        known_as: ".mif/.mih",
+        magic: Magic {
+            text: Some(mrtrix::sniff_text),
+            ..Magic::NONE
+        },
+        frames: true,
+        arrays: false,
+        levels: false,
+        read: mrtrix::read,
+    },
+    FormatSpec {
         format: VolumeFormat::Vtkhdf,
         name: "vtkhdf",
         description: "VTKHDF image data",
@@ -603,10 +718,11 @@ impl VolumeFormat {
     /// number (`head` should hold at least the first 1024 bytes, or the
     /// whole file if shorter).
     pub fn sniff(head: &[u8]) -> Option<Self> {
-        // A gzip file (.nii.gz, .mgz) is known by what it inflates to; a
-        // gzip file that shows nothing is still taken for a .nii.gz.
-        if head.starts_with(b"\x1f\x8b")
-            && let Some(format) = Self::sniff_plain(&inflate_head(head))
+        // A gzip file (.nii.gz, .mgz, .cube.gz), or a bzip2 or xz one, is
+        // known by what it decompresses to (shared/packed.rs); a gzip file
+        // that shows nothing is still taken for a .nii.gz.
+        if let Some(unpacked) = crate::shared::packed::unpack_head(head)
+            && let Some(format) = Self::sniff_plain(&unpacked)
         {
             return Some(format);
         }
@@ -637,24 +753,6 @@ impl VolumeFormat {
         })?;
         Some(spec.format)
     }
-}
-
-/// The first bytes (at most 1024) that the gzip stream starting `head`
-/// inflates to, as far as `head` goes; empty if it is no gzip stream.
-fn inflate_head(head: &[u8]) -> Vec<u8> {
-    use std::io::Read;
-    let mut out = Vec::with_capacity(1024);
-    let mut decoder = flate2::read::MultiGzDecoder::new(head).take(1024);
-    let mut buf = [0u8; 256];
-    // A stream cut short by `head`'s end fails after yielding what it
-    // could: keep that.
-    while let Ok(n) = decoder.read(&mut buf) {
-        if n == 0 {
-            break;
-        }
-        out.extend_from_slice(&buf[..n]);
-    }
-    out
 }
 
 impl fmt::Display for VolumeFormat {
@@ -789,13 +887,13 @@ mod tests {
     fn lists_are_joined_from_the_table() {
         assert_eq!(
             VolumeFormat::KNOWN,
-            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .vtkhdf (or an HDF5 file with a /VTKHDF group), dataset.xml (BigDataViewer, or its .h5)"
+            ".npy, .nrrd/.nhdr, .mha/.mhd, .nii/.nii.gz, .vtk, .vti, DICOM (.dcm or a directory), .tif/.tiff, .h5:/dataset, .cube, .map/.mrc/.ccp4, CHGCAR/CHG, .mnc, Zarr/OME-Zarr (a directory), .nc/.cdf, .fits/.fits.gz, .mgh/.mgz, .hdr/.img (Analyze 7.5), .dx, .xsf/.bxsf, .plt (gOpenMol), .npz, .gipl, .mif/.mih, .vtkhdf (or an HDF5 file with a /VTKHDF group), dataset.xml (BigDataViewer, or its .h5)"
         );
         assert_eq!(
             VolumeFormat::NAMES,
-            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, vtkhdf, bdv"
+            "raw, npy, nrrd, metaimage, nifti, vtk, vti, dicom, tiff, hdf5, cube, mrc, chgcar, minc, zarr, netcdf, fits, mgh, analyze, dx, xsf, plt, npz, gipl, mrtrix, vtkhdf, bdv"
         );
-        assert_eq!(VolumeFormat::ALL.len(), 21);
+        assert_eq!(VolumeFormat::ALL.len(), 27);
         assert_eq!(VolumeFormat::ALL[13], VolumeFormat::Minc);
     }
 

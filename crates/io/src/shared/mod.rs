@@ -14,6 +14,7 @@
 //! | `geometry.rs` | a file's grid (origin, step vectors) → the axis-aligned volume | every reader with geometry |
 //! | `text_header.rs` | header lines and field values | NRRD, MetaImage |
 //! | `payload/` | the data behind a text header: skips, encodings, multi-file lists, frames | NRRD, MetaImage |
+//! | `packed.rs` | files behind gzip, bzip2 or xz, known by their first bytes, streamed as they decompress | cube, CHGCAR, legacy VTK, OpenDX, XSF, gOpenMol; the sniffers |
 //! | `text_reader.rs` | numbers streamed out of text | cube, CHGCAR, text data of NRRD and MetaImage |
 //! | `rescale.rs` | stored values rescaled (slope, intercept), kept in an integer type where exact | NIfTI, DICOM |
 //! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |
@@ -31,6 +32,7 @@ pub(crate) mod input;
 pub(crate) mod limits;
 pub(crate) mod mapped;
 pub(crate) mod matlab;
+pub(crate) mod packed;
 pub mod panics;
 pub(crate) mod payload;
 pub(crate) mod periodic_cell;

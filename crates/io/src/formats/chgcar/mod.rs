@@ -34,15 +34,14 @@ mod poscar;
 
 pub(crate) use poscar::sniff_text;
 
-use std::io::BufReader;
 use std::path::Path;
 
 use volray_core::glam::DVec3;
 
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::input::open_input;
 use crate::shared::limits::{check_held, format_bytes};
+use crate::shared::packed::open_unpacked;
 use crate::shared::periodic_cell;
 use crate::shared::text_reader::{TextReader, number, parse_number};
 use crate::{FileInfo, Loaded, ReadOptions, VolumeFormat};
@@ -97,8 +96,10 @@ struct Chosen {
 
 /// Reads the VASP volumetric file at `path` (see the module docs).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let (file, file_len) = open_input(path)?;
-    let mut r = TextReader::new(path, BufReader::new(file));
+    let opened = open_unpacked(path)?;
+    let packed_note = opened.note();
+    let file_len = opened.len;
+    let mut r = TextReader::new(path, opened.reader);
     let content = content_of(path);
     let wanted = opts.frame.unwrap_or(0);
 
@@ -192,6 +193,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     };
 
     let mut info = FileInfo::new("decimal text");
+    info.notes.extend(packed_note);
     info.header = chosen.poscar.header;
     info.header
         .push(("NGX NGY NGZ".into(), chosen.grid_fields.join(" ")));

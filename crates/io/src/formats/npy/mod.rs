@@ -103,21 +103,7 @@ fn read_npy_with_info(
         (Plan::Map, Elem::Plain(d, _)) => mapped::map_samples(path, header.data_offset, d, count)?,
         _ => read_as_stored!(stored, |T| read_data::<T>(path, &mut file, &header, count))?,
     };
-    let elem = header.elem;
-    let mut info = FileInfo::new(descr_name(elem));
-    info.header = vec![
-        ("descr".into(), descr_name(elem)),
-        (
-            "fortran_order".into(),
-            if header.fortran_order {
-                "True"
-            } else {
-                "False"
-            }
-            .into(),
-        ),
-        ("shape".into(), format!("({nx}, {ny}, {nz})")),
-    ];
+    let mut info = header_info(&header);
     let dims = if plan == Plan::Map && !header.fortran_order {
         // Index axes z, y, x in the file, each along its world axis.
         info.notes.push(
@@ -142,6 +128,59 @@ fn read_npy_with_info(
     if plan == Plan::Map {
         info.notes.push(mapped::mapped_note(&volume));
     }
+    Ok((volume, info))
+}
+
+/// What `header` says, for `volray info`: the stored type and the fields.
+fn header_info(header: &Header) -> FileInfo {
+    let elem = header.elem;
+    let [nx, ny, nz] = header.shape;
+    let mut info = FileInfo::new(descr_name(elem));
+    info.header = vec![
+        ("descr".into(), descr_name(elem)),
+        (
+            "fortran_order".into(),
+            if header.fortran_order {
+                "True"
+            } else {
+                "False"
+            }
+            .into(),
+        ),
+        ("shape".into(), format!("({nx}, {ny}, {nz})")),
+    ];
+    info
+}
+
+/// The 3-D array of the `.npy` bytes `reader` gives, `len` of them (a
+/// member of an `.npz` archive, `formats/npz.rs`), read into memory
+/// within `max_memory` (never mapped): as [`read_npy`] reads a file.
+pub(crate) fn read_stream(
+    path: &Path,
+    reader: &mut impl Read,
+    len: u64,
+    max_memory: u64,
+) -> Result<(Volume, FileInfo), IoError> {
+    let header = read_header(path, reader, len)?;
+    let [nx, ny, nz] = header.shape;
+    if nx < 2 || ny < 2 || nz < 2 {
+        return Err(IoError::volume(path, VolumeError::TooThin(nx, ny, nz)));
+    }
+    let stored = header.elem.stored();
+    let count = check_dims(
+        path,
+        "shape",
+        &header.shape,
+        stored.bytes() as u64,
+        max_memory,
+    )?;
+    let data = read_as_stored!(stored, |T| read_data::<T>(path, reader, &header, count))?;
+    let mut info = header_info(&header);
+    if !header.fortran_order {
+        info.notes
+            .push("C order: the array a[x, y, z] was transposed to x fastest".into());
+    }
+    let volume = Volume::from_samples(header.shape, data).map_err(|e| IoError::volume(path, e))?;
     Ok((volume, info))
 }
 

@@ -20,14 +20,13 @@ mod attributes;
 mod lexer;
 mod values;
 
-use std::io::BufReader;
 use std::path::Path;
 
 use volray_core::glam::DVec3;
 
 use crate::error::IoError;
 use crate::shared::geometry::grid_to_volume;
-use crate::shared::input::open_input;
+use crate::shared::packed::open_unpacked;
 use crate::shared::vtk_arrays::{
     Association, cell_centres, cell_dims, no_match, not_scalar, record_choice,
 };
@@ -38,9 +37,10 @@ use values::{Encoding, array_values};
 
 /// Reads the legacy VTK file at `path` (see the module documentation).
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
-    let (file, len) = open_input(path)?;
-    let mut lx = Lexer::new(path, BufReader::new(file), len);
+    let opened = open_unpacked(path)?;
     let mut info = FileInfo::new("");
+    info.notes.extend(opened.note());
+    let mut lx = Lexer::new(path, opened.reader, opened.len);
 
     let first = lx.line()?.unwrap_or_default();
     let version = first
