@@ -500,14 +500,21 @@ fn open_lazy_as(
                 info,
             }))
         }
-        VolumeFormat::Hdf5 | VolumeFormat::Vtkhdf => Ok(crate::formats::hdf5_lazy::open(
-            path, opts,
-        )?
-        .map(|(source, info)| Lazy {
-            source: Arc::new(source),
-            format,
-            info,
-        })),
+        VolumeFormat::Hdf5 => Ok(crate::formats::hdf5::open_lazy(path, opts)?.map(
+            |(source, info)| Lazy {
+                source: Arc::new(source),
+                format,
+                info,
+            },
+        )),
+        VolumeFormat::Vtkhdf => {
+            let (source, info) = crate::formats::vtkhdf::open_lazy(path, opts)?;
+            Ok(Some(Lazy {
+                source: Arc::new(source),
+                format,
+                info,
+            }))
+        }
         VolumeFormat::Bdv => {
             let (source, info) = crate::formats::bdv::open_lazy(path, opts)?;
             Ok(Some(Lazy {

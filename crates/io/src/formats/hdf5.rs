@@ -28,7 +28,8 @@
 //! before anything is read, and samples are read in slabs of the first
 //! axis, so the scratch memory beside the volume stays small. A file
 //! holding MINC2's layout (`/minc-2.0`) is MINC2's (`formats/minc.rs`);
-//! one holding a `/VTKHDF` group is VTKHDF (`formats/vtkhdf.rs`).
+//! one holding a `/VTKHDF` group is told apart before (`read.rs`) and read
+//! by `formats/vtkhdf.rs` through [`read_opened`].
 
 use std::path::{Path, PathBuf};
 
@@ -36,6 +37,7 @@ use hdf5_pure::{AttrValue, Dataset, Group};
 use volray_core::SampleType;
 use volray_core::glam::DVec3;
 
+pub(crate) use super::hdf5_axes::Opened;
 use super::hdf5_axes::{self, Placement, Role, axis_order};
 use crate::dtype::{Stored, read_as_stored};
 use crate::error::IoError;
@@ -50,27 +52,6 @@ const MAX_DEPTH: usize = 32;
 
 /// Datasets listed in an error, at most.
 const LISTED: usize = 10;
-
-/// A dataset named (or found) and checked, its metadata read, nothing of
-/// its samples: what the eager reader ([`read`]) and the lazy source
-/// (`hdf5_lazy.rs`) both start from.
-pub(crate) struct Opened {
-    /// The HDF5 file's own path (without `:/dataset`).
-    pub file_path: PathBuf,
-    pub h5: h5::H5File,
-    /// The dataset's absolute path in the file.
-    pub name: String,
-    pub dataset: Dataset,
-    pub sample: h5::NumericType,
-    pub shape: Vec<usize>,
-    /// Which dataset axis is x, y, z, and the volume read (the frame).
-    pub placement: Placement,
-    /// Samples along x, y, z (a 2-D image: z is 1).
-    pub dims: [usize; 3],
-    pub info: FileInfo,
-    pub spacing: DVec3,
-    pub origin: DVec3,
-}
 
 /// What a path opens as: a dataset, or a MINC2 file (read by `minc.rs`).
 pub(crate) enum Found {
@@ -91,6 +72,24 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         DVec3::Z * o.spacing.z,
     ];
     read_opened(o, None, steps, VolumeFormat::Hdf5, opts)
+}
+
+/// Opens the dataset `path` names as a source of boxes (`hdf5_lazy.rs`),
+/// with what the eager reader would say of it; `None` for what the eager
+/// reader reads otherwise (a MINC2 file, a 2-D image or a volume one
+/// sample thick).
+pub(crate) fn open_lazy(
+    path: &Path,
+    opts: &ReadOptions,
+) -> Result<Option<(super::hdf5_lazy::H5Source, FileInfo)>, IoError> {
+    let o = match open(path, opts)? {
+        Found::Minc(_) => return Ok(None),
+        Found::Dataset(o) => *o,
+    };
+    if o.dims.iter().any(|&n| n < 2) {
+        return Ok(None);
+    }
+    super::hdf5_lazy::from_opened(o, None, [false; 3], opts).map(Some)
 }
 
 /// Reads the volume of a dataset opened and placed (by [`open`], or a
@@ -177,9 +176,6 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     let root = h5.file.root();
     if dataset_path.is_none() && h5.file.group("minc-2.0").is_ok() {
         return Ok(Found::Minc(file_path));
-    }
-    if dataset_path.is_none() && h5.file.group(super::vtkhdf::ROOT).is_ok() {
-        return super::vtkhdf::open(file_path, h5, opts).map(|o| Found::Dataset(Box::new(o)));
     }
 
     let (name, dataset) = match &dataset_path {

@@ -396,6 +396,28 @@ pub(crate) fn frame_of(shape: &[usize], roles: &[Role], picked: Picked) -> usize
         .fold(0, |f, a| f * shape[a].max(1) + index[a])
 }
 
+/// A dataset named (or found) and checked, its metadata read, nothing of
+/// its samples: what the eager reader (`hdf5.rs`'s `read_opened`) and
+/// the lazy source (`hdf5_lazy.rs`) both start from, kept here beside
+/// its [`Placement`] so that neither imports the other for it.
+pub(crate) struct Opened {
+    /// The HDF5 file's own path (without `:/dataset`).
+    pub file_path: std::path::PathBuf,
+    pub h5: crate::shared::hdf5::H5File,
+    /// The dataset's absolute path in the file.
+    pub name: String,
+    pub dataset: Dataset,
+    pub sample: crate::shared::hdf5::NumericType,
+    pub shape: Vec<usize>,
+    /// Which dataset axis is x, y, z, and the volume read (the frame).
+    pub placement: Placement,
+    /// Samples along x, y, z (a 2-D image: z is 1).
+    pub dims: [usize; 3],
+    pub info: crate::FileInfo,
+    pub spacing: volray_core::glam::DVec3,
+    pub origin: volray_core::glam::DVec3,
+}
+
 /// Where each sample of a dataset lands: which dataset axis is x, y, z,
 /// and at which index the other axes (time, channel) are held for the
 /// volume read.

@@ -60,8 +60,7 @@ use hdf5_pure::{ChunkIndex, Dataset, Layout};
 use volray_core::sampling::grid::GridFrame;
 use volray_core::{SampleType, SourceError, Volume, VolumeSource, check_box};
 
-use super::hdf5::{Found, Opened};
-use super::hdf5_axes::{Placement, each_index};
+use super::hdf5_axes::{Opened, Placement, each_index};
 use crate::dtype::{Stored, read_as_stored};
 use crate::shared::hdf5::{self as h5, check_stored, slab_rows, slab_samples};
 use crate::shared::hdf5_index::{self, Listed, REPACK};
@@ -113,23 +112,6 @@ pub(crate) struct H5Source {
     /// The file as `hdf5-pure` opened it for the row windows, once.
     rows: Mutex<Option<Arc<h5::H5File>>>,
     max_memory: u64,
-}
-
-/// Opens the dataset `path` names as a source of boxes, with what the
-/// eager reader would say of it; `None` for what the eager reader reads
-/// otherwise (a MINC2 file, a 2-D image or a volume one sample thick).
-pub(crate) fn open(
-    path: &Path,
-    opts: &ReadOptions,
-) -> Result<Option<(H5Source, FileInfo)>, IoError> {
-    let o = match super::hdf5::open(path, opts)? {
-        Found::Minc(_) => return Ok(None),
-        Found::Dataset(o) => *o,
-    };
-    if o.dims.iter().any(|&n| n < 2) {
-        return Ok(None);
-    }
-    from_opened(o, None, [false; 3], opts).map(Some)
 }
 
 /// Maps a stored sample to the value kept (CF's `scale_factor`,

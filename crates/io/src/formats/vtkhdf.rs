@@ -60,9 +60,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     read_opened(o, None, steps, VolumeFormat::Vtkhdf, opts)
 }
 
+/// The VTKHDF image data at `path` as a source of boxes (`hdf5_lazy.rs`).
+pub(crate) fn open_lazy(
+    path: &Path,
+    opts: &ReadOptions,
+) -> Result<(super::hdf5_lazy::H5Source, FileInfo), IoError> {
+    let h5 = h5::open(path)?;
+    let o = open(path.to_path_buf(), h5, opts)?;
+    super::hdf5_lazy::from_opened(o, None, [false; 3], opts)
+}
+
 /// The VTKHDF file `file_path`, open as `h5`, with its array picked and
-/// placed: what the eager reader and the box-by-box one (through
-/// `hdf5::open`) read.
+/// placed: what the eager reader and the box-by-box one read.
 pub(crate) fn open(
     file_path: PathBuf,
     h5: h5::H5File,
