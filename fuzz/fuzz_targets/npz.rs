@@ -15,6 +15,7 @@ static HARNESS: OnceLock<Harness> = OnceLock::new();
 fuzz_target!(|data: &[u8]| {
     let harness = HARNESS.get_or_init(|| Harness::new("npz", &[]));
     let (control, file) = split_control(data);
-    let array = [None, Some("arr_0"), Some("density"), Some("missing")][usize::from(control >> 4) & 3];
+    let array =
+        [None, Some("arr_0"), Some("density"), Some("missing")][usize::from(control >> 4) & 3];
     harness.read("input.npz", file, VolumeFormat::Npz, None, array);
 });

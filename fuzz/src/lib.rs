@@ -131,7 +131,8 @@ pub fn read_lazy_half(path: &Path, opts: &ReadOptions) {
                 Ok(v) => {
                     std::hint::black_box((v.value_range(), v.count_non_finite()));
                 }
-                Err(message) => {
+                Err(e) => {
+                    let message = e.to_string();
                     assert!(
                         !message.contains('\n') && message.contains(SCRATCH_PREFIX),
                         "a box's error is not one line naming the file: {message:?}"
