@@ -23,9 +23,12 @@ fn info_on_a_cd_reads_the_largest_series_and_lists_the_other() {
         "2 series; read the largest, 2: SeriesNumber 1, CT, 5 file(s), 4 x 3, UID",
         "the others: 1: SeriesNumber 1, CT \"series B\", 2 file(s), 4 x 3, UID",
         "--series N|UID",
+        // Series of their own grids: neither time points nor channels.
+        "series:    2 (read: 2, counted from 1; --series N or a SeriesInstanceUID picks another",
     ] {
         assert!(text.contains(expect), "missing {expect:?} in\n{text}");
     }
+    assert!(!text.contains("time points:"), "{text}");
     let dicomdir = format!("{CD}/DICOMDIR");
     let out = volray(&["info", &dicomdir, "--series", "1", "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));

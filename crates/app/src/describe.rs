@@ -307,7 +307,15 @@ fn stored(l: &volray_io::LevelInfo) -> String {
 fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
     outln!(out, "stored as: {}", i.stored_type);
     let (t, c) = (i.time_points, i.channels);
-    if t > 1 {
+    if i.frames_are_series {
+        // A DICOM directory's series: each its own grid, so neither an
+        // animation nor channels of one picture.
+        outln!(
+            out,
+            "series:    {t} (read: {}, counted from 1; --series N or a SeriesInstanceUID picks another: the notes list them)",
+            i.time_point + 1
+        );
+    } else if t > 1 {
         outln!(
             out,
             "time points: {t} (read: {}; --frame picks another; as an animation: volray render {name} --frames all -o OUT.gif)",
@@ -320,7 +328,7 @@ fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
             "channels:  {c} (read: {}; --channel picks another; together: volray render {name} --channels all)",
             i.channel
         );
-    } else if t > 1 {
+    } else if t > 1 && !i.frames_are_series {
         outln!(
             out,
             "channels:  1 (its {t} time points rendered together as channels: volray render {name} --channels all)"

@@ -182,6 +182,10 @@ pub struct FileInfo {
     /// The segments of a label volume whose file names them (a DICOM
     /// Segmentation): each label value's name and colour.
     pub segments: Vec<Segment>,
+    /// Whether the file's frames are the series of a DICOM directory
+    /// (each its own grid, one picked by `--series`, the notes listing
+    /// them), not time points of one grid.
+    pub frames_are_series: bool,
 }
 
 /// One segment of a label volume: the label value that marks it, its

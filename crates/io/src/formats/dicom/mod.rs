@@ -306,6 +306,7 @@ fn read_directory(
     let mut info = FileInfo::new("");
     info.frames = count;
     info.frame = s;
+    info.frames_are_series = count > 1;
     if let Some(d) = &listing.dicomdir {
         info.notes.push(format!(
             "read through {} ({count} series listed)",
