@@ -143,9 +143,16 @@ impl Input {
 /// Segmentation's segment colours), `(label, sRGB 0..1)`, for the look's
 /// `label_colours`; none for other inputs.
 pub fn label_colours(input: &Input) -> Vec<(i64, [f32; 3])> {
-    let Some((_, info)) = &input.file else {
-        return Vec::new();
-    };
+    match &input.file {
+        Some((_, info)) => segment_colours(info),
+        None => Vec::new(),
+    }
+}
+
+/// The colours a file's `info` gives its labels (a DICOM Segmentation's
+/// segments), each label with its sRGB colour in 0..1: what `--labels`
+/// (and Python's `labels=True`) draws them in.
+pub fn segment_colours(info: &FileInfo) -> Vec<(i64, [f32; 3])> {
     (info.segments.iter())
         .filter_map(|s| Some((s.label, s.colour?.map(|c| f32::from(c) / 255.0))))
         .collect()

@@ -151,6 +151,9 @@ pub(crate) struct Recipe {
     /// The file's display window (an OME-Zarr `omero` window), the
     /// default `range`.
     window: Option<(f64, f64)>,
+    /// The colours the file gives its labels (a DICOM Segmentation's
+    /// segments), which `labels=True` draws them in.
+    label_colours: Vec<(i64, [f32; 3])>,
 }
 
 /// Where the samples come from.

@@ -203,6 +203,15 @@ impl Volume {
         self.file.as_ref()?.1.display_window()
     }
 
+    /// The colours its file gives its labels (a DICOM Segmentation's
+    /// segments), which `labels=True` renders draw them in.
+    pub fn label_colours(&self) -> Vec<(i64, [f32; 3])> {
+        self.file
+            .as_ref()
+            .map(|(_, info)| volray_app::input::segment_colours(info))
+            .unwrap_or_default()
+    }
+
     /// Whether the file marks its NaN values as space it does not cover
     /// (always rendered as empty space).
     pub fn nan_is_empty(&self) -> bool {

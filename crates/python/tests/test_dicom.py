@@ -32,3 +32,14 @@ def test_a_segmentation_is_a_label_volume_of_its_segment_numbers():
     want[0, :, :] = 1
     want[3, 2, :] = 2
     assert np.array_equal(seg.data, want)
+
+
+def test_labels_are_drawn_in_the_colours_the_segmentation_gives_them():
+    # "bone" (label 1) red and "vessel" (label 2) blue in the file, which
+    # neither palette colour of labels 1 and 2 (orange, green) is.
+    seg = volray.read(FIXTURES / "dicom/seg.dcm")
+    image = np.asarray(volray.render(seg, labels=True, size=48))
+    rgb = image[..., :3].astype(int)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    assert ((b > 40) & (b > np.maximum(r, g) + 10)).any(), "no blue pixel"
+    assert ((r > 40) & (r > 2 * np.maximum(g, b))).any(), "no red pixel"

@@ -167,6 +167,10 @@ impl Recipe {
             Source::Volume(v) => v.get().display_window(),
             Source::Array { .. } => None,
         };
+        let label_colours = match &source {
+            Source::Volume(v) => v.get().label_colours(),
+            Source::Array { .. } => Vec::new(),
+        };
         Ok(Recipe {
             source,
             spacing,
@@ -177,6 +181,7 @@ impl Recipe {
             max_memory,
             name,
             window,
+            label_colours,
         })
     }
 
@@ -237,13 +242,20 @@ impl Recipe {
         settings: &mut RenderSettings,
     ) -> PyResult<()> {
         match (&known.labels, &known.histogram) {
-            (Some(found), _) => volray_options::label_transfer_function(
-                &options.look,
-                &mut settings.transfer_function,
-                found,
-                &self.name,
-            )
-            .map_err(option_error),
+            (Some(found), _) => {
+                // The colours the file gives its labels, unless given.
+                let mut look = options.look.clone();
+                if look.label_colours.is_empty() {
+                    look.label_colours = self.label_colours.clone();
+                }
+                volray_options::label_transfer_function(
+                    &look,
+                    &mut settings.transfer_function,
+                    found,
+                    &self.name,
+                )
+                .map_err(option_error)
+            }
             (None, Some(histogram)) if options.look.auto_tf() => {
                 volray_options::apply_auto(
                     &options.look,
