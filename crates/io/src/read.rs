@@ -511,22 +511,20 @@ fn open_lazy_as(
                 info,
             },
         )),
-        VolumeFormat::Vtkhdf => {
-            let (source, info) = crate::formats::vtkhdf::open_lazy(path, opts)?;
-            Ok(Some(Lazy {
+        VolumeFormat::Vtkhdf => Ok(crate::formats::vtkhdf::open_lazy(path, opts)?.map(
+            |(source, info)| Lazy {
                 source: Arc::new(source),
                 format,
                 info,
-            }))
-        }
-        VolumeFormat::Bdv => {
-            let (source, info) = crate::formats::bdv::open_lazy(path, opts)?;
-            Ok(Some(Lazy {
-                source,
+            },
+        )),
+        VolumeFormat::Bdv => Ok(crate::formats::bdv::open_lazy(path, opts)?.map(
+            |(source, info)| Lazy {
+                source: Arc::new(source),
                 format,
                 info,
-            }))
-        }
+            },
+        )),
         // A NetCDF-4 variable (HDF5 underneath) with its CF geometry and
         // packing; a NetCDF-3 variable is read whole.
         VolumeFormat::Netcdf if crate::formats::netcdf::is_netcdf4(path) => Ok(

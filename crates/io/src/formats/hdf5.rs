@@ -66,11 +66,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         Found::Minc(file_path) => return super::minc::read(&file_path, opts),
         Found::Dataset(o) => *o,
     };
-    let steps = [
-        DVec3::X * o.spacing.x,
-        DVec3::Y * o.spacing.y,
-        DVec3::Z * o.spacing.z,
-    ];
+    let steps = o.axis_steps();
     read_opened(o, None, steps, VolumeFormat::Hdf5, opts)
 }
 
@@ -82,14 +78,25 @@ pub(crate) fn open_lazy(
     path: &Path,
     opts: &ReadOptions,
 ) -> Result<Option<(super::hdf5_lazy::H5Source, FileInfo)>, IoError> {
-    let o = match open(path, opts)? {
-        Found::Minc(_) => return Ok(None),
-        Found::Dataset(o) => *o,
-    };
+    match open(path, opts)? {
+        Found::Minc(_) => Ok(None),
+        Found::Dataset(o) => lazy_opened(*o, None, opts),
+    }
+}
+
+/// A dataset opened and placed (by [`open`], `vtkhdf.rs` or `bdv/`) as a
+/// source of boxes, each stored value through `real` where given; `None`
+/// for a 2-D image or a volume one sample thick, which the eager reader
+/// reads (or refuses as an image).
+pub(crate) fn lazy_opened(
+    o: Opened,
+    real: Option<super::hdf5_lazy::RealValue>,
+    opts: &ReadOptions,
+) -> Result<Option<(super::hdf5_lazy::H5Source, FileInfo)>, IoError> {
     if o.dims.iter().any(|&n| n < 2) {
         return Ok(None);
     }
-    super::hdf5_lazy::from_opened(o, None, [false; 3], opts).map(Some)
+    super::hdf5_lazy::from_opened(o, real, [false; 3], opts).map(Some)
 }
 
 /// Reads the volume of a dataset opened and placed (by [`open`], or a

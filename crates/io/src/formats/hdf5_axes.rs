@@ -418,6 +418,18 @@ pub(crate) struct Opened {
     pub origin: volray_core::glam::DVec3,
 }
 
+impl Opened {
+    /// The grid's steps along x, y, z: the spacing along the world axes.
+    pub(crate) fn axis_steps(&self) -> [volray_core::glam::DVec3; 3] {
+        use volray_core::glam::DVec3;
+        [
+            DVec3::X * self.spacing.x,
+            DVec3::Y * self.spacing.y,
+            DVec3::Z * self.spacing.z,
+        ]
+    }
+}
+
 /// Where each sample of a dataset lands: which dataset axis is x, y, z,
 /// and at which index the other axes (time, channel) are held for the
 /// volume read.

@@ -52,22 +52,19 @@ pub(crate) fn is_vtkhdf(path: &Path) -> bool {
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let h5 = h5::open(path)?;
     let o = open(path.to_path_buf(), h5, opts)?;
-    let steps = [
-        DVec3::X * o.spacing.x,
-        DVec3::Y * o.spacing.y,
-        DVec3::Z * o.spacing.z,
-    ];
+    let steps = o.axis_steps();
     read_opened(o, None, steps, VolumeFormat::Vtkhdf, opts)
 }
 
-/// The VTKHDF image data at `path` as a source of boxes (`hdf5_lazy.rs`).
+/// The VTKHDF image data at `path` as a source of boxes (`hdf5_lazy.rs`),
+/// as `hdf5.rs`'s `lazy_opened` takes a dataset.
 pub(crate) fn open_lazy(
     path: &Path,
     opts: &ReadOptions,
-) -> Result<(super::hdf5_lazy::H5Source, FileInfo), IoError> {
+) -> Result<Option<(super::hdf5_lazy::H5Source, FileInfo)>, IoError> {
     let h5 = h5::open(path)?;
     let o = open(path.to_path_buf(), h5, opts)?;
-    super::hdf5_lazy::from_opened(o, None, [false; 3], opts)
+    super::hdf5::lazy_opened(o, None, opts)
 }
 
 /// The VTKHDF file `file_path`, open as `h5`, with its array picked and

@@ -40,7 +40,7 @@ use volray_core::glam::DVec3;
 
 use super::hdf5::{Opened, read_opened};
 use super::hdf5_axes::{Placement, Role};
-use super::hdf5_lazy::{RealValue, from_opened};
+use super::hdf5_lazy::RealValue;
 use crate::error::IoError;
 use crate::shared::hdf5::{self as h5, numeric_type, read_small};
 use crate::{AxisNames, FileInfo, LevelInfo, Loaded, ReadOptions, VolumeFormat, Volumes};
@@ -56,24 +56,19 @@ pub(crate) fn is_bdv_h5(path: &Path) -> bool {
 /// Reads the level, time point and view setup `opts` names, whole.
 pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let (o, real) = open(path, opts)?;
-    let steps = [
-        DVec3::X * o.spacing.x,
-        DVec3::Y * o.spacing.y,
-        DVec3::Z * o.spacing.z,
-    ];
+    let steps = o.axis_steps();
     let real = real.as_deref().map(|f| f as &dyn Fn(f64) -> f64);
     read_opened(o, real, steps, VolumeFormat::Bdv, opts)
 }
 
 /// The level, time point and view setup `opts` names, as a source of
-/// boxes.
+/// boxes, as `hdf5.rs`'s `lazy_opened` takes a dataset.
 pub(crate) fn open_lazy(
     path: &Path,
     opts: &ReadOptions,
-) -> Result<(Arc<dyn volray_core::VolumeSource>, FileInfo), IoError> {
+) -> Result<Option<(super::hdf5_lazy::H5Source, FileInfo)>, IoError> {
     let (o, real) = open(path, opts)?;
-    let (source, info) = from_opened(o, real, [false; 3], opts)?;
-    Ok((Arc::new(source), info))
+    super::hdf5::lazy_opened(o, real, opts)
 }
 
 /// Where the data is and what it holds: from the XML, or from the HDF5
