@@ -19,6 +19,8 @@
 //! | `rescale.rs` | stored values rescaled (slope, intercept), kept in an integer type where exact | NIfTI, DICOM |
 //! | `periodic_cell.rs` | skewed periodic cells resampled onto an axis-aligned grid | cube, CHGCAR, MRC |
 //! | `vtk_arrays.rs` | choosing the named point or cell array to read | legacy VTK, VTI |
+//! | `xml.rs` | an XML element's name and attributes without namespace prefixes | OME-TIFF, BigDataViewer |
+//! | `matlab.rs` | the real matrices of a MATLAB `.mat` file (levels 4 and 5) | SPM's Analyze orientation |
 //! | `panics.rs` | a panic inside a third-party decoder as an error, with no panic text | DICOM |
 //! | `cf.rs` | the CF conventions, format neutral: axes, coordinate variables, packing, fill values | NetCDF-3, MINC1, NetCDF-4 |
 //! | `units.rs` | each axis's length unit brought to one (the finest), other units kept apart | OME-Zarr, OME-TIFF, CF, NRRD, MINC, FITS |
@@ -42,3 +44,4 @@ pub(crate) mod text_header;
 pub(crate) mod text_reader;
 pub(crate) mod units;
 pub(crate) mod vtk_arrays;
+pub(crate) mod xml;

@@ -20,6 +20,8 @@ use std::path::{Path, PathBuf};
 
 use quick_xml::events::{BytesStart, Event};
 
+use crate::shared::xml::{attributes, local};
+
 /// One view setup (a channel, tile or angle: each is read as a channel).
 #[derive(Debug, Clone)]
 pub(super) struct Setup {
@@ -289,19 +291,9 @@ fn tree(xml: &str) -> Result<Node, String> {
 }
 
 fn node(e: &BytesStart) -> Result<Node, String> {
-    let mut attrs = Vec::new();
-    for attr in e.attributes() {
-        let attr = attr.map_err(|err| format!("bad XML attribute: {err}"))?;
-        let key = attr.key.local_name().as_ref().to_string();
-        let value = attr
-            .normalized_value(quick_xml::XmlVersion::Implicit1_0)
-            .map_err(|err| format!("bad XML attribute {key}: {err}"))?
-            .into_owned();
-        attrs.push((key, value));
-    }
     Ok(Node {
-        name: e.local_name().as_ref().to_string(),
-        attrs,
+        name: local(e),
+        attrs: attributes(e)?,
         ..Node::default()
     })
 }

@@ -22,7 +22,9 @@
 
 use std::path::Path;
 
-use quick_xml::events::{BytesStart, Event};
+use quick_xml::events::Event;
+
+use crate::shared::xml::{attributes, local};
 use volray_core::glam::DVec3;
 
 use super::imagej::Shape;
@@ -262,26 +264,6 @@ fn plane_order(order: &str) -> Option<[u8; 3]> {
     let mut sorted = planes;
     sorted.sort_unstable();
     (sorted == *b"CTZ").then_some(planes)
-}
-
-/// An element's name without its namespace prefix.
-fn local(e: &BytesStart) -> String {
-    e.local_name().as_ref().to_string()
-}
-
-/// The XML attributes of `e` as (local name, value) pairs.
-fn attributes(e: &BytesStart) -> Result<Vec<(String, String)>, String> {
-    let mut out = Vec::new();
-    for attr in e.attributes() {
-        let attr = attr.map_err(|err| format!("bad XML attribute: {err}"))?;
-        let key = attr.key.local_name().as_ref().to_string();
-        let value = attr
-            .normalized_value(quick_xml::XmlVersion::Implicit1_0)
-            .map_err(|err| format!("bad XML attribute {key}: {err}"))?
-            .into_owned();
-        out.push((key, value));
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
