@@ -24,7 +24,6 @@
 //!   `t`, NetCDF time), read and rendered as a series of files is.
 
 use crate::error::CliError;
-use crate::flags::{InputArgs, RenderArgs};
 use crate::outfile::OutputKind;
 use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_failure, renderer_for, streamed_note,
@@ -33,6 +32,7 @@ use rayon::ThreadPool;
 use volray_app::animation::{Views, series_settings};
 use volray_app::plan::Plan;
 use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, Renderer};
+use volray_flags::{InputArgs, RenderArgs};
 use volray_io::Animation;
 
 /// The views `views` of INPUT (`--turntable FRAMES`: volray-app's
@@ -52,7 +52,7 @@ pub fn views(
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
             let base = &(streamed
-                .settings_from_volume(&crate::settings::look(&args.view.look), base.clone()))
+                .settings_from_volume(&volray_flags::look(&args.view.look), base.clone()))
             .map_err(|e| app_failure(&args.view, e))?;
             let mut writer = Writer::new(args, base, frames)?;
             let mut last = None;
@@ -183,7 +183,7 @@ fn series_of(
     let look = &args.view.look;
     let requests: Vec<_> = inputs.iter().map(InputArgs::request).collect();
     let non_finite = args.view.sampling.nonfinite.into();
-    let options = crate::settings::look(look);
+    let options = volray_flags::look(look);
     let settings = series_settings(&requests, base, &options, non_finite, pool)
         .map_err(|e| renderer_failure(&args.view, e))?;
 

@@ -4,13 +4,13 @@
 //! `volray_app::bench`'s.
 
 use crate::error::CliError;
-use crate::flags::BenchArgs;
 use crate::session::{load, render_failure, renderer_for, thread_pool};
 use crate::settings::settings;
 use std::path::Path;
 use volray_app::bench::peers::{self, Peers};
 use volray_app::bench::{JsonRow, Timed, median, ms, time_frames, write_json};
 use volray_core::Method;
+use volray_flags::BenchArgs;
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     match &args.peers {

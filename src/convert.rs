@@ -10,10 +10,10 @@
 //! saying what was written.
 
 use crate::error::CliError;
-use crate::flags::ConvertArgs;
 use std::path::Path;
 use volray_app::convert::{OutputFormat, is_zarr, write_volume, write_zarr, zarr_summary};
 use volray_app::input;
+use volray_flags::ConvertArgs;
 
 pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
     let out = &args.output;

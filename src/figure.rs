@@ -5,13 +5,13 @@
 //! or each frame of a turntable or series (`animate.rs`).
 
 use crate::error::CliError;
-use crate::flags::{ColorBarSide, FigureArgs, RenderArgs, ScaleLength};
 use crate::outfile::OutputKind;
 use volray_annotate::colorbar::Side;
 use volray_annotate::figure::{Annotations, Rendered, annotate_frame};
 use volray_app::input::Input;
 use volray_core::glam::DVec3;
 use volray_core::{Image, RenderSettings, Renderer};
+use volray_flags::{ColorBarSide, FigureArgs, RenderArgs, ScaleLength};
 
 /// The annotations the flags ask for.
 pub fn annotations(args: &FigureArgs) -> Annotations {

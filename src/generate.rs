@@ -2,10 +2,10 @@
 //! cloud) to a file, in the format its extension names.
 
 use crate::error::CliError;
-use crate::flags::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 use volray_data::DataError;
 use volray_data::fractal::FractalParams;
 use volray_data::hydrogen::HydrogenParams;
+use volray_flags::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 
 pub fn run(args: &GenerateArgs) -> Result<(), CliError> {
     match &args.kind {

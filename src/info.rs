@@ -2,7 +2,7 @@
 //! (described by `volray_app::describe`), printed.
 
 use crate::error::CliError;
-use crate::flags::InfoArgs;
+use volray_flags::InfoArgs;
 
 pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     let lines = volray_app::describe::lines(&args.input.request(), args.bins, args.json)?;

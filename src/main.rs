@@ -1,5 +1,7 @@
-//! `volray`: the command line: flags, output writing and progress
-//! display. It parses arguments and calls the libraries: `volray-app` for
+//! `volray`: the command line: output writing and progress display. It
+//! parses arguments with `volray-flags` (every flag, one module per group
+//! and one per subcommand, and the flags as volray-options' options) and
+//! calls the libraries: `volray-app` for
 //! what the front ends share (the input, its plan, the memory budget,
 //! scenes, animations, the files an input reads, volumes written back),
 //! `volray-core` to render, `volray-io` for the images, `volray-view` to
@@ -7,9 +9,6 @@
 //!
 //! Where things are:
 //!
-//! - `flags/`: every flag, one module per group (input, camera, look,
-//!   sampling, output, animation) and one per subcommand; `flags/mod.rs`
-//!   parses the command line and lists them all;
 //! - one module per subcommand: `render.rs` (one still image, and the
 //!   checks before any work) with `animate.rs` (turntables, series and
 //!   `--frames`, written frame by frame) and `scene.rs` (several volumes in
@@ -19,8 +18,8 @@
 //!   `generate.rs`, `paper.rs`, `view.rs` (the flags as volray-view's
 //!   `open` and `Launch`, with `view/reproduce.rs`: the page's state as a
 //!   `volray render` command; `view/scene.rs`; `view/browser.rs`);
-//! - what they share: `settings.rs` (the flags as volray-options'
-//!   `Options` and volray-core's `RenderSettings`), `session.rs` (the
+//! - what they share: `settings.rs` (the flags' settings, the `--tf`
+//!   file read, option errors worded with the flags), `session.rs` (the
 //!   flags as volray-app's input requests, plans and renderers within the
 //!   `--max-memory` budget, threads, progress, which flag a render error
 //!   is about), `outfile.rs` and `figure.rs` (the output file, the
@@ -41,7 +40,6 @@ mod bench;
 mod convert;
 mod error;
 mod figure;
-mod flags;
 mod generate;
 mod info;
 mod interrupt;
@@ -55,11 +53,11 @@ mod session;
 mod settings;
 mod view;
 
-use flags::Command;
 use std::process::ExitCode;
+use volray_flags::Command;
 
 fn main() -> ExitCode {
-    let cli = match flags::parse() {
+    let cli = match volray_flags::parse() {
         Ok(cli) => cli,
         Err(code) => return code,
     };

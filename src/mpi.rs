@@ -5,7 +5,6 @@
 //! distributed run refuses, and the output rank 0 writes.
 
 use crate::error::CliError;
-use crate::flags::{BenchArgs, MixMode, RenderArgs, ViewArgs};
 use crate::render::{self, OutputKind};
 use crate::session::{app_failure, app_failure_of};
 use crate::settings::settings;
@@ -15,6 +14,7 @@ use volray_app::scene::{ChannelAxis, channel_axis};
 use volray_core::RenderSettings;
 use volray_distributed::frame::Failure;
 use volray_distributed::transport::Transport;
+use volray_flags::{BenchArgs, MixMode, RenderArgs, ViewArgs};
 
 /// Whether this process runs under an MPI launcher, and so renders as one
 /// rank of a distributed run.
@@ -144,11 +144,11 @@ fn bench_rank(args: &BenchArgs) -> Result<(), CliError> {
 }
 
 /// The distributed job the flags describe.
-fn job(input: &crate::flags::InputArgs, view: &ViewArgs, settings: RenderSettings) -> Job {
+fn job(input: &volray_flags::InputArgs, view: &ViewArgs, settings: RenderSettings) -> Job {
     Job {
         request: input.request(),
         settings,
-        look: crate::settings::look(&view.look),
+        look: volray_flags::look(&view.look),
         non_finite: view.sampling.nonfinite.into(),
     }
 }

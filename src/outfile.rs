@@ -7,8 +7,8 @@
 //! of which it calls.
 
 use crate::error::CliError;
-use crate::flags::RenderArgs;
 use std::path::{Path, PathBuf};
+use volray_flags::RenderArgs;
 use volray_io::{Animation, AnimationKind, BitDepth};
 
 /// Frames per second when `--fps` is not given.

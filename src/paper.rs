@@ -2,8 +2,8 @@
 //! by `volray-paper`.
 
 use crate::error::CliError;
-use crate::flags::{PaperArgs, PaperItem};
 use crate::session::thread_pool;
+use volray_flags::{PaperArgs, PaperItem};
 use volray_paper::{Item, PaperError, Sizes};
 
 pub fn run(args: &PaperArgs) -> Result<(), CliError> {

@@ -6,7 +6,6 @@
 use crate::animate;
 // The output file, as `distributed.rs` (MPI) takes it from here.
 use crate::error::CliError;
-use crate::flags::RenderArgs;
 pub use crate::outfile::{OutputKind, check_output, output_files, output_kind, write_still};
 use crate::session::{
     app_failure, load, progress_bar, render_failure, renderer_for, streamed_note, thread_pool,
@@ -16,6 +15,7 @@ use volray_app::animation::Turntable;
 use volray_app::input;
 use volray_app::plan::Plan;
 use volray_core::{FrameRequest, Render, RenderSettings, Rendered};
+use volray_flags::RenderArgs;
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_scene_flags_alone(args)?;
@@ -61,7 +61,7 @@ fn still(
         Plan::Streamed(mut streamed) => {
             crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
             let settings = &(streamed
-                .settings_from_volume(&crate::settings::look(&args.view.look), settings.clone()))
+                .settings_from_volume(&volray_flags::look(&args.view.look), settings.clone()))
             .map_err(|e| app_failure(&args.view, e))?;
             let bar = progress_bar((settings.width * settings.height) as u64);
             let (image, times) = pool

@@ -16,7 +16,6 @@
 
 use crate::animate;
 use crate::error::CliError;
-use crate::flags::{Channels, InputArgs, LookArgs, RenderArgs, SceneArgs, ViewArgs};
 use crate::outfile::{OutputKind, output_kind, write_still};
 use crate::session::{progress_bar, render_failure, renderer_for, thread_pool};
 use std::path::{Path, PathBuf};
@@ -29,6 +28,7 @@ use volray_app::scene::{
 };
 use volray_core::scene::{Mix, Scene, SceneSettings};
 use volray_core::{FrameRequest, Render, RenderError, RenderSettings, Rendered, SceneError};
+use volray_flags::{Channels, InputArgs, LookArgs, RenderArgs, SceneArgs, ViewArgs};
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_unsupported(args)?;
@@ -181,7 +181,7 @@ impl Pictures<'_> {
         input_args: &InputArgs,
         first: Vec<Layer>,
         settings: &RenderSettings,
-        range: crate::flags::Frames,
+        range: volray_flags::Frames,
     ) -> Result<(), CliError> {
         let args = self.args;
         let spec = args.input.input.as_deref().unwrap_or(input::DEMO);
@@ -254,8 +254,8 @@ pub fn overlay_specs(scene: &SceneArgs) -> Result<Vec<OverlaySpec>, CliError> {
 /// How the volumes mix: `--mix`, else additive for channels.
 pub fn mix(scene: &SceneArgs) -> Mix {
     match scene.mix {
-        Some(crate::flags::MixMode::Composite) => Mix::Composite,
-        Some(crate::flags::MixMode::Additive) => Mix::Additive,
+        Some(volray_flags::MixMode::Composite) => Mix::Composite,
+        Some(volray_flags::MixMode::Additive) => Mix::Additive,
         None => default_mix(scene.channels.is_some()),
     }
 }
@@ -286,7 +286,7 @@ pub fn picked(
 /// Refuses the look flags that do not apply to `--channels`, whose
 /// colours are `--channel-colors`' (render's and view's).
 pub fn refuse_channel_look(look: &LookArgs) -> Result<(), CliError> {
-    volray_app::scene::refuse_channel_look(&crate::settings::look(look)).map_err(refused)
+    volray_app::scene::refuse_channel_look(&volray_flags::look(look)).map_err(refused)
 }
 
 /// The volumes of the picture, each read whole with its look
@@ -307,7 +307,7 @@ pub fn read_layers(
         })
         .collect::<Result<Vec<_>, _>>()?;
     let request = input_args.request();
-    let look = crate::settings::look(&view.look);
+    let look = volray_flags::look(&view.look);
     let first = First {
         request: &request,
         log: view.look.log,

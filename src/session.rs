@@ -6,7 +6,6 @@
 //! `animate.rs`, `bench.rs` and `paper.rs` share these.
 
 use crate::error::CliError;
-use crate::flags::{InputArgs, ViewArgs};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
@@ -17,6 +16,7 @@ use volray_app::plan::{Chosen, Frames, Plan, StreamedInput};
 use volray_core::{RenderError, RenderSettings, Renderer};
 use volray_distributed::frame::FrameError;
 use volray_distributed::streamed::{StreamError, StreamTimes};
+use volray_flags::{InputArgs, ViewArgs};
 use volray_io::format_bytes;
 
 /// Reads the volume `args` name and, with `--log`, takes its log10.
@@ -176,9 +176,9 @@ pub fn render_failure(view: &ViewArgs, name: &str, e: RenderError) -> CliError {
 
 /// The flag whose value a core error is about, if one is.
 fn flag_of(view: &ViewArgs, e: &RenderError) -> Option<String> {
-    let camera = crate::settings::camera(&view.camera);
+    let camera = volray_flags::camera(&view.camera);
     volray_options::option_of(e, &camera)
-        .map(|opt| volray_options::Naming::option(&crate::settings::Flags, opt))
+        .map(|opt| volray_options::Naming::option(&volray_flags::Flags, opt))
 }
 
 /// A pool of `threads` workers (default: one per core).

@@ -13,7 +13,6 @@ mod reproduce;
 mod scene;
 
 use crate::error::CliError;
-use crate::flags::ViewerArgs;
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{from_volume, named_transfer_function, read_tf_file, settings_with_tf_text};
 use reproduce::CliReproduce;
@@ -22,6 +21,7 @@ use std::path::Path;
 use std::sync::Arc;
 use volray_app::input::{self, Input};
 use volray_core::RenderSettings;
+use volray_flags::ViewerArgs;
 use volray_io::format_bytes;
 use volray_options::level::LevelChoice;
 use volray_view::launch::Launch;
@@ -158,8 +158,8 @@ fn serve(args: &ViewerArgs, launch: Launch) -> Result<(), CliError> {
 /// with the figure the flags ask for.
 pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
     let options = volray_options::Options {
-        camera: crate::settings::camera(&args.view.camera),
-        look: crate::settings::look(&args.view.look),
+        camera: volray_flags::camera(&args.view.camera),
+        look: volray_flags::look(&args.view.look),
         ..Default::default()
     };
     ViewState {
@@ -169,8 +169,8 @@ pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
 }
 
 /// The page's figure as the flags start it.
-fn figure_state(args: &crate::flags::FigureArgs) -> volray_view::Figure {
-    use crate::flags::{ColorBarSide as Flag, ScaleLength};
+fn figure_state(args: &volray_flags::FigureArgs) -> volray_view::Figure {
+    use volray_flags::{ColorBarSide as Flag, ScaleLength};
     volray_view::Figure {
         colorbar: args.colorbar.map(|side| match side {
             Flag::Right => volray_view::ColorBarSide::Right,

@@ -11,7 +11,6 @@
 //! runs the command to check).
 
 use crate::error::CliError;
-use crate::flags::{Cli, Command, InputArgs, ViewerArgs};
 use crate::settings::settings_with_tf_text;
 use clap::Parser;
 use volray_app::input;
@@ -20,6 +19,7 @@ use volray_app::reproduce::command::{CommandWords, TF_FILE, Words, shell_quote, 
 use volray_core::glam::DVec3;
 use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, SampleType, TransferFunction};
+use volray_flags::{Cli, Command, InputArgs, ViewerArgs};
 use volray_view::{Refusal, Reproduce, Reproduction, SceneLooks, ViewState};
 
 /// `volray view`'s flags, kept as the words of the command lines it
@@ -46,9 +46,9 @@ impl CliReproduce {
         max_memory: u64,
     ) -> Self {
         let options = volray_options::Options {
-            camera: crate::settings::camera(&args.view.camera),
-            look: crate::settings::look(&args.view.look),
-            sampling: crate::settings::sampling(&args.view.sampling),
+            camera: volray_flags::camera(&args.view.camera),
+            look: volray_flags::look(&args.view.look),
+            sampling: volray_flags::sampling(&args.view.sampling),
         };
         let input = args.input.input.as_deref().unwrap_or(input::DEMO);
         let reading = reading(&args.input);
@@ -93,7 +93,7 @@ impl CliReproduce {
     /// command's words: `--overlay`s with their files' texts.
     fn scene_looks(
         &self,
-        args: &crate::flags::RenderArgs,
+        args: &volray_flags::RenderArgs,
         files: Vec<(String, String)>,
     ) -> Result<Option<SceneLooks>, Refusal> {
         let Some(scene) = self.words.scene() else {
@@ -119,7 +119,7 @@ impl CliReproduce {
             });
         }
         let mix = match args.scene.mix {
-            Some(crate::flags::MixMode::Additive) => Mix::Additive,
+            Some(volray_flags::MixMode::Additive) => Mix::Additive,
             _ => Mix::Composite,
         };
         Ok(Some(SceneLooks {
@@ -135,7 +135,7 @@ impl Reproduce for CliReproduce {
         let (words, json, files) = self.words.words(state)?;
         let argv = std::iter::once("volray").chain(words.iter().map(String::as_str));
         let cli =
-            Cli::try_parse_from(argv).map_err(|e| Refusal(crate::flags::one_line_error(&e)))?;
+            Cli::try_parse_from(argv).map_err(|e| Refusal(volray_flags::one_line_error(&e)))?;
         let Command::Render(args) = cli.command else {
             unreachable!("the words start with render")
         };
@@ -185,8 +185,8 @@ fn reading(inp: &InputArgs) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flags::Cli;
     use crate::settings::{named_transfer_function, settings};
+    use volray_flags::Cli;
     use volray_view::{BlendMode, START_COLOURS, WHITE};
 
     fn viewer(extra: &[&str]) -> ViewerArgs {

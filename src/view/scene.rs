@@ -19,11 +19,11 @@
 use super::reproduce::{CliReproduce, SceneWords};
 use super::{launch, serve};
 use crate::error::CliError;
-use crate::flags::ViewerArgs;
 use crate::scene::{overlay_specs, read_layers, whole_input};
 use crate::session::{load, renderer_for};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use volray_app::input;
+use volray_flags::ViewerArgs;
 use volray_view::{LayerState, START_COLOURS, TimePoints, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
@@ -55,7 +55,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
             range: [frames.start, end],
             start: frames.start,
             read: Box::new(move |t| {
-                let one = crate::flags::InputArgs {
+                let one = volray_flags::InputArgs {
                     frame: Some(t),
                     ..read_args.clone()
                 };

@@ -13,7 +13,7 @@ use volray_options::level::LevelChoice;
 
 /// The volume a command reads when given no input: the paper's first
 /// fractal cloud (Figure 2a's), which `volray render` without INPUT draws
-/// in the demo's look (the CLI's `flags/demo.rs`).
+/// in the demo's look (volray-flags' `demo.rs`).
 pub const DEMO: &str = "fractal:129,seed=1,dim=3.7,sigma=1,ramp=0.3,threshold=0.5869113206863403";
 
 /// Where a volume comes from.

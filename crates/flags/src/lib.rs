@@ -1,7 +1,29 @@
-//! The command line's flags, split by concern as ripgrep splits its own:
-//! each group of flags is a clap `Args` struct in its own module, and the
-//! subcommands' arguments flatten the groups they take. Nothing here
-//! renders; the modules beside `main.rs` turn these into library calls.
+//! The `volray` command's words: its flags, split by concern as ripgrep
+//! splits its own, each group a clap `Args` struct in its own module that
+//! the subcommands' arguments flatten; the command line parsed (errors
+//! on one line); and the flags as volray-options' [`Options`](volray_options::Options)
+//! ([`options()`]), which every front end checks and turns into settings
+//! alike.
+//!
+//! A library, not the binary's private module, because three readers of
+//! `volray render` words need one parser: the `volray` binary (its
+//! command line), `volray view` (the page's state is written as a
+//! `volray render` command and parsed back here, so the frame the page
+//! shows is that command's frame by construction), and tests and scripts
+//! that check a command means what it should.
+//!
+//! ```
+//! use clap::Parser;
+//! use volray_flags::{Cli, Command};
+//!
+//! let cli = Cli::try_parse_from(["volray", "render", "ct.nrrd", "--azimuth", "30", "-o", "a.png"])
+//!     .unwrap();
+//! let Command::Render(args) = cli.command else { unreachable!() };
+//! let options = volray_flags::options(&args.view, None);
+//! assert_eq!(options.camera.azimuth, 30.0);
+//! let settings = volray_options::settings(&options).unwrap();
+//! assert_eq!(settings.camera.azimuth, 30.0);
+//! ```
 //!
 //! - `input.rs`: INPUT and how to read it (render, bench, info);
 //! - `view.rs`: how to render a frame (render, bench), made of
@@ -15,8 +37,10 @@
 //!   `--scale-bar`, `--title`, `--label`);
 //! - `render.rs`, `bench.rs`, `info.rs`, `convert.rs`, `generate.rs`, `paper.rs`,
 //!   `viewer.rs` (`volray view`): each subcommand's arguments (`bench.rs`
-//!   also says which groups `--peers` refuses);
-//! - `parse.rs`: the value parsers, and clap's errors on one line.
+//!   also says which groups `--peers` refuses), `demo.rs`: `volray
+//!   render` with no INPUT;
+//! - `parse.rs`: the value parsers, and clap's errors on one line;
+//! - `options.rs`: the flags as volray-options' options.
 
 mod animation;
 mod bench;
@@ -28,6 +52,7 @@ mod generate;
 mod info;
 mod input;
 mod look;
+mod options;
 mod output;
 mod paper;
 mod parse;
@@ -45,6 +70,7 @@ pub use generate::{FractalArgs, GenerateArgs, GenerateKind, HydrogenArgs};
 pub use info::InfoArgs;
 pub use input::InputArgs;
 pub use look::{BlendMode, LookArgs};
+pub use options::{Flags, camera, look, options, sampling};
 pub use paper::{PaperArgs, PaperItem};
 pub use parse::one_line_error;
 pub use render::RenderArgs;

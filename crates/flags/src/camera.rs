@@ -18,7 +18,7 @@ use clap::Args;
 pub const DEFAULT_SIZE: (usize, usize) = (480, 480);
 
 impl CameraArgs {
-    /// `--size`, else [`DEFAULT_SIZE`].
+    /// `--size`, else `DEFAULT_SIZE`.
     pub fn size(&self) -> (usize, usize) {
         self.size.unwrap_or(DEFAULT_SIZE)
     }

@@ -90,8 +90,8 @@ fn peers_ignores() -> Vec<clap::Id> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flags::Cli;
-    use crate::flags::parse::one_line_error;
+    use crate::Cli;
+    use crate::parse::one_line_error;
     use clap::error::ErrorKind;
     use clap::{CommandFactory, Parser};
 

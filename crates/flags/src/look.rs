@@ -176,7 +176,7 @@ impl LookArgs {
     /// no `--tf`, `--preset`, `--colormap` or `--iso` (volray-options'
     /// `LookOptions::auto_tf` decides).
     pub fn auto_tf(&self) -> bool {
-        crate::settings::look(self).auto_tf()
+        crate::options::look(self).auto_tf()
     }
 }
 

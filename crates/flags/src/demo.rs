@@ -8,7 +8,7 @@
 //! picture can be remade and changed flag by flag.
 //!
 //! The demo's look applies only when the command names nothing but where
-//! and how big to write (the flags of [`PLAIN`]); any other flag renders
+//! and how big to write (the flags of `PLAIN`); any other flag renders
 //! the demo volume with the user's look instead, as it would any file.
 
 use clap::ArgMatches;
@@ -66,7 +66,7 @@ const PLAIN: &[&str] = &[
 ];
 
 /// `argv` with the demo's words inserted after `render` when `render`
-/// (its matches `render`) has no INPUT and only [`PLAIN`] flags; `None`
+/// (its matches `render`) has no INPUT and only `PLAIN` flags; `None`
 /// otherwise. The words come before the user's, so the user's `--size`
 /// is the one kept (the demo's is left out then).
 pub fn words(argv: &[OsString], render: &ArgMatches) -> Option<Vec<OsString>> {
@@ -124,9 +124,7 @@ mod tests {
 
     fn demo_of(words: &[&str]) -> Option<Vec<OsString>> {
         let argv = argv(words);
-        let matches = crate::flags::Cli::command()
-            .try_get_matches_from(&argv)
-            .unwrap();
+        let matches = crate::Cli::command().try_get_matches_from(&argv).unwrap();
         super::words(&argv, matches.subcommand_matches("render").unwrap())
     }
 
@@ -161,9 +159,9 @@ mod tests {
     #[test]
     fn the_demos_words_parse_as_a_render_command() {
         let words = demo_of(&["volray", "render", "-o", "a.png"]).unwrap();
-        let cli = crate::flags::Cli::try_parse_from(&words).unwrap();
+        let cli = crate::Cli::try_parse_from(&words).unwrap();
         match cli.command {
-            crate::flags::Command::Render(args) => {
+            crate::Command::Render(args) => {
                 assert_eq!(args.input.input.as_deref(), Some(VOLUME));
                 assert!(args.figure.colorbar.is_some());
             }
