@@ -123,12 +123,16 @@ struct Pictures<'a> {
 }
 
 impl Pictures<'_> {
-    /// The scene of `layers`, each volume's renderer within `--max-memory`.
+    /// The scene of `layers`, each volume's renderer within `--max-memory`,
+    /// their caches sharing what the frames leave.
     fn scene<'v>(&self, layers: &'v [Layer]) -> Result<Scene<'v>, CliError> {
         let view = &self.args.view;
         let renderers = (layers.iter())
             .map(|l| renderer_for(view, &l.settings, &l.input))
             .collect::<Result<Vec<_>, _>>()?;
+        let each: Vec<_> = layers.iter().map(|l| (&l.input, &l.settings)).collect();
+        let mode = view.sampling.nonfinite.into();
+        let renderers = volray_app::renderer::share_caches(renderers, &each, mode);
         Scene::new(renderers).map_err(|e| scene_failure(view, layers, RenderError::Scene(e)))
     }
 

@@ -120,9 +120,35 @@ pub fn cache_budget(
         .map_or(DEFAULT_CACHE_BUDGET, |room| room.min(DEFAULT_CACHE_BUDGET)))
 }
 
+/// The brick caches' budget of each of `layers` volumes rendered together
+/// (a scene), whose frames take `frames` bytes together with no cache
+/// (the sum of each volume's [`frame_bytes`]): what the limit leaves
+/// after them, shared evenly, each share at most the library's default
+/// ([`DEFAULT_CACHE_BUDGET`]). The caches of several volumes live at
+/// once, so one volume's [`cache_budget`] (the limit less its own frame)
+/// would let them take the limit several times over. Whether the frames
+/// fit at all is each front end's check, made before.
+pub fn shared_cache_budget(frames: u128, layers: usize, limit: u64) -> usize {
+    let room = u128::from(limit).saturating_sub(frames) / layers.max(1) as u128;
+    usize::try_from(room).map_or(DEFAULT_CACHE_BUDGET, |room| room.min(DEFAULT_CACHE_BUDGET))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_caches_of_a_scene_share_what_its_frames_leave() {
+        let mib = 1u64 << 20;
+        // 100 MiB less 40 MiB of frames, among 3 volumes: 20 MiB each.
+        assert_eq!(
+            shared_cache_budget(40 * u128::from(mib), 3, 100 * mib),
+            20 * mib as usize
+        );
+        // Never more than one volume's default, nor less than nothing.
+        assert_eq!(shared_cache_budget(0, 1, u64::MAX), DEFAULT_CACHE_BUDGET);
+        assert_eq!(shared_cache_budget(200 * u128::from(mib), 2, 100 * mib), 0);
+    }
     use volray_options::{BlendMode, Options};
 
     /// The settings of `options` changed by `change` (the command line's

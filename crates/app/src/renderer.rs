@@ -46,3 +46,38 @@ pub fn renderer_for<'v>(
         })?;
     Ok(renderer.with_cache_budget(budget))
 }
+
+/// The renderers of volumes rendered together (a scene: `layers`, each
+/// an input and its settings, the renderers built by [`renderer_for`]),
+/// their brick caches sharing what the limit leaves after every volume's
+/// frame and the one 16-bit PNG ([`crate::memory::shared_cache_budget`]):
+/// each volume's own budget counts only its own frame, and their caches
+/// live at once.
+pub fn share_caches<'v>(
+    renderers: Vec<Renderer<'v>>,
+    layers: &[(&Input, &RenderSettings)],
+    non_finite: NonFinite,
+) -> Vec<Renderer<'v>> {
+    let Some(&(first, first_settings)) = layers.first() else {
+        return renderers;
+    };
+    let budget = Budget {
+        limit: first.max_memory,
+        extra: 0,
+        samples_count: true,
+    };
+    let frames: u128 = (layers.iter())
+        .map(|(input, settings)| {
+            let mode = input.non_finite(non_finite);
+            crate::memory::frame_bytes(&input.volume, settings, mode, &budget)
+        })
+        .sum::<u128>()
+        + png_bytes(first_settings);
+    let share = crate::memory::shared_cache_budget(frames, layers.len(), first.max_memory);
+    (renderers.into_iter())
+        .map(|r| {
+            let budget = r.cache_budget().min(share);
+            r.with_cache_budget(budget)
+        })
+        .collect()
+}

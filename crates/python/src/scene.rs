@@ -71,6 +71,11 @@ struct Built {
     scene: CoreScene<'static>,
     known: Vec<Known>,
     digests: Vec<Option<u64>>,
+    /// The most each volume's brick caches may take: what `max_memory`
+    /// leaves after the frames rendered so far, shared (volray-app's
+    /// `shared_cache_budget`); `None` before the first frame. It never
+    /// grows back, as a `Renderer`'s budget does not.
+    share: Option<usize>,
 }
 
 /// Whether `render(volume, **kwargs)` renders a scene: a list or tuple of
@@ -197,7 +202,7 @@ impl Scene {
         let digests = (layers.iter())
             .map(|l| l.recipe.digest(py, None))
             .collect::<PyResult<Vec<_>>>()?;
-        let built = prepare(py, &layers, digests)?;
+        let built = prepare(py, &layers, digests, None)?;
         Ok(Scene {
             layers,
             looks: Mutex::new(looks),
@@ -216,8 +221,9 @@ impl Scene {
         if digests == last.digests {
             return Ok(last);
         }
+        let share = last.share;
         drop(last);
-        let fresh = Arc::new(prepare(py, &self.layers, digests)?);
+        let fresh = Arc::new(prepare(py, &self.layers, digests, share)?);
         *self.state.lock().unwrap_or_else(|e| e.into_inner()) = Arc::clone(&fresh);
         Ok(fresh)
     }
@@ -285,6 +291,25 @@ impl Scene {
                 format_bytes(u128::from(max_memory)),
             )));
         }
+        // The caches share what the frames leave: the volumes are
+        // prepared again with smaller ones where this frame needs more
+        // room than the last (the pixels are the same).
+        let share = volray_app::memory::shared_cache_budget(needed, n, max_memory);
+        let built = match built
+            .scene
+            .layers()
+            .iter()
+            .any(|r| r.cache_budget() > share)
+        {
+            false => built,
+            true => {
+                let digests = built.digests.clone();
+                drop(built);
+                let fresh = Arc::new(prepare(py, &self.layers, digests, Some(share))?);
+                *self.state.lock().unwrap_or_else(|e| e.into_inner()) = Arc::clone(&fresh);
+                fresh
+            }
+        };
         let name = match n {
             1 => self.layers[0].recipe.name.clone(),
             _ => "scene".to_string(),
@@ -406,8 +431,13 @@ impl Scene {
 }
 
 /// Every volume of `layers` prepared, whose samples' digests are
-/// `digests`, and put together.
-fn prepare(py: Python<'_>, layers: &[Layer], digests: Vec<Option<u64>>) -> PyResult<Built> {
+/// `digests`, and put together, each volume's caches within `share`.
+fn prepare(
+    py: Python<'_>,
+    layers: &[Layer],
+    digests: Vec<Option<u64>>,
+    share: Option<usize>,
+) -> PyResult<Built> {
     let n = layers.len();
     let mut renderers = Vec::with_capacity(n);
     let mut known = Vec::with_capacity(n);
@@ -417,7 +447,11 @@ fn prepare(py: Python<'_>, layers: &[Layer], digests: Vec<Option<u64>>) -> PyRes
         let prepared = (layer.recipe)
             .prepare(py, *digest, &RenderSettings::default())
             .map_err(|e| in_volume(py, i, n, e))?;
-        renderers.push(prepared.inner);
+        let budget = prepared
+            .inner
+            .cache_budget()
+            .min(share.unwrap_or(usize::MAX));
+        renderers.push(prepared.inner.with_cache_budget(budget));
         known.push(prepared.known);
     }
     let scene = CoreScene::new(renderers).map_err(|e| value_error(e.to_string()))?;
@@ -425,6 +459,7 @@ fn prepare(py: Python<'_>, layers: &[Layer], digests: Vec<Option<u64>>) -> PyRes
         scene,
         known,
         digests,
+        share,
     })
 }
 
@@ -465,6 +500,19 @@ impl Scene {
     #[pyo3(signature = (**kwargs))]
     fn render(&self, py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Frame> {
         self.frame(py, kwargs, false)
+    }
+
+    /// The budgets of the volumes' brick caches, in bytes, as the next
+    /// frame starts with them (for tests: they change speed, never pixels).
+    #[getter]
+    fn _cache_budgets(&self) -> Vec<usize> {
+        let built = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        built
+            .scene
+            .layers()
+            .iter()
+            .map(|r| r.cache_budget())
+            .collect()
     }
 
     /// The looks, one dict per volume (copies: set `looks` to change them).

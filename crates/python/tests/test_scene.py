@@ -270,3 +270,30 @@ def test_ctrl_c_stops_a_scene_frame(mix):
     assert np.array_equal(
         np.asarray(scene.render(**arguments)), np.asarray(fresh.render(**arguments))
     )
+
+
+def test_the_volumes_brick_caches_share_what_max_memory_leaves_after_the_frame():
+    # Each volume alone would get the limit less its own frame; together
+    # their caches live at once, so they share what every frame leaves
+    # (volray-app's shared_cache_budget), and a larger frame shrinks them.
+    a, b = ball((16, 8, 16)), ball((16, 24, 16))
+    limit = 64 << 20
+    alone = volray.Renderer(a, max_memory=limit)
+    alone.render()
+    need = limit - alone._cache_budget  # one volume's default frame
+    scene = volray.Scene([a, b], max_memory=limit)
+    small = scene.render()
+    shares = scene._cache_budgets
+    assert len(shares) == 2 and shares[0] == shares[1]
+    # Two volumes' frames, the rest halved: not the limit less one frame each.
+    assert limit - 2 * need - 1 <= 2 * shares[0] <= limit - 2 * need
+    assert 0 < shares[0] < alone._cache_budget / 2
+    big = scene.render(size=(520, 500))
+    # 16 bytes a pixel for each of the two frames, shared by two volumes.
+    assert shares[0] - scene._cache_budgets[0] >= 16 * (520 * 500 - 480 * 480)
+    budget = scene._cache_budgets
+    again = scene.render()
+    assert scene._cache_budgets == budget  # never grows back
+    # The budget changes speed, never pixels.
+    assert np.array_equal(pixels(small), pixels(again))
+    assert np.array_equal(pixels(big), pixels(volray.Scene([a, b]).render(size=(520, 500))))
