@@ -72,12 +72,10 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
 fn one_volume(args: &BenchArgs) -> Result<(), CliError> {
     let mut input = load(&args.input, args.view.look.log)?;
     let mut base = settings(&args.view)?;
-    crate::settings::from_volume(
-        &args.view.look,
-        &mut base.transfer_function,
-        &mut input.volume,
-        &input.name,
-    )?;
+    // What the look leaves to the volume, as `render` leaves it.
+    let look = volray_flags::look(&args.view.look);
+    volray_app::look::leave_to_volume(&look, &mut base.transfer_function, &mut input)
+        .map_err(crate::settings::refused)?;
     let pool = thread_pool(args.view.threads)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
 

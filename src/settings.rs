@@ -5,7 +5,7 @@
 
 use crate::error::CliError;
 use std::path::Path;
-use volray_core::{RenderSettings, TransferFunction, Volume};
+use volray_core::{RenderSettings, TransferFunction};
 use volray_flags::{Flags, LookArgs, RenderArgs, ViewArgs, look};
 use volray_options::{OptionError, Options, Tf};
 
@@ -55,17 +55,6 @@ pub fn named_transfer_function(
         *text = tf_text.unwrap_or_default().to_string();
     }
     volray_options::named_transfer_function(&look).map_err(refused)
-}
-
-/// What the flags leave to the volume `name`: `--labels`, or the transfer
-/// function chosen from its histogram (volray-options' `from_volume`).
-pub fn from_volume(
-    look_args: &LookArgs,
-    transfer_function: &mut TransferFunction,
-    volume: &mut Volume,
-    name: &str,
-) -> Result<(), CliError> {
-    volray_options::from_volume(&look(look_args), transfer_function, volume, name).map_err(refused)
 }
 
 /// `settings` with what the flags leave to `input`'s volume (volray-app's

@@ -14,7 +14,7 @@ mod scene;
 
 use crate::error::CliError;
 use crate::session::{load, renderer_for, thread_pool};
-use crate::settings::{from_volume, named_transfer_function, read_tf_file, settings_with_tf_text};
+use crate::settings::{named_transfer_function, read_tf_file, settings_with_tf_text};
 use reproduce::CliReproduce;
 use std::net::SocketAddr;
 use std::path::Path;
@@ -58,14 +58,13 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         },
         None => load(&args.input, look.log)?,
     };
-    // A transfer function chosen from the volume (`--tf auto`, `--labels`)
-    // is the page's starting one, and its commands name it in full.
-    from_volume(
-        look,
-        &mut settings.transfer_function,
-        &mut input.volume,
-        &input.name,
-    )?;
+    // What the look leaves to the volume, as `render` leaves it (volray-
+    // app's `look`: the file's display window, `--labels` in the colours
+    // the file gives them, `--tf auto`), is the page's starting transfer
+    // function, and its commands name it in full.
+    let tf = &mut settings.transfer_function;
+    volray_app::look::leave_to_volume(&volray_flags::look(look), tf, &mut input)
+        .map_err(crate::settings::refused)?;
     if look.labels && look.tf_file().is_none() {
         named = settings.transfer_function.clone();
     } else if look.auto_tf() {

@@ -153,6 +153,36 @@ async fn a_label_volumes_page_names_its_labels_and_reproduces_its_frame() {
 }
 
 #[tokio::test(flavor = "current_thread")]
+async fn a_segmentations_page_draws_its_labels_in_the_files_colours_as_render_does() {
+    // The DICOM Segmentation's segments are "bone" red and "vessel" blue,
+    // which neither palette colour of labels 1 and 2 (orange, green) is.
+    let seg = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/io/tests/fixtures/dicom/seg.dcm"
+    );
+    let Some((_viewer, b)) = open(&[seg, "--labels", "--size", "48"]).await else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let still = picture(&b.frame_bytes().await, dir.path(), "still.png");
+    let bluish = |&[r, g, b]: &[u8; 3]| b > 40 && b > r.max(g).saturating_add(10);
+    let reddish = |&[r, g, b]: &[u8; 3]| r > 40 && u16::from(r) > 2 * u16::from(g.max(b));
+    assert!(
+        still.rgb.iter().any(bluish),
+        "no blue: the file's colours unused"
+    );
+    assert!(
+        still.rgb.iter().any(reddish),
+        "no red: the file's colours unused"
+    );
+    let command = b.text("command").await;
+    let tf_json = b.text("tf-json").await;
+    let cli = run_command(&command, Some(("view-tf.json", &tf_json)), dir.path());
+    assert_eq!(cli, still, "the CLI's image differs from the page's");
+    b.close().await;
+}
+
+#[tokio::test(flavor = "current_thread")]
 async fn the_page_renders_orbits_edits_and_its_command_reproduces_the_still_frame() {
     if !browser::available() {
         return;

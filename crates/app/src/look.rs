@@ -6,6 +6,7 @@
 //! and a transfer-function file read ([`read_tf_file`]), bounded.
 
 use crate::input::Input;
+use std::borrow::Cow;
 use std::path::Path;
 use volray_core::TransferFunction;
 use volray_options::{LookOptions, OptionError};
@@ -68,22 +69,24 @@ pub fn leave_to_volume(
 ) -> Result<(), OptionError> {
     let window = (input.file.as_ref()).and_then(|(_, info)| info.display_window());
     volray_options::file_window(look, transfer_function, window);
-    // The colours the file gives its labels (a DICOM Segmentation's
-    // segments), for `--labels`, unless the look names its own.
-    let file_colours = crate::input::label_colours(input);
+    let look = with_file_colours(look, crate::input::label_colours(input));
+    volray_options::from_volume(&look, transfer_function, &mut input.volume, &input.name)
+}
+
+/// `look` with the colours its file gives the labels (a DICOM
+/// Segmentation's segments, `file_colours`) for `--labels`, unless the
+/// look names its own.
+pub fn with_file_colours(
+    look: &LookOptions,
+    file_colours: Vec<(i64, [f32; 3])>,
+) -> Cow<'_, LookOptions> {
     if look.label_colours.is_empty() && !file_colours.is_empty() {
-        let look = LookOptions {
+        return Cow::Owned(LookOptions {
             label_colours: file_colours,
             ..look.clone()
-        };
-        return volray_options::from_volume(
-            &look,
-            transfer_function,
-            &mut input.volume,
-            &input.name,
-        );
+        });
     }
-    volray_options::from_volume(look, transfer_function, &mut input.volume, &input.name)
+    Cow::Borrowed(look)
 }
 
 #[cfg(test)]

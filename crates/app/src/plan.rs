@@ -37,6 +37,8 @@ pub struct StreamedInput {
     found: Found,
     /// The file's display window (OME-Zarr `omero`), the default `--range`.
     window: Option<(f64, f64)>,
+    /// The colours the file gives its labels, for `--labels`.
+    label_colours: Vec<(i64, [f32; 3])>,
     /// The level, what it may take whole, and the limit (for the note
     /// after a frame).
     pub level: usize,
@@ -121,6 +123,7 @@ pub fn plan(
             streamed: streamed.with_labels(frames.labels),
             found: Found::default(),
             window: chunked.info().display_window(),
+            label_colours: crate::input::segment_colours(chunked.info()),
             level,
             whole: need,
             max_memory,
@@ -191,9 +194,10 @@ pub fn open_chunked(request: &Request, max_memory: u64) -> Result<Option<Chunked
 
 impl StreamedInput {
     /// `settings` with what the look options leave to the volume
-    /// (`--labels`, `--tf auto`), found piece by piece (volray-lazy's
-    /// [`Found`], which the Python module shares), within the file's
-    /// display window where the options give no range.
+    /// (`--labels`, in the colours the file gives them, `--tf auto`),
+    /// found piece by piece (volray-lazy's [`Found`], which the Python
+    /// module shares), within the file's display window where the options
+    /// give no range.
     pub fn settings_from_volume(
         &mut self,
         look: &LookOptions,
@@ -201,9 +205,10 @@ impl StreamedInput {
     ) -> Result<RenderSettings, AppError> {
         let name = self.name.clone();
         volray_options::file_window(look, &mut settings.transfer_function, self.window);
+        let look = crate::look::with_file_colours(look, self.label_colours.clone());
         let found = self
             .found
-            .apply(&mut self.streamed, look, &mut settings, &name);
+            .apply(&mut self.streamed, &look, &mut settings, &name);
         match found {
             Ok(()) => Ok(settings),
             Err(LookError::Stream(error)) => Err(AppError::Stream { name, error }),
