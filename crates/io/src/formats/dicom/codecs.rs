@@ -26,15 +26,17 @@
 //! JPEG-LS is decoded by volray's own [`jpegls`] (dicom-pixeldata's adapter
 //! needs the C++ CharLS, built with CMake).
 //!
-//! Not decoded: 12-bit DCT JPEG (JPEG Extended, process 4: `jpeg-decoder`
-//! reads 8-bit DCT only), refused by name.
+//! 12-bit DCT JPEG (JPEG Extended, process 4: `jpeg-decoder` reads 8-bit
+//! DCT only) is decoded by volray's own [`jpeg12`]; 12-bit progressive or
+//! hierarchical DCT (processes 6 to 12, never seen in DICOM files) are
+//! refused by name.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use crate::shared::panics;
 
 use super::header::ImageFormat;
-use super::jpegls;
+use super::{jpeg12, jpegls};
 
 /// The codec family of a transfer syntax decoded here.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -294,15 +296,21 @@ pub(super) fn decode_frames(
             Codec::Jpeg => {
                 let h = jpeg_header(&stream).map_err(|e| format!("frame {f}: {e}"))?;
                 check_header(&h, format, f, "JPEG")?;
-                if h.precision > 8 && h.process != 0xC3 && h.process != 0xC7 {
+                let samples = if (h.precision, h.process) == (12, 0xC1) {
+                    // Extended sequential DCT at 12 bits: volray's own decoder.
+                    guarded(f, "JPEG", false, || {
+                        jpeg12::decode(&stream, pixels).map(Samples::U16)
+                    })?
+                } else if h.precision <= 8 || matches!(h.process, 0xC3 | 0xC7) {
+                    guarded(f, "JPEG", true, || jpeg(&stream, pixels))?
+                } else {
                     return Err(format!(
-                        "frame {f} is {}-bit DCT JPEG (SOF{} marker FF{:02X}), which volray's JPEG decoder (jpeg-decoder) does not read: only 8-bit DCT and lossless JPEG are decoded",
+                        "frame {f} is {}-bit DCT JPEG (SOF{} marker FF{:02X}), which volray does not decode: 8-bit DCT, 12-bit extended sequential DCT (SOF1) and lossless JPEG are decoded",
                         h.precision,
                         h.process - 0xC0,
                         h.process
                     ));
-                }
-                let samples = guarded(f, "JPEG", true, || jpeg(&stream, pixels))?;
+                };
                 push(samples, format, out);
             }
             Codec::Jpeg2000 => {

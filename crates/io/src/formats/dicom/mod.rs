@@ -51,6 +51,7 @@
 mod codecs;
 mod dicomdir;
 mod header;
+mod jpeg12;
 mod jpegls;
 mod pixels;
 mod prescan;
