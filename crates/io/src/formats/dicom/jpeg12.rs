@@ -501,6 +501,90 @@ mod tests {
         assert!(bits.marker);
     }
 
+    /// A 12-bit stream of flat 8×8 blocks `values` in a row, written as
+    /// T.81 says, DC only: every quantiser 1 (8-bit DQT), a DC table of
+    /// sixteen 4-bit codes (category c is code c), an AC table whose one
+    /// code `0` is the end of block; with `restart` (DRI) 1, an RSTm after
+    /// every block numbered from `first_rst`.
+    fn flat_blocks(values: &[u16], restart: bool, first_rst: u8) -> Vec<u8> {
+        let mut s = vec![0xFF, 0xD8];
+        s.extend([0xFF, 0xDB, 0, 67, 0x00]);
+        s.extend([1u8; 64]);
+        s.extend([0xFF, 0xC4, 0, 3 + 16 + 16, 0x00]);
+        s.extend([0, 0, 0, 16, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]);
+        s.extend(0u8..16);
+        s.extend([0xFF, 0xC4, 0, 3 + 16 + 1, 0x10, 1]);
+        s.extend([0u8; 15]);
+        s.push(0x00);
+        if restart {
+            s.extend([0xFF, 0xDD, 0, 4, 0, 1]);
+        }
+        let width = 8 * values.len() as u16;
+        s.extend([0xFF, 0xC1, 0, 11, 12, 0, 8]);
+        s.extend(width.to_be_bytes());
+        s.extend([1, 1, 0x11, 0]);
+        s.extend([0xFF, 0xDA, 0, 8, 1, 1, 0x00, 0, 63, 0]);
+        let (mut bits, mut previous): (Vec<u8>, i32) = (Vec::new(), 0);
+        let flush = |bits: &mut Vec<u8>, s: &mut Vec<u8>| {
+            while bits.len() % 8 != 0 {
+                bits.push(1);
+            }
+            for byte in bits.chunks(8) {
+                let byte = byte.iter().fold(0u8, |b, &bit| (b << 1) | bit);
+                s.push(byte);
+                if byte == 0xFF {
+                    s.push(0);
+                }
+            }
+            bits.clear();
+        };
+        let put = |bits: &mut Vec<u8>, value: u32, n: u32| {
+            bits.extend((0..n).rev().map(|i| ((value >> i) & 1) as u8));
+        };
+        for (b, &v) in values.iter().enumerate() {
+            let dc = 8 * (i32::from(v) - 2048);
+            let diff = dc - previous;
+            previous = if restart { 0 } else { dc };
+            let cat = 32 - diff.unsigned_abs().leading_zeros();
+            let coded = if diff >= 0 {
+                diff
+            } else {
+                diff + (1 << cat) - 1
+            };
+            put(&mut bits, cat, 4);
+            put(&mut bits, coded as u32, cat);
+            put(&mut bits, 0, 1); // EOB
+            if restart && b + 1 < values.len() {
+                flush(&mut bits, &mut s);
+                s.extend([0xFF, 0xD0 + (first_rst + b as u8) % 8]);
+            }
+        }
+        flush(&mut bits, &mut s);
+        s.extend([0xFF, 0xD9]);
+        s
+    }
+
+    #[test]
+    fn flat_blocks_decode_to_their_values_with_and_without_restarts() {
+        let values = [3000, 1000, 4095, 0, 2048, 2049, 7, 9, 4000, 1];
+        for restart in [false, true] {
+            let stream = flat_blocks(&values, restart, 0);
+            let image = decode(&stream, 64 * values.len()).unwrap();
+            let width = 8 * values.len();
+            for (b, &v) in values.iter().enumerate() {
+                for y in 0..8 {
+                    for x in 0..8 {
+                        assert_eq!(image[y * width + 8 * b + x], v, "block {b}, {restart}");
+                    }
+                }
+            }
+        }
+        // Restart markers out of order are named.
+        let stream = flat_blocks(&values, true, 3);
+        let err = decode(&stream, 64 * values.len()).unwrap_err();
+        assert!(err.contains("restart marker FFD0 expected"), "{err}");
+    }
+
     #[test]
     fn truncated_and_garbled_streams_are_errors_not_panics() {
         let soi = [0xFF, 0xD8];
