@@ -358,7 +358,7 @@ fn scan(
     let mut samples = [0f64; 64];
     let cosines = cosines();
     for block in 0..across * down {
-        if restart > 0 && block > 0 && block % restart == 0 {
+        if restart > 0 && block > 0 && block.is_multiple_of(restart) {
             bits.restart(((block / restart - 1) % 8) as u8)?;
             prediction = 0;
         }
@@ -526,7 +526,7 @@ mod tests {
         s.extend([0xFF, 0xDA, 0, 8, 1, 1, 0x00, 0, 63, 0]);
         let (mut bits, mut previous): (Vec<u8>, i32) = (Vec::new(), 0);
         let flush = |bits: &mut Vec<u8>, s: &mut Vec<u8>| {
-            while bits.len() % 8 != 0 {
+            while !bits.len().is_multiple_of(8) {
                 bits.push(1);
             }
             for byte in bits.chunks(8) {
