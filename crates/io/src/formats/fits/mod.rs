@@ -34,7 +34,8 @@
 //! A gzip file (`.fits.gz`) is inflated as a stream (`source.rs`), within
 //! deflate's ratio and the memory limit. Tile-compressed images (§10: a
 //! BINTABLE with ZIMAGE = T, written by fpack or astropy's CompImageHDU)
-//! are refused by name: `funpack` or astropy write them uncompressed.
+//! are decompressed as they are read (`tiled.rs`: Rice and gzip, dithered
+//! quantisation undone); PLIO and HCOMPRESS are refused by name.
 //!
 //! Why a parser of volray's own rather than the `fitsrs` crate: reading a
 //! FITS image is a header of fixed-width cards and one contiguous
@@ -49,7 +50,9 @@
 
 mod data;
 mod header;
+mod rice;
 mod source;
+mod tiled;
 mod wcs;
 
 use std::path::Path;
@@ -196,16 +199,24 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         if index == 0 && hdu.header.logical("SIMPLE") != Some(true) {
             later.push("SIMPLE is not T: the file says it does not conform to the standard; read all the same".into());
         }
-        if hdu.is_compressed_image() {
-            compressed.push(format!(
-                "{} is a tile-compressed image (ZIMAGE = T, ZCMPTYPE '{}', ZNAXIS {})",
-                hdu.name(),
-                hdu.header.string("ZCMPTYPE").unwrap_or_default(),
-                hdu.header.text("ZNAXIS")
-            ));
-        }
-        let layout = if hdu.is_image() {
-            match layout(&hdu) {
+        // A tile-compressed image is laid out as the image it holds.
+        let tiled = match hdu.is_compressed_image() {
+            false => None,
+            true => match tiled::image_of(&hdu) {
+                Ok(image) => Some(image),
+                Err(reason) => {
+                    compressed.push(format!(
+                        "{} is a tile-compressed image (ZIMAGE = T, ZCMPTYPE '{}') whose header is not read: {reason}",
+                        hdu.name(),
+                        hdu.header.string("ZCMPTYPE").unwrap_or_default().trim_end(),
+                    ));
+                    None
+                }
+            },
+        };
+        let image = tiled.as_ref().unwrap_or(&hdu);
+        let layout = if hdu.is_image() || tiled.is_some() {
+            match layout(image) {
                 Ok(l) => l,
                 Err(reason) => {
                     refused.push(format!("{}: {reason}", hdu.name()));
@@ -230,11 +241,26 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
                 volumes.push((hdu.name(), frames));
                 frames_before += frames;
             }
-        } else if layout.is_some() && flat.is_none() {
+        } else if layout.is_some() && flat.is_none() && tiled.is_none() {
             flat = Some(hdu.clone());
         }
         if let (Some(frame_in_hdu), Some(l)) = (wanted, layout) {
-            let c = read_chosen(path, &mut src, opts, hdu.clone(), l, frame_in_hdu)?;
+            let c = match &tiled {
+                None => read_chosen(path, &mut src, opts, hdu.clone(), l, frame_in_hdu)?,
+                Some(image) => {
+                    let bytes = tiled::decompress(path, &mut src, &hdu, image, opts.max_memory)?;
+                    let mut memory = Source::from_bytes(bytes);
+                    let mut c =
+                        read_chosen(path, &mut memory, opts, image.clone(), l, frame_in_hdu)?;
+                    c.notes.push(format!(
+                        "{} is a tile-compressed image (ZCMPTYPE '{}', tiles {}): decompressed as read",
+                        hdu.name(),
+                        hdu.header.string("ZCMPTYPE").unwrap_or_default().trim_end(),
+                        tiles_text(&hdu.header, &image.naxes),
+                    ));
+                    c
+                }
+            };
             chosen = Some(c);
         }
         let skipped = skip_rest(path, &mut src, &hdu);
@@ -259,6 +285,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
         ));
     };
     finish(path, opts, c, volumes, arrays, compressed, later, trailing)
+}
+
+/// The tiles' size as `7x1x1` (`ZTILEn`, else the row: NAXIS1 by 1).
+fn tiles_text(h: &header::Header, naxes: &[u64]) -> String {
+    (naxes.iter().enumerate())
+        .map(|(a, n)| match h.int(&format!("ZTILE{}", a + 1)) {
+            Ok(Some(t)) => t.to_string(),
+            _ if a == 0 => n.to_string(),
+            _ => "1".to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("x")
 }
 
 /// Skips the rest of `hdu`'s data and its padding to a whole block; the
@@ -317,6 +355,8 @@ fn read_chosen(
     let dtype = data::dtype(hdu.bitpix);
     let mappable = if src.is_gzip() {
         Err("gzip-compressed data: store it as .fits".to_string())
+    } else if src.is_memory() {
+        Err("tile-compressed data: decompressed as it is read".to_string())
     } else if !scaling.is_identity() {
         Err("BSCALE/BZERO scale the values as they are read".to_string())
     } else if scaling.blank.is_some() {
@@ -389,9 +429,7 @@ fn nothing_chosen(
     if let Some(c) = compressed.first() {
         return IoError::invalid(
             path,
-            format!(
-                "{c}: volray does not read tile-compressed FITS; write it uncompressed first (funpack, or astropy's ImageHDU)"
-            ),
+            format!("{c}; write it uncompressed first (funpack, or astropy's ImageHDU)"),
         );
     }
     if let Some(r) = refused.first() {

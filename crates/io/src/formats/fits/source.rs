@@ -28,6 +28,8 @@ pub(super) struct Source {
 enum Reader {
     Plain(BufReader<File>),
     Gzip(Box<MultiGzDecoder<BufReader<File>>>),
+    /// An image decompressed from its tiles (`tiled.rs`).
+    Memory(io::Cursor<Vec<u8>>),
 }
 
 impl Source {
@@ -54,8 +56,24 @@ impl Source {
         })
     }
 
+    /// The bytes of an image decompressed from its tiles, read as its
+    /// file would be.
+    pub(super) fn from_bytes(bytes: Vec<u8>) -> Source {
+        let file_len = bytes.len() as u64;
+        Source {
+            reader: Reader::Memory(io::Cursor::new(bytes)),
+            pos: 0,
+            file_len,
+        }
+    }
+
     pub(super) fn is_gzip(&self) -> bool {
         matches!(self.reader, Reader::Gzip(_))
+    }
+
+    /// Whether the bytes are in memory, not the file's.
+    pub(super) fn is_memory(&self) -> bool {
+        matches!(self.reader, Reader::Memory(_))
     }
 
     /// Fills as much of `buf` as the file still holds: the number of
@@ -72,6 +90,7 @@ impl Source {
             let got = match &mut self.reader {
                 Reader::Plain(r) => r.read(&mut buf[done..]),
                 Reader::Gzip(r) => r.read(&mut buf[done..]),
+                Reader::Memory(r) => r.read(&mut buf[done..]),
             };
             match got {
                 Ok(0) => break,
