@@ -55,17 +55,26 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
                 .to_string(),
             file: None,
             max_memory: args.input.request().max_memory(),
+            display_note: None,
         },
         None => load(&args.input, look.log)?,
     };
     // A transfer function chosen from the volume (`--tf auto`, `--labels`)
     // is the page's starting one, and its commands name it in full.
-    from_volume(
-        look,
-        &mut settings.transfer_function,
-        &mut input.volume,
-        &input.name,
-    )?;
+    let ct = volray_app::look::ct_look_of(&crate::settings::look(look), &input);
+    if let Some((tf, note)) = ct {
+        // A CT's look (volray-app's `look`), which the page starts from.
+        eprintln!("volray: {}: {note}", input.name);
+        settings.transfer_function = tf.clone();
+        named = tf;
+    } else {
+        from_volume(
+            look,
+            &mut settings.transfer_function,
+            &mut input.volume,
+            &input.name,
+        )?;
+    }
     if look.labels && look.tf_file().is_none() {
         named = settings.transfer_function.clone();
     } else if look.auto_tf() {
