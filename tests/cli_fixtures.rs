@@ -42,10 +42,7 @@ const REFUSED: &[(&str, &str)] = &[
         "crates/io/tests/fixtures/fuzz/",
         "hostile files: fuzz regressions",
     ),
-    (
-        "crates/io/tests/fixtures/flat/",
-        "2-D images, not volumes",
-    ),
+    ("crates/io/tests/fixtures/flat/", "2-D images, not volumes"),
     (
         "crates/io/tests/fixtures/tiff/single_page.tif",
         "a 2-D image, not a volume",
@@ -102,10 +99,7 @@ const REFUSED: &[(&str, &str)] = &[
         "crates/io/tests/fixtures/fits/compressed.fits",
         "a tile-compressed FITS image, not read",
     ),
-    (
-        "fuzz/seeds/raw/",
-        "raw seeds without a header: need --dims",
-    ),
+    ("fuzz/seeds/raw/", "raw seeds without a header: need --dims"),
     (
         "fuzz/seeds/zarr/",
         "the Zarr fuzz target's seeds: a store serialised into one file, not a store",
@@ -266,8 +260,14 @@ fn the_refused_list_reads_as_written() {
     assert!(refused(slice, false).unwrap().1.starts_with("a slice"));
     // The series directory itself is read.
     assert_eq!(refused("crates/io/tests/fixtures/dicom/ct", true), None);
-    assert_eq!(refused("crates/io/tests/fixtures/dicom/enhanced_ct.dcm", false), None);
+    assert_eq!(
+        refused("crates/io/tests/fixtures/dicom/enhanced_ct.dcm", false),
+        None
+    );
     assert!(refused("crates/io/tests/fixtures/dicom/gap", true).is_some());
     assert!(refused("crates/io/tests/fixtures/analyze/u8.img", false).is_some());
-    assert_eq!(refused("crates/io/tests/fixtures/netcdf/packed.nc", false), None);
+    assert_eq!(
+        refused("crates/io/tests/fixtures/netcdf/packed.nc", false),
+        None
+    );
 }
