@@ -173,6 +173,7 @@ fn reading(inp: &InputArgs) -> Vec<String> {
     reading.opt("--dtype", inp.dtype.clone());
     reading.opt("--endian", inp.endian.clone());
     reading.opt("--spacing", inp.spacing.map(v3));
+    reading.opt("--scale", inp.scale.map(v3));
     reading.opt("--format", inp.format.clone());
     reading.opt("--frame", inp.frame.map(|f| f.to_string()));
     reading.opt("--series", inp.series.clone());

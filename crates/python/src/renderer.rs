@@ -142,6 +142,11 @@ pub(crate) struct Recipe {
     /// `Source`).
     spacing: Option<[f64; 3]>,
     origin: Option<[f64; 3]>,
+    /// Each world axis stretched for drawing (`scale=`), else `None` for
+    /// the default rule (volray-app's `display`): its file's axis units
+    /// (`display`) and modality (a CT's look, volray-app's `look`).
+    scale: Option<[f64; 3]>,
+    display: Option<volray_io::FileInfo>,
     /// What the volume-level options fixed.
     pub labels: bool,
     log: bool,
