@@ -210,7 +210,9 @@ impl Renderer {
                     .get()
                     .lazy
                     .as_ref()
-                    .map_or(1, |l| l.chunked.levels().len());
+                    // A file read box by box without levels (an HDF5 or
+                    // NetCDF-4 dataset) is its one level.
+                    .map_or(1, |l| l.chunked.levels().len().max(1));
                 check_level(&recipe.name, n, levels)?;
             }
             return Ok(Renderer {
