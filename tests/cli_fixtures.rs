@@ -124,7 +124,7 @@ fn refused(path: &str, is_dir: bool) -> Option<&'static (&'static str, &'static 
         path.to_string()
     };
     REFUSED.iter().find(|&&(pattern, _)| {
-        let hit = if let Some(end) = pattern.strip_prefix('*') {
+        if let Some(end) = pattern.strip_prefix('*') {
             !is_dir && path.ends_with(end)
         } else if let Some((folder, rest)) = pattern.split_once("/*/") {
             // Any file in a subfolder of `folder` (not the subfolders),
@@ -140,8 +140,7 @@ fn refused(path: &str, is_dir: bool) -> Option<&'static (&'static str, &'static 
             shown.starts_with(pattern)
         } else {
             path == pattern
-        };
-        hit
+        }
     })
 }
 
