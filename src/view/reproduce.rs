@@ -465,6 +465,15 @@ mod tests {
     }
 
     #[test]
+    fn the_command_keeps_the_scale_it_was_started_with() {
+        let (r, state) = reproduce(&["--scale", "1,1,0.5"]);
+        let command = r.reproduce(&state).unwrap().command;
+        assert!(command.contains(" --scale 1,1,0.5"), "{command}");
+        let (r, state) = reproduce(&[]);
+        assert!(!r.reproduce(&state).unwrap().command.contains("--scale"));
+    }
+
+    #[test]
     fn refusals_are_one_line_messages() {
         let (r, mut state) = reproduce(&[]);
         state.colormap = START_COLOURS.into();
