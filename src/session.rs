@@ -69,8 +69,15 @@ pub fn plan(
         extra: png_bytes(settings),
     };
     let spec = request.spec.name();
-    volray_app::plan::plan(&request, &frames, &mut |c| say_chosen(&spec, c))
-        .map_err(|e| app_failure(view, e))
+    let plan = volray_app::plan::plan(&request, &frames, &mut |c| say_chosen(&spec, c))
+        .map_err(|e| app_failure(view, e))?;
+    // How axes in different units were stretched for drawing.
+    if let Plan::Streamed(s) = &plan
+        && let Some(note) = &s.display_note
+    {
+        eprintln!("volray: {}: {note}", s.name);
+    }
+    Ok(plan)
 }
 
 /// The line `--level auto` prints as it chooses.

@@ -242,3 +242,40 @@ fn a_file_in_one_length_unit_is_not_stretched() {
     );
     assert!(!said.contains("drawn at"), "{said}");
 }
+
+/// A Zarr array of 64 × 64 × 32 (x, y, z) written by zarr-python: a
+/// Gaussian blob in chunks of 16 × 16 × 8.
+const ZARR: &str = r#"
+import sys, numpy as np, zarr
+k, j, i = np.mgrid[0:32, 0:64, 0:64]
+a = np.exp(-((i - 32) ** 2 + (j - 32) ** 2 + (k - 16) ** 2) / 200.0).astype(np.float32)
+z = zarr.open_array(sys.argv[1] + "/z.zarr", mode="w", shape=a.shape, chunks=(8, 16, 16), dtype="f4", zarr_format=2)
+z[:] = a
+"#;
+
+#[test]
+fn a_level_rendered_in_pieces_is_stretched_as_it_is_whole() {
+    let Some(dir) = written_by_python(&["zarr", "numpy"], &[], ZARR) else {
+        return;
+    };
+    let store = dir.path().join("z.zarr");
+    let store = store.to_str().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let png = |name: &str| out.path().join(name);
+    let scaled = [store, "--size", "48", "--scale", "1,1,3"];
+    render(&scaled, &png("whole.png"));
+    // Under 600 KiB the level (626 KiB whole) is rendered in two pieces.
+    let pieces = [&scaled[..], &["--max-memory", "600K"][..]].concat();
+    let said = render(&pieces, &png("pieces.png"));
+    assert!(said.contains("rendered in pieces"), "{said}");
+    render(
+        &[store, "--size", "48", "--max-memory", "600K"],
+        &png("as_stored.png"),
+    );
+    let (whole, in_pieces) = (
+        Picture::read(&png("whole.png")),
+        Picture::read(&png("pieces.png")),
+    );
+    assert_eq!(whole.max_diff(&in_pieces), 0);
+    assert!(in_pieces.max_diff(&Picture::read(&png("as_stored.png"))) > 50);
+}

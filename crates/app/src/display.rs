@@ -23,11 +23,15 @@
 //! The stretch multiplies the volume's spacing and origin (world
 //! coordinates become display coordinates: `--look-at`, `--crop` and
 //! `--clip` are in them too). It applies where an input is opened for
-//! rendering (`input::load_log`, the MPI ranks' sources), not where it
-//! is read for its values (`volray info`, `convert`, Python's `read`).
+//! rendering (`input::load_log`, the MPI ranks' sources, a chunked level
+//! rendered in pieces through [`Stretched`]), not where it is read for
+//! its values (`volray info`, `convert`, Python's `read`).
 
 use crate::input::Input;
+use std::sync::Arc;
 use volray_core::glam::DVec3;
+use volray_core::sampling::grid::GridFrame;
+use volray_core::{SampleType, SourceError, SourceErrorKind, Volume, VolumeSource};
 use volray_io::FileInfo;
 
 /// How the axes are stretched for drawing.
@@ -201,6 +205,55 @@ pub fn displayed(mut input: Input, explicit: Option<[f64; 3]>) -> Result<Input, 
     }
     input.display_note = stretch.note;
     Ok(input)
+}
+
+/// A source's boxes placed in the stretched world (a chunked level
+/// rendered in pieces: `plan.rs`): its grid's and each box's spacing and
+/// origin multiplied by `factors`, the samples as read.
+pub struct Stretched {
+    inner: Arc<dyn VolumeSource>,
+    factors: DVec3,
+}
+
+impl Stretched {
+    /// `inner` stretched by `factors` (positive, finite: [`stretch`]'s).
+    pub fn new(inner: Arc<dyn VolumeSource>, factors: [f64; 3]) -> Stretched {
+        Stretched {
+            inner,
+            factors: DVec3::from(factors),
+        }
+    }
+}
+
+impl VolumeSource for Stretched {
+    fn grid(&self) -> GridFrame {
+        let g = self.inner.grid();
+        GridFrame {
+            dims: g.dims,
+            origin: g.origin * self.factors,
+            spacing: g.spacing * self.factors,
+        }
+    }
+
+    fn sample_type(&self) -> SampleType {
+        self.inner.sample_type()
+    }
+
+    fn is_labels(&self) -> bool {
+        self.inner.is_labels()
+    }
+
+    fn voxel_bytes(&self) -> usize {
+        self.inner.voxel_bytes()
+    }
+
+    fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume, SourceError> {
+        let v = self.inner.read_box(lo, hi)?;
+        let (spacing, origin) = (v.spacing() * self.factors, v.origin() * self.factors);
+        (v.with_spacing(spacing))
+            .and_then(|v| v.with_origin(origin))
+            .map_err(|e| SourceError::new(SourceErrorKind::BadData, format!("scale: {e}")))
+    }
 }
 
 #[cfg(test)]

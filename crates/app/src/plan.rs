@@ -32,6 +32,9 @@ pub enum Plan {
 /// A chunked volume rendered piece by piece.
 pub struct StreamedInput {
     pub name: String,
+    /// How its axes were stretched for drawing, where they were by the
+    /// default rule (`display.rs`): the note a front end says.
+    pub display_note: Option<String>,
     pub streamed: Streamed,
     /// The labels or histogram found in the level, once.
     found: Found,
@@ -116,15 +119,38 @@ pub fn plan(
             level,
             need,
             streamed,
-        } => Ok(Plan::Streamed(Box::new(StreamedInput {
-            name: spec,
-            streamed: streamed.with_labels(frames.labels),
-            found: Found::default(),
-            window: chunked.info().display_window(),
-            level,
-            whole: need,
-            max_memory,
-        }))),
+        } => {
+            // Axes in different units stretched for drawing, as a whole
+            // volume's are (display.rs): each piece placed in the
+            // stretched world, in pieces of the same budget.
+            let grid = streamed.grid();
+            let n = grid.dims.map(|n| n.saturating_sub(1) as f64);
+            let extent = grid.spacing * volray_core::glam::DVec3::from(n);
+            let stretch = crate::display::stretch(Some(chunked.info()), extent, request.scale);
+            let (streamed, display_note) = match stretch {
+                None => (*streamed, None),
+                Some(s) => {
+                    let budget = max_memory.min(volray_lazy::PIECE_BUDGET);
+                    // `--log`'s pieces get a third (volray-lazy's log_pieces).
+                    let budget = if frames.log { budget / 3 } else { budget };
+                    let source =
+                        crate::display::Stretched::new(streamed.source().clone(), s.factors);
+                    let source: std::sync::Arc<dyn volray_core::VolumeSource> =
+                        std::sync::Arc::new(source);
+                    (Streamed::new(source, frames.non_finite, budget), s.note)
+                }
+            };
+            Ok(Plan::Streamed(Box::new(StreamedInput {
+                name: spec,
+                display_note,
+                streamed: streamed.with_labels(frames.labels),
+                found: Found::default(),
+                window: chunked.info().display_window(),
+                level,
+                whole: need,
+                max_memory,
+            })))
+        }
     }
 }
 
