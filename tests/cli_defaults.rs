@@ -3,12 +3,12 @@
 //! (`--preset ct-bone`: its bone, not its soft tissue), and axes in
 //! different units (degrees by metres) drawn as a box, not a line
 //! (volray-app's `display.rs`, `--scale`). The files are written at test
-//! time by pydicom and netCDF4.
+//! time by pydicom, netCDF4 and zarr-python, or here (a MetaImage).
 
 use std::path::Path;
 
 mod common;
-use common::{Picture, render, stderr, volray, written_by_python};
+use common::{Picture, render, stderr, stdout, volray, written_by_python};
 
 /// A CT series of 24 slices of 24², 1 mm apart, written by pydicom:
 /// stored uint16 with RescaleIntercept −1024 (HU = stored − 1024), air
@@ -278,4 +278,45 @@ fn a_level_rendered_in_pieces_is_stretched_as_it_is_whole() {
     );
     assert_eq!(whole.max_diff(&in_pieces), 0);
     assert!(in_pieces.max_diff(&Picture::read(&png("as_stored.png"))) > 50);
+}
+
+/// A MetaImage of 8³ int16 Hounsfield values (air, a ball of bone of
+/// radius 2.5 at the centre), its header naming `modality`.
+fn metaimage(dir: &Path, modality: &str) -> String {
+    let mut bytes = format!(
+        "ObjectType = Image\nNDims = 3\nDimSize = 8 8 8\nElementType = MET_SHORT\nElementSpacing = 1 1 1\nElementByteOrderMSB = False\nModality = {modality}\nElementDataFile = LOCAL\n"
+    )
+    .into_bytes();
+    for k in 0..8 {
+        for j in 0..8 {
+            for i in 0..8 {
+                let r2 = [i, j, k]
+                    .map(|v: i32| (v as f64 - 3.5).powi(2))
+                    .iter()
+                    .sum::<f64>();
+                let hu: i16 = if r2 <= 6.25 { 1000 } else { -1000 };
+                bytes.extend(hu.to_le_bytes());
+            }
+        }
+    }
+    let path = dir.join(format!("{modality}.mha"));
+    std::fs::write(&path, bytes).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn a_metaimage_ct_gets_the_ct_look_and_an_mr_does_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ct, mr) = (
+        metaimage(dir.path(), "MET_MOD_CT"),
+        metaimage(dir.path(), "MET_MOD_MR"),
+    );
+    let info = volray(&["info", &ct]);
+    assert!(stdout(&info).contains("modality:  CT"), "{}", stdout(&info));
+    let info = volray(&["info", &mr, "--json"]);
+    let doc: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(doc["modality"], "MR");
+    let out = dir.path().join("out.png");
+    assert!(render(&[&ct, "--size", "16"], &out).contains("--preset ct-bone"));
+    assert!(!render(&[&mr, "--size", "16"], &out).contains("ct-bone"));
 }
