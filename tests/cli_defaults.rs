@@ -251,10 +251,18 @@ k, j, i = np.mgrid[0:32, 0:64, 0:64]
 a = np.exp(-((i - 32) ** 2 + (j - 32) ** 2 + (k - 16) ** 2) / 200.0).astype(np.float32)
 z = zarr.open_array(sys.argv[1] + "/z.zarr", mode="w", shape=a.shape, chunks=(8, 16, 16), dtype="f4", zarr_format=2)
 z[:] = a
+# The same as an OME-Zarr image whose y and x are in degrees, z in metres.
+g = zarr.open_group(sys.argv[1] + "/o.zarr", mode="w", zarr_format=2)
+g.create_array("0", shape=a.shape, chunks=(8, 16, 16), dtype="f4")[:] = a
+g.attrs["multiscales"] = [{"version": "0.4", "axes": [
+    {"name": "z", "type": "space", "unit": "meter"},
+    {"name": "y", "type": "space", "unit": "degree"},
+    {"name": "x", "type": "space", "unit": "degree"}],
+  "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [100.0, 0.25, 0.25]}]}]}]
 "#;
 
 #[test]
-fn a_level_rendered_in_pieces_is_stretched_as_it_is_whole() {
+fn a_level_rendered_in_pieces_is_stretched_as_it_is_whole_as_given_or_by_default() {
     let Some(dir) = written_by_python(&["zarr", "numpy"], &[], ZARR) else {
         return;
     };
@@ -278,6 +286,26 @@ fn a_level_rendered_in_pieces_is_stretched_as_it_is_whole() {
     );
     assert_eq!(whole.max_diff(&in_pieces), 0);
     assert!(in_pieces.max_diff(&Picture::read(&png("as_stored.png"))) > 50);
+
+    // The default stretch of degrees by metres, in pieces as whole: 15.75
+    // degrees across, 3100 m drawn 15.75 degrees tall (0.0051 per m).
+    let ome = dir.path().join("o.zarr");
+    let ome = ome.to_str().unwrap();
+    let note = "z (z, meter) drawn at 1 meter = 0.0051 degree";
+    let said = render(&[ome, "--size", "48"], &png("ome_whole.png"));
+    assert!(said.contains(note), "{said}");
+    let said = render(
+        &[ome, "--size", "48", "--max-memory", "600K"],
+        &png("ome_pieces.png"),
+    );
+    assert!(
+        said.contains(note) && said.contains("rendered in pieces"),
+        "{said}"
+    );
+    let whole = Picture::read(&png("ome_whole.png"));
+    assert_eq!(whole.max_diff(&Picture::read(&png("ome_pieces.png"))), 0);
+    let (count, w, h) = footprint(&whole);
+    assert!(count > 0 && w > 10 && h > 10, "{w} x {h}");
 }
 
 /// A MetaImage of 8³ int16 Hounsfield values (air, a ball of bone of
