@@ -194,7 +194,8 @@ pub struct FileInfo {
     /// gives the axes units that are not one length unit, some not a
     /// length at all (degrees by metres: `units.rs` keeps them apart);
     /// `None` otherwise. What the display scale stretches (volray-app's
-    /// `display.rs`).
+    /// `display.rs`). Filled by the CF readers (NetCDF-3, NetCDF-4) and
+    /// OME-Zarr's.
     pub axis_units: Option<[AxisUnitName; 3]>,
 }
 
