@@ -120,26 +120,8 @@ pub fn plan(
             need,
             streamed,
         } => {
-            // Axes in different units stretched for drawing, as a whole
-            // volume's are (display.rs): each piece placed in the
-            // stretched world, in pieces of the same budget.
-            let grid = streamed.grid();
-            let n = grid.dims.map(|n| n.saturating_sub(1) as f64);
-            let extent = grid.spacing * volray_core::glam::DVec3::from(n);
-            let stretch = crate::display::stretch(Some(chunked.info()), extent, request.scale);
-            let (streamed, display_note) = match stretch {
-                None => (*streamed, None),
-                Some(s) => {
-                    let budget = max_memory.min(volray_lazy::PIECE_BUDGET);
-                    // `--log`'s pieces get a third (volray-lazy's log_pieces).
-                    let budget = if frames.log { budget / 3 } else { budget };
-                    let source =
-                        crate::display::Stretched::new(streamed.source().clone(), s.factors);
-                    let source: std::sync::Arc<dyn volray_core::VolumeSource> =
-                        std::sync::Arc::new(source);
-                    (Streamed::new(source, frames.non_finite, budget), s.note)
-                }
-            };
+            let (streamed, display_note) =
+                stretched_pieces(&chunked, *streamed, frames, max_memory, request.scale);
             Ok(Plan::Streamed(Box::new(StreamedInput {
                 name: spec,
                 display_note,
@@ -152,6 +134,33 @@ pub fn plan(
             })))
         }
     }
+}
+
+/// `streamed`, the pieces of `chunked`'s level planned for `frames`
+/// under `max_memory`, stretched for drawing as a whole volume's axes are
+/// (`display.rs`: `scale` as given, else the default rule): each piece
+/// placed in the stretched world, in pieces of the same budget; and the
+/// default rule's note. Unchanged where nothing is stretched.
+pub fn stretched_pieces(
+    chunked: &Chunked,
+    streamed: Streamed,
+    frames: &Frames<'_>,
+    max_memory: u64,
+    scale: Option<[f64; 3]>,
+) -> (Streamed, Option<String>) {
+    let grid = streamed.grid();
+    let n = grid.dims.map(|n| n.saturating_sub(1) as f64);
+    let extent = grid.spacing * volray_core::glam::DVec3::from(n);
+    let Some(s) = crate::display::stretch(Some(chunked.info()), extent, scale) else {
+        return (streamed, None);
+    };
+    // volray-lazy's budgets: a piece's, a third of it under `--log`
+    // (`Chunked::plan`, `Chunked::log_pieces`).
+    let budget = max_memory.min(volray_lazy::PIECE_BUDGET);
+    let budget = if frames.log { budget / 3 } else { budget };
+    let source = crate::display::Stretched::new(streamed.source().clone(), s.factors);
+    let source: std::sync::Arc<dyn volray_core::VolumeSource> = std::sync::Arc::new(source);
+    (Streamed::new(source, frames.non_finite, budget), s.note)
 }
 
 /// How `chunked`'s level (of the input `name`) is rendered for `frames`

@@ -126,3 +126,26 @@ def test_a_ct_is_drawn_in_the_ct_look_as_the_command_line_draws_it(tmp_path, cli
     # tf="auto" keeps the histogram's choice, as --tf auto does.
     auto = rgb(volray.render(vol, size=48, tf="auto"))
     assert np.abs(auto - cli_image(series, "--size", "48", "--tf", "auto")[:, :, :3]).max() <= 1
+
+
+def test_an_ome_zarr_in_degrees_by_metres_is_stretched_whole_and_in_pieces(tmp_path, cli_image):
+    zarr = need("zarr")
+    k, j, i = np.mgrid[0:32, 0:64, 0:64]
+    a = np.exp(-((i - 32) ** 2 + (j - 32) ** 2 + (k - 16) ** 2) / 200.0).astype(np.float32)
+    path = tmp_path / "o.zarr"
+    g = zarr.open_group(str(path), mode="w", zarr_format=2)
+    g.create_array("0", shape=a.shape, chunks=(8, 16, 16), dtype="f4")[:] = a
+    axes = [{"name": "z", "type": "space", "unit": "meter"}]
+    axes += [{"name": n, "type": "space", "unit": "degree"} for n in "yx"]
+    scale = [{"type": "scale", "scale": [100.0, 0.25, 0.25]}]
+    g.attrs["multiscales"] = [
+        {"version": "0.4", "axes": axes, "datasets": [{"path": "0", "coordinateTransformations": scale}]}
+    ]
+    vol = volray.read(path)
+    whole = rgb(volray.render(vol, size=48))
+    assert np.abs(whole - cli_image(path, "--size", "48")[:, :, :3]).max() <= 1
+    # Under 600 KiB the level (626 KiB whole) is rendered in pieces.
+    pieces = rgb(volray.render(vol, size=48, max_memory=600 << 10))
+    assert np.abs(pieces - whole).max() <= 1
+    width, height = covered(pieces)
+    assert width > 10 and height > 10, (width, height)
