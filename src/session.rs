@@ -21,7 +21,12 @@ use volray_io::format_bytes;
 
 /// Reads the volume `args` name and, with `--log`, takes its log10.
 pub fn load(args: &InputArgs, log: bool) -> Result<Input, CliError> {
-    Ok(volray_app::input::load_log(&args.request(), log)?)
+    let input = volray_app::input::load_log(&args.request(), log)?;
+    // How axes in different units were stretched for drawing.
+    if let Some(note) = &input.display_note {
+        eprintln!("volray: {}: {note}", input.name);
+    }
+    Ok(input)
 }
 
 /// volray-app's error as the CLI's, a render error naming its flag.
@@ -64,8 +69,15 @@ pub fn plan(
         extra: png_bytes(settings),
     };
     let spec = request.spec.name();
-    volray_app::plan::plan(&request, &frames, &mut |c| say_chosen(&spec, c))
-        .map_err(|e| app_failure(view, e))
+    let plan = volray_app::plan::plan(&request, &frames, &mut |c| say_chosen(&spec, c))
+        .map_err(|e| app_failure(view, e))?;
+    // How axes in different units were stretched for drawing.
+    if let Plan::Streamed(s) = &plan
+        && let Some(note) = &s.display_note
+    {
+        eprintln!("volray: {}: {note}", s.name);
+    }
+    Ok(plan)
 }
 
 /// The line `--level auto` prints as it chooses.

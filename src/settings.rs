@@ -68,7 +68,11 @@ pub fn from_input(
 ) -> Result<RenderSettings, CliError> {
     let mut settings = settings.clone();
     let tf = &mut settings.transfer_function;
-    volray_app::look::leave_to_volume(&look(&args.view.look), tf, input).map_err(refused)?;
+    let note = volray_app::look::leave_to_volume(&look(&args.view.look), tf, input);
+    // A CT's look, said.
+    if let Some(note) = note.map_err(refused)? {
+        eprintln!("volray: {}: {note}", input.name);
+    }
     Ok(settings)
 }
 

@@ -55,17 +55,21 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
                 .to_string(),
             file: None,
             max_memory: args.input.request().max_memory(),
+            display_note: None,
         },
         None => load(&args.input, look.log)?,
     };
     // What the look leaves to the volume, as `render` leaves it (volray-
-    // app's `look`: the file's display window, `--labels` in the colours
-    // the file gives them, `--tf auto`), is the page's starting transfer
-    // function, and its commands name it in full.
+    // app's `look`: a CT's look, the file's display window, `--labels` in
+    // the colours the file gives them, `--tf auto`), is the page's
+    // starting transfer function, and its commands name it in full.
     let tf = &mut settings.transfer_function;
-    volray_app::look::leave_to_volume(&volray_flags::look(look), tf, &mut input)
+    let ct = volray_app::look::leave_to_volume(&volray_flags::look(look), tf, &mut input)
         .map_err(crate::settings::refused)?;
-    if look.labels && look.tf_file().is_none() {
+    if let Some(note) = ct {
+        eprintln!("volray: {}: {note}", input.name);
+        named = settings.transfer_function.clone();
+    } else if look.labels && look.tf_file().is_none() {
         named = settings.transfer_function.clone();
     } else if look.auto_tf() {
         // The same points: `t` is relative to the window, whatever its units.

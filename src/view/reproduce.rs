@@ -173,6 +173,7 @@ fn reading(inp: &InputArgs) -> Vec<String> {
     reading.opt("--dtype", inp.dtype.clone());
     reading.opt("--endian", inp.endian.clone());
     reading.opt("--spacing", inp.spacing.map(v3));
+    reading.opt("--scale", inp.scale.map(v3));
     reading.opt("--format", inp.format.clone());
     reading.opt("--frame", inp.frame.map(|f| f.to_string()));
     reading.opt("--series", inp.series.clone());
@@ -461,6 +462,15 @@ mod tests {
         assert_eq!(tf.opacity, preset.opacity);
         assert_eq!(tf.color, preset.color);
         assert_eq!(out.settings.transfer_function.opacity, preset.opacity);
+    }
+
+    #[test]
+    fn the_command_keeps_the_scale_it_was_started_with() {
+        let (r, state) = reproduce(&["--scale", "1,1,0.5"]);
+        let command = r.reproduce(&state).unwrap().command;
+        assert!(command.contains(" --scale 1,1,0.5"), "{command}");
+        let (r, state) = reproduce(&[]);
+        assert!(!r.reproduce(&state).unwrap().command.contains("--scale"));
     }
 
     #[test]

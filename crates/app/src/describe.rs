@@ -53,14 +53,24 @@ pub fn lines(request: &Request, bins: u16, as_json: bool) -> Result<Vec<String>,
         (None, Some((format, info))) => (format.description().to_string(), Some(info)),
         (None, None) => ("built-in source".to_string(), None),
     };
-    let info = info.map(with_bytes_stored);
-    let info = info.as_ref();
+    let mut info = info.map(with_bytes_stored);
     // What is shown of the volume: the level asked for, whichever level
     // the statistics came from.
     let grid = match &chunked {
         Some((lazy, _)) => lazy.source.grid(),
         None => volray_core::VolumeSource::grid(v),
     };
+    // How `render` stretches axes in different units for drawing (the
+    // spacing shown is as stored).
+    if let Some(i) = info.as_mut() {
+        let n = grid.dims.map(|n| n.saturating_sub(1) as f64);
+        let extent = grid.spacing * volray_core::glam::DVec3::from(n);
+        let stretch = crate::display::stretch(Some(i), extent, request.scale);
+        if let Some(note) = stretch.and_then(|s| s.note) {
+            i.notes.push(note);
+        }
+    }
+    let info = info.as_ref();
     let values_from = chunked.as_ref().map(|(lazy, k)| {
         let l = &lazy.info.levels[*k];
         (*k, l.dims)
@@ -306,6 +316,9 @@ fn stored(l: &volray_io::LevelInfo) -> String {
 
 fn print_stored(out: &mut Vec<String>, i: &FileInfo, name: &str) {
     outln!(out, "stored as: {}", i.stored_type);
+    if let Some(m) = &i.modality {
+        outln!(out, "modality:  {m}");
+    }
     let (t, c) = (i.time_points, i.channels);
     if i.frames_are_series {
         // A DICOM directory's series: each its own grid, so neither an
@@ -456,6 +469,8 @@ fn add_file_json(out: &mut Value, i: &FileInfo) {
             .collect::<Vec<_>>()
     );
     out["notes"] = json!(i.notes);
+    // The imaging modality the file names (DICOM's `CT`, `MR`), if any.
+    out["modality"] = json!(i.modality);
     out["nan_is_empty"] = json!(i.nan_is_empty);
     // OME-Zarr's rendering hints for the channel read.
     out["omero"] = json!(i.omero.as_ref().map(|o| json!({

@@ -74,6 +74,10 @@ pub struct Request {
     pub channel: Option<usize>,
     /// The memory limit; `None` for volray-io's default.
     pub max_memory: Option<u64>,
+    /// Each world axis stretched for drawing (`--scale`, Python's
+    /// `scale=`): `None` for the default rule (`display.rs`: axes in
+    /// different units drawn comparable, others as stored).
+    pub scale: Option<[f64; 3]>,
 }
 
 impl Request {
@@ -124,6 +128,9 @@ pub struct Input {
     pub file: Option<(VolumeFormat, FileInfo)>,
     /// `--max-memory` (or its default), which rendering must fit too.
     pub max_memory: u64,
+    /// How its axes were stretched for drawing, where they were by the
+    /// default rule (`display.rs`): the note a front end says.
+    pub display_note: Option<String>,
 }
 
 impl Input {
@@ -169,9 +176,11 @@ pub enum Described {
     },
 }
 
-/// Reads the volume `request` names and, with `log`, takes its log10.
+/// Reads the volume `request` names for rendering: with `log`, its
+/// log10; its axes stretched for drawing as `request.scale` or the
+/// default rule says ([`crate::display`]).
 pub fn load_log(request: &Request, log: bool) -> Result<Input, AppError> {
-    let mut input = load(request)?;
+    let mut input = crate::display::displayed(load(request)?, request.scale)?;
     if log {
         input.volume = input.volume.to_log10().map_err(|e| AppError::Log {
             name: input.name.clone(),
@@ -260,6 +269,7 @@ fn describe_with(request: &Request, map: MapPolicy) -> Result<Described, AppErro
         name: spec,
         file,
         max_memory,
+        display_note: None,
     })))
 }
 

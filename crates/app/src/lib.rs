@@ -80,6 +80,7 @@ pub mod animation;
 pub mod bench;
 pub mod convert;
 pub mod describe;
+pub mod display;
 #[cfg(feature = "mpi")]
 pub mod distributed;
 pub mod error;

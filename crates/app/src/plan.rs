@@ -32,6 +32,9 @@ pub enum Plan {
 /// A chunked volume rendered piece by piece.
 pub struct StreamedInput {
     pub name: String,
+    /// How its axes were stretched for drawing, where they were by the
+    /// default rule (`display.rs`): the note a front end says.
+    pub display_note: Option<String>,
     pub streamed: Streamed,
     /// The labels or histogram found in the level, once.
     found: Found,
@@ -118,17 +121,49 @@ pub fn plan(
             level,
             need,
             streamed,
-        } => Ok(Plan::Streamed(Box::new(StreamedInput {
-            name: spec,
-            streamed: streamed.with_labels(frames.labels),
-            found: Found::default(),
-            window: chunked.info().display_window(),
-            label_colours: crate::input::segment_colours(chunked.info()),
-            level,
-            whole: need,
-            max_memory,
-        }))),
+        } => {
+            let (streamed, display_note) =
+                stretched_pieces(&chunked, *streamed, frames, max_memory, request.scale);
+            Ok(Plan::Streamed(Box::new(StreamedInput {
+                name: spec,
+                display_note,
+                streamed: streamed.with_labels(frames.labels),
+                found: Found::default(),
+                window: chunked.info().display_window(),
+                label_colours: crate::input::segment_colours(chunked.info()),
+                level,
+                whole: need,
+                max_memory,
+            })))
+        }
     }
+}
+
+/// `streamed`, the pieces of `chunked`'s level planned for `frames`
+/// under `max_memory`, stretched for drawing as a whole volume's axes are
+/// (`display.rs`: `scale` as given, else the default rule): each piece
+/// placed in the stretched world, in pieces of the same budget; and the
+/// default rule's note. Unchanged where nothing is stretched.
+pub fn stretched_pieces(
+    chunked: &Chunked,
+    streamed: Streamed,
+    frames: &Frames<'_>,
+    max_memory: u64,
+    scale: Option<[f64; 3]>,
+) -> (Streamed, Option<String>) {
+    let grid = streamed.grid();
+    let n = grid.dims.map(|n| n.saturating_sub(1) as f64);
+    let extent = grid.spacing * volray_core::glam::DVec3::from(n);
+    let Some(s) = crate::display::stretch(Some(chunked.info()), extent, scale) else {
+        return (streamed, None);
+    };
+    // volray-lazy's budgets: a piece's, a third of it under `--log`
+    // (`Chunked::plan`, `Chunked::log_pieces`).
+    let budget = max_memory.min(volray_lazy::PIECE_BUDGET);
+    let budget = if frames.log { budget / 3 } else { budget };
+    let source = crate::display::Stretched::new(streamed.source().clone(), s.factors);
+    let source: std::sync::Arc<dyn volray_core::VolumeSource> = std::sync::Arc::new(source);
+    (Streamed::new(source, frames.non_finite, budget), s.note)
 }
 
 /// How `chunked`'s level (of the input `name`) is rendered for `frames`

@@ -41,6 +41,16 @@ pub struct InputArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_spacing, allow_hyphen_values = true)]
     pub spacing: Option<[f64; 3]>,
 
+    /// Stretch each world axis by these factors for drawing (vertical
+    /// exaggeration): spacing and origin are multiplied, so --look-at,
+    /// --crop and --clip are in the stretched coordinates [default: axes
+    /// in different units (degrees by metres) drawn with comparable
+    /// extents, a note says how; others as stored]. 1,1,1 draws the axes
+    /// as stored. `info` notes the default; `convert` writes the volume
+    /// as stored.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_spacing, allow_hyphen_values = true)]
+    pub scale: Option<[f64; 3]>,
+
     /// Read the file as this format, whatever its name and content say
     /// [default: from the extension, else from the file's magic number].
     #[arg(
@@ -116,6 +126,7 @@ impl InputArgs {
             level: self.level,
             channel: self.channel,
             max_memory: self.max_memory,
+            scale: self.scale,
         }
     }
 

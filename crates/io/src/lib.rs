@@ -157,8 +157,8 @@ pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
 pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
 pub use read::{
-    FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, Segment, open_lazy,
-    read, read_volume, split_hdf5_path, world_axis_names,
+    AxisUnitName, FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, Segment,
+    open_lazy, read, read_volume, split_hdf5_path, world_axis_names,
 };
 pub use shared::compress::{Compression, inflate_exact};
 pub use shared::geometry::{Reorientation, grid_to_volume};

@@ -186,6 +186,28 @@ pub struct FileInfo {
     /// (each its own grid, one picked by `--series`, the notes listing
     /// them), not time points of one grid.
     pub frames_are_series: bool,
+    /// The imaging modality the file names (DICOM Modality `CT`, `MR`;
+    /// MetaImage `Modality = MET_MOD_CT` as `CT`), if it names one: what
+    /// picks a CT's default look (volray-app's `look.rs`).
+    pub modality: Option<String>,
+    /// The name and unit of each world axis (x, y, z) where the file
+    /// gives the axes units that are not one length unit, some not a
+    /// length at all (degrees by metres: `units.rs` keeps them apart);
+    /// `None` otherwise. What the display scale stretches (volray-app's
+    /// `display.rs`). Filled by the CF readers (NetCDF-3, NetCDF-4) and
+    /// OME-Zarr's.
+    pub axis_units: Option<[AxisUnitName; 3]>,
+}
+
+/// One world axis as a file names it and the unit its spacing and origin
+/// are in ([`FileInfo::axis_units`]): `("lev", Some("Pa"))`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct AxisUnitName {
+    /// The axis's name in the file (a CF dimension's), for the notes.
+    pub name: String,
+    /// Its unit as written, after lengths are brought to one unit; `None`
+    /// where the file gives it none.
+    pub unit: Option<String>,
 }
 
 /// One segment of a label volume: the label value that marks it, its

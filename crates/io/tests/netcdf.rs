@@ -86,6 +86,8 @@ fn the_three_versions_read_alike_with_coordinates_in_mm_and_m() {
         // y decreases: flipped, its lowest value 20 - 2·9 = 2.
         assert!((l.volume.origin() - DVec3::new(-3.0, 2.0, 10.0)).length() < 1e-9);
         assert_eq!(l.info.length_unit.as_deref(), Some("mm"), "{name}");
+        // Lengths brought to one unit: nothing for the display scale.
+        assert_eq!(l.info.axis_units, None, "{name}");
         assert_note(
             &l,
             "x (x)/y (y) in mm, z (z) in m: spacing in mm (z (z) × 1000)",
@@ -165,6 +167,18 @@ fn xarray_packing_and_fill_values_with_latitude_and_longitude() {
         (stored * 0.1 + 5.0) as f32
     });
     assert_eq!(l.info.length_unit, None);
+    // Each world axis's name and unit, for the display scale.
+    let units = l.info.axis_units.clone().expect("kept apart");
+    let named = units.map(|a| (a.name, a.unit.unwrap_or_default()));
+    assert_eq!(
+        named,
+        [
+            ("lon", "degrees_east"),
+            ("lat", "degrees_north"),
+            ("lev", "m")
+        ]
+        .map(|(n, u)| (n.to_string(), u.to_string()))
+    );
     assert_note(
         &l,
         "x (lon) in degrees_east, y (lat) in degrees_north: not length units, kept as written",

@@ -68,6 +68,7 @@ pub const FRAME: &[&str] = &[
 pub const VOLUME: &[&str] = &[
     "spacing",
     "origin",
+    "scale",
     "order",
     "labels",
     "log",

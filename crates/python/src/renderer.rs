@@ -142,6 +142,11 @@ pub(crate) struct Recipe {
     /// `Source`).
     spacing: Option<[f64; 3]>,
     origin: Option<[f64; 3]>,
+    /// Each world axis stretched for drawing (`scale=`), else `None` for
+    /// the default rule (volray-app's `display`): its file's axis units
+    /// (`display`) and modality (a CT's look, volray-app's `look`).
+    scale: Option<[f64; 3]>,
+    display: Option<volray_io::FileInfo>,
     /// What the volume-level options fixed.
     pub labels: bool,
     log: bool,
@@ -205,7 +210,9 @@ impl Renderer {
                     .get()
                     .lazy
                     .as_ref()
-                    .map_or(1, |l| l.chunked.levels().len());
+                    // A file read box by box without levels (an HDF5 or
+                    // NetCDF-4 dataset) is its one level.
+                    .map_or(1, |l| l.chunked.levels().len().max(1));
                 check_level(&recipe.name, n, levels)?;
             }
             return Ok(Renderer {

@@ -32,7 +32,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::sync::{Arc, Mutex};
 use volray_annotate::figure::preset_unit;
-use volray_app::reproduce::keywords::{Value, call, figure_keywords, keywords};
+use volray_app::reproduce::keywords::{Value, call, figure_keywords, keywords, volume_keywords};
 use volray_core::RenderSettings;
 use volray_options::level::LevelChoice;
 use volray_options::{Options, Tf};
@@ -72,6 +72,8 @@ struct PyReproduce {
     /// A chunked file's level the stills show, as `render`'s `level=`:
     /// `Some(None)` for `"auto"`; `None` for a volume in memory.
     level: Option<Option<usize>>,
+    /// `scale=` as given, which the call repeats.
+    scale: Option<[f64; 3]>,
 }
 
 impl PyReproduce {
@@ -83,7 +85,13 @@ impl PyReproduce {
     /// The keywords beside the options': a chunked file's `level`, and
     /// the annotations that draw `figure` as the page does.
     fn extra_words(&self, figure: &Figure) -> Vec<(&'static str, Value)> {
-        figure_keywords(self.level, self.value_unit.as_deref(), figure)
+        let mut words = volume_keywords(self.scale);
+        words.extend(figure_keywords(
+            self.level,
+            self.value_unit.as_deref(),
+            figure,
+        ));
+        words
     }
 
     fn settings(&self, options: &Options) -> Result<RenderSettings, Refusal> {
@@ -176,6 +184,7 @@ impl ViewHost {
             value_unit: (what.units.clone())
                 .or_else(|| preset_unit(options.look.preset.as_deref()).map(String::from)),
             level: levels.as_ref().map(|o| o.pyramid.fixed()),
+            scale: recipe.scale(),
         });
         reproduce
             .reproduce(&state)

@@ -462,6 +462,8 @@ pub fn read(
         channel,
         series,
         max_memory,
+        // `read` keeps the stored geometry; `render` stretches (`scale=`).
+        scale: None,
     };
     let max_memory = request.max_memory();
     let chunked = py

@@ -192,7 +192,11 @@ impl RankSource {
         }
         // A file mapped wherever it can be, in its own axis order if need
         // be; else read whole by rank 0 (a fractal generated whole).
-        let load = || input::load_with(args, MapPolicy::AlwaysInFileOrder);
+        // Stretched for drawing as a whole render's (display.rs).
+        let load = || {
+            input::load_with(args, MapPolicy::AlwaysInFileOrder)
+                .and_then(|i| crate::display::displayed(i, args.scale))
+        };
         // Rank 0 first: whether the file maps, and the grid.
         let first = if mpi.rank() == 0 {
             load().map(Some)

@@ -64,6 +64,16 @@ pub enum Value {
     Numbers(Vec<f64>),
 }
 
+/// The volume's keywords beside the options': `scale` where the axes are
+/// stretched as given (`scale=`, the command line's `--scale`; the
+/// default stretch needs no keyword, `render` applies it again).
+pub fn volume_keywords(scale: Option<[f64; 3]>) -> Vec<(&'static str, Value)> {
+    scale
+        .map(|s| ("scale", Value::Numbers(s.to_vec())))
+        .into_iter()
+        .collect()
+}
+
 /// The keywords of `render` that give `options` (a state's: the look's
 /// transfer function whole), the defaults left out.
 pub fn keywords(options: &Options) -> Vec<(&'static str, Value)> {
@@ -308,6 +318,14 @@ mod tests {
             ]
         );
         assert!(figure_keywords(None, Some("HU"), &Figure::default()).is_empty());
+    }
+
+    #[test]
+    fn a_scale_given_is_spelled_as_its_keyword() {
+        let w = volume_keywords(Some([1.0, 1.0, 0.5]));
+        let code: Vec<String> = w.iter().map(|(k, v)| format!("{k}={}", code(v))).collect();
+        assert_eq!(code, ["scale=(1.0, 1.0, 0.5)"]);
+        assert!(volume_keywords(None).is_empty());
     }
 
     #[test]

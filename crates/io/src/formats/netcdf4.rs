@@ -366,6 +366,7 @@ fn open(path: &Path, opts: &ReadOptions) -> Result<Found, IoError> {
     };
     let placed = cf::place(&file_path, &var, &vars, &layout, &mut coordinate, &mut info)?;
     info.length_unit = placed.length_unit.clone();
+    info.axis_units = placed.axis_units.clone();
     // cf.rs's steps run along the variable's spatial dimensions fastest
     // first; here along x, y, z.
     let order = layout.fastest_first();

@@ -438,6 +438,9 @@ pub(crate) struct Placement {
     pub origin: DVec3,
     /// The unit of spacing and origin, where all three axes have one.
     pub length_unit: Option<String>,
+    /// Each world axis's name and unit where they are kept apart
+    /// ([`FileInfo::axis_units`](crate::FileInfo)).
+    pub axis_units: Option<[crate::AxisUnitName; 3]>,
 }
 
 /// Places the slab of `var` that `layout` reads: spacing, origin and unit
@@ -537,6 +540,13 @@ pub(crate) fn place(
     }
     info.notes.extend(one.notes);
     let length_unit_name = one.length_unit;
+    // Named by the coordinate's dimension, for the display scale's note.
+    let axis_units = (one.apart.len() == 3).then(|| {
+        std::array::from_fn(|a| crate::AxisUnitName {
+            name: var.dims[layout.spatial[a]].clone(),
+            unit: one.apart[a].clone(),
+        })
+    });
 
     let world = [DVec3::X, DVec3::Y, DVec3::Z];
     let mut origin = DVec3::ZERO;
@@ -561,6 +571,7 @@ pub(crate) fn place(
         steps,
         origin,
         length_unit: length_unit_name,
+        axis_units,
     })
 }
 

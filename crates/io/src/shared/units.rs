@@ -116,6 +116,12 @@ pub(crate) struct OneUnit {
     /// What was converted and what was kept apart, for `volray info`
     /// (empty where every axis has the same unit or none has one).
     pub notes: Vec<String>,
+    /// Per axis, in the order given, where some axis has a unit that is
+    /// not a length and the units differ (degrees by metres): its unit
+    /// once converted (a length axis's is the finest length unit), `None`
+    /// for an axis without one; empty otherwise. What the display scale
+    /// stretches ([`FileInfo::axis_units`](crate::FileInfo)).
+    pub apart: Vec<Option<String>>,
 }
 
 /// Brings `axes` to one length unit: the finest of their length units
@@ -205,10 +211,32 @@ pub(crate) fn one_length_unit(axes: &[AxisUnit]) -> OneUnit {
             }
         ));
     }
+    // Kept apart: after conversion, the axes with units are in more than
+    // one unit, one of them not a length.
+    let converted: Vec<Option<String>> = (0..axes.len())
+        .map(|a| match (lengths[a], finest) {
+            (Some(_), Some((at, _))) => units[at].map(str::to_string),
+            _ => units[a].map(str::to_string),
+        })
+        .collect();
+    let mut distinct: Vec<&str> = converted.iter().flatten().map(String::as_str).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    let apart = if distinct.len() > 1
+        && lengths
+            .iter()
+            .zip(&units)
+            .any(|(m, u)| m.is_none() && u.is_some())
+    {
+        converted
+    } else {
+        Vec::new()
+    };
     OneUnit {
         factors,
         length_unit,
         notes,
+        apart,
     }
 }
 
@@ -231,6 +259,7 @@ mod tests {
         ]));
         assert_eq!(one.factors, [1000.0, 1.0, 1.0]);
         assert_eq!(one.length_unit.as_deref(), Some("nanometer"));
+        assert!(one.apart.is_empty(), "lengths are one unit once converted");
         assert_eq!(
             one.notes,
             ["z in micrometer, y/x in nanometer: spacing in nanometer (z × 1000)"]
@@ -283,6 +312,8 @@ mod tests {
         assert_eq!(one.factors, [1000.0, 1.0, 1.0]);
         assert_eq!(one.length_unit, None);
         assert_eq!(one.notes[0], "x in km, y in m: spacing in m (x × 1000)");
+        let m = Some("m".to_string());
+        assert_eq!(one.apart, [m.clone(), m, Some("degrees".into())]);
         assert!(one.notes[1].starts_with("depth in degrees: not length units"));
     }
 

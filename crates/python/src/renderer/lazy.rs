@@ -165,6 +165,10 @@ impl Renderer {
                     return Err(refuse_override("in pieces"));
                 }
                 if !matches!(state.way, Way::Pieces { level: l, .. } if l == level) {
+                    // Stretched for drawing as the command line's pieces.
+                    let scale = self.recipe.scale;
+                    let (streamed, _) =
+                        plan::stretched_pieces(chunked, *streamed, &frames, max_memory, scale);
                     state.way = Way::Pieces {
                         level,
                         streamed: Box::new(streamed.with_labels(self.recipe.labels)),

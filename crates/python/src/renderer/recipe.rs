@@ -82,6 +82,16 @@ impl Recipe {
                 .with_origin(o.into())
                 .map_err(|e| value_error(format!("origin: {e}")))?;
         }
+        // Axes in different units stretched for drawing, or as `scale=`
+        // says (the command line's rule: volray-app's `display`).
+        let stretch =
+            volray_app::display::stretch(self.display.as_ref(), core.extent(), self.scale);
+        if let Some(f) = stretch.map(|s| volray_core::glam::DVec3::from(s.factors)) {
+            let (spacing, origin) = (core.spacing() * f, core.origin() * f);
+            core = (core.with_spacing(spacing))
+                .and_then(|c| c.with_origin(origin))
+                .map_err(|e| value_error(format!("scale: {e}")))?;
+        }
         if self.log {
             core = py
                 .detach(|| core.to_log10())
@@ -122,6 +132,14 @@ impl Recipe {
             None => Order::Xyz,
         };
         let spacing = k.take::<[f64; 3]>("spacing", "three numbers (dx, dy, dz)")?;
+        let scale = k.take::<[f64; 3]>("scale", "three positive numbers (x, y, z)")?;
+        if let Some(s) = scale
+            && !s.iter().all(|v| v.is_finite() && *v > 0.0)
+        {
+            return Err(value_error(format!(
+                "scale: {s:?}: every factor must be positive"
+            )));
+        }
         let origin = k.take::<[f64; 3]>("origin", "three numbers (x, y, z)")?;
         let labels_given = k.take::<bool>("labels", "True or False")?;
         let (source, spacing, origin, vol_labels, name, nan_is_empty) =
@@ -171,10 +189,21 @@ impl Recipe {
             Source::Volume(v) => v.get().label_colours(),
             Source::Array { .. } => Vec::new(),
         };
+        // What the file says of its axes' units and its modality.
+        let display = match &source {
+            Source::Volume(v) => v.get().file.as_ref().map(|(_, info)| volray_io::FileInfo {
+                axis_units: info.axis_units.clone(),
+                modality: info.modality.clone(),
+                ..volray_io::FileInfo::default()
+            }),
+            Source::Array { .. } => None,
+        };
         Ok(Recipe {
             source,
             spacing,
             origin,
+            scale,
+            display,
             labels,
             log,
             nonfinite,
@@ -218,6 +247,11 @@ impl Recipe {
         self.spacing.is_some() || self.origin.is_some() || self.log
     }
 
+    /// `scale=` as given, if it was.
+    pub(crate) fn scale(&self) -> Option<[f64; 3]> {
+        self.scale
+    }
+
     /// The file's display window (an OME-Zarr `omero` window), if any.
     pub(crate) fn window(&self) -> Option<(f64, f64)> {
         self.window
@@ -257,6 +291,13 @@ impl Recipe {
                 .map_err(option_error)
             }
             (None, Some(histogram)) if options.look.auto_tf() => {
+                // A CT in Hounsfield units: the CT look (volray-app's `look`).
+                let modality = self.display.as_ref().and_then(|i| i.modality.as_deref());
+                let range = Some((histogram.min, histogram.max));
+                if let Some((tf, _)) = volray_app::look::ct_look(&options.look, modality, range) {
+                    settings.transfer_function = tf;
+                    return Ok(());
+                }
                 volray_options::apply_auto(
                     &options.look,
                     &mut settings.transfer_function,

@@ -478,6 +478,9 @@ fn finish(
         "world coordinates are DICOM patient coordinates (LPS: +x to the patient's left, +y posterior, +z head), in mm".into(),
     );
     info.length_unit = Some("mm".into());
+    // Modality (0008,0060): `CT` picks a CT's default look (volray-app).
+    let modality = header.modality.trim();
+    info.modality = (!modality.is_empty()).then(|| modality.to_string());
     let dims = [format.columns, format.rows, grid.order.len()];
     let volume = grid_to_volume(path, dims, data, grid.steps, grid.origin, &mut info)?;
     Ok(Loaded {

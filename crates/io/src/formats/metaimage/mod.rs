@@ -287,6 +287,12 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     )?;
 
     info.length_unit = geometry.unit.clone();
+    // ITK's MetaIO names the modality MET_MOD_CT, MET_MOD_MR, ...
+    // (metaTypes.h's MET_ModalityEnumType): kept as DICOM spells it, `CT`.
+    info.modality = header
+        .get("Modality")
+        .map(|m| m.trim().trim_start_matches("MET_MOD_").to_string())
+        .filter(|m| !m.is_empty() && m != "UNKNOWN");
     info.set_volumes(volumes, picked);
     let volume = grid_to_volume(
         path,

@@ -171,6 +171,7 @@ fn read_cf(
     }
     info.nan_is_empty = !packing.missing.is_empty() || packing.lo.is_some() || packing.hi.is_some();
     info.length_unit = placement.length_unit.clone();
+    info.axis_units = placement.axis_units.clone();
 
     // The slab: the frame along the frame dimension, every other
     // non-spatial dimension (length 1) at 0; C order keeps the spatial

@@ -168,6 +168,7 @@ pub(crate) fn open(path: &Path, opts: &ReadOptions) -> Result<(ZarrLevel, FileIn
             .push(format!("channel {channel} of {channels} read"));
     }
     file_info.length_unit = layout.unit.clone();
+    file_info.axis_units = layout.axis_units.clone();
     file_info.notes.extend(layout.unit_notes.iter().cloned());
     file_info.set_volumes(volumes, picked);
     let level = ZarrLevel::new(
@@ -236,6 +237,9 @@ struct Layout {
     factors: [f64; 3],
     /// What the conversion did, for the notes.
     unit_notes: Vec<String>,
+    /// Each space axis's name and unit, as x, y, z, where they are kept
+    /// apart ([`FileInfo::axis_units`](crate::FileInfo)).
+    axis_units: Option<[crate::AxisUnitName; 3]>,
     /// How many axes there are: the last three are z, y, x.
     n: usize,
 }
@@ -275,12 +279,20 @@ impl Layout {
             })
             .collect();
         let one = one_length_unit(&space);
+        // The space axes are z, y, x: x is the last.
+        let axis_units = (one.apart.len() == 3).then(|| {
+            std::array::from_fn(|a| crate::AxisUnitName {
+                name: space[2 - a].name.to_string(),
+                unit: one.apart[2 - a].clone(),
+            })
+        });
         Ok(Layout {
             time,
             channel,
             unit: one.length_unit,
             factors: [one.factors[2], one.factors[1], one.factors[0]],
             unit_notes: one.notes,
+            axis_units,
             n,
         })
     }
