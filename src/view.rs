@@ -55,6 +55,7 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
                 .to_string(),
             file: None,
             max_memory: args.input.request().max_memory(),
+            auto_log: false,
         },
         None => load(&args.input, look.log)?,
     };
@@ -72,6 +73,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         // The same points: `t` is relative to the window, whatever its units.
         named.opacity = settings.transfer_function.opacity.clone();
         named.color = settings.transfer_function.color.clone();
+        // The window the histogram was refined to, where none was given.
+        named.domain = named.domain.or(settings.transfer_function.domain);
     }
     // The checks `render` makes: memory, non-finite values, the view.
     let renderer = renderer_for(&args.view, &settings, &input)?;

@@ -9,7 +9,7 @@
 use crate::AppError;
 use crate::input::{self, Request};
 use volray_core::glam::DVec3;
-use volray_core::{Camera, Fit, Histogram, NonFinite, RenderSettings};
+use volray_core::{Camera, Fit, NonFinite, RenderSettings};
 use volray_options::LookOptions;
 
 /// The views of an animation of one picture: how many frames, and the
@@ -120,7 +120,7 @@ pub fn series_settings(
     for one in inputs {
         let input = input::load_log(one, look.log)?;
         if first.is_none() && look.auto_tf() {
-            first = Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
+            first = volray_core::transfer::auto::robust_histogram_of(&input.volume);
         }
         if look.labels {
             let found = volray_options::volume_labels(&input.volume, &input.name);

@@ -4,7 +4,7 @@
 
 use crate::protocol::{Hello, VolumeHello};
 use crate::state::{Lighting, START_COLOURS, ViewState, WHITE};
-use volray_core::transfer::colormap;
+use volray_core::transfer::{auto, colormap};
 use volray_core::{Histogram, RenderSettings, Volume};
 
 /// Bins of the histogram drawn under the transfer-function editor.
@@ -32,8 +32,22 @@ pub struct Start<'a> {
 
 /// What a panel draws over: the value histogram and its range, and the
 /// transfer function's starting window (its domain, else the range).
+/// Where a few outliers stretch the values' range (volray-core's
+/// [`auto::robust_histogram`] refines it, as `--tf auto` does), the
+/// histogram and its range are those of the window it refines to, the
+/// outliers counted in its end bins: over the whole range the data would
+/// be one bar.
 fn histogram_of(volume: &Volume, settings: &RenderSettings) -> (Vec<u64>, [f32; 2], [f64; 2]) {
-    let histogram = Histogram::of(volume, HISTOGRAM_BINS);
+    let robust = auto::robust_histogram_of(volume);
+    let histogram = match robust.and_then(|r| r.window) {
+        Some(window) => Some(Histogram::of_box(
+            volume,
+            ([0; 3], volume.dims()),
+            window,
+            HISTOGRAM_BINS,
+        )),
+        None => Histogram::of(volume, HISTOGRAM_BINS),
+    };
     let range = histogram.as_ref().map_or([0.0, 0.0], |h| [h.min, h.max]);
     let start_window = (settings.transfer_function.domain)
         .map_or([f64::from(range[0]), f64::from(range[1])], |(lo, hi)| {

@@ -91,7 +91,7 @@ impl Recipe {
             let found = volray_options::volume_labels(&core, name).map_err(option_error)?;
             (Some(found), None)
         } else {
-            (None, py.detach(|| Histogram::of(&core, auto::BINS)))
+            (None, py.detach(|| auto::robust_histogram_of(&core)))
         };
         let core = if self.labels { core.as_labels() } else { core };
         let nonfinite = self.nonfinite;
