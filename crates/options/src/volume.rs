@@ -134,9 +134,9 @@ pub fn label_transfer_function(
 /// use volray_core::{TransferFunction, Volume};
 /// use volray_options::{LookOptions, chooses_log};
 ///
-/// // Values from 1 to 10⁶, most of them small: ten voxels per decade
-/// // fraction, as a star field's or a density's.
-/// let data = (0..4096).map(|i| 10f32.powf(6.0 * (i as f32 / 4096.0).powi(4))).collect();
+/// // Values 4096/n for n = 1..=4096: as many above v as 4096/v, as a
+/// // density falling as r⁻³ about a point.
+/// let data = (1..=4096).map(|n| 4096.0 / n as f32).collect();
 /// let v = Volume::new([16, 16, 16], data).unwrap();
 /// let tf = TransferFunction::default();
 /// assert!(chooses_log(&LookOptions::default(), &tf, &v));
@@ -152,7 +152,7 @@ pub fn chooses_log(look: &LookOptions, transfer_function: &TransferFunction, vol
         && !look.labels
         && !volume.is_labels()
         && transfer_function.domain.is_none()
-        && auto::spans_decades(volume)
+        && auto::robust_histogram_of(volume).is_some_and(|r| auto::spans_decades_of(volume, &r))
 }
 
 /// The note a front end prints when [`chooses_log`] chose the log10 of
@@ -160,8 +160,9 @@ pub fn chooses_log(look: &LookOptions, transfer_function: &TransferFunction, vol
 /// `log=False`).
 pub fn auto_log_note(name: &str, linear: &str) -> String {
     format!(
-        "note: {name}: the values span decades (the median positive value is under {} % of the \
-         99.9 % point): rendering their log10, as with log; {linear} or a range keeps the values",
+        "note: {name}: the values span decades (half of those above the background lie in the \
+         lowest {} % of a linear ramp): rendering their log10, as with log; {linear} or a range \
+         keeps the values",
         auto::LOG_MEDIAN * 100.0
     )
 }

@@ -36,11 +36,11 @@
 //! transfer function is then chosen on the last histogram and spans its
 //! window: the outliers above it take the top colour at full opacity.
 //!
-//! When the values **span decades** ([`spans_decades`]: none negative,
-//! the median positive value under [`LOG_MEDIAN`] of the 99.9 % point,
-//! and [`DECADES`] decades or more between the 0.1 % and 99.9 % points),
-//! the front ends that hold the whole volume render its log10 instead,
-//! as `--log` does, and say so.
+//! When the values **span decades** ([`spans_decades`]: those above the
+//! background all positive, the top [`DECADES`] decades above the edge or
+//! more, and half of them in the lowest [`LOG_MEDIAN`] of the ramp), the
+//! front ends that hold the whole volume render its log10 instead, as
+//! `--log` does, and say so.
 //!
 //! Like VTK's and ParaView's "reset to data range" with a ramp, and yt's
 //! default of a colour map over the data's range, but with the background
@@ -104,12 +104,11 @@ pub const ZOOM_BINS: usize = 16;
 /// values 0..100 takes two (to the window 0..3.9e27, whose values are
 /// 0..100; then 0..100).
 pub const MAX_PASSES: usize = 4;
-/// [`spans_decades`]: the share of the 99.9 % point below which the median
-/// positive value must lie.
+/// [`spans_decades`]: the share of the shown range (background edge to
+/// top) below which half of the shown voxels lie.
 pub const LOG_MEDIAN: f64 = 0.01;
-/// [`spans_decades`]: the decades the positive values' robust range must
-/// span.
-pub const DECADES: f64 = 3.0;
+/// [`spans_decades`]: the decades from the background edge to the top.
+pub const DECADES: f64 = 2.0;
 
 /// The upper edge of the background peak of `histogram`, in the data's
 /// units, or `None` when its most common values are in the upper half of
@@ -316,70 +315,67 @@ pub fn robust_transfer_function(robust: &Robust, domain: Option<(f64, f64)>) -> 
     transfer_function(&robust.histogram, domain.or(window))
 }
 
-/// Whether a volume's values span decades, so that `--tf auto` renders
-/// their log10 (as `--log` does): no finite value is negative, and of the
-/// positive ones (the zeros are background) the median lies below
-/// [`LOG_MEDIAN`] of the 99.9 % point (the `1 − ROBUST` point; a linear
-/// ramp would give half of them under a hundredth of its colours and,
-/// squared, under 10⁻⁴ of its opacity) while the `ROBUST` and `1 − ROBUST`
-/// points are [`DECADES`] decades apart or more. Found on a histogram of
-/// the log10 of the positive values ([`BINS`] bins over their range), at
-/// its bins' resolution: the median's bin must lie wholly below, the
-/// ends' bins wholly apart. A density falling as r⁻³ about a point spans
-/// decades on any grid (its median is 0.2 % of its 99.9 % point); r⁻² does
-/// not (1.6 %), nor a Gaussian blob (6 %).
-pub fn spans_decades(volume: &crate::Volume) -> bool {
-    // Read in the volume's own type (no f32 copy of a 16-bit volume).
-    let Some(h) = crate::with_samples!(volume.samples(), |data| log_histogram(data)) else {
-        return false;
+/// Whether values whose [`robust_histogram`] is `histogram` span
+/// decades, so that `--tf auto` renders their log10 (as `--log` does):
+/// the values shown (above the background edge) are all positive, their
+/// top is at least [`DECADES`] decades above the edge, and a linear ramp
+/// from the edge to the top would put half of them in its lowest
+/// [`LOG_MEDIAN`] (their median under a hundredth of the way up: under
+/// 10⁻⁴ of the opacity, the ramp being squared). The median is found on
+/// one more histogram, over the shown window (`pass`: the histogram of
+/// the data in [`BINS`] bins over a window, as for [`robust_histogram`]),
+/// so that a hundredth of it is two and a half bins, and placed within
+/// its bin by linear interpolation.
+///
+/// Why these numbers: above an edge `e`, a density falling as r⁻³ about
+/// a point has as many voxels above `v` as `1/v`: its median is `2e` and
+/// the 99.5 % top `200e`, the median 0.5 % of the way up. r⁻² gives
+/// 1.8 %, a Gaussian blob (`e` at a twentieth of its peak) about 10 %, a
+/// hydrogen orbital's exponential 5 %: these stay linear.
+pub fn spans_decades<E>(
+    histogram: &Histogram,
+    pass: impl FnOnce((f32, f32)) -> Result<Option<Histogram>, E>,
+) -> Result<bool, E> {
+    let edge = background_edge(histogram).unwrap_or(f64::from(histogram.min));
+    let top = top(histogram, edge);
+    if !(edge > 0.0) || top < 10f64.powf(DECADES) * edge {
+        return Ok(false);
+    }
+    // The voxels below the edge, counted in the shown window's bin 0.
+    let counts = &histogram.counts;
+    let first = (0..counts.len())
+        .find(|&b| histogram.edge(b + 1) > edge)
+        .unwrap_or(counts.len());
+    let below: u64 = counts[..first].iter().sum();
+    let above: u64 = counts[first..].iter().sum();
+    let Some(shown) = pass((edge as f32, top as f32))? else {
+        return Ok(false);
     };
-    let Some((b0, b1)) = robust_bins(&h) else {
-        return false;
-    };
-    let n: u64 = h.counts.iter().sum();
-    let mut seen = 0;
-    let median = (h.counts.iter())
-        .position(|&c| {
-            seen += c;
-            2 * seen > n
-        })
-        .unwrap_or(BINS - 1);
-    h.edge(b1) - h.edge(median + 1) >= -LOG_MEDIAN.log10() && h.edge(b1) - h.edge(b0 + 1) >= DECADES
+    // The median's rank among all voxels, placed within its bin by linear
+    // interpolation (as a percentile from a histogram is).
+    let target = below as f64 + above as f64 / 2.0;
+    let mut seen = 0.0;
+    for (b, &c) in shown.counts.iter().enumerate() {
+        let c = c as f64;
+        if c > 0.0 && seen + c >= target {
+            let (lo, hi) = (shown.edge(b), shown.edge(b + 1));
+            let median = lo + (hi - lo) * ((target - seen) / c).clamp(0.0, 1.0);
+            return Ok(median - edge <= LOG_MEDIAN * (top - edge));
+        }
+        seen += c;
+    }
+    Ok(false)
 }
 
-/// The histogram in [`BINS`] bins of the log10 of `data`'s positive
-/// finite values, over their range; `None` when a value is negative, or
-/// the positive values span less than [`DECADES`] decades.
-fn log_histogram<T: crate::volume::Sample>(data: &[T]) -> Option<Histogram> {
-    let mut range = (f32::INFINITY, f32::NEG_INFINITY);
-    for v in data.iter().map(|v| v.to_f32()) {
-        if v < 0.0 {
-            return None;
-        }
-        if v > 0.0 && v.is_finite() {
-            range = (range.0.min(v), range.1.max(v));
-        }
+/// [`spans_decades`] of a volume in memory, whose robust histogram is
+/// `robust`.
+pub fn spans_decades_of(volume: &crate::Volume, robust: &Robust) -> bool {
+    let whole = ([0; 3], volume.dims());
+    let pass = |window| Ok::<_, Infallible>(Some(Histogram::of_box(volume, whole, window, BINS)));
+    match spans_decades(&robust.histogram, pass) {
+        Ok(spans) => spans,
+        Err(never) => match never {},
     }
-    let (lo, hi) = (f64::from(range.0).log10(), f64::from(range.1).log10());
-    if !(hi - lo >= DECADES) {
-        return None;
-    }
-    let width = (hi - lo) / BINS as f64;
-    let mut counts = vec![0u64; BINS];
-    for v in data.iter().map(|v| v.to_f32()) {
-        if v > 0.0 && v.is_finite() {
-            let b = ((f64::from(v).log10() - lo) / width) as usize;
-            counts[b.min(BINS - 1)] += 1;
-        }
-    }
-    Some(Histogram {
-        min: lo as f32,
-        max: hi as f32,
-        mean: 0.0,
-        counts,
-        non_finite: 0,
-        within: None,
-    })
 }
 
 #[cfg(test)]
@@ -497,9 +493,7 @@ mod tests {
 
     #[test]
     fn a_density_falling_as_the_cube_of_the_distance_spans_decades() {
-        // r⁻³ about the centre of a 32³ grid: from 1.5 (r = √3/2) down to
-        // 5e-5 in the corners. Half the voxels lie beyond r = 15.7
-        // (under 2.6e-4); the 99.9 % point is near r = 2 (0.125).
+        // r⁻³ about the centre of a 32³ grid: 1.5 down to 5e-5.
         let at = |p: glam::DVec3| (p - glam::DVec3::splat(15.5)).length();
         let power = |k: i32| {
             Volume::from_fn([32, 32, 32], glam::DVec3::ONE, glam::DVec3::ZERO, |p| {
@@ -507,27 +501,21 @@ mod tests {
             })
             .unwrap()
         };
-        assert!(spans_decades(&power(3)));
-        // r⁻²: the median is 1.6 % of the 99.9 % point.
-        assert!(!spans_decades(&power(2)));
+        let spans = |v: &Volume| spans_decades_of(v, &robust_histogram_of(v).unwrap());
+        assert!(spans(&power(3)));
+        // r⁻²: the median is 1.8 % of the way up.
+        assert!(!spans(&power(2)));
         // A Gaussian blob in zeros, a ramp and the hot pixels do not.
         let blob = Volume::from_fn([32, 32, 32], glam::DVec3::ONE, glam::DVec3::ZERO, |p| {
-            let r = at(p);
-            if r < 15.0 { (-r * r / 50.0).exp() as f32 } else { 0.0 }
+            (-at(p).powi(2) / 50.0).exp() as f32
         })
         .unwrap();
-        assert!(!spans_decades(&blob));
+        assert!(!spans(&blob));
         let ramp = Volume::new([8, 8, 8], (1..513).map(|i| i as f32).collect()).unwrap();
-        assert!(!spans_decades(&ramp));
-        assert!(!spans_decades(&hot_pixels(1e6, 5)));
-        // Negative values: not a log scale.
-        let mut signed = power(3);
-        signed = Volume::new([32, 32, 32], {
-            let mut d = signed.values().to_vec();
-            d[0] = -1.0;
-            d
-        })
-        .unwrap();
-        assert!(!spans_decades(&signed));
+        assert!(!spans(&ramp));
+        assert!(!spans(&hot_pixels(1e6, 5)));
+        // Shown values that are not all positive: not a log scale.
+        let shifted = power(3).values().iter().map(|v| v - 0.1).collect();
+        assert!(!spans(&Volume::new([32, 32, 32], shifted).unwrap()));
     }
 }
