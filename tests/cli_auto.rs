@@ -194,3 +194,26 @@ fn a_density_spanning_decades_is_rendered_as_its_log_unless_linear_or_a_range_is
         assert!(Picture::read(&out(name)).max_diff(&auto) > 16, "{extra:?}");
     }
 }
+
+#[test]
+fn a_series_with_hot_pixels_takes_the_window_of_its_first_volume() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = npy(dir.path(), "a.npy", RASTER, with_hot_pixels(RASTER, &raster_value, 1e6, 3));
+    let second = npy(dir.path(), "b.npy", RASTER, with_hot_pixels(RASTER, &raster_value, 1e9, 2));
+    let size = ["--size", "96x80"];
+    // The first alone: the window 10..100.
+    let still = dir.path().join("still.png");
+    render(&[&[first.as_str()], &size[..]].concat(), &still);
+    let pattern = dir.path().join("frame_%03d.png");
+    render(&[&[first.as_str(), second.as_str()], &size[..]].concat(), &pattern);
+    let frames = [0, 1].map(|i| Picture::read(&dir.path().join(format!("frame_{i:03}.png"))));
+    // The choice made on the first volume's refined histogram, its window
+    // the series' (a colour bar's): the first frame is the still, the
+    // second as covered.
+    let still = Picture::read(&still);
+    let still_shown = coloured(&still).iter().filter(|c| **c).count();
+    assert!(still_shown > 96 * 80 / 2, "{still_shown}");
+    assert_eq!(frames[0].max_diff(&still), 0);
+    let shown = coloured(&frames[1]).iter().filter(|c| **c).count();
+    assert!(shown as f64 > 0.8 * coloured(&still).iter().filter(|c| **c).count() as f64, "{shown}");
+}

@@ -134,6 +134,14 @@ pub fn series_settings(
         }
     }
     let mut settings = extent.fix(base);
+    // Where the first volume's histogram was refined past outliers, its
+    // window is the series' (a window given still wins), as for one
+    // volume: over the union of the ranges the bulk would be squeezed.
+    if let Some((lo, hi)) = first.as_ref().and_then(|r| r.window)
+        && base.transfer_function.domain.is_none()
+    {
+        settings.transfer_function.domain = Some((f64::from(lo), f64::from(hi)));
+    }
     let tf = &mut settings.transfer_function;
     if look.labels {
         let found: Vec<i64> = labels.into_iter().collect();
