@@ -67,26 +67,48 @@ fn a_raster_with_a_few_hot_pixels_renders_its_values_with_no_options() {
     let size = ["--size", "96x80"];
     // The footprint: every ray through the raster, as its maximum
     // (values of 10 and more, all coloured) shows it.
-    let clean = npy(dir.path(), "clean.npy", RASTER, with_hot_pixels(RASTER, &raster_value, 0.0, 0));
+    let clean = npy(
+        dir.path(),
+        "clean.npy",
+        RASTER,
+        with_hot_pixels(RASTER, &raster_value, 0.0, 0),
+    );
     let footprint_png = dir.path().join("footprint.png");
-    render(&[&[clean.as_str(), "--blend", "mip", "--colormap", "viridis"], &size[..]].concat(), &footprint_png);
+    render(
+        &[
+            &[clean.as_str(), "--blend", "mip", "--colormap", "viridis"],
+            &size[..],
+        ]
+        .concat(),
+        &footprint_png,
+    );
     let footprint = coloured(&Picture::read(&footprint_png));
     let area = footprint.iter().filter(|c| **c).count();
     // The y–z rectangle, 48 × 40 voxels, framed in 96 × 80 pixels: most
     // of the picture.
     assert!(area > 96 * 80 / 2, "{area}");
     for hot in [1e6f32, 1e30] {
-        let file = npy(dir.path(), "hot.npy", RASTER, with_hot_pixels(RASTER, &raster_value, hot, 3));
+        let file = npy(
+            dir.path(),
+            "hot.npy",
+            RASTER,
+            with_hot_pixels(RASTER, &raster_value, hot, 3),
+        );
         let out = dir.path().join("hot.png");
         let said = render(&[&[file.as_str()], &size[..]].concat(), &out);
         assert!(!said.contains("decades"), "{said}");
         let shown = coloured(&Picture::read(&out));
-        let covered = (footprint.iter().zip(&shown)).filter(|(f, s)| **f && **s).count();
+        let covered = (footprint.iter().zip(&shown))
+            .filter(|(f, s)| **f && **s)
+            .count();
         // Most of the footprint: the values 10..100 span the ramp (over a
         // window of 0..3.9e27 they would all be transparent). The rays
         // through only low values (transparent at 10, the ramp's foot)
         // stay dark: 86 % are coloured, as without the hot pixels.
-        assert!(covered as f64 >= 0.8 * area as f64, "{hot}: {covered} of {area}");
+        assert!(
+            covered as f64 >= 0.8 * area as f64,
+            "{hot}: {covered} of {area}"
+        );
     }
 }
 
@@ -188,8 +210,14 @@ fn a_density_spanning_decades_is_rendered_as_its_log_unless_linear_or_a_range_is
     let auto = Picture::read(&out("auto.png"));
     assert_eq!(auto.max_diff(&Picture::read(&out("log.png"))), 0);
     // --linear and --range keep the values, and say nothing.
-    for (name, extra) in [("linear.png", &["--linear"][..]), ("range.png", &["--range", "0,1.5"][..])] {
-        let said = render(&[&[file.as_str(), "--size", "48"], extra].concat(), &out(name));
+    for (name, extra) in [
+        ("linear.png", &["--linear"][..]),
+        ("range.png", &["--range", "0,1.5"][..]),
+    ] {
+        let said = render(
+            &[&[file.as_str(), "--size", "48"], extra].concat(),
+            &out(name),
+        );
         assert!(!said.contains("decades"), "{extra:?}: {said}");
         assert!(Picture::read(&out(name)).max_diff(&auto) > 16, "{extra:?}");
     }
@@ -198,14 +226,27 @@ fn a_density_spanning_decades_is_rendered_as_its_log_unless_linear_or_a_range_is
 #[test]
 fn a_series_with_hot_pixels_takes_the_window_of_its_first_volume() {
     let dir = tempfile::tempdir().unwrap();
-    let first = npy(dir.path(), "a.npy", RASTER, with_hot_pixels(RASTER, &raster_value, 1e6, 3));
-    let second = npy(dir.path(), "b.npy", RASTER, with_hot_pixels(RASTER, &raster_value, 1e9, 2));
+    let first = npy(
+        dir.path(),
+        "a.npy",
+        RASTER,
+        with_hot_pixels(RASTER, &raster_value, 1e6, 3),
+    );
+    let second = npy(
+        dir.path(),
+        "b.npy",
+        RASTER,
+        with_hot_pixels(RASTER, &raster_value, 1e9, 2),
+    );
     let size = ["--size", "96x80"];
     // The first alone: the window 10..100.
     let still = dir.path().join("still.png");
     render(&[&[first.as_str()], &size[..]].concat(), &still);
     let pattern = dir.path().join("frame_%03d.png");
-    render(&[&[first.as_str(), second.as_str()], &size[..]].concat(), &pattern);
+    render(
+        &[&[first.as_str(), second.as_str()], &size[..]].concat(),
+        &pattern,
+    );
     let frames = [0, 1].map(|i| Picture::read(&dir.path().join(format!("frame_{i:03}.png"))));
     // The choice made on the first volume's refined histogram, its window
     // the series' (a colour bar's): the first frame is the still, the
@@ -215,5 +256,8 @@ fn a_series_with_hot_pixels_takes_the_window_of_its_first_volume() {
     assert!(still_shown > 96 * 80 / 2, "{still_shown}");
     assert_eq!(frames[0].max_diff(&still), 0);
     let shown = coloured(&frames[1]).iter().filter(|c| **c).count();
-    assert!(shown as f64 > 0.8 * coloured(&still).iter().filter(|c| **c).count() as f64, "{shown}");
+    assert!(
+        shown as f64 > 0.8 * coloured(&still).iter().filter(|c| **c).count() as f64,
+        "{shown}"
+    );
 }

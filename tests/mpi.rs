@@ -648,7 +648,13 @@ fn hot_pixels_are_histogrammed_away_across_ranks_as_in_one_process() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("hot.npy");
     volray_io::write_npy(&file, &volray_core::Volume::new(dims, data).unwrap()).unwrap();
-    let args = [file.to_str().unwrap(), "--size", "64x64", "--elevation", "30"];
+    let args = [
+        file.to_str().unwrap(),
+        "--size",
+        "64x64",
+        "--elevation",
+        "30",
+    ];
     ranks_match_one_process(dir.path(), "hot pixels", &args, &[2, 3]);
     // Not blank: over 0..3.9e27 every value would be transparent.
     let one = pixels(&dir.path().join("one.png"));

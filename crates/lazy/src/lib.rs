@@ -448,9 +448,7 @@ impl Found {
             .map_err(LookError::Refused);
         }
         if look.auto_tf()
-            && let Some(robust) = self
-                .robust(streamed, settings)
-                .map_err(LookError::Stream)?
+            && let Some(robust) = self.robust(streamed, settings).map_err(LookError::Stream)?
         {
             volray_options::apply_auto(look, &mut settings.transfer_function, robust);
         }

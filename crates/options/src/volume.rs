@@ -145,7 +145,11 @@ pub fn label_transfer_function(
 /// let ranged = TransferFunction { domain: Some((1.0, 1e6)), ..TransferFunction::default() };
 /// assert!(!chooses_log(&LookOptions::default(), &ranged, &v));
 /// ```
-pub fn chooses_log(look: &LookOptions, transfer_function: &TransferFunction, volume: &Volume) -> bool {
+pub fn chooses_log(
+    look: &LookOptions,
+    transfer_function: &TransferFunction,
+    volume: &Volume,
+) -> bool {
     look.auto_tf()
         && !look.log
         && !look.linear

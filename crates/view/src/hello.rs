@@ -234,7 +234,12 @@ mod tests {
         assert_eq!(hello.range, [0.0, 100.0]);
         assert_eq!(hello.histogram.iter().sum::<u64>(), 4096);
         // Evenly spread: no bin holds more than a few times its share.
-        assert!(hello.histogram.iter().all(|&c| c < 4 * 4096 / HISTOGRAM_BINS as u64));
+        assert!(
+            hello
+                .histogram
+                .iter()
+                .all(|&c| c < 4 * 4096 / HISTOGRAM_BINS as u64)
+        );
         assert_eq!(hello.start_window, [0.0, 100.0]);
     }
 }

@@ -66,10 +66,9 @@ pub(super) fn from_volume(
     {
         // Every pass is collective: the windows depend only on the summed
         // counts, the same on every rank.
-        let robust = auto::robust_histogram(first, |window| {
-            d.histogram_in(Some(window), auto::BINS)
-        })
-        .map_err(fail)?;
+        let robust =
+            auto::robust_histogram(first, |window| d.histogram_in(Some(window), auto::BINS))
+                .map_err(fail)?;
         volray_options::apply_auto(look, &mut settings.transfer_function, &robust);
     }
     Ok(settings)

@@ -435,7 +435,11 @@ mod tests {
         // the 99.9 % point in the top bin).
         let ramp = Volume::new([8, 8, 8], (0..512).map(|i| i as f32).collect()).unwrap();
         let ball = Volume::from_fn([16, 16, 16], glam::DVec3::ONE, glam::DVec3::ZERO, |p| {
-            if (p - glam::DVec3::splat(7.5)).length() < 5.0 { 1.0 } else { 0.0 }
+            if (p - glam::DVec3::splat(7.5)).length() < 5.0 {
+                1.0
+            } else {
+                0.0
+            }
         })
         .unwrap();
         for v in [ramp, ball] {
@@ -447,7 +451,13 @@ mod tests {
             })
             .unwrap();
             assert_eq!(calls.get(), 0);
-            assert_eq!(robust, Robust { histogram: plain.clone(), window: None });
+            assert_eq!(
+                robust,
+                Robust {
+                    histogram: plain.clone(),
+                    window: None
+                }
+            );
             assert_eq!(
                 robust_transfer_function(&robust, None),
                 transfer_function(&plain, None)
@@ -459,7 +469,9 @@ mod tests {
     fn a_bulk_of_one_value_is_not_zoomed_into() {
         // 99.95 % zeros and a few ones: the robust range is the zeros'
         // bin; its window holds one value, so the first histogram stays.
-        let data = (0..32 * 32 * 16).map(|i| if i < 8 { 1.0 } else { 0.0 }).collect();
+        let data = (0..32 * 32 * 16)
+            .map(|i| if i < 8 { 1.0 } else { 0.0 })
+            .collect();
         let v = Volume::new([32, 32, 16], data).unwrap();
         let robust = robust_histogram_of(&v).unwrap();
         assert_eq!(robust.window, None);
