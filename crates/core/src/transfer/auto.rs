@@ -249,7 +249,7 @@ pub fn zoom(histogram: &Histogram) -> Option<(f32, f32)> {
     };
     let (lo, hi) = (lo.max(within_lo), hi.min(within_hi));
     let resolution = BINS as f32 * f32::EPSILON * lo.abs().max(hi.abs());
-    if !(hi - lo > resolution) || (lo, hi) == (histogram.min, histogram.max) {
+    if hi - lo <= resolution || (lo, hi) == (histogram.min, histogram.max) {
         return None;
     }
     Some((lo, hi))
@@ -338,7 +338,7 @@ pub fn spans_decades<E>(
 ) -> Result<bool, E> {
     let edge = background_edge(histogram).unwrap_or(f64::from(histogram.min));
     let top = top(histogram, edge);
-    if !(edge > 0.0) || top < 10f64.powf(DECADES) * edge {
+    if edge <= 0.0 || top < 10f64.powf(DECADES) * edge {
         return Ok(false);
     }
     // The voxels below the edge, counted in the shown window's bin 0.
