@@ -126,7 +126,7 @@ pub fn label_transfer_function(
 /// window is given (`transfer_function` has no domain: no range, no
 /// file's window), neither the log option nor [`LookOptions::linear`] is
 /// given, the volume is not labels, and its values span decades
-/// (volray-core's [`auto::spans_decades`]). The caller takes the log10
+/// (volray-core's [`auto::volume_spans_decades`]). The caller takes the log10
 /// and says so ([`auto_log_note`]); a volume read piece by piece or
 /// across ranks, a series and a scene keep their values.
 ///
@@ -156,7 +156,7 @@ pub fn chooses_log(
         && !look.labels
         && !volume.is_labels()
         && transfer_function.domain.is_none()
-        && auto::robust_histogram_of(volume).is_some_and(|r| auto::spans_decades_of(volume, &r))
+        && auto::volume_spans_decades(volume)
 }
 
 /// The note a front end prints when [`chooses_log`] chose the log10 of
