@@ -59,6 +59,15 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         },
         None => load(&args.input, look.log)?,
     };
+    // `--tf auto`'s log window of values spanning decades, for a volume
+    // read whole (levels read as the frames need them keep their values).
+    if pyramid.is_none() {
+        let look = crate::settings::look(look);
+        let tf = &settings.transfer_function;
+        if let Some(note) = volray_app::input::auto_log(&look, tf, &mut input, "--linear")? {
+            eprintln!("volray: {note}");
+        }
+    }
     // A transfer function chosen from the volume (`--tf auto`, `--labels`)
     // is the page's starting one, and its commands name it in full.
     from_volume(
@@ -89,7 +98,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         Some(p) => p.coarsest_grid(),
         None => (volume.dims(), volume.spacing(), volume.sample_type()),
     };
-    let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory)
+    let limits = (input.max_memory, input.auto_log);
+    let reproduce = CliReproduce::new(args, named, grid, non_finite, limits)
         .with_level(level_word(args, pyramid.as_ref()));
     let mut launch = launch(args, input, settings, reproduce)?;
     launch.levels = pyramid;
@@ -110,8 +120,8 @@ fn launch(
     let figure = figure_context(args, &input);
     Ok(Launch {
         name: input.name,
+        log: args.view.look.log || input.auto_log,
         volume: input.volume,
-        log: args.view.look.log,
         state: start_state(args, &settings),
         settings,
         others: Vec::new(),
@@ -199,7 +209,7 @@ pub fn figure_context(
 ) -> volray_view::FigureContext {
     let look = &args.view.look;
     volray_view::FigureContext {
-        log: look.log,
+        log: look.log || input.auto_log,
         value_unit: volray_annotate::figure::preset_unit(look.preset.as_deref()).map(String::from),
         length_unit: (input.file.as_ref()).and_then(|(_, info)| info.length_unit.clone()),
         axis_names: crate::figure::axis_names(input).map(String::from),

@@ -261,3 +261,55 @@ fn a_series_with_hot_pixels_takes_the_window_of_its_first_volume() {
         "{shown}"
     );
 }
+
+/// `volray view ARGS --port 0 --no-browser` until it prints its URL,
+/// then stopped: what it said on stderr.
+fn viewer_says(args: &[&str]) -> String {
+    use std::io::{BufRead, BufReader, Read};
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_volray"))
+        .args(
+            [
+                &["view"],
+                args,
+                &["--size", "32", "--port", "0", "--no-browser"],
+            ]
+            .concat(),
+        )
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut url = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut url)
+        .unwrap();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    let mut said = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut said)
+        .unwrap();
+    said
+}
+
+#[test]
+fn the_viewer_of_a_density_spanning_decades_starts_from_its_log() {
+    const N: usize = 32;
+    let data = (0..N * N * N)
+        .map(|i| {
+            let p = [i % N, (i / N) % N, i / (N * N)].map(|c| c as f64 - 15.5);
+            (p.iter().map(|c| c * c).sum::<f64>()).powf(-1.5) as f32
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let file = npy(dir.path(), "density.npy", [N; 3], data);
+    let said = viewer_says(&[&file]);
+    assert!(said.contains("the values span decades"), "{said}");
+    let said = viewer_says(&[&file, "--linear"]);
+    assert!(!said.contains("decades"), "{said}");
+}
