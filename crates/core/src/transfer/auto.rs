@@ -427,6 +427,18 @@ mod tests {
             assert_eq!(plain.counts[0], 32 * 32 * 16 - 5, "{hot}");
             let robust = robust_histogram_of(&v).unwrap();
             assert_eq!(robust.window, Some((0.0, 100.0)), "{hot}");
+            // Two passes: to 0..3906 (0..3.9e27), whose values are
+            // 0..100, then 0..100 (a third is not needed).
+            let mut windows = vec![];
+            let whole = ([0; 3], v.dims());
+            let counted = robust_histogram(plain.clone(), |w| {
+                windows.push(w);
+                Ok::<_, ()>(Some(Histogram::of_box(&v, whole, w, BINS)))
+            })
+            .unwrap();
+            assert_eq!(counted, robust);
+            assert_eq!(windows.len(), 2, "{windows:?}");
+            assert_eq!(windows[0], (0.0, (hot as f64 / 256.0) as f32), "{hot}");
             let h = &robust.histogram;
             assert_eq!((h.min, h.max), (0.0, 100.0));
             // The hot pixels in the last bin, with the 100s.
