@@ -106,7 +106,7 @@ pub fn draw_framed(
         .as_ref()
         .and_then(|(_, info)| info.length_unit.clone());
     let rendered = Rendered {
-        log: args.view.look.log,
+        log: args.view.look.log || input.auto_log,
         value_unit: volray_annotate::figure::preset_unit(args.view.look.preset.as_deref()),
         length_unit: length_unit.as_deref(),
         axis_names: axis_names(input),

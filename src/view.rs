@@ -56,9 +56,19 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
             file: None,
             max_memory: args.input.request().max_memory(),
             display_note: None,
+            auto_log: false,
         },
         None => load(&args.input, look.log)?,
     };
+    // `--tf auto`'s log window of values spanning decades, for a volume
+    // read whole (levels read as the frames need them keep their values).
+    if pyramid.is_none() {
+        let look = volray_flags::look(look);
+        let tf = &settings.transfer_function;
+        if let Some(note) = volray_app::input::auto_log(&look, tf, &mut input, "--linear")? {
+            eprintln!("volray: {note}");
+        }
+    }
     // What the look leaves to the volume, as `render` leaves it (volray-
     // app's `look`: a CT's look, the file's display window, `--labels` in
     // the colours the file gives them, `--tf auto`), is the page's
@@ -75,6 +85,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         // The same points: `t` is relative to the window, whatever its units.
         named.opacity = settings.transfer_function.opacity.clone();
         named.color = settings.transfer_function.color.clone();
+        // The window the histogram was refined to, where none was given.
+        named.domain = named.domain.or(settings.transfer_function.domain);
     }
     // The checks `render` makes: memory, non-finite values, the view.
     let renderer = renderer_for(&args.view, &settings, &input)?;
@@ -89,7 +101,8 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
         Some(p) => p.coarsest_grid(),
         None => (volume.dims(), volume.spacing(), volume.sample_type()),
     };
-    let reproduce = CliReproduce::new(args, named, grid, non_finite, input.max_memory)
+    let limits = (input.max_memory, input.auto_log);
+    let reproduce = CliReproduce::new(args, named, grid, non_finite, limits)
         .with_level(level_word(args, pyramid.as_ref()));
     let mut launch = launch(args, input, settings, reproduce)?;
     launch.levels = pyramid;
@@ -110,8 +123,8 @@ fn launch(
     let figure = figure_context(args, &input);
     Ok(Launch {
         name: input.name,
+        log: args.view.look.log || input.auto_log,
         volume: input.volume,
-        log: args.view.look.log,
         state: start_state(args, &settings),
         settings,
         others: Vec::new(),
@@ -199,7 +212,7 @@ pub fn figure_context(
 ) -> volray_view::FigureContext {
     let look = &args.view.look;
     volray_view::FigureContext {
-        log: look.log,
+        log: look.log || input.auto_log,
         value_unit: volray_annotate::figure::preset_unit(look.preset.as_deref()).map(String::from),
         length_unit: (input.file.as_ref()).and_then(|(_, info)| info.length_unit.clone()),
         axis_names: crate::figure::axis_names(input).map(String::from),

@@ -631,6 +631,38 @@ fn label_volumes_render_as_one_process() {
     assert!(!out.exists());
 }
 
+#[test]
+fn hot_pixels_are_histogrammed_away_across_ranks_as_in_one_process() {
+    if mpirun().is_none() {
+        return;
+    }
+    // Values 10..=100 with three voxels at 1e6: `--tf auto` refines its
+    // histogram to 10..100, each pass summed over the ranks.
+    let dims = [24, 32, 40];
+    let data = (0..dims.iter().product::<usize>())
+        .map(|i| match i {
+            100 | 9_000 | 25_000 => 1e6,
+            _ => 10.0 + 90.0 * (i % 97) as f32 / 96.0,
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("hot.npy");
+    volray_io::write_npy(&file, &volray_core::Volume::new(dims, data).unwrap()).unwrap();
+    let args = [
+        file.to_str().unwrap(),
+        "--size",
+        "64x64",
+        "--elevation",
+        "30",
+    ];
+    ranks_match_one_process(dir.path(), "hot pixels", &args, &[2, 3]);
+    // Not blank: over 0..3.9e27 every value would be transparent.
+    let one = pixels(&dir.path().join("one.png"));
+    let background = &one[..3];
+    let shown = one.chunks_exact(3).filter(|p| *p != background).count();
+    assert!(shown > 64 * 64 / 4, "{shown}");
+}
+
 /// `ARGS` under `mpirun -np N`, each rank run by a Python parent that
 /// writes the rank's exact peak resident memory (`ru_maxrss` of its
 /// child, KiB) to a file of its own (lines of ranks sharing stderr can

@@ -37,17 +37,22 @@ impl CliReproduce {
     /// The command lines of a `volray view` started with `args`, whose
     /// transfer function (`--tf`, `--preset`, `--colormap`, `--range`) is
     /// `start`, for a volume of `grid` (dims, spacing, sample type) whose
-    /// non-finite values are rendered as `non_finite` says.
+    /// non-finite values are rendered as `non_finite` says; `auto_log`
+    /// where `--tf auto` took the log10 of the volume (volray-app's
+    /// `input::auto_log`): its commands then say `--log`, as the page
+    /// shows log units.
     pub fn new(
         args: &ViewerArgs,
         start: TransferFunction,
         grid: ([usize; 3], DVec3, SampleType),
         non_finite: NonFinite,
-        max_memory: u64,
+        (max_memory, auto_log): (u64, bool),
     ) -> Self {
+        let mut look = volray_flags::look(&args.view.look);
+        look.log |= auto_log;
         let options = volray_options::Options {
             camera: volray_flags::camera(&args.view.camera),
-            look: volray_flags::look(&args.view.look),
+            look,
             sampling: volray_flags::sampling(&args.view.sampling),
         };
         let input = args.input.input.as_deref().unwrap_or(input::DEMO);
@@ -199,13 +204,24 @@ mod tests {
     }
 
     fn reproduce(extra: &[&str]) -> (CliReproduce, ViewState) {
+        reproduce_logged(extra, false)
+    }
+
+    /// [`reproduce`], the volume's log10 taken by `--tf auto` or not.
+    fn reproduce_logged(extra: &[&str], auto_log: bool) -> (CliReproduce, ViewState) {
         let args = viewer(extra);
         let start = named_transfer_function(&args.view.look, None).unwrap();
         let settings = settings(&args.view).unwrap();
         let state = super::super::start_state(&args, &settings);
         let max_memory = args.input.max_memory.unwrap_or(1 << 30);
         let grid = ([16; 3], DVec3::ONE, SampleType::F32);
-        let r = CliReproduce::new(&args, start, grid, NonFinite::Refuse, max_memory);
+        let r = CliReproduce::new(
+            &args,
+            start,
+            grid,
+            NonFinite::Refuse,
+            (max_memory, auto_log),
+        );
         (r, state)
     }
 
@@ -492,5 +508,15 @@ mod tests {
                 && e.contains("more than --max-memory 1 MiB"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_volume_whose_log_tf_auto_took_is_reproduced_with_log() {
+        let (r, state) = reproduce_logged(&[], true);
+        let out = r.reproduce(&state).unwrap();
+        assert!(out.command.contains(" --log"), "{}", out.command);
+        let (r, state) = reproduce_logged(&[], false);
+        let out = r.reproduce(&state).unwrap();
+        assert!(!out.command.contains("--log"), "{}", out.command);
     }
 }

@@ -80,7 +80,13 @@ pub fn run(args: &ViewerArgs) -> Result<(), CliError> {
     let grid = (volume.dims(), volume.spacing(), volume.sample_type());
     // The first volume's transfer function, as its command names it.
     let named = settings.transfer_function.clone();
-    let mut reproduce = CliReproduce::new(args, named, grid, non_finite, first.input.max_memory);
+    let mut reproduce = CliReproduce::new(
+        args,
+        named,
+        grid,
+        non_finite,
+        (first.input.max_memory, false),
+    );
     if time.is_some() {
         reproduce = reproduce.with_time();
     }

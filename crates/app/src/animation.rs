@@ -9,7 +9,7 @@
 use crate::AppError;
 use crate::input::{self, Request};
 use volray_core::glam::DVec3;
-use volray_core::{Camera, Fit, Histogram, NonFinite, RenderSettings};
+use volray_core::{Camera, Fit, NonFinite, RenderSettings};
 use volray_options::LookOptions;
 
 /// The views of an animation of one picture: how many frames, and the
@@ -120,7 +120,7 @@ pub fn series_settings(
     for one in inputs {
         let input = input::load_log(one, look.log)?;
         if first.is_none() && look.auto_tf() {
-            first = Histogram::of(&input.volume, volray_core::transfer::auto::BINS);
+            first = volray_core::transfer::auto::robust_histogram_of(&input.volume);
         }
         if look.labels {
             let found = volray_options::volume_labels(&input.volume, &input.name);
@@ -134,6 +134,14 @@ pub fn series_settings(
         }
     }
     let mut settings = extent.fix(base);
+    // Where the first volume's histogram was refined past outliers, its
+    // window is the series' (a window given still wins), as for one
+    // volume: over the union of the ranges the bulk would be squeezed.
+    if let Some((lo, hi)) = first.as_ref().and_then(|r| r.window)
+        && base.transfer_function.domain.is_none()
+    {
+        settings.transfer_function.domain = Some((f64::from(lo), f64::from(hi)));
+    }
     let tf = &mut settings.transfer_function;
     if look.labels {
         let found: Vec<i64> = labels.into_iter().collect();

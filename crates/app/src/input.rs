@@ -131,6 +131,10 @@ pub struct Input {
     /// How its axes were stretched for drawing, where they were by the
     /// default rule (`display.rs`): the note a front end says.
     pub display_note: Option<String>,
+    /// Whether `volume` is the log10 of the data because `--tf auto`
+    /// chose it ([`auto_log`]): figures then label decades, as with
+    /// `--log`.
+    pub auto_log: bool,
 }
 
 impl Input {
@@ -188,6 +192,33 @@ pub fn load_log(request: &Request, log: bool) -> Result<Input, AppError> {
         })?;
     }
     Ok(input)
+}
+
+/// With `look`'s `--tf auto` and no window (`transfer_function`, the
+/// flags' before the volume completes it), takes the log10 of `input`'s
+/// volume where its values span decades (volray-options'
+/// [`chooses_log`](volray_options::chooses_log)), marks it
+/// [`Input::auto_log`] and returns the note to print (`linear`: how the
+/// front end keeps the values, `--linear`); `None` where it keeps them.
+/// For a volume read whole and rendered alone: a series, a scene and a
+/// volume read piece by piece keep their values.
+pub fn auto_log(
+    look: &volray_options::LookOptions,
+    transfer_function: &volray_core::TransferFunction,
+    input: &mut Input,
+    linear: &str,
+) -> Result<Option<String>, AppError> {
+    // The file's own window counts as a window given.
+    let window = (input.file.as_ref()).and_then(|(_, info)| info.display_window());
+    if window.is_some() || !volray_options::chooses_log(look, transfer_function, &input.volume) {
+        return Ok(None);
+    }
+    input.volume = input.volume.to_log10().map_err(|e| AppError::Log {
+        name: input.name.clone(),
+        message: e.to_string(),
+    })?;
+    input.auto_log = true;
+    Ok(Some(volray_options::auto_log_note(&input.name, linear)))
 }
 
 /// Loads the input for rendering: a file holding an image, not a volume,
@@ -270,6 +301,7 @@ fn describe_with(request: &Request, map: MapPolicy) -> Result<Described, AppErro
         file,
         max_memory,
         display_note: None,
+        auto_log: false,
     })))
 }
 

@@ -459,6 +459,18 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
     /// and the counts are summed on every rank. `None` for a volume with
     /// no finite value.
     pub fn histogram(&self, bins: usize) -> Result<Option<Histogram>, FrameError> {
+        self.histogram_in(None, bins)
+    }
+
+    /// [`Self::histogram`] over `window` (`None`: the value range), the
+    /// values outside it counted in the end bins (volray-core's
+    /// `auto::robust_histogram` passes). Every rank must call it together.
+    pub fn histogram_in(
+        &self,
+        window: Option<(f32, f32)>,
+        bins: usize,
+    ) -> Result<Option<Histogram>, FrameError> {
+        let range = window.unwrap_or(self.value_range);
         let local = self.held.renderer.as_ref().map(|r| {
             let (lo, hi) = self.held.piece_owned;
             let o = self.held.offset;
@@ -466,11 +478,16 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
                 std::array::from_fn(|a| lo[a] - o[a]),
                 std::array::from_fn(|a| hi[a] - o[a]),
             );
-            Histogram::of_box(r.volume(), owned, self.value_range, bins)
+            Histogram::of_box(r.volume(), owned, range, bins)
         });
+        // The mean, the non-finite count, the values within the window
+        // (two f32, +∞ and −∞ for none) and the counts.
         let bytes = local.map_or_else(Vec::new, |h| {
             let mut out: Vec<u8> = h.mean.to_le_bytes().to_vec();
             out.extend_from_slice(&h.non_finite.to_le_bytes());
+            let (lo, hi) = h.within.unwrap_or((f32::INFINITY, f32::NEG_INFINITY));
+            out.extend_from_slice(&lo.to_le_bytes());
+            out.extend_from_slice(&hi.to_le_bytes());
             for c in &h.counts {
                 out.extend_from_slice(&c.to_le_bytes());
             }
@@ -478,15 +495,17 @@ impl<'t, T: Transport + ?Sized> Distributed<'t, T> {
         });
         let all = agree(self.transport, Ok::<_, Failure>(bytes))?;
         let mut whole: Option<Histogram> = None;
-        for m in all.iter().filter(|m| m.len() == 16 + 8 * bins.max(1)) {
+        for m in all.iter().filter(|m| m.len() == 24 + 8 * bins.max(1)) {
             let word = |i: usize| m[8 * i..8 * i + 8].try_into().unwrap();
+            let half = |i: usize| f32::from_le_bytes(m[i..i + 4].try_into().unwrap());
             let part = Histogram {
-                min: self.value_range.0,
-                max: self.value_range.1,
+                min: range.0,
+                max: range.1,
                 mean: f64::from_le_bytes(word(0)),
                 non_finite: u64::from_le_bytes(word(1)),
+                within: Some((half(16), half(20))).filter(|(lo, hi)| lo <= hi),
                 counts: (0..bins.max(1))
-                    .map(|b| u64::from_le_bytes(word(2 + b)))
+                    .map(|b| u64::from_le_bytes(word(3 + b)))
                     .collect(),
             };
             match &mut whole {

@@ -230,16 +230,35 @@ impl Streamed {
         settings: &RenderSettings,
         bins: usize,
     ) -> Result<Option<Histogram>, StreamError> {
+        self.histogram_in(settings, None, bins)
+    }
+
+    /// [`Self::histogram`] over `window` (`None`: the value range), the
+    /// values outside it counted in the end bins (volray-core's
+    /// `auto::robust_histogram` passes: each reads every piece again).
+    pub fn histogram_in(
+        &self,
+        settings: &RenderSettings,
+        window: Option<(f32, f32)>,
+        bins: usize,
+    ) -> Result<Option<Histogram>, StreamError> {
         let pieces = &mut *self.lock();
         self.split_for(pieces, settings)?;
         self.keep_whole(pieces)?;
         if let Some(r) = &pieces.whole {
-            return Ok(Histogram::of(r.volume(), bins));
+            let volume = r.volume();
+            return Ok(match window {
+                None => Histogram::of(volume, bins),
+                Some(w) => volume
+                    .value_range()
+                    .map(|_| Histogram::of_box(volume, ([0; 3], volume.dims()), w, bins)),
+            });
         }
         self.learn(pieces, true, false, &Progress::new(&|_| {}))?;
         let Some(range) = pieces.value_range() else {
             return Ok(None);
         };
+        let range = window.unwrap_or(range);
         let mut whole: Option<Histogram> = None;
         for owned in pieces.decomposition.boxes.clone() {
             if owned.is_empty() {

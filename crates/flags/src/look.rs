@@ -149,6 +149,12 @@ pub struct LookArgs {
     #[arg(long, help_heading = "Rendering options")]
     pub log: bool,
 
+    /// Render the data's own values: --tf auto takes the log10 of values
+    /// spanning decades (their median under 1 % of their 99.9 % point)
+    /// unless this, --range or --log is given.
+    #[arg(long, conflicts_with = "log", help_heading = "Rendering options")]
+    pub linear: bool,
+
     /// Opacity times a ramp of the gradient magnitude |∇f|, 0 at LO and 1
     /// at HI, fractions of the volume's largest |∇f| (0 <= LO < HI <= 1):
     /// boundaries show and uniform insides fade.

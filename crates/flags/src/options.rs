@@ -104,6 +104,7 @@ pub fn look(look: &LookArgs) -> LookOptions {
         iso: look.iso,
         iso_thickness: look.iso_thickness,
         log: look.log,
+        linear: look.linear,
         gradient_opacity: look.gradient_opacity,
         post_classification: look.post_classification,
     }

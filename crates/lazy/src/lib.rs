@@ -61,7 +61,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use volray_core::camera::CameraError;
 use volray_core::glam::DVec3;
 use volray_core::sampling::grid::GridFrame;
-use volray_core::transfer::{auto, labels::MAX_LABELS};
+use volray_core::transfer::auto::{self, Robust};
+use volray_core::transfer::labels::MAX_LABELS;
 use volray_core::{
     Histogram, MemoryBound, NonFinite, RenderSettings, SampleType, SourceError, SourceErrorKind,
     Volume, VolumeSource,
@@ -368,6 +369,7 @@ pub enum LookError {
 pub struct Found {
     labels: Option<Vec<i64>>,
     histogram: Option<Option<Histogram>>,
+    robust: Option<Option<Robust>>,
 }
 
 impl Found {
@@ -383,6 +385,26 @@ impl Found {
             self.histogram = Some(streamed.histogram(settings, auto::BINS)?);
         }
         Ok(self.histogram.as_ref().and_then(Option::as_ref))
+    }
+
+    /// The level's histogram made robust to outliers (volray-core's
+    /// [`auto::robust_histogram`]), found once: each refining pass reads
+    /// every piece again. `None` for a level with no finite value.
+    pub fn robust(
+        &mut self,
+        streamed: &mut Streamed,
+        settings: &RenderSettings,
+    ) -> Result<Option<&Robust>, StreamError> {
+        if self.robust.is_none() {
+            let robust = match self.histogram(streamed, settings)? {
+                None => None,
+                Some(first) => Some(auto::robust_histogram(first.clone(), |window| {
+                    streamed.histogram_in(settings, Some(window), auto::BINS)
+                })?),
+            };
+            self.robust = Some(robust);
+        }
+        Ok(self.robust.as_ref().and_then(Option::as_ref))
     }
 
     /// The level's distinct labels, sorted, found once; refused (naming
@@ -426,11 +448,9 @@ impl Found {
             .map_err(LookError::Refused);
         }
         if look.auto_tf()
-            && let Some(histogram) = self
-                .histogram(streamed, settings)
-                .map_err(LookError::Stream)?
+            && let Some(robust) = self.robust(streamed, settings).map_err(LookError::Stream)?
         {
-            volray_options::apply_auto(look, &mut settings.transfer_function, histogram);
+            volray_options::apply_auto(look, &mut settings.transfer_function, robust);
         }
         Ok(())
     }

@@ -42,6 +42,6 @@ pub use option::{Naming, Opt, Plain};
 pub use options::{BlendMode, CameraOptions, LookOptions, Options, SamplingOptions, Tf};
 pub use settings::{named_transfer_function, settings};
 pub use volume::{
-    apply_auto, choose_auto, file_window, from_volume, label_transfer_function, labels_found,
-    volume_labels,
+    apply_auto, auto_log_note, choose_auto, chooses_log, file_window, from_volume,
+    label_transfer_function, labels_found, volume_labels,
 };

@@ -171,6 +171,10 @@ pub struct LookOptions {
     /// Render the log10 of the data (`--log`): windows and isovalues stay
     /// in the data's units.
     pub log: bool,
+    /// The data's own values, never the log10 that `--tf auto` takes of
+    /// values spanning decades ([`crate::chooses_log`]): `--linear`,
+    /// Python's `log=False`.
+    pub linear: bool,
     /// Opacity scaled by gradient magnitude between these fractions of its
     /// largest (`--gradient-opacity`).
     pub gradient_opacity: Option<(f32, f32)>,
@@ -205,6 +209,7 @@ impl Default for LookOptions {
             iso: None,
             iso_thickness: None,
             log: false,
+            linear: false,
             gradient_opacity: None,
             post_classification: false,
         }

@@ -8,7 +8,7 @@ use crate::error::OptionError;
 use crate::option::Opt;
 use crate::options::{LookOptions, Tf};
 use volray_core::transfer::{auto, labels};
-use volray_core::{Histogram, TransferFunction, Volume};
+use volray_core::{TransferFunction, Volume};
 
 /// The file's own display window (an OME-Zarr image's `omero` window of
 /// the channel read) as the default range: the transfer function's domain
@@ -121,6 +121,56 @@ pub fn label_transfer_function(
     }
 }
 
+/// Whether the automatic transfer function renders `volume` as its log10
+/// (as the log option does): where [`LookOptions::auto_tf`] says so, no
+/// window is given (`transfer_function` has no domain: no range, no
+/// file's window), neither the log option nor [`LookOptions::linear`] is
+/// given, the volume is not labels, and its values span decades
+/// (volray-core's [`auto::volume_spans_decades`]). The caller takes the log10
+/// and says so ([`auto_log_note`]); a volume read piece by piece or
+/// across ranks, a series and a scene keep their values.
+///
+/// ```
+/// use volray_core::{TransferFunction, Volume};
+/// use volray_options::{LookOptions, chooses_log};
+///
+/// // Values 4096/n for n = 1..=4096: as many above v as 4096/v, as a
+/// // density falling as r⁻³ about a point.
+/// let data = (1..=4096).map(|n| 4096.0 / n as f32).collect();
+/// let v = Volume::new([16, 16, 16], data).unwrap();
+/// let tf = TransferFunction::default();
+/// assert!(chooses_log(&LookOptions::default(), &tf, &v));
+/// let linear = LookOptions { linear: true, ..LookOptions::default() };
+/// assert!(!chooses_log(&linear, &tf, &v));
+/// let ranged = TransferFunction { domain: Some((1.0, 1e6)), ..TransferFunction::default() };
+/// assert!(!chooses_log(&LookOptions::default(), &ranged, &v));
+/// ```
+pub fn chooses_log(
+    look: &LookOptions,
+    transfer_function: &TransferFunction,
+    volume: &Volume,
+) -> bool {
+    look.auto_tf()
+        && !look.log
+        && !look.linear
+        && !look.labels
+        && !volume.is_labels()
+        && transfer_function.domain.is_none()
+        && auto::volume_spans_decades(volume)
+}
+
+/// The note a front end prints when [`chooses_log`] chose the log10 of
+/// the volume `name`; `linear` says how to keep the values (`--linear`,
+/// `log=False`).
+pub fn auto_log_note(name: &str, linear: &str) -> String {
+    format!(
+        "note: {name}: the values span decades (half of those above the background lie in the \
+         lowest {} % of a linear ramp): rendering their log10, as with log; {linear} or a range \
+         keeps the values",
+        auto::LOG_MEDIAN * 100.0
+    )
+}
+
 /// Where [`LookOptions::auto_tf`] says so, the transfer function chosen
 /// from `volume`'s histogram (volray-core's [`auto`]) over
 /// `transfer_function`'s window: its opacity unless the opacity ramp is
@@ -132,20 +182,24 @@ pub fn choose_auto(look: &LookOptions, transfer_function: &mut TransferFunction,
         return;
     }
     // A volume with no finite value is refused later, by the renderer.
-    if let Some(histogram) = Histogram::of(volume, auto::BINS) {
-        apply_auto(look, transfer_function, &histogram);
+    if let Some(robust) = auto::robust_histogram_of(volume) {
+        apply_auto(look, transfer_function, &robust);
     }
 }
 
 /// The transfer function chosen from values whose statistics are
-/// `histogram`, put into `transfer_function` as [`choose_auto`] says (a
-/// series chooses from its first volume's histogram).
+/// `robust` (volray-core's [`auto::robust_histogram`]), put into
+/// `transfer_function` as [`choose_auto`] says (a series chooses from its
+/// first volume's histogram): where the histogram was refined to a window
+/// narrower than the data's range and no window is given, the window
+/// becomes the domain, so that outliers above it take the top colour.
 pub fn apply_auto(
     look: &LookOptions,
     transfer_function: &mut TransferFunction,
-    histogram: &Histogram,
+    robust: &auto::Robust,
 ) {
-    let chosen = auto::transfer_function(histogram, transfer_function.domain);
+    let chosen = auto::robust_transfer_function(robust, transfer_function.domain);
+    transfer_function.domain = chosen.domain;
     if look.opacity.is_none() {
         transfer_function.opacity = chosen.opacity;
     }

@@ -45,7 +45,7 @@ use volray_app::memory::Budget;
 use volray_app::plan::{self, Frames};
 use volray_core::transfer::auto;
 use volray_core::{
-    FrameRequest, Histogram, Image, NonFinite, Render, RenderError, RenderSettings, Rendered,
+    FrameRequest, Image, NonFinite, Render, RenderError, RenderSettings, Rendered,
     Renderer as CoreRenderer, Volume as CoreVolume,
 };
 use volray_distributed::streamed::{StreamError, Streamed};
@@ -189,7 +189,7 @@ pub(crate) struct Prepared {
 /// function is chosen from (else).
 pub(crate) struct Known {
     pub labels: Option<Vec<i64>>,
-    pub histogram: Option<Histogram>,
+    pub histogram: Option<auto::Robust>,
 }
 
 impl Renderer {

@@ -113,3 +113,21 @@ def test_label_volumes_render_as_the_command_line_renders_them(cli_image, tmp_pa
     expected = cli_image(tmp_path / "labels.npy", "--size", "64", "--labels", "--label-opacity", "2:0.3")
     got = rgb(volray.render(labels, size=64, labels=True, label_opacity={2: 0.3}))
     assert np.abs(got - expected).max() == 0
+
+
+def test_a_few_hot_pixels_leave_the_command_lines_window(cli_image, tmp_path):
+    """Values 10..100 with three voxels at 1e6: `--tf auto` refines its
+    histogram to the values' window (core's robust_histogram), in Python
+    as on the command line, and the picture shows them."""
+    z, y, x = np.meshgrid(np.arange(20), np.arange(24), np.arange(28), indexing="ij")
+    data = (10 + 90 * ((x * 31 + y * 7 + z * 13) % 97) / 96).astype(np.float32)
+    data[3, 5, 7] = data[10, 20, 4] = data[15, 2, 20] = 1e6
+    path = tmp_path / "hot.npy"
+    np.save(path, data)
+    expected = cli_image(path, "--size", "64")
+    for source in (volray.read(str(path)), data):
+        got = rgb(volray.render(source, size=64))
+        assert np.abs(got - expected).max() == 0, "pixels differ from volray render"
+    # Over the range 10..1e6 every value would be transparent.
+    shown = np.any(np.abs(got - got[0, 0]) > 8, axis=-1).mean()
+    assert shown > 0.25, shown

@@ -4,7 +4,7 @@
 
 use crate::protocol::{Hello, VolumeHello};
 use crate::state::{Lighting, START_COLOURS, ViewState, WHITE};
-use volray_core::transfer::colormap;
+use volray_core::transfer::{auto, colormap};
 use volray_core::{Histogram, RenderSettings, Volume};
 
 /// Bins of the histogram drawn under the transfer-function editor.
@@ -32,8 +32,22 @@ pub struct Start<'a> {
 
 /// What a panel draws over: the value histogram and its range, and the
 /// transfer function's starting window (its domain, else the range).
+/// Where a few outliers stretch the values' range (volray-core's
+/// [`auto::robust_histogram`] refines it, as `--tf auto` does), the
+/// histogram and its range are those of the window it refines to, the
+/// outliers counted in its end bins: over the whole range the data would
+/// be one bar. A label volume's is over its labels.
 fn histogram_of(volume: &Volume, settings: &RenderSettings) -> (Vec<u64>, [f32; 2], [f64; 2]) {
-    let histogram = Histogram::of(volume, HISTOGRAM_BINS);
+    let robust = (!volume.is_labels()).then(|| auto::robust_histogram_of(volume));
+    let histogram = match robust.flatten().and_then(|r| r.window) {
+        Some(window) => Some(Histogram::of_box(
+            volume,
+            ([0; 3], volume.dims()),
+            window,
+            HISTOGRAM_BINS,
+        )),
+        None => Histogram::of(volume, HISTOGRAM_BINS),
+    };
     let range = histogram.as_ref().map_or([0.0, 0.0], |h| [h.min, h.max]);
     let start_window = (settings.transfer_function.domain)
         .map_or([f64::from(range[0]), f64::from(range[1])], |(lo, hi)| {
@@ -194,5 +208,38 @@ mod tests {
             (settings.phong.diffuse[0], None)
         );
         assert_eq!(second.start_window, [0.0, 2.0]);
+    }
+
+    #[test]
+    fn a_few_hot_pixels_leave_the_histogram_over_the_values_window() {
+        // 0..100 (i mod 101) with one voxel at 1e6: the histogram and its
+        // range are the refined window's (as `--tf auto` chooses in), the
+        // hot pixel in the top bin.
+        let data = (0..4096)
+            .map(|i| if i == 7 { 1e6 } else { (i % 101) as f32 })
+            .collect();
+        let volume = Volume::new([16, 16, 16], data).unwrap();
+        let settings = RenderSettings::default();
+        let state = ViewState::default();
+        let hello = Start {
+            name: "hot",
+            volume: &volume,
+            log: false,
+            state: &state,
+            settings: &settings,
+            others: vec![],
+            time: None,
+        }
+        .hello();
+        assert_eq!(hello.range, [0.0, 100.0]);
+        assert_eq!(hello.histogram.iter().sum::<u64>(), 4096);
+        // Evenly spread: no bin holds more than a few times its share.
+        assert!(
+            hello
+                .histogram
+                .iter()
+                .all(|&c| c < 4 * 4096 / HISTOGRAM_BINS as u64)
+        );
+        assert_eq!(hello.start_window, [0.0, 100.0]);
     }
 }

@@ -4,6 +4,7 @@
 
 use crate::error::AppError;
 use crate::input::Request;
+use volray_core::transfer::auto;
 use volray_core::{NonFinite, RenderSettings};
 use volray_distributed::frame::{Distributed, Failure, FrameError};
 use volray_distributed::mpi::Mpi;
@@ -61,11 +62,14 @@ pub(super) fn from_volume(
         return Ok(settings);
     }
     if look.auto_tf()
-        && let Some(histogram) = d
-            .histogram(volray_core::transfer::auto::BINS)
-            .map_err(fail)?
+        && let Some(first) = d.histogram(auto::BINS).map_err(fail)?
     {
-        volray_options::apply_auto(look, &mut settings.transfer_function, &histogram);
+        // Every pass is collective: the windows depend only on the summed
+        // counts, the same on every rank.
+        let robust =
+            auto::robust_histogram(first, |window| d.histogram_in(Some(window), auto::BINS))
+                .map_err(fail)?;
+        volray_options::apply_auto(look, &mut settings.transfer_function, &robust);
     }
     Ok(settings)
 }

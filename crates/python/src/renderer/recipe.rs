@@ -101,7 +101,7 @@ impl Recipe {
             let found = volray_options::volume_labels(&core, name).map_err(option_error)?;
             (Some(found), None)
         } else {
-            (None, py.detach(|| Histogram::of(&core, auto::BINS)))
+            (None, py.detach(|| auto::robust_histogram_of(&core)))
         };
         let core = if self.labels { core.as_labels() } else { core };
         let nonfinite = self.nonfinite;
@@ -293,7 +293,7 @@ impl Recipe {
             (None, Some(histogram)) if options.look.auto_tf() => {
                 // A CT in Hounsfield units: the CT look (volray-app's `look`).
                 let modality = self.display.as_ref().and_then(|i| i.modality.as_deref());
-                let range = Some((histogram.min, histogram.max));
+                let range = Some((histogram.histogram.min, histogram.histogram.max));
                 if let Some((tf, _)) = volray_app::look::ct_look(&options.look, modality, range) {
                     settings.transfer_function = tf;
                     return Ok(());
