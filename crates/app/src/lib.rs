@@ -85,6 +85,7 @@ pub mod distributed;
 pub mod error;
 pub mod input;
 pub mod look;
+pub mod movie;
 pub mod memory;
 pub mod plan;
 pub mod reads;
