@@ -392,8 +392,14 @@ fn coefficients(v: &Value) -> Result<[f32; 3], String> {
     Ok(c.map(|k| k as f32))
 }
 
-/// A colour: `[r, g, b]` in [0, 1], or `"#rrggbb"`.
+/// A colour: `[r, g, b]` in [0, 1], `"#rrggbb"` or a name (as the
+/// flags take them).
 fn colour(v: &Value) -> Result<[f32; 3], String> {
+    if let Value::String(s) = v
+        && let Some(c) = volray_options::colors::named(s.trim())
+    {
+        return Ok(c);
+    }
     if let Value::String(s) = v
         && let Some(hex) = s.strip_prefix('#')
         && hex.len() == 6
