@@ -102,7 +102,15 @@ pub fn draw_titled(
         return Ok(());
     }
     let bounds = renderer.volume().bounds();
-    annotate(args, settings, renderer, input, &annotations, (&[bounds], bounds), image)
+    annotate(
+        args,
+        settings,
+        renderer,
+        input,
+        &annotations,
+        (&[bounds], bounds),
+        image,
+    )
 }
 
 /// [`draw`], the outline drawing `boxes`, a perspective scale bar holding
@@ -131,7 +139,15 @@ pub fn draw_framed(
         return Ok(());
     }
     let boxes = (boxes, scale_box);
-    annotate(args, settings, renderer, input, &annotations(&args.figure), boxes, image)
+    annotate(
+        args,
+        settings,
+        renderer,
+        input,
+        &annotations(&args.figure),
+        boxes,
+        image,
+    )
 }
 
 /// Draws `annotations` (if any) into `image`, the outline drawing
@@ -157,12 +173,6 @@ fn annotate(
         boxes,
         scale_box,
     };
-    annotate_frame(
-        image,
-        annotations,
-        renderer,
-        settings,
-        &rendered,
-    )
-    .map_err(|e| CliError::input(e.to_string()))
+    annotate_frame(image, annotations, renderer, settings, &rendered)
+        .map_err(|e| CliError::input(e.to_string()))
 }

@@ -81,7 +81,10 @@ fn an_mp4_holds_every_frame_at_its_size_and_rate_and_each_is_the_still_of_its_in
     render(&[&base[..], &["--keyframes", &keys]].concat(), &movie);
     let probe = Command::new("ffprobe")
         .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
-        .args(["-show_entries", "stream=width,height,r_frame_rate,nb_read_frames"])
+        .args([
+            "-show_entries",
+            "stream=width,height,r_frame_rate,nb_read_frames",
+        ])
         .args(["-of", "csv=p=0"])
         .arg(&movie)
         .output()
@@ -171,7 +174,11 @@ fn a_png_sequence_of_a_clip_sweep_a_tf_fade_and_time_points_equals_the_stills_ex
         let still = d.join(format!("still{k}.png"));
         let frame = time_point.to_string();
         render(
-            &[&base[..], &["--frame", &frame, "--clip", &clip, "--tf", &tf_file]].concat(),
+            &[
+                &base[..],
+                &["--frame", &frame, "--clip", &clip, "--tf", &tf_file],
+            ]
+            .concat(),
             &still,
         );
         let diff = Picture::read(&one.join(&name)).max_diff(&Picture::read(&still));
@@ -189,11 +196,22 @@ fn a_turntable_through_the_movie_path_is_the_turntable_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let plain = dir.path().join("plain.gif");
     let kept = dir.path().join("kept.gif");
-    let base = ["blobs:32", "--size", SIZE, "--turntable", "6", "--fps", "12"];
+    let base = [
+        "blobs:32",
+        "--size",
+        SIZE,
+        "--turntable",
+        "6",
+        "--fps",
+        "12",
+    ];
     render(&base, &plain);
     // --resume takes the movie path: frames kept, then encoded.
     render(&[&base[..], &["--resume"]].concat(), &kept);
-    assert_eq!(std::fs::read(&plain).unwrap(), std::fs::read(&kept).unwrap());
+    assert_eq!(
+        std::fs::read(&plain).unwrap(),
+        std::fs::read(&kept).unwrap()
+    );
     assert_eq!(names(dir.path()), ["kept.gif", "plain.gif"]);
 }
 
@@ -215,7 +233,10 @@ fn interrupted(args: &[&str], after: usize) -> (Option<i32>, String) {
         .env("VOLRAY_TEST_INTERRUPT_AFTER", after.to_string())
         .output()
         .unwrap();
-    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 #[test]
@@ -234,12 +255,21 @@ fn resumed_after_ctrl_c_only_the_missing_frames_are_rendered_and_the_movie_is_th
     assert_eq!(code, Some(130), "{said}");
     assert!(!apng.exists());
     let work = d.join("movie.png.frames");
-    assert_eq!(names(&work).iter().filter(|n| n.ends_with(".png")).count(), 10);
+    assert_eq!(
+        names(&work).iter().filter(|n| n.ends_with(".png")).count(),
+        10
+    );
     let said = render(&[&base[..], &["--resume"]].concat(), &apng);
     assert!(said.contains("resumed: 10 of 24 frames kept"), "{said}");
     assert!(said.contains("14 to render"), "{said}");
-    assert_eq!(std::fs::read(&apng).unwrap(), std::fs::read(&whole).unwrap());
-    assert!(!work.exists(), "the work folder is removed once the movie is done");
+    assert_eq!(
+        std::fs::read(&apng).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
+    assert!(
+        !work.exists(),
+        "the work folder is removed once the movie is done"
+    );
 
     // A PNG sequence: its finished files are not written again.
     let seq = d.join("seq");
@@ -257,7 +287,10 @@ fn resumed_after_ctrl_c_only_the_missing_frames_are_rendered_and_the_movie_is_th
     let said = render(&[&base[..], &["--resume"]].concat(), &pattern);
     assert!(said.contains("resumed: 12 of 24 frames kept"), "{said}");
     for (k, time) in kept.iter().enumerate() {
-        assert_eq!(std::fs::metadata(file(k)).unwrap().modified().unwrap(), *time);
+        assert_eq!(
+            std::fs::metadata(file(k)).unwrap().modified().unwrap(),
+            *time
+        );
     }
     // Frame for frame the uninterrupted movie's.
     let plain = d.join("plain");
@@ -288,10 +321,18 @@ fn parts_rendered_apart_make_the_movie_once_the_last_is_in() {
     assert!(!parts.exists());
     let said = render(&[&base[..], &["--movie-frames", "0:12"]].concat(), &parts);
     assert!(!said.contains("missing"), "{said}");
-    assert_eq!(std::fs::read(&parts).unwrap(), std::fs::read(&whole).unwrap());
+    assert_eq!(
+        std::fs::read(&parts).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
     // A part outside the movie is refused.
     let out = volray(
-        &[&["render"], &base[..], &["--movie-frames", "20:30", "-o", "x.gif"]].concat(),
+        &[
+            &["render"],
+            &base[..],
+            &["--movie-frames", "20:30", "-o", "x.gif"],
+        ]
+        .concat(),
     );
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("24 frames"), "{}", stderr(&out));
@@ -315,7 +356,10 @@ fn a_movie_stopped_by_ctrl_c_or_without_ffmpeg_leaves_nothing() {
     let said = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{said}");
     assert_eq!(said.trim().lines().count(), 1, "{said}");
-    assert!(said.contains("needs ffmpeg, which is not on PATH"), "{said}");
+    assert!(
+        said.contains("needs ffmpeg, which is not on PATH"),
+        "{said}"
+    );
     assert_eq!(names(d), ["keys.json"]);
     if !has_ffmpeg() {
         return;
@@ -335,18 +379,33 @@ fn a_bad_keyframes_file_is_refused_in_one_line_naming_the_file_and_the_key() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     for (text, says) in [
-        (r#"{"keyframes": [{"t": 0, "zooom": 2}]}"#, "keyframes[0].zooom: unknown key"),
+        (
+            r#"{"keyframes": [{"t": 0, "zooom": 2}]}"#,
+            "keyframes[0].zooom: unknown key",
+        ),
         (
             r#"{"keyframes": [{"t": 1}, {"t": 0.5}]}"#,
             "keyframes[1].t: 0.5 is not after",
         ),
-        (r#"{"keyframes": [{"t": 0, "azimuth": [1]}]}"#, "keyframes[0].azimuth"),
+        (
+            r#"{"keyframes": [{"t": 0, "azimuth": [1]}]}"#,
+            "keyframes[0].azimuth",
+        ),
         (r#"{"version": 7, "keyframes": [{"t": 0}]}"#, "version 7"),
-        (r#"{"keyframes": [{"t": 0, "colormap": "plaid"}]}"#, "keyframes[0]: "),
+        (
+            r#"{"keyframes": [{"t": 0, "colormap": "plaid"}]}"#,
+            "keyframes[0]: ",
+        ),
     ] {
         let keys = write(d, "bad.json", text);
         let out = volray(&[
-            "render", "blobs:32", "--size", SIZE, "--keyframes", &keys, "-o",
+            "render",
+            "blobs:32",
+            "--size",
+            SIZE,
+            "--keyframes",
+            &keys,
+            "-o",
             d.join("m.gif").to_str().unwrap(),
         ]);
         let said = stderr(&out);

@@ -181,7 +181,11 @@ impl Encoder {
             .take()
             .and_then(|t| t.join().ok())
             .unwrap_or_default();
-        let said: Vec<&str> = said.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+        let said: Vec<&str> = said
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect();
         let said = if said.is_empty() {
             String::new()
         } else {

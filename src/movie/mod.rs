@@ -82,7 +82,12 @@ enum Sink {
 }
 
 impl Sink {
-    fn start(args: &RenderArgs, size: (usize, usize), frames: usize, fps: f64) -> Result<Self, CliError> {
+    fn start(
+        args: &RenderArgs,
+        size: (usize, usize),
+        frames: usize,
+        fps: f64,
+    ) -> Result<Self, CliError> {
         let output = &args.out.output;
         Ok(match Codec::of(output) {
             Some(codec) => {
@@ -177,7 +182,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         Path::Keys { movie, .. } => movie.frames(),
         Path::Turntable(n) => *n,
     };
-    let spec = args.input.input.clone().unwrap_or(volray_app::input::DEMO.into());
+    let spec = args
+        .input
+        .input
+        .clone()
+        .unwrap_or(volray_app::input::DEMO.into());
     let outputs: Vec<PathBuf> = match sequence {
         true => (0..frames)
             .filter_map(|k| volray_io::sequence_path(output, k))
@@ -196,7 +205,12 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         None => 0..frames,
     };
     let work = match args.animation.resume || args.animation.movie_frames.is_some() {
-        true => Some(Work::open(output, &identity(&keys_text, frames, size), sequence, size)?),
+        true => Some(Work::open(
+            output,
+            &identity(&keys_text, frames, size),
+            sequence,
+            size,
+        )?),
         false => None,
     };
     let pool = thread_pool(args.view.threads)?;
@@ -257,7 +271,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         }
         // What the look leaves to this volume, for each frame (kept while
         // the look stays: `tf auto`'s histogram is taken once).
-        let mut last: Option<(LookOptions, volray_core::TransferFunction, volray_core::TransferFunction)> = None;
+        let mut last: Option<(
+            LookOptions,
+            volray_core::TransferFunction,
+            volray_core::TransferFunction,
+        )> = None;
         for p in &mut planned {
             let tf = p.settings.transfer_function.clone();
             match &last {
@@ -265,8 +283,12 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                     p.settings.transfer_function = after.clone();
                 }
                 _ => {
-                    volray_app::look::leave_to_volume(&p.look, &mut p.settings.transfer_function, &mut input)
-                        .map_err(crate::settings::refused)?;
+                    volray_app::look::leave_to_volume(
+                        &p.look,
+                        &mut p.settings.transfer_function,
+                        &mut input,
+                    )
+                    .map_err(crate::settings::refused)?;
                     last = Some((p.look.clone(), tf, p.settings.transfer_function.clone()));
                 }
             }
@@ -332,13 +354,19 @@ fn refuse_with_movie(args: &RenderArgs) -> Result<(), CliError> {
     let a = &args.animation;
     let refuse = |what: &str| Err(CliError::input(what.to_string()));
     if a.keyframes.is_some() && a.turntable.is_some() {
-        return refuse("--keyframes and --turntable each make a movie: give one (a turntable is keyframes of the azimuth, docs/movies.md)");
+        return refuse(
+            "--keyframes and --turntable each make a movie: give one (a turntable is keyframes of the azimuth, docs/movies.md)",
+        );
     }
     if args.scene.is_scene() {
-        return refuse("--keyframes renders one volume: --channels and --overlay are not animated yet");
+        return refuse(
+            "--keyframes renders one volume: --channels and --overlay are not animated yet",
+        );
     }
     if args.scene.frames.is_some() {
-        return refuse("--frames animates the time points one by one: with --keyframes give \"frame\" in the keyframes");
+        return refuse(
+            "--frames animates the time points one by one: with --keyframes give \"frame\" in the keyframes",
+        );
     }
     if !a.series.is_empty() {
         return refuse("a movie renders one input: give one");
@@ -397,7 +425,11 @@ fn keys_failure(path: &Path, k: usize, e: volray_options::OptionError) -> CliErr
 }
 
 /// The volume a frame shows: a time point, or two blended.
-fn load_data(input_args: &InputArgs, args: &RenderArgs, data: DataFrame) -> Result<Input, CliError> {
+fn load_data(
+    input_args: &InputArgs,
+    args: &RenderArgs,
+    data: DataFrame,
+) -> Result<Input, CliError> {
     let at = |frame: Option<usize>| InputArgs {
         frame,
         ..input_args.clone()
@@ -485,7 +517,10 @@ fn frame_bar(frames: u64) -> ProgressBar {
 /// For the tests of `--resume`: `VOLRAY_TEST_INTERRUPT_AFTER=N` sends
 /// this process SIGINT once N frames are rendered, as Ctrl-C would.
 fn test_interrupt_after() -> Option<usize> {
-    std::env::var("VOLRAY_TEST_INTERRUPT_AFTER").ok()?.parse().ok()
+    std::env::var("VOLRAY_TEST_INTERRUPT_AFTER")
+        .ok()?
+        .parse()
+        .ok()
 }
 
 #[cfg(unix)]

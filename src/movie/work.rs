@@ -91,7 +91,9 @@ impl Work {
                     encoder.set_color(png::ColorType::Rgb);
                     encoder.set_depth(png::BitDepth::Eight);
                     let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-                    writer.write_image_data(rgb).map_err(std::io::Error::other)?;
+                    writer
+                        .write_image_data(rgb)
+                        .map_err(std::io::Error::other)?;
                     writer.finish().map_err(std::io::Error::other)
                 })?;
             }
@@ -119,7 +121,9 @@ impl Work {
             )));
         }
         let mut rgb = vec![0; w * h * 3];
-        reader.next_frame(&mut rgb).map_err(|e| bad(e.to_string()))?;
+        reader
+            .next_frame(&mut rgb)
+            .map_err(|e| bad(e.to_string()))?;
         Ok(rgb)
     }
 

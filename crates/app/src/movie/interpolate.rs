@@ -26,9 +26,9 @@
 //! flags give.
 
 use super::color;
+use volray_core::TransferFunction;
 use volray_core::glam::{DQuat, DVec3};
 use volray_core::transfer::function::PiecewiseLinear;
-use volray_core::TransferFunction;
 use volray_options::{Options, Tf};
 
 /// What a keyframe fixes: every render option (the command line's where
@@ -335,7 +335,10 @@ mod tests {
         // same distance: (cos 45°, sin 45°, 0)·2.
         let mid = slerp([2.0, 0.0, 0.0], [0.0, 2.0, 0.0], 0.5);
         let h = 2.0 * std::f64::consts::FRAC_1_SQRT_2;
-        assert!(close(mid[0], h) && close(mid[1], h) && close(mid[2], 0.0), "{mid:?}");
+        assert!(
+            close(mid[0], h) && close(mid[1], h) && close(mid[2], 0.0),
+            "{mid:?}"
+        );
         // A third of the way turns 30°.
         let third = slerp([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0 / 3.0);
         let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
@@ -376,11 +379,10 @@ mod tests {
 
     #[test]
     fn transfer_functions_fade_point_by_point() {
-        let tf = |opacity: f32| {
-            let mut f = TransferFunction::default();
-            f.opacity = Some(PiecewiseLinear::new("o", vec![(0.0, [0.0]), (1.0, [opacity])]).unwrap());
-            f.color = Some(PiecewiseLinear::constant([1.0, 0.5, 0.0]));
-            f
+        let tf = |opacity: f32| TransferFunction {
+            domain: None,
+            opacity: Some(PiecewiseLinear::new("o", vec![(0.0, [0.0]), (1.0, [opacity])]).unwrap()),
+            color: Some(PiecewiseLinear::constant([1.0, 0.5, 0.0])),
         };
         let mut a = State::default();
         let mut b = State::default();

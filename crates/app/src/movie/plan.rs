@@ -132,7 +132,11 @@ pub fn data_frame(time: TimeMode, frame: Option<f64>) -> DataFrame {
 
 /// The frames `A:B` of `count` names (`B` exclusive; `None`: to the end),
 /// checked.
-pub fn part(start: usize, end: Option<usize>, count: usize) -> Result<std::ops::Range<usize>, String> {
+pub fn part(
+    start: usize,
+    end: Option<usize>,
+    count: usize,
+) -> Result<std::ops::Range<usize>, String> {
     let end = end.unwrap_or(count);
     if start >= end || end > count {
         return Err(format!(
@@ -155,8 +159,10 @@ mod tests {
 
     #[test]
     fn frame_k_shows_time_k_over_fps_to_the_last_keyframe_inclusive() {
-        let m = movie(r#"{"fps": 4, "keyframes": [
-            {"t": 0, "azimuth": 0, "ease": "linear"}, {"t": 2, "azimuth": 80}]}"#);
+        let m = movie(
+            r#"{"fps": 4, "keyframes": [
+            {"t": 0, "azimuth": 0, "ease": "linear"}, {"t": 2, "azimuth": 80}]}"#,
+        );
         assert_eq!(m.frames(), 9);
         // Frame 4 is t = 1 s, half way: 40°; frame 1 a quarter of a second.
         assert_eq!(m.at(4, [0.0; 3]).options.camera.azimuth, 40.0);
@@ -169,13 +175,18 @@ mod tests {
 
     #[test]
     fn smooth_segments_ease_and_unchanged_keys_hold() {
-        let m = movie(r#"{"fps": 4, "keyframes": [
+        let m = movie(
+            r#"{"fps": 4, "keyframes": [
             {"t": 0, "zoom": 1, "elevation": 10},
             {"t": 1, "zoom": 3},
             {"t": 2, "elevation": 50, "ease": "linear"},
-            {"t": 3, "zoom": 1}]}"#);
+            {"t": 3, "zoom": 1}]}"#,
+        );
         // Smooth: a quarter of the way in time is 5/32 of the way in value.
-        assert_eq!(m.at(1, [0.0; 3]).options.camera.zoom, 1.0 + 2.0 * 5.0 / 32.0);
+        assert_eq!(
+            m.at(1, [0.0; 3]).options.camera.zoom,
+            1.0 + 2.0 * 5.0 / 32.0
+        );
         assert_eq!(m.at(2, [0.0; 3]).options.camera.zoom, 2.0);
         // Elevation not given at t = 1 holds 10 there, then eases to 50.
         assert_eq!(m.at(4, [0.0; 3]).options.camera.elevation, 10.0);

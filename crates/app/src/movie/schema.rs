@@ -128,13 +128,17 @@ pub fn read(path: &Path, base: &State) -> Result<Keyframes, KeyframesError> {
 
 /// Parses a keyframes file's `text` (`file` names it in messages; `dir`
 /// is where its `tf` files are found).
-pub fn parse(file: &str, text: &str, base: &State, dir: &Path) -> Result<Keyframes, KeyframesError> {
+pub fn parse(
+    file: &str,
+    text: &str,
+    base: &State,
+    dir: &Path,
+) -> Result<Keyframes, KeyframesError> {
     let fail = |message: String| KeyframesError {
         file: file.to_string(),
         message,
     };
-    let root: Value =
-        serde_json::from_str(text).map_err(|e| fail(format!("not JSON: {e}")))?;
+    let root: Value = serde_json::from_str(text).map_err(|e| fail(format!("not JSON: {e}")))?;
     let Value::Object(root) = root else {
         return Err(fail(
             "expected an object: {\"version\": 1, \"fps\": 30, \"keyframes\": [...]}".into(),
@@ -190,20 +194,30 @@ pub fn parse(file: &str, text: &str, base: &State, dir: &Path) -> Result<Keyfram
         let t = match keys.get("t").map(Value::as_f64) {
             Some(Some(t)) if t.is_finite() && t >= 0.0 => t,
             Some(_) => return Err(at("t", "expected a time in seconds, ≥ 0".into())),
-            None => return Err(fail(format!("keyframes[{i}]: no \"t\" (its time in seconds)"))),
+            None => {
+                return Err(fail(format!(
+                    "keyframes[{i}]: no \"t\" (its time in seconds)"
+                )));
+            }
         };
         if let Some(before) = keyframes.last()
             && t <= before.t
         {
             return Err(at(
                 "t",
-                format!("{t} is not after the keyframe before's {}: times must increase", before.t),
+                format!(
+                    "{t} is not after the keyframe before's {}: times must increase",
+                    before.t
+                ),
             ));
         }
         let ease = match keys.get("ease") {
             None => Ease::default(),
             Some(v) => v.as_str().and_then(Ease::from_name).ok_or_else(|| {
-                at("ease", format!("{v}: expected one of {}", Ease::NAMES.join(", ")))
+                at(
+                    "ease",
+                    format!("{v}: expected one of {}", Ease::NAMES.join(", ")),
+                )
             })?,
         };
         for (key, value) in keys {
@@ -262,14 +276,27 @@ fn apply(state: &mut State, key: &str, value: &Value, dir: &Path) -> Result<(), 
         "gradient_opacity" => {
             look.gradient_opacity = if null { None } else { Some(pair32(value)?) }
         }
-        "iso" => look.iso = if null { None } else { Some(number(value)? as f32) },
+        "iso" => {
+            look.iso = if null {
+                None
+            } else {
+                Some(number(value)? as f32)
+            }
+        }
         "iso_thickness" => {
-            look.iso_thickness = if null { None } else { Some(positive(value)? as f32) }
+            look.iso_thickness = if null {
+                None
+            } else {
+                Some(positive(value)? as f32)
+            }
         }
         "blend" => {
             let name = text(value)?;
             look.blend = BlendMode::from_name(&name).ok_or_else(|| {
-                format!("\"{name}\": expected one of {}", BlendMode::NAMES.join(", "))
+                format!(
+                    "\"{name}\": expected one of {}",
+                    BlendMode::NAMES.join(", ")
+                )
             })?
         }
         "ambient" => look.ambient = coefficients(value)?,
@@ -300,8 +327,7 @@ fn apply(state: &mut State, key: &str, value: &Value, dir: &Path) -> Result<(), 
         "label" => state.label = text_or_null(value)?,
         "size" => {
             return Err(
-                "the frame size is one for the whole movie: give --size on the command line"
-                    .into(),
+                "the frame size is one for the whole movie: give --size on the command line".into(),
             );
         }
         "channel_colors" => {
@@ -321,7 +347,10 @@ fn apply(state: &mut State, key: &str, value: &Value, dir: &Path) -> Result<(), 
 
 fn number(v: &Value) -> Result<f64, String> {
     match v {
-        Value::Number(n) => n.as_f64().filter(|f| f.is_finite()).ok_or(format!("{v}: not finite")),
+        Value::Number(n) => n
+            .as_f64()
+            .filter(|f| f.is_finite())
+            .ok_or(format!("{v}: not finite")),
         Value::String(s) => s
             .trim()
             .parse::<f64>()
@@ -334,7 +363,11 @@ fn number(v: &Value) -> Result<f64, String> {
 
 fn positive(v: &Value) -> Result<f64, String> {
     let f = number(v)?;
-    if f > 0.0 { Ok(f) } else { Err(format!("{v}: expected a number > 0")) }
+    if f > 0.0 {
+        Ok(f)
+    } else {
+        Err(format!("{v}: expected a number > 0"))
+    }
 }
 
 /// `N` numbers: a JSON array, or the flag's comma-separated text.
@@ -366,16 +399,15 @@ fn pair32(v: &Value) -> Result<(f32, f32), String> {
     Ok((a as f32, b as f32))
 }
 
+/// A clip plane: a point and its normal.
+type Plane = ([f64; 3], [f64; 3]);
+
 /// One clip plane `[x, y, z, nx, ny, nz]`, or a list of them.
-fn clips(v: &Value) -> Result<Vec<([f64; 3], [f64; 3])>, String> {
-    let one = |v: &Value| {
-        numbers::<6>(v).map(|[x, y, z, a, b, c]| ([x, y, z], [a, b, c]))
-    };
+fn clips(v: &Value) -> Result<Vec<Plane>, String> {
+    let one = |v: &Value| numbers::<6>(v).map(|[x, y, z, a, b, c]| ([x, y, z], [a, b, c]));
     match v {
         Value::Null => Ok(Vec::new()),
-        Value::Array(items) if items.iter().all(Value::is_array) => {
-            items.iter().map(one).collect()
-        }
+        Value::Array(items) if items.iter().all(Value::is_array) => items.iter().map(one).collect(),
         v => Ok(vec![one(v)?]),
     }
 }
@@ -419,11 +451,17 @@ fn boolean(v: &Value) -> Result<bool, String> {
 }
 
 fn text(v: &Value) -> Result<String, String> {
-    v.as_str().map(str::to_string).ok_or(format!("{v}: expected a string"))
+    v.as_str()
+        .map(str::to_string)
+        .ok_or(format!("{v}: expected a string"))
 }
 
 fn text_or_null(v: &Value) -> Result<Option<String>, String> {
-    if v.is_null() { Ok(None) } else { text(v).map(Some) }
+    if v.is_null() {
+        Ok(None)
+    } else {
+        text(v).map(Some)
+    }
 }
 
 /// `tf`: `"auto"`, a transfer-function file (relative to `dir`), a
@@ -434,8 +472,8 @@ fn tf(v: &Value, dir: &Path) -> Result<Option<Tf>, String> {
         Value::String(s) if s == "auto" => Ok(Some(Tf::Auto)),
         Value::String(s) => {
             let path = dir.join(s);
-            let text = crate::look::read_tf_file(&path)
-                .map_err(|e| format!("{}: {e}", path.display()))?;
+            let text =
+                crate::look::read_tf_file(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             Ok(Some(Tf::Json {
                 source: path.display().to_string(),
                 text,
@@ -446,7 +484,9 @@ fn tf(v: &Value, dir: &Path) -> Result<Option<Tf>, String> {
                 .map_err(|e| format!("{e}"))?;
             Ok(Some(Tf::Function(f)))
         }
-        _ => Err(format!("{v}: expected \"auto\", a file's name or a transfer function")),
+        _ => Err(format!(
+            "{v}: expected \"auto\", a file's name or a transfer function"
+        )),
     }
 }
 
@@ -474,7 +514,10 @@ mod tests {
         assert_eq!(b.state.options.camera.azimuth, 30.0);
         assert_eq!(b.state.options.look.range, Some((0.0, 100.0)));
         assert_eq!(b.state.options.camera.look_at, Some([1.0, 2.0, 3.0]));
-        assert_eq!(b.state.options.camera.clip, [([0.0, 0.0, 5.0], [0.0, 0.0, -1.0])]);
+        assert_eq!(
+            b.state.options.camera.clip,
+            [([0.0, 0.0, 5.0], [0.0, 0.0, -1.0])]
+        );
         assert_eq!(b.state.options.look.background, [1.0, 0.0, 0.0]);
         assert_eq!(b.state.frame, Some(1.5));
         assert_eq!(b.state.options.look.blend, BlendMode::Mip);
@@ -488,20 +531,35 @@ mod tests {
             assert!(e.starts_with("k.json: ") && e.contains(says), "{e}");
             assert!(!e.contains('\n'), "{e}");
         };
-        bad(r#"{"keyframes": [{"t": 0, "zooom": 2}]}"#, "keyframes[0].zooom: unknown key");
+        bad(
+            r#"{"keyframes": [{"t": 0, "zooom": 2}]}"#,
+            "keyframes[0].zooom: unknown key",
+        );
         bad(
             r#"{"keyframes": [{"t": 1}, {"t": 1, "zoom": 2}]}"#,
             "keyframes[1].t: 1 is not after",
         );
-        bad(r#"{"keyframes": [{"t": 0, "zoom": "big"}]}"#, "keyframes[0].zoom: \"big\"");
-        bad(r#"{"keyframes": [{"t": 0, "view": [1, 2]}]}"#, "keyframes[0].view");
+        bad(
+            r#"{"keyframes": [{"t": 0, "zoom": "big"}]}"#,
+            "keyframes[0].zoom: \"big\"",
+        );
+        bad(
+            r#"{"keyframes": [{"t": 0, "view": [1, 2]}]}"#,
+            "keyframes[0].view",
+        );
         bad(r#"{"version": 2, "keyframes": [{"t": 0}]}"#, "version 2");
         bad(r#"{"keyframes": []}"#, "empty");
         bad(r#"{"keyframes": [{"zoom": 1}]}"#, "no \"t\"");
-        bad(r#"{"keyframes": [{"t": 0, "ease": "fast"}]}"#, "keyframes[0].ease");
+        bad(
+            r#"{"keyframes": [{"t": 0, "ease": "fast"}]}"#,
+            "keyframes[0].ease",
+        );
         bad(r#"{"fps": 0, "keyframes": [{"t": 0}]}"#, "fps");
         // Checked as the flags are: a preset that does not exist.
-        bad(r#"{"keyframes": [{"t": 0, "preset": "nope"}]}"#, "keyframes[0]: ");
+        bad(
+            r#"{"keyframes": [{"t": 0, "preset": "nope"}]}"#,
+            "keyframes[0]: ",
+        );
         bad(r#"[1, 2]"#, "expected an object");
     }
 }
