@@ -68,7 +68,7 @@ impl Naming for Keys {
 }
 
 /// The keys a keyframe takes, besides `t` and `ease`.
-pub const KEYS: [&str; 31] = [
+pub const KEYS: [&str; 32] = [
     "azimuth",
     "elevation",
     "zoom",
@@ -100,6 +100,7 @@ pub const KEYS: [&str; 31] = [
     "step",
     "frame",
     "title",
+    "label",
 ];
 
 /// Reads the keyframes file `path` (bounded by [`MAX_BYTES`]), its keys
@@ -337,7 +338,7 @@ fn apply(state: &mut State, key: &str, value: &Value, dir: &Path) -> Result<(), 
         }
         _ => {
             return Err(format!(
-                "unknown key (a keyframe takes t, ease, label and {})",
+                "unknown key (a keyframe takes t, ease and {})",
                 KEYS.join(", ")
             ));
         }
