@@ -416,3 +416,33 @@ fn a_bad_keyframes_file_is_refused_in_one_line_naming_the_file_and_the_key() {
         assert!(!d.join("m.gif").exists());
     }
 }
+
+#[test]
+fn time_points_interpolated_are_the_stills_of_the_volumes_mixed_voxel_by_voxel() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (a, b) = (ball(8.0), ball(16.0));
+    let series = nifti(d, "series.nii", &[a.clone(), b.clone()]);
+    let keys = write(
+        d,
+        "keys.json",
+        r#"{"version": 1, "fps": 4, "time": "interpolate", "keyframes": [
+            {"t": 0, "frame": 0, "ease": "linear"}, {"t": 1, "frame": 1}]}"#,
+    );
+    let base = ["--size", SIZE, "--elevation", "30", "--range", "0,1"];
+    let frames = d.join("f_%d.png");
+    render(
+        &[&[series.as_str()], &base[..], &["--keyframes", &keys]].concat(),
+        &frames,
+    );
+    for k in 0..5 {
+        // Frame k shows time point k/4: (1 − w)·a + w·b as volray mixes them.
+        let w = k as f32 / 4.0;
+        let mixed: Vec<f32> = (a.iter().zip(&b)).map(|(&x, &y)| x + (y - x) * w).collect();
+        let one = nifti(d, &format!("mixed{k}.nii"), &[mixed]);
+        let still = d.join(format!("still{k}.png"));
+        render(&[&[one.as_str()], &base[..]].concat(), &still);
+        let movie = Picture::read(&d.join(format!("f_{k}.png")));
+        assert_eq!(movie.max_diff(&Picture::read(&still)), 0, "frame {k}");
+    }
+}
