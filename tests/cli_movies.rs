@@ -361,6 +361,45 @@ fn a_movie_stopped_by_ctrl_c_or_without_ffmpeg_leaves_nothing() {
         "{said}"
     );
     assert_eq!(names(d), ["keys.json"]);
+    // Not even kept frames are rendered for a movie ffmpeg cannot write.
+    let resumable = [&args[..], &["--resume"]].concat();
+    let out = Command::new(env!("CARGO_BIN_EXE_volray"))
+        .arg("render")
+        .args(&resumable)
+        .env("PATH", d)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(names(d), ["keys.json"]);
+    // An ffmpeg that fails: rendering stops, its words in one line.
+    let bin = d.join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let fake = bin.join("ffmpeg");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\necho \"Unknown encoder 'libx264'\" >&2\nexit 1\n",
+    )
+    .unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_volray"))
+        .arg("render")
+        .args(&args)
+        .env("PATH", &bin)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{said}");
+    assert_eq!(said.trim().lines().count(), 1, "{said}");
+    assert!(
+        said.contains("ffmpeg") && said.contains("Unknown encoder 'libx264'"),
+        "{said}"
+    );
+    std::fs::remove_dir_all(&bin).unwrap();
+    assert_eq!(names(d), ["keys.json"]);
     if !has_ffmpeg() {
         return;
     }

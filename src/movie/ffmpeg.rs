@@ -120,12 +120,7 @@ impl Encoder {
             .stdin(Stdio::piped())
             .stdout(Stdio::from(out))
             .stderr(Stdio::piped());
-        let mut child = command.spawn().map_err(|e| match e.kind() {
-            std::io::ErrorKind::NotFound => CliError::io(format!(
-                "{name}: writing a movie needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg); or write .gif, .png (animated) or numbered PNGs (frame_%05d.png)"
-            )),
-            _ => CliError::io(format!("{name}: cannot start ffmpeg: {e}")),
-        })?;
+        let mut child = command.spawn().map_err(|e| not_started(path, e))?;
         let stdin = child.stdin.take();
         let stderr = child.stderr.take().map(|mut err| {
             std::thread::spawn(move || {
@@ -205,6 +200,31 @@ impl Drop for Encoder {
             let _ = self.child.wait();
         }
     }
+}
+
+/// Why ffmpeg did not start, in one line.
+fn not_started(path: &Path, e: std::io::Error) -> CliError {
+    let name = path.display();
+    match e.kind() {
+        std::io::ErrorKind::NotFound => CliError::io(format!(
+            "{name}: writing a movie needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg); or write .gif, .png (animated) or numbered PNGs (frame_%05d.png)"
+        )),
+        _ => CliError::io(format!("{name}: cannot start ffmpeg: {e}")),
+    }
+}
+
+/// Refuses, before any frame is rendered, a movie ffmpeg cannot write
+/// because it is not there (a resumable movie starts ffmpeg only once
+/// every frame is kept).
+pub fn check_available(path: &Path) -> Result<(), CliError> {
+    Command::new(FFMPEG)
+        .arg("-version")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .map(|_| ())
+        .map_err(|e| not_started(path, e))
 }
 
 /// 4:2:0 chroma needs even sides.

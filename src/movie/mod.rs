@@ -149,6 +149,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let size = options.camera.size;
     if Codec::of(output).is_some() {
         ffmpeg::check_size(output, size.0, size.1)?;
+        ffmpeg::check_available(output)?;
     }
     let base = State {
         options,
