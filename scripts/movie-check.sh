@@ -10,7 +10,7 @@
 #     frames 0..N-2 with --movie-frames, then the last with --resume);
 #   - volray's peak memory for those frames (ffmpeg is not running then).
 #
-#   scripts/movie-check.sh VOLRAY [VOXELS=512] [FRAMES=360] [SIZE=1920x1080]
+#   [CRF=N] scripts/movie-check.sh VOLRAY [VOXELS=512] [FRAMES=360] [SIZE=1920x1080]
 #
 # Heavy at the defaults (a 512^3 volume, 360 frames of 1080p): run it on a
 # quiet machine. Needs ffmpeg, ffprobe, GNU time and python3 with numpy
@@ -39,7 +39,9 @@ JSON
 
 # Every frame but the last, kept with their finishing times; then the last
 # and the encoding.
-/usr/bin/time -v "$volray" render "${input[@]}" --keyframes orbit.json -o orbit.mp4 \
+crf=()
+[ -n "${CRF:-}" ] && crf=(--crf "$CRF")
+/usr/bin/time -v "$volray" render "${input[@]}" --keyframes orbit.json -o orbit.mp4 "${crf[@]}" \
   --movie-frames "0:$((frames - 1))" 2>time.txt >/dev/null
 rss=$(awk -F: '/Maximum resident/ {gsub(/ /, "", $2); print $2}' time.txt)
 python3 - "$frames" orbit.mp4.frames <<'PY' >tenths.txt
@@ -51,7 +53,7 @@ tenth = max(1, len(d) // 10)
 first, last = sum(d[:tenth]) / tenth, sum(d[-tenth:]) / tenth
 print(f"{first:.3f} {last:.3f} {100 * (last / first - 1):+.1f}")
 PY
-"$volray" render "${input[@]}" --keyframes orbit.json -o orbit.mp4 --resume 2>/dev/null
+"$volray" render "${input[@]}" --keyframes orbit.json -o orbit.mp4 "${crf[@]}" --resume 2>/dev/null
 
 probe=$(ffprobe -v error -count_frames -select_streams v:0 \
   -show_entries stream=width,height,r_frame_rate,nb_read_frames -of csv=p=0 orbit.mp4)

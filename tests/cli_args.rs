@@ -278,6 +278,7 @@ fn render_cases() -> Vec<Refused> {
         ("{out}/x.mkv", &["--turntable", "2"], "--turntable"),
         ("{out}/x.mp4", &[], "--keyframes"),
         ("{out}/x.gif", &["--resume"], "--resume"),
+        ("{out}/x.gif", &["--turntable", "2", "--crf", "20"], "--crf"),
         ("{out}/x.exr", &["sphere:8"], ".exr"),
     ] {
         cases.push(refused(

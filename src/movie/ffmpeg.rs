@@ -6,7 +6,7 @@
 //! wrote in ten minutes).
 //!
 //! - `.mp4`: H.264 (libx264), `yuv420p` so that every player shows it,
-//!   at `--crf` (default 18, visually lossless); `.webm`: VP9 (libvpx),
+//!   at `--crf` (default 16: every frame of the check in scripts/movie-check.sh at ≥ 40 dB PSNR against its still); `.webm`: VP9 (libvpx),
 //!   the same. 4:2:0 chroma halves each side, so the frame's sides must
 //!   be even: an odd `--size` is refused (not padded: a padded frame
 //!   would not be the frame a still render gives).
@@ -73,7 +73,7 @@ impl Codec {
 }
 
 /// The `--crf` when none is given.
-pub const DEFAULT_CRF: u8 = 18;
+pub const DEFAULT_CRF: u8 = 16;
 
 /// Where ffmpeg writes: its standard output's file, opened again by
 /// name (seekable, as MP4's index needs; `pipe:1` is not).

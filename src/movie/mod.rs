@@ -134,6 +134,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             "{name}: a movie is written as .mp4 or .webm (through ffmpeg), .gif, .png (animated) or numbered PNGs (e.g. frame_%05d.png)"
         )));
     }
+    if args.animation.crf.is_some() && Codec::of(output).is_none() {
+        return Err(CliError::input(format!(
+            "{name}: --crf sets the quality of an .mp4 or .webm movie; GIF and PNG frames are written without it"
+        )));
+    }
     if args.out.bit_depth != 8 {
         return Err(CliError::input(format!(
             "{name}: --bit-depth {}: movies are written at 8 bits per channel",

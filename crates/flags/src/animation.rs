@@ -37,7 +37,7 @@ pub struct AnimationArgs {
     pub keyframes: Option<PathBuf>,
 
     /// Quality of an .mp4 (H.264) or .webm (VP9) movie: ffmpeg's constant
-    /// rate factor, 0 (lossless for VP9, best) to 51 (worst) [default: 18].
+    /// rate factor, 0 (lossless for VP9, best) to 51 (worst) [default: 16].
     #[arg(long, value_name = "CRF", value_parser = clap::value_parser!(u8).range(0..=51), help_heading = "Animations")]
     pub crf: Option<u8>,
 
