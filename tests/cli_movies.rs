@@ -485,3 +485,52 @@ fn time_points_interpolated_are_the_stills_of_the_volumes_mixed_voxel_by_voxel()
         assert_eq!(movie.max_diff(&Picture::read(&still)), 0, "frame {k}");
     }
 }
+
+#[test]
+fn a_chunked_dataset_over_max_memory_is_filmed_piece_by_piece_as_its_stills_are() {
+    // A chunked HDF5 dataset written by h5py: 48·40·36 u16 voxels (138 kB)
+    // that 100 kB cannot hold whole.
+    let script = r#"
+import sys
+import numpy as np
+import h5py
+x, y, z = np.meshgrid(np.arange(48.0), np.arange(40.0), np.arange(36.0), indexing="ij")
+v = (30000 * np.exp(-((x - 20)**2 + (y - 18)**2 + (z - 14)**2) / 72) + 40 * z).astype("<u2")
+with h5py.File(sys.argv[1] + "/vol.h5", "w") as f:
+    f.create_dataset("data", data=v, chunks=(16, 16, 16), compression="gzip")
+"#;
+    let Some(dir) = common::written_by_python(&["h5py", "numpy"], &[], script) else {
+        return;
+    };
+    let d = dir.path();
+    let input = format!("{}/vol.h5:/data", d.display());
+    let keys = write(
+        d,
+        "keys.json",
+        r#"{"version": 1, "fps": 2, "keyframes": [
+            {"t": 0, "azimuth": 0, "ease": "linear"}, {"t": 1, "azimuth": 40}]}"#,
+    );
+    let base = [
+        input.as_str(),
+        "--preset",
+        "mr",
+        "--range",
+        "0,32000",
+        "--size",
+        "40x36",
+        "--max-memory",
+        "100K",
+    ];
+    let said = render(
+        &[&base[..], &["--keyframes", &keys]].concat(),
+        &d.join("f_%d.png"),
+    );
+    assert!(said.contains("rendered in pieces"), "{said}");
+    for k in 0..3 {
+        let still = d.join(format!("still{k}.png"));
+        let azimuth = (20 * k).to_string();
+        render(&[&base[..], &["--azimuth", &azimuth]].concat(), &still);
+        let frame = Picture::read(&d.join(format!("f_{k}.png")));
+        assert_eq!(frame.max_diff(&Picture::read(&still)), 0, "frame {k}");
+    }
+}

@@ -22,7 +22,7 @@ mod work;
 
 use crate::error::CliError;
 use crate::outfile::DEFAULT_FPS;
-use crate::session::{load, renderer_for, thread_pool};
+use crate::session::{app_failure, load, renderer_for, streamed_note, thread_pool};
 use ffmpeg::{Codec, Encoder};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -30,8 +30,8 @@ use std::path::PathBuf;
 use volray_app::animation::turntable_frame;
 use volray_app::input::Input;
 use volray_app::movie::{DataFrame, Movie, State};
-use volray_app::plan::Plan;
-use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered};
+use volray_app::plan::{Plan, StreamedInput};
+use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, TransferFunction};
 use volray_flags::{InputArgs, RenderArgs};
 use volray_io::{Animation, AnimationKind};
 use volray_options::LookOptions;
@@ -221,17 +221,6 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     };
     let pool = thread_pool(args.view.threads)?;
 
-    // Whole volumes only: the level for the first frame.
-    let level = match crate::session::plan(&args.input, &args.view, &base_settings)? {
-        Plan::Whole { level } => level,
-        Plan::Streamed(_) => {
-            return Err(CliError::input(format!(
-                "{spec}: a movie renders volumes read whole, and this one would be rendered piece by piece within --max-memory: raise --max-memory or give a coarser --level"
-            )));
-        }
-    };
-    let input_args = args.input.at_level(level);
-
     // The frames to render: those of the range not kept already.
     let todo: Vec<usize> = range
         .clone()
@@ -248,87 +237,33 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             );
         }
     }
-
-    let bar = frame_bar(todo.len() as u64);
-    let mut sink = match &work {
+    let job = Job {
+        args,
+        path,
+        base,
+        base_settings,
+        frames,
+        todo,
+        pool,
+    };
+    let sink = match &work {
         None => Some(Sink::start(args, size, frames, fps)?),
         Some(_) => None,
     };
-    let interrupt_after = test_interrupt_after();
-    let mut rendered = 0usize;
-    let mut centre = None;
-    let mut at = 0;
-    while at < todo.len() {
-        // One run of frames showing one time point.
-        let first_data = data_of(&path, todo[at], &base, centre.unwrap_or([0.0; 3]));
-        let mut input = load_data(&input_args, args, first_data)?;
-        let c = centre.get_or_insert(input.volume.centre().to_array());
-        let c = *c;
-        let mut planned = Vec::new();
-        let mut end = at;
-        while end < todo.len() {
-            let p = plan_frame(&path, todo[end], &base, &base_settings, c, frames)
-                .map_err(|e| keys_failure(&path, todo[end], e))?;
-            if p.data != first_data && end > at {
-                break;
-            }
-            planned.push(p);
-            end += 1;
-        }
-        // What the look leaves to this volume, for each frame (kept while
-        // the look stays: `tf auto`'s histogram is taken once).
-        let mut last: Option<(
-            LookOptions,
-            volray_core::TransferFunction,
-            volray_core::TransferFunction,
-        )> = None;
-        for p in &mut planned {
-            let tf = p.settings.transfer_function.clone();
-            match &last {
-                Some((look, before, after)) if *look == p.look && *before == tf => {
-                    p.settings.transfer_function = after.clone();
-                }
-                _ => {
-                    volray_app::look::leave_to_volume(
-                        &p.look,
-                        &mut p.settings.transfer_function,
-                        &mut input,
-                    )
-                    .map_err(crate::settings::refused)?;
-                    last = Some((p.look.clone(), tf, p.settings.transfer_function.clone()));
-                }
-            }
-        }
-        let renderer = renderer_for(&args.view, &planned[0].settings, &input)?;
-        for (p, &k) in planned.iter().zip(&todo[at..end]) {
-            let mut image = pool
-                .install(|| renderer.render(FrameRequest::new(&p.settings)))
-                .map(Rendered::image)
-                .map_err(|e| crate::session::render_failure(&args.view, &input.name, e))?;
-            crate::figure::draw_titled(
-                args,
-                &p.settings,
-                &renderer,
-                &input,
-                (p.title.clone(), p.label.clone()),
-                &mut image,
-            )?;
-            let rgb = rgb8(&image);
-            match (&work, &mut sink) {
-                (Some(w), _) => w.save(k, &image, &rgb)?,
-                (None, Some(s)) => s.push(&image, &rgb)?,
-                (None, None) => unreachable!("a sink or a work folder"),
-            }
-            bar.inc(1);
-            rendered += 1;
-            if interrupt_after == Some(rendered) {
-                interrupt_self();
-            }
-        }
-        at = end;
+    let mut out = Out {
+        work,
+        sink,
+        bar: frame_bar(job.todo.len() as u64),
+        rendered: 0,
+        interrupt_after: test_interrupt_after(),
+    };
+    // The level (and whether the volume is read whole) for the first frame.
+    match crate::session::plan(&args.input, &args.view, &job.base_settings)? {
+        Plan::Whole { level } => render_whole(&job, &args.input.at_level(level), &mut out)?,
+        Plan::Streamed(streamed) => render_streamed(&job, *streamed, &mut out)?,
     }
-    bar.finish_and_clear();
-    match (work, sink) {
+    out.bar.finish_and_clear();
+    match (out.work, out.sink) {
         (None, Some(sink)) => sink.finish(),
         (Some(work), _) => {
             let missing = (0..frames).filter(|&k| !work.has(k)).count();
@@ -353,6 +288,139 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         }
         (None, None) => unreachable!("a sink or a work folder"),
     }
+}
+
+/// What every frame of a movie needs.
+struct Job<'a> {
+    args: &'a RenderArgs,
+    path: Path,
+    base: State,
+    base_settings: RenderSettings,
+    frames: usize,
+    /// The frames to render, in order.
+    todo: Vec<usize>,
+    pool: rayon::ThreadPool,
+}
+
+/// Where the rendered frames go: the work folder, else the output.
+struct Out {
+    work: Option<Work>,
+    sink: Option<Sink>,
+    bar: ProgressBar,
+    rendered: usize,
+    interrupt_after: Option<usize>,
+}
+
+impl Out {
+    /// Frame `k`, rendered and annotated, handed on at once.
+    fn put(&mut self, k: usize, image: &Image) -> Result<(), CliError> {
+        let rgb = rgb8(image);
+        match (&self.work, &mut self.sink) {
+            (Some(w), _) => w.save(k, image, &rgb)?,
+            (None, Some(s)) => s.push(image, &rgb)?,
+            (None, None) => unreachable!("a sink or a work folder"),
+        }
+        self.bar.inc(1);
+        self.rendered += 1;
+        if self.interrupt_after == Some(self.rendered) {
+            interrupt_self();
+        }
+        Ok(())
+    }
+}
+
+/// The frames of a volume read whole, in runs that show one time point:
+/// the time point read (two, blended), what the look leaves to it, its
+/// renderer built once for the run.
+fn render_whole(job: &Job, input_args: &InputArgs, out: &mut Out) -> Result<(), CliError> {
+    let (args, todo) = (job.args, &job.todo);
+    let mut centre = None;
+    let mut at = 0;
+    while at < todo.len() {
+        let first_data = data_of(&job.path, todo[at], &job.base, centre.unwrap_or([0.0; 3]));
+        let mut input = load_data(input_args, args, first_data)?;
+        let c = *centre.get_or_insert(input.volume.centre().to_array());
+        let mut planned = Vec::new();
+        let mut end = at;
+        while end < todo.len() {
+            let p = plan_frame(job, todo[end], c)?;
+            if p.data != first_data && end > at {
+                break;
+            }
+            planned.push(p);
+            end += 1;
+        }
+        // What the look leaves to this volume, for each frame (kept while
+        // the look stays: `tf auto`'s histogram is taken once).
+        let mut last: Option<(LookOptions, TransferFunction, TransferFunction)> = None;
+        for p in &mut planned {
+            let tf = p.settings.transfer_function.clone();
+            match &last {
+                Some((look, before, after)) if *look == p.look && *before == tf => {
+                    p.settings.transfer_function = after.clone();
+                }
+                _ => {
+                    let slot = &mut p.settings.transfer_function;
+                    volray_app::look::leave_to_volume(&p.look, slot, &mut input)
+                        .map_err(crate::settings::refused)?;
+                    last = Some((p.look.clone(), tf, p.settings.transfer_function.clone()));
+                }
+            }
+        }
+        let renderer = renderer_for(&args.view, &planned[0].settings, &input)?;
+        for (p, &k) in planned.iter().zip(&todo[at..end]) {
+            let mut image = (job.pool)
+                .install(|| renderer.render(FrameRequest::new(&p.settings)))
+                .map(Rendered::image)
+                .map_err(|e| crate::session::render_failure(&args.view, &input.name, e))?;
+            let words = (p.title.clone(), p.label.clone());
+            crate::figure::draw_titled(args, &p.settings, &renderer, &input, words, &mut image)?;
+            out.put(k, &image)?;
+        }
+        at = end;
+    }
+    Ok(())
+}
+
+/// The frames of a volume too large to read whole, each rendered piece
+/// by piece within `--max-memory` as a still would be (one time point:
+/// a `frame` that moves needs the volume read whole; annotations are not
+/// drawn into pieces yet).
+fn render_streamed(job: &Job, mut streamed: StreamedInput, out: &mut Out) -> Result<(), CliError> {
+    let args = job.args;
+    crate::figure::refuse(&args.figure, "a volume rendered piece by piece")?;
+    let (lo, hi) = streamed.streamed.grid().bounds();
+    let centre = ((lo + hi) / 2.0).to_array();
+    let mut last = None;
+    for &k in &job.todo {
+        let p = plan_frame(job, k, centre)?;
+        if p.data != DataFrame::At(args.input.frame) {
+            return Err(CliError::input(format!(
+                "--keyframes: frame {k}: \"frame\" moves the time point of {}, which is rendered piece by piece within --max-memory: a moving time point needs the volume read whole (raise --max-memory or give a coarser --level)",
+                streamed.name
+            )));
+        }
+        if p.title.is_some() || p.label.is_some() {
+            return Err(CliError::input(
+                "--keyframes: title and label are drawn into frames of a volume read whole; not into a volume rendered piece by piece yet",
+            ));
+        }
+        let settings = (streamed.settings_from_volume(&p.look, p.settings))
+            .map_err(|e| app_failure(&args.view, e))?;
+        let (image, times) = (job.pool)
+            .install(|| streamed.render(&settings, &|_| {}))
+            .map_err(|e| app_failure(&args.view, e))?;
+        out.put(k, &image)?;
+        last = Some(times);
+    }
+    if let Some(times) = last {
+        let n = job.todo.len();
+        eprintln!(
+            "{} (the last of {n} frames)",
+            streamed_note(&streamed, &times)
+        );
+    }
+    Ok(())
 }
 
 /// Refuses what a movie does not take.
@@ -388,20 +456,15 @@ fn data_of(path: &Path, k: usize, base: &State, centre: [f64; 3]) -> DataFrame {
     }
 }
 
-/// Frame `k`'s settings, look, data and words.
-fn plan_frame(
-    path: &Path,
-    k: usize,
-    base: &State,
-    base_settings: &RenderSettings,
-    centre: [f64; 3],
-    frames: usize,
-) -> Result<Planned, volray_options::OptionError> {
-    Ok(match path {
+/// Frame `k`'s settings, look, data and words; `centre` is the point
+/// looked at by default.
+fn plan_frame(job: &Job, k: usize, centre: [f64; 3]) -> Result<Planned, CliError> {
+    Ok(match &job.path {
         Path::Keys { movie, .. } => {
             let state = movie.at(k, centre);
             Planned {
-                settings: volray_options::settings(&state.options)?,
+                settings: volray_options::settings(&state.options)
+                    .map_err(|e| keys_failure(&job.path, k, e))?,
                 data: movie.data_frame(&state),
                 look: state.options.look,
                 title: state.title,
@@ -409,11 +472,11 @@ fn plan_frame(
             }
         }
         Path::Turntable(_) => Planned {
-            settings: turntable_frame(base_settings, k, frames),
-            look: base.options.look.clone(),
-            data: DataFrame::At(base.frame.map(|f| f as usize)),
-            title: base.title.clone(),
-            label: base.label.clone(),
+            settings: turntable_frame(&job.base_settings, k, job.frames),
+            look: job.base.options.look.clone(),
+            data: DataFrame::At(job.base.frame.map(|f| f as usize)),
+            title: job.base.title.clone(),
+            label: job.base.label.clone(),
         },
     })
 }
