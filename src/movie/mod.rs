@@ -15,7 +15,9 @@
 //!
 //! Frames are rendered in runs that show one time point of the data: the
 //! time point is read (two, blended, for `"time": "interpolate"`), its
-//! renderer built once, and every frame of the run rendered with it.
+//! renderer built once, and every frame of the run rendered with it. A
+//! volume too large to read whole is rendered piece by piece, frame by
+//! frame, as its stills are.
 
 mod ffmpeg;
 mod work;
