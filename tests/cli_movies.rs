@@ -319,6 +319,28 @@ fn parts_rendered_apart_make_the_movie_once_the_last_is_in() {
     let said = render(&[&base[..], &["--movie-frames", "12:24"]].concat(), &parts);
     assert!(said.contains("12 of 24 still missing"), "{said}");
     assert!(!parts.exists());
+    // Another command's part is not mixed in.
+    let out = volray(
+        &[
+            &["render"],
+            &base[..],
+            &[
+                "--zoom",
+                "2",
+                "--movie-frames",
+                "0:12",
+                "-o",
+                parts.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("parts.gif.frames: holds the frames of another command"),
+        "{}",
+        stderr(&out)
+    );
     let said = render(&[&base[..], &["--movie-frames", "0:12"]].concat(), &parts);
     assert!(!said.contains("missing"), "{said}");
     assert_eq!(

@@ -529,7 +529,8 @@ fn load_data(
 fn identity(keys: &str, frames: usize, size: (usize, usize)) -> String {
     let mut words = Vec::new();
     let mut skip = false;
-    for word in std::env::args().skip(1) {
+    for word in std::env::args_os().skip(1) {
+        let word = word.to_string_lossy().into_owned();
         if std::mem::take(&mut skip) {
             continue;
         }

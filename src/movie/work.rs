@@ -35,7 +35,7 @@ impl Work {
         let dir = output.with_file_name(name);
         let io = |e: std::io::Error| CliError::io(format!("{}: {e}", dir.display()));
         let run = dir.join("run.json");
-        if dir.is_dir() {
+        if dir.is_dir() && run.exists() {
             let earlier = std::fs::read_to_string(&run).unwrap_or_default();
             if earlier != identity {
                 return Err(CliError::input(format!(
@@ -44,7 +44,10 @@ impl Work {
                 )));
             }
         } else {
-            std::fs::create_dir(&dir).map_err(io)?;
+            // A folder without its run.json was stopped as it was made.
+            if !dir.is_dir() {
+                std::fs::create_dir(&dir).map_err(io)?;
+            }
             volray_io::write_atomically(&run, |w| w.write_all(identity.as_bytes()))?;
         }
         Ok(Work {
