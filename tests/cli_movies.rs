@@ -556,3 +556,43 @@ with h5py.File(sys.argv[1] + "/vol.h5", "w") as f:
         assert_eq!(frame.max_diff(&Picture::read(&still)), 0, "frame {k}");
     }
 }
+
+#[test]
+fn every_frame_is_held_within_max_memory_before_the_first_is_rendered() {
+    // 32³ at 64x48 takes 218 KiB, 512 KiB with shadows: 300 KiB holds the
+    // first keyframe's frames but not the second's.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let keys = write(
+        d,
+        "keys.json",
+        r#"{"version": 1, "fps": 2, "keyframes": [{"t": 0}, {"t": 1, "shadows": true}]}"#,
+    );
+    let movie = d.join("m.gif");
+    let base = ["render", "blobs:32", "--size", SIZE, "--max-memory", "300K"];
+    let out = volray(
+        &[
+            &base[..],
+            &["--keyframes", &keys, "-o", movie.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    let said = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(said.contains("more than --max-memory 300 KiB"), "{said}");
+    assert_eq!(names(d), ["keys.json"]);
+    // Without the shadows, the same limit holds every frame.
+    let keys = write(
+        d,
+        "keys.json",
+        r#"{"fps": 2, "keyframes": [{"t": 0}, {"t": 1, "zoom": 2}]}"#,
+    );
+    let out = volray(
+        &[
+            &base[..],
+            &["--keyframes", &keys, "-o", movie.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}

@@ -369,7 +369,15 @@ fn render_whole(job: &Job, input_args: &InputArgs, out: &mut Out) -> Result<(), 
                 }
             }
         }
-        let renderer = renderer_for(&args.view, &planned[0].settings, &input)?;
+        // Built for the run's most demanding frame (the smallest room
+        // left for caches): every frame within --max-memory, checked
+        // before the first is rendered.
+        let mut worst = (usize::MAX, 0);
+        for (i, p) in planned.iter().enumerate() {
+            let room = crate::session::cache_budget(&args.view, &p.settings, &input)?;
+            worst = worst.min((room, i));
+        }
+        let renderer = renderer_for(&args.view, &planned[worst.1].settings, &input)?;
         for (p, &k) in planned.iter().zip(&todo[at..end]) {
             let mut image = (job.pool)
                 .install(|| renderer.render(FrameRequest::new(&p.settings)))
