@@ -535,10 +535,16 @@ fn load_data(
 /// that choose which frames or how many threads, which change no pixel),
 /// the keyframes file's text, the frame count and size.
 fn identity(keys: &str, frames: usize, size: (usize, usize)) -> String {
-    let mut words = Vec::new();
+    let words = std::env::args_os().skip(1);
+    let words: Vec<String> = words.map(|w| w.to_string_lossy().into_owned()).collect();
+    identity_of(&words, keys, frames, size)
+}
+
+/// [`identity`] of the command's words `words`.
+fn identity_of(words: &[String], keys: &str, frames: usize, size: (usize, usize)) -> String {
+    let mut kept = Vec::new();
     let mut skip = false;
-    for word in std::env::args_os().skip(1) {
-        let word = word.to_string_lossy().into_owned();
+    for word in words {
         if std::mem::take(&mut skip) {
             continue;
         }
@@ -546,12 +552,12 @@ fn identity(keys: &str, frames: usize, size: (usize, usize)) -> String {
             "--resume" => {}
             "--movie-frames" | "--threads" => skip = true,
             w if w.starts_with("--movie-frames=") || w.starts_with("--threads=") => {}
-            _ => words.push(word),
+            _ => kept.push(word),
         }
     }
     serde_json::json!({
         "version": 1,
-        "command": words,
+        "command": kept,
         "keyframes": keys,
         "frames": frames,
         "size": [size.0, size.1],
@@ -612,3 +618,67 @@ fn interrupt_self() {
 
 #[cfg(not(unix))]
 fn interrupt_self() {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(text: &str) -> Vec<String> {
+        text.split(' ').map(String::from).collect()
+    }
+
+    #[test]
+    fn a_run_is_its_words_less_those_that_change_no_pixel() {
+        let id = |text: &str| identity_of(&words(text), "{}", 24, (64, 48));
+        let plain = id("render a.nii --keyframes k.json -o m.mp4");
+        assert_eq!(
+            id("render a.nii --resume --keyframes k.json -o m.mp4 --threads 2"),
+            plain
+        );
+        assert_eq!(
+            id("render a.nii --movie-frames 0:12 --keyframes k.json -o m.mp4"),
+            plain
+        );
+        assert_eq!(
+            id("render a.nii --movie-frames=3: --threads=1 --keyframes k.json -o m.mp4"),
+            plain
+        );
+        assert_ne!(
+            id("render a.nii --zoom 2 --keyframes k.json -o m.mp4"),
+            plain
+        );
+        assert_ne!(
+            identity_of(
+                &words("render a.nii --keyframes k.json -o m.mp4"),
+                "{}",
+                25,
+                (64, 48)
+            ),
+            plain
+        );
+    }
+
+    #[test]
+    fn kept_frames_come_back_as_the_bytes_they_were() {
+        let image =
+            Image::from_pixels(2, 1, vec![[0.1, 0.5, 0.99, 1.0], [0.0, 1.0, 0.731, 0.5]]).unwrap();
+        let rgb = rgb8(&image);
+        assert_eq!(rgb8(&image_of(&rgb, (2, 1))), rgb);
+        assert_eq!(rgb, [26, 128, 252, 0, 255, 186]);
+    }
+
+    #[test]
+    fn movie_names_pick_the_codec_and_sides_must_be_even() {
+        use std::path::Path as P;
+        assert_eq!(Codec::of(P::new("a/m.MP4")), Some(Codec::Mp4));
+        assert_eq!(Codec::of(P::new("m.webm")), Some(Codec::Webm));
+        assert_eq!(Codec::of(P::new("m.gif")), None);
+        assert!(ffmpeg::check_size(P::new("m.mp4"), 64, 48).is_ok());
+        let odd = ffmpeg::check_size(P::new("m.mp4"), 65, 48).unwrap_err();
+        assert!(
+            odd.message.contains("--size 65x48") && odd.message.contains("66x48"),
+            "{}",
+            odd.message
+        );
+    }
+}
