@@ -20,5 +20,5 @@ pub mod schema;
 pub mod time;
 
 pub use interpolate::{Ease, State};
-pub use plan::{DataFrame, Movie, TimeMode};
-pub use schema::KeyframesError;
+pub use plan::{DataFrame, Movie};
+pub use schema::{KeyframesError, TimeMode};

@@ -6,28 +6,7 @@
 //! and a part of the frames (`--movie-frames A:B`, [`part`]).
 
 use super::interpolate::{State, between};
-use super::schema::{Keyframe, Keyframes};
-
-/// How a fractional `frame` (the data's time point) is shown.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum TimeMode {
-    /// The time point last reached (the value rounded down): a
-    /// simulation's steps shown as they were computed.
-    #[default]
-    Hold,
-    /// The two time points either side, their values mixed linearly.
-    Interpolate,
-}
-
-impl TimeMode {
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "hold" => Some(TimeMode::Hold),
-            "interpolate" => Some(TimeMode::Interpolate),
-            _ => None,
-        }
-    }
-}
+use super::schema::{Keyframe, Keyframes, TimeMode};
 
 /// The data a frame shows.
 #[derive(Debug, Clone, Copy, PartialEq)]

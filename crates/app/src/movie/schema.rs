@@ -18,10 +18,30 @@
 //! key.
 
 use super::interpolate::{Ease, State};
-use super::plan::TimeMode;
 use serde_json::Value;
 use std::path::Path;
 use volray_options::{BlendMode, Naming, Opt, Tf};
+
+/// How a fractional `frame` (the data's time point) is shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TimeMode {
+    /// The time point last reached (the value rounded down): a
+    /// simulation's steps shown as they were computed.
+    #[default]
+    Hold,
+    /// The two time points either side, their values mixed linearly.
+    Interpolate,
+}
+
+impl TimeMode {
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "hold" => Some(TimeMode::Hold),
+            "interpolate" => Some(TimeMode::Interpolate),
+            _ => None,
+        }
+    }
+}
 
 /// The version of the schema this reads.
 pub const VERSION: u64 = 1;
