@@ -90,6 +90,21 @@ fn an_mp4_holds_every_frame_at_its_size_and_rate_and_each_is_the_still_of_its_in
         .output()
         .unwrap();
     assert_eq!(String::from_utf8_lossy(&probe.stdout).trim(), "64,48,8/1,9");
+    // WebM: VP9, the same frames.
+    let webm = dir.path().join("orbit.webm");
+    render(&[&base[..], &["--keyframes", &keys]].concat(), &webm);
+    let probe = Command::new("ffprobe")
+        .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
+        .args([
+            "-show_entries",
+            "stream=codec_name,nb_read_frames",
+            "-of",
+            "csv=p=0",
+        ])
+        .arg(&webm)
+        .output()
+        .unwrap();
+    assert_eq!(String::from_utf8_lossy(&probe.stdout).trim(), "vp9,9");
     let decoded = Command::new("ffmpeg")
         .args(["-v", "error", "-i"])
         .arg(&movie)

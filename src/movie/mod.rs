@@ -279,11 +279,14 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                 return Ok(());
             }
             if !sequence {
+                let bar = frame_bar(frames as u64);
                 let mut sink = Sink::start(args, size, frames, fps)?;
                 for k in 0..frames {
                     let rgb = work.load(k)?;
                     sink.push(&image_of(&rgb, size), &rgb)?;
+                    bar.inc(1);
                 }
+                bar.finish_and_clear();
                 sink.finish()?;
             }
             work.remove()
