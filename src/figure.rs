@@ -76,6 +76,43 @@ pub fn draw(
     )
 }
 
+/// [`draw`] into a movie's frame, with the frame's own `--title` and
+/// `--label` (a keyframe may change them) in place of the flags'.
+pub fn draw_titled(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    renderer: &Renderer,
+    input: &Input,
+    (title, label): (Option<String>, Option<String>),
+    image: &mut Image,
+) -> Result<(), CliError> {
+    let annotations = Annotations {
+        title,
+        label,
+        ..annotations(&args.figure)
+    };
+    let a = &annotations;
+    let any = a.colorbar.is_some()
+        || a.scale_bar.is_some()
+        || a.title.is_some()
+        || a.label.is_some()
+        || a.axes
+        || a.outline;
+    if !any {
+        return Ok(());
+    }
+    let bounds = renderer.volume().bounds();
+    annotate(
+        args,
+        settings,
+        renderer,
+        input,
+        &annotations,
+        (&[bounds], bounds),
+        image,
+    )
+}
+
 /// [`draw`], the outline drawing `boxes`, a perspective scale bar holding
 /// at the centre of `scale_box` (a series: the box framing every frame,
 /// so that the bar is the same in each).
@@ -101,6 +138,29 @@ pub fn draw_framed(
         );
         return Ok(());
     }
+    let boxes = (boxes, scale_box);
+    annotate(
+        args,
+        settings,
+        renderer,
+        input,
+        &annotations(&args.figure),
+        boxes,
+        image,
+    )
+}
+
+/// Draws `annotations` (if any) into `image`, the outline drawing
+/// `boxes.0`, a perspective scale bar holding at the centre of `boxes.1`.
+fn annotate(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    renderer: &Renderer,
+    input: &Input,
+    annotations: &Annotations,
+    (boxes, scale_box): (&[(DVec3, DVec3)], (DVec3, DVec3)),
+    image: &mut Image,
+) -> Result<(), CliError> {
     let length_unit = input
         .file
         .as_ref()
@@ -113,12 +173,6 @@ pub fn draw_framed(
         boxes,
         scale_box,
     };
-    annotate_frame(
-        image,
-        &annotations(&args.figure),
-        renderer,
-        settings,
-        &rendered,
-    )
-    .map_err(|e| CliError::input(e.to_string()))
+    annotate_frame(image, annotations, renderer, settings, &rendered)
+        .map_err(|e| CliError::input(e.to_string()))
 }

@@ -43,6 +43,7 @@ mod figure;
 mod generate;
 mod info;
 mod interrupt;
+mod movie;
 #[cfg(feature = "mpi")]
 mod mpi;
 mod outfile;

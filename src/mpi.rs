@@ -40,9 +40,12 @@ fn render_rank(args: &RenderArgs) -> Result<(), CliError> {
             args.figure.first_flag()
         )));
     }
-    if args.animation.turntable.is_some() || !args.animation.series.is_empty() {
+    if args.animation.turntable.is_some()
+        || args.animation.keyframes.is_some()
+        || !args.animation.series.is_empty()
+    {
         return Err(CliError::input(
-            "under mpirun, render writes one still image: --turntable and series are rendered by one process",
+            "under mpirun, render writes one still image: --turntable, --keyframes and series are rendered by one process",
         ));
     }
     let kind = render::output_kind(&args.out.output, args.out.bit_depth, None)?;

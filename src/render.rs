@@ -19,6 +19,10 @@ use volray_flags::RenderArgs;
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     refuse_scene_flags_alone(args)?;
+    if crate::movie::wanted(args) {
+        return crate::movie::run(args);
+    }
+    crate::movie::refuse_movie_flags(args)?;
     if args.scene.is_scene() {
         return crate::scene::run(args);
     }

@@ -273,7 +273,12 @@ fn render_cases() -> Vec<Refused> {
         ("{out}/x.exr", &["--bit-depth", "16"][..], "--bit-depth"),
         ("{out}/x.gif", &["--bit-depth", "16"], "--bit-depth"),
         ("{out}/x.exr", &["--turntable", "2"], "--turntable"),
-        ("{out}/x.mp4", &["--turntable", "2"], "--turntable"),
+        // A turntable is written as .mp4 or .webm (tests/cli_movies.rs); .mkv
+        // is no animation, and a still is no movie.
+        ("{out}/x.mkv", &["--turntable", "2"], "--turntable"),
+        ("{out}/x.mp4", &[], "--keyframes"),
+        ("{out}/x.gif", &["--resume"], "--resume"),
+        ("{out}/x.gif", &["--turntable", "2", "--crf", "20"], "--crf"),
         ("{out}/x.exr", &["sphere:8"], ".exr"),
     ] {
         cases.push(refused(

@@ -16,7 +16,8 @@ use volray_options::LookOptions;
 /// settings of each from the settings the options describe. The front
 /// end renders and writes frame after frame; the level (and whether the
 /// volume is rendered in pieces) is chosen for the first. A turntable is
-/// one ([`Turntable`]); a camera path through keyframes would be another.
+/// one ([`Turntable`]). A camera and look path through keyframes is
+/// [`crate::movie`]'s: it moves the options, not only the settings.
 pub trait Views {
     /// The number of frames.
     fn frames(&self) -> usize;

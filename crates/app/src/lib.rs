@@ -36,6 +36,10 @@
 //! - [`animation`]: an animation's views ([`animation::Views`]: a
 //!   turntable's, or any per-frame camera path), and the window and
 //!   framing the frames of a series share (its first pass);
+//! - [`movie`]: movies: a keyframes file read into the flags' options,
+//!   the values between keyframes (orbits, quaternions, OKLab colours,
+//!   mixed transfer functions), the frame plan (frame `k` at `k / fps`,
+//!   time points held or blended, parts `A:B`);
 //! - [`bench`](mod@bench): `volray bench`'s timed frames, their medians and `--json`
 //!   rows, and the peer benchmark's workloads (with VTK timed beside them);
 //! - [`convert`]: a volume written back as a file (NRRD, `.npy`, raw,
@@ -87,6 +91,7 @@ pub mod error;
 pub mod input;
 pub mod look;
 pub mod memory;
+pub mod movie;
 pub mod plan;
 pub mod reads;
 pub mod renderer;

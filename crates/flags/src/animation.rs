@@ -1,8 +1,13 @@
 //! Animations of `render`: the volumes after INPUT (a series, one frame
-//! each), `--turntable` and `--fps`. `animate.rs` renders them.
+//! each), `--turntable` and `--fps`, which `animate.rs` renders; and
+//! movies: `--keyframes` (volray-app's `movie`), encoded with ffmpeg at
+//! `--crf`, resumable (`--resume`) and splittable (`--movie-frames`),
+//! which `movie/` (beside `main.rs`) renders.
 
 use super::parse::parse_fps;
+use super::scene::{Frames, parse_frames};
 use clap::Args;
+use std::path::PathBuf;
 
 /// A turntable or a series, and its frame rate.
 #[derive(Debug, Args)]
@@ -24,4 +29,29 @@ pub struct AnimationArgs {
     /// keeps the delay in hundredths of a second.
     #[arg(long, value_name = "FPS", value_parser = parse_fps, allow_hyphen_values = true, help_heading = "Animations")]
     pub fps: Option<f64>,
+
+    /// A movie: the camera and look moving through the keyframes of a
+    /// JSON file (its schema: docs/movies.md), written as .mp4 or .webm
+    /// (through ffmpeg), .gif, .png (animated) or numbered PNGs.
+    #[arg(long, value_name = "FILE", help_heading = "Animations")]
+    pub keyframes: Option<PathBuf>,
+
+    /// Quality of an .mp4 (H.264) or .webm (VP9) movie: ffmpeg's constant
+    /// rate factor, 0 (lossless for VP9, best) to 51 (worst) [default: 16].
+    #[arg(long, value_name = "CRF", value_parser = clap::value_parser!(u8).range(0..=51), help_heading = "Animations")]
+    pub crf: Option<u8>,
+
+    /// Keep every finished frame of an animation (lossless PNGs in the
+    /// folder OUTPUT.frames beside the output; a PNG sequence's frames
+    /// are its own files) and, run again after an interruption, render
+    /// only the missing ones.
+    #[arg(long, help_heading = "Animations")]
+    pub resume: bool,
+
+    /// Render only the frames A up to B-1 of an animation (B left out: to
+    /// the last) into its folder of finished frames (as --resume keeps
+    /// them); the movie is written once every frame is there, by the
+    /// part that completes it or a run with --resume.
+    #[arg(long, value_name = "A:B", value_parser = parse_frames, help_heading = "Animations")]
+    pub movie_frames: Option<Frames>,
 }

@@ -132,7 +132,7 @@ fn parse_colors(s: &str) -> Result<ChannelColors, String> {
         .map(ChannelColors)
 }
 
-fn parse_frames(s: &str) -> Result<Frames, String> {
+pub(crate) fn parse_frames(s: &str) -> Result<Frames, String> {
     let s = s.trim();
     if s == "all" {
         return Ok(Frames {
