@@ -78,7 +78,7 @@ pub fn views(
         Plan::Whole { level } => args.input.at_level(level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
-    crate::render::auto_log(args, base, &mut input)?;
+    crate::session::auto_log(&args.view, base, &mut input)?;
     let base = &crate::settings::from_input(args, base, &mut input)?;
     let fail = |e: volray_core::RenderError| render_failure(&args.view, &input.name, e);
     let renderer = renderer_for(&args.view, base, &input)?;

@@ -79,7 +79,7 @@ fn still(
         Plan::Whole { level } => args.input.at_level(level),
     };
     let mut input = load(&input_args, args.view.look.log)?;
-    auto_log(args, settings, &mut input)?;
+    crate::session::auto_log(&args.view, settings, &mut input)?;
     let settings = &crate::settings::from_input(args, settings, &mut input)?;
     let renderer = renderer_for(&args.view, settings, &input)?;
     let bar = progress_bar((settings.width * settings.height) as u64);
@@ -91,21 +91,6 @@ fn still(
     crate::figure::draw(args, kind, settings, &renderer, &input, &mut image)?;
 
     write_still(args, kind, &image)
-}
-
-/// With `--tf auto` and no window, `input`'s volume as its log10 where
-/// its values span decades (volray-app's `auto_log`), said on stderr.
-pub(crate) fn auto_log(
-    args: &RenderArgs,
-    settings: &RenderSettings,
-    input: &mut volray_app::input::Input,
-) -> Result<(), CliError> {
-    let look = volray_flags::look(&args.view.look);
-    let note = volray_app::input::auto_log(&look, &settings.transfer_function, input, "--linear")?;
-    if let Some(note) = note {
-        eprintln!("volray: {note}");
-    }
-    Ok(())
 }
 
 /// The inputs in order: INPUT (or the demo volume), then MORE.

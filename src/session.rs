@@ -203,3 +203,18 @@ pub fn thread_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, CliError> 
         .build()
         .map_err(|e| CliError::io(format!("cannot start worker threads: {e}")))
 }
+
+/// With `--tf auto` and no window, `input`'s volume as its log10 where
+/// its values span decades (volray-app's `auto_log`), said on stderr.
+pub fn auto_log(
+    view: &ViewArgs,
+    settings: &RenderSettings,
+    input: &mut volray_app::input::Input,
+) -> Result<(), CliError> {
+    let look = volray_flags::look(&view.look);
+    let note = volray_app::input::auto_log(&look, &settings.transfer_function, input, "--linear")?;
+    if let Some(note) = note {
+        eprintln!("volray: {note}");
+    }
+    Ok(())
+}

@@ -180,11 +180,57 @@ pub enum Described {
     },
 }
 
+/// `input` stretched for drawing as [`crate::display::stretch`] says (`explicit`:
+/// `--scale`), its note kept in `input.display_note`; unchanged where
+/// nothing is stretched.
+pub fn displayed(mut input: Input, explicit: Option<[f64; 3]>) -> Result<Input, crate::AppError> {
+    let info = input.file.as_ref().map(|(_, info)| info);
+    let reoriented = info.and_then(|i| i.reorientation.as_ref());
+    let extent = match reoriented {
+        Some(r) => {
+            let d = r.dims();
+            r.spacing * DVec3::new(d[0] as f64 - 1.0, d[1] as f64 - 1.0, d[2] as f64 - 1.0)
+        }
+        None => input.volume.extent(),
+    };
+    let Some(stretch) = crate::display::stretch(info, extent, explicit) else {
+        return Ok(input);
+    };
+    let f = DVec3::from(stretch.factors);
+    if !(f.is_finite() && f.min_element() > 0.0) {
+        let e = volray_core::VolumeError::BadSpacing(f.x, f.y, f.z);
+        return Err(crate::AppError::Spacing(e));
+    }
+    // Kept in the file's axes (a distributed render's mapping): the
+    // world-aligned volume's spacing and origin, which its boxes take.
+    match input
+        .file
+        .as_mut()
+        .and_then(|(_, i)| i.reorientation.as_mut())
+    {
+        Some(r) => {
+            r.spacing *= f;
+            r.origin *= f;
+        }
+        None => {
+            let (spacing, origin) = (input.volume.spacing() * f, input.volume.origin() * f);
+            input.volume = (input.volume.with_spacing(spacing))
+                .and_then(|v| v.with_origin(origin))
+                .map_err(crate::AppError::Spacing)?;
+        }
+    }
+    if let (Some(note), Some((_, info))) = (&stretch.note, input.file.as_mut()) {
+        info.notes.push(note.clone());
+    }
+    input.display_note = stretch.note;
+    Ok(input)
+}
+
 /// Reads the volume `request` names for rendering: with `log`, its
 /// log10; its axes stretched for drawing as `request.scale` or the
-/// default rule says ([`crate::display`]).
+/// default rule says ([`displayed`]).
 pub fn load_log(request: &Request, log: bool) -> Result<Input, AppError> {
-    let mut input = crate::display::displayed(load(request)?, request.scale)?;
+    let mut input = displayed(load(request)?, request.scale)?;
     if log {
         input.volume = input.volume.to_log10().map_err(|e| AppError::Log {
             name: input.name.clone(),

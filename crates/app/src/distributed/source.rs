@@ -195,7 +195,7 @@ impl RankSource {
         // Stretched for drawing as a whole render's (display.rs).
         let load = || {
             input::load_with(args, MapPolicy::AlwaysInFileOrder)
-                .and_then(|i| crate::display::displayed(i, args.scale))
+                .and_then(|i| crate::input::displayed(i, args.scale))
         };
         // Rank 0 first: whether the file maps, and the grid.
         let first = if mpi.rank() == 0 {
