@@ -5,28 +5,27 @@
 //! where there is a display, and serves until Ctrl-C or SIGTERM, then
 //! exits 0.
 //!
-//! `view/reproduce.rs` turns the page's states into `volray render`
+//! volray-flags' `reproduce` turns the page's states into `volray render`
 //! commands (volray-app's words) and their settings; `view/browser.rs` opens the browser.
 
 mod browser;
-mod reproduce;
 mod scene;
 
 use crate::error::CliError;
 use crate::session::{load, renderer_for, thread_pool};
 use crate::settings::{named_transfer_function, read_tf_file, settings_with_tf_text};
-use reproduce::CliReproduce;
 use std::net::SocketAddr;
 use std::path::Path;
 use std::sync::Arc;
 use volray_app::input::{self, Input};
 use volray_core::RenderSettings;
 use volray_flags::ViewerArgs;
+use volray_flags::reproduce::{CliReproduce, start_state};
 use volray_io::format_bytes;
 use volray_options::level::LevelChoice;
+use volray_view::DRAFT_SHARE;
 use volray_view::launch::Launch;
 use volray_view::open::{OpenError, Opened};
-use volray_view::{DRAFT_SHARE, ViewState};
 
 /// The most tabs rendering at once, whatever the memory allows (the
 /// memory itself is held to `--max-memory` by the viewer's ledger:
@@ -167,41 +166,6 @@ fn serve(args: &ViewerArgs, launch: Launch) -> Result<(), CliError> {
     let stopper = server.stopper();
     crate::interrupt::stop_instead(move || stopper.stop());
     server.run().map_err(|e| CliError::io(e.to_string()))
-}
-
-/// The page's starting state: the view the flags describe (as
-/// `volray.view` starts from its keywords, [`volray_view::start_state`]),
-/// with the figure the flags ask for.
-pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
-    let options = volray_options::Options {
-        camera: volray_flags::camera(&args.view.camera),
-        look: volray_flags::look(&args.view.look),
-        ..Default::default()
-    };
-    ViewState {
-        figure: figure_state(&args.figure),
-        ..volray_view::start_state(&options, settings)
-    }
-}
-
-/// The page's figure as the flags start it.
-fn figure_state(args: &volray_flags::FigureArgs) -> volray_view::Figure {
-    use volray_flags::{ColorBarSide as Flag, ScaleLength};
-    volray_view::Figure {
-        colorbar: args.colorbar.map(|side| match side {
-            Flag::Right => volray_view::ColorBarSide::Right,
-            Flag::Left => volray_view::ColorBarSide::Left,
-        }),
-        scale_bar: args.scale_bar.is_some(),
-        scale_length: match args.scale_bar {
-            Some(ScaleLength::Given(l)) => Some(l),
-            _ => None,
-        },
-        axes: args.axes,
-        outline: args.outline,
-        title: args.title.clone(),
-        label: args.label.clone(),
-    }
 }
 
 /// What the frames' annotations need of `input`, as `volray render`

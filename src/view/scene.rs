@@ -16,7 +16,6 @@
 //! function serve every time point, as a series' do), and each tab reads
 //! the one its slider asks for, as `--frame T`.
 
-use super::reproduce::{CliReproduce, SceneWords};
 use super::{launch, serve};
 use crate::error::CliError;
 use crate::scene::{overlay_specs, read_layers, whole_input};
@@ -24,6 +23,7 @@ use crate::session::{load, renderer_for};
 use crate::settings::{read_tf_file, settings_with_tf_text};
 use volray_app::input;
 use volray_flags::ViewerArgs;
+use volray_flags::reproduce::{CliReproduce, SceneWords};
 use volray_view::{LayerState, START_COLOURS, TimePoints, WHITE};
 
 pub fn run(args: &ViewerArgs) -> Result<(), CliError> {

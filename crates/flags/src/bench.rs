@@ -125,9 +125,9 @@ mod tests {
             .collect();
         // The 41 flags of the list this replaced (all but INPUT of the
         // input options, and all but --threads of the view options), and
-        // --labels, --label-opacity, --show-labels, --level, --channel and
-        // --series since.
-        assert_eq!(flags.len(), 47);
+        // --labels, --label-opacity, --show-labels, --level, --channel,
+        // --series, --scale and --linear since.
+        assert_eq!(flags.len(), 49);
         for arg in flags {
             let given = given(arg);
             let given: Vec<&str> = given.iter().map(String::as_str).collect();

@@ -40,7 +40,9 @@
 //!   also says which groups `--peers` refuses), `demo.rs`: `volray
 //!   render` with no INPUT;
 //! - `parse.rs`: the value parsers, and clap's errors on one line;
-//! - `options.rs`: the flags as volray-options' options.
+//! - `options.rs`: the flags as volray-options' options;
+//! - `reproduce.rs`: `volray view`'s page state as `volray render` words
+//!   (volray-app's), parsed back here into the frame's settings.
 
 mod animation;
 mod bench;
@@ -57,6 +59,7 @@ mod output;
 mod paper;
 mod parse;
 mod render;
+pub mod reproduce;
 mod sampling;
 mod scene;
 mod view;

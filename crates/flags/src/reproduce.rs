@@ -10,17 +10,18 @@
 //! frame, pixel for pixel, by construction (and `tests/view_browser.rs`
 //! runs the command to check).
 
-use crate::error::CliError;
-use crate::settings::settings_with_tf_text;
+use crate::{Cli, Command, Flags, InputArgs, ViewerArgs};
 use clap::Parser;
 use volray_app::input;
 pub use volray_app::reproduce::command::SceneWords;
 use volray_app::reproduce::command::{CommandWords, TF_FILE, Words, shell_quote, v3};
+use volray_app::reproduce::state::ViewState;
+use volray_app::reproduce::viewer::{Refusal, Reproduce, Reproduction, SceneLooks};
+use volray_app::scene::OverlaySpec;
+use volray_core::RenderSettings;
 use volray_core::glam::DVec3;
 use volray_core::scene::{Look, Mix};
 use volray_core::{NonFinite, SampleType, TransferFunction};
-use volray_flags::{Cli, Command, InputArgs, ViewerArgs};
-use volray_view::{Refusal, Reproduce, Reproduction, SceneLooks, ViewState};
 
 /// `volray view`'s flags, kept as the words of the command lines it
 /// writes, and what the memory check of each command's frame needs.
@@ -48,12 +49,12 @@ impl CliReproduce {
         non_finite: NonFinite,
         (max_memory, auto_log): (u64, bool),
     ) -> Self {
-        let mut look = volray_flags::look(&args.view.look);
+        let mut look = crate::look(&args.view.look);
         look.log |= auto_log;
         let options = volray_options::Options {
-            camera: volray_flags::camera(&args.view.camera),
+            camera: crate::camera(&args.view.camera),
             look,
-            sampling: volray_flags::sampling(&args.view.sampling),
+            sampling: crate::sampling(&args.view.sampling),
         };
         let input = args.input.input.as_deref().unwrap_or(input::DEMO);
         let reading = reading(&args.input);
@@ -98,14 +99,15 @@ impl CliReproduce {
     /// command's words: `--overlay`s with their files' texts.
     fn scene_looks(
         &self,
-        args: &volray_flags::RenderArgs,
+        args: &crate::RenderArgs,
         files: Vec<(String, String)>,
     ) -> Result<Option<SceneLooks>, Refusal> {
         let Some(scene) = self.words.scene() else {
             return Ok(None);
         };
-        let refuse = |e: CliError| Refusal(e.message);
-        let specs = crate::scene::overlay_specs(&args.scene).map_err(refuse)?;
+        let specs = (args.scene.overlay.iter())
+            .map(|spec| OverlaySpec::parse(spec).map_err(|e| Refusal(e.0)))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut looks = Vec::with_capacity(specs.len());
         for (spec, other) in specs.iter().zip(&scene.others) {
             let look = if spec.labels {
@@ -114,7 +116,7 @@ impl CliReproduce {
                 let text = (files.iter())
                     .find(|(name, _)| Some(name) == spec.tf.as_ref())
                     .map(|(_, text)| text.as_str());
-                let shared = crate::settings::options(&args.view, Some("")).map_err(refuse)?;
+                let shared = crate::options(&args.view, Some(""));
                 let (_, settings) = spec.settings(shared, text).map_err(|e| Refusal(e.0))?;
                 Look::of(&settings)
             };
@@ -124,7 +126,7 @@ impl CliReproduce {
             });
         }
         let mix = match args.scene.mix {
-            Some(volray_flags::MixMode::Additive) => Mix::Additive,
+            Some(crate::MixMode::Additive) => Mix::Additive,
             _ => Mix::Composite,
         };
         Ok(Some(SceneLooks {
@@ -139,13 +141,11 @@ impl Reproduce for CliReproduce {
     fn reproduce(&self, state: &ViewState) -> Result<Reproduction, Refusal> {
         let (words, json, files) = self.words.words(state)?;
         let argv = std::iter::once("volray").chain(words.iter().map(String::as_str));
-        let cli =
-            Cli::try_parse_from(argv).map_err(|e| Refusal(volray_flags::one_line_error(&e)))?;
+        let cli = Cli::try_parse_from(argv).map_err(|e| Refusal(crate::one_line_error(&e)))?;
         let Command::Render(args) = cli.command else {
             unreachable!("the words start with render")
         };
-        let refuse = |e: CliError| Refusal(e.message);
-        let settings = settings_with_tf_text(&args.view, json.as_deref()).map_err(refuse)?;
+        let settings = settings_with_tf_text(&args.view, json.as_deref())?;
         // The frame must fit with no brick cache (as `render` checks).
         let need = volray_app::memory::render_bytes(self.grid, &settings, self.non_finite, 0);
         if need > u128::from(self.max_memory) {
@@ -171,6 +171,51 @@ impl Reproduce for CliReproduce {
     }
 }
 
+/// The render settings the view arguments give with the `--tf` file's
+/// text, refused in the flags' words (as `volray render` would refuse
+/// them).
+pub fn settings_with_tf_text(
+    view: &crate::ViewArgs,
+    tf_text: Option<&str>,
+) -> Result<RenderSettings, Refusal> {
+    volray_options::settings(&crate::options(view, tf_text)).map_err(|e| Refusal(e.message(&Flags)))
+}
+
+/// The page's starting state: the view the flags describe (as
+/// `volray.view` starts from its keywords, volray-app's `start_state`),
+/// with the figure the flags ask for.
+pub fn start_state(args: &ViewerArgs, settings: &RenderSettings) -> ViewState {
+    let options = volray_options::Options {
+        camera: crate::camera(&args.view.camera),
+        look: crate::look(&args.view.look),
+        ..Default::default()
+    };
+    ViewState {
+        figure: figure_state(&args.figure),
+        ..volray_app::reproduce::options::start_state(&options, settings)
+    }
+}
+
+/// The page's figure as the flags start it.
+fn figure_state(args: &crate::FigureArgs) -> volray_app::reproduce::state::Figure {
+    use crate::{ColorBarSide as Flag, ScaleLength};
+    volray_app::reproduce::state::Figure {
+        colorbar: args.colorbar.map(|side| match side {
+            Flag::Right => volray_app::reproduce::state::ColorBarSide::Right,
+            Flag::Left => volray_app::reproduce::state::ColorBarSide::Left,
+        }),
+        scale_bar: args.scale_bar.is_some(),
+        scale_length: match args.scale_bar {
+            Some(ScaleLength::Given(l)) => Some(l),
+            _ => None,
+        },
+        axes: args.axes,
+        outline: args.outline,
+        title: args.title.clone(),
+        label: args.label.clone(),
+    }
+}
+
 /// INPUT's reading flags, as given.
 fn reading(inp: &InputArgs) -> Vec<String> {
     let mut reading = Words::default();
@@ -191,9 +236,18 @@ fn reading(inp: &InputArgs) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::settings::{named_transfer_function, settings};
-    use volray_flags::Cli;
-    use volray_view::{BlendMode, START_COLOURS, WHITE};
+    use volray_app::reproduce::state::{BlendMode, START_COLOURS, WHITE};
+
+    fn named_transfer_function(
+        look: &crate::LookArgs,
+        _tf_text: Option<&str>,
+    ) -> Result<TransferFunction, volray_options::OptionError> {
+        volray_options::named_transfer_function(&crate::look(look))
+    }
+
+    fn settings(view: &crate::ViewArgs) -> Result<RenderSettings, Refusal> {
+        settings_with_tf_text(view, None)
+    }
 
     fn viewer(extra: &[&str]) -> ViewerArgs {
         let argv = [&["volray", "view", "blobs:16"][..], extra].concat();
@@ -212,7 +266,7 @@ mod tests {
         let args = viewer(extra);
         let start = named_transfer_function(&args.view.look, None).unwrap();
         let settings = settings(&args.view).unwrap();
-        let state = super::super::start_state(&args, &settings);
+        let state = start_state(&args, &settings);
         let max_memory = args.input.max_memory.unwrap_or(1 << 30);
         let grid = ([16; 3], DVec3::ONE, SampleType::F32);
         let r = CliReproduce::new(
@@ -280,7 +334,7 @@ mod tests {
         let (r, mut state) = reproduce(&["--preset", "ct-bone"]);
         let without = r.reproduce(&state).unwrap().command;
         assert!(!without.contains("--units"), "{without}");
-        state.figure.colorbar = Some(volray_view::ColorBarSide::Right);
+        state.figure.colorbar = Some(volray_app::reproduce::state::ColorBarSide::Right);
         let (words, _) = r.words(&state).unwrap();
         assert!(
             words.windows(2).any(|w| w == ["--units", "HU"]),
@@ -289,7 +343,7 @@ mod tests {
         assert!(!words.iter().any(|w| w == "--preset"), "{words:?}");
         // Without a CT preset, render would say no unit either.
         let (r, mut state) = reproduce(&["--colormap", "magma"]);
-        state.figure.colorbar = Some(volray_view::ColorBarSide::Right);
+        state.figure.colorbar = Some(volray_app::reproduce::state::ColorBarSide::Right);
         let command = r.reproduce(&state).unwrap().command;
         assert!(!command.contains("--units"), "{command}");
     }
@@ -423,7 +477,7 @@ mod tests {
         let mut state = start.clone();
         state.crop = Some([[-0.5, -1.0, -1.0], [1.0, 0.25, 1.0]]);
         state.clip = vec![[[0.0, 0.0, 0.125], [0.0, 0.0, -1.0]]];
-        state.lighting = Some(volray_view::Lighting {
+        state.lighting = Some(volray_app::reproduce::state::Lighting {
             ambient: 0.25,
             diffuse: 0.5,
             specular: 0.75,
