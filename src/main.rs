@@ -16,8 +16,9 @@
 //!   timing, reading and describing are volray-app's), `convert.rs` (the
 //!   flags of volray-app's `convert`, also what `generate` writes with),
 //!   `generate.rs`, `paper.rs`, `view.rs` (the flags as volray-view's
-//!   `open` and `Launch`, with `view/reproduce.rs`: the page's state as a
-//!   `volray render` command; `view/scene.rs`; `view/browser.rs`);
+//!   `open` and `Launch`, its page's commands reproduced by volray-flags'
+//!   `reproduce`; `view/scene.rs`; `view/browser.rs`), `movie/` (movies,
+//!   encoded by volray-io's `ffmpeg`);
 //! - what they share: `settings.rs` (the flags' settings, the `--tf`
 //!   file read, option errors worded with the flags), `session.rs` (the
 //!   flags as volray-app's input requests, plans and renderers within the

@@ -4,12 +4,12 @@
 //! (`.mp4`, `.webm`) or resumably. Each frame is rendered as `volray
 //! render` renders a still with the frame's options (a keyframe means
 //! what its flags mean), annotated, and handed on at once: to ffmpeg
-//! (`ffmpeg.rs`, as the frames come) or volray-io's `Animation` (`.gif`,
+//! (volray-io's `ffmpeg`, as the frames come) or volray-io's `Animation` (`.gif`,
 //! animated `.png`, numbered PNGs). Nothing appears at the output until
 //! every frame is in.
 //!
 //! With `--resume` or `--movie-frames A:B` the frames are kept in a work
-//! folder beside the output (`work.rs`) as they finish; a run renders
+//! folder beside the output (volray-app's `movie::work`) as they finish; a run renders
 //! only the frames missing there, and the movie is encoded from the
 //! folder once every frame is in it (then the folder is deleted).
 //!
@@ -19,25 +19,22 @@
 //! volume too large to read whole is rendered piece by piece, frame by
 //! frame, as its stills are.
 
-mod ffmpeg;
-mod work;
-
 use crate::error::CliError;
 use crate::outfile::DEFAULT_FPS;
 use crate::session::{app_failure, load, renderer_for, streamed_note, thread_pool};
-use ffmpeg::{Codec, Encoder};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use volray_app::animation::turntable_frame;
 use volray_app::input::Input;
+use volray_app::movie::work::Work;
 use volray_app::movie::{DataFrame, Movie, State};
 use volray_app::plan::{Plan, StreamedInput};
 use volray_core::{FrameRequest, Image, Render, RenderSettings, Rendered, TransferFunction};
 use volray_flags::{InputArgs, RenderArgs};
+use volray_io::ffmpeg::{self, Codec, Encoder};
 use volray_io::{Animation, AnimationKind};
 use volray_options::LookOptions;
-use work::Work;
 
 /// Whether `args` ask for a movie this module renders: keyframes, or a
 /// turntable written as `.mp4`/`.webm` or kept frame by frame.
@@ -102,14 +99,14 @@ impl Sink {
 
     fn push(&mut self, image: &Image, rgb: &[u8]) -> Result<(), CliError> {
         match self {
-            Sink::Ffmpeg(e) => e.push(rgb),
+            Sink::Ffmpeg(e) => Ok(e.push(rgb)?),
             Sink::Animation(a) => Ok(a.push(image)?),
         }
     }
 
     fn finish(self) -> Result<(), CliError> {
         match self {
-            Sink::Ffmpeg(e) => e.finish(),
+            Sink::Ffmpeg(e) => Ok(e.finish()?),
             Sink::Animation(a) => a.finish().map(|_| ()).map_err(CliError::from),
         }
     }
@@ -155,7 +152,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let base_settings = volray_options::settings(&options).map_err(crate::settings::refused)?;
     let size = options.camera.size;
     if Codec::of(output).is_some() {
-        ffmpeg::check_size(output, size.0, size.1)?;
+        check_size(output, size)?;
         ffmpeg::check_available(output)?;
     }
     let base = State {
@@ -289,7 +286,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
                 bar.finish_and_clear();
                 sink.finish()?;
             }
-            work.remove()
+            Ok(work.remove()?)
         }
         (None, None) => unreachable!("a sink or a work folder"),
     }
@@ -540,32 +537,7 @@ fn load_data(
 fn identity(keys: &str, frames: usize, size: (usize, usize)) -> String {
     let words = std::env::args_os().skip(1);
     let words: Vec<String> = words.map(|w| w.to_string_lossy().into_owned()).collect();
-    identity_of(&words, keys, frames, size)
-}
-
-/// [`identity`] of the command's words `words`.
-fn identity_of(words: &[String], keys: &str, frames: usize, size: (usize, usize)) -> String {
-    let mut kept = Vec::new();
-    let mut skip = false;
-    for word in words {
-        if std::mem::take(&mut skip) {
-            continue;
-        }
-        match word.as_str() {
-            "--resume" => {}
-            "--movie-frames" | "--threads" => skip = true,
-            w if w.starts_with("--movie-frames=") || w.starts_with("--threads=") => {}
-            _ => kept.push(word),
-        }
-    }
-    serde_json::json!({
-        "version": 1,
-        "command": kept,
-        "keyframes": keys,
-        "frames": frames,
-        "size": [size.0, size.1],
-    })
-    .to_string()
+    volray_app::movie::work::identity_of(&words, keys, frames, size)
 }
 
 /// A frame as 8-bit RGB, as every output quantises it.
@@ -622,44 +594,22 @@ fn interrupt_self() {
 #[cfg(not(unix))]
 fn interrupt_self() {}
 
+/// A movie's frames have even sides (ffmpeg's `check_size`), refused
+/// naming `--size`.
+fn check_size(output: &std::path::Path, (w, h): (usize, usize)) -> Result<(), CliError> {
+    ffmpeg::check_size(output, w, h).map_err(|_| {
+        CliError::input(format!(
+            "{}: --size {w}x{h}: a movie's frames have even sides (H.264 and VP9 at 4:2:0 halve the colour's resolution); give e.g. --size {}x{}",
+            output.display(),
+            w + w % 2,
+            h + h % 2
+        ))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn words(text: &str) -> Vec<String> {
-        text.split(' ').map(String::from).collect()
-    }
-
-    #[test]
-    fn a_run_is_its_words_less_those_that_change_no_pixel() {
-        let id = |text: &str| identity_of(&words(text), "{}", 24, (64, 48));
-        let plain = id("render a.nii --keyframes k.json -o m.mp4");
-        assert_eq!(
-            id("render a.nii --resume --keyframes k.json -o m.mp4 --threads 2"),
-            plain
-        );
-        assert_eq!(
-            id("render a.nii --movie-frames 0:12 --keyframes k.json -o m.mp4"),
-            plain
-        );
-        assert_eq!(
-            id("render a.nii --movie-frames=3: --threads=1 --keyframes k.json -o m.mp4"),
-            plain
-        );
-        assert_ne!(
-            id("render a.nii --zoom 2 --keyframes k.json -o m.mp4"),
-            plain
-        );
-        assert_ne!(
-            identity_of(
-                &words("render a.nii --keyframes k.json -o m.mp4"),
-                "{}",
-                25,
-                (64, 48)
-            ),
-            plain
-        );
-    }
 
     #[test]
     fn kept_frames_come_back_as_the_bytes_they_were() {
@@ -676,8 +626,8 @@ mod tests {
         assert_eq!(Codec::of(P::new("a/m.MP4")), Some(Codec::Mp4));
         assert_eq!(Codec::of(P::new("m.webm")), Some(Codec::Webm));
         assert_eq!(Codec::of(P::new("m.gif")), None);
-        assert!(ffmpeg::check_size(P::new("m.mp4"), 64, 48).is_ok());
-        let odd = ffmpeg::check_size(P::new("m.mp4"), 65, 48).unwrap_err();
+        assert!(check_size(P::new("m.mp4"), (64, 48)).is_ok());
+        let odd = check_size(P::new("m.mp4"), (65, 48)).unwrap_err();
         assert!(
             odd.message.contains("--size 65x48") && odd.message.contains("66x48"),
             "{}",

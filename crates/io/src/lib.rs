@@ -134,6 +134,7 @@ mod atomic;
 mod axes;
 mod dtype;
 mod error;
+pub mod ffmpeg;
 mod formats;
 mod images;
 mod read;

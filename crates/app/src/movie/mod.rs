@@ -11,13 +11,16 @@
 //! time `k / fps`, the data's time point held or blended, a part `A:B`).
 //! A front end turns each frame's options into settings with
 //! `volray_options::settings`, so a keyframe means exactly what the flags
-//! mean, and renders and encodes the frames.
+//! mean, and renders and encodes the frames (volray-io's `ffmpeg` or
+//! `Animation`), keeping finished ones in a work folder to resume
+//! ([`work`]).
 
 pub mod color;
 pub mod interpolate;
 pub mod plan;
 pub mod schema;
 pub mod time;
+pub mod work;
 
 pub use interpolate::{Ease, State};
 pub use plan::{DataFrame, Movie};

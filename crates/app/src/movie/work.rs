@@ -9,7 +9,7 @@
 //! earlier, different run left are not taken for finished frames.
 //! The folder is deleted once the movie is complete.
 
-use crate::error::CliError;
+use crate::AppError;
 use std::path::{Path, PathBuf};
 use volray_core::Image;
 
@@ -29,19 +29,22 @@ impl Work {
         identity: &str,
         sequence: bool,
         size: (usize, usize),
-    ) -> Result<Work, CliError> {
+    ) -> Result<Work, AppError> {
         let mut name = output.file_name().unwrap_or_default().to_os_string();
         name.push(".frames");
         let dir = output.with_file_name(name);
-        let io = |e: std::io::Error| CliError::io(format!("{}: {e}", dir.display()));
+        let io = |e: std::io::Error| failed(format!("{}: {e}", dir.display()));
         let run = dir.join("run.json");
         if dir.is_dir() && run.exists() {
             let earlier = std::fs::read_to_string(&run).unwrap_or_default();
             if earlier != identity {
-                return Err(CliError::input(format!(
-                    "{}: holds the frames of another command (another input, keyframes file, size or options): delete it to start this movie over",
-                    dir.display()
-                )));
+                return Err(AppError::Refused {
+                    message: format!(
+                        "{}: holds the frames of another command (another input, keyframes file, size or options): delete it to start this movie over",
+                        dir.display()
+                    ),
+                    bad_input: true,
+                });
             }
         } else {
             // A folder without its run.json was stopped as it was made.
@@ -80,7 +83,7 @@ impl Work {
 
     /// Keeps frame `k`: a sequence's file (as the sequence writes it),
     /// then its marker; else the lossless frame in the folder.
-    pub fn save(&self, k: usize, image: &Image, rgb: &[u8]) -> Result<(), CliError> {
+    pub fn save(&self, k: usize, image: &Image, rgb: &[u8]) -> Result<(), AppError> {
         match &self.sequence {
             Some(pattern) => {
                 let file = volray_io::sequence_path(pattern, k).expect("a sequence's pattern");
@@ -106,9 +109,9 @@ impl Work {
 
     /// Frame `k` as 8-bit RGB, read back (not for a sequence, whose
     /// frames are the output already).
-    pub fn load(&self, k: usize) -> Result<Vec<u8>, CliError> {
+    pub fn load(&self, k: usize) -> Result<Vec<u8>, AppError> {
         let path = self.frame_file(k);
-        let bad = |why: String| CliError::io(format!("{}: {why}", path.display()));
+        let bad = |why: String| failed(format!("{}: {why}", path.display()));
         let file = std::fs::File::open(&path).map_err(|e| bad(e.to_string()))?;
         let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
         decoder.set_transformations(png::Transformations::IDENTITY);
@@ -131,8 +134,83 @@ impl Work {
     }
 
     /// Deletes the folder: the movie is complete.
-    pub fn remove(self) -> Result<(), CliError> {
+    pub fn remove(self) -> Result<(), AppError> {
         std::fs::remove_dir_all(&self.dir)
-            .map_err(|e| CliError::io(format!("{}: {e}", self.dir.display())))
+            .map_err(|e| failed(format!("{}: {e}", self.dir.display())))
+    }
+}
+
+/// A failure of the work folder's files: an I/O failure.
+fn failed(message: String) -> AppError {
+    AppError::Refused {
+        message,
+        bad_input: false,
+    }
+}
+
+/// What a run is, for its work folder: the command's words `words`
+/// (less those that choose which frames or how many threads, which change
+/// no pixel), the keyframes file's text, the frame count and size.
+pub fn identity_of(words: &[String], keys: &str, frames: usize, size: (usize, usize)) -> String {
+    let mut kept = Vec::new();
+    let mut skip = false;
+    for word in words {
+        if std::mem::take(&mut skip) {
+            continue;
+        }
+        match word.as_str() {
+            "--resume" => {}
+            "--movie-frames" | "--threads" => skip = true,
+            w if w.starts_with("--movie-frames=") || w.starts_with("--threads=") => {}
+            _ => kept.push(word),
+        }
+    }
+    serde_json::json!({
+        "version": 1,
+        "command": kept,
+        "keyframes": keys,
+        "frames": frames,
+        "size": [size.0, size.1],
+    })
+    .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(text: &str) -> Vec<String> {
+        text.split(' ').map(String::from).collect()
+    }
+
+    #[test]
+    fn a_run_is_its_words_less_those_that_change_no_pixel() {
+        let id = |text: &str| identity_of(&words(text), "{}", 24, (64, 48));
+        let plain = id("render a.nii --keyframes k.json -o m.mp4");
+        assert_eq!(
+            id("render a.nii --resume --keyframes k.json -o m.mp4 --threads 2"),
+            plain
+        );
+        assert_eq!(
+            id("render a.nii --movie-frames 0:12 --keyframes k.json -o m.mp4"),
+            plain
+        );
+        assert_eq!(
+            id("render a.nii --movie-frames=3: --threads=1 --keyframes k.json -o m.mp4"),
+            plain
+        );
+        assert_ne!(
+            id("render a.nii --zoom 2 --keyframes k.json -o m.mp4"),
+            plain
+        );
+        assert_ne!(
+            identity_of(
+                &words("render a.nii --keyframes k.json -o m.mp4"),
+                "{}",
+                25,
+                (64, 48)
+            ),
+            plain
+        );
     }
 }

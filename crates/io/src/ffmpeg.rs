@@ -6,12 +6,12 @@
 //! wrote in ten minutes).
 //!
 //! - `.mp4`: H.264 (libx264), `yuv420p` so that every player shows it,
-//!   at `--crf` (default 16: every frame of the check in scripts/movie-check.sh at ≥ 40 dB PSNR against its still); `.webm`: VP9 (libvpx),
+//!   at a constant rate factor (`crf`, default 16: every frame of the check in scripts/movie-check.sh at ≥ 40 dB PSNR against its still); `.webm`: VP9 (libvpx),
 //!   the same. 4:2:0 chroma halves each side, so the frame's sides must
-//!   be even: an odd `--size` is refused (not padded: a padded frame
+//!   be even: an odd size is refused (not padded: a padded frame
 //!   would not be the frame a still render gives).
 //! - The movie is written to a temporary file beside the output, listed
-//!   in volray-io's registry (so Ctrl-C deletes it), and renamed into
+//!   in the registry of unfinished files (so Ctrl-C deletes it), and renamed into
 //!   place only once ffmpeg has finished well: a failed or interrupted
 //!   run leaves nothing. ffmpeg writes through its standard output's
 //!   file (`/dev/stdout`: the temporary file's own inode,
@@ -21,12 +21,12 @@
 //!   the pipe never fills) and shown in one line if it fails; if it dies,
 //!   the next frame's write fails and rendering stops.
 
-use crate::error::CliError;
+use crate::AtomicFile;
+use crate::error::IoError;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::thread::JoinHandle;
-use volray_io::AtomicFile;
 
 /// The container and codec an output name asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,14 +101,13 @@ impl Encoder {
         (width, height): (usize, usize),
         fps: f64,
         crf: u8,
-    ) -> Result<Self, CliError> {
-        let name = path.display();
+    ) -> Result<Self, IoError> {
         check_size(path, width, height)?;
         let mut file = AtomicFile::create(path)?;
         let out = file
             .file()
             .try_clone()
-            .map_err(|e| CliError::io(format!("{name}: {e}")))?;
+            .map_err(|e| IoError::os(path, "write", e))?;
         let mut command = Command::new(FFMPEG);
         command
             .args(["-hide_banner", "-loglevel", "error", "-f", "rawvideo"])
@@ -142,7 +141,7 @@ impl Encoder {
     }
 
     /// Sends the next frame, `rgb` 8-bit RGB rows top to bottom.
-    pub fn push(&mut self, rgb: &[u8]) -> Result<(), CliError> {
+    pub fn push(&mut self, rgb: &[u8]) -> Result<(), IoError> {
         assert_eq!(rgb.len(), self.frame_bytes, "a frame of the movie's size");
         let stdin = self.stdin.as_mut().expect("open until finish");
         if stdin.write_all(rgb).is_err() {
@@ -155,12 +154,12 @@ impl Encoder {
     }
 
     /// Ends the input, waits for ffmpeg and publishes the movie.
-    pub fn finish(mut self) -> Result<(), CliError> {
+    pub fn finish(mut self) -> Result<(), IoError> {
         drop(self.stdin.take());
         let status = self
             .child
             .wait()
-            .map_err(|e| CliError::io(format!("{}: ffmpeg: {e}", self.path.display())))?;
+            .map_err(|e| failed(&self.path, format!("ffmpeg: {e}")))?;
         if !status.success() {
             return Err(self.failure(&format!("failed ({status})")));
         }
@@ -170,7 +169,7 @@ impl Encoder {
     }
 
     /// ffmpeg's failure in one line: what happened and what it said.
-    fn failure(&mut self, what: &str) -> CliError {
+    fn failure(&mut self, what: &str) -> IoError {
         let said = self
             .stderr
             .take()
@@ -186,7 +185,7 @@ impl Encoder {
         } else {
             format!(": {}", said.join("; "))
         };
-        CliError::io(format!("{}: ffmpeg {what}{said}", self.path.display()))
+        failed(&self.path, format!("ffmpeg {what}{said}"))
     }
 }
 
@@ -202,21 +201,26 @@ impl Drop for Encoder {
     }
 }
 
+/// An encoding that failed, in one line naming the movie: an I/O failure.
+fn failed(path: &Path, message: String) -> IoError {
+    IoError::os(path, "write", std::io::Error::other(message))
+}
+
 /// Why ffmpeg did not start, in one line.
-fn not_started(path: &Path, e: std::io::Error) -> CliError {
-    let name = path.display();
+fn not_started(path: &Path, e: std::io::Error) -> IoError {
     match e.kind() {
-        std::io::ErrorKind::NotFound => CliError::io(format!(
-            "{name}: writing a movie needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg); or write .gif, .png (animated) or numbered PNGs (frame_%05d.png)"
-        )),
-        _ => CliError::io(format!("{name}: cannot start ffmpeg: {e}")),
+        std::io::ErrorKind::NotFound => failed(
+            path,
+            "writing a movie needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg); or write .gif, .png (animated) or numbered PNGs (frame_%05d.png)".into(),
+        ),
+        _ => failed(path, format!("cannot start ffmpeg: {e}")),
     }
 }
 
 /// Refuses, before any frame is rendered, a movie ffmpeg cannot write
 /// because it is not there (a resumable movie starts ffmpeg only once
 /// every frame is kept).
-pub fn check_available(path: &Path) -> Result<(), CliError> {
+pub fn check_available(path: &Path) -> Result<(), IoError> {
     Command::new(FFMPEG)
         .arg("-version")
         .stdin(Stdio::null())
@@ -228,14 +232,16 @@ pub fn check_available(path: &Path) -> Result<(), CliError> {
 }
 
 /// 4:2:0 chroma needs even sides.
-pub fn check_size(path: &Path, width: usize, height: usize) -> Result<(), CliError> {
+pub fn check_size(path: &Path, width: usize, height: usize) -> Result<(), IoError> {
     if width % 2 == 1 || height % 2 == 1 {
-        return Err(CliError::input(format!(
-            "{}: --size {width}x{height}: a movie's frames have even sides (H.264 and VP9 at 4:2:0 halve the colour's resolution); give e.g. --size {}x{}",
-            path.display(),
-            width + width % 2,
-            height + height % 2
-        )));
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "frames of {width}x{height}: a movie's frames have even sides (H.264 and VP9 at 4:2:0 halve the colour's resolution); e.g. {}x{}",
+                width + width % 2,
+                height + height % 2
+            ),
+        ));
     }
     Ok(())
 }
