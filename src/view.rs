@@ -208,7 +208,8 @@ fn open_levels(args: &ViewerArgs, settings: &RenderSettings) -> Result<Option<Op
     };
     let fixed = request.fixed_level();
     let non_finite = args.view.sampling.nonfinite.into();
-    let opened = volray_view::open::open_levels(&chunked, fixed, settings, non_finite, max_memory.into())
+    let scale = request.scale;
+    let opened = volray_view::open::open_levels(&chunked, fixed, settings, non_finite, max_memory.into(), scale)
         .map_err(|e| match e {
             OpenError::Read(e) => CliError::from(e),
             OpenError::CoarsestTooLarge { dims: [x, y, z], need, limit } => CliError::input(format!(
@@ -233,6 +234,10 @@ fn open_levels(args: &ViewerArgs, settings: &RenderSettings) -> Result<Option<Op
         if count == 1 { "" } else { "s" },
         opened.start
     );
+    // How axes in different units are stretched for drawing.
+    if let Some(note) = &opened.display_note {
+        eprintln!("volray: {}: {note}", Path::new(spec).display());
+    }
     Ok(Some(opened))
 }
 

@@ -590,6 +590,54 @@ async fn a_pyramids_page_says_which_level_its_still_shows() {
     b.close().await;
 }
 
+/// An OME-Zarr image whose y and x are in degrees and z in metres
+/// (zarr-python): a Gaussian blob, 64 × 64 × 32 (x, y, z).
+const DEGREES_BY_METRES: &str = r#"
+import sys, numpy as np, zarr
+k, j, i = np.mgrid[0:32, 0:64, 0:64]
+a = np.exp(-((i - 32) ** 2 + (j - 32) ** 2 + (k - 16) ** 2) / 200.0).astype(np.float32)
+g = zarr.open_group(sys.argv[1] + "/o.zarr", mode="w", zarr_format=2)
+g.create_array("0", shape=a.shape, chunks=(8, 16, 16), dtype="f4")[:] = a
+g.attrs["multiscales"] = [{"version": "0.4", "axes": [
+    {"name": "z", "type": "space", "unit": "meter"},
+    {"name": "y", "type": "space", "unit": "degree"},
+    {"name": "x", "type": "space", "unit": "degree"}],
+  "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [100.0, 0.25, 0.25]}]}]}]
+"#;
+
+#[tokio::test(flavor = "current_thread")]
+async fn a_pyramid_in_degrees_by_metres_is_drawn_stretched_as_render_draws_it() {
+    // The viewer opens a chunked file level by level; its levels are
+    // stretched by the rule `render` applies to the level it reads, so
+    // the page's still is the command's picture, not a line.
+    let Some(dir) = common::written_by_python(&["zarr", "numpy"], &[], DEGREES_BY_METRES) else {
+        return;
+    };
+    let path = dir.path().join("o.zarr");
+    let Some((_viewer, b)) = open(&[path.to_str().unwrap(), "--size", "48"]).await else {
+        return;
+    };
+    let out = tempfile::tempdir().unwrap();
+    let still = picture(&b.frame_bytes().await, out.path(), "still.png");
+    let cli = run_shown(&b, out.path()).await;
+    let differ = cli.max_diff(&still);
+    assert_eq!(differ, 0, "the CLI's image differs from the page's");
+    // A box, not the line the stored spacings draw.
+    let lit: Vec<(usize, usize)> = (0..still.height)
+        .flat_map(|r| (0..still.width).map(move |c| (c, r)))
+        .filter(|&(c, r)| still.at(c, r).iter().any(|&v| v > 8))
+        .collect();
+    let span = |f: fn(&(usize, usize)) -> usize| {
+        let v: Vec<usize> = lit.iter().map(f).collect();
+        v.iter().max().unwrap_or(&0) - v.iter().min().unwrap_or(&0)
+    };
+    assert!(
+        span(|p| p.0) > 10 && span(|p| p.1) > 10,
+        "a line, not a box"
+    );
+    b.close().await;
+}
+
 #[tokio::test(flavor = "current_thread")]
 async fn a_scenes_page_has_a_panel_per_volume_and_its_command_reproduces_each_edit() {
     if !browser::available() {

@@ -421,7 +421,15 @@ fn open_levels(
     // refusals worded here.
     let limit = u128::from(recipe.max_memory);
     let opened = py.detach(|| {
-        volray_view::open::open_levels(&file.chunked, fixed, settings, recipe.nonfinite, limit)
+        let scale = recipe.scale();
+        volray_view::open::open_levels(
+            &file.chunked,
+            fixed,
+            settings,
+            recipe.nonfinite,
+            limit,
+            scale,
+        )
     });
     use volray_view::open::OpenError;
     match opened {

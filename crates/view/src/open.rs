@@ -12,14 +12,21 @@
 
 use crate::{Pyramid, PyramidError, draft_side};
 use std::sync::Arc;
+use volray_app::display::Stretched;
 use volray_core::glam::DVec3;
-use volray_core::{CameraError, NonFinite, RenderSettings, SampleType, SourceError, Volume};
+use volray_core::{
+    CameraError, NonFinite, RenderSettings, SampleType, SourceError, Volume, VolumeSource,
+};
 use volray_io::IoError;
 use volray_lazy::Chunked;
 
 /// A chunked file opened for the viewer.
 pub struct Opened {
     pub pyramid: Pyramid,
+    /// How axes in different units were stretched for drawing, where the
+    /// default rule stretched them (volray-app's `display`): the note the
+    /// front end says.
+    pub display_note: Option<String>,
     /// The level the starting view's drafts show, read for the page's
     /// first message.
     pub start: usize,
@@ -54,18 +61,32 @@ pub enum OpenError {
 /// Opens every level of `chunked` as the viewer's pyramid, the stills
 /// showing `fixed` (`None`: the level each still needs) and the drafts
 /// of the starting view (`settings`) a level whose frames fit their
-/// share of `limit`.
+/// share of `limit`; its axes stretched for drawing as `scale` (`--scale`)
+/// or, for axes in different units, volray-app's default rule says, every
+/// level alike, as `render` stretches the level it reads.
 pub fn open_levels(
     chunked: &Chunked,
     fixed: Option<usize>,
     settings: &RenderSettings,
     non_finite: NonFinite,
     limit: u128,
+    scale: Option<[f64; 3]>,
 ) -> Result<Opened, OpenError> {
     let count = chunked.levels().len();
-    let mut sources = Vec::with_capacity(count);
+    let mut sources: Vec<Arc<dyn VolumeSource>> = Vec::with_capacity(count);
     for level in 0..count {
         sources.push(Arc::clone(chunked.open_level(level)?.source()));
+    }
+    // The stretch of the finest level's box (`render` reads the file's
+    // first level's metadata for it too).
+    let finest = sources[0].grid();
+    let n = finest.dims.map(|n| n.saturating_sub(1) as f64);
+    let extent = finest.spacing * DVec3::from(n);
+    let stretch = volray_app::display::stretch(Some(chunked.info()), extent, scale);
+    if let Some(s) = &stretch {
+        sources = (sources.into_iter())
+            .map(|source| Arc::new(Stretched::new(source, s.factors)) as Arc<dyn VolumeSource>)
+            .collect();
     }
     let pyramid = Pyramid::new(sources, fixed)?;
     let still = pyramid.still_level(settings)?;
@@ -84,6 +105,7 @@ pub fn open_levels(
     };
     Ok(Opened {
         pyramid,
+        display_note: stretch.and_then(|s| s.note),
         start,
         still,
     })
