@@ -112,45 +112,6 @@ fn a_raster_with_a_few_hot_pixels_renders_its_values_with_no_options() {
     }
 }
 
-/// One level of `dims` (x, y, z) at `dir`, `at(x, y, z)` its values, in
-/// `float32` chunks of 16³ (z, y, x) stored little-endian.
-fn write_zarr_level(dir: &Path, dims: [usize; 3], at: &dyn Fn(usize, usize, usize) -> f32) {
-    const CHUNK: usize = 16;
-    let shape = [dims[2], dims[1], dims[0]];
-    let meta = json!({
-        "zarr_format": 3,
-        "node_type": "array",
-        "shape": shape,
-        "data_type": "float32",
-        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [CHUNK, CHUNK, CHUNK]}},
-        "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
-        "fill_value": 0.0,
-        "codecs": [{"name": "bytes", "configuration": {"endian": "little"}}],
-    });
-    fs::create_dir_all(dir).unwrap();
-    fs::write(dir.join("zarr.json"), meta.to_string()).unwrap();
-    let chunks = shape.map(|n| n.div_ceil(CHUNK));
-    for cz in 0..chunks[0] {
-        for cy in 0..chunks[1] {
-            for cx in 0..chunks[2] {
-                let mut bytes = Vec::with_capacity(4 * CHUNK.pow(3));
-                for z in cz * CHUNK..(cz + 1) * CHUNK {
-                    for y in cy * CHUNK..(cy + 1) * CHUNK {
-                        for x in cx * CHUNK..(cx + 1) * CHUNK {
-                            let inside = x < dims[0] && y < dims[1] && z < dims[2];
-                            let v = if inside { at(x, y, z) } else { 0.0 };
-                            bytes.extend_from_slice(&v.to_le_bytes());
-                        }
-                    }
-                }
-                let file = dir.join(format!("c/{cz}/{cy}/{cx}"));
-                fs::create_dir_all(file.parent().unwrap()).unwrap();
-                fs::write(file, bytes).unwrap();
-            }
-        }
-    }
-}
-
 #[test]
 fn hot_pixels_read_piece_by_piece_give_the_picture_read_whole() {
     // 48·40·36 f32 voxels (276 kB): 100 kB holds only pieces of them.
@@ -159,7 +120,8 @@ fn hot_pixels_read_piece_by_piece_give_the_picture_read_whole() {
     let at = |x: usize, y: usize, z: usize| data[x + DIMS[0] * (y + DIMS[1] * z)];
     let dir = tempfile::tempdir().unwrap();
     let image = dir.path().join("hot.ome.zarr");
-    write_zarr_level(&image.join("0"), DIMS, &at);
+    let bytes = |x, y, z| at(x, y, z).to_le_bytes();
+    common::zarr::write_level(&image.join("0"), DIMS, "float32", json!(0.0), &bytes);
     let meta = json!({
         "zarr_format": 3,
         "node_type": "group",

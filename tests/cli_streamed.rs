@@ -15,7 +15,6 @@ use serde_json::json;
 
 /// The image's finest level, (x, y, z).
 const DIMS: [usize; 3] = [48, 40, 36];
-const CHUNK: usize = 16;
 
 /// A smooth u16 field: two blobs over a ramp.
 fn value(x: usize, y: usize, z: usize) -> u16 {
@@ -28,49 +27,12 @@ fn value(x: usize, y: usize, z: usize) -> u16 {
     (v + 40.0 * p[2]) as u16
 }
 
-/// One level of `dims` (x, y, z) at `dir`, `at(x, y, z)` its values, in
-/// chunks of 16³ (z, y, x) stored little-endian.
-fn write_level(dir: &Path, dims: [usize; 3], at: &dyn Fn(usize, usize, usize) -> u16) {
-    let shape = [dims[2], dims[1], dims[0]];
-    let meta = json!({
-        "zarr_format": 3,
-        "node_type": "array",
-        "shape": shape,
-        "data_type": "uint16",
-        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [CHUNK, CHUNK, CHUNK]}},
-        "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
-        "fill_value": 0,
-        "codecs": [{"name": "bytes", "configuration": {"endian": "little"}}],
-    });
-    fs::create_dir_all(dir).unwrap();
-    fs::write(dir.join("zarr.json"), meta.to_string()).unwrap();
-    let chunks = shape.map(|n| n.div_ceil(CHUNK));
-    for cz in 0..chunks[0] {
-        for cy in 0..chunks[1] {
-            for cx in 0..chunks[2] {
-                let mut bytes = Vec::with_capacity(2 * CHUNK.pow(3));
-                for z in cz * CHUNK..(cz + 1) * CHUNK {
-                    for y in cy * CHUNK..(cy + 1) * CHUNK {
-                        for x in cx * CHUNK..(cx + 1) * CHUNK {
-                            // Past the array's edge: the fill value.
-                            let inside = x < dims[0] && y < dims[1] && z < dims[2];
-                            let v = if inside { at(x, y, z) } else { 0 };
-                            bytes.extend_from_slice(&v.to_le_bytes());
-                        }
-                    }
-                }
-                let file = dir.join(format!("c/{cz}/{cy}/{cx}"));
-                fs::create_dir_all(file.parent().unwrap()).unwrap();
-                fs::write(file, bytes).unwrap();
-            }
-        }
-    }
-}
-
 /// An OME-Zarr 0.5 image of three levels, each halving every axis (2³
 /// block means), unit spacing at level 0.
 fn write_image(root: &Path) {
-    write_level(&root.join("0"), DIMS, &value);
+    common::zarr::write_level(&root.join("0"), DIMS, "uint16", json!(0), &|x, y, z| {
+        value(x, y, z).to_le_bytes()
+    });
     let mut dims = DIMS;
     let mut scale = 1.0;
     let mut datasets = vec![json!({"path": "0", "coordinateTransformations": [
@@ -92,7 +54,13 @@ fn write_image(root: &Path) {
             }
             (sum / n).round() as u16
         };
-        write_level(&root.join(level.to_string()), dims, &mean);
+        common::zarr::write_level(
+            &root.join(level.to_string()),
+            dims,
+            "uint16",
+            json!(0),
+            &|x, y, z| mean(x, y, z).to_le_bytes(),
+        );
         let shift = (scale - 1.0) / 2.0;
         datasets.push(
             json!({"path": level.to_string(), "coordinateTransformations": [

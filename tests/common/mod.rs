@@ -2,6 +2,7 @@
 #![allow(dead_code)] // each test binary uses part of this
 
 pub mod nifti;
+pub mod zarr;
 
 use std::fs;
 use std::path::{Path, PathBuf};
