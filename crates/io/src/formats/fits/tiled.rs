@@ -31,15 +31,13 @@
 //! array against the heap, the image against `--max-memory` before it is
 //! allocated, and each tile's decoded length against its tile.
 
-use std::io::Read;
 use std::path::Path;
-
-use flate2::read::MultiGzDecoder;
 
 use super::header::{Hdu, Kind};
 use super::rice::rice;
 use super::source::Source;
 use crate::error::IoError;
+use crate::shared::compress::{Compression, inflate_exact};
 
 /// §10.2: the integer that marks an undefined value of a quantised tile.
 const NULL_VALUE: i64 = -2_147_483_647;
@@ -265,11 +263,11 @@ pub(super) fn decompress(
     }
     let mut data = vec![0u8; table.data_bytes as usize];
     src.fill(path, &mut data, &format!("{} data", table.name()))?;
-    tiles(table, image, &data).map_err(bad)
+    tiles(path, table, image, &data).map_err(bad)
 }
 
 /// The image's bytes from the table's `data` (see the module doc).
-fn tiles(table: &Hdu, image: &Hdu, data: &[u8]) -> Result<Vec<u8>, String> {
+fn tiles(path: &Path, table: &Hdu, image: &Hdu, data: &[u8]) -> Result<Vec<u8>, String> {
     let h = &table.header;
     let row_bytes =
         usize::try_from(*table.naxes.first().unwrap_or(&0)).map_err(|e| e.to_string())?;
@@ -402,7 +400,7 @@ fn tiles(table: &Hdu, image: &Hdu, data: &[u8]) -> Result<Vec<u8>, String> {
                     "Rice-coded floats that were not quantised (no ZSCALE)".into(),
                 ));
             };
-            let raw = gunzip(ints_bytes, n * size).map_err(what)?;
+            let raw = gunzip(path, ints_bytes, n * size).map_err(what)?;
             let raw = match shuffled {
                 false => raw,
                 true => (0..n * size)
@@ -416,7 +414,7 @@ fn tiles(table: &Hdu, image: &Hdu, data: &[u8]) -> Result<Vec<u8>, String> {
         let values: Vec<f64> = if !ints_bytes.is_empty() {
             let ints = match method {
                 Method::Rice { block, bytepix } => rice(ints_bytes, n, block, bytepix),
-                Method::Gzip { shuffled } => gunzip_ints(ints_bytes, n, int_bytes, shuffled),
+                Method::Gzip { shuffled } => gunzip_ints(path, ints_bytes, n, int_bytes, shuffled),
             }
             .map_err(what)?;
             match (float, quantised) {
@@ -439,7 +437,7 @@ fn tiles(table: &Hdu, image: &Hdu, data: &[u8]) -> Result<Vec<u8>, String> {
         } else if let Some(c) = gzip_column.or(raw_column) {
             let bytes = table_bytes.array(row, &c).map_err(what)?;
             let raw = match gzip_column {
-                Some(_) => gunzip(bytes, n * size).map_err(what)?,
+                Some(_) => gunzip(path, bytes, n * size).map_err(what)?,
                 None => bytes.to_vec(),
             };
             if raw.len() != n * size {
@@ -519,33 +517,35 @@ fn to_bytes(values: &[f64], bitpix: i32) -> Vec<u8> {
     out
 }
 
-/// Inflates a gzip (or zlib) stream that should hold `expected` bytes,
-/// refusing one that holds more.
-fn gunzip(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
-    let mut out = Vec::with_capacity(expected);
-    let limit = expected as u64 + 1;
-    let got = if bytes.starts_with(&[0x1f, 0x8b]) {
-        MultiGzDecoder::new(bytes).take(limit).read_to_end(&mut out)
-    } else {
-        flate2::read::ZlibDecoder::new(bytes)
-            .take(limit)
-            .read_to_end(&mut out)
+/// Inflates a gzip (or zlib) stream of the file `path` that should hold
+/// exactly `expected` bytes (volray-io's `inflate_exact`: bounded by
+/// deflate's ratio before it allocates), its refusal without the path,
+/// which the caller names.
+fn gunzip(path: &Path, bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+    let kind = match bytes.starts_with(&[0x1f, 0x8b]) {
+        true => Compression::Gzip,
+        false => Compression::Zlib,
     };
-    got.map_err(|e| format!("corrupt gzip data: {e}"))?;
-    if out.len() != expected {
-        return Err(format!(
-            "gzip data holds {} bytes, not {expected}",
-            out.len()
-        ));
-    }
-    Ok(out)
+    inflate_exact(path, bytes, kind, expected, "the tile").map_err(|e| {
+        let message = e.to_string();
+        let prefix = format!("{}: ", path.display());
+        message
+            .strip_prefix(&prefix)
+            .map_or(message.clone(), str::to_string)
+    })
 }
 
 /// `GZIP_1`/`GZIP_2`: `n` big-endian integers of `bytes` bytes, the
 /// bytes grouped by significance (most significant of every value first)
 /// where `shuffled`.
-fn gunzip_ints(data: &[u8], n: usize, bytes: usize, shuffled: bool) -> Result<Vec<i64>, String> {
-    let raw = gunzip(data, n * bytes)?;
+fn gunzip_ints(
+    path: &Path,
+    data: &[u8],
+    n: usize,
+    bytes: usize,
+    shuffled: bool,
+) -> Result<Vec<i64>, String> {
+    let raw = gunzip(path, data, n * bytes)?;
     let byte = |i: usize, k: usize| {
         if shuffled {
             raw[k * n + i]
