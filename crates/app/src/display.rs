@@ -160,6 +160,20 @@ fn two_digits(v: f64) -> f64 {
     }
 }
 
+/// `volume` in the stretched world: its spacing and origin multiplied by
+/// `factors`, the samples as they are (refused where a factor is not a
+/// positive number).
+pub fn stretched(volume: Volume, factors: [f64; 3]) -> Result<Volume, volray_core::VolumeError> {
+    let f = DVec3::from(factors);
+    if !(f.is_finite() && f.min_element() > 0.0) {
+        return Err(volray_core::VolumeError::BadSpacing(f.x, f.y, f.z));
+    }
+    let (spacing, origin) = (volume.spacing() * f, volume.origin() * f);
+    volume
+        .with_spacing(spacing)
+        .and_then(|v| v.with_origin(origin))
+}
+
 /// A source's boxes placed in the stretched world (a chunked level
 /// rendered in pieces: `plan.rs`): its grid's and each box's spacing and
 /// origin multiplied by `factors`, the samples as read.

@@ -213,9 +213,7 @@ pub fn displayed(mut input: Input, explicit: Option<[f64; 3]>) -> Result<Input, 
             r.origin *= f;
         }
         None => {
-            let (spacing, origin) = (input.volume.spacing() * f, input.volume.origin() * f);
-            input.volume = (input.volume.with_spacing(spacing))
-                .and_then(|v| v.with_origin(origin))
+            input.volume = crate::display::stretched(input.volume, stretch.factors)
                 .map_err(crate::AppError::Spacing)?;
         }
     }

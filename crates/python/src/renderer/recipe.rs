@@ -86,10 +86,8 @@ impl Recipe {
         // says (the command line's rule: volray-app's `display`).
         let stretch =
             volray_app::display::stretch(self.display.as_ref(), core.extent(), self.scale);
-        if let Some(f) = stretch.map(|s| volray_core::glam::DVec3::from(s.factors)) {
-            let (spacing, origin) = (core.spacing() * f, core.origin() * f);
-            core = (core.with_spacing(spacing))
-                .and_then(|c| c.with_origin(origin))
+        if let Some(s) = stretch {
+            core = volray_app::display::stretched(core, s.factors)
                 .map_err(|e| value_error(format!("scale: {e}")))?;
         }
         if self.log {
@@ -278,10 +276,8 @@ impl Recipe {
         match (&known.labels, &known.histogram) {
             (Some(found), _) => {
                 // The colours the file gives its labels, unless given.
-                let mut look = options.look.clone();
-                if look.label_colours.is_empty() {
-                    look.label_colours = self.label_colours.clone();
-                }
+                let look =
+                    volray_app::look::with_file_colours(&options.look, self.label_colours.clone());
                 volray_options::label_transfer_function(
                     &look,
                     &mut settings.transfer_function,
