@@ -316,7 +316,8 @@ struct Out {
 impl Out {
     /// Frame `k`, rendered and annotated, handed on at once.
     fn put(&mut self, k: usize, image: &Image) -> Result<(), CliError> {
-        let rgb = rgb8(image);
+        let mut rgb = Vec::new();
+        volray_io::rgb8(image, &mut rgb);
         match (&self.work, &mut self.sink) {
             (Some(w), _) => w.save(k, image, &rgb)?,
             (None, Some(s)) => s.push(image, &rgb)?,
@@ -540,14 +541,6 @@ fn identity(keys: &str, frames: usize, size: (usize, usize)) -> String {
     volray_app::movie::work::identity_of(&words, keys, frames, size)
 }
 
-/// A frame as 8-bit RGB, as every output quantises it.
-fn rgb8(image: &Image) -> Vec<u8> {
-    let q = volray_io::quantize_8;
-    (image.pixels().iter())
-        .flat_map(|p| [q(p[0]), q(p[1]), q(p[2])])
-        .collect()
-}
-
 /// A kept frame back as an image (opaque; its 8-bit values exactly).
 fn image_of(rgb: &[u8], (w, h): (usize, usize)) -> Image {
     let pixels = rgb
@@ -615,8 +608,10 @@ mod tests {
     fn kept_frames_come_back_as_the_bytes_they_were() {
         let image =
             Image::from_pixels(2, 1, vec![[0.1, 0.5, 0.99, 1.0], [0.0, 1.0, 0.731, 0.5]]).unwrap();
-        let rgb = rgb8(&image);
-        assert_eq!(rgb8(&image_of(&rgb, (2, 1))), rgb);
+        let (mut rgb, mut back) = (Vec::new(), Vec::new());
+        volray_io::rgb8(&image, &mut rgb);
+        volray_io::rgb8(&image_of(&rgb, (2, 1)), &mut back);
+        assert_eq!(back, rgb);
         assert_eq!(rgb, [26, 128, 252, 0, 255, 186]);
     }
 

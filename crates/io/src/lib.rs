@@ -156,7 +156,7 @@ pub use formats::zarr::{
 };
 pub use images::animation::{Animation, AnimationKind, sequence_path};
 pub use images::exr::write_exr;
-pub use images::png::{BitDepth, quantize_8, quantize_16, write_png};
+pub use images::png::{BitDepth, quantize_8, quantize_16, rgb8, write_png};
 pub use read::{
     AxisUnitName, FileInfo, FlatImage, Lazy, LevelInfo, Loaded, OmeroChannel, ReadOptions, Segment,
     open_lazy, read, read_volume, split_hdf5_path, world_axis_names,

@@ -42,9 +42,8 @@ impl Frame {
     /// The frame as an 8-bit RGB PNG, the bytes `volray render` writes.
     fn png(&self) -> PyResult<Vec<u8>> {
         let (w, h) = (self.image.width() as u32, self.image.height() as u32);
-        let rgb: Vec<u8> = (self.image.pixels().iter())
-            .flat_map(|p| [p[0], p[1], p[2]].map(quantize_8))
-            .collect();
+        let mut rgb = Vec::new();
+        volray_io::rgb8(&self.image, &mut rgb);
         let mut out = Vec::new();
         let mut encoder = png::Encoder::new(&mut out, w, h);
         encoder.set_color(png::ColorType::Rgb);

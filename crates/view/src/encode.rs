@@ -4,7 +4,7 @@
 //! still frame's pixels are the command's.
 
 use volray_core::Image;
-use volray_io::quantize_8;
+use volray_io::rgb8;
 
 /// The JPEG quality of frames shown while the view moves.
 pub const DRAFT_QUALITY: u8 = 80;
@@ -18,16 +18,6 @@ pub enum EncodeError {
     Png(#[from] png::EncodingError),
     #[error("a {0}x{1} frame is too large for a JPEG")]
     TooLarge(usize, usize),
-}
-
-/// The frame's RGB bytes, 8 bits a channel, top row first, written into
-/// `rgb` (its allocation reused).
-pub fn rgb8(image: &Image, rgb: &mut Vec<u8>) {
-    rgb.clear();
-    rgb.reserve(image.pixels().len() * 3);
-    for px in image.pixels() {
-        rgb.extend(px[..3].iter().map(|&c| quantize_8(c)));
-    }
 }
 
 /// `image` as a JPEG of `quality` (1 to 100).

@@ -31,6 +31,18 @@ pub fn quantize_8(c: f32) -> u8 {
     }
 }
 
+/// `image`'s RGB bytes, 8 bits a channel ([`quantize_8`], as the PNGs
+/// `volray render` writes), top row first, written into `rgb` (its
+/// allocation reused): what the viewer encodes, a movie pipes to ffmpeg
+/// and Python hands over.
+pub fn rgb8(image: &Image, rgb: &mut Vec<u8>) {
+    rgb.clear();
+    rgb.reserve(image.pixels().len() * 3);
+    for px in image.pixels() {
+        rgb.extend(px[..3].iter().map(|&c| quantize_8(c)));
+    }
+}
+
 /// `round(clamp(c, 0, 1) · 65535)`, with NaN mapped to 0.
 pub fn quantize_16(c: f32) -> u16 {
     if c.is_nan() {
